@@ -1,0 +1,3 @@
+"""Alignment of simulation and measurement in xarray, and validation metrics (``jointwear.compare``)."""
+
+__all__: list[str] = []

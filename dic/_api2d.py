@@ -1,0 +1,3 @@
+"""Public names of the 2D subset-DIC engine."""
+
+__all__: list[str] = []

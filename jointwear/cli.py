@@ -1,0 +1,122 @@
+"""The ``jointwear`` command line: one group per module, plus ``info`` and ``demo``.
+
+The CLI is a thin layer: each command parses options, calls the library and writes files.
+Sub-command groups live next to their module (``sim/cli.py`` -> ``jointwear sim ...``).
+
+Exit codes: 0 ok, 1 a validation criterion failed, 2 usage error, 3 bad input (message on
+stderr; the traceback only with ``--debug``).
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from jointwear._version import __version__
+from jointwear.errors import EXIT_BAD_INPUT, EXIT_USAGE, JointwearError
+
+app = typer.Typer(
+    name="jointwear",
+    help="Validate wear simulations of joints with clearance against test-rig measurements.",
+    no_args_is_help=True,
+    pretty_exceptions_enable=False,
+    add_completion=False,
+)
+
+_STATE = {"debug": False}
+
+
+def _version_callback(value: bool) -> None:
+    if value:
+        typer.echo(f"jointwear {__version__}")
+        raise typer.Exit()
+
+
+@app.callback()
+def _root(
+    version: Annotated[
+        bool,
+        typer.Option(
+            "--version",
+            callback=_version_callback,
+            is_eager=True,
+            help="Print the version and exit.",
+        ),
+    ] = False,
+    debug: Annotated[bool, typer.Option("--debug", help="Show tracebacks on errors.")] = False,
+) -> None:
+    _STATE["debug"] = debug
+
+
+def _register_groups() -> None:
+    from jointwear.compare.cli import app as compare_app
+    from jointwear.datasets.cli import app as datasets_app
+    from jointwear.dic.cli import app as dic_app
+    from jointwear.metrology.cli import app as metrology_app
+    from jointwear.reports.cli import app as report_app
+    from jointwear.sim.cli import app as sim_app
+
+    app.add_typer(sim_app, name="sim")
+    app.add_typer(dic_app, name="dic")
+    app.add_typer(metrology_app, name="metrology")
+    app.add_typer(compare_app, name="compare")
+    app.add_typer(report_app, name="report")
+    app.add_typer(datasets_app, name="datasets")
+
+
+@app.command()
+def info(
+    file: Annotated[Path, typer.Argument(help="A jointwear netCDF file.")],
+    no_validate: Annotated[
+        bool, typer.Option("--no-validate", help="Summarise even if the file breaks the contract.")
+    ] = False,
+) -> None:
+    """Summarise a jointwear file: variables, dimensions, units, conventions, provenance."""
+    from jointwear.summary import summarise
+
+    typer.echo(summarise(file, validate=not no_validate))
+
+
+@app.command()
+def demo(
+    out: Annotated[Path, typer.Option("--out", help="Output folder.")] = Path("jointwear-demo"),
+    quick: Annotated[
+        bool, typer.Option("--quick", help="Reduced size (seconds instead of about a minute).")
+    ] = False,
+) -> None:
+    """Run the whole chain on the embedded default data and write a validation report."""
+    from jointwear.reports.demo import run_demo
+
+    report = run_demo(out, quick=quick)
+    typer.echo(f"report: {report}")
+
+
+_register_groups()
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of the ``jointwear`` script; returns the exit code."""
+    args = sys.argv[1:] if argv is None else list(argv)
+    debug = "--debug" in args
+    try:
+        app(args=args, prog_name="jointwear", standalone_mode=True)
+    except SystemExit as exc:  # click's own exits: 0, usage errors (2), aborts
+        code = exc.code
+        return code if isinstance(code, int) else (0 if code is None else EXIT_USAGE)
+    except JointwearError as exc:
+        if debug:
+            raise
+        typer.echo(f"jointwear: error: {exc}", err=True)
+        return exc.exit_code
+    except KeyboardInterrupt:
+        typer.echo("interrupted", err=True)
+        return 130
+    except (OSError, MemoryError) as exc:
+        if debug:
+            raise
+        typer.echo(f"jointwear: error: {exc}", err=True)
+        return EXIT_BAD_INPUT
+    return 0

@@ -1,0 +1,228 @@
+"""Reading and writing jointwear files: netCDF with units and provenance, written atomically.
+
+``save`` writes to a temporary file in the destination folder and renames it over the target
+only when the write succeeded, so a crash never leaves a half-written file or clobbers the
+previous one. Attributes netCDF cannot store (booleans, dicts, lists of mixed type, None) are
+encoded as JSON strings with the prefix ``"json:"`` and decoded by ``load``.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import os
+import tempfile
+from collections.abc import Iterable, Iterator, Mapping
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import xarray as xr
+
+from jointwear import conventions
+from jointwear._version import __version__
+from jointwear.errors import BadInputError
+from jointwear.provenance import build_provenance, dumps, history_line
+
+__all__ = [
+    "save",
+    "load",
+    "atomic_path",
+    "check_writable",
+    "encode_attrs",
+    "decode_attrs",
+    "parse_provenance",
+]
+
+_JSON_PREFIX = "json:"
+
+
+def _encode_value(value: Any) -> Any:
+    if isinstance(value, (bool, np.bool_)) or value is None or isinstance(value, Mapping):
+        return _JSON_PREFIX + json.dumps(value if not isinstance(value, np.bool_) else bool(value))
+    if isinstance(value, (list, tuple)):
+        if len(value) and all(
+            isinstance(v, (int, float, np.number)) and not isinstance(v, bool) for v in value
+        ):
+            return np.asarray(value)
+        if len(value) and all(isinstance(v, str) for v in value):
+            return _JSON_PREFIX + json.dumps(list(value))
+        return _JSON_PREFIX + json.dumps(list(value), default=str)
+    if isinstance(value, Path):
+        return str(value)
+    return value
+
+
+def encode_attrs(attrs: Mapping[str, Any]) -> dict[str, Any]:
+    """Encode attribute values netCDF cannot store as ``"json:..."`` strings."""
+    return {k: _encode_value(v) for k, v in attrs.items()}
+
+
+def decode_attrs(attrs: Mapping[str, Any]) -> dict[str, Any]:
+    """Inverse of :func:`encode_attrs`."""
+    out = {}
+    for k, v in attrs.items():
+        if isinstance(v, str) and v.startswith(_JSON_PREFIX):
+            try:
+                v = json.loads(v[len(_JSON_PREFIX) :])
+            except ValueError:
+                pass
+        out[k] = v
+    return out
+
+
+def check_writable(path: str | Path, *, what: str = "output") -> Path:
+    """Fail early (before a long computation) if ``path`` cannot be written.
+
+    Creates the parent folder if needed and tries a temporary file there.
+    """
+    path = Path(path)
+    if path.is_dir():
+        raise BadInputError(f"{what} path '{path}' is a folder; give a file name")
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".check")
+        os.close(fd)
+        os.unlink(tmp)
+    except OSError as exc:
+        raise BadInputError(
+            f"{what} path '{path}' is not writable ({exc.strerror}); choose another location"
+        ) from None
+    return path
+
+
+@contextlib.contextmanager
+def atomic_path(path: str | Path) -> Iterator[Path]:
+    """Yield a temporary path next to ``path``; rename it over ``path`` if the block succeeds.
+
+    Use for any file type::
+
+        with atomic_path("report.html") as tmp:
+            tmp.write_text(html)
+    """
+    path = Path(path)
+    check_writable(path)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    os.close(fd)
+    tmp_path = Path(tmp)
+    try:
+        yield tmp_path
+        with open(tmp_path, "rb") as fh:
+            os.fsync(fh.fileno())
+        os.replace(tmp_path, path)
+    finally:
+        if tmp_path.exists():
+            tmp_path.unlink()
+
+
+def parse_provenance(ds: xr.Dataset) -> dict[str, Any]:
+    """The provenance record of a dataset as a dict (empty if absent)."""
+    text = ds.attrs.get("provenance")
+    if not text:
+        return {}
+    try:
+        return json.loads(text)
+    except (TypeError, ValueError):
+        return {}
+
+
+def save(
+    ds: xr.Dataset,
+    path: str | Path,
+    *,
+    inputs: Iterable[str | Path] = (),
+    parameters: Any = None,
+    command: str | None = None,
+    source: str | None = None,
+    title: str | None = None,
+    parents: Iterable[xr.Dataset] = (),
+    validate: bool = True,
+) -> Path:
+    """Write ``ds`` to netCDF atomically, with units, history and provenance.
+
+    Parameters
+    ----------
+    ds : Dataset
+        Data following the contract of :mod:`jointwear.conventions`.
+    path : path
+        Destination ``.nc`` file. Its folder is created if needed.
+    inputs : iterable of path
+        Input files (recorded with sha256 in ``provenance``).
+    parameters : object
+        Resolved parameters (dataclass or mapping), recorded in full.
+    command : str, optional
+        Command line; defaults to ``sys.argv``.
+    source : str, optional
+        CF ``source`` attribute, e.g. ``"jointwear 0.1 (sim.wear)"``; kept from ``ds`` if set.
+    title : str, optional
+        CF ``title``; kept from ``ds`` if set.
+    parents : iterable of Dataset
+        Input datasets whose provenance should be carried along.
+    validate : bool
+        Check the contract (units, conventions) before writing (default True).
+
+    Returns
+    -------
+    Path
+        The written file.
+    """
+    path = Path(path)
+    out = ds.copy()
+    if validate:
+        conventions.validate(out, what=f"dataset to be written to '{path}'")
+    out.attrs["Conventions"] = "CF-1.11"
+    out.attrs["title"] = title or out.attrs.get("title") or "jointwear dataset"
+    out.attrs["source"] = source or out.attrs.get("source") or f"jointwear {__version__}"
+    line = history_line(command)
+    previous = out.attrs.get("history")
+    out.attrs["history"] = f"{previous}\n{line}" if previous else line
+    parent_records = [parse_provenance(p) for p in parents]
+    if out.attrs.get("provenance") and not parent_records:
+        # keep the provenance of the data as it came in
+        try:
+            parent_records = [json.loads(out.attrs["provenance"])]
+        except (TypeError, ValueError):
+            parent_records = []
+    prov = build_provenance(
+        inputs=inputs,
+        parameters=parameters,
+        command=command,
+        parents=[p for p in parent_records if p],
+    )
+    out.attrs["provenance"] = dumps(prov)
+    out.attrs = encode_attrs(out.attrs)
+    for name in list(out.variables):
+        out[name].attrs = encode_attrs(out[name].attrs)
+    with atomic_path(path) as tmp:
+        out.to_netcdf(tmp, engine="netcdf4", format="NETCDF4")
+    return path
+
+
+def load(path: str | Path, *, validate: bool = True) -> xr.Dataset:
+    """Read a jointwear netCDF file fully into memory and check it against the contract.
+
+    Raises
+    ------
+    BadInputError
+        The file does not exist, is not netCDF, or breaks the contract (the message lists
+        every problem).
+    """
+    path = Path(path)
+    if not path.exists():
+        raise BadInputError(f"'{path}' does not exist")
+    if path.is_dir():
+        raise BadInputError(f"'{path}' is a folder, expected a netCDF (.nc) file")
+    try:
+        with xr.open_dataset(path, engine="netcdf4") as raw:
+            ds = raw.load()
+    except (OSError, ValueError) as exc:
+        raise BadInputError(
+            f"'{path}' could not be read as netCDF ({exc}); is it a jointwear .nc file?"
+        ) from None
+    ds.attrs = decode_attrs(ds.attrs)
+    for name in list(ds.variables):
+        ds[name].attrs = decode_attrs(ds[name].attrs)
+    if validate:
+        conventions.validate(ds, require_provenance=True, what=f"'{path}'")
+    ds.encoding["source"] = str(path)
+    return ds

@@ -1,0 +1,179 @@
+"""Building frozen parameter dataclasses from TOML files and mappings, with clear errors."""
+
+from __future__ import annotations
+
+import dataclasses
+import tomllib
+import types
+import typing
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any, TypeVar
+
+import numpy as np
+
+from jointwear.errors import BadInputError, ParameterError
+
+__all__ = ["from_mapping", "read_toml", "to_jsonable", "replace_nested"]
+
+T = TypeVar("T")
+
+
+def read_toml(path: str | Path) -> dict[str, Any]:
+    """Read a TOML file into a dict, with an error that names the file on failure."""
+    path = Path(path)
+    try:
+        with path.open("rb") as fh:
+            return tomllib.load(fh)
+    except FileNotFoundError:
+        raise BadInputError(f"parameter file '{path}' does not exist") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise BadInputError(
+            f"parameter file '{path}' is not valid TOML: {exc} - fix the syntax at that line"
+        ) from None
+
+
+def _field_types(cls: type) -> dict[str, Any]:
+    return typing.get_type_hints(cls)
+
+
+def _is_dataclass_type(tp: Any) -> bool:
+    return isinstance(tp, type) and dataclasses.is_dataclass(tp)
+
+
+def _coerce(value: Any, tp: Any, where: str) -> Any:
+    origin = typing.get_origin(tp)
+    if _is_dataclass_type(tp):
+        if isinstance(value, tp):
+            return value
+        if not isinstance(value, Mapping):
+            raise ParameterError(f"{where}: expected a table of parameters, got {value!r}")
+        return from_mapping(tp, value, where=where)
+    if origin in (typing.Union, types.UnionType):
+        args = typing.get_args(tp)
+        if value is None and type(None) in args:
+            return None
+        errors = []
+        for arg in args:
+            if arg is type(None):
+                continue
+            try:
+                return _coerce(value, arg, where)
+            except ParameterError as exc:
+                errors.append(str(exc))
+        raise ParameterError("; ".join(errors))
+    if origin is typing.Literal:
+        allowed = typing.get_args(tp)
+        if value not in allowed:
+            raise ParameterError(f"{where}: expected one of {list(allowed)}, got {value!r}")
+        return value
+    if origin in (tuple, list):
+        if isinstance(value, (str, bytes)) or not hasattr(value, "__iter__"):
+            raise ParameterError(f"{where}: expected a list, got {value!r}")
+        args = typing.get_args(tp)
+        if origin is tuple and args and args[-1] is not Ellipsis:
+            if len(args) != len(value):
+                raise ParameterError(f"{where}: expected {len(args)} values, got {len(value)}")
+            return tuple(
+                _coerce(v, a, f"{where}[{i}]")
+                for i, (v, a) in enumerate(zip(args, value, strict=True))
+            )
+        inner = args[0] if args else Any
+        out = [_coerce(v, inner, f"{where}[{i}]") for i, v in enumerate(value)]
+        return tuple(out) if origin is tuple else out
+    if tp is float:
+        if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+            raise ParameterError(f"{where}: expected a number, got {value!r}")
+        value = float(value)
+        if not np.isfinite(value):
+            raise ParameterError(f"{where}: expected a finite number, got {value!r}")
+        return value
+    if tp is int:
+        if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+            if isinstance(value, float) and value.is_integer():
+                return int(value)
+            raise ParameterError(f"{where}: expected an integer, got {value!r}")
+        return int(value)
+    if tp is bool:
+        if not isinstance(value, (bool, np.bool_)):
+            raise ParameterError(f"{where}: expected true or false, got {value!r}")
+        return bool(value)
+    if tp is str:
+        if not isinstance(value, str):
+            raise ParameterError(f"{where}: expected a string, got {value!r}")
+        return value
+    return value
+
+
+def from_mapping(cls: type[T], mapping: Mapping[str, Any], *, where: str | None = None) -> T:
+    """Build the (possibly nested) frozen dataclass ``cls`` from a mapping.
+
+    Unknown keys raise :class:`~jointwear.errors.ParameterError` naming the key and listing the
+    known ones; values are checked against the field types (numbers, booleans, strings,
+    literals, nested tables). Missing keys take the dataclass defaults.
+
+    Parameters
+    ----------
+    cls : type
+        A dataclass type.
+    mapping : Mapping
+        Values by field name (as read from TOML).
+    where : str, optional
+        Dotted prefix used in error messages (e.g. ``"joint"``).
+    """
+    prefix = f"{where}." if where else ""
+    types_ = _field_types(cls)
+    names = [f.name for f in dataclasses.fields(cls) if f.init]
+    unknown = [k for k in mapping if k not in names]
+    if unknown:
+        raise ParameterError(
+            f"unknown parameter(s) {', '.join(prefix + k for k in unknown)}; "
+            f"known names{' in [' + where + ']' if where else ''}: {', '.join(names)}"
+        )
+    kwargs = {k: _coerce(v, types_[k], prefix + k) for k, v in mapping.items()}
+    try:
+        return cls(**kwargs)
+    except ParameterError:
+        raise
+    except (TypeError, ValueError) as exc:
+        raise ParameterError(f"{where or cls.__name__}: {exc}") from None
+
+
+def replace_nested(obj: T, **changes: Any) -> T:
+    """``dataclasses.replace`` that accepts dotted names (``"joint.radial_clearance"``)."""
+    direct: dict[str, Any] = {}
+    nested: dict[str, dict[str, Any]] = {}
+    for key, value in changes.items():
+        head, _, rest = key.partition(".")
+        if rest:
+            nested.setdefault(head, {})[rest] = value
+        else:
+            direct[head] = value
+    names = {f.name for f in dataclasses.fields(obj)}
+    for head in list(direct) + list(nested):
+        if head not in names:
+            raise ParameterError(
+                f"unknown parameter '{head}' for {type(obj).__name__}; known: {', '.join(sorted(names))}"
+            )
+    for head, sub in nested.items():
+        direct[head] = replace_nested(getattr(obj, head), **sub)
+    return dataclasses.replace(obj, **direct)
+
+
+def to_jsonable(obj: Any) -> Any:
+    """Convert dataclasses, numpy scalars/arrays, paths and tuples into JSON-ready values."""
+    if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
+        return {f.name: to_jsonable(getattr(obj, f.name)) for f in dataclasses.fields(obj)}
+    if isinstance(obj, Mapping):
+        return {str(k): to_jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [to_jsonable(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return obj.tolist()
+    if isinstance(obj, np.generic):
+        return obj.item()
+    if isinstance(obj, Path):
+        return str(obj)
+    if isinstance(obj, float) and not np.isfinite(obj):
+        return str(obj)
+    return obj

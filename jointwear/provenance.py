@@ -1,0 +1,132 @@
+"""Provenance records: software versions, input files with sha256, parameters, command."""
+
+from __future__ import annotations
+
+import datetime as _dt
+import hashlib
+import json
+import platform
+import shlex
+import sys
+from collections.abc import Iterable, Mapping
+from importlib import metadata
+from pathlib import Path
+from typing import Any
+
+from jointwear._version import __version__
+from jointwear.params import to_jsonable
+
+__all__ = [
+    "sha256_file",
+    "software_versions",
+    "build_provenance",
+    "history_line",
+    "command_line",
+    "utc_now",
+]
+
+_PACKAGES = (
+    "numpy",
+    "scipy",
+    "pandas",
+    "xarray",
+    "netCDF4",
+    "numba",
+    "opencv-python-headless",
+    "matplotlib",
+)
+
+
+def utc_now() -> str:
+    """Current UTC time, ISO 8601 to the second."""
+    return _dt.datetime.now(_dt.UTC).strftime("%Y-%m-%dT%H:%M:%SZ")
+
+
+def sha256_file(path: str | Path, *, chunk: int = 1 << 20) -> str:
+    """SHA-256 hex digest of a file (a folder: digest of its files' names and digests)."""
+    path = Path(path)
+    h = hashlib.sha256()
+    if path.is_dir():
+        for sub in sorted(p for p in path.rglob("*") if p.is_file()):
+            h.update(str(sub.relative_to(path)).encode())
+            h.update(sha256_file(sub).encode())
+        return h.hexdigest()
+    with path.open("rb") as fh:
+        while block := fh.read(chunk):
+            h.update(block)
+    return h.hexdigest()
+
+
+def software_versions() -> dict[str, str]:
+    """Versions of jointwear, Python and the main numerical dependencies."""
+    out = {"jointwear": __version__, "python": platform.python_version()}
+    for name in _PACKAGES:
+        try:
+            out[name] = metadata.version(name)
+        except metadata.PackageNotFoundError:
+            continue
+    return out
+
+
+def command_line(argv: Iterable[str] | None = None) -> str:
+    """The command line as a shell-quoted string (defaults to ``sys.argv``)."""
+    args = list(sys.argv if argv is None else argv)
+    if args:
+        args[0] = Path(args[0]).name
+    return shlex.join(args)
+
+
+def build_provenance(
+    *,
+    inputs: Iterable[str | Path] = (),
+    parameters: Any = None,
+    command: str | None = None,
+    parents: Iterable[Mapping[str, Any]] = (),
+    extra: Mapping[str, Any] | None = None,
+) -> dict[str, Any]:
+    """A provenance record (JSON-ready dict).
+
+    Parameters
+    ----------
+    inputs : iterable of path
+        Input files; each is recorded with its absolute path and sha256.
+    parameters : object
+        Resolved parameters (dataclass, mapping, ...), stored in full.
+    command : str, optional
+        The command line; defaults to ``sys.argv``.
+    parents : iterable of dict
+        Provenance records of input datasets, kept so the chain can be traced.
+    extra : mapping, optional
+        Further entries.
+    """
+    records = []
+    for p in inputs:
+        p = Path(p)
+        rec: dict[str, Any] = {"path": str(p.resolve())}
+        if p.exists():
+            rec["sha256"] = sha256_file(p)
+        records.append(rec)
+    prov: dict[str, Any] = {
+        "created": utc_now(),
+        "software": software_versions(),
+        "platform": platform.platform(),
+        "command": command if command is not None else command_line(),
+        "inputs": records,
+        "parameters": to_jsonable(parameters) if parameters is not None else {},
+    }
+    parents = list(parents)
+    if parents:
+        prov["parents"] = parents
+    if extra:
+        prov.update(to_jsonable(dict(extra)))
+    return prov
+
+
+def history_line(command: str | None = None) -> str:
+    """One ``history`` line: timestamp and command."""
+    return f"{utc_now()}: {command if command is not None else command_line()}"
+
+
+def dumps(prov: Mapping[str, Any]) -> str:
+    """Serialise a provenance record (sorted keys, so identical inputs give identical text)."""
+    return json.dumps(to_jsonable(prov), sort_keys=True, separators=(",", ":"))

@@ -1,0 +1,62 @@
+"""Human-readable summary of a jointwear file (``jointwear info``)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+
+from jointwear import io
+
+__all__ = ["summarise"]
+
+
+def _fmt_range(values: np.ndarray) -> str:
+    if values.size == 0:
+        return "empty"
+    if values.dtype.kind in "fiu":
+        return f"{np.nanmin(values):.6g} .. {np.nanmax(values):.6g}"
+    shown = ", ".join(map(str, values[:4]))
+    return shown + (", ..." if values.size > 4 else "")
+
+
+def summarise(path: str | Path, *, validate: bool = True) -> str:
+    """Return a text summary of the file at ``path`` (validated against the contract)."""
+    ds = io.load(path, validate=validate)
+    lines = [f"file: {path}"]
+    for key in ("title", "source", "Conventions"):
+        if key in ds.attrs:
+            lines.append(f"{key}: {ds.attrs[key]}")
+    lines.append("dimensions: " + ", ".join(f"{k}={v}" for k, v in ds.sizes.items()))
+    lines.append("coordinates:")
+    for name, c in ds.coords.items():
+        extra = ""
+        if name == "theta":
+            extra = f"  [zero {c.attrs.get('angle_zero')}, {c.attrs.get('angle_direction')}]"
+        lines.append(
+            f"  {name} ({c.attrs.get('units', '?')}): {_fmt_range(np.asarray(c.values))}{extra}"
+        )
+    lines.append("variables:")
+    for name, v in ds.data_vars.items():
+        dims = ", ".join(v.dims)
+        lines.append(
+            f"  {name}({dims}) [{v.attrs.get('units', '?')}]: {v.attrs.get('long_name', '')}"
+        )
+    if "history" in ds.attrs:
+        lines.append("history:")
+        lines.extend("  " + h for h in str(ds.attrs["history"]).splitlines())
+    prov = io.parse_provenance(ds)
+    if prov:
+        lines.append("provenance:")
+        sw = prov.get("software", {})
+        lines.append("  software: " + ", ".join(f"{k} {v}" for k, v in sw.items()))
+        if prov.get("command"):
+            lines.append(f"  command: {prov['command']}")
+        for rec in prov.get("inputs", []):
+            lines.append(f"  input: {rec.get('path')} sha256={rec.get('sha256', '?')[:16]}")
+        params = prov.get("parameters")
+        if params:
+            text = json.dumps(params, sort_keys=True)
+            lines.append("  parameters: " + (text if len(text) < 400 else text[:400] + " ..."))
+    return "\n".join(lines)

@@ -1,0 +1,3 @@
+"""Roundness and cylindricity metrology (``jointwear.metrology``): readers, ISO form, wear maps."""
+
+__all__: list[str] = []

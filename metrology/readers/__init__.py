@@ -1,0 +1,1 @@
+"""Instrument file readers (one module per instrument family)."""

@@ -1,0 +1,3 @@
+"""Validation reports (``jointwear.reports``): self-contained HTML with figures, and the demo."""
+
+__all__: list[str] = []

@@ -1,0 +1,10 @@
+"""``jointwear report``: command-line interface of :mod:`jointwear.reports`."""
+
+from __future__ import annotations
+
+import typer
+
+from jointwear._cli import discover_commands
+
+app = typer.Typer(help="Build validation reports (HTML with figures).", no_args_is_help=True)
+discover_commands(app, "jointwear.reports")
