@@ -31,7 +31,12 @@ def test_usage_error_exit_code(capsys):
 
 
 def test_python_dash_m():
-    res = subprocess.run([sys.executable, "-m", "jointwear", "--version"], capture_output=True, text=True, check=False)
+    res = subprocess.run(
+        [sys.executable, "-m", "jointwear", "--version"],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
     assert res.returncode == 0
     assert res.stdout.strip() == f"jointwear {__version__}"
 

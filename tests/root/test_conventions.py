@@ -72,7 +72,11 @@ def test_round_trip_any_convention(conv, other, n, offset):
 
 def test_conversion_preserves_physical_direction():
     # a value sitting at physical +y must end at canonical 90 from any convention
-    for conv in [C.AngleConvention(z, d) for z in ("+x", "-y", "123.4") for d in ("clockwise", "counterclockwise")]:
+    for conv in [
+        C.AngleConvention(z, d)
+        for z in ("+x", "-y", "123.4")
+        for d in ("clockwise", "counterclockwise")
+    ]:
         theta_at_plus_y = conv.from_physical(np.array([90.0]))[0]
         da = _field([theta_at_plus_y], conv, values=np.array([7.0]))
         out = C.to_canonical(da)
@@ -80,7 +84,9 @@ def test_conversion_preserves_physical_direction():
 
 
 def test_refuses_unstated_convention():
-    da = xr.DataArray([1.0, 2.0], coords={"theta": ("theta", [0.0, 180.0], {"units": "degree"})}, dims="theta")
+    da = xr.DataArray(
+        [1.0, 2.0], coords={"theta": ("theta", [0.0, 180.0], {"units": "degree"})}, dims="theta"
+    )
     with pytest.raises(ConventionError, match="does not state its angle convention"):
         C.to_canonical(da)
 
@@ -107,7 +113,9 @@ def test_validate_lists_every_problem():
     ds = _dataset()
     del ds["wear_depth"].attrs["units"]
     ds["wear_depth"].attrs["long_name"] = "x"
-    ds = ds.assign_coords(z=("z", [0.0, 2e-3, 1e-3], {"units": "mm", "z_zero": "mid", "z_direction": "+z"}))
+    ds = ds.assign_coords(
+        z=("z", [0.0, 2e-3, 1e-3], {"units": "mm", "z_zero": "mid", "z_direction": "+z"})
+    )
     ds["extra"] = ("z", np.ones(3))
     with pytest.raises(ConventionError) as info:
         C.validate(ds)

@@ -19,12 +19,18 @@ def _dataset(seed=0):
     rng = np.random.default_rng(seed)
     ds = xr.Dataset(
         {
-            "wear_depth": (("z", "theta"), rng.random((3, 8)) * 1e-5, C.variable_attrs("wear_depth")),
+            "wear_depth": (
+                ("z", "theta"),
+                rng.random((3, 8)) * 1e-5,
+                C.variable_attrs("wear_depth"),
+            ),
             "contact_force": ("time", rng.random(5) * 100, C.variable_attrs("contact_force")),
         },
         coords={
             "z": C.z_coord([-5e-3, 0.0, 5e-3]),
-            "theta": C.theta_coord(np.arange(8) * 45.0, C.AngleConvention("+y", "counterclockwise")),
+            "theta": C.theta_coord(
+                np.arange(8) * 45.0, C.AngleConvention("+y", "counterclockwise")
+            ),
             "time": ("time", np.linspace(0, 0.5, 5), {"units": "s", "long_name": "time"}),
         },
     )
@@ -38,8 +44,14 @@ def test_round_trip_values_units_conventions_provenance(tmp_path):
     src.write_text("some measured data\n")
     path = tmp_path / "out.nc"
     ds = _dataset()
-    io.save(ds, path, inputs=[src], parameters={"kw": 1.5e-14, "nested": {"n": 3}},
-            command="jointwear sim wear --cycles 10", source="jointwear test")
+    io.save(
+        ds,
+        path,
+        inputs=[src],
+        parameters={"kw": 1.5e-14, "nested": {"n": 3}},
+        command="jointwear sim wear --cycles 10",
+        source="jointwear test",
+    )
     back = io.load(path)
     np.testing.assert_array_equal(back.wear_depth.values, ds.wear_depth.values)
     np.testing.assert_array_equal(back.contact_force.values, ds.contact_force.values)
@@ -87,7 +99,9 @@ def test_crash_during_save_leaves_previous_file_intact(tmp_path, monkeypatch):
     assert path.read_bytes() == before
     assert sorted(os.listdir(tmp_path)) == ["result.nc"]  # no temporary file left behind
     monkeypatch.undo()
-    np.testing.assert_array_equal(io.load(path).wear_depth.values, _dataset(seed=1).wear_depth.values)
+    np.testing.assert_array_equal(
+        io.load(path).wear_depth.values, _dataset(seed=1).wear_depth.values
+    )
 
 
 def test_save_refuses_dataset_without_units(tmp_path):

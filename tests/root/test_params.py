@@ -31,7 +31,10 @@ def test_nested_mapping_and_defaults():
 
 
 def test_unknown_names_are_listed():
-    with pytest.raises(ParameterError, match=r"unknown parameter\(s\) joint.radus; known names in \[joint\]: radius, layers, model"):
+    with pytest.raises(
+        ParameterError,
+        match=r"unknown parameter\(s\) joint.radus; known names in \[joint\]: radius, layers, model",
+    ):
         from_mapping(Params, {"joint": {"radus": 1.0}})
 
 
@@ -57,6 +60,9 @@ def test_toml_errors_name_the_file(tmp_path):
 def test_replace_nested_and_json():
     p = replace_nested(Params(), **{"joint.layers": 10, "gravity": False})
     assert p.joint.layers == 10 and p.gravity is False
-    assert to_jsonable(p) == {"joint": {"radius": 7.5e-3, "layers": 10, "model": "line"}, "gravity": False}
+    assert to_jsonable(p) == {
+        "joint": {"radius": 7.5e-3, "layers": 10, "model": "line"},
+        "gravity": False,
+    }
     with pytest.raises(ParameterError, match="unknown parameter 'jiont'"):
         replace_nested(Params(), **{"jiont.layers": 1})

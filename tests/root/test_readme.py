@@ -24,5 +24,7 @@ def test_two_setup_commands_demo_and_tests():
 def test_ci_runs_the_readme_test_command():
     test_cmd = _setup_commands()[1].split("&&")[-1].strip()
     ci = (ROOT / ".ci" / "run").read_text()
-    ci_cmds = [line.strip() for line in ci.splitlines() if line.strip().startswith("python -m pytest")]
+    ci_cmds = [
+        line.strip() for line in ci.splitlines() if line.strip().startswith("python -m pytest")
+    ]
     assert ci_cmds == [test_cmd]
