@@ -1,3 +1,4 @@
 """Roundness and cylindricity metrology (``jointwear.metrology``): readers, ISO form, wear maps."""
 
-__all__: list[str] = []
+from jointwear.metrology._api import *  # noqa: F403
+from jointwear.metrology._api import __all__  # noqa: F401

@@ -1,0 +1,490 @@
+"""Roundness and cylindricity: reference circles/cylinders and form parameters (ISO 12181/12180).
+
+All four references (least squares LS, minimum zone MZ, maximum inscribed MI, minimum
+circumscribed MC) are evaluated on the *limaçon* model used by roundness instruments: a radius
+profile r(theta) measured about the spindle axis is compared with a reference whose centre is
+offset by (x0, y0) (and, for a cylinder, tilted by (tx, ty) per metre of z),
+
+    e_i = r_i - (x0 + tx z_i) cos(theta_i) - (y0 + ty z_i) sin(theta_i).
+
+The model is linear in the centre parameters, so the LS reference is an exact linear least
+squares fit and MZ/MI/MC are linear programmes. They are solved with HiGHS
+(:func:`scipy.optimize.linprog`) by *constraint generation*: the LP is solved on a small set of
+candidate points, every point is checked against the solution, the violators are added and the
+LP is solved again. The solution of the final small LP is feasible for all points, so it is the
+true optimum of the full LP (to the solver's tolerance, far below 1 nm), while each LP has only a
+few hundred rows. The limaçon neglects a second-harmonic term of amplitude e^2/(4R) (e the
+eccentricity, R the radius); :func:`limacon_error` gives it and :func:`assess` warns when it
+exceeds a tolerance. Exact (geometric, non-linearised) least-squares fits are in
+:mod:`jointwear.metrology.fit`.
+
+Angles are taken in the data's own convention: form values do not depend on where theta = 0
+is or which way it turns; centres are reported as (eccentricity, direction in that convention).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import xarray as xr
+from scipy.optimize import linprog
+
+from jointwear.errors import BadInputError
+
+__all__ = [
+    "REFERENCES",
+    "ZoneResult",
+    "normalise_reference",
+    "circle_zone",
+    "cylinder_zone",
+    "roundness",
+    "cylindricity",
+    "limacon_error",
+]
+
+#: Reference names accepted (short form -> ISO circle / cylinder names).
+REFERENCES: dict[str, tuple[str, str]] = {
+    "LS": ("LSCI", "LSCY"),
+    "MZ": ("MZCI", "MZCY"),
+    "MI": ("MICI", "MICY"),
+    "MC": ("MCCI", "MCCY"),
+}
+_ALIASES = {
+    **{k: k for k in REFERENCES},
+    **{v[0]: k for k, v in REFERENCES.items()},
+    **{v[1]: k for k, v in REFERENCES.items()},
+    "LSQ": "LS",
+    "LEASTSQUARES": "LS",
+    "MINIMUMZONE": "MZ",
+    "MRS": "MZ",
+    "MIC": "MI",
+    "MCC": "MC",
+}
+
+# internal unit for the LPs: micrometres (keeps the solver's absolute tolerances << 1 nm)
+_SCALE = 1e6
+# acceptance tolerance of constraint generation [m]
+_TOL = 1e-13
+
+
+def normalise_reference(reference: str) -> str:
+    """``"MZ"``, ``"mzci"``, ``"MZCY"`` ... -> ``"MZ"``; a clear error for anything else."""
+    key = str(reference).strip().upper().replace("_", "").replace("-", "").replace(" ", "")
+    if key not in _ALIASES:
+        raise BadInputError(
+            f"reference {reference!r} is not known; use one of LS (least squares), MZ (minimum "
+            "zone), MI (maximum inscribed), MC (minimum circumscribed)"
+        )
+    return _ALIASES[key]
+
+
+@dataclass(frozen=True)
+class ZoneResult:
+    """Form deviation of a profile (circle) or surface (cylinder) from one reference.
+
+    Attributes
+    ----------
+    reference : str
+        ``"LS"``, ``"MZ"``, ``"MI"`` or ``"MC"``.
+    total : float
+        Peak-to-valley deviation from the reference (RONt / CYLt) [m].
+    peak, valley : float
+        Largest deviation outward / inward of the reference (RONp / RONv) [m], both >= 0.
+    rms : float
+        Root-mean-square deviation from the reference (RONq / CYLq) [m].
+    centre : tuple of float
+        Reference centre (x0, y0) relative to the measurement axis at z = z_ref [m], in the data's
+        angle frame (x along theta = 0, y along theta = 90 degree).
+    tilt : tuple of float
+        Axis tilt (dx/dz, dy/dz) [1]; (0, 0) for circles.
+    z_ref : float
+        Axial position the centre refers to [m].
+    radius : float
+        Reference radius (mean of the two zone circles for MZ) in the units of the input [m].
+    residual : ndarray
+        Deviation of each input point from the reference [m], NaN where the input was NaN.
+    active : int
+        Number of candidate points in the final LP (0 for LS).
+    """
+
+    reference: str
+    total: float
+    peak: float
+    valley: float
+    rms: float
+    centre: tuple[float, float]
+    tilt: tuple[float, float]
+    z_ref: float
+    radius: float
+    residual: np.ndarray = field(repr=False)
+    active: int = 0
+
+    @property
+    def eccentricity(self) -> float:
+        """Distance of the reference centre from the measurement axis at z_ref [m]."""
+        return float(np.hypot(*self.centre))
+
+    @property
+    def eccentricity_angle_deg(self) -> float:
+        """Direction of the centre offset, in the data's theta convention [degree]."""
+        return float(np.degrees(np.arctan2(self.centre[1], self.centre[0])) % 360.0)
+
+
+def limacon_error(eccentricity: float, radius: float) -> float:
+    """Amplitude of the second harmonic the limaçon model neglects, e^2 / (4 R) [m].
+
+    The exact radius seen from an axis offset by e is e cos(phi) + sqrt(R^2 - e^2 sin^2 phi)
+    = R + e cos(phi) - e^2 / (4 R) (1 - cos 2 phi) + O(e^4/R^3), so the neglected form term has
+    peak-to-valley e^2 / (2 R) and amplitude e^2 / (4 R).
+    """
+    if radius <= 0 or not np.isfinite(radius):
+        return float("nan")
+    return float(eccentricity**2 / (4.0 * radius))
+
+
+# --------------------------------------------------------------------------------------------
+# core solvers on flat arrays
+# --------------------------------------------------------------------------------------------
+
+
+def _design(theta_rad: np.ndarray, z: np.ndarray | None) -> np.ndarray:
+    c, s = np.cos(theta_rad), np.sin(theta_rad)
+    if z is None:
+        return np.column_stack([c, s])
+    return np.column_stack([c, s, z * c, z * s])
+
+
+def _ls(G: np.ndarray, r: np.ndarray) -> tuple[np.ndarray, float]:
+    A = np.column_stack([G, np.ones(len(r))])
+    # normal equations: the basis (cos, sin, z cos, z sin, 1) with centred z is well conditioned
+    sol = np.linalg.solve(A.T @ A, A.T @ r)
+    return sol[:-1], float(sol[-1])
+
+
+def _initial_candidates(
+    e: np.ndarray, groups: np.ndarray | None, n_groups: int, kind: str, k: int = 6
+) -> np.ndarray:
+    """Extreme points of a first residual (per group) plus an even subsample."""
+    n = len(e)
+    idx = [np.linspace(0, n - 1, min(n, 32 * max(n_groups, 1)), dtype=np.int64)]
+    if groups is None or n_groups <= 1:
+        order = np.argsort(e)
+        if kind in ("MZ", "MI"):
+            idx.append(order[:k])
+        if kind in ("MZ", "MC"):
+            idx.append(order[-k:])
+    else:
+        # per group extremes: groups are contiguous blocks of equal length if reshapeable
+        for g in range(n_groups):
+            sel = np.flatnonzero(groups == g)
+            if sel.size == 0:
+                continue
+            order = sel[np.argsort(e[sel])]
+            if kind in ("MZ", "MI"):
+                idx.append(order[:k])
+            if kind in ("MZ", "MC"):
+                idx.append(order[-k:])
+    return np.unique(np.concatenate(idx))
+
+
+def _zone_lp(
+    G: np.ndarray,
+    r: np.ndarray,
+    kind: str,
+    groups: np.ndarray | None = None,
+    n_groups: int = 1,
+    what: str = "profile",
+) -> tuple[np.ndarray, float, float, int]:
+    """Solve the MZ / MI / MC LP by constraint generation.
+
+    Returns (centre parameters p, lower radius a, upper radius b, number of candidate rows);
+    residuals e = r - G p lie in [a, b] (MI: a is the inscribed radius, MC: b circumscribed).
+    Inputs are in micrometres.
+    """
+    m = G.shape[1]
+    p0, a0 = _ls(G, r)
+    e0 = r - G @ p0
+    cand = _initial_candidates(e0, groups, n_groups, kind)
+    tol = _TOL * _SCALE
+    for _ in range(200):
+        Gs, rs = G[cand], r[cand]
+        ns = len(cand)
+        if kind == "MZ":
+            # vars [p (m), a, t]; min t; G p + a <= r ; -G p - a - t <= -r
+            c = np.zeros(m + 2)
+            c[-1] = 1.0
+            A = np.block(
+                [
+                    [Gs, np.ones((ns, 1)), np.zeros((ns, 1))],
+                    [-Gs, -np.ones((ns, 1)), -np.ones((ns, 1))],
+                ]
+            )
+            b = np.concatenate([rs, -rs])
+            bounds = [(None, None)] * (m + 1) + [(0, None)]
+        elif kind == "MI":
+            # vars [p, a]; max a; G p + a <= r
+            c = np.zeros(m + 1)
+            c[-1] = -1.0
+            A = np.column_stack([Gs, np.ones(ns)])
+            b = rs
+            bounds = [(None, None)] * (m + 1)
+        else:  # MC: vars [p, bb]; min bb; -G p - bb <= -r
+            c = np.zeros(m + 1)
+            c[-1] = 1.0
+            A = np.column_stack([-Gs, -np.ones(ns)])
+            b = -rs
+            bounds = [(None, None)] * (m + 1)
+        res = linprog(c, A_ub=A, b_ub=b, bounds=bounds, method="highs")
+        if res.status != 0:
+            raise BadInputError(
+                f"{what}: the {kind} reference could not be computed ({res.message.strip()}); "
+                "the points probably do not surround the axis (a closed profile needs angles "
+                "spread over more than half a turn, a cylinder at least two layers)"
+            )
+        x = res.x
+        p = x[:m]
+        e = r - G @ p
+        if kind == "MZ":
+            a, bnd = x[m], x[m] + x[m + 1]
+            viol = np.maximum(a - e, e - bnd)
+        elif kind == "MI":
+            a, bnd = x[m], float(np.max(e))
+            viol = a - e
+        else:
+            a, bnd = float(np.min(e)), x[m]
+            viol = e - bnd
+        bad = viol > tol
+        if not np.any(bad):
+            return p, float(np.min(e)), float(np.max(e)), len(cand)
+        # add the worst violators (globally and per group)
+        worst = np.flatnonzero(bad)
+        if worst.size > 8 * max(n_groups, 1):
+            worst = worst[np.argsort(viol[worst])[-8 * max(n_groups, 1) :]]
+        if groups is not None and n_groups > 1:
+            per = []
+            for g in np.unique(groups[bad]):
+                sel = np.flatnonzero(bad & (groups == g))
+                per.append(sel[np.argmax(viol[sel])])
+            worst = np.concatenate([worst, np.asarray(per, dtype=np.int64)])
+        cand = np.union1d(cand, worst)
+    raise BadInputError(f"{what}: {kind} constraint generation did not converge in 200 rounds")
+
+
+def _zone(
+    theta_rad: np.ndarray,
+    r: np.ndarray,
+    z: np.ndarray | None,
+    reference: str,
+    groups: np.ndarray | None,
+    n_groups: int,
+    what: str,
+) -> ZoneResult:
+    kind = normalise_reference(reference)
+    theta_rad = np.asarray(theta_rad, dtype=float).ravel()
+    r = np.asarray(r, dtype=float).ravel()
+    ok = np.isfinite(r) & np.isfinite(theta_rad)
+    if z is not None:
+        z = np.asarray(z, dtype=float).ravel()
+        ok &= np.isfinite(z)
+    n_ok = int(ok.sum())
+    need = 3 if z is None else 5
+    if n_ok < need + 1:
+        raise BadInputError(
+            f"{what}: only {n_ok} finite points; a form assessment needs at least {need + 1}"
+        )
+    th, rr = theta_rad[ok], r[ok]
+    z_ref = 0.0
+    zz = None
+    if z is not None:
+        z_ref = float(0.5 * (np.min(z[ok]) + np.max(z[ok])))
+        zz = z[ok] - z_ref
+        if np.ptp(zz) == 0:
+            raise BadInputError(
+                f"{what}: all points lie in one layer; cylindricity needs at least two layers"
+            )
+    grp = groups[ok] if groups is not None else None
+    offset = float(np.mean(rr))
+    G = _design(th, zz)
+    rs = (rr - offset) * _SCALE
+    active = 0
+    if kind == "LS":
+        p, a = _ls(G, rs)
+        e = rs - G @ p
+        ref = a
+    else:
+        p, lo, hi, active = _zone_lp(G, rs, kind, grp, n_groups, what)
+        e = rs - G @ p
+        ref = {"MZ": 0.5 * (lo + hi), "MI": lo, "MC": hi}[kind]
+    dev = (e - ref) / _SCALE
+    peak = float(max(np.max(dev), 0.0))
+    valley = float(max(-np.min(dev), 0.0))
+    p = p / _SCALE
+    resid = np.full(r.shape, np.nan)
+    resid[ok] = dev
+    return ZoneResult(
+        reference=kind,
+        total=float(np.max(dev) - np.min(dev)),
+        peak=peak,
+        valley=valley,
+        rms=float(np.sqrt(np.mean(dev**2))),
+        centre=(float(p[0]), float(p[1])),
+        tilt=(float(p[2]), float(p[3])) if z is not None else (0.0, 0.0),
+        z_ref=z_ref,
+        radius=float(offset + ref / _SCALE),
+        residual=resid,
+        active=active,
+    )
+
+
+def circle_zone(
+    theta_deg: np.ndarray, r: np.ndarray, *, reference: str = "MZ", what: str = "profile"
+) -> ZoneResult:
+    """Roundness of one closed profile against a reference circle (limaçon model).
+
+    Parameters
+    ----------
+    theta_deg : array_like
+        Angles of the points [degree] (any convention, any order).
+    r : array_like
+        Radius, or radial deviation from any constant, at those angles [m]. NaN points are
+        ignored.
+    reference : {"LS", "MZ", "MI", "MC"}
+        Reference circle (also accepts the ISO names LSCI, MZCI, MICI, MCCI).
+    what : str
+        Name used in error messages.
+
+    Returns
+    -------
+    ZoneResult
+        ``total`` is RONt, ``peak`` RONp, ``valley`` RONv and ``rms`` RONq [m].
+    """
+    return _zone(np.radians(theta_deg), r, None, reference, None, 1, what)
+
+
+def cylinder_zone(
+    z: np.ndarray,
+    theta_deg: np.ndarray,
+    r: np.ndarray,
+    *,
+    reference: str = "MZ",
+    what: str = "surface",
+) -> ZoneResult:
+    """Cylindricity of points (z, theta, r) against a reference cylinder (limaçon model).
+
+    Parameters
+    ----------
+    z : array_like
+        Axial position of each point [m].
+    theta_deg : array_like
+        Angle of each point [degree].
+    r : array_like
+        Radius or radial deviation [m]; NaN points are ignored.
+    reference : {"LS", "MZ", "MI", "MC"}
+        Reference cylinder (also LSCY, MZCY, MICY, MCCY).
+
+    Returns
+    -------
+    ZoneResult
+        ``total`` is CYLt, ``peak`` CYLp, ``valley`` CYLv, ``rms`` CYLq [m]; ``centre`` is the
+        axis position at ``z_ref`` (mid of the measured z range) and ``tilt`` its slope.
+    """
+    z = np.asarray(z, dtype=float).ravel()
+    _, inv = np.unique(z, return_inverse=True)
+    return _zone(
+        np.radians(np.asarray(theta_deg, dtype=float)),
+        r,
+        z,
+        reference,
+        inv,
+        int(inv.max()) + 1,
+        what,
+    )
+
+
+def _as_grid(data: xr.DataArray | xr.Dataset, what: str) -> xr.DataArray:
+    if isinstance(data, xr.Dataset):
+        for name in ("radius", "radial_deviation"):
+            if name in data:
+                data = data[name]
+                break
+        else:
+            raise BadInputError(
+                f"{what}: the dataset has neither 'radius' nor 'radial_deviation' "
+                f"(variables: {', '.join(map(str, data.data_vars)) or 'none'})"
+            )
+    if "theta" not in data.dims:
+        raise BadInputError(f"{what}: expected a 'theta' dimension, found dims {data.dims}")
+    return data
+
+
+def roundness(profile: xr.DataArray | xr.Dataset, *, reference: str = "MZ") -> float | xr.DataArray:
+    """RONt of a profile over ``theta`` [m], or of each layer of a (z, theta) scan.
+
+    Parameters
+    ----------
+    profile : DataArray or Dataset
+        ``radius`` or ``radial_deviation`` [m] over ``theta`` [degree] (and optionally ``z``).
+    reference : {"LS", "MZ", "MI", "MC"}
+        Reference circle.
+
+    Returns
+    -------
+    float or DataArray
+        RONt [m]; a DataArray over ``z`` for a multi-layer scan.
+    """
+    da = _as_grid(profile, "roundness")
+    th = np.asarray(da["theta"].values, dtype=float)
+    if da.ndim == 1:
+        return circle_zone(th, da.values, reference=reference).total
+    if "z" not in da.dims or da.ndim != 2:
+        raise BadInputError(f"roundness: expected dims (theta,) or (z, theta), got {da.dims}")
+    da = da.transpose("z", "theta")
+    vals = [
+        circle_zone(th, da.values[i], reference=reference, what=f"layer {i}").total
+        for i in range(da.sizes["z"])
+    ]
+    return xr.DataArray(
+        np.asarray(vals),
+        dims="z",
+        coords={"z": da["z"]},
+        attrs={"units": "m", "long_name": f"roundness RONt ({normalise_reference(reference)}CI)"},
+    )
+
+
+def cylindricity(radius: xr.DataArray | xr.Dataset, *, reference: str = "MZ") -> float:
+    """Cylindricity CYLt of a bore or shaft scanned over (z, theta) [m].
+
+    Parameters
+    ----------
+    radius : DataArray or Dataset
+        ``radius`` (or ``radial_deviation``) [m] over dims ``z`` [m] and ``theta`` [degree];
+        a Dataset is searched for either variable. NaN points are ignored.
+    reference : {"MZ", "LS", "MI", "MC"}
+        Reference cylinder: minimum zone (default), least squares, maximum inscribed, minimum
+        circumscribed (limaçon model; see the module docstring).
+
+    Returns
+    -------
+    float
+        Peak-to-valley radial deviation from the reference cylinder [m].
+
+    Examples
+    --------
+    >>> import numpy as np, xarray as xr
+    >>> th = np.arange(0, 360, 1.0)
+    >>> z = np.array([-1e-3, 0.0, 1e-3])
+    >>> r = 8e-3 + 1e-6 * np.cos(np.radians(2 * th)) + 0 * z[:, None]
+    >>> da = xr.DataArray(r, dims=("z", "theta"), coords={"z": z, "theta": th})
+    >>> round(cylindricity(da) * 1e6, 6)
+    2.0
+    """
+    da = _as_grid(radius, "cylindricity")
+    if "z" not in da.dims or da.ndim != 2:
+        raise BadInputError(f"cylindricity: expected dims (z, theta), got {da.dims}")
+    da = da.transpose("z", "theta")
+    z = np.asarray(da["z"].values, dtype=float)
+    th = np.asarray(da["theta"].values, dtype=float)
+    zz = np.broadcast_to(z[:, None], da.shape)
+    tt = np.broadcast_to(th[None, :], da.shape)
+    return cylinder_zone(zz, tt, da.values, reference=reference, what="cylindricity").total

@@ -1,0 +1,608 @@
+"""Wear maps: wear depth over (z, theta) from a worn scan and a reference.
+
+Two ways to get the unworn reference
+------------------------------------
+* **With a before-wear scan** of the same bearing: both scans are put in the canonical angle
+  convention, the before-scan is rotated by the set-up's angular offset (or, only if asked, by
+  the offset found by registering the unworn regions) and interpolated onto the worn scan's
+  grid. The difference d = r_worn - r_before still contains the change of set-up (the part is
+  re-mounted: a different eccentricity and tilt, and for deviation data an unknown radius
+  offset), so a limaçon cylinder c + (x0 + tx z) cos(theta) + (y0 + ty z) sin(theta) is fitted to
+  d on the *unworn* points and removed. The bore's own form errors cancel in d.
+* **Without one**: a reference cylinder (or one circle per layer, ``shape="circle"``) is fitted
+  by least squares to the unworn part of the worn scan itself; the original form errors of the
+  bore then stay in the map and are counted in its uncertainty.
+
+How the unworn part is chosen: unless given explicitly (``unworn``), it is found iteratively.
+Start with all points; fit the reference; estimate the scatter of the residuals of the current
+unworn set robustly (1.4826 x median absolute deviation); call unworn the points whose residual
+lies within ``threshold`` times that scatter of the median; refit; repeat until the set no longer
+changes. Worn points (material removed) sit far on one side and drop out after one or two
+rounds. This assumes that a part of the bore is unworn (true for a journal bearing loaded on one
+side); if wear covers the whole circumference, pass a before-scan.
+
+Uncertainty: ``wear_depth_u`` [m] combines in quadrature the RMS residual of the unworn points
+(noise of both scans, unmodelled form and misalignment: how far an unworn point's "wear" scatters
+about 0) with the standard error of the fitted reference at each point.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import xarray as xr
+
+from jointwear.conventions import (
+    CANONICAL,
+    angle_convention_of,
+    convert_theta,
+    theta_coord,
+    z_coord,
+)
+from jointwear.errors import BadInputError
+from jointwear.metrology.form import cylinder_zone
+
+__all__ = ["wear_map", "worn_volume", "register_angle"]
+
+
+def _radius_var(ds: xr.Dataset | xr.DataArray, what: str) -> tuple[xr.DataArray, str]:
+    if isinstance(ds, xr.DataArray):
+        name = str(ds.name) if ds.name in ("radius", "radial_deviation") else "radius"
+        da = ds
+    else:
+        for name in ("radius", "radial_deviation"):
+            if name in ds:
+                da = ds[name]
+                break
+        else:
+            raise BadInputError(
+                f"{what}: expected a 'radius' or 'radial_deviation' variable over (z, theta); "
+                f"found {', '.join(map(str, ds.data_vars)) or 'no variables'}"
+            )
+    if set(da.dims) != {"z", "theta"}:
+        raise BadInputError(f"{what}: '{name}' must have dims (z, theta), found {da.dims}")
+    units = da.attrs.get("units", "m")
+    if units != "m":
+        raise BadInputError(f"{what}: '{name}' has units {units!r}; expected 'm' (SI)")
+    angle_convention_of(da, what=what)
+    da = convert_theta(da, CANONICAL).transpose("z", "theta")
+    return da, name
+
+
+def _periodic_interp(theta_new: np.ndarray, theta: np.ndarray, values: np.ndarray) -> np.ndarray:
+    """Linear interpolation of each row of ``values`` (over ``theta`` [degree]) periodically."""
+    order = np.argsort(theta)
+    th = theta[order]
+    v = values[:, order]
+    th_ext = np.concatenate([th[-1:] - 360.0, th, th[:1] + 360.0])
+    v_ext = np.concatenate([v[:, -1:], v, v[:, :1]], axis=1)
+    tn = np.mod(theta_new, 360.0)
+    return np.stack([np.interp(tn, th_ext, row) for row in v_ext])
+
+
+def _rotate(theta_new: np.ndarray, theta: np.ndarray, values: np.ndarray, off: float) -> np.ndarray:
+    """Values of a scan rotated by ``off`` [degree] (feature at t moves to t + off), sampled at
+    ``theta_new``. Exact Fourier shift when both grids are the same uniform grid (keeps the noise
+    variance, so registration is not biased towards half-sample shifts), else periodic linear
+    interpolation."""
+    n = theta.size
+    uniform = n > 2 and np.allclose(np.diff(theta), 360.0 / n, atol=1e-9, rtol=0)
+    if uniform and theta_new.size == n and np.allclose(theta_new, theta, atol=1e-9, rtol=0):
+        k = np.arange(n // 2 + 1)
+        spec = np.fft.rfft(values, axis=1) * np.exp(-2j * np.pi * k * off / 360.0)[None, :]
+        return np.fft.irfft(spec, n, axis=1)
+    return _periodic_interp(theta_new, np.mod(theta + off, 360.0), values)
+
+
+def _theta_weights(theta: np.ndarray) -> np.ndarray:
+    """Periodic trapezoid weights [rad] for angles ``theta`` [degree] (sorted)."""
+    th = np.radians(np.sort(theta))
+    gaps = np.diff(np.concatenate([th, th[:1] + 2 * np.pi]))
+    return 0.5 * (gaps + np.roll(gaps, 1))
+
+
+def _z_weights(z: np.ndarray) -> np.ndarray:
+    """Trapezoid weights [m] over the measured z range (one layer: weight 1 m -> per metre)."""
+    if z.size == 1:
+        return np.ones(1)
+    w = np.zeros_like(z)
+    d = np.diff(z)
+    w[:-1] += 0.5 * d
+    w[1:] += 0.5 * d
+    return np.abs(w)
+
+
+def worn_volume(
+    wear_depth: np.ndarray, z: np.ndarray, theta_deg: np.ndarray, radius: float
+) -> float:
+    """Volume of removed material over the measured band [m^3].
+
+    V = integral of h(z, theta) R dtheta dz (trapezoid in z between the first and last layer,
+    periodic trapezoid in theta); R the bore radius [m], h the wear depth [m] (NaN ignored).
+    """
+    h = np.nan_to_num(np.asarray(wear_depth, dtype=float))
+    w = _z_weights(np.asarray(z, dtype=float))[:, None] * _theta_weights(theta_deg)[None, :]
+    return float(radius * np.sum(w * h))
+
+
+def _basis(z: np.ndarray, theta_deg: np.ndarray, shape: str) -> np.ndarray:
+    nz, nt = z.size, theta_deg.size
+    t = np.radians(theta_deg)
+    c = np.broadcast_to(np.cos(t)[None, :], (nz, nt)).ravel()
+    s = np.broadcast_to(np.sin(t)[None, :], (nz, nt)).ravel()
+    if shape == "cylinder":
+        zc = z - 0.5 * (z.min() + z.max())
+        span = max(np.ptp(zc), 1e-12)
+        zz = np.broadcast_to((zc / span)[:, None], (nz, nt)).ravel()
+        return np.column_stack([np.ones(nz * nt), c, s, zz * c, zz * s])
+    # one circle per layer: block columns (1, cos, sin) for each layer
+    X = np.zeros((nz * nt, 3 * nz))
+    for i in range(nz):
+        sl = slice(i * nt, (i + 1) * nt)
+        X[sl, 3 * i] = 1.0
+        X[sl, 3 * i + 1] = c[sl]
+        X[sl, 3 * i + 2] = s[sl]
+    return X
+
+
+def _smooth_theta(v: np.ndarray, win: int) -> np.ndarray:
+    """Periodic moving average of each row over ``win`` samples (NaN ignored)."""
+    if win <= 1:
+        return v
+    ok = np.isfinite(v)
+    x = np.where(ok, v, 0.0)
+    h = win // 2
+    n = v.shape[1]
+    h = min(h, n - 1)
+    ext = np.concatenate([x[:, n - h :], x, x[:, :h]], axis=1) if h else x
+    cnt = np.concatenate([ok[:, n - h :], ok, ok[:, :h]], axis=1) if h else ok
+    cs = np.concatenate([np.zeros((v.shape[0], 1)), np.cumsum(ext, axis=1)], axis=1)
+    cc = np.concatenate([np.zeros((v.shape[0], 1)), np.cumsum(cnt, axis=1)], axis=1)
+    w = 2 * h + 1
+    num = cs[:, w:] - cs[:, :-w]
+    den = cc[:, w:] - cc[:, :-w]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(den > 0, num / np.maximum(den, 1), np.nan)
+
+
+def _robust_reference(
+    d: np.ndarray,
+    X: np.ndarray,
+    threshold: float,
+    unworn: np.ndarray | None,
+    max_iter: int,
+    what: str,
+    shape: tuple[int, int] | None = None,
+    theta_deg: np.ndarray | None = None,
+    margin_deg: float = 5.0,
+    smooth_deg: float = 2.0,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, float, int]:
+    """Fit X b ~ d on the unworn points (found iteratively unless given).
+
+    A point is unworn when its residual is within ``threshold`` robust standard deviations of
+    the median, and it is not within ``margin_deg`` of a worn region (where the residual
+    smoothed over ``smooth_deg`` exceeds ``threshold`` robust deviations of the smoothed
+    residual) -- so the faint tails of a worn patch do not bias the reference.
+    """
+    finite = np.isfinite(d)
+    mask = finite.copy() if unworn is None else (finite & unworn)
+    n_iter = 0
+    win = 1
+    if shape is not None and theta_deg is not None:
+        win = max(1, int(round(smooth_deg * shape[1] / 360.0)))
+    for n_iter in range(1, max_iter + 1):  # noqa: B007
+        if mask.sum() < X.shape[1] + 2:
+            raise BadInputError(
+                f"{what}: only {int(mask.sum())} unworn points left to fit the reference; "
+                "pass a before-wear scan, a larger threshold, or an explicit unworn mask"
+            )
+        Xm = X[mask]
+        XtX = Xm.T @ Xm
+        try:
+            b = np.linalg.solve(XtX, Xm.T @ d[mask])
+        except np.linalg.LinAlgError:
+            raise BadInputError(
+                f"{what}: the unworn points do not determine the reference (they cover too "
+                "little of the circumference); pass a before-wear scan or an explicit unworn mask"
+            ) from None
+        resid = d - X @ b
+        if unworn is not None:
+            break
+        rm = resid[mask]
+        med = np.median(rm)
+        scale = 1.4826 * np.median(np.abs(rm - med))
+        if scale == 0:
+            scale = np.sqrt(np.mean((rm - med) ** 2)) or 1e-15
+        new = finite & (np.abs(resid - med) <= threshold * scale)
+        if shape is not None and theta_deg is not None:
+            sm = _smooth_theta(resid.reshape(shape), win)
+            smm = sm.ravel()[mask]
+            smed = np.nanmedian(smm)
+            sscale = 1.4826 * np.nanmedian(np.abs(smm - smed)) or scale
+            region = ~(np.abs(sm - smed) > threshold * sscale)
+            region = _dilate(region, theta_deg, margin_deg)
+            new &= region.ravel()
+        changed = int(np.count_nonzero(new != mask))
+        mask = new
+        if changed <= 1e-4 * mask.size:
+            break
+    resid = d - X @ b
+    s2 = float(np.mean(resid[mask] ** 2) * mask.sum() / max(mask.sum() - X.shape[1], 1))
+    cov = np.linalg.inv(X[mask].T @ X[mask]) * s2
+    var_fit = np.einsum("ij,jk,ik->i", X, cov, X)
+    return resid, mask, var_fit, s2, n_iter
+
+
+def _dilate(unworn: np.ndarray, theta_deg: np.ndarray, margin_deg: float) -> np.ndarray:
+    """Shrink the unworn mask: drop points within ``margin_deg`` (in theta) of a worn point."""
+    if margin_deg <= 0:
+        return unworn
+    worn = ~unworn
+    th = np.asarray(theta_deg, dtype=float)
+    step = 360.0 / th.size if th.size else 360.0
+    k = int(np.ceil(margin_deg / step))
+    if k <= 0 or not worn.any():
+        return unworn
+    k = min(k, th.size)
+    # running maximum over a periodic window of 2k+1 samples via cumulative sums
+    ext = np.concatenate([worn[:, -k:], worn, worn[:, :k]], axis=1).astype(np.int32)
+    c = np.concatenate([np.zeros((worn.shape[0], 1), np.int32), np.cumsum(ext, axis=1)], axis=1)
+    win = c[:, 2 * k + 1 :] - c[:, : -(2 * k + 1)]
+    return unworn & (win == 0)
+
+
+def _refine_offset(
+    rw: np.ndarray,
+    rbz: np.ndarray,
+    th: np.ndarray,
+    thb: np.ndarray,
+    X: np.ndarray,
+    sign: float,
+    offset: float,
+    mask: np.ndarray,
+) -> float:
+    """Offset [degree] minimising the RMS of the set-up-corrected difference on ``mask``."""
+    from scipy.optimize import minimize_scalar
+
+    Xm = X[mask]
+    lhs = Xm.T @ Xm
+
+    def cost(off: float) -> float:
+        d = sign * (rw - _rotate(th, thb, rbz, off)).ravel()[mask]
+        b = np.linalg.solve(lhs, Xm.T @ d)
+        return float(np.mean((d - Xm @ b) ** 2))
+
+    step = max(4.0 * 360.0 / max(thb.size, 1), 2.0)
+    res = minimize_scalar(
+        cost, bounds=(offset - step, offset + step), method="bounded", options={"xatol": 1e-4}
+    )
+    return float(res.x) if res.fun <= cost(offset) else offset
+
+
+def register_angle(
+    worn: xr.DataArray, before: xr.DataArray, *, exclude: np.ndarray | None = None
+) -> float:
+    """Angular offset [degree] that best aligns ``before`` with ``worn`` (canonical theta).
+
+    Both are reduced to their residual from a least-squares limaçon cylinder, averaged over z,
+    resampled on a common uniform angle grid and circularly cross-correlated (points flagged in
+    ``exclude``, e.g. the worn region, are set to zero); the peak is refined by a parabola.
+    Returns the offset to add to the before-scan's theta.
+    """
+    th_w = np.asarray(worn["theta"].values, dtype=float)
+    n = max(th_w.size, 64)
+    grid = np.arange(n) * 360.0 / n
+    prof = []
+    for da, ex in ((worn, exclude), (before, None)):
+        z = np.asarray(da["z"].values, dtype=float)
+        th = np.asarray(da["theta"].values, dtype=float)
+        v = np.asarray(da.values, dtype=float)
+        X = _basis(z, th, "cylinder")
+        vv = v.ravel()
+        ok = np.isfinite(vv)
+        if ex is not None:
+            ok &= ~ex.ravel()
+        b, *_ = np.linalg.lstsq(X[ok], vv[ok], rcond=None)
+        res = (vv - X @ b).reshape(v.shape)
+        if ex is not None:
+            res = np.where(ex, np.nan, res)
+        res = np.where(np.isfinite(res), res, 0.0)
+        prof.append(_periodic_interp(grid, th, res).mean(axis=0))
+    a, b = prof
+    xc = np.fft.irfft(np.fft.rfft(a) * np.conj(np.fft.rfft(b)), n)
+    k = int(np.argmax(xc))
+    y0, y1, y2 = xc[(k - 1) % n], xc[k], xc[(k + 1) % n]
+    den = y0 - 2 * y1 + y2
+    frac = 0.5 * (y0 - y2) / den if den != 0 else 0.0
+    off = (k + frac) * 360.0 / n
+    return float((off + 180.0) % 360.0 - 180.0)
+
+
+def wear_map(
+    worn: xr.Dataset | xr.DataArray,
+    before: xr.Dataset | xr.DataArray | None = None,
+    *,
+    angle_offset_deg: float = 0.0,
+    register: bool = False,
+    shape: str = "cylinder",
+    threshold: float = 3.0,
+    unworn: np.ndarray | xr.DataArray | None = None,
+    surface: str = "bore",
+    radius: float | None = None,
+    margin_deg: float = 5.0,
+    max_iter: int = 30,
+) -> xr.Dataset:
+    """Wear depth over (z, theta) from a worn scan and a before-scan or a fitted reference.
+
+    Parameters
+    ----------
+    worn : Dataset or DataArray
+        Worn scan: ``radius`` or ``radial_deviation`` [m] over (``z`` [m], ``theta`` [degree]);
+        theta must state its angle convention.
+    before : Dataset or DataArray, optional
+        Scan of the same bearing before wear, same layers (z values within 1 µm or inside the
+        worn scan's z range for interpolation). Without it the reference is fitted to the
+        unworn part of the worn scan (see the module docstring).
+    angle_offset_deg : float
+        Set-up rotation [degree, canonical convention]: a feature at theta in the before-scan is
+        at theta + offset in the worn scan.
+    register : bool
+        Estimate the offset by correlating the unworn regions instead (added to
+        ``angle_offset_deg``). Only when asked.
+    shape : {"cylinder", "circle"}
+        Reference fitted to the unworn points: a limaçon cylinder (centre and tilt, default) or
+        one circle per layer.
+    threshold : float
+        Unworn points lie within ``threshold`` robust standard deviations of the reference.
+    unworn : bool array (z, theta), optional
+        Explicit unworn mask (canonical theta order of the worn scan); skips the iteration.
+    surface : {"bore", "shaft"}
+        A bore's radius grows with wear, a shaft's shrinks; wear depth is positive for material
+        removed in both.
+    radius : float, optional
+        Bore radius for the worn volume [m]; by default the mean worn radius (``radius`` data) or
+        the ``nominal_radius`` attribute (deviation data).
+    margin_deg : float
+        Points within this angle [degree] of a worn region are not used as unworn reference.
+    max_iter : int
+        Maximum rounds of the unworn-region iteration.
+
+    Returns
+    -------
+    Dataset
+        ``wear_depth`` and ``wear_depth_u`` [m] over (z, theta) in the canonical convention,
+        ``unworn`` (flag: 1 if the point was used as unworn reference), scalars
+        ``worn_volume`` and ``worn_volume_u`` [m^3], ``cylindricity_before`` and
+        ``cylindricity_after`` [m] (MZ), ``angle_offset`` [degree]; method in attrs.
+    """
+    if shape not in ("cylinder", "circle"):
+        raise BadInputError(f"wear_map: shape must be 'cylinder' or 'circle', got {shape!r}")
+    if surface not in ("bore", "shaft"):
+        raise BadInputError(f"wear_map: surface must be 'bore' or 'shaft', got {surface!r}")
+    if not threshold > 0:
+        raise BadInputError(f"wear_map: threshold must be > 0, got {threshold!r}")
+    w, wname = _radius_var(worn, "worn scan")
+    z = np.asarray(w["z"].values, dtype=float)
+    th = np.asarray(w["theta"].values, dtype=float)
+    rw = np.asarray(w.values, dtype=float)
+    sign = 1.0 if surface == "bore" else -1.0
+    X = _basis(z, th, shape)
+    mask_in = None
+    if unworn is not None:
+        mask_in = np.asarray(unworn, dtype=bool)
+        if mask_in.shape != rw.shape:
+            raise BadInputError(
+                f"wear_map: unworn mask has shape {mask_in.shape}, expected {rw.shape} (z, theta)"
+            )
+        mask_in = mask_in.ravel()
+    offset = float(angle_offset_deg)
+    if before is not None:
+        b, bname = _radius_var(before, "before scan")
+        if (bname == "radius") != (wname == "radius"):
+            pass  # a constant offset is fitted anyway
+        zb = np.asarray(b["z"].values, dtype=float)
+        thb = np.asarray(b["theta"].values, dtype=float)
+        rb = np.asarray(b.values, dtype=float)
+        if zb.size == z.size and np.allclose(zb, z, atol=1e-6, rtol=0):
+            rbz = rb
+        elif z.min() >= zb.min() - 1e-9 and z.max() <= zb.max() + 1e-9 and zb.size > 1:
+            o = np.argsort(zb)
+            rbz = np.stack([np.interp(z, zb[o], rb[o, j]) for j in range(thb.size)], axis=1)
+        else:
+            raise BadInputError(
+                f"wear_map: the before scan covers z = [{zb.min():.6g}, {zb.max():.6g}] m but the "
+                f"worn scan needs [{z.min():.6g}, {z.max():.6g}] m; scan the same layers or crop "
+                "the worn scan"
+            )
+        if register:
+            wz = xr.DataArray(rw, dims=("z", "theta"), coords={"z": z, "theta": th})
+            # first guess of the worn region from the worn scan alone
+            _, m0, _, _, _ = _robust_reference(
+                sign * rw.ravel(),
+                X,
+                threshold,
+                mask_in,
+                max_iter,
+                "wear_map",
+                rw.shape,
+                th,
+                margin_deg,
+            )
+            excl = ~m0.reshape(rw.shape)
+            rb_i = _rotate(th, thb, rbz, offset)
+            bz = xr.DataArray(rb_i, dims=("z", "theta"), coords={"z": z, "theta": th})
+            offset += register_angle(wz, bz, exclude=excl)
+            unw = ~excl.ravel()
+            for _ in range(3):
+                new_off = _refine_offset(rw, rbz, th, thb, X, sign, offset, unw)
+                rb_i = _rotate(th, thb, rbz, new_off)
+                _, unw, _, _, _ = _robust_reference(
+                    sign * (rw - rb_i).ravel(),
+                    X,
+                    threshold,
+                    mask_in,
+                    max_iter,
+                    "wear_map",
+                    rw.shape,
+                    th,
+                    margin_deg,
+                )
+                done = abs(new_off - offset) < 1e-3
+                offset = new_off
+                if done:
+                    break
+        rb_i = _rotate(th, thb, rbz, offset)
+        d = sign * (rw - rb_i).ravel()
+        method = (
+            "difference to the before-wear scan (rotated by angle_offset and interpolated onto "
+            "the worn grid) minus a limaçon "
+            + ("cylinder" if shape == "cylinder" else "circle per layer")
+            + " fitted to the unworn points (change of set-up)"
+        )
+    else:
+        if register:
+            raise BadInputError("wear_map: register=True needs a before scan")
+        d = sign * rw.ravel()
+        rbz = None
+        method = (
+            "residual from a least-squares limaçon "
+            + ("cylinder" if shape == "cylinder" else "circle per layer")
+            + " fitted to the unworn part of the worn scan (no before-wear scan)"
+        )
+    resid, mask, var_fit, s2, n_iter = _robust_reference(
+        d, X, threshold, mask_in, max_iter, "wear_map", rw.shape, th, margin_deg
+    )
+    wear = resid.reshape(rw.shape)
+    u = np.sqrt(s2 + var_fit).reshape(rw.shape)
+    mask2 = mask.reshape(rw.shape)
+
+    # radius for the volume
+    if radius is None:
+        if wname == "radius":
+            radius = float(np.nanmean(rw))
+        else:
+            radius = _attr_radius(worn, w)
+    if radius is None or not np.isfinite(radius) or radius <= 0:
+        raise BadInputError(
+            "wear_map: the worn scan holds radial deviations without a 'nominal_radius' "
+            "attribute; pass radius=<bore radius in m> for the worn volume"
+        )
+    vol = worn_volume(wear, z, th, radius)
+    wts = _z_weights(z)[:, None] * _theta_weights(th)[None, :] * radius
+    sd_fit = np.sqrt(var_fit).reshape(rw.shape)
+    vol_u = float(np.hypot(np.sum(wts * sd_fit), np.sqrt(np.sum(wts**2) * s2)))
+
+    cyl_after = (
+        cylinder_zone(
+            np.broadcast_to(z[:, None], rw.shape), np.broadcast_to(th, rw.shape), rw
+        ).total
+        if z.size > 1
+        else float("nan")
+    )
+    if rbz is not None:
+        cyl_before = (
+            cylinder_zone(
+                np.broadcast_to(z[:, None], rbz.shape), np.broadcast_to(thb, rbz.shape), rbz
+            ).total
+            if z.size > 1
+            else float("nan")
+        )
+        cyl_before_note = "MZ cylindricity of the before-wear scan"
+    else:
+        masked = np.where(mask2, rw, np.nan)
+        cyl_before = (
+            cylinder_zone(
+                np.broadcast_to(z[:, None], rw.shape), np.broadcast_to(th, rw.shape), masked
+            ).total
+            if z.size > 1
+            else float("nan")
+        )
+        cyl_before_note = (
+            "MZ cylindricity of the unworn points of the worn scan (estimate of the "
+            "cylindricity before wear; no before-wear scan)"
+        )
+
+    zc = z_coord(z)
+    tc = theta_coord(th, CANONICAL)
+    out = xr.Dataset(
+        {
+            "wear_depth": (
+                ("z", "theta"),
+                wear,
+                {
+                    "units": "m",
+                    "long_name": "wear depth of the bearing surface (positive = material removed)",
+                    "ancillary_variables": "wear_depth_u",
+                },
+            ),
+            "wear_depth_u": (
+                ("z", "theta"),
+                u,
+                {"units": "m", "long_name": "standard uncertainty of wear_depth"},
+            ),
+            "unworn": (
+                ("z", "theta"),
+                mask2.astype(np.int8),
+                {
+                    "units": "1",
+                    "long_name": "point used as unworn reference",
+                    "flag_values": np.array([0, 1], dtype=np.int8),
+                    "flag_meanings": "worn_or_outlier unworn_reference",
+                },
+            ),
+            "worn_volume": (
+                (),
+                vol,
+                {
+                    "units": "m3",
+                    "long_name": "volume of material removed over the measured band",
+                    "ancillary_variables": "worn_volume_u",
+                },
+            ),
+            "worn_volume_u": (
+                (),
+                vol_u,
+                {"units": "m3", "long_name": "standard uncertainty of worn_volume"},
+            ),
+            "cylindricity_before": ((), cyl_before, {"units": "m", "long_name": cyl_before_note}),
+            "cylindricity_after": (
+                (),
+                cyl_after,
+                {"units": "m", "long_name": "MZ cylindricity of the worn scan"},
+            ),
+            "angle_offset": (
+                (),
+                offset,
+                {
+                    "units": "degree",
+                    "long_name": "rotation applied to the before-wear scan (canonical theta)",
+                },
+            ),
+        },
+        coords={"z": zc, "theta": tc},
+        attrs={
+            "title": "wear map",
+            "wear_reference": method,
+            "unworn_selection": (
+                "explicit mask"
+                if mask_in is not None
+                else f"iterative: |residual - median| <= {threshold} x 1.4826 MAD ({n_iter} rounds)"
+            ),
+            "n_unworn_points": int(mask.sum()),
+            "reference_rms_residual": float(np.sqrt(s2)),
+            "volume_radius": float(radius),
+            "surface": surface,
+            "registered": bool(register),
+        },
+    )
+    return out
+
+
+def _attr_radius(orig: xr.Dataset | xr.DataArray, da: xr.DataArray) -> float | None:
+    for src in (da.attrs, getattr(orig, "attrs", {})):
+        for key in ("nominal_radius", "radius"):
+            if key in src:
+                try:
+                    return float(src[key])
+                except (TypeError, ValueError):
+                    pass
+    return None
