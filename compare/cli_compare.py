@@ -1,0 +1,98 @@
+"""``jointwear compare SIM.nc [SIM2.nc] MEAS.nc [...] --out metrics.nc``."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+
+def register(app: typer.Typer) -> None:
+    """Make the ``jointwear compare`` group itself the command (no sub-command needed)."""
+
+    @app.callback(
+        invoke_without_command=True,
+        context_settings={"allow_interspersed_args": True},
+    )
+    def compare_files(
+        ctx: typer.Context,
+        sim: Annotated[
+            Path, typer.Argument(help="Simulated data (.nc): wear map and/or motion record.")
+        ],
+        meas: Annotated[
+            Path, typer.Argument(help="Measured data (.nc): wear map (metrology) or motion (DIC).")
+        ],
+        out: Annotated[
+            Path,
+            typer.Option("--out", "-o", help="netCDF of aligned fields, differences, metrics."),
+        ] = Path("metrics.nc"),
+        sim_extra: Annotated[
+            list[Path] | None,
+            typer.Option("--sim", help="Further simulated file (e.g. the motion record)."),
+        ] = None,
+        meas_extra: Annotated[
+            list[Path] | None,
+            typer.Option("--meas", help="Further measured file (e.g. the DIC motion record)."),
+        ] = None,
+        table: Annotated[
+            Path | None, typer.Option("--table", help="Also write the metrics table as CSV.")
+        ] = None,
+        criteria: Annotated[
+            Path | None, typer.Option("--criteria", help="TOML file with validation criteria.")
+        ] = None,
+        cycles: Annotated[
+            float | None,
+            typer.Option("--cycles", help="Crank cycles at which to compare the wear maps."),
+        ] = None,
+        period: Annotated[
+            float | None,
+            typer.Option(
+                "--period", help="Crank period in seconds (when neither record has a crank angle)."
+            ),
+        ] = None,
+        method: Annotated[
+            str,
+            typer.Option(
+                "--method", help="Motion alignment: auto, crank_angle, cross_correlation."
+            ),
+        ] = "auto",
+        strict: Annotated[
+            bool, typer.Option("--strict", help="Exit with code 1 if a criterion fails.")
+        ] = False,
+    ) -> None:
+        """Compare simulation and measurement (wear maps and/or motion, detected from variables).
+
+        Writes the aligned fields, their differences and every metric (units and definition in
+        the attributes) to OUT, prints the decision card, and exits 1 with --strict when a
+        validation criterion fails.
+        """
+        if ctx.invoked_subcommand is not None:
+            return
+        from jointwear import io
+        from jointwear.compare.comparison import compare, load_criteria, save_comparison
+        from jointwear.errors import ValidationFailed
+
+        io.check_writable(out)
+        crit = load_criteria(criteria)
+        sim_paths = [sim, *(sim_extra or [])]
+        meas_paths = [meas, *(meas_extra or [])]
+        sims = [io.load(p) for p in sim_paths]
+        meass = [io.load(p) for p in meas_paths]
+        result = compare(
+            sims, meass, criteria=crit, cycles=cycles, period_s=period, motion_method=method
+        )
+        save_comparison(result, out, inputs=[*sim_paths, *meas_paths], parents=[*sims, *meass])
+        if table is not None:
+            with io.atomic_path(table) as tmp:
+                result.metrics.to_csv(tmp, index=False, float_format="%.6g")
+        for row in result.decisions.itertuples():
+            mark = "PASS" if row.passed else "FAIL"
+            typer.echo(f"{mark}  {row.quantity}: {row.value}  [{row.criterion}]")
+        for note in result.notes:
+            typer.echo(f"note: {note}")
+        typer.echo(f"metrics: {out}")
+        if strict and not result.passed:
+            raise ValidationFailed(
+                f"validation failed for: {', '.join(result.failed())} (details in {out})"
+            )

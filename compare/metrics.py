@@ -1,0 +1,395 @@
+"""Validation metrics on aligned simulation/measurement data (plain numpy, SI units).
+
+Every metric here is a pure function of arrays that are already on a common grid
+(:mod:`jointwear.compare.align` puts them there). ``S`` is the simulation ("computed"), ``D`` the
+measurement ("data"), both in the same units. :data:`DEFINITIONS` holds the one-line
+definition and the unit rule of every metric; :mod:`jointwear.compare.comparison` copies them
+into the attributes of the result so that every number carries its meaning.
+
+References
+----------
+- Sprague, M. A., Geers, T. L. (2004). A spectral-element method for modelling cavitation in
+  transient fluid-structure interaction. *Int. J. Numer. Meth. Eng.* 60, 2467-2499 (the
+  magnitude/phase/comprehensive error factors; also Schwer 2007, *Eng. Comput.* 23, 295-309).
+- ASME V&V 20-2009 (R2021), *Standard for Verification and Validation in Computational Fluid
+  Dynamics and Heat Transfer*, sections 1-2 (E = S - D, u_val, expanded U_val).
+- Ferson, S., Oberkampf, W. L., Ginzburg, L. (2008). Model validation and predictive
+  capability for the thermal challenge problem. *CMAME* 197, 2408-2430 (area validation metric).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from jointwear.errors import BadInputError
+
+__all__ = [
+    "DEFINITIONS",
+    "rmse",
+    "nrmse",
+    "pearson_r",
+    "sprague_geers",
+    "SpragueGeers",
+    "area_validation_metric",
+    "VV20",
+    "vv20",
+    "wrap_angle_deg",
+    "max_location",
+    "worn_volume",
+    "lsq_cylindricity",
+]
+
+#: metric name -> (long name, one-line definition, unit rule). The unit rule is ``"same"``
+#: (units of the compared quantity), ``"1"`` (dimensionless) or a UDUNITS string.
+DEFINITIONS: dict[str, tuple[str, str, str]] = {
+    "rmse": (
+        "root-mean-square error",
+        "sqrt(mean((S - D)^2)) over the common grid (S simulation, D measurement)",
+        "same",
+    ),
+    "nrmse": (
+        "normalised root-mean-square error",
+        "RMSE / (max(D) - min(D)), the range of the measurement on the common grid",
+        "1",
+    ),
+    "pearson_r": (
+        "Pearson correlation coefficient",
+        "cov(S, D) / (std(S) std(D)) over the common grid; 1 = same shape up to scale and offset",
+        "1",
+    ),
+    "mean_error": ("mean error", "mean(S - D) over the common grid (bias)", "same"),
+    "max_abs_error": ("maximum absolute error", "max |S - D| over the common grid", "same"),
+    "sg_magnitude": (
+        "Sprague-Geers magnitude error M",
+        "sqrt(sum S^2 / sum D^2) - 1 on the common time base (0 = same energy)",
+        "1",
+    ),
+    "sg_phase": (
+        "Sprague-Geers phase error P",
+        "arccos(sum S D / sqrt(sum S^2 sum D^2)) / pi (0 = in phase, 1 = opposite)",
+        "1",
+    ),
+    "sg_comprehensive": (
+        "Sprague-Geers comprehensive error C",
+        "sqrt(M^2 + P^2)",
+        "1",
+    ),
+    "area_validation_metric": (
+        "area validation metric",
+        "integral |F_S(x) - F_D(x)| dx between the empirical distribution functions of S and D",
+        "same",
+    ),
+    "max_angle_error": (
+        "error of the angle of maximum wear",
+        "theta(max S) - theta(max D) wrapped to (-180, 180], canonical convention",
+        "degree",
+    ),
+    "max_z_error": (
+        "error of the axial position of maximum wear",
+        "z(max S) - z(max D)",
+        "m",
+    ),
+    "value_sim": ("simulated value", "value of the quantity from the simulation", "same"),
+    "value_meas": ("measured value", "value of the quantity from the measurement", "same"),
+    "relative_error": ("relative error", "(S - D) / |D|", "1"),
+    "E": ("comparison error E", "E = S - D (ASME V&V 20)", "same"),
+    "u_num": ("numerical standard uncertainty", "u_num of the simulation (ASME V&V 20)", "same"),
+    "u_input": (
+        "input standard uncertainty",
+        "u_input: simulation uncertainty propagated from its input parameters (ASME V&V 20)",
+        "same",
+    ),
+    "u_D": ("measurement standard uncertainty", "u_D of the measured value (ASME V&V 20)", "same"),
+    "u_val": (
+        "validation standard uncertainty",
+        "u_val = sqrt(u_num^2 + u_input^2 + u_D^2) (ASME V&V 20)",
+        "same",
+    ),
+    "U_val": ("expanded validation uncertainty", "U_val = k u_val (ASME V&V 20)", "same"),
+    "fraction_within_U_val": (
+        "fraction of points within U_val",
+        "share of grid points where |S - D| <= k sqrt(u_S^2 + u_D^2) (point-wise V&V 20)",
+        "1",
+    ),
+}
+
+
+def _pair(s: np.ndarray, d: np.ndarray, what: str = "S and D") -> tuple[np.ndarray, np.ndarray]:
+    """Flatten, check shapes and drop pairs where either side is NaN."""
+    s = np.asarray(s, dtype=float).ravel()
+    d = np.asarray(d, dtype=float).ravel()
+    if s.shape != d.shape:
+        raise BadInputError(
+            f"{what} must be on the same grid; got {s.size} and {d.size} values - align them first "
+            "(jointwear.compare.align_wear_maps / align_time_series)"
+        )
+    ok = np.isfinite(s) & np.isfinite(d)
+    if not np.any(ok):
+        raise BadInputError(f"{what} have no finite value in common")
+    return s[ok], d[ok]
+
+
+def rmse(s: np.ndarray, d: np.ndarray) -> float:
+    """Root-mean-square error ``sqrt(mean((S - D)^2))`` [units of the inputs]."""
+    s, d = _pair(s, d)
+    return float(np.sqrt(np.mean((s - d) ** 2)))
+
+
+def nrmse(s: np.ndarray, d: np.ndarray) -> float:
+    """RMSE normalised by the range of the measurement ``max(D) - min(D)`` [1].
+
+    NaN when the measurement is constant (the normalisation is undefined).
+    """
+    s, d = _pair(s, d)
+    span = float(np.max(d) - np.min(d))
+    if span <= 0:
+        return float("nan")
+    return float(np.sqrt(np.mean((s - d) ** 2)) / span)
+
+
+def pearson_r(s: np.ndarray, d: np.ndarray) -> float:
+    """Pearson correlation coefficient of ``S`` and ``D`` [1]; NaN if either is constant."""
+    s, d = _pair(s, d)
+    sc = s - s.mean()
+    dc = d - d.mean()
+    den = math.sqrt(float(np.sum(sc * sc)) * float(np.sum(dc * dc)))
+    if den == 0.0:
+        return float("nan")
+    return float(np.clip(np.sum(sc * dc) / den, -1.0, 1.0))
+
+
+@dataclass(frozen=True)
+class SpragueGeers:
+    """Sprague-Geers error factors (all dimensionless).
+
+    Attributes
+    ----------
+    M : float
+        Magnitude error ``sqrt(psi_cc / psi_mm) - 1``.
+    P : float
+        Phase error ``arccos(psi_mc / sqrt(psi_mm psi_cc)) / pi``.
+    C : float
+        Comprehensive error ``sqrt(M^2 + P^2)``.
+    """
+
+    M: float
+    P: float
+    C: float
+
+
+def sprague_geers(
+    s: np.ndarray, d: np.ndarray, *, weights: np.ndarray | None = None
+) -> SpragueGeers:
+    """Sprague-Geers magnitude, phase and comprehensive errors of a computed history.
+
+    Parameters
+    ----------
+    s : ndarray
+        Computed (simulated) history on the common time base [any unit].
+    d : ndarray
+        Measured history on the same time base [same unit].
+    weights : ndarray, optional
+        Quadrature weights (time steps [s]); uniform sampling needs none.
+
+    Returns
+    -------
+    SpragueGeers
+        ``M``, ``P``, ``C``. With ``s = a d`` (pure amplitude error, ``a > 0``): ``M = a - 1``,
+        ``P = 0``. With a pure phase shift of a sinusoid over whole periods: ``M = 0``,
+        ``P = shift / pi`` (shift in radians).
+    """
+    s_arr = np.asarray(s, dtype=float).ravel()
+    d_arr = np.asarray(d, dtype=float).ravel()
+    w = np.ones_like(s_arr) if weights is None else np.asarray(weights, dtype=float).ravel()
+    if w.shape != s_arr.shape:
+        raise BadInputError(f"weights have {w.size} values, the histories {s_arr.size}")
+    if s_arr.shape != d_arr.shape:
+        raise BadInputError(
+            f"histories have {s_arr.size} and {d_arr.size} samples; align them first"
+        )
+    ok = np.isfinite(s_arr) & np.isfinite(d_arr) & np.isfinite(w)
+    if not np.any(ok):
+        raise BadInputError("Sprague-Geers: the histories have no finite sample in common")
+    s_arr, d_arr, w = s_arr[ok], d_arr[ok], w[ok]
+    psi_mm = float(np.sum(w * d_arr * d_arr))
+    psi_cc = float(np.sum(w * s_arr * s_arr))
+    psi_mc = float(np.sum(w * s_arr * d_arr))
+    if psi_mm == 0.0 or psi_cc == 0.0:
+        return SpragueGeers(float("nan"), float("nan"), float("nan"))
+    m = math.sqrt(psi_cc / psi_mm) - 1.0
+    p = math.acos(max(-1.0, min(1.0, psi_mc / math.sqrt(psi_mm * psi_cc)))) / math.pi
+    return SpragueGeers(m, p, math.hypot(m, p))
+
+
+def area_validation_metric(s: np.ndarray, d: np.ndarray) -> float:
+    """Area between the empirical cumulative distribution functions of ``S`` and ``D``.
+
+    ``d = integral |F_S(x) - F_D(x)| dx`` [units of the inputs] (Ferson et al. 2008). It is 0 only
+    for identical distributions; for two point masses it is their distance, and shifting a
+    distribution by ``c`` gives ``|c|``. ``S`` and ``D`` may have different sizes; NaNs are
+    dropped.
+    """
+    a = np.sort(np.asarray(s, dtype=float).ravel())
+    b = np.sort(np.asarray(d, dtype=float).ravel())
+    a = a[np.isfinite(a)]
+    b = b[np.isfinite(b)]
+    if a.size == 0 or b.size == 0:
+        raise BadInputError("area validation metric: both samples need at least one finite value")
+    x = np.union1d(a, b)
+    fa = np.searchsorted(a, x, side="right") / a.size
+    fb = np.searchsorted(b, x, side="right") / b.size
+    return float(np.sum(np.abs(fa - fb)[:-1] * np.diff(x)))
+
+
+@dataclass(frozen=True)
+class VV20:
+    """ASME V&V 20 validation of one scalar quantity (same units for every field).
+
+    Attributes
+    ----------
+    S, D : float
+        Simulated and measured values.
+    E : float
+        Comparison error ``S - D``.
+    u_num, u_input, u_D : float
+        Standard uncertainties: numerical, input-parameter, measurement.
+    u_val : float
+        ``sqrt(u_num^2 + u_input^2 + u_D^2)``.
+    k : float
+        Coverage factor.
+    U_val : float
+        ``k u_val``.
+    passed : bool
+        ``|E| <= U_val``: the model error is not distinguishable from the validation
+        uncertainty at this level.
+    """
+
+    S: float
+    D: float
+    E: float
+    u_num: float
+    u_input: float
+    u_D: float
+    u_val: float
+    k: float
+    U_val: float
+    passed: bool
+
+
+def vv20(
+    s: float,
+    d: float,
+    *,
+    u_num: float = 0.0,
+    u_input: float = 0.0,
+    u_d: float = 0.0,
+    k: float = 2.0,
+) -> VV20:
+    """Validation comparison of ASME V&V 20: ``E = S - D`` against ``U_val = k u_val``.
+
+    Parameters
+    ----------
+    s, d : float
+        Simulated and measured value [same unit].
+    u_num, u_input, u_d : float
+        Standard uncertainties (numerical, input, measurement) [same unit], >= 0.
+    k : float
+        Coverage factor (2 for about 95 % with a normal distribution).
+
+    Returns
+    -------
+    VV20
+        ``passed`` is ``|E| <= U_val``.
+    """
+    for name, value in (("u_num", u_num), ("u_input", u_input), ("u_D", u_d), ("k", k)):
+        if not (np.isfinite(value) and value >= 0):
+            raise BadInputError(f"V&V 20: {name} must be a finite number >= 0, got {value!r}")
+    e = float(s) - float(d)
+    u_val = math.sqrt(u_num**2 + u_input**2 + u_d**2)
+    big_u = k * u_val
+    return VV20(
+        float(s),
+        float(d),
+        e,
+        float(u_num),
+        float(u_input),
+        float(u_d),
+        u_val,
+        float(k),
+        big_u,
+        bool(abs(e) <= big_u),
+    )
+
+
+def wrap_angle_deg(angle_deg: float | np.ndarray) -> float | np.ndarray:
+    """Wrap an angle difference to (-180, 180] degree."""
+    out = -((-np.asarray(angle_deg, dtype=float) + 180.0) % 360.0) + 180.0
+    return float(out) if np.ndim(out) == 0 else out
+
+
+def max_location(
+    field: np.ndarray, z: np.ndarray, theta_deg: np.ndarray
+) -> tuple[float, float, float]:
+    """Value and location ``(value, z, theta_deg)`` of the maximum of a ``(z, theta)`` field.
+
+    The angle is refined by a periodic parabola through the maximum and its two neighbours in
+    its layer (sub-grid location, so a rotation that is not a multiple of the grid step is
+    still recovered); ``z`` is the layer of the maximum.
+    """
+    f = np.asarray(field, dtype=float)
+    if f.ndim != 2 or f.shape != (len(z), len(theta_deg)):
+        raise BadInputError(
+            f"field of shape {f.shape} does not match (z, theta) = ({len(z)}, {len(theta_deg)})"
+        )
+    if not np.any(np.isfinite(f)):
+        raise BadInputError("the field has no finite value")
+    i, j = np.unravel_index(np.nanargmax(f), f.shape)
+    n = f.shape[1]
+    th = float(theta_deg[j])
+    value = float(f[i, j])
+    if n >= 3:
+        ym, y0, yp = f[i, (j - 1) % n], f[i, j], f[i, (j + 1) % n]
+        den = ym - 2 * y0 + yp
+        step = float(np.median(np.diff(theta_deg))) if n > 1 else 0.0
+        if np.isfinite(den) and den < 0:
+            delta = 0.5 * (ym - yp) / den
+            th = float((th + delta * step) % 360.0)
+            value = float(y0 - 0.25 * (ym - yp) * delta)
+    return value, float(z[i]), th
+
+
+def worn_volume(field: np.ndarray, z: np.ndarray, theta_deg: np.ndarray, radius: float) -> float:
+    """Worn volume ``R * integral h dtheta dz`` over the grid [m^3].
+
+    Trapezoid rule in ``z`` over the given layers (so the integral covers ``[z_min, z_max]``),
+    periodic rectangle rule in ``theta`` (uniform grid over the full circle). First order in
+    ``h / R``. ``radius`` is the unworn bore radius [m]; NaN gives NaN.
+    """
+    f = np.nan_to_num(np.asarray(field, dtype=float), nan=0.0)
+    dtheta = 2 * math.pi / len(theta_deg)
+    per_layer = f.sum(axis=1) * dtheta * radius
+    if len(z) == 1:
+        return float("nan")
+    return float(np.trapezoid(per_layer, np.asarray(z, dtype=float)))
+
+
+def lsq_cylindricity(field: np.ndarray, z: np.ndarray, theta_deg: np.ndarray) -> float:
+    """Least-squares cylindricity (LSCY, limacon model) of a radial-deviation field [m].
+
+    The bore radius is ``R + h(z, theta)``; a least-squares cylinder (radius, centre offset and
+    tilt: ``a0 + (a1 + a2 z) cos(theta) + (b1 + b2 z) sin(theta)``) is removed and the peak-to-
+    valley of the residual returned. Independent of the angle convention (the cosine/sine pair
+    spans the same functions in any convention).
+    """
+    f = np.asarray(field, dtype=float)
+    zz, tt = np.meshgrid(np.asarray(z, dtype=float), np.deg2rad(theta_deg), indexing="ij")
+    ok = np.isfinite(f)
+    c, s = np.cos(tt[ok]), np.sin(tt[ok])
+    zk = zz[ok]
+    a = np.column_stack([np.ones_like(c), c, zk * c, s, zk * s])
+    coef, *_ = np.linalg.lstsq(a, f[ok], rcond=None)
+    res = f[ok] - a @ coef
+    return float(res.max() - res.min())
