@@ -1,0 +1,733 @@
+"""Virtual stereo rig: what the test rig's two cameras would record, with ground truth.
+
+The mechanism is the reference study's four-bar (crank 0.10 m, coupler 0.40 m, follower 0.30 m,
+ground 0.30 m, crank at 120 rev/min counter-clockwise). Motion is analytic planar four-bar
+kinematics plus a prescribed out-of-plane motion: joint C (the journal) moves along z by
+``z_c(t) = z_amplitude * sin(omega t + z_phase)``; the follower, which hangs on a spherical joint at
+D, tilts so that its end follows C (``sin(psi) = z_c / L3``). Three speckled planar patches are
+attached to the bodies:
+
+* ``follower``: a plate on the follower between 20 % and 80 % of its length;
+* ``journal``: a square cap centred on joint C, turning with the coupler, in front of the
+  follower (it translates with C, including z_c);
+* ``crank``: a plate on the crank (rendered only if in view).
+
+Rendering is by exact ray casting: for every camera pixel the undistorted viewing ray (the
+inverse of the lens model, solved to 1e-12) is intersected with each patch plane, and the
+speckle texture - a band-limited field sampled at 1/4 of the pixel footprint - is sampled there
+with bicubic interpolation (OpenCV ``remap``); nearer patches hide farther ones. Optical blur is a
+Gaussian point-spread function in the image, sensor noise is additive Gaussian, exposure scales
+the brightness (and, with ``motion_blur_samples`` > 1, averages sub-frames over the exposure time),
+and images are quantised to 8 bits. Calibration boards are rendered analytically with
+pixel-footprint anti-aliasing.
+
+World frame of the ground truth: the mechanism frame, x from joint A to joint D along the ground
+link, y up (gravity along -y), z out of the mechanism plane towards the cameras.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import asdict, dataclass, field, replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import xarray as xr
+
+from jointwear.dic._calib import Camera, StereoCalibration
+from jointwear.errors import BadInputError
+
+__all__ = [
+    "RigConfig",
+    "VirtualRig",
+    "fourbar_pose",
+    "speckle_texture",
+    "generate_rig",
+    "CODECS",
+]
+
+L1, L2, L3, L4 = 0.10, 0.40, 0.30, 0.30
+
+#: Video codecs the bundled OpenCV/FFmpeg can write here: name -> (fourcc, extension, lossless).
+CODECS: dict[str, tuple[str, str, bool]] = {
+    "ffv1": ("FFV1", ".avi", True),
+    "mjpg": ("MJPG", ".avi", False),
+    "mp4v": ("mp4v", ".mp4", False),
+    "png": ("png ", ".avi", True),
+}
+
+
+@dataclass(frozen=True)
+class RigConfig:
+    """Parameters of the virtual rig (SI units; pixel quantities say so).
+
+    The defaults describe a rig like the study's: two 1280 x 1024 cameras 1.0 m from the
+    mechanism plane, 0.30 m apart (toe-in towards ``look_at``), a 0.42 m x 0.34 m field of view
+    (0.33 mm per pixel) covering the follower and joint C, 50 frames/s.
+    """
+
+    width: int = 1280
+    height: int = 1024
+    fov_width: float = 0.42
+    distance: float = 1.0
+    baseline: float = 0.30
+    look_at: tuple[float, float, float] = (0.29, 0.16, 0.0)
+    distortion: tuple[float, float, float, float, float] = (-0.08, 0.10, 2e-4, -1e-4, 0.0)
+    principal_offset_px: tuple[float, float] = (6.0, -4.0)
+    fps: float = 50.0
+    duration: float = 1.0
+    crank_speed_rpm: float = 120.0
+    crank_angle0_deg: float = 30.0
+    z_amplitude: float = 2.5e-3
+    z_phase_deg: float = 0.0
+    journal_size: float = 0.04
+    journal_z: float = 0.02
+    crank_z: float = 0.03
+    follower_width: float = 0.03
+    speckle_size: float | None = None
+    noise_sigma: float = 1.0
+    blur_sigma_px: float = 0.6
+    exposure: float = 1.0
+    exposure_time: float = 2e-4
+    motion_blur_samples: int = 1
+    background: float = 40.0
+    seed: int = 0
+    drop_frames: tuple[int, ...] = ()
+    duplicate_frames: tuple[int, ...] = ()
+    board_squares: tuple[int, int] = (10, 8)
+    board_square_size: float = 0.025
+    board_views: int = 12
+
+    def __post_init__(self) -> None:
+        if self.width < 64 or self.height < 64:
+            raise BadInputError(f"rig image size {self.width}x{self.height} is too small")
+        if not self.fps > 0 or not self.duration > 0:
+            raise BadInputError("rig fps and duration must be positive")
+        if self.motion_blur_samples < 1:
+            raise BadInputError("motion_blur_samples must be >= 1")
+
+    @property
+    def focal_px(self) -> float:
+        """Focal length [pixel] giving ``fov_width`` at ``distance``."""
+        return self.width * self.distance / self.fov_width
+
+    @property
+    def n_frames(self) -> int:
+        return int(round(self.duration * self.fps))
+
+    @property
+    def omega(self) -> float:
+        """Crank angular speed [rad/s]."""
+        return self.crank_speed_rpm * 2 * np.pi / 60.0
+
+
+# ---------------------------------------------------------------------------------------------
+# kinematics
+def _rz(a: float) -> np.ndarray:
+    c, s = np.cos(a), np.sin(a)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+def _ry(b: float) -> np.ndarray:
+    c, s = np.cos(b), np.sin(b)
+    return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
+
+
+def fourbar_pose(t: float, cfg: RigConfig) -> dict[str, Any]:
+    """Poses of the rig's bodies at time ``t`` [s] (mechanism frame).
+
+    Returns a dict with ``crank_angle`` [rad], ``B``, ``C`` (joint positions [m]), and per body
+    ``(R, p)``: rotation and origin of the body frame (``X = R x_body + p``).
+    """
+    th1 = np.deg2rad(cfg.crank_angle0_deg) + cfg.omega * t
+    B = np.array([L1 * np.cos(th1), L1 * np.sin(th1)])
+    D = np.array([L4, 0.0])
+    d = np.linalg.norm(D - B)
+    a = (L2**2 - L3**2 + d**2) / (2 * d)
+    h = np.sqrt(max(L2**2 - a**2, 0.0))
+    e = (D - B) / d
+    C = B + a * e + h * np.array([-e[1], e[0]])
+    phi3 = np.arctan2(C[1] - D[1], C[0] - D[0])
+    phi2 = np.arctan2(C[1] - B[1], C[0] - B[0])
+    zc = cfg.z_amplitude * np.sin(cfg.omega * t + np.deg2rad(cfg.z_phase_deg))
+    psi = np.arcsin(np.clip(zc / L3, -1, 1))
+    R_f = _rz(phi3) @ _ry(-psi)
+    C3 = np.array([D[0], D[1], 0.0]) + L3 * R_f[:, 0]
+    return {
+        "crank_angle": th1,
+        "B": np.array([B[0], B[1], 0.0]),
+        "C": C3,
+        "follower": (R_f, np.array([D[0], D[1], 0.0])),
+        "journal": (_rz(phi2), C3 + np.array([0.0, 0.0, cfg.journal_z])),
+        "crank": (_rz(th1), np.array([0.0, 0.0, cfg.crank_z])),
+        "follower_centroid": np.array([D[0], D[1], 0.0]) + 0.5 * L3 * R_f[:, 0],
+    }
+
+
+def _truth_state(t: float, cfg: RigConfig) -> dict[str, np.ndarray]:
+    p = fourbar_pose(t, cfg)
+    return {
+        "follower_position": p["follower_centroid"],
+        "journal_position": p["journal"][1],
+        "crank_angle": np.array([p["crank_angle"]]),
+    }
+
+
+def _truth_derivative(t: float, cfg: RigConfig, key: str, h: float = 1e-5) -> np.ndarray:
+    """4th-order central difference of an analytic quantity (truncation error ~1e-12 m/s)."""
+    f = [_truth_state(t + k * h, cfg)[key] for k in (-2, -1, 1, 2)]
+    return (f[0] - 8 * f[1] + 8 * f[2] - f[3]) / (12 * h)
+
+
+# ---------------------------------------------------------------------------------------------
+# textures and patches
+def speckle_texture(
+    shape: tuple[int, int], texel: float, speckle_size: float, *, seed: int = 0
+) -> np.ndarray:
+    """A band-limited speckle pattern in [0.1, 0.9] (float32) of ``shape`` texels.
+
+    Speckles are Gaussian-smoothed random dots of about ``speckle_size`` [m] diameter at a fill
+    factor near 50 %; ``texel`` is the texel size [m].
+    """
+    import cv2
+
+    rng = np.random.default_rng(seed)
+    sigma = 0.25 * speckle_size / texel
+    field_ = rng.standard_normal(shape).astype(np.float32)
+    field_ = cv2.GaussianBlur(field_, (0, 0), sigma)
+    field_ /= field_.std() + 1e-12
+    img = 0.5 + 0.4 * np.tanh(1.5 * field_)
+    img = cv2.GaussianBlur(img.astype(np.float32), (0, 0), 0.35 * sigma)
+    return img.astype(np.float32)
+
+
+@dataclass(frozen=True, eq=False)
+class Patch:
+    """A speckled rectangle in a body frame: corner ``origin`` + [0, size_a] e_a + [0, size_b] e_b."""
+
+    body: str
+    origin: np.ndarray  # body frame [m]
+    e_a: np.ndarray
+    e_b: np.ndarray
+    size: tuple[float, float]
+    texel: float
+    texture: np.ndarray = field(repr=False)
+
+    def corners_body(self) -> np.ndarray:
+        a, b = self.size
+        return np.array(
+            [
+                self.origin,
+                self.origin + a * self.e_a,
+                self.origin + a * self.e_a + b * self.e_b,
+                self.origin + b * self.e_b,
+            ]
+        )
+
+
+# ---------------------------------------------------------------------------------------------
+def _look_at_camera(
+    centre: np.ndarray, target: np.ndarray, K: np.ndarray, dist: np.ndarray, size: tuple[int, int]
+) -> Camera:
+    z = target - centre
+    z /= np.linalg.norm(z)
+    x = np.array([1.0, 0.0, 0.0]) - z * z[0]
+    x /= np.linalg.norm(x)
+    y = np.cross(z, x)
+    R = np.stack([x, y, z])
+    return Camera(K, dist, R, -R @ centre, size)
+
+
+class VirtualRig:
+    """Renders the virtual rig's images.
+
+    Parameters
+    ----------
+    config : RigConfig
+        Rig parameters (see :class:`RigConfig`).
+    """
+
+    def __init__(self, config: RigConfig | None = None) -> None:
+        self.config = cfg = config or RigConfig()
+        f = cfg.focal_px
+        target = np.asarray(cfg.look_at, dtype=float)
+        cams = {}
+        for name, sign, df in (("left", -1.0, 1.0), ("right", 1.0, 1.003)):
+            K = np.array(
+                [
+                    [f * df, 0.0, (cfg.width - 1) / 2 + sign * cfg.principal_offset_px[0]],
+                    [0.0, f * df * 1.0005, (cfg.height - 1) / 2 + cfg.principal_offset_px[1]],
+                    [0.0, 0.0, 1.0],
+                ]
+            )
+            centre = target + np.array([sign * cfg.baseline / 2, 0.0, cfg.distance])
+            dist = np.asarray(cfg.distortion, dtype=float) * (1.0 if name == "left" else 0.9)
+            cams[name] = _look_at_camera(centre, target, K, dist, (cfg.width, cfg.height))
+        self.calibration = StereoCalibration(
+            cams["left"],
+            cams["right"],
+            source="virtual rig (exact)",
+            world_frame="mechanism frame (x A->D, y up, z out of plane towards the cameras)",
+        )
+        self._rays: dict[str, np.ndarray] = {}
+        self.patches = self._make_patches()
+
+    # ---- geometry --------------------------------------------------------------------------
+    @property
+    def pixel_footprint(self) -> float:
+        """Object-space size of one pixel at the mechanism plane [m]."""
+        return self.config.distance / self.config.focal_px
+
+    def noise_floor_z(self, sigma_u: float) -> float:
+        """Stereo out-of-plane noise floor per point ``Z^2/(f B) sqrt(2) sigma_u`` [m]."""
+        c = self.config
+        return c.distance**2 / (c.focal_px * c.baseline) * np.sqrt(2) * sigma_u
+
+    def _make_patches(self) -> list[Patch]:
+        c = self.config
+        texel = self.pixel_footprint / 4
+        ex, ey = np.array([1.0, 0, 0]), np.array([0, 1.0, 0])
+        specs = [
+            (
+                "follower",
+                np.array([0.2 * L3, -c.follower_width / 2, 0.0]),
+                (0.6 * L3, c.follower_width),
+            ),
+            (
+                "journal",
+                np.array([-c.journal_size / 2, -c.journal_size / 2, 0.0]),
+                (c.journal_size,) * 2,
+            ),
+            ("crank", np.array([0.015, -0.01, 0.0]), (0.07, 0.02)),
+        ]
+        out = []
+        for i, (body, origin, size) in enumerate(specs):
+            shape = (int(np.ceil(size[1] / texel)) + 4, int(np.ceil(size[0] / texel)) + 4)
+            size_m = c.speckle_size or 4.0 * self.pixel_footprint
+            tex = speckle_texture(shape, texel, size_m, seed=c.seed * 100 + i + 1)
+            out.append(Patch(body, origin, ex, ey, size, texel, tex))
+        return out
+
+    def rays(self, camera: str) -> np.ndarray:
+        """Unit world ray directions of every pixel centre (H, W, 3)."""
+        if camera not in self._rays:
+            cam = self.calibration.cameras[camera]
+            w, h = cam.image_size
+            u, v = np.meshgrid(np.arange(w, dtype=float), np.arange(h, dtype=float))
+            uv = np.stack([u.ravel(), v.ravel()], axis=1)
+            self._rays[camera] = cam.rays(uv).reshape(h, w, 3)
+        return self._rays[camera]
+
+    # ---- rendering -------------------------------------------------------------------------
+    def _render_radiance(self, camera: str, t: float) -> np.ndarray:
+        import cv2
+
+        c = self.config
+        cam = self.calibration.cameras[camera]
+        w, h = cam.image_size
+        img = np.full((h, w), c.background / 255.0, dtype=np.float32)
+        depth = np.full((h, w), np.inf)
+        pose = fourbar_pose(t, c)
+        rays = self.rays(camera)
+        C = cam.centre
+        for patch in self.patches:
+            R, p = pose[patch.body]
+            corners = patch.corners_body() @ R.T + p
+            Xc = cam.world_to_camera(corners)
+            if np.any(Xc[:, 2] <= 0):
+                continue
+            uv = cam.project(corners)
+            x0, y0 = np.floor(uv.min(0)).astype(int) - 3
+            x1, y1 = np.ceil(uv.max(0)).astype(int) + 4
+            x0, y0, x1, y1 = max(x0, 0), max(y0, 0), min(x1, w), min(y1, h)
+            if x1 <= x0 or y1 <= y0:
+                continue
+            d = rays[y0:y1, x0:x1]
+            n = R[:, 2]
+            p0 = R @ patch.origin + p
+            denom = d @ n
+            with np.errstate(divide="ignore", invalid="ignore"):
+                tt = ((p0 - C) @ n) / denom
+            X = C + tt[..., None] * d
+            rel = X - p0
+            a = rel @ (R @ patch.e_a)
+            b = rel @ (R @ patch.e_b)
+            inside = (tt > 0) & (a >= 0) & (a <= patch.size[0]) & (b >= 0) & (b <= patch.size[1])
+            sub_depth = depth[y0:y1, x0:x1]
+            inside &= tt < sub_depth
+            if not np.any(inside):
+                continue
+            mx = (a / patch.texel + 2).astype(np.float32)
+            my = (b / patch.texel + 2).astype(np.float32)
+            sampled = cv2.remap(
+                patch.texture,
+                mx,
+                my,
+                interpolation=cv2.INTER_CUBIC,
+                borderMode=cv2.BORDER_REFLECT,
+            )
+            sub = img[y0:y1, x0:x1]
+            sub[inside] = sampled[inside]
+            sub_depth[inside] = tt[inside]
+        return img
+
+    def render(self, camera: str, t: float, *, frame_index: int = 0) -> np.ndarray:
+        """The 8-bit grey image camera ``camera`` records at time ``t`` [s]."""
+        import cv2
+
+        c = self.config
+        n = c.motion_blur_samples
+        if n == 1:
+            rad = self._render_radiance(camera, t)
+        else:
+            ts = t + (np.arange(n) / (n - 1) - 0.5) * c.exposure_time
+            rad = np.mean([self._render_radiance(camera, ti) for ti in ts], axis=0)
+        img = rad * 255.0 * c.exposure
+        if c.blur_sigma_px > 0:
+            img = cv2.GaussianBlur(img, (0, 0), c.blur_sigma_px)
+        rng = np.random.default_rng([c.seed, frame_index, 0 if camera == "left" else 1])
+        if c.noise_sigma > 0:
+            img = img + rng.normal(0.0, c.noise_sigma, img.shape)
+        return np.clip(np.rint(img), 0, 255).astype(np.uint8)
+
+    def frame_times(self) -> np.ndarray:
+        """Times of the frames the cameras record [s] (before dropping/duplicating)."""
+        return np.arange(self.config.n_frames) / self.config.fps
+
+    # ---- calibration boards -----------------------------------------------------------------
+    def board_poses(self) -> list[tuple[np.ndarray, np.ndarray]]:
+        """Board poses (R, origin) in the mechanism frame; the last one lies on the mechanism
+        plane with columns along +x and rows along -y (the world-frame view)."""
+        c = self.config
+        rng = np.random.default_rng(c.seed + 7)
+        sx, sy = c.board_squares
+        s = c.board_square_size
+        target = np.asarray(c.look_at, dtype=float)
+        base = np.diag([1.0, -1.0, -1.0])  # board x = +x, y = -y, z = -z (faces the cameras)
+        poses = []
+        for k in range(c.board_views):
+            ang = 2 * np.pi * k / max(c.board_views, 1)
+            tilt = np.deg2rad(rng.uniform(20, 35))
+            axis = np.array([np.cos(ang), np.sin(ang), 0.0])
+            Kx = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
+            Rt = np.eye(3) + np.sin(tilt) * Kx + (1 - np.cos(tilt)) * Kx @ Kx
+            R = Rt @ _rz(np.deg2rad(rng.uniform(-10, 10))) @ base
+            centre = target + np.array(
+                [rng.uniform(-0.03, 0.03), rng.uniform(-0.03, 0.03), rng.uniform(-0.08, 0.12)]
+            )
+            origin = centre - R @ np.array([sx * s / 2, sy * s / 2, 0.0])
+            poses.append((R, origin))
+        R = base
+        origin = target - R @ np.array([sx * s / 2, sy * s / 2, 0.0])
+        poses.append((R, origin))
+        return poses
+
+    def world_board_origin(self) -> np.ndarray:
+        """Mechanism-frame position of the first inner corner of the world-frame board [m]."""
+        R, origin = self.board_poses()[-1]
+        s = self.config.board_square_size
+        return origin + R @ np.array([s, s, 0.0])
+
+    def render_board(
+        self, camera: str, R: np.ndarray, origin: np.ndarray, *, index: int = 0
+    ) -> np.ndarray:
+        """Image of a chessboard (squares ``board_squares``, 1-square white margin)."""
+        import cv2
+
+        c = self.config
+        cam = self.calibration.cameras[camera]
+        rays = self.rays(camera)
+        C = cam.centre
+        n = R[:, 2]
+        denom = rays @ n
+        with np.errstate(divide="ignore", invalid="ignore"):
+            tt = ((origin - C) @ n) / denom
+        X = C + tt[..., None] * rays
+        rel = X - origin
+        bx = rel @ R[:, 0]
+        by = rel @ R[:, 1]
+        s = c.board_square_size
+        sx, sy = c.board_squares
+
+        def tri(x, wpx):
+            f = x / s
+            k = np.floor(f)
+            frac = f - k
+            sign = np.where(k % 2 == 0, 1.0, -1.0)
+            return np.clip(sign * np.minimum(frac, 1 - frac) * s / np.maximum(wpx, 1e-12), -1, 1)
+
+        gx_u = np.abs(np.gradient(bx, axis=1)) + np.abs(np.gradient(bx, axis=0))
+        gy_u = np.abs(np.gradient(by, axis=1)) + np.abs(np.gradient(by, axis=0))
+        val = 0.5 + 0.5 * tri(bx, 0.5 * gx_u) * tri(by, 0.5 * gy_u)
+        white, black = 0.9, 0.08
+        img = black + (white - black) * val
+        inside = (bx >= 0) & (bx <= sx * s) & (by >= 0) & (by <= sy * s)
+        margin = (bx >= -s) & (bx <= (sx + 1) * s) & (by >= -s) & (by <= (sy + 1) * s) & ~inside
+        out = np.where(inside, img, np.where(margin, white, c.background / 255.0))
+        out = np.where(tt > 0, out, c.background / 255.0)
+        out = (out * 255.0 * c.exposure).astype(np.float32)
+        if c.blur_sigma_px > 0:
+            out = cv2.GaussianBlur(out, (0, 0), c.blur_sigma_px)
+        rng = np.random.default_rng([c.seed, 10_000 + index, 0 if camera == "left" else 1])
+        out = out + rng.normal(0.0, c.noise_sigma, out.shape)
+        return np.clip(np.rint(out), 0, 255).astype(np.uint8)
+
+    def board_images(self) -> list[tuple[np.ndarray, np.ndarray]]:
+        """(left, right) board images, the world-frame view last."""
+        return [
+            (self.render_board("left", R, o, index=i), self.render_board("right", R, o, index=i))
+            for i, (R, o) in enumerate(self.board_poses())
+        ]
+
+    # ---- regions of interest ----------------------------------------------------------------
+    def body_rois(self, *, shrink_px: float = 6.0) -> dict[str, list[list[float]]]:
+        """Polygons [pixel] of each patch in the left reference image (frame 0), shrunk inwards."""
+        cam = self.calibration.left
+        pose = fourbar_pose(0.0, self.config)
+        out = {}
+        w, h = cam.image_size
+        for patch in self.patches:
+            R, p = pose[patch.body]
+            uv = cam.project(patch.corners_body() @ R.T + p)
+            ctr = uv.mean(0)
+            vec = uv - ctr
+            uv = ctr + vec * (1 - shrink_px / np.linalg.norm(vec, axis=1, keepdims=True))
+            if np.all((uv >= 0) & (uv < [w, h])):
+                out[patch.body] = uv.round(2).tolist()
+        return out
+
+    # ---- ground truth -----------------------------------------------------------------------
+    def ground_truth(self, times: np.ndarray | None = None) -> xr.Dataset:
+        """Ground truth over ``times`` [s] (default: every frame), mechanism frame."""
+        from jointwear import conventions as C
+
+        c = self.config
+        t = self.frame_times() if times is None else np.asarray(times, dtype=float)
+        fp = np.array([_truth_state(ti, c)["follower_position"] for ti in t])
+        fv = np.array([_truth_derivative(ti, c, "follower_position") for ti in t])
+        jp = np.array([_truth_state(ti, c)["journal_position"] for ti in t])
+        jv = np.array([_truth_derivative(ti, c, "journal_position") for ti in t])
+        ca = np.array([_truth_state(ti, c)["crank_angle"][0] for ti in t])
+        poses = [fourbar_pose(ti, c) for ti in t]
+        bodies = [p.body for p in self.patches]
+        rot = np.array([[pp[b][0] for b in bodies] for pp in poses])
+        org = np.array([[pp[b][1] for b in bodies] for pp in poses])
+        ds = xr.Dataset(
+            {
+                "follower_position": (("time", "axis"), fp, C.variable_attrs("follower_position")),
+                "follower_velocity": (("time", "axis"), fv, C.variable_attrs("follower_velocity")),
+                "journal_position": (
+                    ("time", "axis"),
+                    jp,
+                    {"units": "m", "long_name": "position of the journal cap centre"},
+                ),
+                "journal_displacement": (
+                    ("time", "axis"),
+                    jp - jp[:1],
+                    {
+                        "units": "m",
+                        "long_name": "displacement of the journal cap centre since the first frame (z = out of plane)",
+                    },
+                ),
+                "journal_velocity": (
+                    ("time", "axis"),
+                    jv,
+                    {"units": "m s-1", "long_name": "velocity of the journal cap centre"},
+                ),
+                "crank_angle": ("time", ca, C.variable_attrs("crank_angle")),
+                "body_rotation": (
+                    ("time", "body", "row", "col"),
+                    rot,
+                    {"units": "1", "long_name": "body-to-mechanism rotation of each patch's body"},
+                ),
+                "body_origin": (
+                    ("time", "body", "axis"),
+                    org,
+                    {"units": "m", "long_name": "origin of each patch's body frame"},
+                ),
+            },
+            coords={
+                "time": ("time", t, {"units": "s", "long_name": C.COORDINATES["time"][1]}),
+                "axis": ("axis", ["x", "y", "z"], {"long_name": "vector component"}),
+                "body": ("body", bodies, {"long_name": "rigid body carrying a speckle patch"}),
+                "row": ("row", [0, 1, 2], {"long_name": "matrix row"}),
+                "col": ("col", [0, 1, 2], {"long_name": "matrix column"}),
+            },
+        )
+        cal = self.calibration.to_dataset()
+        for name in ("camera_matrix", "distortion", "rotation", "translation", "image_size"):
+            ds[f"true_{name}"] = (
+                cal[name].rename({"axis": "axis"}) if name == "translation" else cal[name]
+            )
+            ds[f"true_{name}"].attrs["long_name"] = "true " + cal[name].attrs["long_name"]
+        ds.attrs.update(
+            {
+                "title": "jointwear virtual rig ground truth",
+                "frame": "mechanism frame: x from A to D, y up, z out of plane towards the cameras",
+                "rig_config": json.dumps(_jsonable(asdict(c))),
+                "baseline_m": self.calibration.baseline,
+                "focal_px": c.focal_px,
+                "pixel_footprint_m": self.pixel_footprint,
+                "noise_floor_z_per_point_m_at_0p01px": self.noise_floor_z(0.01),
+                "world_board_origin_m": self.world_board_origin().tolist(),
+                "rendering": "exact ray casting + bicubic sampling of a band-limited speckle texture",
+            }
+        )
+        return ds
+
+
+def _jsonable(obj: Any) -> Any:
+    if isinstance(obj, dict):
+        return {k: _jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_jsonable(v) for v in obj]
+    if isinstance(obj, np.generic):
+        return obj.item()
+    return obj
+
+
+def _write_video(path: Path, frames, fps: float, codec: str, size: tuple[int, int]) -> None:
+    import cv2
+
+    fourcc, _, _ = CODECS[codec]
+    writer = cv2.VideoWriter(str(path), cv2.VideoWriter_fourcc(*fourcc), fps, size, False)
+    if not writer.isOpened():
+        raise BadInputError(
+            f"OpenCV could not open a '{codec}' ({fourcc}) video writer for '{path}'; choose "
+            f"another codec ({', '.join(CODECS)})"
+        )
+    if codec == "mjpg":
+        writer.set(cv2.VIDEOWRITER_PROP_QUALITY, 100)
+    try:
+        for frame in frames:
+            writer.write(frame)
+    finally:
+        writer.release()
+
+
+def generate_rig(
+    out: str | Path,
+    config: RigConfig | None = None,
+    *,
+    video: bool = True,
+    images: bool = True,
+    codec: str = "ffv1",
+    calibration_images: bool = True,
+) -> dict[str, Path]:
+    """Render the virtual rig to ``out``: footage, board images, ground truth and ROI file.
+
+    Writes ``left/`` and ``right/`` (PNG frames named ``frame_<index>.png``; a dropped frame's
+    number is missing), ``left<ext>``/``right<ext>`` videos, ``calibration/left|right/board_XX.png``
+    (the last view is the world-frame board lying on the mechanism plane), ``truth.nc`` (ground
+    truth with provenance) and ``bodies.toml`` (regions of interest for ``jointwear dic track``).
+
+    Returns
+    -------
+    dict
+        Paths of what was written.
+    """
+    import cv2
+
+    from jointwear import io
+
+    if codec not in CODECS:
+        raise BadInputError(f"codec {codec!r} is not available; choose one of {', '.join(CODECS)}")
+    rig = VirtualRig(config)
+    c = rig.config
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    written: dict[str, Path] = {}
+    n = c.n_frames
+    dropped = set(c.drop_frames)
+    duplicated = set(c.duplicate_frames)
+    # a duplicated frame k re-sends frame k's image in frame k+1's slot; a dropped frame is absent
+    content = {k: (k - 1 if (k - 1) in duplicated else k) for k in range(n) if k not in dropped}
+    times = rig.frame_times()
+    for cam in ("left", "right"):
+        folder = out / cam
+
+        def frames(cam=cam, folder=folder):
+            last: tuple[int, np.ndarray] | None = None
+            for k, src in content.items():
+                if last is None or last[0] != src:
+                    last = (src, rig.render(cam, times[src], frame_index=src))
+                img = last[1]
+                if images:
+                    folder.mkdir(exist_ok=True)
+                    cv2.imwrite(str(folder / f"frame_{k:06d}.png"), img)
+                yield img
+
+        if video:
+            path = out / f"{cam}{CODECS[codec][1]}"
+            _write_video(path, frames(), c.fps, codec, (c.width, c.height))
+            written[f"{cam}_video"] = path
+        else:
+            for _ in frames():
+                pass
+        if images:
+            written[f"{cam}_images"] = folder
+    if calibration_images:
+        for i, (L, R) in enumerate(rig.board_images()):
+            for cam, img in (("left", L), ("right", R)):
+                folder = out / "calibration" / cam
+                folder.mkdir(parents=True, exist_ok=True)
+                cv2.imwrite(str(folder / f"board_{i:02d}.png"), img)
+        written["calibration"] = out / "calibration"
+    truth = rig.ground_truth()
+    truth["frame_recorded"] = (
+        "time",
+        np.array([0 if k in dropped else 1 for k in range(n)], dtype=np.int8),
+        {
+            "units": "1",
+            "long_name": "frame present in the footage (0 = dropped)",
+            "flag_values": np.array([0, 1], dtype=np.int8),
+            "flag_meanings": "dropped recorded",
+        },
+    )
+    truth.attrs["duplicated_frames"] = json.dumps(list(c.duplicate_frames))
+    truth.attrs["dropped_frames"] = json.dumps(list(c.drop_frames))
+    written["truth"] = io.save(
+        truth, out / "truth.nc", parameters=asdict(c), source="jointwear (datasets.rig)"
+    )
+    written["bodies"] = _write_bodies_toml(rig, out / "bodies.toml")
+    return written
+
+
+def _write_bodies_toml(rig: VirtualRig, path: Path) -> Path:
+    rois = rig.body_rois()
+    c = rig.config
+    pose0 = fourbar_pose(0.0, c)
+    lines = [
+        "# Regions of interest for `jointwear dic track`, written by `jointwear datasets rig`.",
+        "# Polygons in pixels of the left camera's first frame.",
+        "[track]",
+        "subset_size = 21",
+        "step = 10",
+        "",
+    ]
+    for body, poly in rois.items():
+        role = {"follower": "follower", "journal": "journal", "crank": "crank"}[body]
+        lines.append(f"[bodies.{body}]")
+        lines.append(f'role = "{role}"')
+        lines.append("polygon = [" + ", ".join(f"[{x:.2f}, {y:.2f}]" for x, y in poly) + "]")
+        if body == "follower":
+            lines.append(
+                "# follower centre of mass at the first frame, mechanism frame [m] (the world frame "
+                "of a calibration made with the rig's board view)"
+            )
+            lines.append(
+                "centroid_mechanism = ["
+                + ", ".join(f"{v:.9f}" for v in pose0["follower_centroid"])
+                + "]"
+            )
+        if body == "crank":
+            lines.append(f"reference_angle_deg = {np.rad2deg(pose0['crank_angle']):.6f}")
+        lines.append("")
+    with open(path, "w") as fh:
+        fh.write("\n".join(lines))
+    return path
+
+
+def _replace(cfg: RigConfig, **kw: Any) -> RigConfig:
+    return replace(cfg, **kw)

@@ -1,0 +1,638 @@
+"""Camera models and stereo calibration: projection, undistortion, (de)serialisation, importers.
+
+Camera model
+------------
+A pinhole camera with Brown–Conrady lens distortion in OpenCV's convention. A world point
+``X`` [m] goes to camera coordinates ``Xc = R @ X + t``; normalised coordinates
+``x = Xc[0] / Xc[2]``, ``y = Xc[1] / Xc[2]`` are distorted with the radial (k1, k2, k3 and the
+rational k4..k6) and tangential (p1, p2) terms, then mapped to pixels with
+``u = fx * xd + skew * yd + cx`` and ``v = fy * yd + cy``. Pixel coordinates have their origin at
+the centre of the top-left pixel, x to the right, y down (OpenCV). The skew term is kept so that
+VIC-3D calibrations (which carry one) are represented exactly; OpenCV calibrations have
+``skew = 0``.
+
+The world frame is the left camera's frame unless a board pose was chosen as world frame
+(:meth:`StereoCalibration.with_world_frame`), in which case z is normal to the board: lay the
+board on the mechanism's plane and z becomes the rig's out-of-plane direction.
+"""
+
+from __future__ import annotations
+
+import re
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import xarray as xr
+
+from jointwear.errors import BadInputError, CalibrationError
+
+__all__ = [
+    "Camera",
+    "StereoCalibration",
+    "cardan_to_matrix",
+    "matrix_to_cardan",
+    "read_opencv_calibration",
+    "read_vic3d_calibration",
+    "read_calibration",
+    "DISTORTION_NAMES",
+]
+
+#: OpenCV's order of the distortion coefficients jointwear supports.
+DISTORTION_NAMES = ("k1", "k2", "p1", "p2", "k3", "k4", "k5", "k6")
+
+_LENGTH_UNITS = {"m": 1.0, "mm": 1e-3, "cm": 1e-2, "um": 1e-6, "in": 0.0254}
+
+
+def _as_matrix3(value: Any, what: str) -> np.ndarray:
+    arr = np.asarray(value, dtype=float)
+    if arr.shape != (3, 3) or not np.all(np.isfinite(arr)):
+        raise BadInputError(f"{what}: expected a finite 3x3 matrix, got shape {arr.shape}")
+    return arr
+
+
+@dataclass(frozen=True, eq=False)
+class Camera:
+    """One calibrated pinhole camera with lens distortion.
+
+    Parameters
+    ----------
+    matrix : (3, 3) array
+        Intrinsic matrix ``[[fx, skew, cx], [0, fy, cy], [0, 0, 1]]`` [pixel].
+    distortion : array
+        Distortion coefficients in OpenCV order (k1, k2, p1, p2[, k3[, k4, k5, k6]]) [1].
+    rotation : (3, 3) array
+        World-to-camera rotation ``R`` (``Xc = R X + t``) [1].
+    translation : (3,) array
+        World-to-camera translation ``t`` [m].
+    image_size : (int, int)
+        Image (width, height) [pixel].
+    """
+
+    matrix: np.ndarray
+    distortion: np.ndarray = field(default_factory=lambda: np.zeros(5))
+    rotation: np.ndarray = field(default_factory=lambda: np.eye(3))
+    translation: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    image_size: tuple[int, int] = (0, 0)
+
+    def __post_init__(self) -> None:
+        K = _as_matrix3(self.matrix, "camera matrix")
+        if K[0, 0] <= 0 or K[1, 1] <= 0 or abs(K[2, 2] - 1) > 1e-9 or np.any(K[1:, 0] != 0):
+            raise BadInputError(
+                f"camera matrix {K.tolist()} is not of the form [[fx, skew, cx], [0, fy, cy], "
+                "[0, 0, 1]] with positive focal lengths"
+            )
+        dist = np.zeros(8)
+        d = np.asarray(self.distortion, dtype=float).ravel()
+        if d.size > 8 and np.any(d[8:] != 0):
+            raise BadInputError(
+                f"distortion has {d.size} coefficients with non-zero thin-prism/tilt terms "
+                "(s1..s4, tauX, tauY); jointwear supports k1, k2, p1, p2, k3, k4, k5, k6 only - "
+                "recalibrate without CALIB_THIN_PRISM_MODEL/CALIB_TILTED_MODEL"
+            )
+        dist[: min(d.size, 8)] = d[:8]
+        R = _as_matrix3(self.rotation, "camera rotation")
+        if not np.allclose(R @ R.T, np.eye(3), atol=1e-6) or np.linalg.det(R) < 0:
+            raise BadInputError("camera rotation is not a proper rotation matrix (R R^T != I)")
+        t = np.asarray(self.translation, dtype=float).ravel()
+        if t.shape != (3,):
+            raise BadInputError(f"camera translation: expected 3 values, got {t.size}")
+        w, h = (int(v) for v in self.image_size)
+        object.__setattr__(self, "matrix", K)
+        object.__setattr__(self, "distortion", dist)
+        object.__setattr__(self, "rotation", R)
+        object.__setattr__(self, "translation", t)
+        object.__setattr__(self, "image_size", (w, h))
+
+    # ---- basic properties -------------------------------------------------------------------
+    @property
+    def focal(self) -> tuple[float, float]:
+        """Focal lengths (fx, fy) [pixel]."""
+        return float(self.matrix[0, 0]), float(self.matrix[1, 1])
+
+    @property
+    def centre(self) -> np.ndarray:
+        """Projection centre in world coordinates [m]."""
+        return -self.rotation.T @ self.translation
+
+    @property
+    def projection_matrix(self) -> np.ndarray:
+        """Projection matrix of the *undistorted* camera ``K [R | t]`` (3, 4)."""
+        return self.matrix @ np.hstack([self.rotation, self.translation[:, None]])
+
+    # ---- distortion -------------------------------------------------------------------------
+    def distort_normalized(self, xy: np.ndarray) -> np.ndarray:
+        """Apply lens distortion to normalised coordinates (N, 2) -> (N, 2)."""
+        k1, k2, p1, p2, k3, k4, k5, k6 = self.distortion
+        x, y = xy[..., 0], xy[..., 1]
+        r2 = x * x + y * y
+        radial = (1 + r2 * (k1 + r2 * (k2 + r2 * k3))) / (1 + r2 * (k4 + r2 * (k5 + r2 * k6)))
+        xd = x * radial + 2 * p1 * x * y + p2 * (r2 + 2 * x * x)
+        yd = y * radial + p1 * (r2 + 2 * y * y) + 2 * p2 * x * y
+        return np.stack([xd, yd], axis=-1)
+
+    def normalized_to_pixels(self, xy: np.ndarray) -> np.ndarray:
+        """Distort normalised coordinates and map them to pixels."""
+        d = self.distort_normalized(np.asarray(xy, dtype=float))
+        K = self.matrix
+        u = K[0, 0] * d[..., 0] + K[0, 1] * d[..., 1] + K[0, 2]
+        v = K[1, 1] * d[..., 1] + K[1, 2]
+        return np.stack([u, v], axis=-1)
+
+    def pixels_to_normalized(self, uv: np.ndarray, *, iterations: int = 30) -> np.ndarray:
+        """Undistort pixel coordinates (N, 2) to normalised coordinates (inverse of the model).
+
+        Fixed-point iteration followed by Newton steps; accurate to ~1e-12 for the distortion
+        of measurement lenses.
+        """
+        uv = np.asarray(uv, dtype=float)
+        K = self.matrix
+        yd = (uv[..., 1] - K[1, 2]) / K[1, 1]
+        xd = (uv[..., 0] - K[0, 2] - K[0, 1] * yd) / K[0, 0]
+        target = np.stack([xd, yd], axis=-1)
+        if not np.any(self.distortion):
+            return target
+        k1, k2, p1, p2, k3, k4, k5, k6 = self.distortion
+        xy = target.copy()
+        for _ in range(iterations):
+            x, y = xy[..., 0], xy[..., 1]
+            r2 = x * x + y * y
+            radial = (1 + r2 * (k1 + r2 * (k2 + r2 * k3))) / (1 + r2 * (k4 + r2 * (k5 + r2 * k6)))
+            dx = 2 * p1 * x * y + p2 * (r2 + 2 * x * x)
+            dy = p1 * (r2 + 2 * y * y) + 2 * p2 * x * y
+            xy = np.stack([(target[..., 0] - dx) / radial, (target[..., 1] - dy) / radial], -1)
+        eps = 1e-7
+        for _ in range(3):  # Newton polish with a finite-difference Jacobian
+            f0 = self.distort_normalized(xy) - target
+            fx = (self.distort_normalized(xy + [eps, 0.0]) - target - f0) / eps
+            fy = (self.distort_normalized(xy + [0.0, eps]) - target - f0) / eps
+            a, c = fx[..., 0], fx[..., 1]
+            b, d = fy[..., 0], fy[..., 1]
+            det = a * d - b * c
+            det = np.where(np.abs(det) < 1e-12, 1e-12, det)
+            step_x = (d * f0[..., 0] - b * f0[..., 1]) / det
+            step_y = (-c * f0[..., 0] + a * f0[..., 1]) / det
+            xy = xy - np.stack([step_x, step_y], -1)
+        return xy
+
+    # ---- projection -------------------------------------------------------------------------
+    def world_to_camera(self, X: np.ndarray) -> np.ndarray:
+        """World points (N, 3) [m] -> camera-frame points (N, 3) [m]."""
+        return np.asarray(X, dtype=float) @ self.rotation.T + self.translation
+
+    def project(self, X: np.ndarray) -> np.ndarray:
+        """Project world points (N, 3) [m] to distorted pixel coordinates (N, 2) [pixel]."""
+        Xc = self.world_to_camera(X)
+        xy = Xc[..., :2] / Xc[..., 2:3]
+        return self.normalized_to_pixels(xy)
+
+    def rays(self, uv: np.ndarray) -> np.ndarray:
+        """Unit viewing directions in world coordinates (N, 3) for pixels (N, 2)."""
+        xy = self.pixels_to_normalized(uv)
+        d = np.concatenate([xy, np.ones(xy.shape[:-1] + (1,))], axis=-1)
+        d = d @ self.rotation  # R^T d for row vectors
+        return d / np.linalg.norm(d, axis=-1, keepdims=True)
+
+    def transformed(self, R_wn: np.ndarray, t_wn: np.ndarray) -> Camera:
+        """The same camera with a new world frame.
+
+        ``X_old = R_wn @ X_new + t_wn`` (the new frame expressed in the old one).
+        """
+        R = self.rotation @ R_wn
+        t = self.rotation @ t_wn + self.translation
+        return Camera(self.matrix, self.distortion, R, t, self.image_size)
+
+
+@dataclass(frozen=True, eq=False)
+class StereoCalibration:
+    """A calibrated camera pair and how the calibration was obtained.
+
+    Parameters
+    ----------
+    left, right : Camera
+        The two cameras, extrinsics in a common world frame.
+    rms : float or None
+        Overall stereo reprojection RMS [pixel] (None for imported calibrations).
+    per_view_rms : (n_views, 2) array or None
+        Reprojection RMS per accepted view and camera [pixel].
+    views_used, views_rejected : int
+        Number of calibration views accepted and rejected.
+    source : str
+        Where the calibration came from (``"jointwear calibrate"``, ``"opencv:<file>"``,
+        ``"vic3d:<file>"``).
+    world_frame : str
+        Description of the world frame.
+    """
+
+    left: Camera
+    right: Camera
+    rms: float | None = None
+    per_view_rms: np.ndarray | None = None
+    views_used: int = 0
+    views_rejected: int = 0
+    source: str = ""
+    world_frame: str = "left camera frame (x right, y down, z along the optical axis)"
+
+    @property
+    def cameras(self) -> dict[str, Camera]:
+        return {"left": self.left, "right": self.right}
+
+    @property
+    def baseline(self) -> float:
+        """Distance between the two projection centres [m]."""
+        return float(np.linalg.norm(self.left.centre - self.right.centre))
+
+    @property
+    def relative_pose(self) -> tuple[np.ndarray, np.ndarray]:
+        """(R, T) taking left-camera coordinates to right-camera coordinates (OpenCV's R, T)."""
+        R = self.right.rotation @ self.left.rotation.T
+        T = self.right.translation - R @ self.left.translation
+        return R, T
+
+    def fundamental_matrix(self) -> np.ndarray:
+        """Fundamental matrix of the undistorted pixel coordinates (x_r^T F x_l = 0)."""
+        R, T = self.relative_pose
+        tx = np.array([[0, -T[2], T[1]], [T[2], 0, -T[0]], [-T[1], T[0], 0]])
+        E = tx @ R
+        F = np.linalg.inv(self.right.matrix).T @ E @ np.linalg.inv(self.left.matrix)
+        return F / np.linalg.norm(F)
+
+    def with_world_frame(self, R_wn: np.ndarray, t_wn: np.ndarray, description: str) -> Any:
+        """Express both cameras in a new world frame ``X_old = R_wn X_new + t_wn``."""
+        return StereoCalibration(
+            self.left.transformed(R_wn, t_wn),
+            self.right.transformed(R_wn, t_wn),
+            rms=self.rms,
+            per_view_rms=self.per_view_rms,
+            views_used=self.views_used,
+            views_rejected=self.views_rejected,
+            source=self.source,
+            world_frame=description,
+        )
+
+    # ---- xarray ----------------------------------------------------------------------------
+    def to_dataset(self) -> xr.Dataset:
+        """The calibration as an :class:`xarray.Dataset` (save it with :func:`jointwear.io.save`)."""
+        cams = [self.left, self.right]
+        ds = xr.Dataset(
+            {
+                "camera_matrix": (
+                    ("camera", "row", "col"),
+                    np.stack([c.matrix for c in cams]),
+                    {
+                        "units": "pixel",
+                        "long_name": "intrinsic matrix [[fx, skew, cx], [0, fy, cy], [0, 0, 1]]",
+                    },
+                ),
+                "distortion": (
+                    ("camera", "coefficient"),
+                    np.stack([c.distortion for c in cams]),
+                    {
+                        "units": "1",
+                        "long_name": "Brown-Conrady distortion coefficients (OpenCV order)",
+                    },
+                ),
+                "rotation": (
+                    ("camera", "row", "col"),
+                    np.stack([c.rotation for c in cams]),
+                    {"units": "1", "long_name": "world-to-camera rotation R (Xc = R X + t)"},
+                ),
+                "translation": (
+                    ("camera", "axis"),
+                    np.stack([c.translation for c in cams]),
+                    {"units": "m", "long_name": "world-to-camera translation t (Xc = R X + t)"},
+                ),
+                "image_size": (
+                    ("camera", "extent"),
+                    np.array([c.image_size for c in cams], dtype=np.int64),
+                    {"units": "pixel", "long_name": "image width and height"},
+                ),
+            },
+            coords={
+                "camera": ("camera", ["left", "right"], {"long_name": "stereo camera"}),
+                "row": ("row", [0, 1, 2], {"long_name": "matrix row"}),
+                "col": ("col", [0, 1, 2], {"long_name": "matrix column"}),
+                "coefficient": (
+                    "coefficient",
+                    list(DISTORTION_NAMES),
+                    {"long_name": "distortion coefficient"},
+                ),
+                "axis": ("axis", ["x", "y", "z"], {"long_name": "vector component"}),
+                "extent": ("extent", ["width", "height"], {"long_name": "image extent"}),
+            },
+        )
+        if self.per_view_rms is not None and len(self.per_view_rms):
+            ds["view_rms"] = (
+                ("view", "camera"),
+                np.asarray(self.per_view_rms, dtype=float),
+                {"units": "pixel", "long_name": "reprojection RMS per accepted calibration view"},
+            )
+        ds.attrs.update(
+            {
+                "title": "jointwear stereo calibration",
+                "baseline_m": self.baseline,
+                "reprojection_rms_px": float(self.rms) if self.rms is not None else -1.0,
+                "views_used": int(self.views_used),
+                "views_rejected": int(self.views_rejected),
+                "calibration_source": self.source,
+                "world_frame": self.world_frame,
+            }
+        )
+        return ds
+
+    @classmethod
+    def from_dataset(cls, ds: xr.Dataset, *, what: str = "calibration") -> StereoCalibration:
+        """Inverse of :meth:`to_dataset`."""
+        missing = [
+            v
+            for v in ("camera_matrix", "distortion", "rotation", "translation", "image_size")
+            if v not in ds
+        ]
+        if missing:
+            raise BadInputError(
+                f"{what} is not a jointwear stereo calibration (missing {', '.join(missing)}); "
+                "create one with `jointwear dic calibrate` or import one with "
+                "`jointwear dic import-calibration`"
+            )
+        cams = []
+        for name in ("left", "right"):
+            sel = ds.sel(camera=name)
+            cams.append(
+                Camera(
+                    sel["camera_matrix"].values,
+                    sel["distortion"].values,
+                    sel["rotation"].values,
+                    sel["translation"].values,
+                    tuple(int(v) for v in sel["image_size"].values),
+                )
+            )
+        rms = float(ds.attrs.get("reprojection_rms_px", -1.0))
+        return cls(
+            cams[0],
+            cams[1],
+            rms=None if rms < 0 else rms,
+            per_view_rms=ds["view_rms"].values if "view_rms" in ds else None,
+            views_used=int(ds.attrs.get("views_used", 0)),
+            views_rejected=int(ds.attrs.get("views_rejected", 0)),
+            source=str(ds.attrs.get("calibration_source", "")),
+            world_frame=str(ds.attrs.get("world_frame", "")),
+        )
+
+    def save(self, path: str | Path, *, inputs=(), parameters: Any = None) -> Path:
+        """Write the calibration as a jointwear netCDF file with provenance."""
+        from jointwear import io
+
+        return io.save(
+            self.to_dataset(),
+            path,
+            inputs=inputs,
+            parameters=parameters,
+            source="jointwear (dic.calibrate)",
+        )
+
+
+# ---- rotations ------------------------------------------------------------------------------
+def cardan_to_matrix(alpha_deg: float, beta_deg: float, gamma_deg: float) -> np.ndarray:
+    """Rotation matrix ``Rz(gamma) @ Ry(beta) @ Rx(alpha)`` from Cardan angles [degree].
+
+    This is the convention of VIC-3D's ``cal.xml`` orientation (as implemented by Sandia's
+    DICe reader): the matrix takes world coordinates to camera coordinates.
+    """
+    a, b, g = np.deg2rad([alpha_deg, beta_deg, gamma_deg])
+    ca, sa, cb, sb, cg, sg = np.cos(a), np.sin(a), np.cos(b), np.sin(b), np.cos(g), np.sin(g)
+    Rx = np.array([[1, 0, 0], [0, ca, -sa], [0, sa, ca]])
+    Ry = np.array([[cb, 0, sb], [0, 1, 0], [-sb, 0, cb]])
+    Rz = np.array([[cg, -sg, 0], [sg, cg, 0], [0, 0, 1]])
+    return Rz @ Ry @ Rx
+
+
+def matrix_to_cardan(R: np.ndarray) -> tuple[float, float, float]:
+    """Inverse of :func:`cardan_to_matrix` (alpha, beta, gamma) [degree]."""
+    beta = np.arcsin(-np.clip(R[2, 0], -1, 1))
+    alpha = np.arctan2(R[2, 1], R[2, 2])
+    gamma = np.arctan2(R[1, 0], R[0, 0])
+    return tuple(float(v) for v in np.rad2deg([alpha, beta, gamma]))
+
+
+# ---- importers ------------------------------------------------------------------------------
+_OPENCV_KEYS = {
+    "K1": ("K1", "M1", "cameraMatrix1", "camera_matrix_left", "left_camera_matrix"),
+    "D1": ("D1", "dist1", "distCoeffs1", "distortion_left", "left_distortion"),
+    "K2": ("K2", "M2", "cameraMatrix2", "camera_matrix_right", "right_camera_matrix"),
+    "D2": ("D2", "dist2", "distCoeffs2", "distortion_right", "right_distortion"),
+    "R": ("R", "rotation", "R_lr"),
+    "T": ("T", "translation", "T_lr"),
+}
+
+
+def read_opencv_calibration(
+    path: str | Path,
+    *,
+    length_unit: str,
+    image_size: tuple[int, int] | None = None,
+) -> StereoCalibration:
+    """Import a stereo calibration saved by OpenCV (``cv::FileStorage`` YAML or XML).
+
+    The file holds the two intrinsic matrices and distortion vectors and ``stereoCalibrate``'s
+    ``R``, ``T`` (left-camera to right-camera). Accepted names: ``K1/M1/cameraMatrix1``,
+    ``D1/dist1/distCoeffs1``, ``K2/M2/cameraMatrix2``, ``D2/dist2/distCoeffs2``, ``R``, ``T``, and
+    ``image_width``/``image_height`` or ``image_size``/``imageSize``.
+
+    Parameters
+    ----------
+    path : path
+        The ``.yml``/``.yaml``/``.xml`` file.
+    length_unit : {"m", "mm", "cm", "um", "in"}
+        Unit of ``T`` (OpenCV uses whatever unit the board square size was given in; the file
+        does not say, so it must be stated).
+    image_size : (width, height), optional
+        Image size [pixel] when the file does not hold it.
+
+    Returns
+    -------
+    StereoCalibration
+        World frame = left camera frame.
+    """
+    import cv2
+
+    path = Path(path)
+    if not path.exists():
+        raise BadInputError(f"OpenCV calibration file '{path}' does not exist")
+    if length_unit not in _LENGTH_UNITS:
+        raise BadInputError(
+            f"length_unit {length_unit!r} is not known; use one of {', '.join(_LENGTH_UNITS)} "
+            "(the unit the calibration board's square size was given in)"
+        )
+    try:
+        fs = cv2.FileStorage(str(path), cv2.FILE_STORAGE_READ)
+        ok = fs.isOpened()
+    except cv2.error:
+        ok = False
+    if not ok:
+        raise BadInputError(
+            f"'{path}' could not be read as an OpenCV FileStorage YAML/XML file; check that it "
+            "starts with '%YAML:1.0' or '<?xml' and was written by cv::FileStorage"
+        )
+    try:
+        found: dict[str, np.ndarray] = {}
+        for key, names in _OPENCV_KEYS.items():
+            for name in names:
+                node = fs.getNode(name)
+                if not node.empty():
+                    mat = node.mat()
+                    if mat is not None:
+                        found[key] = np.asarray(mat, dtype=float)
+                        break
+        size = image_size
+        if size is None:
+            w, h = fs.getNode("image_width"), fs.getNode("image_height")
+            if not w.empty() and not h.empty():
+                size = (int(w.real()), int(h.real()))
+            for name in ("image_size", "imageSize"):
+                node = fs.getNode(name)
+                if size is None and not node.empty():
+                    if node.isSeq():
+                        size = (int(node.at(0).real()), int(node.at(1).real()))
+                    else:
+                        m = node.mat()
+                        if m is not None:
+                            m = np.asarray(m).ravel()
+                            size = (int(m[0]), int(m[1]))
+    finally:
+        fs.release()
+    missing = [k for k in _OPENCV_KEYS if k not in found]
+    if missing:
+        raise BadInputError(
+            f"OpenCV calibration '{path}' lacks {', '.join(missing)} (looked for "
+            + "; ".join(f"{k}: {'/'.join(_OPENCV_KEYS[k])}" for k in missing)
+            + "); it must hold both cameras' matrices and distortion and stereoCalibrate's R and T"
+        )
+    if size is None:
+        raise BadInputError(
+            f"OpenCV calibration '{path}' does not state the image size; pass image_size="
+            "(width, height) (CLI: --image-size W H)"
+        )
+    R = found["R"]
+    if R.shape == (3, 1) or R.shape == (1, 3):
+        R = cv2.Rodrigues(R)[0]
+    T = found["T"].ravel() * _LENGTH_UNITS[length_unit]
+    left = Camera(found["K1"], found["D1"].ravel(), np.eye(3), np.zeros(3), size)
+    right = Camera(found["K2"], found["D2"].ravel(), R, T, size)
+    return StereoCalibration(left, right, source=f"opencv:{path.name}")
+
+
+_FLOAT = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
+
+
+def read_vic3d_calibration(
+    path: str | Path, *, image_size: tuple[int, int] | None = None
+) -> StereoCalibration:
+    """Import the calibration of a VIC-3D project or calibration file (``cal.xml``/``.z3d`` XML).
+
+    VIC-3D stores, per camera, ``cx cy fx fy fs k1 k2 k3`` [pixel, pixel, pixel, pixel, pixel,
+    1, 1, 1] followed by ``<orientation>alpha beta gamma tx ty tz</orientation>`` with the
+    Cardan angles in degrees (world-to-camera rotation ``Rz(gamma) Ry(beta) Rx(alpha)``) and the
+    translation in millimetres. ``fs`` is taken as the skew term of the intrinsic matrix and
+    k1..k3 as radial coefficients of r², r⁴, r⁶ on normalised coordinates (the Brown model);
+    this is the reading of Sandia's DICe importer, which also has ``fs`` multiply the
+    normalised y. The image size is read from ``<polygonmask width= height=>`` when present.
+
+    Returns
+    -------
+    StereoCalibration
+        Cameras in VIC-3D's world frame (converted to metres); camera 0 is the left camera.
+    """
+    path = Path(path)
+    if not path.exists():
+        raise BadInputError(f"VIC-3D calibration file '{path}' does not exist")
+    text = path.read_text(encoding="latin-1", errors="replace")
+    text_nodoctype = re.sub(r"<!DOCTYPE[^>]*>", "", text)
+    try:
+        root = ET.fromstring(text_nodoctype)
+    except ET.ParseError as exc:
+        raise BadInputError(
+            f"'{path}' is not well-formed XML ({exc}); is it a VIC-3D cal.xml?"
+        ) from None
+    cams: dict[int, Camera] = {}
+    size = image_size
+    if size is None:
+        for node in root.iter():
+            if node.tag.lower() == "polygonmask" and "width" in node.attrib:
+                size = (int(float(node.attrib["width"])), int(float(node.attrib["height"])))
+                break
+    for node in root.iter():
+        if node.tag.lower() != "camera":
+            continue
+        ident = node.attrib.get("id", node.attrib.get("ID"))
+        orient = next((c for c in node if c.tag.lower() == "orientation"), None)
+        intr = [float(v) for v in re.findall(_FLOAT, node.text or "")]
+        if ident is None or orient is None or len(intr) < 8:
+            raise BadInputError(
+                f"VIC-3D calibration '{path}': a <camera> element must hold an id, eight "
+                "intrinsic values 'cx cy fx fy fs k1 k2 k3' and an <orientation> with 'alpha "
+                f"beta gamma tx ty tz'; found id={ident!r}, {len(intr)} values"
+            )
+        ext = [float(v) for v in re.findall(_FLOAT, orient.text or "")]
+        if len(ext) != 6:
+            raise BadInputError(
+                f"VIC-3D calibration '{path}', camera {ident}: <orientation> must hold 6 values "
+                f"(alpha beta gamma [deg], tx ty tz [mm]); found {len(ext)}"
+            )
+        cx, cy, fx, fy, fs, k1, k2, k3 = intr[:8]
+        K = np.array([[fx, fs, cx], [0, fy, cy], [0, 0, 1.0]])
+        dist = np.array([k1, k2, 0.0, 0.0, k3])
+        R = cardan_to_matrix(*ext[:3])
+        t = np.array(ext[3:]) * 1e-3
+        cams[int(ident)] = (K, dist, R, t)
+    if len(cams) != 2:
+        raise BadInputError(
+            f"VIC-3D calibration '{path}': expected 2 <camera> elements, found {len(cams)}; "
+            "export the stereo system's calibration (cal.xml) from VIC-3D"
+        )
+    if size is None:
+        raise BadInputError(
+            f"VIC-3D calibration '{path}' does not state the image size (no <polygonmask "
+            "width= height=>); pass image_size=(width, height) (CLI: --image-size W H)"
+        )
+    ids = sorted(cams)
+    left = Camera(*cams[ids[0]], size)
+    right = Camera(*cams[ids[1]], size)
+    return StereoCalibration(
+        left, right, source=f"vic3d:{path.name}", world_frame="VIC-3D world frame"
+    )
+
+
+def read_calibration(path: str | Path) -> StereoCalibration:
+    """Load a jointwear calibration file (``.nc``, written by ``jointwear dic calibrate``)."""
+    from jointwear import io
+
+    path = Path(path)
+    if path.suffix.lower() in (".yml", ".yaml") or (
+        path.suffix.lower() == ".xml"
+        and path.exists()
+        and "opencv_storage" in path.read_text(errors="replace")[:400]
+    ):
+        raise BadInputError(
+            f"'{path}' looks like an OpenCV calibration; import it first with "
+            "`jointwear dic import-calibration --format opencv --length-unit mm` "
+            "(or read_opencv_calibration)"
+        )
+    if path.suffix.lower() == ".xml":
+        raise BadInputError(
+            f"'{path}' looks like a VIC-3D calibration; import it first with "
+            "`jointwear dic import-calibration --format vic3d` (or read_vic3d_calibration)"
+        )
+    ds = io.load(path)
+    return StereoCalibration.from_dataset(ds, what=f"'{path}'")
+
+
+def _check_enough_views(n_ok: int, n_total: int, minimum: int, reasons: list[str]) -> None:
+    if n_ok < minimum:
+        detail = "; ".join(reasons[:5]) + (" ..." if len(reasons) > 5 else "")
+        raise CalibrationError(
+            f"only {n_ok} of {n_total} calibration view(s) are usable, at least {minimum} are "
+            f"needed ({detail}); record more views with the whole board visible to both "
+            "cameras, tilted by 20-45 degrees in different directions and filling the field of view"
+        )
