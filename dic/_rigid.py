@@ -1,0 +1,163 @@
+"""Rigid-body fits of tracked points and smoothing differentiation of time series."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from jointwear.errors import BadInputError
+
+__all__ = ["fit_rigid", "fit_rigid_robust", "derivative", "rotation_angle_z"]
+
+
+def fit_rigid(
+    P: np.ndarray, Q: np.ndarray, weights: np.ndarray | None = None
+) -> tuple[np.ndarray, np.ndarray]:
+    """Least-squares rigid transform ``Q ≈ R P + t`` (Kabsch/Umeyama without scale).
+
+    Parameters
+    ----------
+    P, Q : (N, d) arrays
+        Corresponding points (d = 2 or 3) [m or pixel].
+    weights : (N,) array, optional
+        Non-negative weights.
+
+    Returns
+    -------
+    R : (d, d) array
+        Proper rotation (det = +1).
+    t : (d,) array
+        Translation.
+    """
+    P = np.asarray(P, dtype=float)
+    Q = np.asarray(Q, dtype=float)
+    if P.shape != Q.shape or P.ndim != 2 or P.shape[1] not in (2, 3):
+        raise BadInputError(
+            f"rigid fit needs two (N, 2|3) arrays of equal shape, got {P.shape}, {Q.shape}"
+        )
+    w = np.ones(len(P)) if weights is None else np.asarray(weights, dtype=float)
+    if w.sum() <= 0 or np.count_nonzero(w) < P.shape[1]:
+        raise BadInputError(
+            f"rigid fit needs at least {P.shape[1]} points, got {np.count_nonzero(w)}"
+        )
+    w = w / w.sum()
+    cp = w @ P
+    cq = w @ Q
+    H = (P - cp).T @ ((Q - cq) * w[:, None])
+    U, _, Vt = np.linalg.svd(H)
+    d = np.sign(np.linalg.det(Vt.T @ U.T))
+    D = np.eye(P.shape[1])
+    D[-1, -1] = d
+    R = Vt.T @ D @ U.T
+    return R, cq - R @ cp
+
+
+def fit_rigid_robust(
+    P: np.ndarray,
+    Q: np.ndarray,
+    *,
+    threshold: float = 4.0,
+    iterations: int = 3,
+    min_points: int = 3,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
+    """Rigid fit with outlier rejection (residual > ``threshold`` x 1.4826 x MAD, iterated).
+
+    NaN rows are ignored.
+
+    Returns
+    -------
+    R, t : arrays
+        The transform ``Q ≈ R P + t``.
+    inliers : (N,) bool array
+    rms : float
+        RMS residual of the inliers (same unit as the points).
+    """
+    P = np.asarray(P, dtype=float)
+    Q = np.asarray(Q, dtype=float)
+    ok = np.all(np.isfinite(P), axis=1) & np.all(np.isfinite(Q), axis=1)
+    if ok.sum() < min_points:
+        raise BadInputError(
+            f"rigid fit: only {ok.sum()} valid points, at least {min_points} needed"
+        )
+    inl = ok.copy()
+    for _ in range(iterations):
+        R, t = fit_rigid(P[inl], Q[inl])
+        res = np.full(len(P), np.inf)
+        res[ok] = np.linalg.norm(Q[ok] - (P[ok] @ R.T + t), axis=1)
+        med = np.median(res[inl])
+        mad = np.median(np.abs(res[inl] - med))
+        limit = med + threshold * 1.4826 * max(mad, 1e-12) + 1e-12
+        new = ok & (res <= max(limit, 1e-9))
+        if new.sum() < min_points or np.array_equal(new, inl):
+            break
+        inl = new
+    R, t = fit_rigid(P[inl], Q[inl])
+    res = np.linalg.norm(Q[inl] - (P[inl] @ R.T + t), axis=1)
+    return R, t, inl, float(np.sqrt(np.mean(res**2)))
+
+
+def rotation_angle_z(R: np.ndarray) -> np.ndarray:
+    """Rotation angle about z of rotation matrices (..., 3, 3) or (..., 2, 2) [rad]."""
+    R = np.asarray(R)
+    return np.arctan2(R[..., 1, 0], R[..., 0, 0])
+
+
+def derivative(
+    t: np.ndarray, x: np.ndarray, *, window: int = 9, order: int = 5
+) -> tuple[np.ndarray, np.ndarray]:
+    """First derivative by local polynomial least squares (Savitzky–Golay on actual times).
+
+    At every sample a polynomial of degree ``order`` in ``t - t_i`` is fitted to the ``window``
+    samples centred on it (shifted inwards at the ends; NaN samples skipped) and its slope
+    taken. On uniform samples this is the Savitzky–Golay differentiator; gaps (dropped frames)
+    are handled exactly because the real times are used.
+
+    Parameters
+    ----------
+    t : (N,) array
+        Sample times [s], increasing.
+    x : (N, ...) array
+        Samples.
+    window : int
+        Odd number of samples per fit (default 9: 0.18 s at 50 fps).
+    order : int
+        Polynomial degree (default 5). With 9/5 the truncation error on the study's four-bar
+        kinematics at 50 fps is 0.23 % of the peak follower speed.
+
+    Returns
+    -------
+    dxdt : (N, ...) array
+        Derivative [unit of x per s]; NaN where fewer than ``order + 1`` valid samples.
+    gain : (N,) array
+        Noise gain ``sqrt(sum c_j^2)`` [1/s]: the derivative's standard uncertainty is
+        ``gain * sigma_x`` for independent sample noise ``sigma_x``.
+    """
+    t = np.asarray(t, dtype=float)
+    x = np.asarray(x, dtype=float)
+    n = len(t)
+    if window % 2 == 0 or window <= order:
+        raise BadInputError(
+            f"derivative window must be odd and > order; got window={window}, order={order}"
+        )
+    if n < window:
+        window = n if n % 2 == 1 else n - 1
+        order = min(order, window - 1)
+    if n < 2 or window < 2:
+        return np.full_like(x, np.nan), np.full(n, np.nan)
+    flat = x.reshape(n, -1)
+    h = window // 2
+    starts = np.clip(np.arange(n) - h, 0, n - window)
+    idx = starts[:, None] + np.arange(window)[None, :]
+    dt = t[idx] - t[:, None]
+    scale = np.nanmax(np.abs(dt)) or 1.0
+    A = (dt / scale)[..., None] ** np.arange(order + 1)  # (n, w, p+1)
+    vals = flat[idx]  # (n, w, k)
+    valid = np.all(np.isfinite(vals), axis=2)
+    Aw = A * valid[..., None]
+    pinv = np.linalg.pinv(Aw)  # (n, p+1, w)
+    c = pinv[:, 1, :] / scale  # slope coefficients
+    enough = valid.sum(axis=1) >= order + 1
+    out = np.einsum("nw,nwk->nk", c, np.where(valid[..., None], vals, 0.0))
+    out[~enough] = np.nan
+    gain = np.sqrt(np.sum(c**2, axis=1))
+    gain[~enough] = np.nan
+    return out.reshape(x.shape), gain
