@@ -1,3 +1,49 @@
 """Public names of the wear part of jointwear.sim (Archard wear, cycle updates, wear maps)."""
 
-__all__: list[str] = []
+from jointwear.sim._wear_contact import (
+    ConstantContact,
+    ContactModel,
+    CycleWear,
+    DynamicContact,
+    WinklerContact,
+)
+from jointwear.sim.wear import (
+    DEFAULT_KW,
+    KW_RANGE,
+    KwCalibration,
+    WearRun,
+    WearSettings,
+    calibrate_kw,
+    default_snapshots,
+    simulate_wear,
+)
+from jointwear.sim.wearmap import (
+    BearingGrid,
+    bore_cylindricity,
+    bore_radius,
+    plot_wear_map,
+    wear_map_dataset,
+    worn_volume,
+)
+
+__all__ = [
+    "DEFAULT_KW",
+    "KW_RANGE",
+    "WearSettings",
+    "WearRun",
+    "simulate_wear",
+    "default_snapshots",
+    "KwCalibration",
+    "calibrate_kw",
+    "BearingGrid",
+    "wear_map_dataset",
+    "worn_volume",
+    "bore_radius",
+    "bore_cylindricity",
+    "plot_wear_map",
+    "CycleWear",
+    "ContactModel",
+    "ConstantContact",
+    "WinklerContact",
+    "DynamicContact",
+]
