@@ -1,3 +1,45 @@
 """Public names of the dynamics part of jointwear.sim (mechanism, contact, friction, integrator)."""
 
-__all__: list[str] = []
+from jointwear.sim.contact import contact_constant, contact_stiffness, lankarani_nikravesh_force
+from jointwear.sim.dynamics import (
+    CONTACT_MODES,
+    CycleResult,
+    SimState,
+    initial_state,
+    point_area,
+    run_cycles,
+)
+from jointwear.sim.friction import friction_coefficient
+from jointwear.sim.mechanism import loop_closure
+from jointwear.sim.parameters import (
+    PARAMETER_SETS,
+    ContactParameters,
+    FrictionParameters,
+    JointParameters,
+    MechanismParameters,
+    SimParameters,
+    SolverParameters,
+    load_parameters,
+)
+
+__all__ = [
+    "SimParameters",
+    "MechanismParameters",
+    "JointParameters",
+    "ContactParameters",
+    "FrictionParameters",
+    "SolverParameters",
+    "PARAMETER_SETS",
+    "load_parameters",
+    "run_cycles",
+    "CycleResult",
+    "SimState",
+    "initial_state",
+    "point_area",
+    "CONTACT_MODES",
+    "contact_constant",
+    "contact_stiffness",
+    "lankarani_nikravesh_force",
+    "friction_coefficient",
+    "loop_closure",
+]

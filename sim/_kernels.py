@@ -1,0 +1,1178 @@
+"""numba kernels of the four-bar simulator: contact search, forces, equations of motion, DOPRI5.
+
+Everything here works on plain float arrays; :mod:`jointwear.sim.dynamics` packs the parameters
+(index constants below) and unpacks the results. Units are SI throughout.
+
+State vector, clearance model (11): theta1, theta2, theta1_dot, theta2_dot, q_w, q_x, q_y, q_z
+(follower orientation, body -> global), omega_x, omega_y, omega_z (follower angular velocity in
+its body frame). Ideal model (6): theta1, theta2, theta3, and their rates.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+# ---- float parameters (P) ---------------------------------------------------------------------
+L1, L2, L3, L4 = 0, 1, 2, 3
+M1, M2, M3 = 4, 5, 6
+I1, I2, I3X, I3Y, I3Z = 7, 8, 9, 10, 11
+GRAV, OMEGA, JOFF = 12, 13, 14
+RJ, LJ, RB, WB, CA, RHO = 15, 16, 17, 18, 19, 20
+KFAC, K0, NEXP, CE, VFLOOR, KAX = 21, 22, 23, 24, 25, 26
+MUS, MUD, VS, VD, MUON = 27, 28, 29, 30, 31
+BAUM, DPHI = 32, 33
+NP = 34
+# ---- integer parameters (IP) ------------------------------------------------------------------
+DRIVER, ON_COUPLER, IDEAL, PER_POINT, KVARY, KDEN_WORN, NL, ND = 0, 1, 2, 3, 4, 5, 6, 7
+NIP = 8
+# ---- diagnostics row (recorded at output times) ----------------------------------------------
+D_TH1 = 0
+D_CRANK_POS, D_CRANK_VEL = 1, 4
+D_COUP_POS, D_COUP_VEL = 7, 10
+D_FOLL_POS, D_FOLL_VEL = 13, 16
+D_FOLL_OMEGA = 19
+D_TH2, D_TH3 = 22, 23
+D_OFFSET, D_AXIS, D_TILT = 24, 27, 30
+D_FORCE = 31
+D_FN, D_FT, D_FMAG = 34, 35, 36
+D_MODE, D_PEN, D_PENAX, D_K, D_ENERGY, D_NSLICE, D_TH2DOT = 37, 38, 39, 40, 41, 42, 43
+D_QUAT = 44
+D_FAX = 48
+ND_DIAG = 49
+# ---- info (per evaluation) -------------------------------------------------------------------
+I_PEN, I_CONTACT, I_BAD = 0, 1, 2
+NINFO = 4
+# contact modes
+MODE_FREE, MODE_POINT, MODE_LINE, MODE_TWO, MODE_AXIAL, MODE_AXIAL_RADIAL, MODE_IDEAL = (
+    0,
+    1,
+    2,
+    3,
+    4,
+    5,
+    6,
+)
+
+
+@njit(cache=True)
+def friction_coefficient(v, mus, mud, vs, vd):
+    """Eq. 12: smoothed Coulomb friction coefficient at sliding speed v >= 0 [m/s]."""
+    if v < vs:
+        return mus * math.sin(0.5 * math.pi * v / vs)
+    if v <= vd:
+        return mud + (mus - mud) * 0.5 * (1.0 + math.cos(math.pi * (v - vs) / (vd - vs)))
+    return mud
+
+
+@njit(cache=True)
+def ln_factor(rate, vimp, ce):
+    """Lankarani-Nikravesh damping factor 1 + 3(1-ce^2) rate / (4 vimp), clamped at 0."""
+    f = 1.0 + 3.0 * (1.0 - ce * ce) * rate / (4.0 * vimp)
+    return f if f > 0.0 else 0.0
+
+
+@njit(cache=True)
+def _quat_matrix(q0, q1, q2, q3, R):
+    n = math.sqrt(q0 * q0 + q1 * q1 + q2 * q2 + q3 * q3)
+    w, x, y, z = q0 / n, q1 / n, q2 / n, q3 / n
+    R[0, 0] = 1 - 2 * (y * y + z * z)
+    R[0, 1] = 2 * (x * y - w * z)
+    R[0, 2] = 2 * (x * z + w * y)
+    R[1, 0] = 2 * (x * y + w * z)
+    R[1, 1] = 1 - 2 * (x * x + z * z)
+    R[1, 2] = 2 * (y * z - w * x)
+    R[2, 0] = 2 * (x * z - w * y)
+    R[2, 1] = 2 * (y * z + w * x)
+    R[2, 2] = 1 - 2 * (x * x + y * y)
+
+
+@njit(cache=True)
+def _node(n, m, J0, u, P, H, ZL, Nd):
+    """Signed penetration of bearing point (n, m) by the journal and its geometry (bearing frame).
+
+    Returns delta, Dx, Dy, Dz (the point), nx, ny, nz (unit normal from the journal axis towards
+    the point), s (axial position of the foot on the journal axis, from the journal centre).
+    """
+    m = m % Nd
+    phi = m * P[DPHI]
+    R = P[RB] + H[n, m]
+    Dx = -R * math.cos(phi)
+    Dy = R * math.sin(phi)
+    Dz = ZL[n]
+    wx, wy, wz = Dx - J0[0], Dy - J0[1], Dz - J0[2]
+    s = wx * u[0] + wy * u[1] + wz * u[2]
+    dx, dy, dz = wx - s * u[0], wy - s * u[1], wz - s * u[2]
+    dist = math.sqrt(dx * dx + dy * dy + dz * dz)
+    if dist < 1e-300:
+        dist = 1e-300
+    return P[RJ] - dist, Dx, Dy, Dz, dx / dist, dy / dist, dz / dist, s
+
+
+@njit(cache=True)
+def _node_delta(n, m, J0, u, P, H, ZL, Nd):
+    d = _node(n, m, J0, u, P, H, ZL, Nd)
+    if abs(d[7]) > 0.5 * P[LJ]:
+        return -1.0  # beyond the journal's end: no contact possible
+    return d[0]
+
+
+@njit(cache=True)
+def _stiffness(P, IP, h):
+    if IP[KVARY] == 0:
+        return P[K0]
+    rbt = P[RB] + h
+    if IP[KDEN_WORN] == 1:
+        den = rbt - P[RJ]
+    else:
+        den = P[RB] - P[RJ]
+    return P[KFAC] * math.sqrt(P[RJ] * rbt / den)
+
+
+@njit(cache=True)
+def _cross_acc(ax, ay, az, bx, by, bz, out, k, s):
+    out[k] += s * (ay * bz - az * by)
+    out[k + 1] += s * (az * bx - ax * bz)
+    out[k + 2] += s * (ax * by - ay * bx)
+
+
+@njit(cache=True)
+def _contact(
+    J0,
+    u,
+    V0,
+    W,
+    P,
+    IP,
+    H,
+    HMIN,
+    ZL,
+    WL,
+    AREA,
+    vimp,
+    srate,
+    son,
+    wrench,
+    info,
+    acc,
+    hstep,
+    WW,
+    acc_out,
+):
+    """Contact of the journal with the bore and the end faces, in the bearing frame.
+
+    Adds to ``wrench`` (6: force on the bearing, moment about the bearing centre) and returns
+    (elastic energy, normal force magnitude sum, max radial penetration, max axial penetration,
+    mode, stiffness at the deepest slice, number of contacting slices, axial force magnitude).
+    """
+    Nl = IP[NL]
+    Nd = IP[ND]
+    nexp = P[NEXP]
+    ce = P[CE]
+    vfloor = P[VFLOOR]
+    muon = P[MUON]
+    energy = 0.0
+    fnsum = 0.0
+    pen_rad = -1.0
+    kdeep = 0.0
+    dmaxslice = -1.0
+    nslice = 0
+    wcontact = 0.0
+    two = False
+    fn0x, fn0y, fn0z = 0.0, 0.0, 0.0
+    have0 = False
+    uz = u[2]
+    K = 0.0
+    hx, hy, hz = 0.0, 0.0, 0.0
+    dstar = 0.0
+    for n in range(Nl):
+        z = ZL[n]
+        s0 = (z - J0[2]) / uz
+        if abs(s0) > 0.5 * P[LJ]:
+            son[n] = 0
+            continue
+        ax = J0[0] + s0 * u[0]
+        ay = J0[1] + s0 * u[1]
+        e = math.sqrt(ax * ax + ay * ay)
+        dest = uz * e + P[RJ] - uz * (P[RB] + HMIN[n])
+        if dest <= 0.0:
+            if dest > pen_rad:
+                pen_rad = dest
+            son[n] = 0
+            continue
+        phi0 = math.atan2(ay, -ax)
+        if phi0 < 0.0:
+            phi0 += 2.0 * math.pi
+        m0 = int(round(phi0 / P[DPHI])) % Nd
+        # hill-climb to the local maximum of the penetration
+        d0 = _node_delta(n, m0, J0, u, P, H, ZL, Nd)
+        dp = _node_delta(n, m0 + 1, J0, u, P, H, ZL, Nd)
+        dm = _node_delta(n, m0 - 1, J0, u, P, H, ZL, Nd)
+        ms = m0
+        for _ in range(Nd):
+            if dp > d0 and dp >= dm:
+                ms += 1
+                dm = d0
+                d0 = dp
+                dp = _node_delta(n, ms + 1, J0, u, P, H, ZL, Nd)
+            elif dm > d0:
+                ms -= 1
+                dp = d0
+                d0 = dm
+                dm = _node_delta(n, ms - 1, J0, u, P, H, ZL, Nd)
+            else:
+                break
+        if IP[PER_POINT] == 0:
+            # parabola through the three nodes around the maximum
+            b = 0.5 * (dp - dm)
+            dd = 2.0 * d0 - dp - dm
+            if dd > 1e-300:
+                x = b / dd
+                if x > 1.0:
+                    x = 1.0
+                elif x < -1.0:
+                    x = -1.0
+            else:
+                x = 0.0
+            dstar = d0 + b * x - 0.5 * dd * x * x
+            if dstar > pen_rad:
+                pen_rad = dstar
+            if dstar <= 0.0:
+                son[n] = 0
+                continue
+            lm = 0.5 * x * (x - 1.0)
+            l0 = 1.0 - x * x
+            lp = 0.5 * x * (x + 1.0)
+            nm = _node(n, ms - 1, J0, u, P, H, ZL, Nd)
+            n0 = _node(n, ms, J0, u, P, H, ZL, Nd)
+            npp = _node(n, ms + 1, J0, u, P, H, ZL, Nd)
+            cx = lm * nm[1] + l0 * n0[1] + lp * npp[1]
+            cy = lm * nm[2] + l0 * n0[2] + lp * npp[2]
+            cz = lm * nm[3] + l0 * n0[3] + lp * npp[3]
+            nx = lm * nm[4] + l0 * n0[4] + lp * npp[4]
+            ny = lm * nm[5] + l0 * n0[5] + lp * npp[5]
+            nz = lm * nm[6] + l0 * n0[6] + lp * npp[6]
+            nn = math.sqrt(nx * nx + ny * ny + nz * nz)
+            hx, hy, hz = nx / nn, ny / nn, nz / nn
+            hc = lm * H[n, (ms - 1) % Nd] + l0 * H[n, ms % Nd] + lp * H[n, (ms + 1) % Nd]
+            K = _stiffness(P, IP, hc)
+            vx = V0[0] + W[1] * cz - W[2] * cy
+            vy = V0[1] + W[2] * cx - W[0] * cz
+            vz = V0[2] + W[0] * cy - W[1] * cx
+            rate = vx * hx + vy * hy + vz * hz
+            vm = vimp[n]
+            if vm <= 0.0:
+                vm = rate if rate > vfloor else vfloor
+            fel = WL[n] * K * dstar**nexp
+            fn = fel * ln_factor(rate, vm, ce)
+            energy += WL[n] * K * dstar ** (nexp + 1.0) / (nexp + 1.0)
+            # normal force on the bearing, distributed on the three nodes (exactly conservative)
+            for k in range(3):
+                nd = nm if k == 0 else (n0 if k == 1 else npp)
+                lk = lm if k == 0 else (l0 if k == 1 else lp)
+                s = fn * lk
+                wrench[0] += s * nd[4]
+                wrench[1] += s * nd[5]
+                wrench[2] += s * nd[6]
+                _cross_acc(nd[1], nd[2], nd[3], nd[4], nd[5], nd[6], wrench, 3, s)
+            fnsum += fn
+            # friction on the bearing along the journal's sliding velocity
+            tx = vx - rate * hx
+            ty = vy - rate * hy
+            tz = vz - rate * hz
+            vt = math.sqrt(tx * tx + ty * ty + tz * tz)
+            if muon > 0.0 and vt > 0.0:
+                mu = friction_coefficient(vt, P[MUS], P[MUD], P[VS], P[VD])
+                s = mu * fn / vt
+                wrench[0] += s * tx
+                wrench[1] += s * ty
+                wrench[2] += s * tz
+                _cross_acc(cx, cy, cz, tx, ty, tz, wrench, 3, s)
+            srate[n] = rate
+            son[n] = 1
+            if acc:
+                # pressure spread over the contiguous penetrating nodes, weights sqrt(delta)
+                wsum = 0.0
+                lo = ms
+                while lo - ms > -Nd // 2 and _node_delta(n, lo - 1, J0, u, P, H, ZL, Nd) > 0.0:
+                    lo -= 1
+                hi = ms
+                while hi - ms < Nd // 2 and _node_delta(n, hi + 1, J0, u, P, H, ZL, Nd) > 0.0:
+                    hi += 1
+                for mm in range(lo, hi + 1):
+                    dk = _node_delta(n, mm, J0, u, P, H, ZL, Nd)
+                    if dk > 0.0:
+                        wsum += math.sqrt(dk) * AREA[n, mm % Nd]
+                if wsum > 0.0:
+                    for mm in range(lo, hi + 1):
+                        dk = _node_delta(n, mm, J0, u, P, H, ZL, Nd)
+                        if dk > 0.0:
+                            WW[n, mm % Nd] += fn * math.sqrt(dk) / wsum * vt * hstep
+                else:
+                    WW[n, ms % Nd] += fn / AREA[n, ms % Nd] * vt * hstep
+                acc_out[0] += fn * vt * hstep
+                acc_out[2] += fn * hstep
+        else:
+            # the study's literal form: a full L-N force at every penetrating node
+            if d0 > pen_rad:
+                pen_rad = d0
+            if d0 <= 0.0:
+                son[n] = 0
+                continue
+            lo = ms
+            while lo - ms > -Nd // 2 and _node_delta(n, lo - 1, J0, u, P, H, ZL, Nd) > 0.0:
+                lo -= 1
+            hi = ms
+            while hi - ms < Nd // 2 and _node_delta(n, hi + 1, J0, u, P, H, ZL, Nd) > 0.0:
+                hi += 1
+            hx, hy, hz = 0.0, 0.0, 0.0
+            rate0 = 0.0
+            kdk = 0.0
+            dstar = d0
+            for mm in range(lo, hi + 1):
+                nd = _node(n, mm, J0, u, P, H, ZL, Nd)
+                dk = nd[0]
+                if dk <= 0.0:
+                    continue
+                K = _stiffness(P, IP, H[n, mm % Nd])
+                vx = V0[0] + W[1] * nd[3] - W[2] * nd[2]
+                vy = V0[1] + W[2] * nd[1] - W[0] * nd[3]
+                vz = V0[2] + W[0] * nd[2] - W[1] * nd[1]
+                rate = vx * nd[4] + vy * nd[5] + vz * nd[6]
+                if mm == ms:
+                    rate0 = rate
+                    hx, hy, hz = nd[4], nd[5], nd[6]
+                    kdk = K
+                vm = vimp[n]
+                if vm <= 0.0:
+                    vm = rate if rate > vfloor else vfloor
+                fn = K * dk**nexp * ln_factor(rate, vm, ce)
+                energy += K * dk ** (nexp + 1.0) / (nexp + 1.0)
+                wrench[0] += fn * nd[4]
+                wrench[1] += fn * nd[5]
+                wrench[2] += fn * nd[6]
+                _cross_acc(nd[1], nd[2], nd[3], nd[4], nd[5], nd[6], wrench, 3, fn)
+                fnsum += fn
+                tx = vx - rate * nd[4]
+                ty = vy - rate * nd[5]
+                tz = vz - rate * nd[6]
+                vt = math.sqrt(tx * tx + ty * ty + tz * tz)
+                if muon > 0.0 and vt > 0.0:
+                    mu = friction_coefficient(vt, P[MUS], P[MUD], P[VS], P[VD])
+                    s = mu * fn / vt
+                    wrench[0] += s * tx
+                    wrench[1] += s * ty
+                    wrench[2] += s * tz
+                    _cross_acc(nd[1], nd[2], nd[3], tx, ty, tz, wrench, 3, s)
+                if acc:
+                    WW[n, mm % Nd] += fn / AREA[n, mm % Nd] * vt * hstep
+                    acc_out[0] += fn * vt * hstep
+                    acc_out[2] += fn * hstep
+            K = kdk
+            srate[n] = rate0
+            son[n] = 1
+        # contact statistics (modes)
+        nslice += 1
+        wcontact += WL[n]
+        if dstar > dmaxslice:
+            dmaxslice = dstar
+            kdeep = K
+        if not have0:
+            fn0x, fn0y, fn0z = hx, hy, hz
+            have0 = True
+        elif fn0x * hx + fn0y * hy + fn0z * hz < 0.0:
+            two = True
+    # ---- axial stops: journal shoulders against the bearing end faces ----
+    pen_ax = -1.0
+    fax = 0.0
+    upx, upy = u[0], u[1]
+    up = math.sqrt(upx * upx + upy * upy)
+    half = 0.5 * (P[WB] + P[CA])
+    kax = P[KAX]
+    for face in range(2):
+        sg = 1.0 if face == 0 else -1.0
+        if up > 1e-14:
+            rx, ry = sg * upx / up, sg * upy / up
+        else:
+            rx, ry = 0.0, 0.0
+        xx = P[RHO] * rx
+        xy = P[RHO] * ry
+        xz = sg * 0.5 * P[WB]
+        qx = J0[0] + sg * half * u[0]
+        qy = J0[1] + sg * half * u[1]
+        qz = J0[2] + sg * half * u[2]
+        dlt = sg * ((xx - qx) * u[0] + (xy - qy) * u[1] + (xz - qz) * u[2])
+        if dlt > pen_ax:
+            pen_ax = dlt
+        k = Nl + face
+        if dlt <= 0.0:
+            son[k] = 0
+            continue
+        vx = V0[0] + W[1] * xz - W[2] * xy
+        vy = V0[1] + W[2] * xx - W[0] * xz
+        vz = V0[2] + W[0] * xy - W[1] * xx
+        vn = vx * u[0] + vy * u[1] + vz * u[2]
+        rate = -sg * vn
+        vm = vimp[k]
+        if vm <= 0.0:
+            vm = rate if rate > vfloor else vfloor
+        fn = kax * dlt**nexp * ln_factor(rate, vm, ce)
+        energy += kax * dlt ** (nexp + 1.0) / (nexp + 1.0)
+        s = -sg * fn
+        wrench[0] += s * u[0]
+        wrench[1] += s * u[1]
+        wrench[2] += s * u[2]
+        _cross_acc(xx, xy, xz, u[0], u[1], u[2], wrench, 3, s)
+        tx, ty, tz = vx - vn * u[0], vy - vn * u[1], vz - vn * u[2]
+        vt = math.sqrt(tx * tx + ty * ty + tz * tz)
+        if muon > 0.0 and vt > 0.0:
+            mu = friction_coefficient(vt, P[MUS], P[MUD], P[VS], P[VD])
+            s = mu * fn / vt
+            wrench[0] += s * tx
+            wrench[1] += s * ty
+            wrench[2] += s * tz
+            _cross_acc(xx, xy, xz, tx, ty, tz, wrench, 3, s)
+        srate[k] = rate
+        son[k] = 1
+        fax += fn
+        if acc:
+            acc_out[1] += fn * vt * hstep
+    if nslice == 0:
+        mode = MODE_FREE
+    elif two:
+        mode = MODE_TWO
+    elif wcontact >= 0.5:
+        mode = MODE_LINE
+    else:
+        mode = MODE_POINT
+    if fax > 0.0 or pen_ax > 0.0:
+        mode = MODE_AXIAL if nslice == 0 else MODE_AXIAL_RADIAL
+    info[I_PEN] = max(pen_rad, pen_ax)
+    info[I_CONTACT] = 1.0 if (nslice > 0 or pen_ax > 0.0) else 0.0
+    return energy, fnsum, pen_rad, pen_ax, mode, kdeep, nslice, fax
+
+
+@njit(cache=True)
+def _eval_clearance(
+    t, y, P, IP, H, HMIN, ZL, WL, AREA, vimp, srate, son, info, dy, acc, hstep, WW, acc_out, diag
+):
+    """Right-hand side of the clearance model; optionally accumulates wear work / fills diag."""
+    th1, th2, w1, w2 = y[0], y[1], y[2], y[3]
+    c1, s1 = math.cos(th1), math.sin(th1)
+    c2, s2 = math.cos(th2), math.sin(th2)
+    l1, l2, l3, l4 = P[L1], P[L2], P[L3], P[L4]
+    Bx, By = l1 * c1, l1 * s1
+    vBx, vBy = -l1 * w1 * s1, l1 * w1 * c1
+    Ccx, Ccy = Bx + l2 * c2, By + l2 * s2
+    R = np.empty((3, 3))
+    _quat_matrix(y[4], y[5], y[6], y[7], R)
+    ob0, ob1, ob2 = y[8], y[9], y[10]
+    # follower angular velocity, global
+    wgx = R[0, 0] * ob0 + R[0, 1] * ob1 + R[0, 2] * ob2
+    wgy = R[1, 0] * ob0 + R[1, 1] * ob1 + R[1, 2] * ob2
+    wgz = R[2, 0] * ob0 + R[2, 1] * ob1 + R[2, 2] * ob2
+    dz = P[JOFF]
+    Cfx = l4 + l3 * R[0, 1] + dz * R[0, 2]
+    Cfy = l3 * R[1, 1] + dz * R[1, 2]
+    Cfz = l3 * R[2, 1] + dz * R[2, 2]
+    Rb = np.empty((3, 3))
+    Og = np.empty(3)
+    Cj = np.empty(3)
+    ug = np.empty(3)
+    on_coupler = IP[ON_COUPLER] == 1
+    if on_coupler:
+        Rb[0, 0], Rb[1, 0], Rb[2, 0] = c2, s2, 0.0
+        Rb[0, 1], Rb[1, 1], Rb[2, 1] = -s2, c2, 0.0
+        Rb[0, 2], Rb[1, 2], Rb[2, 2] = 0.0, 0.0, 1.0
+        Og[0], Og[1], Og[2] = Ccx, Ccy, dz
+        Cj[0], Cj[1], Cj[2] = Cfx, Cfy, Cfz
+        ug[0], ug[1], ug[2] = R[0, 2], R[1, 2], R[2, 2]
+    else:
+        for i in range(3):
+            for j in range(3):
+                Rb[i, j] = R[i, j]
+        Og[0], Og[1], Og[2] = Cfx, Cfy, Cfz
+        Cj[0], Cj[1], Cj[2] = Ccx, Ccy, dz
+        ug[0], ug[1], ug[2] = 0.0, 0.0, 1.0
+    # velocities at Og of the coupler-fixed and follower-fixed points, and angular velocities
+    vcx = vBx - w2 * (Og[1] - By)
+    vcy = vBy + w2 * (Og[0] - Bx)
+    vcz = 0.0
+    rx, ry, rz = Og[0] - l4, Og[1], Og[2]
+    vfx = wgy * rz - wgz * ry
+    vfy = wgz * rx - wgx * rz
+    vfz = wgx * ry - wgy * rx
+    if on_coupler:  # journal = follower, bearing = coupler
+        V0g = (vfx - vcx, vfy - vcy, vfz - vcz)
+        Wg = (wgx, wgy, wgz - w2)
+    else:
+        V0g = (vcx - vfx, vcy - vfy, vcz - vfz)
+        Wg = (-wgx, -wgy, w2 - wgz)
+    J0 = np.empty(3)
+    u = np.empty(3)
+    V0 = np.empty(3)
+    W = np.empty(3)
+    for i in range(3):
+        J0[i] = Rb[0, i] * (Cj[0] - Og[0]) + Rb[1, i] * (Cj[1] - Og[1]) + Rb[2, i] * (Cj[2] - Og[2])
+        u[i] = Rb[0, i] * ug[0] + Rb[1, i] * ug[1] + Rb[2, i] * ug[2]
+        V0[i] = Rb[0, i] * V0g[0] + Rb[1, i] * V0g[1] + Rb[2, i] * V0g[2]
+        W[i] = Rb[0, i] * Wg[0] + Rb[1, i] * Wg[1] + Rb[2, i] * Wg[2]
+    wrench = np.zeros(6)
+    info[I_BAD] = 0.0
+    if u[2] < 0.5:
+        info[I_BAD] = 1.0
+        u[2] = 0.5
+    energy, fnsum, pen_rad, pen_ax, mode, kdeep, nslice, fax = _contact(
+        J0,
+        u,
+        V0,
+        W,
+        P,
+        IP,
+        H,
+        HMIN,
+        ZL,
+        WL,
+        AREA,
+        vimp,
+        srate,
+        son,
+        wrench,
+        info,
+        acc,
+        hstep,
+        WW,
+        acc_out,
+    )
+    # wrench on the bearing, global: force F, moment M about Og
+    Fx = Rb[0, 0] * wrench[0] + Rb[0, 1] * wrench[1] + Rb[0, 2] * wrench[2]
+    Fy = Rb[1, 0] * wrench[0] + Rb[1, 1] * wrench[1] + Rb[1, 2] * wrench[2]
+    Fz = Rb[2, 0] * wrench[0] + Rb[2, 1] * wrench[1] + Rb[2, 2] * wrench[2]
+    Mx = Rb[0, 0] * wrench[3] + Rb[0, 1] * wrench[4] + Rb[0, 2] * wrench[5]
+    My = Rb[1, 0] * wrench[3] + Rb[1, 1] * wrench[4] + Rb[1, 2] * wrench[5]
+    Mz = Rb[2, 0] * wrench[3] + Rb[2, 1] * wrench[4] + Rb[2, 2] * wrench[5]
+    sgn_c = 1.0 if on_coupler else -1.0  # sign of the contact wrench acting on the coupler
+    # coupler generalised forces
+    Q1c = sgn_c * (Fx * (-l1 * s1) + Fy * (l1 * c1))
+    MBz = Mz + (Og[0] - Bx) * Fy - (Og[1] - By) * Fx
+    Q2c = sgn_c * MBz
+    # follower moment about D (global)
+    sf = -sgn_c
+    MDx = sf * (Mx + ry * Fz - rz * Fy)
+    MDy = sf * (My + rz * Fx - rx * Fz)
+    MDz = sf * (Mz + rx * Fy - ry * Fx)
+    # gravity on the follower: weight at R (0, L3/2, 0)
+    g = P[GRAV]
+    m3 = P[M3]
+    gx, gy, gz = 0.5 * l3 * R[0, 1], 0.5 * l3 * R[1, 1], 0.5 * l3 * R[2, 1]
+    MDx += gy * 0.0 - gz * (-m3 * g)
+    MDz += gx * (-m3 * g) - gy * 0.0
+    # body frame moment
+    mb0 = R[0, 0] * MDx + R[1, 0] * MDy + R[2, 0] * MDz
+    mb1 = R[0, 1] * MDx + R[1, 1] * MDy + R[2, 1] * MDz
+    mb2 = R[0, 2] * MDx + R[1, 2] * MDy + R[2, 2] * MDz
+    a = 0.25 * l3 * l3 * m3
+    Ix, Iy, Iz = P[I3X] + a, P[I3Y], P[I3Z] + a
+    dy[8] = (mb0 - (Iz - Iy) * ob1 * ob2) / Ix
+    dy[9] = (mb1 - (Ix - Iz) * ob2 * ob0) / Iy
+    dy[10] = (mb2 - (Iy - Ix) * ob0 * ob1) / Iz
+    q0, q1, q2, q3 = y[4], y[5], y[6], y[7]
+    dy[4] = -0.5 * (q1 * ob0 + q2 * ob1 + q3 * ob2)
+    dy[5] = 0.5 * (q0 * ob0 + q2 * ob2 - q3 * ob1)
+    dy[6] = 0.5 * (q0 * ob1 + q3 * ob0 - q1 * ob2)
+    dy[7] = 0.5 * (q0 * ob2 + q1 * ob1 - q2 * ob0)
+    # crank + coupler
+    m1, m2 = P[M1], P[M2]
+    hb = 0.5 * l2
+    M11 = P[I1] + m1 * 0.25 * l1 * l1 + m2 * l1 * l1
+    M12 = m2 * l1 * hb * math.cos(th2 - th1)
+    M22 = P[I2] + m2 * hb * hb
+    sd = math.sin(th2 - th1)
+    h1 = -m2 * l1 * hb * sd * w2 * w2
+    h2 = m2 * l1 * hb * sd * w1 * w1
+    Q1 = -(0.5 * m1 * l1 + m2 * l1) * g * c1 + Q1c
+    Q2 = -m2 * g * hb * c2 + Q2c
+    dy[0] = w1
+    dy[1] = w2
+    if IP[DRIVER] == 1:
+        dy[2] = 0.0
+        dy[3] = (Q2 - h2) / M22
+    else:
+        r1 = Q1 - h1
+        r2 = Q2 - h2
+        det = M11 * M22 - M12 * M12
+        dy[2] = (M22 * r1 - M12 * r2) / det
+        dy[3] = (M11 * r2 - M12 * r1) / det
+    if diag.shape[0] > 0:
+        diag[D_TH1] = th1
+        diag[D_CRANK_POS], diag[D_CRANK_POS + 1], diag[D_CRANK_POS + 2] = 0.5 * Bx, 0.5 * By, 0.0
+        diag[D_CRANK_VEL], diag[D_CRANK_VEL + 1], diag[D_CRANK_VEL + 2] = 0.5 * vBx, 0.5 * vBy, 0.0
+        diag[D_COUP_POS] = Bx + hb * c2
+        diag[D_COUP_POS + 1] = By + hb * s2
+        diag[D_COUP_POS + 2] = 0.0
+        diag[D_COUP_VEL] = vBx - w2 * hb * s2
+        diag[D_COUP_VEL + 1] = vBy + w2 * hb * c2
+        diag[D_COUP_VEL + 2] = 0.0
+        diag[D_FOLL_POS] = l4 + gx
+        diag[D_FOLL_POS + 1] = gy
+        diag[D_FOLL_POS + 2] = gz
+        diag[D_FOLL_VEL] = wgy * gz - wgz * gy
+        diag[D_FOLL_VEL + 1] = wgz * gx - wgx * gz
+        diag[D_FOLL_VEL + 2] = wgx * gy - wgy * gx
+        diag[D_FOLL_OMEGA], diag[D_FOLL_OMEGA + 1], diag[D_FOLL_OMEGA + 2] = wgx, wgy, wgz
+        diag[D_TH2] = th2
+        diag[D_TH3] = math.atan2(R[1, 1], R[0, 1])
+        for i in range(3):
+            diag[D_OFFSET + i] = J0[i]
+            diag[D_AXIS + i] = u[i]
+        diag[D_TILT] = math.acos(min(1.0, u[2]))
+        diag[D_FORCE], diag[D_FORCE + 1], diag[D_FORCE + 2] = Fx, Fy, Fz
+        diag[D_FN] = fnsum + fax
+        diag[D_FMAG] = math.sqrt(Fx * Fx + Fy * Fy + Fz * Fz)
+        # tangential part: the resultant minus its projection on the summed normals
+        diag[D_FT] = 0.0
+        diag[D_MODE] = mode
+        diag[D_PEN] = pen_rad
+        diag[D_PENAX] = pen_ax
+        diag[D_K] = kdeep
+        T = 0.5 * (M11 * w1 * w1 + 2 * M12 * w1 * w2 + M22 * w2 * w2)
+        T += 0.5 * (Ix * ob0 * ob0 + Iy * ob1 * ob1 + Iz * ob2 * ob2)
+        V = g * (0.5 * m1 * l1 * s1 + m2 * (l1 * s1 + hb * s2) + m3 * gy)
+        diag[D_ENERGY] = T + V + energy
+        diag[D_NSLICE] = nslice
+        diag[D_TH2DOT] = w2
+        n = math.sqrt(q0 * q0 + q1 * q1 + q2 * q2 + q3 * q3)
+        diag[D_QUAT], diag[D_QUAT + 1], diag[D_QUAT + 2], diag[D_QUAT + 3] = (
+            q0 / n,
+            q1 / n,
+            q2 / n,
+            q3 / n,
+        )
+        diag[D_FAX] = fax
+
+
+@njit(cache=True)
+def _eval_ideal(t, y, P, IP, dy, diag):
+    """Planar four-bar with ideal joint C: loop-closure constraints, Baumgarte-stabilised."""
+    th1, th2, th3, w1, w2, w3 = y[0], y[1], y[2], y[3], y[4], y[5]
+    l1, l2, l3, l4 = P[L1], P[L2], P[L3], P[L4]
+    c1, s1 = math.cos(th1), math.sin(th1)
+    c2, s2 = math.cos(th2), math.sin(th2)
+    c3, s3 = math.cos(th3), math.sin(th3)
+    phx = l1 * c1 + l2 * c2 - l4 - l3 * c3
+    phy = l1 * s1 + l2 * s2 - l3 * s3
+    dphx = -l1 * w1 * s1 - l2 * w2 * s2 + l3 * w3 * s3
+    dphy = l1 * w1 * c1 + l2 * w2 * c2 - l3 * w3 * c3
+    al = P[BAUM]
+    gx = l1 * w1 * w1 * c1 + l2 * w2 * w2 * c2 - l3 * w3 * w3 * c3 - 2 * al * dphx - al * al * phx
+    gy = l1 * w1 * w1 * s1 + l2 * w2 * w2 * s2 - l3 * w3 * w3 * s3 - 2 * al * dphy - al * al * phy
+    a11, a12 = -l2 * s2, l3 * s3
+    a21, a22 = l2 * c2, -l3 * c3
+    det = a11 * a22 - a12 * a21
+    dd2 = (gx * a22 - a12 * gy) / det
+    dd3 = (a11 * gy - a21 * gx) / det
+    dy[0] = w1
+    dy[1] = w2
+    dy[2] = w3
+    dy[3] = 0.0
+    dy[4] = dd2
+    dy[5] = dd3
+    if diag.shape[0] > 0:
+        g = P[GRAV]
+        m1, m2, m3 = P[M1], P[M2], P[M3]
+        hb = 0.5 * l2
+        Bx, By = l1 * c1, l1 * s1
+        vBx, vBy = -l1 * w1 * s1, l1 * w1 * c1
+        for i in range(ND_DIAG):
+            diag[i] = 0.0
+        diag[D_TH1] = th1
+        diag[D_CRANK_POS], diag[D_CRANK_POS + 1] = 0.5 * Bx, 0.5 * By
+        diag[D_CRANK_VEL], diag[D_CRANK_VEL + 1] = 0.5 * vBx, 0.5 * vBy
+        diag[D_COUP_POS], diag[D_COUP_POS + 1] = Bx + hb * c2, By + hb * s2
+        diag[D_COUP_VEL] = vBx - w2 * hb * s2
+        diag[D_COUP_VEL + 1] = vBy + w2 * hb * c2
+        diag[D_FOLL_POS], diag[D_FOLL_POS + 1] = l4 + 0.5 * l3 * c3, 0.5 * l3 * s3
+        diag[D_FOLL_VEL], diag[D_FOLL_VEL + 1] = -0.5 * l3 * w3 * s3, 0.5 * l3 * w3 * c3
+        diag[D_FOLL_OMEGA + 2] = w3
+        diag[D_TH2] = th2
+        diag[D_TH3] = th3
+        diag[D_AXIS + 2] = 1.0
+        # joint reaction at C (force on the follower) from the two rotational equations
+        Ia = P[I3Z] + 0.25 * m3 * l3 * l3
+        rhs_f = Ia * dd3 + m3 * g * 0.5 * l3 * c3  # = ((C-D) x F)_z
+        IB = P[I2] + m2 * hb * hb
+        aBx, aBy = -l1 * w1 * w1 * c1, -l1 * w1 * w1 * s1
+        inert = IB * dd2 + m2 * (hb * c2 * aBy - hb * s2 * aBx)
+        rhs_c = -(inert + m2 * g * hb * c2)  # = ((C-B) x F)_z with F on the follower
+        rdx, rdy = l3 * c3, l3 * s3
+        rbx, rby = l2 * c2, l2 * s2
+        det2 = rdx * rby - rdy * rbx
+        Fx = (rhs_f * rbx - rdx * rhs_c) / det2
+        Fy = (rhs_f * rby - rdy * rhs_c) / det2
+        diag[D_FORCE], diag[D_FORCE + 1] = Fx, Fy
+        diag[D_FN] = math.sqrt(Fx * Fx + Fy * Fy)
+        diag[D_FMAG] = diag[D_FN]
+        diag[D_MODE] = MODE_IDEAL
+        diag[D_PEN] = 0.0
+        M11 = P[I1] + m1 * 0.25 * l1 * l1 + m2 * l1 * l1
+        M12 = m2 * l1 * hb * math.cos(th2 - th1)
+        T = 0.5 * (M11 * w1 * w1 + 2 * M12 * w1 * w2 + IB * w2 * w2) + 0.5 * Ia * w3 * w3
+        V = g * (0.5 * m1 * l1 * s1 + m2 * (l1 * s1 + hb * s2) + m3 * 0.5 * l3 * s3)
+        diag[D_ENERGY] = T + V
+        diag[D_TH2DOT] = w2
+        a = 0.5 * (th3 - 0.5 * math.pi)
+        diag[D_QUAT], diag[D_QUAT + 3] = math.cos(a), math.sin(a)
+
+
+@njit(cache=True)
+def _eval(
+    t, y, P, IP, H, HMIN, ZL, WL, AREA, vimp, srate, son, info, dy, acc, hstep, WW, acc_out, diag
+):
+    if IP[IDEAL] == 1:
+        _eval_ideal(t, y, P, IP, dy, diag)
+        info[I_PEN] = -1.0
+        info[I_CONTACT] = 0.0
+        info[I_BAD] = 0.0
+    else:
+        _eval_clearance(
+            t,
+            y,
+            P,
+            IP,
+            H,
+            HMIN,
+            ZL,
+            WL,
+            AREA,
+            vimp,
+            srate,
+            son,
+            info,
+            dy,
+            acc,
+            hstep,
+            WW,
+            acc_out,
+            diag,
+        )
+
+
+# Dormand-Prince 5(4) coefficients
+_C2, _C3, _C4, _C5 = 1.0 / 5.0, 3.0 / 10.0, 4.0 / 5.0, 8.0 / 9.0
+_A21 = 1.0 / 5.0
+_A31, _A32 = 3.0 / 40.0, 9.0 / 40.0
+_A41, _A42, _A43 = 44.0 / 45.0, -56.0 / 15.0, 32.0 / 9.0
+_A51, _A52, _A53, _A54 = 19372.0 / 6561.0, -25360.0 / 2187.0, 64448.0 / 6561.0, -212.0 / 729.0
+_A61, _A62, _A63, _A64, _A65 = (
+    9017.0 / 3168.0,
+    -355.0 / 33.0,
+    46732.0 / 5247.0,
+    49.0 / 176.0,
+    -5103.0 / 18656.0,
+)
+_B1, _B3, _B4, _B5, _B6 = 35.0 / 384.0, 500.0 / 1113.0, 125.0 / 192.0, -2187.0 / 6784.0, 11.0 / 84.0
+_E1, _E3, _E4, _E5, _E6, _E7 = (
+    71.0 / 57600.0,
+    -71.0 / 16695.0,
+    71.0 / 1920.0,
+    -17253.0 / 339200.0,
+    22.0 / 525.0,
+    -1.0 / 40.0,
+)
+
+
+@njit(cache=True)
+def integrate(
+    t,
+    y,
+    hstep,
+    t_end,
+    t_out,
+    i_out,
+    diag_out,
+    P,
+    IP,
+    H,
+    HMIN,
+    ZL,
+    WL,
+    AREA,
+    vimp,
+    WW,
+    acc_out,
+    ANG,
+    rtol,
+    atol,
+    hmax,
+    hmin,
+    onset,
+    pen_limit,
+):
+    """Advance ``y`` from ``t`` to ``t_end`` with adaptive DOPRI5; record diagnostics.
+
+    Returns (status, t, hstep, i_out, n_accepted, n_rejected). status: 0 done, 1 step-size
+    collapse, 2 penetration beyond ``pen_limit``, 3 non-finite state, 4 journal axis flipped.
+    """
+    n = y.shape[0]
+    Nl = IP[NL]
+    srate = np.zeros(Nl + 2)
+    son = np.zeros(Nl + 2, dtype=np.int64)
+    info = np.zeros(NINFO)
+    k1 = np.empty(n)
+    k2 = np.empty(n)
+    k3 = np.empty(n)
+    k4 = np.empty(n)
+    k5 = np.empty(n)
+    k6 = np.empty(n)
+    k7 = np.empty(n)
+    yt = np.empty(n)
+    y1 = np.empty(n)
+    yi = np.empty(n)
+    nodiag = np.empty(0)
+    dummy = np.zeros(3)
+    ndg = np.empty(ND_DIAG)
+    _eval(
+        t,
+        y,
+        P,
+        IP,
+        H,
+        HMIN,
+        ZL,
+        WL,
+        AREA,
+        vimp,
+        srate,
+        son,
+        info,
+        k1,
+        False,
+        0.0,
+        WW,
+        dummy,
+        nodiag,
+    )
+    pen0 = info[I_PEN]
+    contact0 = info[I_CONTACT]
+    nacc = 0
+    nrej = 0
+    n_out = t_out.shape[0]
+    # record an output point sitting exactly at the start
+    while i_out < n_out and t_out[i_out] <= t:
+        _eval(
+            t,
+            y,
+            P,
+            IP,
+            H,
+            HMIN,
+            ZL,
+            WL,
+            AREA,
+            vimp,
+            srate,
+            son,
+            info,
+            yi,
+            False,
+            0.0,
+            WW,
+            dummy,
+            ndg,
+        )
+        for j in range(ND_DIAG):
+            diag_out[i_out, j] = ndg[j]
+        i_out += 1
+    while t < t_end:
+        h = hstep
+        if h > hmax:
+            h = hmax
+        last = False
+        if t + h >= t_end:
+            h = t_end - t
+            last = True
+        # ---- one DOPRI5 step ----
+        for i in range(n):
+            yt[i] = y[i] + h * _A21 * k1[i]
+        _eval(
+            t + _C2 * h,
+            yt,
+            P,
+            IP,
+            H,
+            HMIN,
+            ZL,
+            WL,
+            AREA,
+            vimp,
+            srate,
+            son,
+            info,
+            k2,
+            False,
+            0.0,
+            WW,
+            dummy,
+            nodiag,
+        )
+        for i in range(n):
+            yt[i] = y[i] + h * (_A31 * k1[i] + _A32 * k2[i])
+        _eval(
+            t + _C3 * h,
+            yt,
+            P,
+            IP,
+            H,
+            HMIN,
+            ZL,
+            WL,
+            AREA,
+            vimp,
+            srate,
+            son,
+            info,
+            k3,
+            False,
+            0.0,
+            WW,
+            dummy,
+            nodiag,
+        )
+        for i in range(n):
+            yt[i] = y[i] + h * (_A41 * k1[i] + _A42 * k2[i] + _A43 * k3[i])
+        _eval(
+            t + _C4 * h,
+            yt,
+            P,
+            IP,
+            H,
+            HMIN,
+            ZL,
+            WL,
+            AREA,
+            vimp,
+            srate,
+            son,
+            info,
+            k4,
+            False,
+            0.0,
+            WW,
+            dummy,
+            nodiag,
+        )
+        for i in range(n):
+            yt[i] = y[i] + h * (_A51 * k1[i] + _A52 * k2[i] + _A53 * k3[i] + _A54 * k4[i])
+        _eval(
+            t + _C5 * h,
+            yt,
+            P,
+            IP,
+            H,
+            HMIN,
+            ZL,
+            WL,
+            AREA,
+            vimp,
+            srate,
+            son,
+            info,
+            k5,
+            False,
+            0.0,
+            WW,
+            dummy,
+            nodiag,
+        )
+        for i in range(n):
+            yt[i] = y[i] + h * (
+                _A61 * k1[i] + _A62 * k2[i] + _A63 * k3[i] + _A64 * k4[i] + _A65 * k5[i]
+            )
+        _eval(
+            t + h,
+            yt,
+            P,
+            IP,
+            H,
+            HMIN,
+            ZL,
+            WL,
+            AREA,
+            vimp,
+            srate,
+            son,
+            info,
+            k6,
+            False,
+            0.0,
+            WW,
+            dummy,
+            nodiag,
+        )
+        for i in range(n):
+            y1[i] = y[i] + h * (_B1 * k1[i] + _B3 * k3[i] + _B4 * k4[i] + _B5 * k5[i] + _B6 * k6[i])
+        _eval(
+            t + h,
+            y1,
+            P,
+            IP,
+            H,
+            HMIN,
+            ZL,
+            WL,
+            AREA,
+            vimp,
+            srate,
+            son,
+            info,
+            k7,
+            False,
+            0.0,
+            WW,
+            dummy,
+            nodiag,
+        )
+        err = 0.0
+        finite = True
+        for i in range(n):
+            ei = h * (
+                _E1 * k1[i] + _E3 * k3[i] + _E4 * k4[i] + _E5 * k5[i] + _E6 * k6[i] + _E7 * k7[i]
+            )
+            if ANG[i] == 1:
+                sc = atol
+            else:
+                a = abs(y[i])
+                b = abs(y1[i])
+                sc = atol + rtol * (a if a > b else b)
+            r = ei / sc
+            err += r * r
+            if not math.isfinite(y1[i]):
+                finite = False
+        err = math.sqrt(err / n)
+        if not finite or not math.isfinite(err):
+            if h <= hmin:
+                return 3, t, h, i_out, nacc, nrej
+            hstep = 0.25 * h
+            nrej += 1
+            continue
+        pen1 = info[I_PEN]
+        contact1 = info[I_CONTACT]
+        bad1 = info[I_BAD]
+        if err > 1.0:
+            fac = 0.9 * err**-0.2
+            if fac < 0.2:
+                fac = 0.2
+            hstep = h * fac
+            nrej += 1
+            if hstep < hmin:
+                return 1, t, hstep, i_out, nacc, nrej
+            continue
+        # event control: a step from free flight may not end deep in contact
+        if contact0 == 0.0 and pen1 > onset and h > hmin * 10.0:
+            frac = (0.5 * onset - pen0) / (pen1 - pen0)
+            if frac > 0.9:
+                frac = 0.9
+            if frac < 0.01:
+                frac = 0.01
+            hstep = h * frac
+            nrej += 1
+            continue
+        if bad1 != 0.0:
+            return 4, t, h, i_out, nacc, nrej
+        # ---- accepted ----
+        # outputs in (t, t + h] by cubic Hermite interpolation
+        t1 = t + h
+        while i_out < n_out and t_out[i_out] <= t1 + 1e-15:
+            th = (t_out[i_out] - t) / h
+            if th > 1.0:
+                th = 1.0
+            h00 = 2 * th**3 - 3 * th**2 + 1
+            h10 = th**3 - 2 * th**2 + th
+            h01 = -2 * th**3 + 3 * th**2
+            h11 = th**3 - th**2
+            for i in range(n):
+                yi[i] = h00 * y[i] + h10 * h * k1[i] + h01 * y1[i] + h11 * h * k7[i]
+            _eval(
+                t_out[i_out],
+                yi,
+                P,
+                IP,
+                H,
+                HMIN,
+                ZL,
+                WL,
+                AREA,
+                vimp,
+                srate,
+                son,
+                info,
+                yt,
+                False,
+                0.0,
+                WW,
+                dummy,
+                ndg,
+            )
+            for j in range(ND_DIAG):
+                diag_out[i_out, j] = ndg[j]
+            i_out += 1
+        for i in range(n):
+            y[i] = y1[i]
+        if IP[IDEAL] == 0:
+            qn = math.sqrt(y[4] ** 2 + y[5] ** 2 + y[6] ** 2 + y[7] ** 2)
+            for i in range(4, 8):
+                y[i] /= qn
+        t = t1
+        if last:
+            t = t_end
+        nacc += 1
+        # wear work and impact-velocity memory at the new state
+        if contact1 != 0.0:
+            _eval(
+                t,
+                y,
+                P,
+                IP,
+                H,
+                HMIN,
+                ZL,
+                WL,
+                AREA,
+                vimp,
+                srate,
+                son,
+                info,
+                k1,
+                True,
+                h,
+                WW,
+                acc_out,
+                nodiag,
+            )
+        else:
+            for i in range(n):
+                k1[i] = k7[i]
+            for k in range(Nl + 2):
+                son[k] = 0
+        pen0 = pen1
+        contact0 = contact1
+        for k in range(Nl + 2):
+            if son[k] == 1:
+                if vimp[k] <= 0.0:
+                    r = srate[k]
+                    vimp[k] = r if r > P[VFLOOR] else P[VFLOOR]
+            else:
+                vimp[k] = 0.0
+        if pen0 > pen_limit:
+            return 2, t, h, i_out, nacc, nrej
+        # next step size
+        if err < 1e-10:
+            fac = 5.0
+        else:
+            fac = 0.9 * err**-0.2
+            if fac > 5.0:
+                fac = 5.0
+        hstep = h * fac
+    return 0, t, hstep, i_out, nacc, nrej

@@ -1,0 +1,530 @@
+"""Running the four-bar simulator: initial state, integration in chunks, results as xarray.
+
+The equations of motion (minimal coordinates, see ``docs/sim.md``) and the contact model run
+in numba (:mod:`jointwear.sim._kernels`); this module packs parameters, drives the integrator
+chunk by chunk (progress, errors with the partial record) and builds the Dataset.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Callable
+
+import numpy as np
+import xarray as xr
+
+from jointwear import conventions
+from jointwear.errors import BadInputError, ParameterError, SimulationError
+from jointwear.params import to_jsonable
+from jointwear.sim import _kernels as kn
+from jointwear.sim.contact import contact_constant
+from jointwear.sim.mechanism import loop_closure, quaternion_to_matrix, rotation_xzy_angles
+from jointwear.sim.parameters import SimParameters
+
+__all__ = ["SimState", "CycleResult", "run_cycles", "initial_state", "CONTACT_MODES"]
+
+#: Contact modes recorded in ``contact_mode`` (flag value -> meaning).
+CONTACT_MODES: dict[int, str] = {
+    kn.MODE_FREE: "free_flight",
+    kn.MODE_POINT: "single_point",
+    kn.MODE_LINE: "line",
+    kn.MODE_TWO: "two_point",
+    kn.MODE_AXIAL: "axial",
+    kn.MODE_AXIAL_RADIAL: "axial_and_radial",
+    kn.MODE_IDEAL: "ideal_joint",
+}
+
+
+@dataclasses.dataclass(frozen=True)
+class SimState:
+    """Where a simulation stopped, to continue it (picklable).
+
+    Attributes
+    ----------
+    time : float
+        Simulated time since the documented initial configuration [s].
+    y : ndarray
+        State vector (see :mod:`jointwear.sim._kernels`).
+    step : float
+        Last step size [s].
+    impact_velocity : ndarray
+        Remembered approach velocities of the contacts in progress (per axial slice, then the
+        two end faces) [m/s]; 0 = not in contact.
+    model : str
+        ``"clearance"`` or ``"ideal"``.
+    """
+
+    time: float
+    y: np.ndarray
+    step: float
+    impact_velocity: np.ndarray
+    model: str
+
+
+@dataclasses.dataclass(frozen=True)
+class CycleResult:
+    """Result of :func:`run_cycles`.
+
+    Attributes
+    ----------
+    dataset : xarray.Dataset or None
+        Record over ``time`` (None with ``record=False``).
+    wear_work : ndarray (Nl, Nd)
+        Integral of p |ds| at each bearing point over the run [Pa m] (p normal contact pressure,
+        ds sliding increment).
+    point_area : ndarray (Nl, Nd)
+        Area each point represents [m2]; sum(wear_work * point_area) == normal_work.
+    normal_work : float
+        Integral of F_n |v_t| dt over all bore contacts [N m].
+    state : SimState
+        State at the end, to continue with ``run_cycles(..., state=result.state)``.
+    cycles : float
+        Crank cycles simulated.
+    axial_normal_work : float
+        Integral of F_n |v_t| dt over the end-face (thrust) contacts [N m]; not part of the bore
+        wear.
+    normal_impulse : float
+        Integral of the summed normal bore-contact force over time [N s].
+    n_steps : int
+        Accepted integration steps.
+    """
+
+    dataset: xr.Dataset | None
+    wear_work: np.ndarray
+    point_area: np.ndarray
+    normal_work: float
+    state: SimState
+    cycles: float
+    axial_normal_work: float = 0.0
+    normal_impulse: float = 0.0
+    n_steps: int = 0
+
+
+def _layers(params: SimParameters) -> tuple[np.ndarray, np.ndarray]:
+    j = params.joint
+    nl = j.n_layers
+    z = j.bearing_width / 2 - np.arange(nl) * j.bearing_width / (nl - 1)
+    w = np.full(nl, 1.0 / (nl - 1))
+    w[0] = w[-1] = 0.5 / (nl - 1)
+    return z, w
+
+
+def _pack(params: SimParameters) -> tuple[np.ndarray, np.ndarray]:
+    m, j, c, f, s = (
+        params.mechanism,
+        params.joint,
+        params.contact,
+        params.friction,
+        params.solver,
+    )
+    P = np.zeros(kn.NP)
+    P[kn.L1], P[kn.L2], P[kn.L3], P[kn.L4] = (
+        m.crank_length,
+        m.coupler_length,
+        m.follower_length,
+        m.ground_length,
+    )
+    P[kn.M1], P[kn.M2], P[kn.M3] = m.crank_mass, m.coupler_mass, m.follower_mass
+    P[kn.I1], P[kn.I2] = m.crank_inertia, m.coupler_inertia
+    P[kn.I3X], P[kn.I3Y], P[kn.I3Z] = m.follower_inertia
+    P[kn.GRAV] = m.gravity
+    P[kn.JOFF] = m.joint_offset
+    P[kn.OMEGA] = m.crank_speed
+    P[kn.RJ], P[kn.LJ], P[kn.RB], P[kn.WB] = (
+        j.journal_radius,
+        j.journal_length,
+        j.bearing_radius,
+        j.bearing_width,
+    )
+    P[kn.CA], P[kn.RHO] = j.axial_clearance, j.thrust_radius
+    kfac, k0 = contact_constant(params)
+    P[kn.KFAC], P[kn.K0] = kfac, k0
+    P[kn.NEXP], P[kn.CE], P[kn.VFLOOR] = c.exponent, c.restitution, c.impact_velocity_floor
+    P[kn.KAX] = c.axial_stiffness if c.axial_stiffness > 0 else k0
+    P[kn.MUS], P[kn.MUD] = f.static_coefficient, f.dynamic_coefficient
+    P[kn.VS], P[kn.VD] = f.stick_velocity, f.slide_velocity
+    P[kn.MUON] = 1.0 if f.enabled else 0.0
+    P[kn.BAUM] = s.baumgarte
+    P[kn.DPHI] = 2 * math.pi / j.n_points
+    IP = np.zeros(kn.NIP, dtype=np.int64)
+    IP[kn.DRIVER] = 1 if m.driver else 0
+    IP[kn.ON_COUPLER] = 1 if m.bearing_on == "coupler" else 0
+    IP[kn.IDEAL] = 1 if j.model == "ideal" else 0
+    IP[kn.PER_POINT] = 1 if c.formulation == "per_point" else 0
+    IP[kn.KVARY] = 1 if c.stiffness == "time_varying" else 0
+    IP[kn.KDEN_WORN] = 1 if c.worn_radius_in_denominator else 0
+    IP[kn.NL], IP[kn.ND] = j.n_layers, j.n_points
+    return P, IP
+
+
+def initial_state(params: SimParameters) -> SimState:
+    """The documented initial configuration.
+
+    Crank at ``initial_crank_angle_deg`` turning at the nominal speed; coupler and follower at
+    the ideal four-bar's loop-closure angles and rates (joint C above the ground line); the
+    journal centred in the bearing and aligned with it; follower not rotated out of plane.
+    """
+    m = params.mechanism
+    th1 = math.radians(m.initial_crank_angle_deg)
+    th2, th3, w2, w3 = (float(v) for v in loop_closure(th1, m))
+    nl = params.joint.n_layers
+    if params.joint.model == "ideal":
+        if not m.driver:
+            raise ParameterError(
+                "joint.model = 'ideal' needs mechanism.driver = true (the ideal four-bar is "
+                "kinematically driven); use the clearance model for a free crank"
+            )
+        y = np.array([th1, th2, th3, m.crank_speed, w2, w3])
+        return SimState(0.0, y, 1e-4, np.zeros(nl + 2), "ideal")
+    # follower in the x-y plane at the ideal angle: bearing and journal centres coincide
+    a = th3 - math.pi / 2
+    q = np.array([math.cos(a / 2), 0.0, 0.0, math.sin(a / 2)])
+    y = np.array([th1, th2, m.crank_speed, w2, *q, 0.0, 0.0, w3])
+    return SimState(0.0, y, 1e-5, np.zeros(nl + 2), "clearance")
+
+
+def _check_wear(params: SimParameters, wear_depth: np.ndarray | None) -> np.ndarray:
+    shape = (params.joint.n_layers, params.joint.n_points)
+    if wear_depth is None:
+        return np.zeros(shape)
+    h = np.asarray(wear_depth, dtype=float)
+    if h.shape != shape:
+        raise BadInputError(
+            f"wear_depth has shape {h.shape}, expected (joint.n_layers, joint.n_points) = "
+            f"{shape}; resample the profile to the simulation grid"
+        )
+    if not np.all(np.isfinite(h)):
+        raise BadInputError("wear_depth contains NaN or infinite values")
+    c = params.joint.radial_clearance
+    if h.min() < -0.9 * c:
+        raise BadInputError(
+            f"wear_depth has values down to {h.min():g} m: material added beyond 90 % of the "
+            f"radial clearance ({c:g} m) would jam the journal; check the sign (wear > 0)"
+        )
+    return np.ascontiguousarray(h)
+
+
+def point_area(params: SimParameters, wear_depth: np.ndarray | None = None) -> np.ndarray:
+    """Area represented by each bearing point (n, m) [m2] (trapezoidal in z, worn radius)."""
+    h = _check_wear(params, wear_depth)
+    _, w = _layers(params)
+    j = params.joint
+    dz = w * j.bearing_width
+    return dz[:, None] * (j.bearing_radius + h) * (2 * math.pi / j.n_points)
+
+
+_ANG = {"clearance": np.array([1, 1, 0, 0, 1, 1, 1, 1, 0, 0, 0], dtype=np.int64)}
+_ANG["ideal"] = np.array([1, 1, 1, 0, 0, 0], dtype=np.int64)
+
+_STATUS = {
+    1: "the step size collapsed below solver.min_step (the contact became too stiff to resolve)",
+    2: "the penetration exceeded contact.max_penetration_fraction of the radial clearance",
+    3: "the state became NaN or infinite",
+    4: "the journal axis turned more than 60 degrees from the bearing axis",
+}
+
+
+def run_cycles(
+    params: SimParameters,
+    *,
+    cycles: float = 1.0,
+    wear_depth: np.ndarray | None = None,
+    state: SimState | None = None,
+    record: bool = True,
+    progress: Callable[[float], None] | None = None,
+) -> CycleResult:
+    """Simulate the four-bar with clearance joint C over a number of crank cycles.
+
+    Parameters
+    ----------
+    params : SimParameters
+        Parameters (e.g. ``PARAMETER_SETS["zhang2023"]`` or :func:`load_parameters`).
+    cycles : float
+        Duration in crank revolutions at the nominal crank speed (fractions allowed).
+    wear_depth : ndarray (Nl, Nd), optional
+        Wear depth h [m] of each bearing point: layer n (n = 0 at z = +wb/2), point m at
+        phi_m = m 360/Nd degrees (0 along -x of the bearing frame, clockwise seen from +z). The
+        worn radius Rb + h enters the contact geometry and K(t). Default: unworn.
+    state : SimState, optional
+        Continue from ``CycleResult.state`` of a previous run; default: :func:`initial_state`.
+    record : bool
+        Build the Dataset over time (False: only the accumulated wear work).
+    progress : callable, optional
+        Called with the fraction done (0..1) after every chunk (1/50 cycle).
+
+    Returns
+    -------
+    CycleResult
+
+    Raises
+    ------
+    SimulationError
+        Excessive penetration, step-size collapse or a non-finite state; the message names the
+        time and crank angle, ``.partial`` holds the Dataset recorded so far.
+    """
+    if not (cycles > 0 and math.isfinite(cycles)):
+        raise ParameterError(f"cycles must be a positive number, got {cycles!r}")
+    h = _check_wear(params, wear_depth)
+    P, IP = _pack(params)
+    st = state if state is not None else initial_state(params)
+    model = params.joint.model
+    if st.model != model or st.impact_velocity.shape != (params.joint.n_layers + 2,):
+        raise BadInputError(
+            f"state comes from a '{st.model}' run with {st.impact_velocity.shape[0] - 2} layers; "
+            f"these parameters need a '{model}' state with {params.joint.n_layers} layers - pass "
+            "state=None to start from the initial configuration"
+        )
+    s = params.solver
+    period = params.mechanism.period
+    duration = cycles * period
+    t0 = st.time
+    t_end = t0 + duration
+    n_out = int(math.floor(duration / s.output_interval + 1e-9)) + 1 if record else 0
+    t_rel = np.arange(n_out) * s.output_interval
+    t_out = t0 + t_rel
+    diag = np.full((max(n_out, 0), kn.ND_DIAG), np.nan)
+    zl, wl = _layers(params)
+    hmin = h.min(axis=1).copy()
+    area = point_area(params, h)
+    ww = np.zeros_like(h)
+    acc = np.zeros(3)
+    y = st.y.astype(float).copy()
+    vimp = st.impact_velocity.astype(float).copy()
+    hstep = float(st.step)
+    t = t0
+    i_out = 0
+    n_chunks = max(1, int(math.ceil(cycles * 50)))
+    pen_limit = params.contact.max_penetration_fraction * params.joint.radial_clearance
+    nacc_total = 0
+    for k in range(n_chunks):
+        t_chunk = t0 + duration * (k + 1) / n_chunks if k < n_chunks - 1 else t_end
+        status, t, hstep, i_out, nacc, _nrej = kn.integrate(
+            t,
+            y,
+            hstep,
+            t_chunk,
+            t_out,
+            i_out,
+            diag,
+            P,
+            IP,
+            h,
+            hmin,
+            zl,
+            wl,
+            area,
+            vimp,
+            ww,
+            acc,
+            _ANG[model],
+            s.rtol,
+            s.atol,
+            s.max_step,
+            s.min_step,
+            s.onset_penetration,
+            pen_limit,
+        )
+        nacc_total += nacc
+        if status != 0:
+            partial = _dataset(params, t_rel[:i_out], diag[:i_out], t0) if record else None
+            theta = math.degrees(y[0]) % 360.0
+            raise SimulationError(
+                f"simulation stopped at t = {t:.6g} s (crank angle {theta:.2f} deg): "
+                f"{_STATUS.get(status, 'unknown failure')}; the record up to there is in "
+                ".partial - tighten solver tolerances, reduce the time step or check the "
+                "parameters",
+                partial=partial,
+            )
+        if progress is not None:
+            progress((k + 1) / n_chunks)
+    new_state = SimState(t, y.copy(), hstep, vimp.copy(), model)
+    ds = _dataset(params, t_rel, diag, t0) if record else None
+    return CycleResult(
+        dataset=ds,
+        wear_work=ww,
+        point_area=area,
+        normal_work=float(acc[0]),
+        state=new_state,
+        cycles=float(cycles),
+        axial_normal_work=float(acc[1]),
+        normal_impulse=float(acc[2]),
+        n_steps=int(nacc_total),
+    )
+
+
+def _vec(diag: np.ndarray, k: int) -> np.ndarray:
+    return diag[:, k : k + 3]
+
+
+def _dataset(params: SimParameters, t_rel: np.ndarray, diag: np.ndarray, t0: float) -> xr.Dataset:
+    """Build the contract Dataset from the recorded diagnostics."""
+    axis = ("time", "axis")
+    v = conventions.variable_attrs
+    quat = diag[:, kn.D_QUAT : kn.D_QUAT + 4]
+    ok = np.all(np.isfinite(quat), axis=1) & (np.linalg.norm(quat, axis=1) > 0)
+    rot = np.full((len(diag), 3), np.nan)
+    if ok.any():
+        rot[ok] = rotation_xzy_angles(quaternion_to_matrix(quat[ok]))
+    fmag = diag[:, kn.D_FMAG]
+    fn = diag[:, kn.D_FN]
+    mode = np.where(np.isfinite(diag[:, kn.D_MODE]), diag[:, kn.D_MODE], 0).astype(np.int8)
+    pen = np.maximum(np.maximum(diag[:, kn.D_PEN], diag[:, kn.D_PENAX]), 0.0)
+    data = {
+        "crank_angle": (
+            "time",
+            np.mod(diag[:, kn.D_TH1], 2 * math.pi),
+            v("crank_angle", note="wrapped to [0, 2 pi)"),
+        ),
+        "coupler_angle": (
+            "time",
+            diag[:, kn.D_TH2],
+            {"units": "rad", "long_name": "coupler angle from +x, counter-clockwise"},
+        ),
+        "follower_angle": (
+            "time",
+            diag[:, kn.D_TH3],
+            {
+                "units": "rad",
+                "long_name": "angle of the follower (D to C) projected on the x-y plane, from +x",
+            },
+        ),
+        "follower_rotation": (
+            axis,
+            rot,
+            {
+                "units": "rad",
+                "long_name": "follower rotations about x, y, z from the vertical reference, "
+                "R = Rx Rz Ry (eq. 4 order)",
+            },
+        ),
+        "crank_position": (
+            axis,
+            _vec(diag, kn.D_CRANK_POS),
+            {"units": "m", "long_name": "position of the crank centre of mass"},
+        ),
+        "crank_velocity": (
+            axis,
+            _vec(diag, kn.D_CRANK_VEL),
+            {"units": "m s-1", "long_name": "velocity of the crank centre of mass"},
+        ),
+        "coupler_position": (
+            axis,
+            _vec(diag, kn.D_COUP_POS),
+            {"units": "m", "long_name": "position of the coupler centre of mass"},
+        ),
+        "coupler_velocity": (
+            axis,
+            _vec(diag, kn.D_COUP_VEL),
+            {"units": "m s-1", "long_name": "velocity of the coupler centre of mass"},
+        ),
+        "follower_position": (axis, _vec(diag, kn.D_FOLL_POS), v("follower_position")),
+        "follower_velocity": (axis, _vec(diag, kn.D_FOLL_VEL), v("follower_velocity")),
+        "follower_angular_velocity": (
+            axis,
+            _vec(diag, kn.D_FOLL_OMEGA),
+            {"units": "rad s-1", "long_name": "angular velocity of the follower, global frame"},
+        ),
+        "journal_offset": (
+            axis,
+            _vec(diag, kn.D_OFFSET),
+            v(
+                "journal_offset",
+                frame="bearing frame: z along the bearing axis, -x = theta 0 direction",
+            ),
+        ),
+        "journal_axis": (
+            axis,
+            _vec(diag, kn.D_AXIS),
+            {"units": "1", "long_name": "unit vector of the journal axis, bearing frame"},
+        ),
+        "journal_tilt": (
+            "time",
+            diag[:, kn.D_TILT],
+            {"units": "rad", "long_name": "angle between the journal and bearing axes"},
+        ),
+        "bearing_force": (
+            axis,
+            _vec(diag, kn.D_FORCE),
+            {
+                "units": "N",
+                "long_name": "resultant contact force on the bearing, global frame",
+            },
+        ),
+        "contact_force": ("time", fmag, v("contact_force")),
+        "contact_force_normal": (
+            "time",
+            fn,
+            {"units": "N", "long_name": "sum of the normal contact forces in joint C"},
+        ),
+        "contact_force_tangential": (
+            "time",
+            np.sqrt(np.maximum(fmag**2 - np.minimum(fn, fmag) ** 2, 0.0)),
+            {
+                "units": "N",
+                "long_name": "tangential (friction) part of the resultant contact force",
+                "note": "sqrt(|F|^2 - Fn^2), Fn the summed normal force",
+            },
+        ),
+        "axial_force": (
+            "time",
+            diag[:, kn.D_FAX],
+            {"units": "N", "long_name": "normal force of the end-face (thrust) contacts"},
+        ),
+        "contact_mode": (
+            "time",
+            mode,
+            {
+                "units": "1",
+                "long_name": "contact mode of joint C",
+                "flag_values": np.array(sorted(CONTACT_MODES), dtype=np.int8),
+                "flag_meanings": " ".join(CONTACT_MODES[k] for k in sorted(CONTACT_MODES)),
+            },
+        ),
+        "penetration": (
+            "time",
+            pen,
+            {"units": "m", "long_name": "largest penetration in joint C (bore or end faces)"},
+        ),
+        "contact_stiffness": (
+            "time",
+            diag[:, kn.D_K],
+            {
+                "units": "N m-1.5",
+                "long_name": "contact stiffness K(t) at the deepest contacting slice (0 if none)",
+            },
+        ),
+        "mechanical_energy": (
+            "time",
+            diag[:, kn.D_ENERGY],
+            {
+                "units": "J",
+                "long_name": "kinetic + gravitational + elastic contact energy",
+            },
+        ),
+    }
+    time = xr.DataArray(
+        t_rel,
+        dims="time",
+        attrs={
+            "units": "s",
+            "long_name": conventions.COORDINATES["time"][1],
+            "simulation_time_at_start": float(t0),
+        },
+    )
+    axis_c = xr.DataArray(
+        np.array(["x", "y", "z"]), dims="axis", attrs={"long_name": "vector component"}
+    )
+    ds = xr.Dataset(
+        {k: xr.Variable(d, np.asarray(val), attrs=a) for k, (d, val, a) in data.items()},
+        coords={"time": time, "axis": axis_c},
+    )
+    ds.attrs["title"] = "jointwear four-bar simulation with a 3D revolute clearance joint"
+    ds.attrs["source"] = "jointwear (sim.dynamics)"
+    ds.attrs["parameter_set"] = params.name
+    ds.attrs["joint_model"] = params.joint.model
+    ds.attrs["contact_formulation"] = params.contact.formulation
+    ds.attrs["contact_stiffness_model"] = params.contact.stiffness
+    ds.attrs["bearing_on"] = params.mechanism.bearing_on
+    ds.attrs["parameters_json"] = __import__("json").dumps(to_jsonable(params))
+    return ds

@@ -1,0 +1,358 @@
+"""Parameters of the four-bar simulator: frozen dataclasses, named sets and TOML loading.
+
+All values are SI (m, kg, kg m2, s, N, Pa) except where a name says otherwise
+(``crank_speed_rpm``, ``initial_crank_angle_deg``). The default set ``"zhang2023"`` holds Tables
+1-2 of the reference study (``docs/sim.md`` lists the choices jointwear adds where the study is
+silent: initial crank angle, axial-stop geometry, impact-velocity floor, solver settings).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from pathlib import Path
+from typing import Literal
+
+from jointwear.errors import ParameterError
+from jointwear.params import from_mapping, read_toml
+
+__all__ = [
+    "MechanismParameters",
+    "JointParameters",
+    "ContactParameters",
+    "FrictionParameters",
+    "SolverParameters",
+    "SimParameters",
+    "PARAMETER_SETS",
+    "load_parameters",
+]
+
+
+def _positive(where: str, **values: float) -> None:
+    for name, value in values.items():
+        if not (value > 0 and math.isfinite(value)):
+            raise ParameterError(
+                f"{where}.{name} must be a positive finite number, got {value!r}; "
+                "set a physical (SI) value"
+            )
+
+
+def _non_negative(where: str, **values: float) -> None:
+    for name, value in values.items():
+        if not (value >= 0 and math.isfinite(value)):
+            raise ParameterError(f"{where}.{name} must be >= 0, got {value!r}")
+
+
+@dataclasses.dataclass(frozen=True)
+class MechanismParameters:
+    """Links, masses and drive of the spatial four-bar (Table 1 of the study).
+
+    Crank A-B, coupler B-C, follower D-C and ground A-D; A at the origin, D at
+    (``ground_length``, 0, 0); gravity along -y. Moments of inertia are about each body's centre
+    of mass (mid-length). The follower's body axes are x (in-plane, normal to the link), y (along
+    the link, D -> C) and z (joint axis); ``follower_inertia`` = (I3x, I3y, I3z).
+    ``joint_offset`` [m]: the centre of joint C (bearing and journal) sits this far along the
+    joint axis (+z) from the mid-plane of the links, which lie side by side; a non-zero offset
+    lets the contact forces turn the follower out of plane about the spherical joint D.
+    """
+
+    crank_length: float = 0.10
+    coupler_length: float = 0.40
+    follower_length: float = 0.30
+    ground_length: float = 0.30
+    crank_mass: float = 0.46
+    coupler_mass: float = 1.45
+    follower_mass: float = 1.50
+    crank_inertia: float = 0.0019
+    coupler_inertia: float = 0.0927
+    follower_inertia: tuple[float, float, float] = (0.0317, 0.0004, 0.0317)
+    gravity: float = 9.81
+    joint_offset: float = 0.01
+    crank_speed_rpm: float = 120.0
+    initial_crank_angle_deg: float = 0.0
+    driver: bool = True
+    bearing_on: Literal["follower", "coupler"] = "follower"
+
+    def __post_init__(self) -> None:
+        w = "mechanism"
+        _positive(
+            w,
+            crank_length=self.crank_length,
+            coupler_length=self.coupler_length,
+            follower_length=self.follower_length,
+            ground_length=self.ground_length,
+            crank_mass=self.crank_mass,
+            coupler_mass=self.coupler_mass,
+            follower_mass=self.follower_mass,
+            crank_inertia=self.crank_inertia,
+            coupler_inertia=self.coupler_inertia,
+        )
+        for i, v in enumerate(self.follower_inertia):
+            _positive(w, **{f"follower_inertia[{i}]": float(v)})
+        _non_negative(w, gravity=self.gravity)
+        if not math.isfinite(self.joint_offset):
+            raise ParameterError(f"{w}.joint_offset must be finite")
+        if not math.isfinite(self.crank_speed_rpm):
+            raise ParameterError(f"{w}.crank_speed_rpm must be finite")
+        if self.driver and self.crank_speed_rpm == 0:
+            raise ParameterError(
+                f"{w}.crank_speed_rpm is 0 with the driver on: a cycle would never end; "
+                "give a speed or set driver = false"
+            )
+        lengths = sorted(
+            [self.crank_length, self.coupler_length, self.follower_length, self.ground_length]
+        )
+        if lengths[0] + lengths[3] > lengths[1] + lengths[2] or (self.crank_length != lengths[0]):
+            raise ParameterError(
+                f"{w}: link lengths crank={self.crank_length}, coupler={self.coupler_length}, "
+                f"follower={self.follower_length}, ground={self.ground_length} m do not make a "
+                "Grashof crank-rocker (the crank must be the shortest link and "
+                "shortest + longest <= sum of the other two); the crank could not turn fully"
+            )
+
+    @property
+    def crank_speed(self) -> float:
+        """Crank angular speed [rad/s] (counter-clockwise positive)."""
+        return self.crank_speed_rpm * 2.0 * math.pi / 60.0
+
+    @property
+    def period(self) -> float:
+        """Duration of one crank revolution at the nominal speed [s]."""
+        return 2.0 * math.pi / abs(self.crank_speed) if self.crank_speed else math.inf
+
+
+@dataclasses.dataclass(frozen=True)
+class JointParameters:
+    """Geometry and discretisation of clearance joint C (Table 2 of the study).
+
+    ``axial_clearance`` is the total axial play: the journal's shoulders sit at
+    +-(bearing_width + axial_clearance)/2 from the journal centre along its axis, and touch the
+    bearing's end faces on a circle of radius ``thrust_radius``. ``model = "ideal"`` makes joint C
+    an ideal revolute (planar four-bar), for validation.
+    """
+
+    model: Literal["clearance", "ideal"] = "clearance"
+    journal_radius: float = 7.5e-3
+    journal_length: float = 17e-3
+    bearing_radius: float = 8.0e-3
+    bearing_width: float = 15e-3
+    axial_clearance: float = 1e-3
+    thrust_radius: float = 9.5e-3
+    n_layers: int = 20
+    n_points: int = 200
+
+    def __post_init__(self) -> None:
+        w = "joint"
+        _positive(
+            w,
+            journal_radius=self.journal_radius,
+            journal_length=self.journal_length,
+            bearing_radius=self.bearing_radius,
+            bearing_width=self.bearing_width,
+            thrust_radius=self.thrust_radius,
+        )
+        _non_negative(w, axial_clearance=self.axial_clearance)
+        if self.bearing_radius <= self.journal_radius:
+            raise ParameterError(
+                f"joint.journal_radius ({self.journal_radius} m) must be smaller than "
+                f"joint.bearing_radius ({self.bearing_radius} m): the radial clearance "
+                f"bearing_radius - journal_radius = {self.radial_clearance:g} m is not positive"
+            )
+        if self.journal_length < self.bearing_width + self.axial_clearance:
+            raise ParameterError(
+                f"joint.journal_length ({self.journal_length} m) must be at least "
+                f"bearing_width + axial_clearance = {self.bearing_width + self.axial_clearance:g} m "
+                "(the journal must span the bearing between its shoulders)"
+            )
+        if self.thrust_radius < self.bearing_radius:
+            raise ParameterError(
+                f"joint.thrust_radius ({self.thrust_radius} m) must be >= bearing_radius "
+                f"({self.bearing_radius} m): the shoulders bear on the end faces outside the bore"
+            )
+        if self.n_layers < 2 or self.n_points < 8:
+            raise ParameterError(
+                f"joint.n_layers must be >= 2 and joint.n_points >= 8, got {self.n_layers} and "
+                f"{self.n_points}"
+            )
+
+    @property
+    def radial_clearance(self) -> float:
+        """Radial clearance c = Rb - Rj [m]."""
+        return self.bearing_radius - self.journal_radius
+
+
+@dataclasses.dataclass(frozen=True)
+class ContactParameters:
+    """Lankarani-Nikravesh contact law with (time-varying) stiffness, eqs. 6-10 of the study.
+
+    ``formulation``: ``"slice"`` (default, grid-independent: each axial slice carries its width
+    share of the joint-level law at its deepest point) or ``"per_point"`` (the study's literal
+    sum of a full law at every penetrating point; grid-dependent, for comparison only).
+    ``stiffness``: ``"time_varying"`` (eq. 9, local worn radius) or ``"constant"`` (eq. 7).
+    ``worn_radius_in_denominator``: the eq. 9 variant with Rb + h also in Rb - Rj.
+    ``axial_stiffness``: L-N stiffness of the end-face (thrust) contact [N/m^n]; 0 means "same
+    as the radial K of eq. 7".
+    """
+
+    formulation: Literal["slice", "per_point"] = "slice"
+    stiffness: Literal["time_varying", "constant"] = "time_varying"
+    worn_radius_in_denominator: bool = False
+    exponent: float = 1.5
+    restitution: float = 0.9
+    journal_modulus: float = 207e9
+    journal_poisson: float = 0.29
+    bearing_modulus: float = 100e9
+    bearing_poisson: float = 0.39
+    impact_velocity_floor: float = 1e-2
+    axial_stiffness: float = 0.0
+    max_penetration_fraction: float = 0.5
+
+    def __post_init__(self) -> None:
+        w = "contact"
+        _positive(
+            w,
+            exponent=self.exponent,
+            journal_modulus=self.journal_modulus,
+            bearing_modulus=self.bearing_modulus,
+            impact_velocity_floor=self.impact_velocity_floor,
+            max_penetration_fraction=self.max_penetration_fraction,
+        )
+        _non_negative(w, axial_stiffness=self.axial_stiffness)
+        if not 0 < self.restitution <= 1:
+            raise ParameterError(f"contact.restitution must be in (0, 1], got {self.restitution}")
+        for name in ("journal_poisson", "bearing_poisson"):
+            v = getattr(self, name)
+            if not -1 < v < 0.5:
+                raise ParameterError(f"contact.{name} must be in (-1, 0.5), got {v}")
+
+
+@dataclasses.dataclass(frozen=True)
+class FrictionParameters:
+    """Smoothed Coulomb friction of eq. 12 (``enabled = false`` switches friction off)."""
+
+    enabled: bool = True
+    static_coefficient: float = 0.2
+    dynamic_coefficient: float = 0.1
+    stick_velocity: float = 1e-3
+    slide_velocity: float = 1e-2
+
+    def __post_init__(self) -> None:
+        _non_negative(
+            "friction",
+            static_coefficient=self.static_coefficient,
+            dynamic_coefficient=self.dynamic_coefficient,
+        )
+        _positive(
+            "friction", stick_velocity=self.stick_velocity, slide_velocity=self.slide_velocity
+        )
+        if self.slide_velocity <= self.stick_velocity:
+            raise ParameterError(
+                f"friction.slide_velocity ({self.slide_velocity}) must exceed "
+                f"friction.stick_velocity ({self.stick_velocity})"
+            )
+
+
+@dataclasses.dataclass(frozen=True)
+class SolverParameters:
+    """Adaptive Dormand-Prince 5(4) integration and output sampling.
+
+    Local error of angles [rad] is held below ``atol``; of angular rates below
+    ``atol + rtol |rate|``. ``onset_penetration`` [m]: a step that starts without contact may end
+    at most this deep (else it is retried shorter), so impact velocities are taken at the onset.
+    """
+
+    rtol: float = 1e-6
+    atol: float = 1e-9
+    max_step: float = 1e-3
+    min_step: float = 1e-11
+    output_interval: float = 1e-4
+    onset_penetration: float = 1e-7
+    baumgarte: float = 1000.0
+
+    def __post_init__(self) -> None:
+        _positive(
+            "solver",
+            rtol=self.rtol,
+            atol=self.atol,
+            max_step=self.max_step,
+            min_step=self.min_step,
+            output_interval=self.output_interval,
+            onset_penetration=self.onset_penetration,
+            baumgarte=self.baumgarte,
+        )
+        if self.min_step >= self.max_step:
+            raise ParameterError("solver.min_step must be smaller than solver.max_step")
+
+
+@dataclasses.dataclass(frozen=True)
+class SimParameters:
+    """All parameters of a simulation (nested: mechanism, joint, contact, friction, solver)."""
+
+    name: str = "zhang2023"
+    mechanism: MechanismParameters = MechanismParameters()
+    joint: JointParameters = JointParameters()
+    contact: ContactParameters = ContactParameters()
+    friction: FrictionParameters = FrictionParameters()
+    solver: SolverParameters = SolverParameters()
+
+
+class _ParameterSets(dict):
+    def __missing__(self, key: str) -> SimParameters:
+        raise KeyError(
+            f"unknown parameter set {key!r}; known parameter sets: {', '.join(sorted(self))}"
+        )
+
+
+#: Named parameter sets. ``"zhang2023"``: Tables 1-2 of the reference study.
+PARAMETER_SETS: dict[str, SimParameters] = _ParameterSets(zhang2023=SimParameters())
+
+
+def load_parameters(toml_path: str | Path, base: str = "zhang2023") -> SimParameters:
+    """Read parameters from a TOML file, on top of a named parameter set.
+
+    The file holds tables ``[mechanism]``, ``[joint]``, ``[contact]``, ``[friction]``,
+    ``[solver]`` with any subset of their fields (SI units), e.g.::
+
+        [joint]
+        bearing_radius = 8.1e-3
+        n_layers = 40
+
+    Parameters
+    ----------
+    toml_path : path
+        The TOML file.
+    base : str
+        Name of the parameter set in :data:`PARAMETER_SETS` whose values are overridden.
+
+    Returns
+    -------
+    SimParameters
+        The resolved parameters.
+
+    Raises
+    ------
+    ParameterError
+        Unknown names (listed with the known ones), wrong types or inconsistent values.
+    """
+    base_params = PARAMETER_SETS[base]
+    data = read_toml(toml_path)
+    merged = dataclasses.asdict(base_params)
+    unknown = [k for k in data if k not in merged]
+    if unknown:
+        raise ParameterError(
+            f"parameter file '{toml_path}': unknown table(s)/name(s) {', '.join(unknown)}; "
+            f"known: {', '.join(merged)}"
+        )
+    for key, value in data.items():
+        if isinstance(merged[key], dict):
+            if not isinstance(value, dict):
+                raise ParameterError(
+                    f"parameter file '{toml_path}': [{key}] must be a table, got {value!r}"
+                )
+            merged[key] = {**merged[key], **value}
+        else:
+            merged[key] = value
+    try:
+        return from_mapping(SimParameters, merged)
+    except ParameterError as exc:
+        raise ParameterError(f"parameter file '{toml_path}': {exc}") from None
