@@ -1,0 +1,75 @@
+"""Taylor Hobson Talyrond preset.
+
+What is publicly known about Talyrond text exports is little: Taylor Hobson's roundness software
+(Talyrond / Ultra / Metrology 4.0) exports traces as plain text or CSV, one trace (layer) per file
+or per block, and a published dataset of Talyrond TR31c traces (Zenodo record 7004548, Aalto
+University) distributes them as CSV with 3600 points per revolution and the radial displacement in
+micrometres. No published specification of the export layouts was found, so this preset *is* the
+generic text reader (:func:`jointwear.metrology.readers.text.read_scan`) with the defaults such a
+trace needs: values are radial deviations in micrometres unless the header says otherwise, angles
+are equally spaced over one revolution when the file has no angle column, and the instrument name
+goes into ``source``. Everything the generic reader sniffs is still sniffed and recorded, and
+every default can be overridden.
+
+The instrument's angle zero and direction in the bearing frame are not in the export: they must
+be given (``convention``) and are recorded, never guessed.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from pathlib import Path
+
+import xarray as xr
+
+from jointwear.conventions import AngleConvention
+from jointwear.metrology.readers.text import read_scan
+
+__all__ = ["TALYROND_DEFAULTS", "read_talyrond"]
+
+#: Defaults of the preset (any can be overridden by the same keyword).
+TALYROND_DEFAULTS: dict[str, object] = {
+    "units": "um",
+    "value": "auto",
+    "instrument": "Taylor Hobson Talyrond",
+}
+
+
+def read_talyrond(
+    paths: str | Path | Iterable[str | Path],
+    *,
+    convention: AngleConvention | tuple[str, str] | None = None,
+    **options,
+) -> xr.Dataset:
+    """Read Talyrond text exports (one trace, a folder of traces, a long or a wide file).
+
+    Parameters
+    ----------
+    paths : path, folder or list of paths
+        The export(s).
+    convention : AngleConvention or (zero, direction)
+        Where the instrument's 0 degree points in the bearing frame and which way its angle
+        turns (seen from +z). Required.
+    **options
+        Any option of :func:`~jointwear.metrology.readers.text.read_scan`; defaults
+        :data:`TALYROND_DEFAULTS` (values in µm unless the header states a unit; the header's
+        unit wins over this default but not over an explicit ``units=``).
+
+    Returns
+    -------
+    Dataset
+        ``radial_deviation`` (or ``radius``) [m] over (z, theta) in the canonical convention.
+    """
+    opts = dict(TALYROND_DEFAULTS)
+    explicit_units = "units" in options
+    opts.update(options)
+    if not explicit_units:
+        # the header's unit (if any) must win over the preset default: try without it first
+        from jointwear.errors import BadInputError
+
+        try:
+            return read_scan(paths, convention=convention, **{**opts, "units": None})
+        except BadInputError as exc:
+            if "unit" not in str(exc) or "not stated" not in str(exc):
+                raise
+    return read_scan(paths, convention=convention, **opts)
