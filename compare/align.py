@@ -350,12 +350,12 @@ def align_wear_maps(
             "cycles_sim": float("nan") if s_cycles is None else float(s_cycles),
             "cycles_meas": float("nan") if m_cycles is None else float(m_cycles),
             "cycles_selection": f"simulation: {s_how}; measurement: {m_how}",
-            "angle_convention_sim": str(
+            "angle_convention_sim": _describe(
                 conventions.angle_convention_of(
                     sim if isinstance(sim, xr.DataArray) else sim[variable]
                 )
             ),
-            "angle_convention_meas": str(
+            "angle_convention_meas": _describe(
                 conventions.angle_convention_of(
                     meas if isinstance(meas, xr.DataArray) else meas[variable]
                 )
@@ -370,6 +370,10 @@ def align_wear_maps(
             if value is not None and np.isfinite(value):
                 out.attrs[f"cylindricity_stated_{side}_m"] = value
     return out
+
+
+def _describe(conv: conventions.AngleConvention) -> str:
+    return f"theta = 0 along {conv.zero}, increasing {conv.direction} seen from +z"
 
 
 def _stated_scalar(ds: xr.Dataset, name: str, cycles: float | None) -> float | None:

@@ -1,0 +1,86 @@
+"""``jointwear report --sim ... --metrology ... --dic ... --out report.html``."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+
+def register(app: typer.Typer) -> None:
+    """Make the ``jointwear report`` group itself build the report (options only)."""
+
+    @app.callback(invoke_without_command=True)
+    def report(
+        ctx: typer.Context,
+        out: Annotated[Path, typer.Option("--out", "-o", help="HTML report to write.")] = Path(
+            "report.html"
+        ),
+        sim: Annotated[
+            list[Path] | None,
+            typer.Option("--sim", help="Simulated wear map and/or motion (.nc); repeatable."),
+        ] = None,
+        metrology: Annotated[
+            list[Path] | None,
+            typer.Option("--metrology", help="Measured wear map (.nc from jointwear metrology)."),
+        ] = None,
+        dic: Annotated[
+            list[Path] | None,
+            typer.Option("--dic", help="Measured motion (.nc from jointwear dic)."),
+        ] = None,
+        comparison: Annotated[
+            Path | None,
+            typer.Option("--comparison", help="A metrics.nc from jointwear compare instead."),
+        ] = None,
+        verification: Annotated[
+            list[Path] | None,
+            typer.Option("--verification", help="Verification (convergence) data (.nc)."),
+        ] = None,
+        criteria: Annotated[
+            Path | None, typer.Option("--criteria", help="TOML file with validation criteria.")
+        ] = None,
+        pdf: Annotated[
+            Path | None, typer.Option("--pdf", help="Also write a PDF (no browser needed).")
+        ] = None,
+        title: Annotated[str | None, typer.Option("--title", help="Report title.")] = None,
+        cycles: Annotated[
+            float | None, typer.Option("--cycles", help="Crank cycles at which to compare wear.")
+        ] = None,
+        period: Annotated[
+            float | None,
+            typer.Option("--period", help="Crank period in seconds (if no crank angle)."),
+        ] = None,
+        strict: Annotated[
+            bool, typer.Option("--strict", help="Exit with code 1 if a criterion fails.")
+        ] = False,
+    ) -> None:
+        """Build a self-contained HTML validation report from simulation and measurement files."""
+        if ctx.invoked_subcommand is not None:
+            return
+        from jointwear import io
+        from jointwear.compare import load_criteria
+        from jointwear.errors import ValidationFailed
+        from jointwear.reports.builder import DEFAULT_TITLE, report_from_files
+
+        io.check_writable(out, what="report")
+        path, result = report_from_files(
+            out,
+            sim=sim or [],
+            metrology=metrology or [],
+            dic=dic or [],
+            comparison=comparison,
+            verification=verification or [],
+            criteria=load_criteria(criteria),
+            title=title or DEFAULT_TITLE,
+            pdf=pdf,
+            cycles=cycles,
+            period_s=period,
+        )
+        for row in result.decisions.itertuples():
+            typer.echo(f"{'PASS' if row.passed else 'FAIL'}  {row.quantity}: {row.value}")
+        typer.echo(f"report: {path}")
+        if pdf is not None:
+            typer.echo(f"pdf: {pdf}")
+        if strict and not result.passed:
+            raise ValidationFailed(f"validation failed for: {', '.join(result.failed())}")

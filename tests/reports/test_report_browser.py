@@ -1,0 +1,84 @@
+"""The report as a person sees it: rendered by headless Chromium (screenshot and DOM)."""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+
+import numpy as np
+import pytest
+from test_report_html import EXPECTED_SECTIONS, _Page  # noqa: I001
+
+from jointwear.reports import report_from_files
+
+pytestmark = pytest.mark.browser
+
+FLAGS = [
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-quic",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+]
+
+
+def _chromium() -> str:
+    for name in ("chromium", "chromium-browser", "google-chrome", "chrome"):
+        path = shutil.which(name)
+        if path:
+            return path
+    message = (
+        "headless Chromium is not installed (Debian: apt-get install chromium); the browser "
+        "check of the report cannot run"
+    )
+    if os.environ.get("CI") == "true":
+        pytest.fail(message + " - CI must install it (.ci/run)")
+    pytest.skip(message)
+
+
+def _run(args: list[str], tmp_path) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [_chromium(), *FLAGS, f"--user-data-dir={tmp_path / 'profile'}", *args],
+        capture_output=True,
+        timeout=180,
+        check=False,
+    )
+
+
+def test_report_renders_in_chromium(report_files, tmp_path):
+    exe = _chromium()
+    assert exe
+    f = report_files
+    html, _ = report_from_files(
+        tmp_path / "report.html",
+        sim=[f["sim_wear"], f["sim_motion"]],
+        metrology=[f["metrology"]],
+        dic=[f["dic"]],
+        command="browser test",
+    )
+    url = html.resolve().as_uri()
+    shot = tmp_path / "shot.png"
+    res = _run(["--window-size=1200,2400", f"--screenshot={shot}", url], tmp_path)
+    assert shot.exists(), res.stderr.decode(errors="replace")[-2000:]
+    from PIL import Image
+
+    img = np.asarray(Image.open(shot).convert("L"), dtype=float)
+    assert img.shape == (2400, 1200)
+    non_white = np.mean(img < 240)
+    assert non_white > 0.03, f"page looks blank ({non_white:.1%} non-white pixels)"
+    assert img.std() > 20
+    # the coloured decision card (green or red border and verdicts) is drawn
+    rgb = np.asarray(Image.open(shot).convert("RGB"), dtype=int)
+    saturation = rgb.max(axis=2) - rgb.min(axis=2)
+    assert np.mean(saturation > 60) > 0.001
+
+    dom = _run(["--dump-dom", url], tmp_path)
+    assert dom.returncode == 0, dom.stderr.decode(errors="replace")[-2000:]
+    page = _Page()
+    page.feed(dom.stdout.decode("utf-8"))
+    assert page.h2 == EXPECTED_SECTIONS
+    assert page.tags.get("svg", 0) >= 2

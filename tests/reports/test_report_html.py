@@ -1,0 +1,153 @@
+"""The HTML report: structure (parsed with html.parser), self-containment, determinism, CLI."""
+
+from __future__ import annotations
+
+from html.parser import HTMLParser
+
+import pytest
+
+from jointwear.cli import main
+from jointwear.reports import report_from_files
+
+EXPECTED_SECTIONS = [
+    "Decision",
+    "Metrics",
+    "Alignment",
+    "Wear maps",
+    "Motion",
+    "Uncertainty budget",
+    "Verification",
+    "Provenance",
+]
+
+
+class _Page(HTMLParser):
+    def __init__(self) -> None:
+        super().__init__(convert_charrefs=True)
+        self.stack: list[str] = []
+        self.h2: list[str] = []
+        self.tags: dict[str, int] = {}
+        self.urls: list[str] = []
+        self.cells: list[tuple[str, str]] = []  # (class, text) of <td>
+        self._cell: list[str] | None = None
+        self._cls = ""
+        self._h2: list[str] | None = None
+
+    def handle_starttag(self, tag, attrs):
+        a = dict(attrs)
+        self.tags[tag] = self.tags.get(tag, 0) + 1
+        for key, value in a.items():
+            if value is not None and (key.endswith("href") or key == "src"):
+                self.urls.append(value)
+        if tag == "h2":
+            self._h2 = []
+        if tag == "td":
+            self._cell, self._cls = [], a.get("class") or ""
+
+    def handle_endtag(self, tag):
+        if tag == "h2" and self._h2 is not None:
+            self.h2.append("".join(self._h2).strip())
+            self._h2 = None
+        if tag == "td" and self._cell is not None:
+            self.cells.append((self._cls, "".join(self._cell).strip()))
+            self._cell = None
+
+    def handle_data(self, data):
+        if self._h2 is not None:
+            self._h2.append(data)
+        if self._cell is not None:
+            self._cell.append(data)
+
+
+def parse(path) -> _Page:
+    page = _Page()
+    page.feed(path.read_text(encoding="utf-8"))
+    return page
+
+
+@pytest.fixture(scope="module")
+def built(report_files, tmp_path_factory):
+    out = tmp_path_factory.mktemp("report") / "report.html"
+    f = report_files
+    path, result = report_from_files(
+        out,
+        sim=[f["sim_wear"], f["sim_motion"]],
+        metrology=[f["metrology"]],
+        dic=[f["dic"]],
+        command="jointwear report (test)",
+    )
+    return path, result
+
+
+def test_report_structure(built):
+    path, result = built
+    page = parse(path)
+    assert page.h2 == EXPECTED_SECTIONS
+    # decision card: one PASS/FAIL cell per decision, matching the comparison
+    verdicts = [
+        text for cls, text in page.cells if cls in ("pass", "fail") and text in ("PASS", "FAIL")
+    ]
+    assert verdicts == ["PASS" if p else "FAIL" for p in result.decisions.passed]
+    # the rotated measurement: angle error of the maximum is -10 degree, shown in the card
+    assert any("-10.0 degree" in text for _, text in page.cells)
+    # figures inline: the wear maps as PNG, polar plots and motion as SVG
+    assert page.tags.get("svg", 0) >= 2 and page.tags.get("img", 0) == 1
+    assert page.tags.get("script", 0) == 0
+    for url in page.urls:  # nothing fetched from elsewhere
+        assert url.startswith(("#", "data:image/png;base64,")), url
+    html = path.read_text(encoding="utf-8")
+    assert "<style>" in html and "<metadata>" not in html
+    assert "jointwear report (test)" in html
+
+
+def test_report_lists_inputs_with_sha256(built, report_files):
+    from jointwear.provenance import sha256_file
+
+    html = built[0].read_text(encoding="utf-8")
+    for p in report_files.values():
+        assert sha256_file(p) in html
+        assert str(p) in html
+
+
+def test_report_is_byte_identical(report_files, built, tmp_path):
+    f = report_files
+    again, _ = report_from_files(
+        tmp_path / "again.html",
+        sim=[f["sim_wear"], f["sim_motion"]],
+        metrology=[f["metrology"]],
+        dic=[f["dic"]],
+        command="jointwear report (test)",
+    )
+    assert again.read_bytes() == built[0].read_bytes()
+
+
+def test_report_states_missing_parts(report_files, tmp_path):
+    f = report_files
+    path, result = report_from_files(
+        tmp_path / "wear-only.html", sim=[f["sim_wear"]], metrology=[f["metrology"]], command="t"
+    )
+    assert result.motion is None
+    html = path.read_text(encoding="utf-8")
+    assert "Not covered:</strong> motion: no DIC file was given (--dic)" in html
+    page = parse(path)
+    assert page.h2 == EXPECTED_SECTIONS
+
+
+def test_report_cli_html_pdf_and_comparison(report_files, tmp_path, capsys):
+    f = report_files
+    out = tmp_path / "r.html"
+    pdf = tmp_path / "r.pdf"
+    argv = ["report", "--sim", str(f["sim_wear"]), "--sim", str(f["sim_motion"])]
+    argv += ["--metrology", str(f["metrology"]), "--dic", str(f["dic"])]
+    assert main([*argv, "--out", str(out), "--pdf", str(pdf), "--strict"]) == 0
+    assert f"report: {out}" in capsys.readouterr().out
+    assert pdf.read_bytes().startswith(b"%PDF") and pdf.stat().st_size > 10_000
+    # from a saved comparison
+    metrics = tmp_path / "m.nc"
+    assert main(["compare", str(f["sim_wear"]), str(f["metrology"]), "-o", str(metrics)]) == 0
+    out2 = tmp_path / "r2.html"
+    assert main(["report", "--comparison", str(metrics), "--out", str(out2)]) == 0
+    assert parse(out2).h2 == EXPECTED_SECTIONS
+    # usage errors
+    assert main(["report", "--out", str(out2)]) == 3
+    assert "no simulation given" in capsys.readouterr().err
