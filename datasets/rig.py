@@ -704,6 +704,9 @@ def _write_bodies_toml(rig: VirtualRig, path: Path) -> Path:
         "[track]",
         "subset_size = 21",
         "step = 10",
+        "# mechanism-frame position of the world origin when the calibration's world frame is the",
+        "# rig's board view (the last calibration image pair); use [0, 0, 0] with the exact cameras",
+        "world_origin = [" + ", ".join(f"{v:.9f}" for v in rig.world_board_origin()) + "]",
         "",
     ]
     for body, poly in rois.items():
@@ -720,6 +723,11 @@ def _write_bodies_toml(rig: VirtualRig, path: Path) -> Path:
                 "centroid_mechanism = ["
                 + ", ".join(f"{v:.9f}" for v in pose0["follower_centroid"])
                 + "]"
+            )
+        if body == "journal":
+            lines.append("# journal cap centre at the first frame, mechanism frame [m]")
+            lines.append(
+                "centroid_mechanism = [" + ", ".join(f"{v:.9f}" for v in pose0["journal"][1]) + "]"
             )
         if body == "crank":
             lines.append(f"reference_angle_deg = {np.rad2deg(pose0['crank_angle']):.6f}")

@@ -141,7 +141,7 @@ class Camera:
         v = K[1, 1] * d[..., 1] + K[1, 2]
         return np.stack([u, v], axis=-1)
 
-    def pixels_to_normalized(self, uv: np.ndarray, *, iterations: int = 30) -> np.ndarray:
+    def pixels_to_normalized(self, uv: np.ndarray, *, iterations: int = 8) -> np.ndarray:
         """Undistort pixel coordinates (N, 2) to normalised coordinates (inverse of the model).
 
         Fixed-point iteration followed by Newton steps; accurate to ~1e-12 for the distortion

@@ -1,0 +1,822 @@
+"""Footage to body motion: stereo (or single-camera) tracking of rigid bodies in rig videos.
+
+Pipeline (``track_footage``)
+---------------------------
+1. The first frame of each camera is the reference. Each body's region of interest (a polygon
+   in the left reference image, from a small TOML file) is filled with a grid of subsets.
+2. Stereo correspondence at the reference: SIFT features of the region are matched into the
+   right image, kept only if they satisfy the calibrated epipolar constraint (< 2 px), and a
+   RANSAC homography gives every subset an initial guess (position and affine gradients); the
+   2D engine (:class:`jointwear.dic.SubsetCorrelator`, affine IC-GN) refines it. Matches with an
+   epipolar distance above ``max_epipolar_px`` or low ZNCC are discarded. The matched pairs are
+   triangulated (undistorted) into the body's reference 3D points.
+3. Temporal tracking: in every frame each camera's subsets are correlated against that camera's
+   reference image (no drift). The guess comes from a quadratic extrapolation of the last three
+   frames (a body-wide affine fitted to the extrapolated points) corrected by phase correlation
+   of the warped reference crop with the current crop, so fast bodies (1 m/s, 80 px per frame)
+   are followed. Only a fixed-size crop around each body is handed to the engine.
+4. Per frame and body: triangulation, robust rigid fit (3D; planar 2D without stereo) of the
+   current points to the reference points -> pose; the body-fixed point of interest (follower
+   centre of mass, journal cap centre) is moved with the pose. Velocities come from a
+   Savitzky–Golay differentiator on the actual frame times (window 9, order 5 by default).
+5. Frames are read and processed in chunks (bounded memory: only the reference images, one
+   frame per camera and the per-frame results are held), the result is written after each chunk
+   when an output path is given, so an interrupted run keeps what was computed.
+"""
+
+from __future__ import annotations
+
+import json
+import time as _time
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import Any, Literal
+
+import numpy as np
+import xarray as xr
+
+from jointwear.dic._calib import StereoCalibration
+from jointwear.dic._rigid import derivative, fit_rigid_robust, rotation_angle_z
+from jointwear.dic._stereo import epipolar_distance, triangulate
+from jointwear.dic._video import FrameSource, check_stereo_pair, open_frames
+from jointwear.errors import BadInputError, ParameterError
+from jointwear.params import from_mapping, read_toml
+
+__all__ = [
+    "BodySpec",
+    "TrackConfig",
+    "read_bodies",
+    "track_footage",
+    "FRAME_FLAGS",
+]
+
+#: Frame quality flags (bit mask) of the ``frame_flag`` output variable.
+FRAME_FLAGS = {"ok": 0, "duplicated": 1, "after_gap": 2, "tracking_failed": 4}
+
+
+@dataclass(frozen=True, eq=False)
+class BodySpec:
+    """A tracked rigid body.
+
+    Parameters
+    ----------
+    name : str
+        Body name (``follower``, ``journal``, ``crank``, ...).
+    role : {"follower", "journal", "crank", "other"}
+        What the body is: the follower's centroid velocity, the journal's displacement and the
+        crank's angle go into the contract variables.
+    polygon : list of [x, y]
+        Region of interest in the left reference image [pixel] (3 or more vertices).
+    centroid : [x, y, z] or None
+        Body-fixed point whose motion is reported, in the world frame at the reference frame
+        [m] (the follower's centre of mass). Default: the centroid of the tracked points.
+    centroid_mechanism : [x, y, z] or None
+        The same in the mechanism frame, used when the calibration's world frame is a board on
+        the mechanism plane (the point is shifted by the board origin given in ``world_origin``).
+    reference_angle_deg : float
+        Crank angle at the reference frame [degree] (crank bodies).
+    """
+
+    name: str
+    role: Literal["follower", "journal", "crank", "other"] = "other"
+    polygon: list[list[float]] = field(default_factory=list)
+    centroid: list[float] | None = None
+    centroid_mechanism: list[float] | None = None
+    reference_angle_deg: float = 0.0
+
+
+@dataclass(frozen=True, eq=False)
+class TrackConfig:
+    """Options of ``jointwear dic track`` (TOML table ``[track]``).
+
+    Parameters
+    ----------
+    subset_size : int
+        Subset side [pixel] (odd).
+    step : int
+        Grid spacing of the subsets in each region [pixel].
+    chunk_size : int
+        Frames per processing chunk (results are saved after each chunk).
+    zncc_min : float
+        Matches below this ZNCC are discarded.
+    max_epipolar_px : float
+        Stereo matches farther from the epipolar line are discarded [pixel].
+    min_points : int
+        Fewest valid points for a body's pose in a frame (fewer: the frame is flagged).
+    velocity_window, velocity_order : int
+        Savitzky–Golay differentiator (samples, polynomial degree).
+    sigma_px : float
+        Standard uncertainty of one subset match [pixel] used for the propagated uncertainty
+        (0: estimated from the image noise and the subset's intensity gradients).
+    duplicate_threshold : float
+        Consecutive frames whose mean absolute difference is below this [grey level] are
+        reported as duplicates.
+    world_origin : [x, y, z]
+        Mechanism-frame position of the world origin (the calibration board's first inner
+        corner), used to place ``centroid_mechanism`` [m].
+    """
+
+    subset_size: int = 21
+    step: int = 10
+    chunk_size: int = 50
+    zncc_min: float = 0.8
+    max_epipolar_px: float = 1.0
+    min_points: int = 6
+    velocity_window: int = 9
+    velocity_order: int = 5
+    sigma_px: float = 0.0
+    duplicate_threshold: float = 0.05
+    world_origin: list[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
+
+    def __post_init__(self) -> None:
+        if self.subset_size < 7 or self.subset_size % 2 == 0:
+            raise ParameterError(
+                f"track.subset_size={self.subset_size}: expected an odd integer >= 7"
+            )
+        if self.step < 1 or self.chunk_size < 1 or self.min_points < 3:
+            raise ParameterError("track.step and chunk_size must be >= 1, min_points >= 3")
+        if self.velocity_window % 2 == 0 or self.velocity_window <= self.velocity_order:
+            raise ParameterError(
+                f"track.velocity_window={self.velocity_window} must be odd and larger than "
+                f"velocity_order={self.velocity_order}"
+            )
+
+
+def read_bodies(path: str | Path) -> tuple[TrackConfig, list[BodySpec]]:
+    """Read the regions-of-interest TOML file: ``[track]`` options and ``[bodies.<name>]``."""
+    data = read_toml(path)
+    unknown = [k for k in data if k not in ("track", "bodies")]
+    if unknown:
+        raise ParameterError(
+            f"'{path}': unknown table(s) {unknown}; expected [track] and [bodies.<name>]"
+        )
+    cfg = from_mapping(TrackConfig, data.get("track", {}), where="track")
+    bodies = []
+    for name, spec in data.get("bodies", {}).items():
+        spec = dict(spec)
+        body = from_mapping(BodySpec, {"name": name, **spec}, where=f"bodies.{name}")
+        if len(body.polygon) < 3:
+            raise ParameterError(
+                f"'{path}': bodies.{name}.polygon needs at least 3 [x, y] vertices in pixels of "
+                "the left reference image"
+            )
+        bodies.append(body)
+    if not bodies:
+        raise ParameterError(f"'{path}' defines no [bodies.<name>] with a polygon")
+    return cfg, bodies
+
+
+# ---------------------------------------------------------------------------------------------
+def _grid_in_polygon(poly: np.ndarray, half: int, step: int) -> np.ndarray:
+    import cv2
+
+    x0, y0 = np.floor(poly.min(0)).astype(int)
+    x1, y1 = np.ceil(poly.max(0)).astype(int)
+    xs = np.arange(x0 + half, x1 - half + 1, step, dtype=float)
+    ys = np.arange(y0 + half, y1 - half + 1, step, dtype=float)
+    X, Y = np.meshgrid(xs, ys)
+    pts = np.column_stack([X.ravel(), Y.ravel()])
+    contour = poly.astype(np.float32).reshape(-1, 1, 2)
+    keep = [cv2.pointPolygonTest(contour, (float(x), float(y)), True) >= half for x, y in pts]
+    return pts[np.asarray(keep, dtype=bool)] if len(pts) else pts
+
+
+def _noise_sigma(img: np.ndarray) -> float:
+    """Image noise standard deviation (Immerkaer's Laplacian method) [grey level]."""
+    import cv2
+
+    k = np.array([[1, -2, 1], [-2, 4, -2], [1, -2, 1]], dtype=np.float32)
+    r = cv2.filter2D(img.astype(np.float32), -1, k)[1:-1, 1:-1]
+    return float(np.sqrt(np.pi / 2) * np.mean(np.abs(r)) / 6.0)
+
+
+def _match_sigma(img: np.ndarray, pts: np.ndarray, half: int, noise: float) -> np.ndarray:
+    """Cramér–Rao-type match uncertainty per subset: sqrt(2) sigma_n / sqrt(sum grad^2) [pixel]."""
+    import cv2
+
+    gx = cv2.Sobel(img, cv2.CV_32F, 1, 0, ksize=3) / 8.0
+    gy = cv2.Sobel(img, cv2.CV_32F, 0, 1, ksize=3) / 8.0
+    out = np.empty(len(pts))
+    for i, (x, y) in enumerate(np.rint(pts).astype(int)):
+        sx = gx[y - half : y + half + 1, x - half : x + half + 1]
+        sy = gy[y - half : y + half + 1, x - half : x + half + 1]
+        g = min(float(np.sum(sx * sx)), float(np.sum(sy * sy)))
+        out[i] = np.sqrt(2.0) * noise / np.sqrt(max(g, 1e-12))
+    return out
+
+
+def _sift_homography(
+    ref: np.ndarray, img: np.ndarray, poly: np.ndarray, *, calibration=None, margin: int = 10
+) -> np.ndarray | None:
+    """Homography from the reference region to ``img`` by SIFT + RANSAC (epipolar-filtered)."""
+    import cv2
+
+    def u8(a):
+        return np.clip(a, 0, 255).astype(np.uint8)
+
+    mask = np.zeros(ref.shape, np.uint8)
+    cv2.fillPoly(mask, [np.rint(poly).astype(np.int32)], 255)
+    mask = cv2.dilate(mask, np.ones((2 * margin + 1,) * 2, np.uint8))
+    sift = cv2.SIFT_create(nfeatures=2000)
+    k1, d1 = sift.detectAndCompute(u8(ref), mask)
+    k2, d2 = sift.detectAndCompute(u8(img), None)
+    if d1 is None or d2 is None or len(k1) < 8 or len(k2) < 8:
+        return None
+    matches = cv2.BFMatcher(cv2.NORM_L2).knnMatch(d1, d2, k=2)
+    good = [m[0] for m in matches if len(m) == 2 and m[0].distance < 0.8 * m[1].distance]
+    if len(good) < 8:
+        return None
+    p1 = np.float64([k1[m.queryIdx].pt for m in good])
+    p2 = np.float64([k2[m.trainIdx].pt for m in good])
+    if calibration is not None:
+        ok = epipolar_distance(calibration, p1, p2) < 3.0
+        p1, p2 = p1[ok], p2[ok]
+        if len(p1) < 8:
+            return None
+    H, inl = cv2.findHomography(p1, p2, cv2.RANSAC, 2.0)
+    if H is None or inl.sum() < 8:
+        return None
+    return H
+
+
+def _homography_guess(H: np.ndarray, pts: np.ndarray) -> np.ndarray:
+    """Affine initial guesses (u, du/dx, du/dy, v, dv/dx, dv/dy) from a homography."""
+    hp = np.column_stack([pts, np.ones(len(pts))]) @ H.T
+    w = hp[:, 2]
+    q = hp[:, :2] / w[:, None]
+    # Jacobian of the homography at each point
+    J = (H[None, :2, :2] - q[:, :, None] * H[None, 2:3, :2]) / w[:, None, None]
+    return np.column_stack(
+        [
+            q[:, 0] - pts[:, 0],
+            J[:, 0, 0] - 1,
+            J[:, 0, 1],
+            q[:, 1] - pts[:, 1],
+            J[:, 1, 0],
+            J[:, 1, 1] - 1,
+        ]
+    )
+
+
+class _CameraBodyTracker:
+    """Tracks one body's subsets in one camera against that camera's reference image."""
+
+    def __init__(self, ref: np.ndarray, pts: np.ndarray, cfg: TrackConfig, what: str) -> None:
+        from jointwear.dic._api2d import CorrelationParams, SubsetCorrelator
+
+        self.what = what
+        self.ref_pts = pts.astype(float)
+        h, w = ref.shape
+        half = cfg.subset_size // 2
+        lo, hi = pts.min(0) - half, pts.max(0) + half
+        centre = 0.5 * (lo + hi)
+        side = int(np.ceil(np.hypot(*(hi - lo)))) + 2 * half + 16
+        side += side % 2
+        self.side = side
+        self.origin = np.floor(centre - side / 2).astype(int)  # reference crop corner (x, y)
+        self.centre = centre
+        crop = _crop(ref, self.origin, side)
+        self.ref_crop = crop
+        params = CorrelationParams(
+            subset_size=cfg.subset_size, zncc_min=cfg.zncc_min, threads=1, search_radius=8
+        )
+        self.corr = SubsetCorrelator(crop, points=self.ref_pts - self.origin, params=params)
+        self.history: list[tuple[np.ndarray, np.ndarray]] = []  # (A 2x3, positions)
+
+    def _predict(self) -> np.ndarray:
+        """Predicted positions (N, 2) from the last frames (quadratic extrapolation)."""
+        hist = self.history
+        if not hist:
+            return self.ref_pts.copy()
+        X = [h[1] for h in hist[-3:]]
+        if len(X) == 1:
+            return X[0]
+        if len(X) == 2:
+            return 2 * X[1] - X[0]
+        return 3 * X[2] - 3 * X[1] + X[0]
+
+    def track(self, img: np.ndarray, point_guess: np.ndarray | None = None):
+        """Correlate the subsets in ``img``; ``point_guess`` (N, 6) affine guesses (reference
+        image coordinates) replace the prediction. Returns positions (N, 2), ZNCC, ok mask."""
+        import cv2
+
+        P = self.ref_pts
+        identity = np.hstack([np.eye(2), np.zeros((2, 1))])
+        if point_guess is not None:
+            q0 = P + point_guess[:, [0, 3]]
+            A, _ = cv2.estimateAffine2D(P, q0, method=cv2.LMEDS)
+            A = identity if A is None else A
+        else:
+            pred = self._predict()
+            ok = np.all(np.isfinite(pred), axis=1)
+            A = None
+            if ok.sum() >= 3:
+                A, _ = cv2.estimateAffine2D(P[ok], pred[ok], method=cv2.LMEDS)
+            A = identity if A is None else A
+        # where the reference crop's centre goes, and the current crop
+        c_new = A[:, :2] @ self.centre + A[:, 2]
+        origin = np.floor(c_new - self.side / 2).astype(int)
+        cur = _crop(img, origin, self.side)
+        shift = np.zeros(2)
+        if point_guess is None and self.history:
+            # correct the translation by phase correlation of the warped reference crop
+            M = A.copy()
+            M[:, 2] = A[:, :2] @ self.origin + A[:, 2] - origin
+            fill = float(np.nanmedian(self.ref_crop))
+            warped = cv2.warpAffine(
+                np.nan_to_num(self.ref_crop, nan=fill),
+                M,
+                (self.side, self.side),
+                flags=cv2.INTER_LINEAR,
+                borderMode=cv2.BORDER_CONSTANT,
+                borderValue=fill,
+            )
+            b = np.nan_to_num(cur, nan=fill).astype(np.float32)
+            win = cv2.createHanningWindow((self.side, self.side), cv2.CV_32F)
+            (dx, dy), resp = cv2.phaseCorrelate(warped.astype(np.float32), b, win)
+            if resp > 0.05 and np.hypot(dx, dy) < self.side / 3:
+                shift = np.array([dx, dy])
+        if point_guess is not None:
+            guess = point_guess.astype(float).copy()
+        else:
+            q = P @ A[:, :2].T + A[:, 2] + shift
+            guess = np.column_stack(
+                [
+                    q[:, 0] - P[:, 0],
+                    np.full(len(P), A[0, 0] - 1),
+                    np.full(len(P), A[0, 1]),
+                    q[:, 1] - P[:, 1],
+                    np.full(len(P), A[1, 0]),
+                    np.full(len(P), A[1, 1] - 1),
+                ]
+            )
+        # displacements in crop coordinates
+        off = origin - self.origin
+        guess[:, 0] -= off[0]
+        guess[:, 3] -= off[1]
+        res = self.corr.match(cur, initial_guess=guess)
+        pos = np.column_stack(
+            [P[:, 0] + res.params[:, 0] + off[0], P[:, 1] + res.params[:, 6] + off[1]]
+        )
+        good = res.ok & (res.zncc >= self.corr.params.zncc_min)
+        pos[~good] = np.nan
+        return pos, res.zncc, good
+
+    def commit(self, pos: np.ndarray) -> None:
+        import cv2
+
+        ok = np.all(np.isfinite(pos), axis=1)
+        if ok.sum() >= 3:
+            filled = pos.copy()
+            A, _ = cv2.estimateAffine2D(self.ref_pts[ok], pos[ok], method=cv2.LMEDS)
+            if A is not None:
+                filled[~ok] = self.ref_pts[~ok] @ A[:, :2].T + A[:, 2]
+            self.history.append((A, filled))
+            self.history = self.history[-3:]
+
+
+def _crop(img: np.ndarray, origin: np.ndarray, side: int) -> np.ndarray:
+    """``side`` x ``side`` crop at ``origin`` (x, y); outside the image is NaN."""
+    h, w = img.shape
+    out = np.full((side, side), np.nan, dtype=np.float32)
+    x0, y0 = int(origin[0]), int(origin[1])
+    sx0, sy0 = max(x0, 0), max(y0, 0)
+    sx1, sy1 = min(x0 + side, w), min(y0 + side, h)
+    if sx1 > sx0 and sy1 > sy0:
+        out[sy0 - y0 : sy1 - y0, sx0 - x0 : sx1 - x0] = img[sy0:sy1, sx0:sx1]
+    return out
+
+
+# ---------------------------------------------------------------------------------------------
+@dataclass
+class _BodyState:
+    spec: BodySpec
+    left: _CameraBodyTracker
+    right: _CameraBodyTracker | None
+    ref3d: np.ndarray  # (N, 3) reference points (world) or (N, 2) pixels (mono)
+    sigma_px: np.ndarray
+    point_of_interest: np.ndarray
+    rows: dict[str, list] = field(default_factory=dict)
+
+
+def _body_point(spec: BodySpec, ref: np.ndarray, cfg: TrackConfig) -> np.ndarray:
+    if spec.centroid is not None:
+        return np.asarray(spec.centroid, dtype=float)
+    if spec.centroid_mechanism is not None and ref.shape[1] == 3:
+        return np.asarray(spec.centroid_mechanism, dtype=float) - np.asarray(cfg.world_origin)
+    return np.nanmean(ref, axis=0)
+
+
+def track_footage(
+    left: str | Path | FrameSource,
+    right: str | Path | FrameSource | None = None,
+    *,
+    bodies: list[BodySpec],
+    calibration: StereoCalibration | None = None,
+    config: TrackConfig | None = None,
+    fps: float | None = None,
+    max_frames: int | None = None,
+    out: str | Path | None = None,
+    progress: bool = False,
+    inputs: tuple = (),
+) -> xr.Dataset:
+    """Track rigid bodies through rig footage; body poses, follower velocity, journal motion.
+
+    Parameters
+    ----------
+    left, right : path or FrameSource
+        Video files or image folders of the two cameras (``right`` None: single camera,
+        planar motion in pixels only).
+    bodies : list of BodySpec
+        Regions of interest (see :func:`read_bodies`).
+    calibration : StereoCalibration
+        Required with two cameras; positions are in its world frame [m].
+    config : TrackConfig
+    fps : float, optional
+        Frame rate [1/s] (image sequences; overrides a video's rate).
+    max_frames : int, optional
+        Process only the first frames.
+    out : path, optional
+        netCDF written after every chunk (atomic): a run that stops keeps what was computed
+        (``status`` attribute says where and why it stopped).
+    progress : bool
+        Progress bar on stderr.
+
+    Returns
+    -------
+    Dataset
+        ``follower_position``, ``follower_velocity`` (time, axis) [m, m/s] with ``_u``
+        uncertainties; ``journal_position``/``journal_displacement`` (time, axis) [m];
+        ``crank_angle`` (time) [rad] when a crank is tracked; per body ``<body>_position``,
+        ``<body>_rotation`` and ``<body>_points``; ``frame_flag``; attrs with the duplicated and
+        dropped frames found.
+    """
+    import cv2
+
+    cfg = config or TrackConfig()
+    L = left if isinstance(left, FrameSource) else open_frames(left, fps=fps, what="left footage")
+    R = None
+    if right is not None:
+        R = (
+            right
+            if isinstance(right, FrameSource)
+            else open_frames(right, fps=fps, what="right footage")
+        )
+        check_stereo_pair(L, R)
+        if calibration is None:
+            raise BadInputError(
+                "two cameras need a stereo calibration (calibration=..., CLI --calibration)"
+            )
+        for name, src in (("left", L), ("right", R)):
+            cam_size = calibration.cameras[name].image_size
+            if tuple(src.size) != tuple(cam_size):
+                raise BadInputError(
+                    f"{name} footage '{src.path}' has {src.size[0]}x{src.size[1]} pixel frames but "
+                    f"the calibration's {name} camera is {cam_size[0]}x{cam_size[1]}; use the "
+                    "calibration made for these cameras at this resolution"
+                )
+    n_total = L.n_frames if max_frames is None else min(L.n_frames, max_frames)
+    half = cfg.subset_size // 2
+    w, h = L.size
+    # ---- reference frames -----------------------------------------------------------------
+    gen_l = L.frames(0, n_total)
+    gen_r = R.frames(0, n_total) if R is not None else None
+    _, t0, ref_l = next(gen_l)
+    ref_r = next(gen_r)[2] if gen_r is not None else None
+    noise = _noise_sigma(ref_l)
+    states: list[_BodyState] = []
+    for spec in bodies:
+        poly = np.asarray(spec.polygon, dtype=float)
+        if np.any(poly < 0) or np.any(poly[:, 0] > w - 1) or np.any(poly[:, 1] > h - 1):
+            raise BadInputError(
+                f"region of interest of body '{spec.name}' reaches outside the {w}x{h} image "
+                f"(x {poly[:, 0].min():.0f}..{poly[:, 0].max():.0f}, y {poly[:, 1].min():.0f}.."
+                f"{poly[:, 1].max():.0f}); fix its polygon in the TOML file (pixels of the left "
+                "reference image, x = column, y = row)"
+            )
+        pts = _grid_in_polygon(poly, half, cfg.step)
+        if len(pts) < cfg.min_points:
+            raise BadInputError(
+                f"region of interest of body '{spec.name}' holds only {len(pts)} subsets of "
+                f"{cfg.subset_size} px at a {cfg.step} px step (at least {cfg.min_points} needed); "
+                "enlarge the polygon or reduce track.subset_size/step"
+            )
+        lt = _CameraBodyTracker(ref_l, pts, cfg, f"left/{spec.name}")
+        sig = (
+            np.full(len(pts), cfg.sigma_px)
+            if cfg.sigma_px > 0
+            else _match_sigma(ref_l, pts, half, noise)
+        )
+        if R is not None:
+            H = _sift_homography(ref_l, ref_r, poly, calibration=calibration)
+            if H is None:
+                raise BadInputError(
+                    f"body '{spec.name}': its region could not be found in the right reference "
+                    "image (too few SIFT matches consistent with the calibration's epipolar "
+                    "geometry); check that both cameras see the speckle pattern and that the "
+                    "calibration belongs to this rig"
+                )
+            guess = _homography_guess(H, pts)
+            pos_r, zn, good = lt.track(ref_r, point_guess=guess)
+            lt.history.clear()
+            epi = epipolar_distance(calibration, pts, np.where(np.isfinite(pos_r), pos_r, 0.0))
+            good &= epi < cfg.max_epipolar_px
+            if good.sum() < cfg.min_points:
+                raise BadInputError(
+                    f"body '{spec.name}': only {good.sum()} of {len(pts)} subsets matched between "
+                    f"the left and right reference images (ZNCC >= {cfg.zncc_min}, epipolar "
+                    f"distance < {cfg.max_epipolar_px} px); check the calibration and the ROI"
+                )
+            pts, pos_r, sig = pts[good], pos_r[good], sig[good]
+            lt = _CameraBodyTracker(ref_l, pts, cfg, f"left/{spec.name}")
+            rt = _CameraBodyTracker(ref_r, pos_r, cfg, f"right/{spec.name}")
+            X, _, _ = triangulate(calibration, pts, pos_r, sigma_px=sig)
+            ref = X
+        else:
+            rt = None
+            ref = pts.copy()
+        st = _BodyState(spec, lt, rt, ref, sig, _body_point(spec, ref, cfg))
+        states.append(st)
+
+    # ---- frames ---------------------------------------------------------------------------
+    times: list[float] = []
+    flags: list[int] = []
+    duplicates: list[int] = []
+    prev_l: np.ndarray | None = None
+    status = "complete"
+    t_start = _time.perf_counter()
+    from jointwear.progress import progress_bar
+
+    def frames_iter():
+        yield 0, t0, ref_l, ref_r
+        if gen_r is None:
+            for i, t, img in gen_l:
+                yield i, t, img, None
+        else:
+            for (i, t, img), (_, _, img_r) in zip(gen_l, gen_r, strict=False):
+                yield i, t, img, img_r
+
+    result: xr.Dataset | None = None
+    try:
+        with progress_bar("tracking frames", n_total, enabled=progress) as bar:
+            task = bar.tasks[0].id
+            for i, t, img_l, img_r in frames_iter():
+                flag = 0
+                if (
+                    prev_l is not None
+                    and float(np.mean(np.abs(img_l - prev_l))) < cfg.duplicate_threshold
+                ):
+                    flag |= FRAME_FLAGS["duplicated"]
+                    duplicates.append(i)
+                prev_l = img_l
+                for st in states:
+                    pl, zl, gl = st.left.track(img_l)
+                    if st.right is not None:
+                        pr, zr, gr = st.right.track(img_r)
+                        good = gl & gr
+                        pl2, pr2 = (
+                            np.where(good[:, None], pl, np.nan),
+                            np.where(good[:, None], pr, np.nan),
+                        )
+                        X, cov, rep = triangulate(calibration, pl2, pr2, sigma_px=st.sigma_px)
+                        cur = X
+                    else:
+                        good = gl
+                        cur = np.where(good[:, None], pl, np.nan)
+                        pr = None
+                    try:
+                        Rm, tv, inl, rms = fit_rigid_robust(
+                            st.ref3d, cur, min_points=cfg.min_points
+                        )
+                        ok_pose = True
+                    except BadInputError:
+                        d = st.ref3d.shape[1]
+                        Rm, tv, inl, rms = (
+                            np.full((d, d), np.nan),
+                            np.full(d, np.nan),
+                            good & False,
+                            np.nan,
+                        )
+                        ok_pose = False
+                        flag |= FRAME_FLAGS["tracking_failed"]
+                    if ok_pose:
+                        st.left.commit(np.where(inl[:, None], pl, np.nan))
+                        if st.right is not None:
+                            st.right.commit(np.where(inl[:, None], pr, np.nan))
+                    poi = Rm @ st.point_of_interest + tv
+                    n_in = int(np.sum(inl))
+                    if st.right is not None and ok_pose:
+                        # propagated: point scatter of the fit / sqrt(n) and triangulation cov
+                        cov_mean = np.nanmean(cov[inl], axis=0) / max(n_in, 1)
+                        u = np.sqrt(np.maximum(np.diag(cov_mean), (rms**2 / 3) / max(n_in - 1, 1)))
+                    else:
+                        u = np.full(st.ref3d.shape[1], rms / np.sqrt(max(n_in - 1, 1)))
+                    row = st.rows
+                    row.setdefault("R", []).append(Rm)
+                    row.setdefault("t", []).append(tv)
+                    row.setdefault("poi", []).append(poi)
+                    row.setdefault("poi_u", []).append(u)
+                    row.setdefault("n", []).append(n_in)
+                    row.setdefault("rms", []).append(rms)
+                    row.setdefault("points", []).append(cur.astype(np.float32))
+                times.append(t)
+                flags.append(flag)
+                bar.update(task, advance=1)
+                if out is not None and (len(times) % cfg.chunk_size == 0):
+                    result = _assemble(
+                        states, times, flags, duplicates, L, R, cfg, calibration, "partial"
+                    )
+                    _write(result, out, inputs, cfg, bodies)
+    except (BadInputError, KeyboardInterrupt) as exc:
+        status = f"stopped after {len(times)} frames: {exc}"
+        if out is not None and times:
+            result = _assemble(states, times, flags, duplicates, L, R, cfg, calibration, status)
+            _write(result, out, inputs, cfg, bodies)
+            raise BadInputError(
+                f"{exc} - the {len(times)} frames processed before are saved in '{out}'"
+            ) from None
+        raise
+    result = _assemble(states, times, flags, duplicates, L, R, cfg, calibration, status)
+    result.attrs["wall_time_s"] = _time.perf_counter() - t_start
+    if out is not None:
+        _write(result, out, inputs, cfg, bodies)
+    del cv2
+    return result
+
+
+def _write(ds: xr.Dataset, out, inputs, cfg, bodies) -> None:
+    from jointwear import io
+
+    io.save(
+        ds,
+        out,
+        inputs=inputs,
+        parameters={"track": asdict(cfg), "bodies": [asdict(b) for b in bodies]},
+        source="jointwear (dic.track)",
+    )
+
+
+def _assemble(states, times, flags, duplicates, L, R, cfg, calibration, status) -> xr.Dataset:
+    from jointwear import conventions as C
+
+    t = np.asarray(times, dtype=float)
+    stereo = R is not None
+    unit = "m" if stereo else "pixel"
+    axes = ["x", "y", "z"] if stereo else ["x", "y"]
+    flag_arr = np.asarray(flags, dtype=np.int8)
+    # gaps in the frame times (dropped frames)
+    dt = np.diff(t)
+    nominal = 1.0 / L.fps
+    gaps = np.flatnonzero(dt > 1.5 * nominal) + 1
+    flag_arr[gaps] |= FRAME_FLAGS["after_gap"]
+    dropped = int(np.sum(np.rint(dt[dt > 1.5 * nominal] / nominal) - 1)) if len(dt) else 0
+    data: dict[str, Any] = {}
+    coords = {
+        "time": ("time", t, {"units": "s", "long_name": C.COORDINATES["time"][1]}),
+        "axis": ("axis", axes, {"long_name": "vector component"}),
+    }
+    valid_time = ~(flag_arr & FRAME_FLAGS["duplicated"]).astype(bool)
+    for st in states:
+        rows = st.rows
+        name = st.spec.name
+        poi = np.asarray(rows["poi"], dtype=float)
+        poi_u = np.asarray(rows["poi_u"], dtype=float)
+        poi_v = np.where(valid_time[:, None], poi, np.nan)
+        vel, gain = derivative(t, poi_v, window=cfg.velocity_window, order=cfg.velocity_order)
+        vel_u = gain[:, None] * np.nanmedian(poi_u, axis=0)[None, :]
+        data[f"{name}_position"] = (
+            ("time", "axis"),
+            poi,
+            {
+                "units": unit,
+                "long_name": f"position of the {name}'s point of interest (world frame)",
+                "ancillary_variables": f"{name}_position_u",
+            },
+        )
+        data[f"{name}_position_u"] = (
+            ("time", "axis"),
+            poi_u,
+            {"units": unit, "long_name": f"standard uncertainty of {name}_position"},
+        )
+        data[f"{name}_velocity"] = (
+            ("time", "axis"),
+            vel,
+            {"units": f"{unit} s-1", "long_name": f"velocity of the {name}'s point of interest"},
+        )
+        data[f"{name}_n_points"] = (
+            "time",
+            np.asarray(rows["n"]),
+            {"units": "1", "long_name": f"subsets used in the {name}'s rigid fit"},
+        )
+        data[f"{name}_fit_rms"] = (
+            "time",
+            np.asarray(rows["rms"], dtype=float),
+            {"units": unit, "long_name": f"RMS residual of the {name}'s rigid fit"},
+        )
+        d = st.ref3d.shape[1]
+        data[f"{name}_rotation"] = (
+            ("time", f"{name}_row", f"{name}_col"),
+            np.asarray(rows["R"], dtype=float),
+            {"units": "1", "long_name": f"rotation of the {name} since the reference frame"},
+        )
+        pts = np.asarray(rows["points"], dtype=np.float32)
+        data[f"{name}_points"] = (
+            ("time", f"{name}_point", f"{name}_point_axis"),
+            pts,
+            {"units": unit, "long_name": f"tracked subset centres of the {name} (world frame)"},
+        )
+        coords[f"{name}_row"] = (f"{name}_row", np.arange(d))
+        coords[f"{name}_col"] = (f"{name}_col", np.arange(d))
+        coords[f"{name}_point_axis"] = (f"{name}_point_axis", axes)
+        role = st.spec.role
+        if role == "follower":
+            data["follower_position"] = (
+                ("time", "axis"),
+                poi,
+                C.variable_attrs("follower_position", ancillary_variables="follower_position_u")
+                if stereo
+                else {"units": unit, "long_name": "follower centre of mass in the image"},
+            )
+            data["follower_position_u"] = (
+                ("time", "axis"),
+                poi_u,
+                {"units": unit, "long_name": "standard uncertainty of follower_position"},
+            )
+            data["follower_velocity"] = (
+                ("time", "axis"),
+                vel,
+                C.variable_attrs(
+                    "follower_velocity",
+                    ancillary_variables="follower_velocity_u",
+                    method=f"Savitzky-Golay on frame times, window {cfg.velocity_window} samples, order {cfg.velocity_order}",
+                )
+                if stereo
+                else {
+                    "units": f"{unit} s-1",
+                    "long_name": "follower centre of mass velocity in the image",
+                },
+            )
+            data["follower_velocity_u"] = (
+                ("time", "axis"),
+                vel_u,
+                {
+                    "units": f"{unit} s-1",
+                    "long_name": "standard uncertainty of follower_velocity (noise propagated through the differentiator)",
+                },
+            )
+        elif role == "journal":
+            disp = poi - poi[:1]
+            data["journal_displacement"] = (
+                ("time", "axis"),
+                disp,
+                {
+                    "units": unit,
+                    "long_name": "displacement of the journal since the reference frame (z = out of plane)",
+                    "ancillary_variables": "journal_displacement_u",
+                },
+            )
+            data["journal_displacement_u"] = (
+                ("time", "axis"),
+                poi_u * np.sqrt(2),
+                {"units": unit, "long_name": "standard uncertainty of journal_displacement"},
+            )
+        elif role == "crank":
+            ang = np.unwrap(rotation_angle_z(np.asarray(rows["R"], dtype=float)))
+            ang = ang + np.deg2rad(st.spec.reference_angle_deg)
+            data["crank_angle"] = (
+                "time",
+                ang,
+                C.variable_attrs(
+                    "crank_angle",
+                    note=f"rotation of the tracked crank about the world z axis plus reference_angle_deg = {st.spec.reference_angle_deg}",
+                ),
+            )
+    data["frame_flag"] = (
+        "time",
+        flag_arr,
+        {
+            "units": "1",
+            "long_name": "frame quality flags (bit mask)",
+            "flag_masks": np.array([1, 2, 4], dtype=np.int8),
+            "flag_meanings": "duplicated after_gap tracking_failed",
+        },
+    )
+    ds = xr.Dataset(data, coords=coords)
+    ds.attrs.update(
+        {
+            "title": "jointwear rig footage tracking",
+            "status": status,
+            "frames_processed": len(t),
+            "duplicated_frames": json.dumps([int(i) for i in duplicates]),
+            "dropped_frames_estimated": dropped,
+            "gaps_after_frames": json.dumps([int(i) for i in gaps]),
+            "left_footage": str(L.path),
+            "right_footage": str(R.path) if R is not None else "",
+            "frame_rate_hz": L.fps,
+            "world_frame": calibration.world_frame
+            if calibration is not None
+            else "left image (pixels)",
+            "velocity_method": f"Savitzky-Golay local polynomial on the frame times, window {cfg.velocity_window} samples, order {cfg.velocity_order}",
+        }
+    )
+    return ds

@@ -1,0 +1,237 @@
+"""Reading footage: video files (OpenCV's FFmpeg) and image sequences, frame times, checks."""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from jointwear.errors import BadInputError
+
+__all__ = ["FrameSource", "open_frames", "check_stereo_pair", "IMAGE_SUFFIXES", "VIDEO_SUFFIXES"]
+
+IMAGE_SUFFIXES = (".png", ".tif", ".tiff", ".bmp", ".jpg", ".jpeg", ".pgm")
+VIDEO_SUFFIXES = (".avi", ".mp4", ".mkv", ".mov", ".m4v", ".mpg", ".mpeg", ".wmv", ".webm")
+_ADVICE = (
+    "convert it to a format OpenCV's bundled FFmpeg reads, losslessly if possible, e.g. "
+    "`ffmpeg -i IN -c:v ffv1 OUT.avi` (lossless) or export an image sequence (`ffmpeg -i IN "
+    "frames/frame_%06d.png`), and pass that instead"
+)
+
+
+def _fourcc_name(code: float) -> str:
+    c = int(code)
+    s = "".join(chr((c >> (8 * i)) & 0xFF) for i in range(4))
+    return s if s.isprintable() and s.strip() else f"0x{c:08x}"
+
+
+@dataclass
+class FrameSource:
+    """A camera's footage: a video file or a folder of numbered images.
+
+    Attributes
+    ----------
+    path : Path
+    kind : {"video", "images"}
+    fps : float
+        Nominal frame rate [1/s].
+    size : (width, height)
+        Frame size [pixel].
+    n_frames : int
+        Number of frames (for videos: as the container states it; may be approximate).
+    frame_numbers : array or None
+        Image sequences: the number in each file name (gaps = dropped frames).
+    codec : str
+        Video codec FourCC (videos).
+    """
+
+    path: Path
+    kind: str
+    fps: float
+    size: tuple[int, int]
+    n_frames: int
+    files: list[Path] = field(default_factory=list)
+    frame_numbers: np.ndarray | None = None
+    codec: str = ""
+
+    def nominal_times(self) -> np.ndarray:
+        """Frame times [s]: file numbers / fps for images, index / fps for videos."""
+        if self.frame_numbers is not None:
+            return (self.frame_numbers - self.frame_numbers[0]) / self.fps
+        return np.arange(self.n_frames) / self.fps
+
+    def frames(
+        self, start: int = 0, stop: int | None = None
+    ) -> Iterator[tuple[int, float, np.ndarray]]:
+        """Yield ``(index, time [s], grey float32 image)`` for frames ``start <= index < stop``.
+
+        Video times come from the container's presentation timestamps when available.
+        Unreadable frames raise :class:`~jointwear.errors.BadInputError` naming the frame.
+        """
+        import cv2
+
+        stop = self.n_frames if stop is None else min(stop, self.n_frames)
+        if self.kind == "images":
+            times = self.nominal_times()
+            for i in range(start, stop):
+                img = cv2.imread(str(self.files[i]), cv2.IMREAD_UNCHANGED)
+                if img is None:
+                    raise BadInputError(
+                        f"image '{self.files[i]}' (frame {i}) could not be read; replace or "
+                        "remove the file"
+                    )
+                yield i, float(times[i]), _to_gray(img)
+            return
+        cap = cv2.VideoCapture(str(self.path))
+        try:
+            if start:
+                cap.set(cv2.CAP_PROP_POS_FRAMES, start)
+            i = start
+            while i < stop:
+                ok, img = cap.read()
+                if not ok:
+                    if i < stop and self.n_frames and i < self.n_frames - 1:
+                        raise BadInputError(
+                            f"video '{self.path}': frame {i} of {self.n_frames} could not be "
+                            f"decoded (codec {self.codec}); the file may be truncated - "
+                            "re-export it or process the frames before it"
+                        )
+                    self.n_frames = i
+                    return
+                pts = cap.get(cv2.CAP_PROP_POS_MSEC) / 1000.0
+                t = pts if pts > 0 or i == 0 else i / self.fps
+                yield i, float(t), _to_gray(img)
+                i += 1
+        finally:
+            cap.release()
+
+
+def _to_gray(img: np.ndarray) -> np.ndarray:
+    import cv2
+
+    if img.ndim == 3:
+        if img.shape[2] == 4:
+            img = img[:, :, :3]
+        img = cv2.cvtColor(img, cv2.COLOR_BGR2GRAY)
+    return img.astype(np.float32)
+
+
+def _natural_key(p: Path):
+    return [int(s) if s.isdigit() else s for s in re.split(r"(\d+)", p.name)]
+
+
+def open_frames(
+    path: str | Path, *, fps: float | None = None, what: str = "footage"
+) -> FrameSource:
+    """Open a video file or a folder of images.
+
+    Parameters
+    ----------
+    path : path
+        Video file (mp4, avi, mkv, ...) or folder of images (png, tif, bmp, jpg) named with a
+        frame number (``frame_000123.png``); gaps in the numbering are dropped frames.
+    fps : float, optional
+        Frame rate [1/s]. Required for image sequences; for videos it overrides the
+        container's rate.
+    what : str
+        Name used in messages (``"left footage"``).
+    """
+    import cv2
+
+    path = Path(path)
+    if not path.exists():
+        raise BadInputError(f"{what} '{path}' does not exist")
+    if path.is_dir():
+        files = sorted(
+            (p for p in path.iterdir() if p.suffix.lower() in IMAGE_SUFFIXES), key=_natural_key
+        )
+        if not files:
+            raise BadInputError(
+                f"{what} folder '{path}' holds no images ({', '.join(IMAGE_SUFFIXES)})"
+            )
+        if fps is None or not fps > 0:
+            raise BadInputError(
+                f"{what} '{path}' is an image sequence: give the frame rate (fps=..., CLI --fps)"
+            )
+        nums = []
+        for p in files:
+            m = re.findall(r"\d+", p.stem)
+            nums.append(int(m[-1]) if m else -1)
+        numbers = np.array(nums)
+        if np.any(numbers < 0) or len(np.unique(numbers)) != len(numbers):
+            numbers = np.arange(len(files))
+        first = cv2.imread(str(files[0]), cv2.IMREAD_UNCHANGED)
+        if first is None:
+            raise BadInputError(f"image '{files[0]}' could not be read")
+        return FrameSource(
+            path,
+            "images",
+            float(fps),
+            (first.shape[1], first.shape[0]),
+            len(files),
+            files=files,
+            frame_numbers=numbers,
+        )
+    suffix = path.suffix.lower()
+    if suffix not in VIDEO_SUFFIXES:
+        raise BadInputError(
+            f"{what} '{path}': unsupported file type '{suffix}'; give a video "
+            f"({', '.join(VIDEO_SUFFIXES)}) or a folder of images ({', '.join(IMAGE_SUFFIXES)})"
+        )
+    cap = cv2.VideoCapture(str(path), cv2.CAP_FFMPEG)
+    try:
+        if not cap.isOpened():
+            raise BadInputError(
+                f"{what} '{path}': OpenCV's FFmpeg could not open this '{suffix[1:]}' container "
+                f"(unreadable, truncated or an unsupported container); {_ADVICE}"
+            )
+        codec = _fourcc_name(cap.get(cv2.CAP_PROP_FOURCC))
+        ok, img = cap.read()
+        if not ok or img is None:
+            raise BadInputError(
+                f"{what} '{path}': the '{suffix[1:]}' container opened but its video stream "
+                f"(codec '{codec}') could not be decoded by OpenCV's bundled FFmpeg; {_ADVICE}"
+            )
+        n = int(cap.get(cv2.CAP_PROP_FRAME_COUNT))
+        rate = float(cap.get(cv2.CAP_PROP_FPS))
+    finally:
+        cap.release()
+    if fps is None:
+        if not rate > 0:
+            raise BadInputError(
+                f"{what} '{path}' does not state its frame rate; give it (fps=..., CLI --fps)"
+            )
+        fps = rate
+    return FrameSource(
+        path, "video", float(fps), (img.shape[1], img.shape[0]), max(n, 1), codec=codec
+    )
+
+
+def check_stereo_pair(left: FrameSource, right: FrameSource) -> None:
+    """Refuse left/right footage of different lengths, rates, sizes or frame numbering."""
+    problems = []
+    if abs(left.fps - right.fps) > 1e-6 * left.fps:
+        problems.append(f"frame rates differ ({left.fps:g} vs {right.fps:g} frames/s)")
+    if left.n_frames != right.n_frames:
+        problems.append(f"lengths differ ({left.n_frames} vs {right.n_frames} frames)")
+    elif (
+        left.frame_numbers is not None
+        and right.frame_numbers is not None
+        and not np.array_equal(left.frame_numbers, right.frame_numbers)
+    ):
+        bad = np.flatnonzero(left.frame_numbers != right.frame_numbers)[0]
+        problems.append(
+            f"frame numbering differs from position {bad} (left {left.frame_numbers[bad]}, "
+            f"right {right.frame_numbers[bad]})"
+        )
+    if left.size != right.size:
+        problems.append(f"frame sizes differ ({left.size} vs {right.size})")
+    if problems:
+        raise BadInputError(
+            f"left footage '{left.path}' and right footage '{right.path}' do not form a "
+            f"synchronised stereo pair: {'; '.join(problems)}. Trim both recordings to the same "
+            "synchronised frames (same start, rate and count) before tracking"
+        )
