@@ -386,19 +386,25 @@ class WearRun:
         return run
 
     # --- the loop ---------------------------------------------------------------------------
-    def _measure(self, h: np.ndarray, state: Any, settle: float) -> tuple[np.ndarray, float, Any]:
-        """Settle on profile ``h``, then one accumulated cycle: (rate [m/cycle], W [N m], state)."""
+    def _measure(
+        self, h: np.ndarray, state: Any, settle: float
+    ) -> tuple[np.ndarray, float, Any, float]:
+        """Settle on profile ``h``, then accumulate one cycle.
+
+        Returns (wear rate [m/cycle] per point, normal work per cycle [N m], state, cycles
+        simulated).
+        """
+        simulated = 0.0
         if settle > 0:
             res = self.contact.run(h, cycles=settle, state=state)
             state = res.state
-            self._s["cycles_simulated"] += res.cycles
+            simulated += res.cycles
         res: CycleWear = self.contact.run(h, cycles=1.0, state=state)
-        self._s["cycles_simulated"] += res.cycles
+        simulated += res.cycles
         rate = self.settings.kw * np.asarray(res.wear_work, dtype=float) / res.cycles
         if np.any(rate < 0):
             raise BadInputError("the contact model returned negative wear work")
-        self._point_area = np.asarray(res.point_area, dtype=float)
-        return rate, res.normal_work / res.cycles, res.state
+        return rate, res.normal_work / res.cycles, res.state, simulated
 
     def _rate_change(self, new: np.ndarray, old: np.ndarray) -> float:
         w = self.grid.point_area
@@ -423,36 +429,48 @@ class WearRun:
         return min(dn, stop - self._s["done"]), dn
 
     def step(self) -> bool:
-        """Advance by one update (or one rejected attempt). Returns False when the target is reached."""
-        s, st = self._s, self.settings
-        if s["rate"] is None:
-            s["rate"], s["work_rate"], s["state"] = self._measure(
+        """Advance by one update (or one rejected attempt). Returns False at the target.
+
+        The new state is assembled aside and swapped in with one assignment, so an interrupt
+        (Ctrl-C) at any moment leaves a consistent state in memory and on disk.
+        """
+        st = self.settings
+        adaptive = st.scheme == "adaptive"
+        if self._s["rate"] is None:
+            s = dict(self._s)
+            s["rate"], s["work_rate"], s["state"], n_sim = self._measure(
                 s["h"], s["state"], st.initial_settle_cycles
             )
-            if st.scheme == "adaptive" and st.estimate_noise:
-                again, work, state = self._measure(s["h"], s["state"], 0.0)
+            if adaptive and st.estimate_noise:
+                again, work, state, n2 = self._measure(s["h"], s["state"], 0.0)
                 s["noise"] = self._rate_change(again, s["rate"])
                 s["rate"], s["work_rate"], s["state"] = again, work, state
+                n_sim += n2
+            s["cycles_simulated"] += n_sim
+            self._s = s
             self._save()
-        if s["done"] >= self.target:
+        old = self._s
+        if old["done"] >= self.target:
             return False
-        stop = next(c for c in self._stops if c > s["done"])
-        dn, dn_wanted = self._propose(s["rate"], stop)
-        h_new = s["h"] + dn * s["rate"]
-        rate_new, work_new, state_new = self._measure(h_new, s["state"], st.settle_cycles)
-        eta_raw = self._rate_change(rate_new, s["rate"])
-        eta = max(0.0, eta_raw - s["noise"] - st.noise_floor)
-        adaptive = st.scheme == "adaptive"
+        stop = next(c for c in self._stops if c > old["done"])
+        dn, dn_wanted = self._propose(old["rate"], stop)
+        h_new = old["h"] + dn * old["rate"]
+        rate_new, work_new, state_new, n_sim = self._measure(h_new, old["state"], st.settle_cycles)
+        eta_raw = self._rate_change(rate_new, old["rate"])
+        eta = max(0.0, eta_raw - old["noise"] - st.noise_floor)
+        s = dict(old)
+        s["cycles_simulated"] = old["cycles_simulated"] + n_sim
         if adaptive and eta > st.reject_factor * st.tol and dn > st.dn_min:
             fac = max(0.2, 0.9 * st.tol / eta)
             s["dn_next"] = max(st.dn_min, int(dn * fac))
-            s["history"].append((s["done"], dn, eta_raw, 0))
+            s["history"] = [*old["history"], (old["done"], dn, eta_raw, 0)]
+            self._s = s
             self._notify(dn, eta, accepted=False)
             return True
-        s["history"].append((s["done"], dn, eta_raw, 1))
-        s["normal_work"] += dn * s["work_rate"]
+        s["history"] = [*old["history"], (old["done"], dn, eta_raw, 1)]
+        s["normal_work"] = old["normal_work"] + dn * old["work_rate"]
         s["h"], s["rate"], s["work_rate"], s["state"] = h_new, rate_new, work_new, state_new
-        s["done"] += dn
+        s["done"] = old["done"] + dn
         if adaptive:
             fac = 2.0 if eta == 0 else min(2.0, max(0.2, 0.9 * st.tol / eta))
             nxt = int(dn * fac)
@@ -460,7 +478,8 @@ class WearRun:
                 nxt = max(nxt, dn_wanted)
             s["dn_next"] = int(min(st.dn_max, max(st.dn_min, nxt)))
         if s["done"] in self._stops:
-            s["snapshots"].append((s["done"], s["h"].copy(), s["normal_work"]))
+            s["snapshots"] = [*old["snapshots"], (s["done"], h_new.copy(), s["normal_work"])]
+        self._s = s
         self._save()
         self._notify(dn, eta, accepted=True)
         return s["done"] < self.target

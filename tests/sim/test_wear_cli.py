@@ -1,0 +1,147 @@
+"""``jointwear sim wear`` on the prescribed Winkler contact: output, errors, Ctrl-C and --resume."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+
+from jointwear import io
+from jointwear.cli import main
+
+SMALL = ["--contact", "winkler", "--layers", "6", "--points", "48", "--kw", "1e-13"]
+
+
+def test_wear_command_writes_a_valid_map_and_figure(tmp_path, capsys):
+    out = tmp_path / "w.nc"
+    fig = tmp_path / "w.png"
+    code = main(
+        [
+            "sim",
+            "wear",
+            *SMALL,
+            "--cycles",
+            "2e4",
+            "--out",
+            str(out),
+            "--figure",
+            str(fig),
+            "--snapshots",
+            "5000,1e4",
+        ]
+    )
+    assert code == 0
+    ds = io.load(out)
+    np.testing.assert_array_equal(ds["cycles"].values, [5000, 10000, 20000])
+    assert ds.attrs["status"] == "complete"
+    assert ds.attrs["kw_m2_per_N"] == 1e-13
+    assert fig.stat().st_size > 1000
+    assert (tmp_path / "w.nc.ckpt").exists()
+    assert "20000 cycles" in capsys.readouterr().out
+
+
+def test_wear_settings_from_toml(tmp_path):
+    toml = tmp_path / "p.toml"
+    toml.write_text('[wear]\nkw = 2e-13\nscheme = "fixed"\ndn = 2500\n')
+    out = tmp_path / "w.nc"
+    args = ["sim", "wear", "--contact", "winkler", "--layers", "6", "--points", "48"]
+    assert (
+        main(
+            [
+                *args,
+                "--cycles",
+                "1e4",
+                "--out",
+                str(out),
+                "--params",
+                str(toml),
+                "--snapshots",
+                "5000",
+            ]
+        )
+        == 0
+    )
+    ds = io.load(out)
+    assert ds.attrs["kw_m2_per_N"] == 2e-13
+    assert set(ds["update_dn"].values) == {2500}
+    toml.write_text("[wear]\nkw = -3\n")
+    assert main([*args, "--cycles", "1e4", "--out", str(out), "--params", str(toml)]) == 3
+
+
+@pytest.mark.parametrize(
+    ("extra", "message"),
+    [
+        (["--kw", "-1e-14"], "must be a positive number"),
+        (["--kw", "5.05e-10"], "absurd"),
+        (["--scheme", "implicit"], "wear.scheme: expected one of"),
+        (["--snapshots", "1e4,abc"], "comma-separated cycle counts"),
+    ],
+)
+def test_bad_options_fail_with_a_message(tmp_path, capsys, extra, message):
+    out = tmp_path / "w.nc"
+    code = main(
+        ["sim", "wear", "--contact", "winkler", "--cycles", "1e4", "--out", str(out), *extra]
+    )
+    assert code == 3
+    assert message in capsys.readouterr().err
+    assert not out.exists()
+
+
+def test_unwritable_output_fails_before_the_run(tmp_path, capsys):
+    blocker = tmp_path / "file"
+    blocker.write_text("x")
+    code = main(["sim", "wear", *SMALL, "--cycles", "1e9", "--out", str(blocker / "w.nc")])
+    assert code == 3
+    assert "not writable" in capsys.readouterr().err
+
+
+def test_resume_errors(tmp_path, capsys):
+    out = tmp_path / "w.nc"
+    assert main(["sim", "wear", *SMALL, "--cycles", "1e4", "--out", str(out), "--resume"]) == 3
+    assert "does not exist" in capsys.readouterr().err
+    assert main(["sim", "wear", *SMALL, "--cycles", "1e4", "--out", str(out)]) == 0
+    assert main(["sim", "wear", *SMALL, "--cycles", "5e3", "--out", str(out), "--resume"]) == 3
+    assert "below the 10000 cycles already done" in capsys.readouterr().err
+    other = [a if a != "1e-13" else "3e-13" for a in SMALL]
+    assert main(["sim", "wear", *other, "--cycles", "2e4", "--out", str(out), "--resume"]) == 3
+    assert "wear.kw: 1e-13 in the checkpoint, 3e-13 now" in capsys.readouterr().err
+
+
+def test_ctrl_c_leaves_valid_partial_output_and_resume_is_identical(tmp_path):
+    run = ["sim", "wear", *SMALL, "--scheme", "fixed", "--dn", "200", "--cycles", "3e4"]
+    ref = tmp_path / "ref.nc"
+    assert main([*run, "--out", str(ref)]) == 0
+
+    out = tmp_path / "w.nc"
+    ckpt = tmp_path / "w.nc.ckpt"
+    env = dict(os.environ, PYTHONUNBUFFERED="1")
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "jointwear", *run, "--out", str(out)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        env=env,
+    )
+    t0 = time.monotonic()
+    while not ckpt.exists() and proc.poll() is None and time.monotonic() - t0 < 60:
+        time.sleep(0.02)
+    time.sleep(0.3)
+    assert proc.poll() is None, "the run finished before it could be interrupted"
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode != 0
+    assert b"interrupted after" in err
+    partial = io.load(out)  # valid contract, provenance
+    assert partial.attrs["status"] == "partial"
+    done = int(partial.attrs["cycles_done"])
+    assert 0 < done < 30_000
+
+    assert main([*run, "--out", str(out), "--resume"]) == 0
+    full, resumed = io.load(ref), io.load(out)
+    assert resumed.attrs["status"] == "complete"
+    for name in ("wear_depth", "worn_volume", "normal_work", "update_dn", "update_rate_change"):
+        np.testing.assert_array_equal(resumed[name].values, full[name].values)
