@@ -236,6 +236,11 @@ def _zone_lp(
             b = -rs
             bounds = [(None, None)] * (m + 1)
         res = linprog(c, A_ub=A, b_ub=b, bounds=bounds, method="highs")
+        if res.status == 3 and len(cand) < len(r):
+            # the candidate subset does not surround the axis yet: take more points
+            more = np.linspace(0, len(r) - 1, min(len(r), 4 * len(cand)), dtype=np.int64)
+            cand = np.union1d(cand, more)
+            continue
         if res.status != 0:
             raise BadInputError(
                 f"{what}: the {kind} reference could not be computed ({res.message.strip()}); "

@@ -337,10 +337,17 @@ def sniff(
                 # a comma that only ever separates integers with leading zeros is a decimal comma
                 if d == "," and c == ".":
                     toks = [_split(ln, ",") for ln in data_sample]
-                    if all(all(re.fullmatch(r"[-+]?\d+", t) for t in row) for row in toks) and any(
+                    ints = all(all(re.fullmatch(r"[-+]?\d+", t) for t in row) for row in toks)
+                    lead0 = any(
                         len(row) > 1 and any(t.startswith("0") and len(t) > 1 for t in row[1:])
                         for row in toks
-                    ):
+                    )
+                    # two integer fields whose second always has the same width (>= 2 digits):
+                    # fixed decimals with a decimal comma, not two integer columns
+                    fixed = all(len(row) == 2 for row in toks) and (
+                        len({len(row[1]) for row in toks}) == 1 and len(toks[0][1]) >= 2
+                    )
+                    if ints and (lead0 or (fixed and len(toks) >= 3)):
                         continue
                 if best is None or key > best[0]:
                     best = (key, d, c)
@@ -380,7 +387,9 @@ def _parse_header(lines: Sequence[str], delim: str, ncols: int) -> tuple[dict[st
             if delim == " " and len(toks) != ncols:
                 cand = [t for t in re.split(r"\s{2,}|\t", s) if t]
             if len(cand) == ncols and not all(_NUM_RE.match(t) for t in cand):
-                if ncols > 1 or not _KV_RE.match(s):
+                kv = _KV_RE.match(s)
+                kv_like = bool(kv and kv.group(2) and re.search(r"[:=]", s))
+                if (ncols > 1 and (delim != " " or not kv_like)) or (ncols == 1 and not kv):
                     names = cand
                     continue
         m = _KV_RE.match(s)
@@ -797,6 +806,12 @@ def _layers_from_file(pf: ParsedFile, expected_points: int | None, layer_kind: s
             out.append(make(np.arange(n), vc, None))
     else:
         out.append(make(np.arange(n), value_cols[0] if value_cols else None, None))
+    for k, lay in enumerate(out):
+        if lay.value.size < 4:
+            raise BadInputError(
+                f"{where}: layer {k + 1} has only {lay.value.size} point(s); a roundness trace "
+                "needs at least 4 (the file looks truncated - re-export it)"
+            )
     if expected_points is not None:
         for k, lay in enumerate(out):
             if lay.value.size != expected_points:
