@@ -233,6 +233,7 @@ def run_cycles(
     state: SimState | None = None,
     record: bool = True,
     progress: Callable[[float], None] | None = None,
+    duration: float | None = None,
 ) -> CycleResult:
     """Simulate the four-bar with clearance joint C over a number of crank cycles.
 
@@ -252,6 +253,8 @@ def run_cycles(
         Build the Dataset over time (False: only the accumulated wear work).
     progress : callable, optional
         Called with the fraction done (0..1) after every chunk (1/50 cycle).
+    duration : float, optional
+        Simulated time [s] instead of ``cycles`` (needed when the crank speed is 0).
 
     Returns
     -------
@@ -263,8 +266,19 @@ def run_cycles(
         Excessive penetration, step-size collapse or a non-finite state; the message names the
         time and crank angle, ``.partial`` holds the Dataset recorded so far.
     """
-    if not (cycles > 0 and math.isfinite(cycles)):
-        raise ParameterError(f"cycles must be a positive number, got {cycles!r}")
+    period = params.mechanism.period
+    if duration is not None:
+        if not (duration > 0 and math.isfinite(duration)):
+            raise ParameterError(f"duration must be a positive number of seconds, got {duration!r}")
+        cycles = duration / period if math.isfinite(period) else 0.0
+    else:
+        if not (cycles > 0 and math.isfinite(cycles)):
+            raise ParameterError(f"cycles must be a positive number, got {cycles!r}")
+        if not math.isfinite(period):
+            raise ParameterError(
+                "mechanism.crank_speed_rpm is 0: a crank cycle has no duration; pass duration="
+            )
+        duration = cycles * period
     h = _check_wear(params, wear_depth)
     P, IP = _pack(params)
     st = state if state is not None else initial_state(params)
@@ -276,8 +290,6 @@ def run_cycles(
             "state=None to start from the initial configuration"
         )
     s = params.solver
-    period = params.mechanism.period
-    duration = cycles * period
     t0 = st.time
     t_end = t0 + duration
     n_out = int(math.floor(duration / s.output_interval + 1e-9)) + 1 if record else 0
@@ -294,7 +306,7 @@ def run_cycles(
     hstep = float(st.step)
     t = t0
     i_out = 0
-    n_chunks = max(1, int(math.ceil(cycles * 50)))
+    n_chunks = max(1, int(math.ceil(cycles * 50)), int(math.ceil(duration / 0.01)))
     pen_limit = params.contact.max_penetration_fraction * params.joint.radial_clearance
     nacc_total = 0
     for k in range(n_chunks):

@@ -65,7 +65,8 @@ class MechanismParameters:
     follower_mass: float = 1.50
     crank_inertia: float = 0.0019
     coupler_inertia: float = 0.0927
-    follower_inertia: tuple[float, float, float] = (0.0317, 0.0004, 0.0317)
+    # tuple[float, ...]: jointwear.params mis-coerces fixed-length tuple annotations
+    follower_inertia: tuple[float, ...] = (0.0317, 0.0004, 0.0317)
     gravity: float = 9.81
     joint_offset: float = 0.01
     crank_speed_rpm: float = 120.0
@@ -87,6 +88,12 @@ class MechanismParameters:
             crank_inertia=self.crank_inertia,
             coupler_inertia=self.coupler_inertia,
         )
+        if len(self.follower_inertia) != 3:
+            raise ParameterError(
+                f"{w}.follower_inertia must hold 3 values (I3x, I3y, I3z) [kg m2], got "
+                f"{len(self.follower_inertia)}"
+            )
+        object.__setattr__(self, "follower_inertia", tuple(float(v) for v in self.follower_inertia))
         for i, v in enumerate(self.follower_inertia):
             _positive(w, **{f"follower_inertia[{i}]": float(v)})
         _non_negative(w, gravity=self.gravity)
@@ -94,11 +101,6 @@ class MechanismParameters:
             raise ParameterError(f"{w}.joint_offset must be finite")
         if not math.isfinite(self.crank_speed_rpm):
             raise ParameterError(f"{w}.crank_speed_rpm must be finite")
-        if self.driver and self.crank_speed_rpm == 0:
-            raise ParameterError(
-                f"{w}.crank_speed_rpm is 0 with the driver on: a cycle would never end; "
-                "give a speed or set driver = false"
-            )
         lengths = sorted(
             [self.crank_length, self.coupler_length, self.follower_length, self.ground_length]
         )
@@ -307,11 +309,16 @@ class _ParameterSets(dict):
 PARAMETER_SETS: dict[str, SimParameters] = _ParameterSets(zhang2023=SimParameters())
 
 
+#: Top-level TOML tables read by other parts of jointwear (ignored here).
+_OTHER_TABLES = ("wear",)
+
+
 def load_parameters(toml_path: str | Path, base: str = "zhang2023") -> SimParameters:
     """Read parameters from a TOML file, on top of a named parameter set.
 
     The file holds tables ``[mechanism]``, ``[joint]``, ``[contact]``, ``[friction]``,
-    ``[solver]`` with any subset of their fields (SI units), e.g.::
+    ``[solver]`` with any subset of their fields (SI units); a ``[wear]`` table is left to
+    :mod:`jointwear.sim.wear`. Example::
 
         [joint]
         bearing_radius = 8.1e-3
@@ -337,6 +344,7 @@ def load_parameters(toml_path: str | Path, base: str = "zhang2023") -> SimParame
     base_params = PARAMETER_SETS[base]
     data = read_toml(toml_path)
     merged = dataclasses.asdict(base_params)
+    data = {k: v for k, v in data.items() if k not in _OTHER_TABLES}
     unknown = [k for k in data if k not in merged]
     if unknown:
         raise ParameterError(
