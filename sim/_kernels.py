@@ -163,7 +163,8 @@ def _contact(
 ):
     """Contact of the journal with the bore and the end faces, in the bearing frame.
 
-    Adds to ``wrench`` (6: force on the bearing, moment about the bearing centre) and returns
+    Adds to ``wrench`` (12: force on the bearing, moment about the bearing centre, normal part of
+    the force, friction part of the force) and returns
     (elastic energy, normal force magnitude sum, max radial penetration, max axial penetration,
     mode, stiffness at the deepest slice, number of contacting slices, axial force magnitude).
     """
@@ -276,6 +277,9 @@ def _contact(
                 wrench[0] += s * nd[4]
                 wrench[1] += s * nd[5]
                 wrench[2] += s * nd[6]
+                wrench[6] += s * nd[4]
+                wrench[7] += s * nd[5]
+                wrench[8] += s * nd[6]
                 _cross_acc(nd[1], nd[2], nd[3], nd[4], nd[5], nd[6], wrench, 3, s)
             fnsum += fn
             # friction on the bearing along the journal's sliding velocity
@@ -289,6 +293,9 @@ def _contact(
                 wrench[0] += s * tx
                 wrench[1] += s * ty
                 wrench[2] += s * tz
+                wrench[9] += s * tx
+                wrench[10] += s * ty
+                wrench[11] += s * tz
                 _cross_acc(cx, cy, cz, tx, ty, tz, wrench, 3, s)
             srate[n] = rate
             son[n] = 1
@@ -353,6 +360,9 @@ def _contact(
                 wrench[0] += fn * nd[4]
                 wrench[1] += fn * nd[5]
                 wrench[2] += fn * nd[6]
+                wrench[6] += fn * nd[4]
+                wrench[7] += fn * nd[5]
+                wrench[8] += fn * nd[6]
                 _cross_acc(nd[1], nd[2], nd[3], nd[4], nd[5], nd[6], wrench, 3, fn)
                 fnsum += fn
                 tx = vx - rate * nd[4]
@@ -365,6 +375,9 @@ def _contact(
                     wrench[0] += s * tx
                     wrench[1] += s * ty
                     wrench[2] += s * tz
+                    wrench[9] += s * tx
+                    wrench[10] += s * ty
+                    wrench[11] += s * tz
                     _cross_acc(nd[1], nd[2], nd[3], tx, ty, tz, wrench, 3, s)
                 if acc:
                     WW[n, mm % Nd] += fn / AREA[n, mm % Nd] * vt * hstep
@@ -424,6 +437,9 @@ def _contact(
         wrench[0] += s * u[0]
         wrench[1] += s * u[1]
         wrench[2] += s * u[2]
+        wrench[6] += s * u[0]
+        wrench[7] += s * u[1]
+        wrench[8] += s * u[2]
         _cross_acc(xx, xy, xz, u[0], u[1], u[2], wrench, 3, s)
         tx, ty, tz = vx - vn * u[0], vy - vn * u[1], vz - vn * u[2]
         vt = math.sqrt(tx * tx + ty * ty + tz * tz)
@@ -433,6 +449,9 @@ def _contact(
             wrench[0] += s * tx
             wrench[1] += s * ty
             wrench[2] += s * tz
+            wrench[9] += s * tx
+            wrench[10] += s * ty
+            wrench[11] += s * tz
             _cross_acc(xx, xy, xz, tx, ty, tz, wrench, 3, s)
         srate[k] = rate
         son[k] = 1
@@ -519,7 +538,7 @@ def _eval_clearance(
         u[i] = Rb[0, i] * ug[0] + Rb[1, i] * ug[1] + Rb[2, i] * ug[2]
         V0[i] = Rb[0, i] * V0g[0] + Rb[1, i] * V0g[1] + Rb[2, i] * V0g[2]
         W[i] = Rb[0, i] * Wg[0] + Rb[1, i] * Wg[1] + Rb[2, i] * Wg[2]
-    wrench = np.zeros(6)
+    wrench = np.zeros(12)
     info[I_BAD] = 0.0
     if u[2] < 0.5:
         info[I_BAD] = 1.0
@@ -629,10 +648,9 @@ def _eval_clearance(
             diag[D_AXIS + i] = u[i]
         diag[D_TILT] = math.acos(min(1.0, u[2]))
         diag[D_FORCE], diag[D_FORCE + 1], diag[D_FORCE + 2] = Fx, Fy, Fz
-        diag[D_FN] = fnsum + fax
+        diag[D_FN] = math.sqrt(wrench[6] ** 2 + wrench[7] ** 2 + wrench[8] ** 2)
         diag[D_FMAG] = math.sqrt(Fx * Fx + Fy * Fy + Fz * Fz)
-        # tangential part: the resultant minus its projection on the summed normals
-        diag[D_FT] = 0.0
+        diag[D_FT] = math.sqrt(wrench[9] ** 2 + wrench[10] ** 2 + wrench[11] ** 2)
         diag[D_MODE] = mode
         diag[D_PEN] = pen_rad
         diag[D_PENAX] = pen_ax

@@ -467,16 +467,12 @@ def _dataset(params: SimParameters, t_rel: np.ndarray, diag: np.ndarray, t0: flo
         "contact_force_normal": (
             "time",
             fn,
-            {"units": "N", "long_name": "sum of the normal contact forces in joint C"},
+            {"units": "N", "long_name": "magnitude of the resultant normal contact force"},
         ),
         "contact_force_tangential": (
             "time",
-            np.sqrt(np.maximum(fmag**2 - np.minimum(fn, fmag) ** 2, 0.0)),
-            {
-                "units": "N",
-                "long_name": "tangential (friction) part of the resultant contact force",
-                "note": "sqrt(|F|^2 - Fn^2), Fn the summed normal force",
-            },
+            diag[:, kn.D_FT],
+            {"units": "N", "long_name": "magnitude of the resultant friction force"},
         ),
         "axial_force": (
             "time",

@@ -186,3 +186,23 @@ def test_failure_names_time_and_keeps_partial_record():
     assert isinstance(partial, xr.Dataset)
     assert 0 < partial.sizes["time"] < 2500
     assert np.isfinite(partial.contact_force.values).all()
+
+
+def test_friction_force_bounded_by_coulomb():
+    ds = run_cycles(BASE, cycles=0.2).dataset
+    fn, ft = ds.contact_force_normal.values, ds.contact_force_tangential.values
+    touching = fn > 1.0
+    assert touching.sum() > 100
+    assert (ft[touching] <= 0.2 * fn[touching] * (1 + 1e-9)).all()  # mu <= mu_s
+    assert np.median(ft[touching] / fn[touching]) > 0.05  # the journal slides: mu ~ mu_d
+    np.testing.assert_allclose(
+        np.hypot(fn, ft)[touching], ds.contact_force.values[touching], rtol=0.05
+    )
+    nofric = run_cycles(replace_nested(BASE, **{"friction.enabled": False}), cycles=0.1).dataset
+    assert (nofric.contact_force_tangential.values == 0).all()
+
+
+def test_step_collapse_is_reported():
+    p = replace_nested(BASE, **{"solver.min_step": 5e-4})
+    with pytest.raises(SimulationError, match="step size collapsed below solver.min_step"):
+        run_cycles(p, cycles=0.2)
