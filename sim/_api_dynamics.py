@@ -21,6 +21,7 @@ from jointwear.sim.parameters import (
     SolverParameters,
     load_parameters,
 )
+from jointwear.sim.plot import plot_cycle
 
 __all__ = [
     "SimParameters",
@@ -42,4 +43,5 @@ __all__ = [
     "lankarani_nikravesh_force",
     "friction_coefficient",
     "loop_closure",
+    "plot_cycle",
 ]
