@@ -271,6 +271,7 @@ class VirtualRig:
             world_frame="mechanism frame (x A->D, y up, z out of plane towards the cameras)",
         )
         self._rays: dict[str, np.ndarray] = {}
+        self._tiles: dict[str, np.ndarray] = {}
         self.patches = self._make_patches()
 
     # ---- geometry --------------------------------------------------------------------------
@@ -309,15 +310,40 @@ class VirtualRig:
             out.append(Patch(body, origin, ex, ey, size, texel, tex))
         return out
 
-    def rays(self, camera: str) -> np.ndarray:
-        """Unit world ray directions of every pixel centre (H, W, 3)."""
+    def rays(
+        self, camera: str, region: tuple[int, int, int, int] | None = None, *, tile: int = 64
+    ) -> np.ndarray:
+        """Unit world ray directions of the pixel centres (H, W, 3), or of ``region``
+        ``(y0, y1, x0, x1)``; computed lazily in tiles and cached."""
+        cam = self.calibration.cameras[camera]
+        w, h = cam.image_size
         if camera not in self._rays:
-            cam = self.calibration.cameras[camera]
-            w, h = cam.image_size
-            u, v = np.meshgrid(np.arange(w, dtype=float), np.arange(h, dtype=float))
-            uv = np.stack([u.ravel(), v.ravel()], axis=1)
-            self._rays[camera] = cam.rays(uv).reshape(h, w, 3)
-        return self._rays[camera]
+            self._rays[camera] = np.zeros((h, w, 3))
+            self._tiles[camera] = np.zeros(((h + tile - 1) // tile, (w + tile - 1) // tile), bool)
+        y0, y1, x0, x1 = region or (0, h, 0, w)
+        done = self._tiles[camera]
+        ty0, ty1, tx0, tx1 = y0 // tile, (y1 - 1) // tile + 1, x0 // tile, (x1 - 1) // tile + 1
+        todo = np.argwhere(~done[ty0:ty1, tx0:tx1]) + [ty0, tx0]
+        if len(todo):
+            blocks = []
+            for ty, tx in todo:
+                ys, xs = (
+                    slice(ty * tile, min((ty + 1) * tile, h)),
+                    slice(tx * tile, min((tx + 1) * tile, w)),
+                )
+                u, v = np.meshgrid(
+                    np.arange(xs.start, xs.stop, dtype=float),
+                    np.arange(ys.start, ys.stop, dtype=float),
+                )
+                blocks.append((ys, xs, u.shape, np.stack([u.ravel(), v.ravel()], axis=1)))
+            d = cam.rays(np.concatenate([b[3] for b in blocks]))
+            k = 0
+            for ys, xs, shape, uv in blocks:
+                n = len(uv)
+                self._rays[camera][ys, xs] = d[k : k + n].reshape(*shape, 3)
+                k += n
+            done[todo[:, 0], todo[:, 1]] = True
+        return self._rays[camera][y0:y1, x0:x1]
 
     # ---- rendering -------------------------------------------------------------------------
     def _render_radiance(self, camera: str, t: float) -> np.ndarray:
@@ -329,7 +355,6 @@ class VirtualRig:
         img = np.full((h, w), c.background / 255.0, dtype=np.float32)
         depth = np.full((h, w), np.inf)
         pose = fourbar_pose(t, c)
-        rays = self.rays(camera)
         C = cam.centre
         for patch in self.patches:
             R, p = pose[patch.body]
@@ -343,7 +368,7 @@ class VirtualRig:
             x0, y0, x1, y1 = max(x0, 0), max(y0, 0), min(x1, w), min(y1, h)
             if x1 <= x0 or y1 <= y0:
                 continue
-            d = rays[y0:y1, x0:x1]
+            d = self.rays(camera, (y0, y1, x0, x1))
             n = R[:, 2]
             p0 = R @ patch.origin + p
             denom = d @ n

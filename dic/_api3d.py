@@ -1,3 +1,51 @@
-"""Public names of stereo calibration, stereo DIC and footage tracking."""
+"""Public names of stereo calibration, stereo DIC and footage tracking (``jointwear.dic``).
 
-__all__: list[str] = []
+Calibration: :class:`Camera`, :class:`StereoCalibration`, :class:`CalibrationBoard`,
+:func:`calibrate_stereo`, :func:`board_world_frame`, importers :func:`read_opencv_calibration`
+and :func:`read_vic3d_calibration`, :func:`read_calibration` (jointwear files).
+Stereo geometry: :func:`triangulate` (with covariance), :func:`epipolar_distance`,
+:func:`stereo_noise_floor`. Rigid bodies and time series: :func:`fit_rigid`,
+:func:`fit_rigid_robust`, :func:`time_derivative`. Footage: :func:`open_frames`,
+:func:`read_bodies`, :class:`BodySpec`, :class:`TrackConfig`, :func:`track_footage`,
+:func:`plot_body_motion`.
+"""
+
+from jointwear.dic._calib import (
+    Camera,
+    StereoCalibration,
+    cardan_to_matrix,
+    read_calibration,
+    read_opencv_calibration,
+    read_vic3d_calibration,
+)
+from jointwear.dic._calib_board import CalibrationBoard, board_world_frame, calibrate_stereo
+from jointwear.dic._footage import BodySpec, TrackConfig, read_bodies, track_footage
+from jointwear.dic._footage_plot import plot_body_motion
+from jointwear.dic._rigid import fit_rigid, fit_rigid_robust, time_derivative
+from jointwear.dic._stereo import epipolar_distance, stereo_noise_floor, triangulate
+from jointwear.dic._video import FrameSource, open_frames
+
+__all__ = [
+    "Camera",
+    "StereoCalibration",
+    "CalibrationBoard",
+    "calibrate_stereo",
+    "board_world_frame",
+    "cardan_to_matrix",
+    "read_calibration",
+    "read_opencv_calibration",
+    "read_vic3d_calibration",
+    "triangulate",
+    "epipolar_distance",
+    "stereo_noise_floor",
+    "fit_rigid",
+    "fit_rigid_robust",
+    "time_derivative",
+    "FrameSource",
+    "open_frames",
+    "BodySpec",
+    "TrackConfig",
+    "read_bodies",
+    "track_footage",
+    "plot_body_motion",
+]

@@ -36,7 +36,7 @@ import numpy as np
 import xarray as xr
 
 from jointwear.dic._calib import StereoCalibration
-from jointwear.dic._rigid import derivative, fit_rigid_robust, rotation_angle_z
+from jointwear.dic._rigid import fit_rigid_robust, rotation_angle_z, time_derivative
 from jointwear.dic._stereo import epipolar_distance, triangulate
 from jointwear.dic._video import FrameSource, check_stereo_pair, open_frames
 from jointwear.errors import BadInputError, ParameterError
@@ -281,23 +281,36 @@ class _CameraBodyTracker:
             subset_size=cfg.subset_size, zncc_min=cfg.zncc_min, threads=1, search_radius=8
         )
         self.corr = SubsetCorrelator(crop, points=self.ref_pts - self.origin, params=params)
-        self.history: list[tuple[np.ndarray, np.ndarray]] = []  # (A 2x3, positions)
+        self.history: list[tuple[float, np.ndarray]] = []  # (time, positions)
+        self.ref_image = ref
+        self.polygon = None
 
-    def _predict(self) -> np.ndarray:
-        """Predicted positions (N, 2) from the last frames (quadratic extrapolation)."""
-        hist = self.history
+    def _predict(self, t: float) -> np.ndarray:
+        """Positions (N, 2) predicted at time ``t`` by Lagrange extrapolation (degree <= 2) of
+        the last frames (their real times, so gaps and duplicates are handled)."""
+        hist = self.history[-3:]
         if not hist:
             return self.ref_pts.copy()
-        X = [h[1] for h in hist[-3:]]
-        if len(X) == 1:
-            return X[0]
-        if len(X) == 2:
-            return 2 * X[1] - X[0]
-        return 3 * X[2] - 3 * X[1] + X[0]
+        ts = np.array([h[0] for h in hist])
+        out = np.zeros_like(hist[0][1])
+        for j, (tj, Xj) in enumerate(hist):
+            w = 1.0
+            for m, tm in enumerate(ts):
+                if m != j:
+                    w *= (t - tm) / (tj - tm) if tj != tm else 0.0
+            out += w * Xj
+        return out
 
-    def track(self, img: np.ndarray, point_guess: np.ndarray | None = None):
-        """Correlate the subsets in ``img``; ``point_guess`` (N, 6) affine guesses (reference
-        image coordinates) replace the prediction. Returns positions (N, 2), ZNCC, ok mask."""
+    def reinit_guess(self, img: np.ndarray) -> np.ndarray | None:
+        """Per-point affine guesses from SIFT features (reference -> img), for lost tracking."""
+        poly = self.polygon if self.polygon is not None else _hull(self.ref_pts)
+        H = _sift_homography(self.ref_image, img, poly)
+        return None if H is None else _homography_guess(H, self.ref_pts)
+
+    def track(self, img: np.ndarray, point_guess: np.ndarray | None = None, t: float = 0.0):
+        """Correlate the subsets in ``img`` (time ``t`` [s]); ``point_guess`` (N, 6) affine
+        guesses (reference image coordinates) replace the prediction. Returns positions (N, 2),
+        ZNCC and the ok mask."""
         import cv2
 
         P = self.ref_pts
@@ -307,7 +320,7 @@ class _CameraBodyTracker:
             A, _ = cv2.estimateAffine2D(P, q0, method=cv2.LMEDS)
             A = identity if A is None else A
         else:
-            pred = self._predict()
+            pred = self._predict(t)
             ok = np.all(np.isfinite(pred), axis=1)
             A = None
             if ok.sum() >= 3:
@@ -362,7 +375,8 @@ class _CameraBodyTracker:
         pos[~good] = np.nan
         return pos, res.zncc, good
 
-    def commit(self, pos: np.ndarray) -> None:
+    def commit(self, pos: np.ndarray, t: float) -> None:
+        """Remember the positions found at time ``t`` [s] for the next prediction."""
         import cv2
 
         ok = np.all(np.isfinite(pos), axis=1)
@@ -371,8 +385,14 @@ class _CameraBodyTracker:
             A, _ = cv2.estimateAffine2D(self.ref_pts[ok], pos[ok], method=cv2.LMEDS)
             if A is not None:
                 filled[~ok] = self.ref_pts[~ok] @ A[:, :2].T + A[:, 2]
-            self.history.append((A, filled))
+            self.history.append((t, filled))
             self.history = self.history[-3:]
+
+
+def _hull(pts: np.ndarray) -> np.ndarray:
+    import cv2
+
+    return cv2.convexHull(pts.astype(np.float32)).reshape(-1, 2).astype(float)
 
 
 def _crop(img: np.ndarray, origin: np.ndarray, side: int) -> np.ndarray:
@@ -451,8 +471,6 @@ def track_footage(
         ``<body>_rotation`` and ``<body>_points``; ``frame_flag``; attrs with the duplicated and
         dropped frames found.
     """
-    import cv2
-
     cfg = config or TrackConfig()
     L = left if isinstance(left, FrameSource) else open_frames(left, fps=fps, what="left footage")
     R = None
@@ -530,6 +548,7 @@ def track_footage(
             pts, pos_r, sig = pts[good], pos_r[good], sig[good]
             lt = _CameraBodyTracker(ref_l, pts, cfg, f"left/{spec.name}")
             rt = _CameraBodyTracker(ref_r, pos_r, cfg, f"right/{spec.name}")
+            lt.polygon = poly
             X, _, _ = triangulate(calibration, pts, pos_r, sigma_px=sig)
             ref = X
         else:
@@ -570,39 +589,37 @@ def track_footage(
                     duplicates.append(i)
                 prev_l = img_l
                 for st in states:
-                    pl, zl, gl = st.left.track(img_l)
-                    if st.right is not None:
-                        pr, zr, gr = st.right.track(img_r)
-                        good = gl & gr
-                        pl2, pr2 = (
-                            np.where(good[:, None], pl, np.nan),
-                            np.where(good[:, None], pr, np.nan),
-                        )
-                        X, cov, rep = triangulate(calibration, pl2, pr2, sigma_px=st.sigma_px)
-                        cur = X
-                    else:
-                        good = gl
-                        cur = np.where(good[:, None], pl, np.nan)
-                        pr = None
-                    try:
-                        Rm, tv, inl, rms = fit_rigid_robust(
-                            st.ref3d, cur, min_points=cfg.min_points
-                        )
-                        ok_pose = True
-                    except BadInputError:
+                    if flag & FRAME_FLAGS["duplicated"]:
+                        # a repeated image carries no new information (and a wrong time)
                         d = st.ref3d.shape[1]
-                        Rm, tv, inl, rms = (
-                            np.full((d, d), np.nan),
+                        nan_pose = (np.full((d, d), np.nan), np.full(d, np.nan))
+                        _append_row(
+                            st,
+                            *nan_pose,
                             np.full(d, np.nan),
-                            good & False,
+                            np.full(d, np.nan),
+                            0,
                             np.nan,
+                            np.full(st.ref3d.shape, np.nan, dtype=np.float32),
                         )
-                        ok_pose = False
-                        flag |= FRAME_FLAGS["tracking_failed"]
+                        continue
+                    ok_pose, Rm, tv, inl, rms, cur, cov, pl, pr = _track_body(
+                        st, img_l, img_r, t, cfg, calibration
+                    )
+                    if not ok_pose:
+                        # lost: re-initialise from SIFT features of the reference images
+                        gl_guess = st.left.reinit_guess(img_l)
+                        gr_guess = st.right.reinit_guess(img_r) if st.right is not None else None
+                        if gl_guess is not None and (st.right is None or gr_guess is not None):
+                            ok_pose, Rm, tv, inl, rms, cur, cov, pl, pr = _track_body(
+                                st, img_l, img_r, t, cfg, calibration, gl_guess, gr_guess
+                            )
                     if ok_pose:
-                        st.left.commit(np.where(inl[:, None], pl, np.nan))
+                        st.left.commit(np.where(inl[:, None], pl, np.nan), t)
                         if st.right is not None:
-                            st.right.commit(np.where(inl[:, None], pr, np.nan))
+                            st.right.commit(np.where(inl[:, None], pr, np.nan), t)
+                    else:
+                        flag |= FRAME_FLAGS["tracking_failed"]
                     poi = Rm @ st.point_of_interest + tv
                     n_in = int(np.sum(inl))
                     if st.right is not None and ok_pose:
@@ -611,14 +628,7 @@ def track_footage(
                         u = np.sqrt(np.maximum(np.diag(cov_mean), (rms**2 / 3) / max(n_in - 1, 1)))
                     else:
                         u = np.full(st.ref3d.shape[1], rms / np.sqrt(max(n_in - 1, 1)))
-                    row = st.rows
-                    row.setdefault("R", []).append(Rm)
-                    row.setdefault("t", []).append(tv)
-                    row.setdefault("poi", []).append(poi)
-                    row.setdefault("poi_u", []).append(u)
-                    row.setdefault("n", []).append(n_in)
-                    row.setdefault("rms", []).append(rms)
-                    row.setdefault("points", []).append(cur.astype(np.float32))
+                    _append_row(st, Rm, tv, poi, u, n_in, rms, cur.astype(np.float32))
                 times.append(t)
                 flags.append(flag)
                 bar.update(task, advance=1)
@@ -640,8 +650,52 @@ def track_footage(
     result.attrs["wall_time_s"] = _time.perf_counter() - t_start
     if out is not None:
         _write(result, out, inputs, cfg, bodies)
-    del cv2
     return result
+
+
+def _append_row(st, Rm, tv, poi, u, n_in, rms, cur) -> None:
+    row = st.rows
+    for key, val in (
+        ("R", Rm),
+        ("t", tv),
+        ("poi", poi),
+        ("poi_u", u),
+        ("n", n_in),
+        ("rms", rms),
+        ("points", cur),
+    ):
+        row.setdefault(key, []).append(val)
+
+
+def _track_body(st, img_l, img_r, t, cfg, calibration, guess_l=None, guess_r=None):
+    """Correlate one body in both cameras, triangulate and fit its pose."""
+    pl, zl, gl = st.left.track(img_l, point_guess=guess_l, t=t)
+    pr, cov = None, None
+    if st.right is not None:
+        pr, zr, gr = st.right.track(img_r, point_guess=guess_r, t=t)
+        good = gl & gr
+        pl2 = np.where(good[:, None], pl, np.nan)
+        pr2 = np.where(good[:, None], pr, np.nan)
+        cur, cov, _ = triangulate(calibration, pl2, pr2, sigma_px=st.sigma_px)
+    else:
+        good = gl
+        cur = np.where(good[:, None], pl, np.nan)
+    d = st.ref3d.shape[1]
+    try:
+        Rm, tv, inl, rms = fit_rigid_robust(st.ref3d, cur, min_points=cfg.min_points)
+    except BadInputError:
+        return (
+            False,
+            np.full((d, d), np.nan),
+            np.full(d, np.nan),
+            good & False,
+            np.nan,
+            cur,
+            cov,
+            pl,
+            pr,
+        )
+    return True, Rm, tv, inl, rms, cur, cov, pl, pr
 
 
 def _write(ds: xr.Dataset, out, inputs, cfg, bodies) -> None:
@@ -682,7 +736,7 @@ def _assemble(states, times, flags, duplicates, L, R, cfg, calibration, status) 
         poi = np.asarray(rows["poi"], dtype=float)
         poi_u = np.asarray(rows["poi_u"], dtype=float)
         poi_v = np.where(valid_time[:, None], poi, np.nan)
-        vel, gain = derivative(t, poi_v, window=cfg.velocity_window, order=cfg.velocity_order)
+        vel, gain = time_derivative(t, poi_v, window=cfg.velocity_window, order=cfg.velocity_order)
         vel_u = gain[:, None] * np.nanmedian(poi_u, axis=0)[None, :]
         data[f"{name}_position"] = (
             ("time", "axis"),

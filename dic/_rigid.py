@@ -6,7 +6,7 @@ import numpy as np
 
 from jointwear.errors import BadInputError
 
-__all__ = ["fit_rigid", "fit_rigid_robust", "derivative", "rotation_angle_z"]
+__all__ = ["fit_rigid", "fit_rigid_robust", "time_derivative", "rotation_angle_z"]
 
 
 def fit_rigid(
@@ -101,7 +101,7 @@ def rotation_angle_z(R: np.ndarray) -> np.ndarray:
     return np.arctan2(R[..., 1, 0], R[..., 0, 0])
 
 
-def derivative(
+def time_derivative(
     t: np.ndarray, x: np.ndarray, *, window: int = 9, order: int = 5
 ) -> tuple[np.ndarray, np.ndarray]:
     """First derivative by local polynomial least squares (Savitzky–Golay on actual times).
@@ -126,7 +126,9 @@ def derivative(
     Returns
     -------
     dxdt : (N, ...) array
-        Derivative [unit of x per s]; NaN where fewer than ``order + 1`` valid samples.
+        Derivative [unit of x per s]; NaN at the first and last sample and where too few
+        valid samples remain. Within ``window // 2`` samples of an end the window shrinks
+        symmetrically (centred differences; degree at most ``2 * distance to the end``).
     gain : (N,) array
         Noise gain ``sqrt(sum c_j^2)`` [1/s]: the derivative's standard uncertainty is
         ``gain * sigma_x`` for independent sample noise ``sigma_x``.
@@ -152,10 +154,18 @@ def derivative(
     A = (dt / scale)[..., None] ** np.arange(order + 1)  # (n, w, p+1)
     vals = flat[idx]  # (n, w, k)
     valid = np.all(np.isfinite(vals), axis=2)
+    # near the record ends the window shrinks symmetrically (half-width = distance to the end)
+    # and the degree with it: an off-centre evaluation of the fitted polynomial is strongly
+    # biased; the first and last samples get NaN
+    pos = np.arange(n)[:, None]
+    reach = np.minimum(np.arange(n), n - 1 - np.arange(n))[:, None]
+    valid &= np.abs(idx - pos) <= reach
+    deg = np.minimum(order, 2 * reach[:, 0])
+    A = np.where(np.arange(order + 1)[None, None, :] <= deg[:, None, None], A, 0.0)
     Aw = A * valid[..., None]
     pinv = np.linalg.pinv(Aw)  # (n, p+1, w)
     c = pinv[:, 1, :] / scale  # slope coefficients
-    enough = valid.sum(axis=1) >= order + 1
+    enough = (valid.sum(axis=1) >= deg + 1) & (deg >= 1)
     out = np.einsum("nw,nwk->nk", c, np.where(valid[..., None], vals, 0.0))
     out[~enough] = np.nan
     gain = np.sqrt(np.sum(c**2, axis=1))

@@ -1,0 +1,56 @@
+"""``jointwear datasets rig --out DIR``: render the virtual stereo rig with ground truth."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+
+def register(app: typer.Typer) -> None:
+    """Add ``rig`` to ``jointwear datasets``."""
+
+    @app.command("rig")
+    def rig(
+        out: Annotated[Path, typer.Option("--out", "-o", help="Output folder.")],
+        duration: Annotated[float, typer.Option(help="Recorded time (s).")] = 1.0,
+        fps: Annotated[float, typer.Option(help="Frame rate (1/s).")] = 50.0,
+        width: Annotated[int, typer.Option(help="Image width (px).")] = 1280,
+        height: Annotated[int, typer.Option(help="Image height (px).")] = 1024,
+        z_amplitude_mm: Annotated[
+            float, typer.Option(help="Out-of-plane amplitude of joint C (mm).")
+        ] = 2.5,
+        noise: Annotated[float, typer.Option(help="Sensor noise (grey levels).")] = 1.0,
+        blur: Annotated[float, typer.Option(help="Optical blur sigma (px).")] = 0.6,
+        exposure: Annotated[float, typer.Option(help="Brightness gain.")] = 1.0,
+        codec: Annotated[str, typer.Option(help="ffv1 (lossless), png, mjpg or mp4v.")] = "ffv1",
+        video: Annotated[bool, typer.Option(help="Write videos.")] = True,
+        images: Annotated[bool, typer.Option(help="Write image folders.")] = True,
+        drop: Annotated[
+            list[int] | None, typer.Option(help="Frame index to drop (repeatable).")
+        ] = None,
+        duplicate: Annotated[
+            list[int] | None, typer.Option(help="Frame index to duplicate (repeatable).")
+        ] = None,
+        seed: Annotated[int, typer.Option(help="Random seed.")] = 0,
+    ) -> None:
+        """Render what the rig's two cameras would record, board images and the ground truth."""
+        from jointwear.datasets.rig import RigConfig, generate_rig
+
+        cfg = RigConfig(
+            width=width,
+            height=height,
+            fps=fps,
+            duration=duration,
+            z_amplitude=z_amplitude_mm * 1e-3,
+            noise_sigma=noise,
+            blur_sigma_px=blur,
+            exposure=exposure,
+            seed=seed,
+            drop_frames=tuple(drop or ()),
+            duplicate_frames=tuple(duplicate or ()),
+        )
+        written = generate_rig(out, cfg, video=video, images=images, codec=codec)
+        for key, path in written.items():
+            typer.echo(f"{key}: {path}")

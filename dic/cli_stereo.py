@@ -1,0 +1,199 @@
+"""``jointwear dic calibrate | import-calibration | track | plot-track``: stereo rig commands."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+
+def _image_list(path: Path, what: str) -> list[Path]:
+    from jointwear.dic._video import IMAGE_SUFFIXES
+    from jointwear.errors import BadInputError
+
+    if not path.exists():
+        raise BadInputError(f"{what} '{path}' does not exist")
+    if path.is_dir():
+        from jointwear.dic._video import _natural_key
+
+        files = sorted(
+            (p for p in path.iterdir() if p.suffix.lower() in IMAGE_SUFFIXES), key=_natural_key
+        )
+        if not files:
+            raise BadInputError(f"{what} folder '{path}' holds no images")
+        return files
+    raise BadInputError(f"{what} '{path}' must be a folder of images")
+
+
+def _video_frames(path: Path, every: int, what: str) -> list:
+    from jointwear.dic._video import open_frames
+
+    src = open_frames(path, what=what)
+    return [img for i, _, img in src.frames() if i % every == 0]
+
+
+def register(app: typer.Typer) -> None:
+    """Add the stereo commands to ``jointwear dic``."""
+
+    @app.command("calibrate")
+    def calibrate(
+        left: Annotated[Path, typer.Option("--left", help="Left board images (folder) or video.")],
+        right: Annotated[
+            Path, typer.Option("--right", help="Right board images (folder) or video.")
+        ],
+        out: Annotated[Path, typer.Option("--out", "-o", help="Calibration file (.nc).")] = Path(
+            "calibration.nc"
+        ),
+        board: Annotated[str, typer.Option(help="chessboard or charuco.")] = "chessboard",
+        squares: Annotated[
+            tuple[int, int], typer.Option(help="Squares along x and y (not inner corners).")
+        ] = (10, 7),
+        square_mm: Annotated[float, typer.Option(help="Square side (mm).")] = 10.0,
+        marker_mm: Annotated[float, typer.Option(help="ChArUco marker side (mm).")] = 7.5,
+        dictionary: Annotated[str, typer.Option(help="ChArUco ArUco dictionary.")] = "DICT_5X5_100",
+        world_view: Annotated[
+            int | None,
+            typer.Option(help="Index of the view whose board pose becomes the world frame."),
+        ] = None,
+        min_views: Annotated[int, typer.Option(help="Fewest usable views.")] = 6,
+        every: Annotated[int, typer.Option(help="Videos: use every N-th frame.")] = 10,
+    ) -> None:
+        """Calibrate a stereo pair from simultaneous views of a chessboard or ChArUco board."""
+        from jointwear import io
+        from jointwear.dic._calib_board import CalibrationBoard, calibrate_stereo
+
+        io.check_writable(out)
+        b = CalibrationBoard(
+            board, squares[0], squares[1], square_mm * 1e-3, marker_mm * 1e-3, dictionary
+        )
+        if left.is_dir():
+            lefts, rights = (
+                _image_list(left, "left calibration"),
+                _image_list(right, "right calibration"),
+            )
+        else:
+            lefts = _video_frames(left, every, "left calibration video")
+            rights = _video_frames(right, every, "right calibration video")
+        cal = calibrate_stereo(lefts, rights, b, min_views=min_views, world_view=world_view)
+        cal.save(
+            out, inputs=[left, right], parameters={"board": b.__dict__, "world_view": world_view}
+        )
+        typer.echo(
+            f"calibrated from {cal.views_used} views ({cal.views_rejected} rejected): RMS "
+            f"{cal.rms:.3f} px, baseline {cal.baseline * 1e3:.2f} mm, focal "
+            f"{cal.left.focal[0]:.1f}/{cal.right.focal[0]:.1f} px -> {out}"
+        )
+
+    @app.command("import-calibration")
+    def import_calibration(
+        path: Annotated[Path, typer.Argument(help="OpenCV YAML/XML or VIC-3D cal.xml file.")],
+        fmt: Annotated[str, typer.Option("--format", help="opencv or vic3d.")],
+        out: Annotated[Path, typer.Option("--out", "-o", help="Calibration file (.nc).")] = Path(
+            "calibration.nc"
+        ),
+        length_unit: Annotated[
+            str | None, typer.Option(help="OpenCV: unit of T (m, mm, cm, um, in).")
+        ] = None,
+        image_size: Annotated[
+            tuple[int, int] | None, typer.Option(help="Image width and height (px) if absent.")
+        ] = None,
+    ) -> None:
+        """Import a calibration made elsewhere (OpenCV FileStorage, VIC-3D) as a jointwear file."""
+        from jointwear.dic._calib import read_opencv_calibration, read_vic3d_calibration
+        from jointwear.errors import BadInputError
+
+        if fmt == "opencv":
+            if length_unit is None:
+                raise BadInputError(
+                    "--length-unit is required for OpenCV files (the unit of T, i.e. of the board "
+                    "square size used when calibrating: m, mm, cm, um or in)"
+                )
+            cal = read_opencv_calibration(path, length_unit=length_unit, image_size=image_size)
+        elif fmt == "vic3d":
+            cal = read_vic3d_calibration(path, image_size=image_size)
+        else:
+            raise BadInputError(f"--format {fmt!r}: expected 'opencv' or 'vic3d'")
+        cal.save(out, inputs=[path], parameters={"format": fmt, "length_unit": length_unit})
+        typer.echo(f"imported {fmt} calibration (baseline {cal.baseline * 1e3:.2f} mm) -> {out}")
+
+    @app.command("track")
+    def track(
+        left: Annotated[Path, typer.Option("--left", help="Left video or image folder.")],
+        bodies: Annotated[
+            Path, typer.Option("--bodies", help="TOML file with the regions of interest.")
+        ],
+        right: Annotated[
+            Path | None, typer.Option("--right", help="Right video or image folder.")
+        ] = None,
+        calibration: Annotated[
+            Path | None, typer.Option("--calibration", "-c", help="Stereo calibration (.nc).")
+        ] = None,
+        out: Annotated[Path, typer.Option("--out", "-o", help="Body motion (.nc).")] = Path(
+            "motion.nc"
+        ),
+        fps: Annotated[
+            float | None, typer.Option(help="Frame rate (1/s) (image sequences).")
+        ] = None,
+        max_frames: Annotated[
+            int | None, typer.Option(help="Process only the first N frames.")
+        ] = None,
+        plot: Annotated[
+            Path | None, typer.Option(help="Also write the velocity/displacement plot.")
+        ] = None,
+    ) -> None:
+        """Track the bodies of rig footage: poses, follower velocity, journal out-of-plane motion.
+
+        The result is written after every chunk of frames, so an interrupted run keeps what was
+        computed (attribute 'status').
+        """
+        from jointwear import io
+        from jointwear.dic._calib import read_calibration
+        from jointwear.dic._footage import read_bodies, track_footage
+
+        io.check_writable(out)
+        cfg, specs = read_bodies(bodies)
+        cal = read_calibration(calibration) if calibration is not None else None
+        inputs = [p for p in (left, right, bodies, calibration) if p is not None]
+        ds = track_footage(
+            left,
+            right,
+            bodies=specs,
+            calibration=cal,
+            config=cfg,
+            fps=fps,
+            max_frames=max_frames,
+            out=out,
+            progress=True,
+            inputs=tuple(inputs),
+        )
+        dup = ds.attrs.get("duplicated_frames", "[]")
+        typer.echo(
+            f"tracked {ds.attrs['frames_processed']} frames in {ds.attrs.get('wall_time_s', 0):.1f} s; "
+            f"duplicated frames: {dup}; dropped frames (time gaps): "
+            f"{ds.attrs.get('dropped_frames_estimated', 0)} -> {out}"
+        )
+        if plot is not None:
+            from jointwear.dic._footage_plot import plot_body_motion
+
+            plot_body_motion(ds, path=plot)
+            typer.echo(f"plot -> {plot}")
+
+    @app.command("plot-track")
+    def plot_track(
+        motion: Annotated[Path, typer.Argument(help="Output of `jointwear dic track` (.nc).")],
+        out: Annotated[Path, typer.Option("--out", "-o", help="Figure (.png/.svg/.pdf).")] = Path(
+            "motion.png"
+        ),
+        reference: Annotated[
+            Path | None, typer.Option(help="Reference to overlay (ground truth, simulation).")
+        ] = None,
+    ) -> None:
+        """Plot the follower velocity and the journal's out-of-plane displacement."""
+        from jointwear import io
+        from jointwear.dic._footage_plot import plot_body_motion
+
+        ds = io.load(motion)
+        ref = io.load(reference) if reference is not None else None
+        plot_body_motion(ds, reference=ref, path=out)
+        typer.echo(f"plot -> {out}")
