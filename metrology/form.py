@@ -148,67 +148,87 @@ def limacon_error(eccentricity: float, radius: float) -> float:
 # --------------------------------------------------------------------------------------------
 
 
-def _design(theta_rad: np.ndarray, z: np.ndarray | None) -> np.ndarray:
-    c, s = np.cos(theta_rad), np.sin(theta_rad)
-    if z is None:
-        return np.column_stack([c, s])
-    return np.column_stack([c, s, z * c, z * s])
+class _Basis:
+    """Design columns (cos, sin[, z cos, z sin]) stored row-wise; fast G @ p and G[idx]."""
+
+    def __init__(self, theta_rad: np.ndarray, z: np.ndarray | None):
+        c, s = np.cos(theta_rad), np.sin(theta_rad)
+        self.cols = np.stack([c, s] if z is None else [c, s, z * c, z * s])
+        self.shape = (c.size, self.cols.shape[0])
+
+    def dot(self, p: np.ndarray) -> np.ndarray:
+        out = self.cols[0] * p[0]
+        for k in range(1, self.cols.shape[0]):
+            out += self.cols[k] * p[k]
+        return out
+
+    def rows(self, idx: np.ndarray) -> np.ndarray:
+        return self.cols[:, idx].T
 
 
-def _ls(G: np.ndarray, r: np.ndarray) -> tuple[np.ndarray, float]:
-    A = np.column_stack([G, np.ones(len(r))])
+def _design(theta_rad: np.ndarray, z: np.ndarray | None) -> _Basis:
+    return _Basis(theta_rad, z)
+
+
+def _ls(G: _Basis, r: np.ndarray) -> tuple[np.ndarray, float]:
+    A = np.vstack([G.cols, np.ones((1, r.size))])
     # normal equations: the basis (cos, sin, z cos, z sin, 1) with centred z is well conditioned
-    sol = np.linalg.solve(A.T @ A, A.T @ r)
+    sol = np.linalg.solve(A @ A.T, A @ r)
     return sol[:-1], float(sol[-1])
 
 
-def _initial_candidates(
-    e: np.ndarray, groups: np.ndarray | None, n_groups: int, kind: str, k: int = 6
-) -> np.ndarray:
-    """Extreme points of a first residual (per group) plus an even subsample."""
-    n = len(e)
-    idx = [np.linspace(0, n - 1, min(n, 32 * max(n_groups, 1)), dtype=np.int64)]
-    if groups is None or n_groups <= 1:
-        order = np.argsort(e)
-        if kind in ("MZ", "MI"):
-            idx.append(order[:k])
-        if kind in ("MZ", "MC"):
-            idx.append(order[-k:])
-    else:
-        # per group extremes: groups are contiguous blocks of equal length if reshapeable
-        for g in range(n_groups):
-            sel = np.flatnonzero(groups == g)
-            if sel.size == 0:
-                continue
-            order = sel[np.argsort(e[sel])]
-            if kind in ("MZ", "MI"):
-                idx.append(order[:k])
-            if kind in ("MZ", "MC"):
-                idx.append(order[-k:])
-    return np.unique(np.concatenate(idx))
+class _Sectors:
+    """Points grouped by (layer, angular sector), for picking one extreme per sector."""
+
+    def __init__(self, theta_rad: np.ndarray, groups: np.ndarray | None, n_sectors: int):
+        sec = np.floor(np.mod(theta_rad, 2 * np.pi) / (2 * np.pi) * n_sectors).astype(np.int64)
+        sec = np.clip(sec, 0, n_sectors - 1)
+        key = sec if groups is None else groups.astype(np.int64) * n_sectors + sec
+        if key.size and np.all(key[1:] >= key[:-1]):
+            self.order = np.arange(key.size)  # grid data, layer-major with ascending angles
+        else:
+            self.order = np.argsort(key, kind="stable")
+        ks = key[self.order]
+        self.starts = np.flatnonzero(np.concatenate([[True], ks[1:] != ks[:-1]]))
+        self.sector_of_sorted = np.repeat(
+            np.arange(self.starts.size), np.diff(np.append(self.starts, ks.size))
+        )
+
+    def argmax(self, values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Index of the largest value in each sector, and that value."""
+        vs = values[self.order]
+        mx = np.maximum.reduceat(vs, self.starts)
+        hit = np.flatnonzero(vs == mx[self.sector_of_sorted])
+        _, first = np.unique(self.sector_of_sorted[hit], return_index=True)
+        return self.order[hit[first]], mx
 
 
 def _zone_lp(
     G: np.ndarray,
     r: np.ndarray,
     kind: str,
-    groups: np.ndarray | None = None,
-    n_groups: int = 1,
+    sectors: _Sectors,
     what: str = "profile",
 ) -> tuple[np.ndarray, float, float, int]:
     """Solve the MZ / MI / MC LP by constraint generation.
 
-    Returns (centre parameters p, lower radius a, upper radius b, number of candidate rows);
-    residuals e = r - G p lie in [a, b] (MI: a is the inscribed radius, MC: b circumscribed).
-    Inputs are in micrometres.
+    Candidates start as the extremes of the least-squares residual in each angular sector of
+    each layer; each round adds, per sector, the point that violates the current solution most.
+    Returns (centre parameters p, min residual, max residual, number of candidates);
+    inputs in micrometres.
     """
     m = G.shape[1]
-    p0, a0 = _ls(G, r)
-    e0 = r - G @ p0
-    cand = _initial_candidates(e0, groups, n_groups, kind)
+    p0, _ = _ls(G, r)
+    e0 = r - G.dot(p0)
+    parts = []
+    if kind in ("MZ", "MC"):
+        parts.append(sectors.argmax(e0)[0])
+    if kind in ("MZ", "MI"):
+        parts.append(sectors.argmax(-e0)[0])
+    cand = np.unique(np.concatenate(parts))
     tol = _TOL * _SCALE
     for _ in range(200):
-        Gs, rs = G[cand], r[cand]
+        Gs, rs = G.rows(cand), r[cand]
         ns = len(cand)
         if kind == "MZ":
             # vars [p (m), a, t]; min t; G p + a <= r ; -G p - a - t <= -r
@@ -249,30 +269,18 @@ def _zone_lp(
             )
         x = res.x
         p = x[:m]
-        e = r - G @ p
+        e = r - G.dot(p)
         if kind == "MZ":
-            a, bnd = x[m], x[m] + x[m + 1]
-            viol = np.maximum(a - e, e - bnd)
+            viol = np.maximum(x[m] - e, e - (x[m] + x[m + 1]))
         elif kind == "MI":
-            a, bnd = x[m], float(np.max(e))
-            viol = a - e
+            viol = x[m] - e
         else:
-            a, bnd = float(np.min(e)), x[m]
-            viol = e - bnd
-        bad = viol > tol
-        if not np.any(bad):
+            viol = e - x[m]
+        idx, worst = sectors.argmax(viol)
+        new = idx[worst > tol]
+        if new.size == 0:
             return p, float(np.min(e)), float(np.max(e)), len(cand)
-        # add the worst violators (globally and per group)
-        worst = np.flatnonzero(bad)
-        if worst.size > 8 * max(n_groups, 1):
-            worst = worst[np.argsort(viol[worst])[-8 * max(n_groups, 1) :]]
-        if groups is not None and n_groups > 1:
-            per = []
-            for g in np.unique(groups[bad]):
-                sel = np.flatnonzero(bad & (groups == g))
-                per.append(sel[np.argmax(viol[sel])])
-            worst = np.concatenate([worst, np.asarray(per, dtype=np.int64)])
-        cand = np.union1d(cand, worst)
+        cand = np.union1d(cand, new)
     raise BadInputError(f"{what}: {kind} constraint generation did not converge in 200 rounds")
 
 
@@ -315,11 +323,13 @@ def _zone(
     active = 0
     if kind == "LS":
         p, a = _ls(G, rs)
-        e = rs - G @ p
+        e = rs - G.dot(p)
         ref = a
     else:
-        p, lo, hi, active = _zone_lp(G, rs, kind, grp, n_groups, what)
-        e = rs - G @ p
+        n_sec = 64 if grp is None else 32
+        sectors = _Sectors(th, grp, n_sec)
+        p, lo, hi, active = _zone_lp(G, rs, kind, sectors, what)
+        e = rs - G.dot(p)
         ref = {"MZ": 0.5 * (lo + hi), "MI": lo, "MC": hi}[kind]
     dev = (e - ref) / _SCALE
     peak = float(max(np.max(dev), 0.0))
@@ -395,7 +405,10 @@ def cylinder_zone(
         axis position at ``z_ref`` (mid of the measured z range) and ``tilt`` its slope.
     """
     z = np.asarray(z, dtype=float).ravel()
-    _, inv = np.unique(z, return_inverse=True)
+    if z.size and np.all(z[1:] >= z[:-1]):  # sorted (layer-major grid): cheap layer ids
+        inv = np.concatenate([[0], np.cumsum(z[1:] != z[:-1])])
+    else:
+        _, inv = np.unique(z, return_inverse=True)
     return _zone(
         np.radians(np.asarray(theta_deg, dtype=float)),
         r,

@@ -1,0 +1,105 @@
+"""``jointwear datasets instruments OUT``: write realistic roundness-instrument files with truth."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+
+def register(app: typer.Typer) -> None:
+    """Add ``jointwear datasets instruments``."""
+
+    @app.command("instruments")
+    def instruments_cmd(
+        out: Annotated[Path, typer.Argument(help="Output folder (or file for long/wide/single).")],
+        layers: Annotated[int, typer.Option("--layers", help="Number of layers.")] = 13,
+        points: Annotated[int, typer.Option("--points", help="Points per layer.")] = 18000,
+        radius_mm: Annotated[float, typer.Option("--radius-mm", help="Bore radius [mm].")] = 8.0,
+        spacing_mm: Annotated[
+            float, typer.Option("--spacing-mm", help="Layer spacing [mm].")
+        ] = 1.0,
+        layout: Annotated[
+            str,
+            typer.Option(
+                "--layout", help="folder, folder-names, folder-header, long, wide or single."
+            ),
+        ] = "folder",
+        value: Annotated[str, typer.Option("--value", help="deviation or radius.")] = "deviation",
+        units: Annotated[str, typer.Option("--units", help="um, mm, m or inch.")] = "um",
+        angle: Annotated[
+            str, typer.Option("--angle", help="Angle column: deg, rad, index, none or xy.")
+        ] = "deg",
+        delimiter: Annotated[
+            str, typer.Option("--delimiter", help="tab, semicolon, comma or space.")
+        ] = "tab",
+        decimal: Annotated[str, typer.Option("--decimal", help="'.' or ','.")] = ".",
+        eccentricity_um: Annotated[
+            tuple[float, float], typer.Option("--eccentricity-um", help="Set-up offset x y [µm].")
+        ] = (15.0, -8.0),
+        tilt: Annotated[
+            tuple[float, float], typer.Option("--tilt", help="Axis slopes dx/dz dy/dz [1].")
+        ] = (1.5e-3, -0.8e-3),
+        wear_um: Annotated[
+            float, typer.Option("--wear-um", help="Peak depth of the imposed wear [µm] (0: none).")
+        ] = 20.0,
+        noise_um: Annotated[float, typer.Option("--noise-um", help="Probe noise [µm].")] = 0.02,
+        quantisation_nm: Annotated[
+            float, typer.Option("--quantisation-nm", help="Reading resolution [nm].")
+        ] = 1.0,
+        angle_zero: Annotated[
+            str, typer.Option("--angle-zero", help="Instrument 0 degree in the bearing frame.")
+        ] = "+y",
+        angle_direction: Annotated[
+            str, typer.Option("--angle-direction", help="Instrument angle sense.")
+        ] = "counterclockwise",
+        seed: Annotated[int, typer.Option("--seed", help="Random seed.")] = 0,
+        truth: Annotated[
+            Path | None,
+            typer.Option("--truth", help="Also save the truth (radius, wear) as netCDF."),
+        ] = None,
+    ) -> None:
+        """Generate a virtual roundness-instrument scan of a worn bore with known truth."""
+        from jointwear import io
+        from jointwear.datasets.instruments import generate, write
+
+        delims = {"tab": "\t", "semicolon": ";", "comma": ",", "space": " ", "whitespace": " "}
+        sc = generate(
+            n_layers=layers,
+            n_points=points,
+            radius=radius_mm * 1e-3,
+            layer_spacing=spacing_mm * 1e-3,
+            eccentricity=(eccentricity_um[0] * 1e-6, eccentricity_um[1] * 1e-6),
+            tilt=tilt,
+            wear="default" if wear_um > 0 else None,
+            wear_depth=wear_um * 1e-6,
+            noise=noise_um * 1e-6,
+            quantisation=quantisation_nm * 1e-9,
+            convention=(angle_zero, angle_direction),
+            seed=seed,
+        )
+        files = write(
+            sc,
+            out,
+            layout=layout,
+            value=value,
+            units=units,
+            angle=angle,
+            delimiter=delims.get(delimiter, delimiter),
+            decimal=decimal,
+        )
+        typer.echo(f"wrote {len(files)} file(s) under {out}")
+        typer.echo(
+            f"import with: jointwear metrology import {out} --angle-zero {angle_zero} "
+            f"--angle-direction {angle_direction} --out scan.nc"
+        )
+        if truth is not None:
+            t = sc.truth
+            io.save(
+                t,
+                truth,
+                source="jointwear 0.1 (datasets.instruments)",
+                parameters={"layers": layers, "points": points, "seed": seed, "layout": layout},
+            )
+            typer.echo(f"wrote {truth}")

@@ -1,0 +1,287 @@
+"""Full form assessment of a scan: per-layer roundness, whole-bore cylindricity, spectrum.
+
+:func:`assess` runs, for a (z, theta) scan: optional outlier removal (reports the count),
+optional filtering (Gaussian or 2RC, cut-off in UPR), centring by the limaçon (eccentricity and
+its direction per layer, with a warning when the limaçon's neglected term e^2/(4R) exceeds a
+tolerance), the four reference circles per layer (RONt/p/v/q), the four reference cylinders
+(CYLt/p/v/q), the exact geometric least-squares cylinder, and the harmonic spectrum per layer.
+"""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pandas as pd
+import xarray as xr
+
+from jointwear.errors import BadInputError
+from jointwear.metrology.filters import (
+    filter_profile,
+    harmonic_spectrum,
+    is_uniform,
+    remove_outliers,
+)
+from jointwear.metrology.fit import fit_cylinder_polar
+from jointwear.metrology.form import (
+    REFERENCES,
+    circle_zone,
+    cylinder_zone,
+    limacon_error,
+    normalise_reference,
+)
+
+__all__ = ["CentringWarning", "assess", "form_table"]
+
+_PARAMS = {"t": "peak-to-valley", "p": "peak", "v": "valley", "q": "RMS"}
+
+
+class CentringWarning(UserWarning):
+    """The eccentricity is so large that the limaçon approximation is off by more than the
+    stated tolerance (re-centre the part, or use the exact fits)."""
+
+
+def _scan_var(scan: xr.Dataset | xr.DataArray) -> tuple[xr.DataArray, str]:
+    if isinstance(scan, xr.DataArray):
+        return scan, str(scan.name or "radius")
+    for name in ("radius", "radial_deviation"):
+        if name in scan:
+            return scan[name], name
+    raise BadInputError(
+        "assess: the scan has neither 'radius' nor 'radial_deviation' "
+        f"(variables: {', '.join(map(str, scan.data_vars)) or 'none'})"
+    )
+
+
+def assess(
+    scan: xr.Dataset | xr.DataArray,
+    *,
+    references: tuple[str, ...] = ("LS", "MZ", "MI", "MC"),
+    filter_upr: float | None = None,
+    filter_kind: str = "gaussian",
+    outliers: float | None = None,
+    max_harmonic: int = 150,
+    limacon_tolerance: float = 10e-9,
+    radius: float | None = None,
+    exact: bool = False,
+) -> xr.Dataset:
+    """Roundness per layer and cylindricity of a scan, for each reference.
+
+    Parameters
+    ----------
+    scan : Dataset or DataArray
+        ``radius`` or ``radial_deviation`` [m] over (``z`` [m], ``theta`` [degree]).
+    references : tuple of str
+        Any of "LS", "MZ", "MI", "MC".
+    filter_upr : float, optional
+        Filter cut-off [UPR] (e.g. 15, 50, 150, 500); None = unfiltered.
+    filter_kind : {"gaussian", "2rc"}
+        Filter type.
+    outliers : float, optional
+        Remove spikes beyond this many robust standard deviations (e.g. 4); None = keep all.
+    max_harmonic : int
+        Highest harmonic order in the spectrum.
+    limacon_tolerance : float
+        Warn (:class:`CentringWarning`) when e^2/(4R) exceeds this [m].
+    radius : float, optional
+        Bore radius for the centring check [m] (default: the mean radius, or the
+        ``nominal_radius`` attribute of deviation data).
+    exact : bool
+        Also compute the exact geometric least-squares cylinder (needs the radius).
+
+    Returns
+    -------
+    Dataset
+        Per layer (``z``): ``RON{t,p,v,q}_{ref}`` [m], ``eccentricity`` [m],
+        ``eccentricity_angle`` [degree, the scan's theta convention], ``outliers_removed``;
+        scalars ``CYL{t,p,v,q}_{ref}`` [m], ``axis_tilt_x``/``_y`` [1]; ``harmonic_amplitude``
+        (z, harmonic) [m]; settings and warnings in attrs.
+    """
+    da, name = _scan_var(scan)
+    if set(da.dims) != {"z", "theta"}:
+        raise BadInputError(f"assess: '{name}' must have dims (z, theta), found {da.dims}")
+    da = da.transpose("z", "theta").sortby("theta")
+    refs = tuple(normalise_reference(r) for r in references)
+    z = np.asarray(da["z"].values, dtype=float)
+    th = np.asarray(da["theta"].values, dtype=float)
+    v = np.asarray(da.values, dtype=float)
+    nz = z.size
+    attrs: dict = {
+        "title": "form assessment",
+        "references": ",".join(refs),
+        "model": "limaçon (linearised about the spindle axis) for LS/MZ/MI/MC; the exact "
+        "geometric LS cylinder is given separately",
+        "angle_convention_of_eccentricity_angle": f"theta of the scan (zero {da['theta'].attrs.get('angle_zero', '?')}, "
+        f"{da['theta'].attrs.get('angle_direction', '?')})",
+    }
+    removed = np.zeros(nz, dtype=np.int64)
+    uniform = is_uniform(th)
+    if outliers is not None:
+        if not uniform:
+            raise BadInputError(
+                "assess: outlier removal needs a uniform angle grid (import with resample=True)"
+            )
+        v, mask = remove_outliers(v, threshold=float(outliers))
+        removed = mask.sum(axis=1)
+        attrs["outliers"] = (
+            f"spikes farther than {outliers:g} robust standard deviations from the running median replaced by interpolation"
+        )
+    elif np.any(~np.isfinite(v)) and filter_upr is not None:
+        raise BadInputError(
+            "assess: the scan has missing points; pass outliers=<k> to fill them before filtering"
+        )
+    if filter_upr is not None:
+        if not uniform:
+            raise BadInputError(
+                "assess: filtering needs a uniform angle grid (import with resample=True)"
+            )
+        v = filter_profile(v, float(filter_upr), kind=filter_kind)
+        attrs["filter"] = f"{filter_kind} {float(filter_upr):g} UPR"
+    else:
+        attrs["filter"] = "none"
+
+    out: dict[str, tuple] = {}
+    ls_layers = []
+    for ref in refs:
+        vals = {k: np.full(nz, np.nan) for k in _PARAMS}
+        for i in range(nz):
+            res = circle_zone(th, v[i], reference=ref, what=f"layer {i + 1} (z = {z[i]:.6g} m)")
+            vals["t"][i], vals["p"][i], vals["v"][i], vals["q"][i] = (
+                res.total,
+                res.peak,
+                res.valley,
+                res.rms,
+            )
+            if ref == "LS":
+                ls_layers.append(res)
+        iso = REFERENCES[ref][0]
+        for k, desc in _PARAMS.items():
+            out[f"RON{k}_{ref}"] = (
+                ("z",),
+                vals[k],
+                {"units": "m", "long_name": f"roundness RON{k} ({desc}) from the {iso} reference"},
+            )
+    if not ls_layers:
+        ls_layers = [circle_zone(th, v[i], reference="LS") for i in range(nz)]
+    ecc = np.array([r.eccentricity for r in ls_layers])
+    ang = np.array([r.eccentricity_angle_deg for r in ls_layers])
+    out["eccentricity"] = (
+        ("z",),
+        ecc,
+        {"units": "m", "long_name": "distance of the LS centre from the spindle axis"},
+    )
+    out["eccentricity_angle"] = (
+        ("z",),
+        ang,
+        {
+            "units": "degree",
+            "long_name": "direction of the LS centre offset (scan's theta convention)",
+        },
+    )
+    out["outliers_removed"] = (
+        ("z",),
+        removed,
+        {"units": "1", "long_name": "points replaced as outliers"},
+    )
+    # centring check
+    if radius is None:
+        if name == "radius":
+            radius = float(np.nanmean(v))
+        else:
+            src = scan.attrs if isinstance(scan, xr.Dataset) else da.attrs
+            radius = src.get("nominal_radius")
+            radius = float(radius) if radius is not None else None
+    if radius is not None and radius > 0:
+        err = limacon_error(float(np.max(ecc)), radius)
+        attrs["limacon_error_max"] = err
+        if err > limacon_tolerance:
+            msg = (
+                f"eccentricity up to {np.max(ecc) * 1e6:.3g} µm on radius {radius * 1e3:.4g} mm: the "
+                f"limaçon approximation is off by up to e²/(4R) = {err * 1e9:.3g} nm (tolerance "
+                f"{limacon_tolerance * 1e9:.3g} nm); re-centre the part or rely on the exact fit"
+            )
+            warnings.warn(msg, CentringWarning, stacklevel=2)
+            attrs["centring_warning"] = msg
+    else:
+        attrs["limacon_error_max"] = "not checked: bore radius unknown (pass radius=)"
+    # cylinders
+    if nz > 1:
+        zz = np.broadcast_to(z[:, None], v.shape)
+        tt = np.broadcast_to(th[None, :], v.shape)
+        for ref in refs:
+            res = cylinder_zone(zz, tt, v, reference=ref)
+            iso = REFERENCES[ref][1]
+            for k, desc in _PARAMS.items():
+                val = {"t": res.total, "p": res.peak, "v": res.valley, "q": res.rms}[k]
+                out[f"CYL{k}_{ref}"] = (
+                    (),
+                    val,
+                    {
+                        "units": "m",
+                        "long_name": f"cylindricity CYL{k} ({desc}) from the {iso} reference",
+                    },
+                )
+            if ref == "LS":
+                out["axis_tilt_x"] = (
+                    (),
+                    res.tilt[0],
+                    {"units": "1", "long_name": "LS axis slope dx/dz (scan frame)"},
+                )
+                out["axis_tilt_y"] = (
+                    (),
+                    res.tilt[1],
+                    {"units": "1", "long_name": "LS axis slope dy/dz (scan frame)"},
+                )
+        if exact and name == "radius":
+            fit = fit_cylinder_polar(zz, tt, v)
+            out["CYLt_LS_exact"] = (
+                (),
+                float(np.nanmax(fit.residual) - np.nanmin(fit.residual)),
+                {"units": "m", "long_name": "CYLt from the exact geometric least-squares cylinder"},
+            )
+            out["radius_LS_exact"] = (
+                (),
+                fit.radius,
+                {"units": "m", "long_name": "radius of the exact geometric least-squares cylinder"},
+            )
+    # spectrum
+    if uniform and np.all(np.isfinite(v)):
+        spec = harmonic_spectrum(v, max_order=max_harmonic)
+        out["harmonic_amplitude"] = (
+            ("z", "harmonic"),
+            spec,
+            {"units": "m", "long_name": "harmonic amplitude of each layer"},
+        )
+    ds = xr.Dataset(
+        out,
+        coords={"z": da["z"]}
+        | ({"harmonic": np.arange(spec.shape[1])} if "harmonic_amplitude" in out else {}),
+        attrs=attrs,
+    )
+    if "harmonic" in ds.coords:
+        ds["harmonic"].attrs = {
+            "units": "1",
+            "long_name": "harmonic order (undulations per revolution)",
+        }
+    return ds
+
+
+def form_table(result: xr.Dataset) -> pd.DataFrame:
+    """Per-layer table of an :func:`assess` result in micrometres (one row per layer + bore)."""
+
+    rows = []
+    refs = result.attrs.get("references", "LS,MZ,MI,MC").split(",")
+    for i, zv in enumerate(result["z"].values):
+        row = {"layer": i + 1, "z_mm": float(zv) * 1e3}
+        for ref in refs:
+            row[f"RONt_{ref}_um"] = float(result[f"RONt_{ref}"].values[i]) * 1e6
+        row["ecc_um"] = float(result["eccentricity"].values[i]) * 1e6
+        row["outliers"] = int(result["outliers_removed"].values[i])
+        rows.append(row)
+    df = pd.DataFrame(rows)
+    if f"CYLt_{refs[0]}" in result:
+        cyl = {"layer": "bore", "z_mm": np.nan}
+        for ref in refs:
+            cyl[f"RONt_{ref}_um"] = float(result[f"CYLt_{ref}"]) * 1e6
+        df = pd.concat([df, pd.DataFrame([cyl])], ignore_index=True)
+    return df

@@ -1,0 +1,335 @@
+"""``jointwear metrology import | assess | wearmap | plot``: a thin layer over the library."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+_SOURCE = "jointwear 0.1 (metrology)"
+
+
+def _outputs(inputs: list[Path], out: Path, suffix: str) -> list[Path]:
+    """One output per input: ``out`` itself for one input, ``out/<name><suffix>`` for several."""
+    if len(inputs) == 1 and out.suffix:
+        return [out]
+    out.mkdir(parents=True, exist_ok=True)
+    names = [p.stem if p.is_file() else p.name for p in inputs]
+    return [out / f"{n}{suffix}" for n in names]
+
+
+def _expand_batch(paths: list[Path], batch: bool) -> list[Path]:
+    if not batch:
+        return paths
+    from jointwear.errors import BadInputError
+
+    items: list[Path] = []
+    for p in paths:
+        if not p.is_dir():
+            raise BadInputError(f"--batch: '{p}' is not a folder of scans")
+        children = sorted(c for c in p.iterdir() if not c.name.startswith("."))
+        if not children:
+            raise BadInputError(f"--batch: folder '{p}' is empty")
+        items.extend(children)
+    return items
+
+
+def register(app: typer.Typer) -> None:
+    """Add the metrology commands."""
+
+    @app.command("import")
+    def import_cmd(
+        paths: Annotated[
+            list[Path],
+            typer.Argument(
+                help="Scan(s): a text export, a folder of per-layer files, or (with --batch) "
+                "folders holding many scans."
+            ),
+        ],
+        out: Annotated[
+            Path,
+            typer.Option("--out", "-o", help="Output .nc (one scan) or folder (several scans)."),
+        ] = Path("scan.nc"),
+        angle_zero: Annotated[
+            str | None,
+            typer.Option(
+                "--angle-zero",
+                help="Where the instrument's 0 degree points in the bearing frame: +x, +y, -x, "
+                "-y or degrees CCW from +x. Required (never guessed).",
+            ),
+        ] = None,
+        angle_direction: Annotated[
+            str | None,
+            typer.Option(
+                "--angle-direction", help="clockwise or counterclockwise, seen from +z. Required."
+            ),
+        ] = None,
+        preset: Annotated[
+            str, typer.Option("--preset", help="generic or talyrond (defaults: values in µm).")
+        ] = "generic",
+        layout: Annotated[
+            str, typer.Option("--layout", help="auto, single, folder, long or wide.")
+        ] = "auto",
+        units: Annotated[
+            str | None, typer.Option("--units", help="Length unit: um, mm, m or inch.")
+        ] = None,
+        delimiter: Annotated[
+            str | None, typer.Option("--delimiter", help="tab, semicolon, comma or whitespace.")
+        ] = None,
+        decimal: Annotated[str | None, typer.Option("--decimal", help="'.' or ','.")] = None,
+        header_lines: Annotated[
+            int | None, typer.Option("--header-lines", help="Lines before the numeric table.")
+        ] = None,
+        columns: Annotated[
+            str | None,
+            typer.Option(
+                "--columns",
+                help="Comma-separated column meanings: angle_deg, angle_rad, index, x, y, z, "
+                "radius, deviation, ignore.",
+            ),
+        ] = None,
+        value: Annotated[str, typer.Option("--value", help="auto, radius or deviation.")] = "auto",
+        layer_spacing_mm: Annotated[
+            float | None, typer.Option("--layer-spacing-mm", help="Layer spacing [mm].")
+        ] = None,
+        z_mid_mm: Annotated[
+            float | None,
+            typer.Option(
+                "--z-mid-mm",
+                help="Instrument height of the bearing mid-width [mm] (default: middle of the "
+                "layers).",
+            ),
+        ] = None,
+        expected_points: Annotated[
+            int | None, typer.Option("--expected-points", help="Points every layer must have.")
+        ] = None,
+        allow_partial: Annotated[
+            bool, typer.Option("--allow-partial", help="Accept incomplete layers (NaN).")
+        ] = False,
+        resample: Annotated[
+            bool, typer.Option("--resample", help="Interpolate layers onto one uniform grid.")
+        ] = False,
+        batch: Annotated[
+            bool,
+            typer.Option("--batch", help="Each entry of each PATH folder is a separate scan."),
+        ] = False,
+    ) -> None:
+        """Import roundness/cylindricity text exports into contract netCDF files."""
+        from jointwear import io
+        from jointwear.errors import BadInputError
+        from jointwear.metrology.readers import read_scan, read_talyrond
+
+        if angle_zero is None or angle_direction is None:
+            from jointwear.errors import ConventionError
+
+            raise ConventionError(
+                "give the instrument's angle convention: --angle-zero (where its 0 degree points "
+                "in the bearing frame: +x, +y, -x, -y or degrees) and --angle-direction "
+                "(clockwise or counterclockwise seen from +z); text exports rarely state it and "
+                "jointwear never guesses it"
+            )
+        if preset not in ("generic", "talyrond"):
+            raise BadInputError(f"--preset {preset!r}: use generic or talyrond")
+        reader = read_talyrond if preset == "talyrond" else read_scan
+        if batch:
+            items: list = _expand_batch(paths, batch)
+        elif len(paths) > 1 and all(p.is_file() for p in paths):
+            items = [list(paths)]  # several files: the layers of one scan
+        else:
+            items = list(paths)
+        names = [i if isinstance(i, Path) else i[0].parent for i in items]
+        if len(items) > 1 and out.suffix:
+            raise BadInputError(
+                f"{len(items)} scans to import: --out must be a folder, not '{out}'"
+            )
+        targets = _outputs(names, out, ".nc")
+        opts = dict(
+            layout=layout,
+            delimiter=delimiter,
+            decimal=decimal,
+            header_lines=header_lines,
+            columns=tuple(c.strip() for c in columns.split(",")) if columns else None,
+            value=value,
+            layer_spacing=layer_spacing_mm * 1e-3 if layer_spacing_mm is not None else None,
+            z_mid=z_mid_mm * 1e-3 if z_mid_mm is not None else "centre",
+            expected_points=expected_points,
+            allow_partial=allow_partial,
+            resample=resample,
+        )
+        if units is not None:
+            opts["units"] = units
+        for item, target in zip(items, targets, strict=True):
+            io.check_writable(target)
+            ds = reader(item, convention=(angle_zero, angle_direction), **opts)
+            files = ds.attrs.get("files", [])
+            io.save(
+                ds,
+                target,
+                inputs=[Path(f) for f in files],
+                parameters={"angle_zero": angle_zero, "angle_direction": angle_direction, **opts},
+                source=ds.attrs.get("source", _SOURCE),
+            )
+            var = "radius" if "radius" in ds else "radial_deviation"
+            typer.echo(
+                f"{target}: {var} {ds.sizes['z']} layers x {ds.sizes['theta']} points "
+                f"(instrument 0 deg along {angle_zero}, {ds.attrs['instrument_angle_direction']})"
+            )
+
+    @app.command("assess")
+    def assess_cmd(
+        scans: Annotated[list[Path], typer.Argument(help="Imported scan(s) (.nc).")],
+        filter_upr: Annotated[
+            float | None,
+            typer.Option("--filter", help="Filter cut-off [UPR], e.g. 15, 50, 150, 500."),
+        ] = None,
+        filter_kind: Annotated[
+            str, typer.Option("--filter-kind", help="gaussian or 2rc.")
+        ] = "gaussian",
+        reference: Annotated[
+            list[str] | None,
+            typer.Option("--reference", "-r", help="LS, MZ, MI, MC (repeat; default: all four)."),
+        ] = None,
+        outliers: Annotated[
+            float | None,
+            typer.Option("--outliers", help="Remove spikes beyond this many robust std devs."),
+        ] = None,
+        exact: Annotated[
+            bool, typer.Option("--exact", help="Also the exact geometric LS cylinder.")
+        ] = False,
+        csv: Annotated[Path | None, typer.Option("--csv", help="Write the table as CSV.")] = None,
+        out: Annotated[
+            Path | None,
+            typer.Option("--out", "-o", help="Write the full result as netCDF (file or folder)."),
+        ] = None,
+    ) -> None:
+        """Roundness per layer and cylindricity (LS/MZ/MI/MC), printed as a table."""
+        import warnings
+
+        import pandas as pd
+
+        from jointwear import io
+        from jointwear.metrology.assess import CentringWarning, assess, form_table
+
+        refs = tuple(reference) if reference else ("LS", "MZ", "MI", "MC")
+        if csv is not None:
+            io.check_writable(csv)
+        targets = _outputs(scans, out, "_form.nc") if out is not None else [None] * len(scans)
+        tables = []
+        for scan_path, target in zip(scans, targets, strict=True):
+            scan = io.load(scan_path)
+            with warnings.catch_warnings(record=True) as caught:
+                warnings.simplefilter("always", CentringWarning)
+                result = assess(
+                    scan,
+                    references=refs,
+                    filter_upr=filter_upr,
+                    filter_kind=filter_kind,
+                    outliers=outliers,
+                    exact=exact,
+                )
+            for w in caught:
+                typer.echo(f"warning: {scan_path}: {w.message}", err=True)
+            table = form_table(result)
+            typer.echo(f"{scan_path}  (filter: {result.attrs['filter']}; values in µm)")
+            typer.echo(table.to_string(index=False, float_format=lambda v: f"{v:.3f}"))
+            if target is not None:
+                result.attrs["source"] = _SOURCE
+                io.save(
+                    result,
+                    target,
+                    inputs=[scan_path],
+                    parameters={
+                        "filter_upr": filter_upr,
+                        "filter_kind": filter_kind,
+                        "references": list(refs),
+                        "outliers": outliers,
+                    },
+                    source=_SOURCE,
+                    parents=[scan],
+                )
+                typer.echo(f"wrote {target}")
+            table.insert(0, "scan", str(scan_path))
+            tables.append(table)
+        if csv is not None:
+            with io.atomic_path(csv) as tmp:
+                pd.concat(tables, ignore_index=True).to_csv(tmp, index=False)
+            typer.echo(f"wrote {csv}")
+
+    @app.command("wearmap")
+    def wearmap_cmd(
+        worn: Annotated[list[Path], typer.Argument(help="Worn scan(s) (.nc).")],
+        before: Annotated[
+            Path | None, typer.Option("--before", help="Scan of the same bearing before wear.")
+        ] = None,
+        out: Annotated[
+            Path, typer.Option("--out", "-o", help="Output .nc (or folder for several).")
+        ] = Path("wear.nc"),
+        angle_offset_deg: Annotated[
+            float,
+            typer.Option("--angle-offset-deg", help="Set-up rotation of the before scan [deg]."),
+        ] = 0.0,
+        register: Annotated[
+            bool, typer.Option("--register", help="Estimate the rotation from the unworn regions.")
+        ] = False,
+        shape: Annotated[
+            str, typer.Option("--shape", help="Unworn reference: cylinder or circle (per layer).")
+        ] = "cylinder",
+        threshold: Annotated[
+            float, typer.Option("--threshold", help="Unworn = within this many robust std devs.")
+        ] = 3.0,
+        radius_mm: Annotated[
+            float | None, typer.Option("--radius-mm", help="Bore radius for the volume [mm].")
+        ] = None,
+        plot: Annotated[
+            Path | None, typer.Option("--plot", help="Also save a wear-map figure (PNG).")
+        ] = None,
+    ) -> None:
+        """Wear depth over (z, theta) from a worn scan and a before-scan or fitted reference."""
+        from jointwear import io
+        from jointwear.metrology.wearmap import wear_map
+
+        targets = _outputs(worn, out, "_wear.nc")
+        ref = io.load(before) if before is not None else None
+        for path, target in zip(worn, targets, strict=True):
+            io.check_writable(target)
+            w = io.load(path)
+            ds = wear_map(
+                w,
+                ref,
+                angle_offset_deg=angle_offset_deg,
+                register=register,
+                shape=shape,
+                threshold=threshold,
+                radius=radius_mm * 1e-3 if radius_mm else None,
+            )
+            inputs = [path] + ([before] if before is not None else [])
+            io.save(
+                ds,
+                target,
+                inputs=inputs,
+                source=_SOURCE,
+                parents=[w],
+                parameters={
+                    "angle_offset_deg": angle_offset_deg,
+                    "register": register,
+                    "shape": shape,
+                    "threshold": threshold,
+                },
+            )
+            typer.echo(
+                f"{target}: max wear {float(ds['wear_depth'].max()) * 1e6:.2f} µm, worn volume "
+                f"{float(ds['worn_volume']) * 1e9:.4f} mm³ ± {float(ds['worn_volume_u']) * 1e9:.4f}, "
+                f"cylindricity {float(ds['cylindricity_before']) * 1e6:.2f} -> "
+                f"{float(ds['cylindricity_after']) * 1e6:.2f} µm (MZ)"
+            )
+            if plot is not None:
+                from jointwear.metrology.plot import plot_wear_map
+
+                fig_path = (
+                    plot
+                    if len(worn) == 1
+                    else plot.with_name(f"{target.stem}{plot.suffix or '.png'}")
+                )
+                plot_wear_map(ds, path=fig_path)
+                typer.echo(f"wrote {fig_path}")
