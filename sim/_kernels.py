@@ -163,7 +163,8 @@ def _contact(
 ):
     """Contact of the journal with the bore and the end faces, in the bearing frame.
 
-    Adds to ``wrench`` (12: force on the bearing, moment about the bearing centre, normal part of
+    With ``acc``, adds to ``WW[0]`` the wear work p |v_t| dt and to ``WW[1]`` the sliding
+    distance |v_t| dt of every contacting bearing point. Adds to ``wrench`` (12: force on the bearing, moment about the bearing centre, normal part of
     the force, friction part of the force) and returns
     (elastic energy, normal force magnitude sum, max radial penetration, max axial penetration,
     mode, stiffness at the deepest slice, number of contacting slices, axial force magnitude).
@@ -316,9 +317,11 @@ def _contact(
                     for mm in range(lo, hi + 1):
                         dk = _node_delta(n, mm, J0, u, P, H, ZL, Nd)
                         if dk > 0.0:
-                            WW[n, mm % Nd] += fn * math.sqrt(dk) / wsum * vt * hstep
+                            WW[0, n, mm % Nd] += fn * math.sqrt(dk) / wsum * vt * hstep
+                            WW[1, n, mm % Nd] += vt * hstep
                 else:
-                    WW[n, ms % Nd] += fn / AREA[n, ms % Nd] * vt * hstep
+                    WW[0, n, ms % Nd] += fn / AREA[n, ms % Nd] * vt * hstep
+                    WW[1, n, ms % Nd] += vt * hstep
                 acc_out[0] += fn * vt * hstep
                 acc_out[2] += fn * hstep
         else:
@@ -380,7 +383,8 @@ def _contact(
                     wrench[11] += s * tz
                     _cross_acc(nd[1], nd[2], nd[3], tx, ty, tz, wrench, 3, s)
                 if acc:
-                    WW[n, mm % Nd] += fn / AREA[n, mm % Nd] * vt * hstep
+                    WW[0, n, mm % Nd] += fn / AREA[n, mm % Nd] * vt * hstep
+                    WW[1, n, mm % Nd] += vt * hstep
                     acc_out[0] += fn * vt * hstep
                     acc_out[2] += fn * hstep
             K = kdk

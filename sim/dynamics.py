@@ -88,6 +88,8 @@ class CycleResult:
         Integral of the summed normal bore-contact force over time [N s].
     n_steps : int
         Accepted integration steps.
+    sliding_distance : ndarray (Nl, Nd)
+        Integral of |ds| at each bearing point while it is in contact [m].
     """
 
     dataset: xr.Dataset | None
@@ -99,6 +101,7 @@ class CycleResult:
     axial_normal_work: float = 0.0
     normal_impulse: float = 0.0
     n_steps: int = 0
+    sliding_distance: np.ndarray | None = None
 
 
 def _layers(params: SimParameters) -> tuple[np.ndarray, np.ndarray]:
@@ -299,7 +302,7 @@ def run_cycles(
     zl, wl = _layers(params)
     hmin = h.min(axis=1).copy()
     area = point_area(params, h)
-    ww = np.zeros_like(h)
+    ww = np.zeros((2, *h.shape))
     acc = np.zeros(3)
     y = st.y.astype(float).copy()
     vimp = st.impact_velocity.astype(float).copy()
@@ -352,9 +355,12 @@ def run_cycles(
             progress((k + 1) / n_chunks)
     new_state = SimState(t, y.copy(), hstep, vimp.copy(), model)
     ds = _dataset(params, t_rel, diag, t0) if record else None
+    if ds is not None:
+        ds = _add_maps(ds, params, ww, area)
     return CycleResult(
         dataset=ds,
-        wear_work=ww,
+        wear_work=ww[0],
+        sliding_distance=ww[1],
         point_area=area,
         normal_work=float(acc[0]),
         state=new_state,
@@ -363,6 +369,42 @@ def run_cycles(
         normal_impulse=float(acc[2]),
         n_steps=int(nacc_total),
     )
+
+
+def _add_maps(
+    ds: xr.Dataset, params: SimParameters, ww: np.ndarray, area: np.ndarray
+) -> xr.Dataset:
+    """Add the accumulated per-point maps over (z, theta) in the canonical angle convention."""
+    z, _ = _layers(params)
+    nd = params.joint.n_points
+    coords = {
+        "z": conventions.z_coord(z, note="layer n = 0 at z = +wb/2 (eq. 2)"),
+        "theta": conventions.theta_coord(np.arange(nd) * 360.0 / nd),
+    }
+    maps = xr.Dataset(
+        {
+            "wear_work": (
+                ("z", "theta"),
+                ww[0],
+                {
+                    "units": "Pa m",
+                    "long_name": "integral of contact pressure times sliding distance over the run",
+                },
+            ),
+            "sliding_distance": (
+                ("z", "theta"),
+                ww[1],
+                {"units": "m", "long_name": "sliding distance while in contact over the run"},
+            ),
+            "point_area": (
+                ("z", "theta"),
+                area,
+                {"units": "m2", "long_name": "bearing surface area represented by each point"},
+            ),
+        },
+        coords=coords,
+    )
+    return xr.merge([ds, maps], combine_attrs="override")
 
 
 def _vec(diag: np.ndarray, k: int) -> np.ndarray:

@@ -40,10 +40,14 @@ def freudenstein(theta_crank, a=0.10, b=0.40, c=0.30, d=0.30, omega=4 * math.pi)
     return t4, w4
 
 
-def test_ideal_joint_matches_loop_closure():
-    p = replace_nested(BASE, **{"joint.model": "ideal"})
+@pytest.mark.parametrize("theta10", [0.0, 137.0])
+def test_ideal_joint_matches_loop_closure(theta10):
+    p = replace_nested(
+        BASE, **{"joint.model": "ideal", "mechanism.initial_crank_angle_deg": theta10}
+    )
     ds = run_cycles(p, cycles=1.0).dataset
     theta = ds.crank_angle.values
+    assert theta[0] == pytest.approx(math.radians(theta10), abs=1e-12)
     assert ds.time.values[-1] == pytest.approx(0.5)
     assert np.ptp(np.unwrap(theta)) == pytest.approx(2 * math.pi, rel=1e-6)
     t4, w4 = freudenstein(theta)
@@ -67,10 +71,16 @@ def test_small_clearance_tends_to_ideal():
     assert errs[1] < 0.5 * errs[0]
 
 
-def test_energy_conserved_without_driver_friction_damping():
+@pytest.mark.parametrize("bearing_on", ["follower", "coupler"])
+def test_energy_conserved_without_driver_friction_damping(bearing_on):
     p = replace_nested(
         BASE,
-        **{"mechanism.driver": False, "friction.enabled": False, "contact.restitution": 1.0},
+        **{
+            "mechanism.driver": False,
+            "mechanism.bearing_on": bearing_on,
+            "friction.enabled": False,
+            "contact.restitution": 1.0,
+        },
     )
     ds = run_cycles(p, cycles=1.0).dataset
     e = ds.mechanical_energy.values
@@ -131,6 +141,18 @@ def test_record_follows_contract_and_wear_work_balances():
     assert (r.wear_work >= 0).all()
     assert r.normal_work > 0
     assert (r.wear_work * r.point_area).sum() == pytest.approx(r.normal_work, rel=1e-10)
+    # the maps are in the record too, on (z, theta) in the canonical convention
+    np.testing.assert_array_equal(ds.wear_work.values, r.wear_work)
+    assert ds.theta.attrs["angle_zero"] == "-x" and ds.z.values[0] == pytest.approx(7.5e-3)
+    # sliding distance: only where there is wear work, bounded by the relative rotation
+    slid = r.sliding_distance
+    assert ((slid > 0) == (r.wear_work > 0)).all()
+    dt = float(ds.time[1] - ds.time[0])
+    w_rel = np.gradient(np.unwrap(ds.coupler_angle.values), dt) - (
+        ds.follower_angular_velocity.sel(axis="z").values
+    )
+    assert 0.3 * np.abs(w_rel).sum() * dt * 8e-3 < slid.max()
+    assert slid.max() < 1.2 * np.abs(w_rel).sum() * dt * 8e-3
     # total area of the bore
     assert r.point_area.sum() == pytest.approx(2 * math.pi * 8e-3 * 15e-3, rel=1e-12)
     touching = ds.contact_mode.values > 0
