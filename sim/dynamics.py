@@ -309,7 +309,8 @@ def run_cycles(
     hstep = float(st.step)
     t = t0
     i_out = 0
-    n_chunks = max(1, int(math.ceil(cycles * 50)), int(math.ceil(duration / 0.01)))
+    # chunks of 1/50 cycle (at most 0.01 s) for progress reports and responsiveness
+    n_chunks = max(1, math.ceil(cycles * 50 - 1e-9), math.ceil(duration / 0.01 - 1e-9))
     pen_limit = params.contact.max_penetration_fraction * params.joint.radial_clearance
     nacc_total = 0
     for k in range(n_chunks):

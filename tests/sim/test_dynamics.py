@@ -228,3 +228,13 @@ def test_step_collapse_is_reported():
     p = replace_nested(BASE, **{"solver.min_step": 5e-4})
     with pytest.raises(SimulationError, match="step size collapsed below solver.min_step"):
         run_cycles(p, cycles=0.2)
+
+
+def test_recording_does_not_change_the_solution_and_reports_progress():
+    seen = []
+    a = run_cycles(BASE, cycles=0.1, progress=seen.append)
+    b = run_cycles(BASE, cycles=0.1, record=False)
+    assert b.dataset is None
+    np.testing.assert_array_equal(a.wear_work, b.wear_work)
+    np.testing.assert_array_equal(a.state.y, b.state.y)
+    assert seen == sorted(seen) and seen[-1] == 1.0 and len(seen) == 5
