@@ -26,6 +26,7 @@ from jointwear.metrology.fit import fit_cylinder_polar
 from jointwear.metrology.form import (
     REFERENCES,
     circle_zone,
+    circle_zones,
     cylinder_zone,
     limacon_error,
     normalise_reference,
@@ -144,16 +145,16 @@ def assess(
     ls_layers = []
     for ref in refs:
         vals = {k: np.full(nz, np.nan) for k in _PARAMS}
-        for i in range(nz):
-            res = circle_zone(th, v[i], reference=ref, what=f"layer {i + 1} (z = {z[i]:.6g} m)")
+        results = circle_zones(th, v, reference=ref, what="scan")
+        for i, res in enumerate(results):
             vals["t"][i], vals["p"][i], vals["v"][i], vals["q"][i] = (
                 res.total,
                 res.peak,
                 res.valley,
                 res.rms,
             )
-            if ref == "LS":
-                ls_layers.append(res)
+        if ref == "LS":
+            ls_layers = results
         iso = REFERENCES[ref][0]
         for k, desc in _PARAMS.items():
             out[f"RON{k}_{ref}"] = (

@@ -11,6 +11,7 @@ from hypothesis import strategies as st
 from jointwear.errors import BadInputError
 from jointwear.metrology.form import (
     circle_zone,
+    circle_zones,
     cylinder_zone,
     cylindricity,
     limacon_error,
@@ -147,3 +148,22 @@ def test_limacon_error():
     lim = rr + e * np.cos(phi)
     amp = 0.5 * np.ptp(exact - lim)
     assert amp == pytest.approx(limacon_error(e, rr), rel=1e-3)
+
+
+def test_block_lp_matches_single_layer_solves():
+    rng = np.random.default_rng(7)
+    th = np.arange(720) * 0.5
+    rad = np.radians(th)
+    r = (
+        R
+        + rng.uniform(-5e-6, 5e-6, (4, 1)) * np.cos(rad)
+        + 1e-6 * np.cos(3 * rad + rng.uniform(0, 6, (4, 1)))
+        + 0.2e-6 * rng.standard_normal((4, 720))
+    )
+    r[1, 5:9] = np.nan
+    for ref in ("MZ", "MI", "MC", "LS"):
+        block = circle_zones(th, r, reference=ref)
+        for i in range(4):
+            single = circle_zone(th, r[i], reference=ref)
+            assert block[i].total == pytest.approx(single.total, abs=1e-12), ref
+            assert block[i].radius == pytest.approx(single.radius, abs=1e-12), ref
