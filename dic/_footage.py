@@ -730,6 +730,7 @@ def _assemble(states, times, flags, duplicates, L, R, cfg, calibration, status) 
         "axis": ("axis", axes, {"long_name": "vector component"}),
     }
     valid_time = ~(flag_arr & FRAME_FLAGS["duplicated"]).astype(bool)
+    attrs_extra: dict[str, float] = {}
     for st in states:
         rows = st.rows
         name = st.spec.name
@@ -782,6 +783,14 @@ def _assemble(states, times, flags, duplicates, L, R, cfg, calibration, status) 
         coords[f"{name}_row"] = (f"{name}_row", np.arange(d))
         coords[f"{name}_col"] = (f"{name}_col", np.arange(d))
         coords[f"{name}_point_axis"] = (f"{name}_point_axis", axes)
+        sig_med = float(np.median(st.sigma_px))
+        attrs_extra[f"{name}_match_sigma_px"] = sig_med
+        if stereo:
+            from jointwear.dic._stereo import stereo_noise_floor
+
+            floor = stereo_noise_floor(calibration, np.nanmean(st.ref3d, axis=0), sig_med)
+            attrs_extra[f"{name}_noise_floor_z_per_point_m"] = floor
+            attrs_extra[f"{name}_noise_floor_z_body_m"] = floor / np.sqrt(len(st.ref3d))
         role = st.spec.role
         if role == "follower":
             data["follower_position"] = (
@@ -856,6 +865,7 @@ def _assemble(states, times, flags, duplicates, L, R, cfg, calibration, status) 
         },
     )
     ds = xr.Dataset(data, coords=coords)
+    ds.attrs.update(attrs_extra)
     ds.attrs.update(
         {
             "title": "jointwear rig footage tracking",

@@ -73,8 +73,10 @@ def test_world_frame_from_board(rig, calibration, boards, board):
 def test_too_few_views(boards, board):
     with pytest.raises(CalibrationError, match=r"only 3 of 3 calibration view\(s\).*at least 6"):
         calibrate_stereo([b[0] for b in boards[:3]], [b[1] for b in boards[:3]], board)
-    blank = np.zeros_like(boards[0][0])
-    with pytest.raises(CalibrationError, match="board not found"):
+    blank = np.zeros((48, 64), np.uint8)
+    with pytest.raises(
+        CalibrationError, match=r"only 0 of 6 .*view 0: board not found \(both cameras\)"
+    ):
         calibrate_stereo([blank] * 6, [blank] * 6, board)
     with pytest.raises(BadInputError, match="3 left and 2 right"):
         calibrate_stereo([blank] * 3, [blank] * 2, board)

@@ -1,0 +1,295 @@
+"""Footage tracking on the virtual rig: out-of-plane accuracy, follower velocity, bad input.
+
+The accuracy tests use a rig like the study's: two 1280 x 1024 cameras 1.0 m from the
+mechanism plane, 0.30 m apart, a 0.42 m x 0.34 m field of view (0.33 mm/pixel), 50 frames/s,
+one crank revolution (0.5 s), joint C moving 2.5 mm out of plane, 1 grey level sensor noise.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from jointwear import io
+from jointwear.datasets.rig import RigConfig, VirtualRig, generate_rig
+from jointwear.dic._footage import BodySpec, TrackConfig, read_bodies, track_footage
+from jointwear.dic._video import check_stereo_pair, open_frames
+from jointwear.errors import BadInputError, ParameterError
+
+pytest.importorskip("jointwear.dic._subset")  # the 2D engine (DIC part 1)
+
+
+@pytest.fixture(scope="module")
+def study(tmp_path_factory):
+    out = tmp_path_factory.mktemp("study_rig")
+    cfg = RigConfig(duration=0.5)
+    written = generate_rig(out, cfg, video=False, images=True, calibration_images=False)
+    truth = io.load(written["truth"])
+    cal = VirtualRig(cfg).calibration  # exact cameras, world = mechanism frame
+    tc, bodies = read_bodies(written["bodies"])
+    tc = dataclasses.replace(tc, world_origin=[0.0, 0.0, 0.0])
+    ds = track_footage(
+        written["left_images"],
+        written["right_images"],
+        fps=cfg.fps,
+        bodies=bodies,
+        calibration=cal,
+        config=tc,
+        out=out / "motion.nc",
+    )
+    return cfg, truth, ds, out / "motion.nc"
+
+
+def test_out_of_plane_displacement_accuracy_and_noise_floor(study):
+    cfg, truth, ds, _ = study
+    err = (
+        ds["journal_displacement"].sel(axis="z").values
+        - truth["journal_displacement"].sel(axis="z").values
+    )
+    rms = float(np.sqrt(np.mean(err**2)))
+    floor_body = ds.attrs["journal_noise_floor_z_body_m"] * np.sqrt(2)  # displacement: 2 poses
+    u = float(np.mean(ds["journal_displacement_u"].sel(axis="z").values[1:]))
+    print(
+        f"\njournal z: RMS error {rms * 1e6:.2f} um, noise floor Z^2/(fB) sqrt(2) sigma_u / sqrt(N) "
+        f"x sqrt(2) = {floor_body * 1e6:.2f} um (sigma_u = {ds.attrs['journal_match_sigma_px']:.4f} px, "
+        f"per point {ds.attrs['journal_noise_floor_z_per_point_m'] * 1e6:.1f} um), propagated u = {u * 1e6:.2f} um"
+    )
+    assert np.ptp(truth["journal_displacement"].sel(axis="z").values) > 4e-3  # mm-scale motion
+    assert rms <= 3e-6
+    # the error is of the order the stereo geometry predicts (not hidden by smoothing)
+    assert 0.2 < rms / floor_body < 5
+    assert 0.2 < rms / u < 5
+
+
+def test_follower_velocity_within_one_percent_of_peak(study):
+    cfg, truth, ds, _ = study
+    assert cfg.fps == 50
+    v, vt = ds["follower_velocity"].values, truth["follower_velocity"].values
+    peak = float(np.max(np.linalg.norm(vt, axis=1)))
+    ok = np.all(np.isfinite(v), axis=1)
+    assert ok.sum() >= len(v) - 2  # only the first and last frame lack a velocity
+    rms = np.sqrt(np.mean((v[ok] - vt[ok]) ** 2, axis=0))
+    print(
+        f"\nfollower velocity RMS error [% of peak {peak:.2f} m/s]: {np.round(rms / peak * 100, 3)}"
+    )
+    assert np.all(rms <= 0.01 * peak)
+    # positions of the centre of mass to a few micrometres
+    perr = ds["follower_position"].values - truth["follower_position"].values
+    assert np.sqrt(np.mean(perr**2)) < 5e-6
+
+
+def test_output_follows_the_contract(study):
+    *_, path = study
+    ds = io.load(path)
+    for name in ("follower_velocity", "follower_position", "journal_displacement", "frame_flag"):
+        assert name in ds and "units" in ds[name].attrs
+    assert ds["follower_velocity"].attrs["units"] == "m s-1"
+    assert list(ds["axis"].values) == ["x", "y", "z"]
+    assert ds.attrs["status"] == "complete"
+    assert ds.attrs["duplicated_frames"] == "[]" and ds.attrs["dropped_frames_estimated"] == 0
+    assert "provenance" in ds.attrs
+
+
+@pytest.fixture(scope="module")
+def small(tmp_path_factory):
+    """Reduced rig (640 x 512) with a dropped and a duplicated frame, videos and images."""
+    out = tmp_path_factory.mktemp("small_rig")
+    cfg = RigConfig(
+        width=640, height=512, duration=0.2, drop_frames=(6,), duplicate_frames=(3,), board_views=7
+    )
+    written = generate_rig(out, cfg, video=True, images=True, calibration_images=True)
+    return cfg, written, out
+
+
+def test_cli_chain_calibrate_track_plot(small):
+    from jointwear.cli import main
+
+    cfg, written, out = small
+    cal = out / "cal.nc"
+    n = cfg.board_views
+    assert (
+        main(
+            [
+                "dic",
+                "calibrate",
+                "--left",
+                str(out / "calibration/left"),
+                "--right",
+                str(out / "calibration/right"),
+                "--squares",
+                *map(str, cfg.board_squares),
+                "--square-mm",
+                str(cfg.board_square_size * 1e3),
+                "--world-view",
+                str(n),
+                "--out",
+                str(cal),
+            ]
+        )
+        == 0
+    )
+    motion = out / "motion.nc"
+    assert (
+        main(
+            [
+                "dic",
+                "track",
+                "--left",
+                str(written["left_images"]),
+                "--right",
+                str(written["right_images"]),
+                "--fps",
+                "50",
+                "--bodies",
+                str(written["bodies"]),
+                "-c",
+                str(cal),
+                "--out",
+                str(motion),
+                "--plot",
+                str(out / "motion.png"),
+            ]
+        )
+        == 0
+    )
+    ds = io.load(motion)
+    truth = io.load(written["truth"])
+    # the duplicated frame (frame 4 repeats frame 3) and the dropped frame 6 are reported
+    assert ds.attrs["duplicated_frames"] == "[4]"
+    assert ds.attrs["dropped_frames_estimated"] == 1
+    assert ds["frame_flag"].values[4] & 1 and ds["frame_flag"].values[6] & 2
+    # calibrated from board images, world frame from the board on the mechanism plane
+    t = truth.sel(time=ds["time"].values)
+    origin = np.asarray(truth.attrs["world_board_origin_m"])
+    good = np.all(np.isfinite(ds["follower_position"].values), axis=1)
+    perr = ds["follower_position"].values[good] - (t["follower_position"].values[good] - origin)
+    assert np.max(np.abs(perr)) < 3e-5
+    assert (out / "motion.png").stat().st_size > 10_000
+    # videos (FFV1, lossless): same result for the first frames, frame rate from the container
+    motion_v = out / "motion_video.nc"
+    assert (
+        main(
+            [
+                "dic",
+                "track",
+                "--left",
+                str(written["left_video"]),
+                "--right",
+                str(written["right_video"]),
+                "--bodies",
+                str(written["bodies"]),
+                "-c",
+                str(cal),
+                "--out",
+                str(motion_v),
+                "--max-frames",
+                "4",
+            ]
+        )
+        == 0
+    )
+    dv = io.load(motion_v)
+    assert np.allclose(
+        dv["follower_position"].values, ds["follower_position"].values[:4], atol=1e-9
+    )
+
+
+def test_partial_results_are_kept(small, tmp_path):
+    import shutil
+
+    cfg, written, out = small
+    for cam in ("left", "right"):
+        shutil.copytree(written[f"{cam}_images"], tmp_path / cam)
+    files = sorted((tmp_path / "left").iterdir())
+    files[5].write_bytes(b"not a png")
+    tc, bodies = read_bodies(written["bodies"])
+    tc = dataclasses.replace(tc, chunk_size=2)
+    cal = VirtualRig(cfg).calibration
+    target = tmp_path / "motion.nc"
+    with pytest.raises(
+        BadInputError, match=r"frame 5\) could not be read.*5 frames processed before are saved"
+    ):
+        track_footage(
+            tmp_path / "left",
+            tmp_path / "right",
+            fps=50,
+            bodies=bodies,
+            calibration=cal,
+            config=tc,
+            out=target,
+        )
+    ds = io.load(target)
+    assert ds.sizes["time"] == 5 and ds.attrs["status"].startswith("stopped after 5 frames")
+
+
+def test_bad_footage_errors(small, tmp_path):
+    import cv2
+
+    cfg, written, out = small
+    bad = tmp_path / "clip.mp4"
+    bad.write_bytes(b"\x00" * 4096)
+    with pytest.raises(
+        BadInputError, match=r"could not open this 'mp4' container.*ffmpeg -i IN -c:v ffv1"
+    ):
+        open_frames(bad)
+    with pytest.raises(BadInputError, match="unsupported file type '.txt'"):
+        (tmp_path / "a.txt").write_text("x")
+        open_frames(tmp_path / "a.txt")
+    with pytest.raises(BadInputError, match="image sequence: give the frame rate"):
+        open_frames(written["left_images"])
+    # left/right of different lengths and rates
+    for name, fps, n in (("l.avi", 50, 5), ("r.avi", 25, 4)):
+        w = cv2.VideoWriter(
+            str(tmp_path / name), cv2.VideoWriter_fourcc(*"FFV1"), fps, (64, 48), False
+        )
+        for _ in range(n):
+            w.write(np.zeros((48, 64), np.uint8))
+        w.release()
+    with pytest.raises(
+        BadInputError, match=r"frame rates differ \(50 vs 25.*lengths differ \(5 vs 4"
+    ):
+        check_stereo_pair(open_frames(tmp_path / "l.avi"), open_frames(tmp_path / "r.avi"))
+    # a region of interest outside the image
+    tc, bodies = read_bodies(written["bodies"])
+    outside = BodySpec("follower", "follower", [[600.0, 10.0], [700.0, 10.0], [700.0, 60.0]])
+    with pytest.raises(
+        BadInputError,
+        match="region of interest of body 'follower' reaches outside the 640x512 image",
+    ):
+        track_footage(
+            written["left_images"],
+            written["right_images"],
+            fps=50,
+            bodies=[outside],
+            calibration=VirtualRig(cfg).calibration,
+            config=tc,
+        )
+    # calibration of another resolution
+    big = VirtualRig(RigConfig()).calibration
+    with pytest.raises(
+        BadInputError, match="640x512 pixel frames but the calibration's left camera is 1280x1024"
+    ):
+        track_footage(
+            written["left_images"],
+            written["right_images"],
+            fps=50,
+            bodies=bodies,
+            calibration=big,
+            config=tc,
+        )
+
+
+def test_bodies_file_errors(tmp_path):
+    p = tmp_path / "b.toml"
+    p.write_text('[bodies.follower]\nrole = "follower"\npolygon = [[1, 2], [3, 4]]\n')
+    with pytest.raises(ParameterError, match="needs at least 3"):
+        read_bodies(p)
+    p.write_text("[track]\nsubset_size = 20\n[bodies.a]\npolygon = [[1, 2], [3, 4], [5, 6]]\n")
+    with pytest.raises(ParameterError, match="subset_size=20"):
+        read_bodies(p)
+    p.write_text('[bodies.a]\nrole = "wheel"\npolygon = [[1, 2], [3, 4], [5, 6]]\n')
+    with pytest.raises(ParameterError, match="role"):
+        read_bodies(p)
+    assert TrackConfig().velocity_window == 9
