@@ -54,7 +54,11 @@ def register(app: typer.Typer) -> None:
         angle_direction: Annotated[
             str, typer.Option("--angle-direction", help="Instrument angle sense.")
         ] = "counterclockwise",
-        seed: Annotated[int, typer.Option("--seed", help="Random seed.")] = 0,
+        seed: Annotated[int, typer.Option("--seed", help="Random seed (form and noise).")] = 0,
+        noise_seed: Annotated[
+            int | None,
+            typer.Option("--noise-seed", help="Separate noise seed (same bore, new measurement)."),
+        ] = None,
         truth: Annotated[
             Path | None,
             typer.Option("--truth", help="Also save the truth (radius, wear) as netCDF."),
@@ -78,6 +82,7 @@ def register(app: typer.Typer) -> None:
             quantisation=quantisation_nm * 1e-9,
             convention=(angle_zero, angle_direction),
             seed=seed,
+            noise_seed=noise_seed,
         )
         files = write(
             sc,

@@ -123,6 +123,7 @@ def generate(
     convention: AngleConvention | tuple[str, str] = ("+y", "counterclockwise"),
     start_angle_deg: float = 0.0,
     seed: int = 0,
+    noise_seed: int | None = None,
 ) -> InstrumentScan:
     """Simulate a roundness-instrument scan of a (worn) bore with known truth.
 
@@ -157,7 +158,11 @@ def generate(
     start_angle_deg : float
         Instrument angle of the first sample [degree].
     seed : int
-        Random seed.
+        Random seed of the bore's form (harmonic phases) and, unless ``noise_seed`` is given,
+        of the noise.
+    noise_seed : int, optional
+        Separate seed for the probe noise: two scans of the same bore (before / after wear)
+        share ``seed`` and differ in ``noise_seed``.
     """
     if n_layers < 1 or n_points < 8:
         raise BadInputError(f"need n_layers >= 1 and n_points >= 8, got {n_layers}, {n_points}")
@@ -210,7 +215,8 @@ def generate(
     e = np.hypot(ex, ey)
     alpha = np.arctan2(ey, ex)
     r_true = e * np.cos(phi - alpha) + np.sqrt(rho**2 - (e * np.sin(phi - alpha)) ** 2)
-    r = r_true + noise * rng.standard_normal(r_true.shape)
+    nrng = rng if noise_seed is None else np.random.default_rng(noise_seed)
+    r = r_true + noise * nrng.standard_normal(r_true.shape)
     if quantisation > 0:
         r = radius + np.round((r - radius) / quantisation) * quantisation
     order = np.argsort(theta_can)

@@ -329,6 +329,7 @@ def wear_map(
     surface: str = "bore",
     radius: float | None = None,
     margin_deg: float = 5.0,
+    exact_centring: bool = True,
     max_iter: int = 30,
 ) -> xr.Dataset:
     """Wear depth over (z, theta) from a worn scan and a before-scan or a fitted reference.
@@ -363,6 +364,10 @@ def wear_map(
         the ``nominal_radius`` attribute (deviation data).
     margin_deg : float
         Points within this angle [degree] of a worn region are not used as unworn reference.
+    exact_centring : bool
+        Re-centre each scan exactly on its own axis before differencing (needs the bore radius:
+        ``radius`` data, the ``nominal_radius`` attribute or ``radius=``); removes the
+        set-up's second-order term e^2/(4R) that the limaçon leaves.
     max_iter : int
         Maximum rounds of the unworn-region iteration.
 
@@ -471,6 +476,26 @@ def wear_map(
     resid, mask, var_fit, s2, n_iter = _robust_reference(
         d, X, threshold, mask_in, max_iter, "wear_map", rw.shape, th, margin_deg
     )
+    # exact centring: the limaçon leaves each scan's e^2/(4R) second harmonic, which differs
+    # between set-ups; with the bore radius known, re-centre each scan exactly on its own axis
+    # (fitted to the unworn points) and redo the fit
+    r0_w = 0.0 if wname == "radius" else (radius or _attr_radius(worn, w))
+    centring = "limaçon only (bore radius unknown: pass radius= for exact centring)"
+    if exact_centring and r0_w:
+        rw_c = _recentre(rw + r0_w, z, th, mask)
+        if rbz is not None:
+            r0_b = 0.0 if bname == "radius" else (radius or _attr_radius(before, b) or r0_w)
+            rb_c = _recentre(_rotate(th, thb, rbz, offset) + r0_b, z, th, np.isfinite(d))
+            d = sign * (rw_c - rb_c).ravel()
+        else:
+            d = sign * (rw_c - r0_w).ravel()
+        resid, mask, var_fit, s2, n_iter = _robust_reference(
+            d, X, threshold, mask_in, max_iter, "wear_map", rw.shape, th, margin_deg
+        )
+        centring = (
+            "exact: each scan re-centred on its own least-squares axis (unworn points), then the "
+            "limaçon reference fitted to the unworn points"
+        )
     wear = resid.reshape(rw.shape)
     u = np.sqrt(s2 + var_fit).reshape(rw.shape)
     mask2 = mask.reshape(rw.shape)
@@ -592,9 +617,25 @@ def wear_map(
             "volume_radius": float(radius),
             "surface": surface,
             "registered": bool(register),
+            "centring": centring,
         },
     )
     return out
+
+
+def _recentre(
+    r_abs: np.ndarray, z: np.ndarray, theta_deg: np.ndarray, mask: np.ndarray
+) -> np.ndarray:
+    """Exact distance of each point from the scan's own LS axis (fitted on ``mask``) [m]."""
+    X = _basis(z, theta_deg, "cylinder")
+    m = np.asarray(mask, dtype=bool).ravel() & np.isfinite(r_abs.ravel())
+    b = np.linalg.lstsq(X[m], r_abs.ravel()[m], rcond=None)[0]
+    zc = z - 0.5 * (z.min() + z.max())
+    zz = zc / max(np.ptp(zc), 1e-12)
+    xc = (b[1] + b[3] * zz)[:, None]
+    yc = (b[2] + b[4] * zz)[:, None]
+    t = np.radians(theta_deg)[None, :]
+    return np.sqrt(r_abs**2 + xc**2 + yc**2 - 2.0 * r_abs * (xc * np.cos(t) + yc * np.sin(t)))
 
 
 def _attr_radius(orig: xr.Dataset | xr.DataArray, da: xr.DataArray) -> float | None:
