@@ -481,7 +481,9 @@ def wear_map(
     # (fitted to the unworn points) and redo the fit
     r0_w = 0.0 if wname == "radius" else (radius or _attr_radius(worn, w))
     centring = "limaçon only (bore radius unknown: pass radius= for exact centring)"
-    if exact_centring and r0_w:
+    if not exact_centring:
+        centring = "limaçon only (exact_centring=False)"
+    elif r0_w is not None:
         rw_c = _recentre(rw + r0_w, z, th, mask)
         if rbz is not None:
             r0_b = 0.0 if bname == "radius" else (radius or _attr_radius(before, b) or r0_w)
