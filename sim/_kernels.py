@@ -208,24 +208,34 @@ def _contact(
         if phi0 < 0.0:
             phi0 += 2.0 * math.pi
         m0 = int(round(phi0 / P[DPHI])) % Nd
-        # hill-climb to the local maximum of the penetration
-        d0 = _node_delta(n, m0, J0, u, P, H, ZL, Nd)
-        dp = _node_delta(n, m0 + 1, J0, u, P, H, ZL, Nd)
-        dm = _node_delta(n, m0 - 1, J0, u, P, H, ZL, Nd)
-        ms = m0
-        for _ in range(Nd):
-            if dp > d0 and dp >= dm:
-                ms += 1
-                dm = d0
-                d0 = dp
-                dp = _node_delta(n, ms + 1, J0, u, P, H, ZL, Nd)
-            elif dm > d0:
-                ms -= 1
-                dp = d0
-                d0 = dm
-                dm = _node_delta(n, ms - 1, J0, u, P, H, ZL, Nd)
-            else:
-                break
+        # climb from the node facing the eccentricity to the nearest local maximum of the
+        # penetration on each side; keep the deeper one (on a worn profile the journal can
+        # bridge a narrow groove and touch both flanks: the deeper flank carries the slice)
+        c0 = _node_delta(n, m0, J0, u, P, H, ZL, Nd)
+        cp = _node_delta(n, m0 + 1, J0, u, P, H, ZL, Nd)
+        cm = _node_delta(n, m0 - 1, J0, u, P, H, ZL, Nd)
+        ms, dm, d0, dp = m0, cm, c0, cp
+        found = False
+        if cp > c0:
+            r, a0, a1, a2 = m0 + 1, c0, cp, _node_delta(n, m0 + 2, J0, u, P, H, ZL, Nd)
+            for _ in range(Nd // 2):
+                if a2 <= a1:
+                    break
+                r += 1
+                a0, a1 = a1, a2
+                a2 = _node_delta(n, r + 1, J0, u, P, H, ZL, Nd)
+            ms, dm, d0, dp = r, a0, a1, a2
+            found = True
+        if cm > c0:
+            r, a0, a1, a2 = m0 - 1, c0, cm, _node_delta(n, m0 - 2, J0, u, P, H, ZL, Nd)
+            for _ in range(Nd // 2):
+                if a2 <= a1:
+                    break
+                r -= 1
+                a0, a1 = a1, a2
+                a2 = _node_delta(n, r - 1, J0, u, P, H, ZL, Nd)
+            if not found or a1 > d0:
+                ms, dm, d0, dp = r, a2, a1, a0
         if IP[PER_POINT] == 0:
             # parabola through the three nodes around the maximum
             b = 0.5 * (dp - dm)
@@ -301,21 +311,33 @@ def _contact(
             srate[n] = rate
             son[n] = 1
             if acc:
-                # pressure spread over the contiguous penetrating nodes, weights sqrt(delta)
-                wsum = 0.0
+                # pressure spread over the contiguous penetrating nodes, weights sqrt(delta);
+                # every node is evaluated once (buf[k] holds node lo + k)
+                half = Nd // 2
+                buf = np.empty(2 * half + 1)
                 lo = ms
-                while lo - ms > -Nd // 2 and _node_delta(n, lo - 1, J0, u, P, H, ZL, Nd) > 0.0:
+                while lo - ms > -half:
+                    dk = _node_delta(n, lo - 1, J0, u, P, H, ZL, Nd)
+                    if dk <= 0.0:
+                        break
                     lo -= 1
+                    buf[lo - ms + half] = dk
                 hi = ms
-                while hi - ms < Nd // 2 and _node_delta(n, hi + 1, J0, u, P, H, ZL, Nd) > 0.0:
+                while hi - ms < half:
+                    dk = _node_delta(n, hi + 1, J0, u, P, H, ZL, Nd)
+                    if dk <= 0.0:
+                        break
                     hi += 1
+                    buf[hi - ms + half] = dk
+                buf[half] = d0
+                wsum = 0.0
                 for mm in range(lo, hi + 1):
-                    dk = _node_delta(n, mm, J0, u, P, H, ZL, Nd)
+                    dk = buf[mm - ms + half]
                     if dk > 0.0:
                         wsum += math.sqrt(dk) * AREA[n, mm % Nd]
                 if wsum > 0.0:
                     for mm in range(lo, hi + 1):
-                        dk = _node_delta(n, mm, J0, u, P, H, ZL, Nd)
+                        dk = buf[mm - ms + half]
                         if dk > 0.0:
                             WW[0, n, mm % Nd] += fn * math.sqrt(dk) / wsum * vt * hstep
                             WW[1, n, mm % Nd] += vt * hstep
