@@ -1,0 +1,1309 @@
+"""Inverse-compositional Gauss-Newton (IC-GN) subset matching, numba kernels.
+
+Criterion: zero-normalised sum of squared differences (ZNSSD, insensitive to offset and gain of
+the intensities), ``C = sum [ (f - fm)/fn - (g - gm)/gn ]**2 = 2 (1 - ZNCC)``, minimised by IC-GN
+(Baker & Matthews 2004; Pan, Li & Tong 2013): the Hessian is built once per subset from the
+reference gradients, each iteration interpolates the deformed image at the warped subset
+(B-spline on prefiltered coefficients, :mod:`jointwear.dic._interp`) and the warp is updated by
+``W(p) <- W(p) o W(dp)^-1``. Second-order warps are composed through their 6x6 matrix
+representation (Gao et al. 2015).
+
+Shape parameters (always a 12-vector, the affine case uses 6 of them)::
+
+    p = [
+        u,
+        du / dx,
+        du / dy,
+        d2u / dx2,
+        d2u / dxdy,
+        d2u / dy2,
+        v,
+        dv / dx,
+        dv / dy,
+        d2v / dx2,
+        d2v / dxdy,
+        d2v / dy2,
+    ]
+
+so that a subset point at offset (dx, dy) from the centre maps to
+``x + dx + u + ux dx + uy dy + uxx dx^2/2 + uxy dx dy + uyy dy^2/2`` (and likewise in y).
+
+Kernels: :func:`icgn_many` (all points in parallel, ``prange``) and :func:`rg_propagate`
+(reliability-guided propagation from seeds, one heap per group of points, groups in parallel).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit, prange
+
+from jointwear.dic._interp import PAD, interp_value, interp_value_grad
+
+FLAG_OK = 0
+FLAG_NOT_CONVERGED = 1
+FLAG_LOW_CORRELATION = 2
+FLAG_OUTSIDE = 3
+FLAG_NO_TEXTURE = 4
+FLAG_INVALID_PIXELS = 5
+FLAG_NOT_REACHED = 6
+FLAG_DIVERGED = 7
+
+FLAG_MEANINGS = (
+    "ok not_converged low_correlation subset_outside_image no_texture invalid_pixels "
+    "not_reached diverged"
+)
+FLAG_VALUES = np.arange(8, dtype=np.int8)
+
+_FM = {"nsz", "arcp", "contract", "reassoc"}  # fastmath without no-NaN/no-inf assumptions
+
+AFFINE_INDEX = np.array([0, 1, 2, 6, 7, 8])
+QUADRATIC_INDEX = np.arange(12)
+
+
+@njit(cache=True)
+def _solve_spd(A, b, n):
+    """Solve A x = b (n x n symmetric positive definite) by Cholesky; None-safe: returns ok flag."""
+    L = np.zeros((n, n))
+    for i in range(n):
+        for j in range(i + 1):
+            s = A[i, j]
+            for k in range(j):
+                s -= L[i, k] * L[j, k]
+            if i == j:
+                if s <= 0.0:
+                    return False
+                L[i, i] = math.sqrt(s)
+            else:
+                L[i, j] = s / L[j, j]
+    # forward / backward substitution for each column of b
+    m = b.shape[1]
+    for c in range(m):
+        y = np.zeros(n)
+        for i in range(n):
+            s = b[i, c]
+            for k in range(i):
+                s -= L[i, k] * y[k]
+            y[i] = s / L[i, i]
+        for i in range(n - 1, -1, -1):
+            s = y[i]
+            for k in range(i + 1, n):
+                s -= L[k, i] * b[k, c]
+            b[i, c] = s / L[i, i]
+    return True
+
+
+@njit(cache=True)
+def _quad_matrix(p, M):
+    a0 = p[0]
+    a1 = 1.0 + p[1]
+    a2 = p[2]
+    a3 = 0.5 * p[3]
+    a4 = p[4]
+    a5 = 0.5 * p[5]
+    b0 = p[6]
+    b1 = p[7]
+    b2 = 1.0 + p[8]
+    b3 = 0.5 * p[9]
+    b4 = p[10]
+    b5 = 0.5 * p[11]
+    M[0, 0] = a1 * a1 + 2 * a0 * a3
+    M[0, 1] = 2 * a1 * a2 + 2 * a0 * a4
+    M[0, 2] = a2 * a2 + 2 * a0 * a5
+    M[0, 3] = 2 * a0 * a1
+    M[0, 4] = 2 * a0 * a2
+    M[0, 5] = a0 * a0
+    M[1, 0] = a1 * b1 + a0 * b3 + a3 * b0
+    M[1, 1] = a1 * b2 + a2 * b1 + a0 * b4 + a4 * b0
+    M[1, 2] = a2 * b2 + a0 * b5 + a5 * b0
+    M[1, 3] = a0 * b1 + a1 * b0
+    M[1, 4] = a0 * b2 + a2 * b0
+    M[1, 5] = a0 * b0
+    M[2, 0] = b1 * b1 + 2 * b0 * b3
+    M[2, 1] = 2 * b1 * b2 + 2 * b0 * b4
+    M[2, 2] = b2 * b2 + 2 * b0 * b5
+    M[2, 3] = 2 * b0 * b1
+    M[2, 4] = 2 * b0 * b2
+    M[2, 5] = b0 * b0
+    M[3, 0] = a3
+    M[3, 1] = a4
+    M[3, 2] = a5
+    M[3, 3] = a1
+    M[3, 4] = a2
+    M[3, 5] = a0
+    M[4, 0] = b3
+    M[4, 1] = b4
+    M[4, 2] = b5
+    M[4, 3] = b1
+    M[4, 4] = b2
+    M[4, 5] = b0
+    for j in range(5):
+        M[5, j] = 0.0
+    M[5, 5] = 1.0
+
+
+@njit(cache=True)
+def _invert(A, out):
+    """Gauss-Jordan inverse with partial pivoting of a small square matrix; False if singular."""
+    n = A.shape[0]
+    M = A.copy()
+    for i in range(n):
+        for j in range(n):
+            out[i, j] = 1.0 if i == j else 0.0
+    for col in range(n):
+        piv = col
+        best = abs(M[col, col])
+        for r in range(col + 1, n):
+            if abs(M[r, col]) > best:
+                best = abs(M[r, col])
+                piv = r
+        if not best > 1e-300:
+            return False
+        if piv != col:
+            for j in range(n):
+                M[col, j], M[piv, j] = M[piv, j], M[col, j]
+                out[col, j], out[piv, j] = out[piv, j], out[col, j]
+        d = 1.0 / M[col, col]
+        for j in range(n):
+            M[col, j] *= d
+            out[col, j] *= d
+        for r in range(n):
+            if r != col:
+                fct = M[r, col]
+                if fct != 0.0:
+                    for j in range(n):
+                        M[r, j] -= fct * M[col, j]
+                        out[r, j] -= fct * out[col, j]
+    return True
+
+
+@njit(cache=True)
+def _compose_affine(p, dp):
+    """p <- p o dp^-1 for affine warps W = [[1+ux, uy, u], [vx, 1+vy, v]]; False if singular."""
+    a11 = 1.0 + dp[1]
+    a12 = dp[2]
+    a21 = dp[7]
+    a22 = 1.0 + dp[8]
+    det = a11 * a22 - a12 * a21
+    if det == 0.0 or not math.isfinite(det):
+        return False
+    i11 = a22 / det
+    i12 = -a12 / det
+    i21 = -a21 / det
+    i22 = a11 / det
+    it1 = -(i11 * dp[0] + i12 * dp[6])
+    it2 = -(i21 * dp[0] + i22 * dp[6])
+    w11 = 1.0 + p[1]
+    w12 = p[2]
+    w21 = p[7]
+    w22 = 1.0 + p[8]
+    t1 = p[0]
+    t2 = p[6]
+    p[1] = w11 * i11 + w12 * i21 - 1.0
+    p[2] = w11 * i12 + w12 * i22
+    p[0] = w11 * it1 + w12 * it2 + t1
+    p[7] = w21 * i11 + w22 * i21
+    p[8] = w21 * i12 + w22 * i22 - 1.0
+    p[6] = w21 * it1 + w22 * it2 + t2
+    return True
+
+
+@njit(cache=True)
+def _compose_quadratic(p, dp):
+    """p <- p o dp^-1 for second-order warps through their 6x6 matrices (Gao et al. 2015)."""
+    Mp = np.empty((6, 6))
+    Md = np.empty((6, 6))
+    Mi = np.empty((6, 6))
+    _quad_matrix(p, Mp)
+    _quad_matrix(dp, Md)
+    if not _invert(Md, Mi):
+        return False
+    R = np.zeros((6, 6))
+    for i in range(3, 5):
+        for j in range(6):
+            s = 0.0
+            for k in range(6):
+                s += Mp[i, k] * Mi[k, j]
+            R[i, j] = s
+    p[3] = 2.0 * R[3, 0]
+    p[4] = R[3, 1]
+    p[5] = 2.0 * R[3, 2]
+    p[1] = R[3, 3] - 1.0
+    p[2] = R[3, 4]
+    p[0] = R[3, 5]
+    p[9] = 2.0 * R[4, 0]
+    p[10] = R[4, 1]
+    p[11] = 2.0 * R[4, 2]
+    p[7] = R[4, 3]
+    p[8] = R[4, 4] - 1.0
+    p[6] = R[4, 5]
+    return True
+
+
+@njit(cache=True)
+def _compose_inverse(p, dp, quadratic):
+    """p <- p o dp^-1 (inverse-compositional update), in place. Returns False if singular."""
+    if quadratic:
+        return _compose_quadratic(p, dp)
+    return _compose_affine(p, dp)
+
+
+@njit(cache=True)
+def _box_has_invalid(integral, x0, y0, x1, y1):
+    """True if any invalid pixel in [x0, x1] x [y0, y1] (integral image of invalid counts)."""
+    h = integral.shape[0] - 1
+    w = integral.shape[1] - 1
+    if x0 < 0:
+        x0 = 0
+    if y0 < 0:
+        y0 = 0
+    if x1 > w - 1:
+        x1 = w - 1
+    if y1 > h - 1:
+        y1 = h - 1
+    s = integral[y1 + 1, x1 + 1] - integral[y0, x1 + 1] - integral[y1 + 1, x0] + integral[y0, x0]
+    return s > 0
+
+
+@njit(cache=True)
+def _load_reference(
+    ref_img,
+    ref_gx,
+    ref_gy,
+    ref_coef,
+    ref_invalid,
+    order,
+    xc,
+    yc,
+    half,
+    min_std,
+    border,
+    f,
+    gx,
+    gy,
+    w,
+):
+    """Reference subset values (zero-mean, into ``f``) and gradients. Returns (flag, fn)."""
+    H, W = ref_img.shape
+    size = 2 * half + 1
+    n = size * size
+    if not math.isfinite(xc) or not math.isfinite(yc):
+        return FLAG_INVALID_PIXELS, 0.0
+    if (
+        xc - half < border
+        or yc - half < border
+        or xc + half > W - 1 - border
+        or yc + half > H - 1 - border
+    ):
+        return FLAG_OUTSIDE, 0.0
+    x0 = int(math.floor(xc)) - half - 1
+    y0 = int(math.floor(yc)) - half - 1
+    if _box_has_invalid(ref_invalid, x0, y0, x0 + size + 2, y0 + size + 2):
+        return FLAG_INVALID_PIXELS, 0.0
+    k = 0
+    if xc == math.floor(xc) and yc == math.floor(yc):
+        ic = int(xc)
+        jc = int(yc)
+        for r in range(-half, half + 1):
+            for c in range(-half, half + 1):
+                f[k] = ref_img[jc + r, ic + c]
+                gx[k] = ref_gx[jc + r, ic + c]
+                gy[k] = ref_gy[jc + r, ic + c]
+                k += 1
+    else:
+        for r in range(-half, half + 1):
+            for c in range(-half, half + 1):
+                v, vx, vy = interp_value_grad(
+                    ref_coef, order, xc + c, yc + r, w[0], w[1], w[2], w[3]
+                )
+                f[k] = v
+                gx[k] = vx
+                gy[k] = vy
+                k += 1
+    fm = 0.0
+    for k in range(n):
+        fm += f[k]
+    fm /= n
+    fn = 0.0
+    for k in range(n):
+        f[k] -= fm
+        fn += f[k] * f[k]
+    fn = math.sqrt(fn)
+    if fn <= min_std * math.sqrt(n):
+        return FLAG_NO_TEXTURE, fn
+    return FLAG_OK, fn
+
+
+@njit(cache=True, fastmath=_FM)
+def _solve_generic(
+    ref_img,
+    ref_gx,
+    ref_gy,
+    ref_coef,
+    ref_invalid,
+    def_coef,
+    def_invalid,
+    order,
+    xc,
+    yc,
+    half,
+    quadratic,
+    p,
+    max_iter,
+    tol,
+    min_std,
+    max_shift,
+    border,
+    f,
+    gx,
+    gy,
+    g,
+    wx,
+    wy,
+    dwx,
+    dwy,
+):
+    """Generic (affine or quadratic, any order) IC-GN for one subset; see :func:`solve_point`."""
+    H, W = ref_img.shape
+    Hd = def_coef.shape[0] - 2 * PAD
+    Wd = def_coef.shape[1] - 2 * PAD
+    size = 2 * half + 1
+    n = size * size
+    np_ = 12 if quadratic else 6
+    w = np.empty((4, 6))
+    flag0, fn = _load_reference(
+        ref_img,
+        ref_gx,
+        ref_gy,
+        ref_coef,
+        ref_invalid,
+        order,
+        xc,
+        yc,
+        half,
+        min_std,
+        border,
+        f,
+        gx,
+        gy,
+        w,
+    )
+    if flag0 != FLAG_OK:
+        return np.nan, 0, flag0
+    # ---- Hessian (Gauss-Newton, steepest-descent images built on the fly)
+    Hm = np.zeros((np_, np_))
+    J = np.empty(np_)
+    k = 0
+    for r in range(-half, half + 1):
+        for c in range(-half, half + 1):
+            a = gx[k]
+            b = gy[k]
+            if quadratic:
+                J[0] = a
+                J[1] = a * c
+                J[2] = a * r
+                J[3] = 0.5 * a * c * c
+                J[4] = a * c * r
+                J[5] = 0.5 * a * r * r
+                J[6] = b
+                J[7] = b * c
+                J[8] = b * r
+                J[9] = 0.5 * b * c * c
+                J[10] = b * c * r
+                J[11] = 0.5 * b * r * r
+            else:
+                J[0] = a
+                J[1] = a * c
+                J[2] = a * r
+                J[3] = b
+                J[4] = b * c
+                J[5] = b * r
+            for i in range(np_):
+                ji = J[i]
+                for j in range(i + 1):
+                    Hm[i, j] += ji * J[j]
+            k += 1
+    for i in range(np_):
+        for j in range(i + 1, np_):
+            Hm[i, j] = Hm[j, i]
+    Hinv = np.eye(np_)
+    if not _solve_spd(Hm.copy(), Hinv, np_):
+        return np.nan, 0, FLAG_NO_TEXTURE
+    # ---- iterations
+    bvec = np.zeros(np_)
+    dp = np.zeros(12)
+    p_start_u = p[0]
+    p_start_v = p[6]
+    zncc = np.nan
+    it = 0
+    hh = float(half)
+    while it < max_iter:
+        it += 1
+        # warped positions: check the bounding box of the corners (affine: exact; quadratic:
+        # the extreme is at a corner or edge midpoint, checked below on the fly)
+        xmin = 1e300
+        xmax = -1e300
+        ymin = 1e300
+        ymax = -1e300
+        for r in (-half, 0, half):
+            for c in (-half, 0, half):
+                xw = xc + c + p[0] + p[1] * c + p[2] * r
+                yw = yc + r + p[6] + p[7] * c + p[8] * r
+                if quadratic:
+                    xw += 0.5 * p[3] * c * c + p[4] * c * r + 0.5 * p[5] * r * r
+                    yw += 0.5 * p[9] * c * c + p[10] * c * r + 0.5 * p[11] * r * r
+                xmin = min(xmin, xw)
+                xmax = max(xmax, xw)
+                ymin = min(ymin, yw)
+                ymax = max(ymax, yw)
+        if not (
+            xmin >= border
+            and ymin >= border
+            and xmax <= Wd - 1 - border
+            and ymax <= Hd - 1 - border
+        ):
+            return np.nan, it, FLAG_OUTSIDE
+        if def_invalid.shape[0] > 1 and _box_has_invalid(
+            def_invalid,
+            int(math.floor(xmin)) - 2,
+            int(math.floor(ymin)) - 2,
+            int(math.ceil(xmax)) + 2,
+            int(math.ceil(ymax)) + 2,
+        ):
+            return np.nan, it, FLAG_INVALID_PIXELS
+        gm = 0.0
+        k = 0
+        for r in range(-half, half + 1):
+            bx = xc + p[0] + p[2] * r
+            by = yc + r + p[6] + p[8] * r
+            if quadratic:
+                bx += 0.5 * p[5] * r * r
+                by += 0.5 * p[11] * r * r
+            for c in range(-half, half + 1):
+                xw = bx + c * (1.0 + p[1])
+                yw = by + p[7] * c
+                if quadratic:
+                    xw += 0.5 * p[3] * c * c + p[4] * c * r
+                    yw += 0.5 * p[9] * c * c + p[10] * c * r
+                    # quadratic warps may bulge beyond the corner box
+                    if xw < border or yw < border or xw > Wd - 1 - border or yw > Hd - 1 - border:
+                        return np.nan, it, FLAG_OUTSIDE
+                v = interp_value(def_coef, order, xw, yw, wx, wy)
+                g[k] = v
+                gm += v
+                k += 1
+        gm /= n
+        gn = 0.0
+        cross = 0.0
+        for k in range(n):
+            d = g[k] - gm
+            g[k] = d
+            gn += d * d
+            cross += d * f[k]
+        gn = math.sqrt(gn)
+        if gn <= 0.0:
+            return np.nan, it, FLAG_NO_TEXTURE
+        zncc = cross / (fn * gn)
+        ratio = fn / gn
+        for i in range(np_):
+            bvec[i] = 0.0
+        k = 0
+        for r in range(-half, half + 1):
+            for c in range(-half, half + 1):
+                e = f[k] - ratio * g[k]
+                a = gx[k] * e
+                b = gy[k] * e
+                bvec[0] += a
+                bvec[1] += a * c
+                bvec[2] += a * r
+                if quadratic:
+                    bvec[3] += 0.5 * a * c * c
+                    bvec[4] += a * c * r
+                    bvec[5] += 0.5 * a * r * r
+                    bvec[6] += b
+                    bvec[7] += b * c
+                    bvec[8] += b * r
+                    bvec[9] += 0.5 * b * c * c
+                    bvec[10] += b * c * r
+                    bvec[11] += 0.5 * b * r * r
+                else:
+                    bvec[3] += b
+                    bvec[4] += b * c
+                    bvec[5] += b * r
+                k += 1
+        # dp = -Hinv b
+        if quadratic:
+            for i in range(12):
+                s = 0.0
+                for j in range(12):
+                    s += Hinv[i, j] * bvec[j]
+                dp[i] = -s
+        else:
+            tmp = np.zeros(6)
+            for i in range(6):
+                s = 0.0
+                for j in range(6):
+                    s += Hinv[i, j] * bvec[j]
+                tmp[i] = -s
+            dp[0] = tmp[0]
+            dp[1] = tmp[1]
+            dp[2] = tmp[2]
+            dp[6] = tmp[3]
+            dp[7] = tmp[4]
+            dp[8] = tmp[5]
+        if not _compose_inverse(p, dp, quadratic):
+            return zncc, it, FLAG_DIVERGED
+        ok = True
+        for i in range(12):
+            if not math.isfinite(p[i]):
+                ok = False
+        if not ok or abs(p[0] - p_start_u) > max_shift or abs(p[6] - p_start_v) > max_shift:
+            return np.nan, it, FLAG_DIVERGED
+        norm = dp[0] * dp[0] + dp[6] * dp[6]
+        norm += hh * hh * (dp[1] * dp[1] + dp[2] * dp[2] + dp[7] * dp[7] + dp[8] * dp[8])
+        if quadratic:
+            q = 0.5 * hh * hh
+            norm += q * q * (dp[3] ** 2 + dp[5] ** 2 + dp[9] ** 2 + dp[11] ** 2)
+            norm += hh**4 * (dp[4] ** 2 + dp[10] ** 2)
+        if math.sqrt(norm) < tol:
+            return zncc, it, FLAG_OK
+    return zncc, it, FLAG_NOT_CONVERGED
+
+
+@njit(cache=True, fastmath=_FM)
+def _hessian_affine(f, gx, gy, half, Hm, jf, js):
+    """Affine Gauss-Newton Hessian ``sum J J^T``, ``sum J f`` and ``sum J`` (row-wise sums)."""
+    m = np.zeros(18)  # aa, ab, bb moments: 1, c, r, cc, cr, rr
+    k = 0
+    for r in range(-half, half + 1):
+        rr = float(r)
+        raa = raac = raacc = rab = rabc = rabcc = rbb = rbbc = rbbcc = 0.0
+        rfa = rfac = rfb = rfbc = rsa = rsac = rsb = rsbc = 0.0
+        for c in range(-half, half + 1):
+            a = gx[k]
+            b = gy[k]
+            fk = f[k]
+            q = a * a
+            raa += q
+            raac += q * c
+            raacc += q * c * c
+            q = a * b
+            rab += q
+            rabc += q * c
+            rabcc += q * c * c
+            q = b * b
+            rbb += q
+            rbbc += q * c
+            rbbcc += q * c * c
+            rfa += a * fk
+            rfac += a * fk * c
+            rfb += b * fk
+            rfbc += b * fk * c
+            rsa += a
+            rsac += a * c
+            rsb += b
+            rsbc += b * c
+            k += 1
+        for o, s1, sc, scc in (
+            (0, raa, raac, raacc),
+            (6, rab, rabc, rabcc),
+            (12, rbb, rbbc, rbbcc),
+        ):
+            m[o] += s1
+            m[o + 1] += sc
+            m[o + 2] += s1 * rr
+            m[o + 3] += scc
+            m[o + 4] += sc * rr
+            m[o + 5] += s1 * rr * rr
+        jf[0] += rfa
+        jf[1] += rfac
+        jf[2] += rfa * rr
+        jf[3] += rfb
+        jf[4] += rfbc
+        jf[5] += rfb * rr
+        js[0] += rsa
+        js[1] += rsac
+        js[2] += rsa * rr
+        js[3] += rsb
+        js[4] += rsbc
+        js[5] += rsb * rr
+    # J = [a, a c, a r, b, b c, b r]: block (i, j) of sum J J^T from the moments
+    for blk_i in range(2):
+        for blk_j in range(blk_i, 2):
+            o = 0 if (blk_i == 0 and blk_j == 0) else (6 if blk_i != blk_j else 12)
+            M3 = np.empty((3, 3))
+            M3[0, 0] = m[o]
+            M3[0, 1] = m[o + 1]
+            M3[0, 2] = m[o + 2]
+            M3[1, 0] = m[o + 1]
+            M3[1, 1] = m[o + 3]
+            M3[1, 2] = m[o + 4]
+            M3[2, 0] = m[o + 2]
+            M3[2, 1] = m[o + 4]
+            M3[2, 2] = m[o + 5]
+            for i in range(3):
+                for j in range(3):
+                    Hm[3 * blk_i + i, 3 * blk_j + j] = M3[i, j]
+                    Hm[3 * blk_j + j, 3 * blk_i + i] = M3[i, j]
+
+
+@njit(cache=True, fastmath=_FM)
+def _sample_cubic(coef, x_start, y_start, a11, a12, a21, a22, half, f, gx, gy, acc):
+    """Sample the deformed subset (cubic B-spline) and accumulate into ``acc`` (9,):
+    sum g, sum g^2, sum g f, sum J g (6)."""
+    for i in range(9):
+        acc[i] = 0.0
+    k = 0
+    for r in range(-half, half + 1):
+        rr = float(r)
+        xw = x_start + a12 * rr
+        yw = y_start + a22 * rr
+        ga = gac = gb = gbc = 0.0
+        sg = sgg = sgf = 0.0
+        for c in range(-half, half + 1):
+            ix = int(xw)
+            iy = int(yw)
+            t = xw - ix
+            s = 1.0 - t
+            t2 = t * t
+            t3 = t2 * t
+            w0 = s * s * s
+            w1 = 4.0 - 6.0 * t2 + 3.0 * t3
+            w2 = 1.0 + 3.0 * (t + t2 - t3)
+            w3 = t3
+            t = yw - iy
+            s = 1.0 - t
+            t2 = t * t
+            t3 = t2 * t
+            bx = ix + PAD - 1
+            by = iy + PAD - 1
+            r0 = coef[by]
+            r1 = coef[by + 1]
+            r2 = coef[by + 2]
+            r3 = coef[by + 3]
+            gv = (
+                s * s * s * (w0 * r0[bx] + w1 * r0[bx + 1] + w2 * r0[bx + 2] + w3 * r0[bx + 3])
+                + (4.0 - 6.0 * t2 + 3.0 * t3)
+                * (w0 * r1[bx] + w1 * r1[bx + 1] + w2 * r1[bx + 2] + w3 * r1[bx + 3])
+                + (1.0 + 3.0 * (t + t2 - t3))
+                * (w0 * r2[bx] + w1 * r2[bx + 1] + w2 * r2[bx + 2] + w3 * r2[bx + 3])
+                + t3 * (w0 * r3[bx] + w1 * r3[bx + 1] + w2 * r3[bx + 2] + w3 * r3[bx + 3])
+            ) * (1.0 / 36.0)
+            sg += gv
+            sgg += gv * gv
+            sgf += gv * f[k]
+            q = gx[k] * gv
+            ga += q
+            gac += q * c
+            q = gy[k] * gv
+            gb += q
+            gbc += q * c
+            xw += a11
+            yw += a21
+            k += 1
+        acc[0] += sg
+        acc[1] += sgg
+        acc[2] += sgf
+        acc[3] += ga
+        acc[4] += gac
+        acc[5] += ga * rr
+        acc[6] += gb
+        acc[7] += gbc
+        acc[8] += gb * rr
+
+
+@njit(cache=True, fastmath=_FM)
+def _sample_quintic(coef, x_start, y_start, a11, a12, a21, a22, half, f, gx, gy, acc):
+    """As :func:`_sample_cubic` with the quintic B-spline."""
+    for i in range(9):
+        acc[i] = 0.0
+    wy = np.empty(6)
+    k = 0
+    for r in range(-half, half + 1):
+        rr = float(r)
+        xw = x_start + a12 * rr
+        yw = y_start + a22 * rr
+        ga = gac = gb = gbc = 0.0
+        sg = sgg = sgf = 0.0
+        for c in range(-half, half + 1):
+            ix = int(xw)
+            iy = int(yw)
+            t = xw - ix
+            s = 1.0 - t
+            t2 = t * t
+            t4 = t2 * t2
+            s2 = s * s
+            w0 = s2 * s2 * s
+            w5 = t4 * t
+            # quintic B-spline weights (x 120)
+            w1 = 26.0 - 50.0 * t + 20.0 * t2 + 20.0 * t2 * t - 20.0 * t4 + 5.0 * w5
+            w2 = 66.0 - 60.0 * t2 + 30.0 * t4 - 10.0 * w5
+            w3 = 26.0 + 50.0 * t + 20.0 * t2 - 20.0 * t2 * t - 20.0 * t4 + 10.0 * w5
+            w4 = 1.0 + 5.0 * t + 10.0 * t2 + 10.0 * t2 * t + 5.0 * t4 - 5.0 * w5
+            t = yw - iy
+            s = 1.0 - t
+            t2 = t * t
+            t4 = t2 * t2
+            s2 = s * s
+            wy[5] = t4 * t
+            wy[0] = s2 * s2 * s
+            wy[1] = 26.0 - 50.0 * t + 20.0 * t2 + 20.0 * t2 * t - 20.0 * t4 + 5.0 * wy[5]
+            wy[2] = 66.0 - 60.0 * t2 + 30.0 * t4 - 10.0 * wy[5]
+            wy[3] = 26.0 + 50.0 * t + 20.0 * t2 - 20.0 * t2 * t - 20.0 * t4 + 10.0 * wy[5]
+            wy[4] = 1.0 + 5.0 * t + 10.0 * t2 + 10.0 * t2 * t + 5.0 * t4 - 5.0 * wy[5]
+            bx = ix + PAD - 2
+            by = iy + PAD - 2
+            gv = 0.0
+            for q5 in range(6):
+                row = coef[by + q5]
+                gv += wy[q5] * (
+                    w0 * row[bx]
+                    + w1 * row[bx + 1]
+                    + w2 * row[bx + 2]
+                    + w3 * row[bx + 3]
+                    + w4 * row[bx + 4]
+                    + w5 * row[bx + 5]
+                )
+            gv *= 1.0 / 14400.0
+            sg += gv
+            sgg += gv * gv
+            sgf += gv * f[k]
+            q = gx[k] * gv
+            ga += q
+            gac += q * c
+            q = gy[k] * gv
+            gb += q
+            gbc += q * c
+            xw += a11
+            yw += a21
+            k += 1
+        acc[0] += sg
+        acc[1] += sgg
+        acc[2] += sgf
+        acc[3] += ga
+        acc[4] += gac
+        acc[5] += ga * rr
+        acc[6] += gb
+        acc[7] += gbc
+        acc[8] += gb * rr
+
+
+@njit(cache=True)
+def _solve_affine(
+    ref_img,
+    ref_gx,
+    ref_gy,
+    ref_coef,
+    ref_invalid,
+    def_coef,
+    def_invalid,
+    order,
+    xc,
+    yc,
+    half,
+    p,
+    max_iter,
+    tol,
+    min_std,
+    max_shift,
+    border,
+    f,
+    gx,
+    gy,
+    w,
+):
+    """Affine IC-GN for one subset, one sampling pass per iteration (see :func:`solve_point`).
+
+    Uses ``sum J (f - fm - fn/gn (g - gm)) = Jf - fn/gn (Jg - gm Js)`` with ``Jf``, ``Js``
+    fixed per subset, so each iteration samples the deformed subset once and accumulates.
+    """
+    Hd = def_coef.shape[0] - 2 * PAD
+    Wd = def_coef.shape[1] - 2 * PAD
+    n = (2 * half + 1) ** 2
+    flag0, fn = _load_reference(
+        ref_img,
+        ref_gx,
+        ref_gy,
+        ref_coef,
+        ref_invalid,
+        order,
+        xc,
+        yc,
+        half,
+        min_std,
+        border,
+        f,
+        gx,
+        gy,
+        w,
+    )
+    if flag0 != FLAG_OK:
+        return np.nan, 0, flag0
+    Hm = np.empty((6, 6))
+    jf = np.zeros(6)
+    js = np.zeros(6)
+    _hessian_affine(f, gx, gy, half, Hm, jf, js)
+    Hinv = np.eye(6)
+    if not _solve_spd(Hm, Hinv, 6):
+        return np.nan, 0, FLAG_NO_TEXTURE
+    acc = np.empty(9)
+    e = np.empty(6)
+    dp = np.zeros(12)
+    p_start_u = p[0]
+    p_start_v = p[6]
+    zncc = np.nan
+    it = 0
+    hh2 = float(half) * float(half)
+    while it < max_iter:
+        it += 1
+        a11 = 1.0 + p[1]
+        a12 = p[2]
+        a21 = p[7]
+        a22 = 1.0 + p[8]
+        # the warped subset is a parallelogram: its corners bound it
+        xmin = 1e300
+        xmax = -1e300
+        ymin = 1e300
+        ymax = -1e300
+        for corner in range(4):
+            c = -half if corner % 2 == 0 else half
+            r = -half if corner < 2 else half
+            xw = xc + p[0] + a11 * c + a12 * r
+            yw = yc + p[6] + a21 * c + a22 * r
+            xmin = min(xmin, xw)
+            xmax = max(xmax, xw)
+            ymin = min(ymin, yw)
+            ymax = max(ymax, yw)
+        if not (
+            xmin >= border
+            and ymin >= border
+            and xmax <= Wd - 1 - border
+            and ymax <= Hd - 1 - border
+        ):
+            return np.nan, it, FLAG_OUTSIDE
+        if def_invalid.shape[0] > 1 and _box_has_invalid(
+            def_invalid,
+            int(math.floor(xmin)) - 3,
+            int(math.floor(ymin)) - 3,
+            int(math.ceil(xmax)) + 3,
+            int(math.ceil(ymax)) + 3,
+        ):
+            return np.nan, it, FLAG_INVALID_PIXELS
+        x_start = xc + p[0] - a11 * half
+        y_start = yc + p[6] - a21 * half
+        if order == 3:
+            _sample_cubic(def_coef, x_start, y_start, a11, a12, a21, a22, half, f, gx, gy, acc)
+        else:
+            _sample_quintic(def_coef, x_start, y_start, a11, a12, a21, a22, half, f, gx, gy, acc)
+        gm = acc[0] / n
+        gn2 = acc[1] - n * gm * gm
+        if not gn2 > 1e-300:
+            return np.nan, it, FLAG_NO_TEXTURE
+        gn = math.sqrt(gn2)
+        zncc = acc[2] / (fn * gn)
+        ratio = fn / gn
+        for j in range(6):
+            e[j] = jf[j] - ratio * (acc[3 + j] - gm * js[j])
+        for i in range(6):
+            s = 0.0
+            for j in range(6):
+                s += Hinv[i, j] * e[j]
+            dp[AFFINE_INDEX[i]] = -s
+        if not _compose_affine(p, dp):
+            return zncc, it, FLAG_DIVERGED
+        ok = True
+        for i in range(12):
+            if not math.isfinite(p[i]):
+                ok = False
+        if not ok or abs(p[0] - p_start_u) > max_shift or abs(p[6] - p_start_v) > max_shift:
+            return np.nan, it, FLAG_DIVERGED
+        norm = dp[0] * dp[0] + dp[6] * dp[6]
+        norm += hh2 * (dp[1] * dp[1] + dp[2] * dp[2] + dp[7] * dp[7] + dp[8] * dp[8])
+        if math.sqrt(norm) < tol:
+            return zncc, it, FLAG_OK
+    return zncc, it, FLAG_NOT_CONVERGED
+
+
+@njit(cache=True)
+def make_work(half):
+    """Scratch arrays for :func:`solve_point` (one set per thread/chunk)."""
+    n = (2 * half + 1) ** 2
+    return np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty((4, 6))
+
+
+@njit(cache=True)
+def solve_point(
+    ref_img,
+    ref_gx,
+    ref_gy,
+    ref_coef,
+    ref_invalid,
+    def_coef,
+    def_invalid,
+    order,
+    xc,
+    yc,
+    half,
+    quadratic,
+    p,
+    max_iter,
+    tol,
+    min_std,
+    max_shift,
+    border,
+    work,
+):
+    """Match one subset centred at (xc, yc) of the reference; refines ``p`` (12,) in place.
+
+    ``work`` comes from :func:`make_work`. Returns ``(zncc, iterations, flag)``.
+    """
+    f, gx, gy, g, w = work
+    if quadratic:
+        return _solve_generic(
+            ref_img,
+            ref_gx,
+            ref_gy,
+            ref_coef,
+            ref_invalid,
+            def_coef,
+            def_invalid,
+            order,
+            xc,
+            yc,
+            half,
+            quadratic,
+            p,
+            max_iter,
+            tol,
+            min_std,
+            max_shift,
+            border,
+            f,
+            gx,
+            gy,
+            g,
+            w[0],
+            w[1],
+            w[2],
+            w[3],
+        )
+    return _solve_affine(
+        ref_img,
+        ref_gx,
+        ref_gy,
+        ref_coef,
+        ref_invalid,
+        def_coef,
+        def_invalid,
+        order,
+        xc,
+        yc,
+        half,
+        p,
+        max_iter,
+        tol,
+        min_std,
+        max_shift,
+        border,
+        f,
+        gx,
+        gy,
+        w,
+    )
+
+
+@njit(cache=True, parallel=True)
+def icgn_many(
+    ref_img,
+    ref_gx,
+    ref_gy,
+    ref_coef,
+    ref_invalid,
+    def_coef,
+    def_invalid,
+    order,
+    centres,
+    P,
+    active,
+    half,
+    quadratic,
+    max_iter,
+    tol,
+    min_std,
+    max_shift,
+    border,
+    zncc_min,
+    zncc,
+    iters,
+    flags,
+):
+    """Refine every active point from its initial parameters ``P[i]`` (in place), in parallel."""
+    n = centres.shape[0]
+    n_chunks = min(n, 64)
+    for ch in prange(n_chunks):
+        work = make_work(half)
+        p = np.empty(12)
+        for i in range(ch, n, n_chunks):
+            if not active[i]:
+                continue
+            for q in range(12):
+                p[q] = P[i, q]
+            z, it, fl = solve_point(
+                ref_img,
+                ref_gx,
+                ref_gy,
+                ref_coef,
+                ref_invalid,
+                def_coef,
+                def_invalid,
+                order,
+                centres[i, 0],
+                centres[i, 1],
+                half,
+                quadratic,
+                p,
+                max_iter,
+                tol,
+                min_std,
+                max_shift,
+                border,
+                work,
+            )
+            if fl == FLAG_OK and not (z >= zncc_min):
+                fl = FLAG_LOW_CORRELATION
+            for q in range(12):
+                P[i, q] = p[q]
+            zncc[i] = z
+            iters[i] = it
+            flags[i] = fl
+
+
+# ---------------------------------------------------------------- reliability-guided propagation
+
+
+@njit(cache=True)
+def _heap_push(keys, vals, size, key, val):
+    i = size
+    keys[i] = key
+    vals[i] = val
+    while i > 0:
+        parent = (i - 1) // 2
+        if keys[parent] >= keys[i]:
+            break
+        keys[parent], keys[i] = keys[i], keys[parent]
+        vals[parent], vals[i] = vals[i], vals[parent]
+        i = parent
+    return size + 1
+
+
+@njit(cache=True)
+def _heap_pop(keys, vals, size):
+    val = vals[0]
+    size -= 1
+    keys[0] = keys[size]
+    vals[0] = vals[size]
+    i = 0
+    while True:
+        left = 2 * i + 1
+        right = left + 1
+        best = i
+        if left < size and keys[left] > keys[best]:
+            best = left
+        if right < size and keys[right] > keys[best]:
+            best = right
+        if best == i:
+            break
+        keys[best], keys[i] = keys[i], keys[best]
+        vals[best], vals[i] = vals[i], vals[best]
+        i = best
+    return val, size
+
+
+@njit(cache=True)
+def _extrapolate(p_from, dx, dy, out):
+    """Shape parameters of a neighbour at offset (dx, dy) from a solved point."""
+    for i in range(12):
+        out[i] = p_from[i]
+    for o in (0, 6):
+        out[o] = (
+            p_from[o]
+            + p_from[o + 1] * dx
+            + p_from[o + 2] * dy
+            + 0.5 * p_from[o + 3] * dx * dx
+            + p_from[o + 4] * dx * dy
+            + 0.5 * p_from[o + 5] * dy * dy
+        )
+        out[o + 1] = p_from[o + 1] + p_from[o + 3] * dx + p_from[o + 4] * dy
+        out[o + 2] = p_from[o + 2] + p_from[o + 4] * dx + p_from[o + 5] * dy
+
+
+@njit(cache=True)
+def _propagate_group(
+    g,
+    group,
+    ref_img,
+    ref_gx,
+    ref_gy,
+    ref_coef,
+    ref_invalid,
+    def_coef,
+    def_invalid,
+    order,
+    centres,
+    nb_ptr,
+    nb_idx,
+    P,
+    half,
+    quadratic,
+    max_iter,
+    tol,
+    min_std,
+    max_shift,
+    border,
+    zncc_min,
+    zncc,
+    iters,
+    flags,
+    done,
+):
+    n = centres.shape[0]
+    keys = np.empty(n)
+    vals = np.empty(n, dtype=np.int64)
+    size = 0
+    for i in range(n):
+        if (g < 0 or group[i] == g) and done[i] and flags[i] == FLAG_OK:
+            size = _heap_push(keys, vals, size, zncc[i], i)
+    guess = np.empty(12)
+    work = make_work(half)
+    while size > 0:
+        i, size = _heap_pop(keys, vals, size)
+        for q in range(nb_ptr[i], nb_ptr[i + 1]):
+            j = nb_idx[q]
+            if done[j] or (g >= 0 and group[j] != g):
+                continue
+            _extrapolate(P[i], centres[j, 0] - centres[i, 0], centres[j, 1] - centres[i, 1], guess)
+            z, it, fl = solve_point(
+                ref_img,
+                ref_gx,
+                ref_gy,
+                ref_coef,
+                ref_invalid,
+                def_coef,
+                def_invalid,
+                order,
+                centres[j, 0],
+                centres[j, 1],
+                half,
+                quadratic,
+                guess,
+                max_iter,
+                tol,
+                min_std,
+                max_shift,
+                border,
+                work,
+            )
+            if fl == FLAG_OK and not (z >= zncc_min):
+                fl = FLAG_LOW_CORRELATION
+            done[j] = True
+            P[j] = guess
+            zncc[j] = z
+            iters[j] = it
+            flags[j] = fl
+            if fl == FLAG_OK:
+                size = _heap_push(keys, vals, size, z, j)
+
+
+@njit(cache=True, parallel=True)
+def rg_propagate(
+    n_groups,
+    group,
+    ref_img,
+    ref_gx,
+    ref_gy,
+    ref_coef,
+    ref_invalid,
+    def_coef,
+    def_invalid,
+    order,
+    centres,
+    nb_ptr,
+    nb_idx,
+    P,
+    half,
+    quadratic,
+    max_iter,
+    tol,
+    min_std,
+    max_shift,
+    border,
+    zncc_min,
+    zncc,
+    iters,
+    flags,
+    done,
+):
+    """Reliability-guided propagation: from the solved (``done`` and ok) points of each group,
+    always extend from the best-correlated point to its unsolved neighbours (guess = its
+    parameters extrapolated). Groups run in parallel; ``n_groups = 0`` runs one global pass
+    ignoring groups."""
+    if n_groups == 0:
+        _propagate_group(
+            -1,
+            group,
+            ref_img,
+            ref_gx,
+            ref_gy,
+            ref_coef,
+            ref_invalid,
+            def_coef,
+            def_invalid,
+            order,
+            centres,
+            nb_ptr,
+            nb_idx,
+            P,
+            half,
+            quadratic,
+            max_iter,
+            tol,
+            min_std,
+            max_shift,
+            border,
+            zncc_min,
+            zncc,
+            iters,
+            flags,
+            done,
+        )
+        return
+    for g in prange(n_groups):
+        _propagate_group(
+            g,
+            group,
+            ref_img,
+            ref_gx,
+            ref_gy,
+            ref_coef,
+            ref_invalid,
+            def_coef,
+            def_invalid,
+            order,
+            centres,
+            nb_ptr,
+            nb_idx,
+            P,
+            half,
+            quadratic,
+            max_iter,
+            tol,
+            min_std,
+            max_shift,
+            border,
+            zncc_min,
+            zncc,
+            iters,
+            flags,
+            done,
+        )

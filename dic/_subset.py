@@ -1,0 +1,732 @@
+"""Subset correlation of a reference image against deformed images (the 2D engine's core).
+
+``SubsetCorrelator(reference, *, points=None, roi=None, subset_size=31, step=10,
+shape="affine", interpolation="cubic", ...)`` validates the reference once, computes its B-spline
+coefficients and node gradients, lays out the points of interest (a grid over ``roi`` with
+``step``, or the given ``(N, 2)`` array of ``(x, y)`` positions [pixel]) and their neighbour
+graph. Then, for each deformed image:
+
+``SubsetCorrelator.correlate(deformed, *, initial_guess=None, seed_points=None) -> Dataset``
+
+* ``initial_guess`` ``(N, 2)`` displacements ``(u, v)`` [pixel], or ``(N, 6)`` affine
+  ``(u, du/dx, du/dy, v, dv/dx, dv/dy)``, or ``(N, 12)`` full shape parameters (layout of
+  :mod:`jointwear.dic._icgn`): every point is refined from its guess in parallel, and points
+  that fail are retried by reliability-guided propagation from their converged neighbours.
+* otherwise seeds are found by OpenCV template matching (``search_radius``; rotated templates
+  when the plain search fails) and the solution propagates from the best-correlated points to
+  their neighbours (reliability-guided DIC), in parallel bands.
+
+``SubsetCorrelator.match(deformed, ...)`` returns the raw arrays (``MatchResult``) instead of a
+Dataset. Points that cannot be correlated are kept and flagged (``flag``, CF
+``flag_values``/``flag_meanings``), with NaN displacements.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import asdict, dataclass
+from typing import Literal
+
+import numpy as np
+import xarray as xr
+
+from jointwear.dic import _icgn
+from jointwear.dic._interp import SplineImage, prefilter
+from jointwear.errors import BadInputError, ParameterError
+
+__all__ = ["CorrelationParams", "SubsetCorrelator", "MatchResult", "FLAG_MEANINGS"]
+
+FLAG_MEANINGS = _icgn.FLAG_MEANINGS
+
+_SHAPES = {"affine": False, "first": False, "quadratic": True, "second": True}
+
+
+@dataclass(frozen=True)
+class CorrelationParams:
+    """Options of the subset correlation.
+
+    Parameters
+    ----------
+    subset_size : int
+        Side of the square subset [pixel], odd, >= 7.
+    step : int
+        Grid spacing of the points of interest [pixel] (grids only).
+    shape : str
+        Subset shape function: ``"affine"`` (first order) or ``"quadratic"`` (second order).
+    interpolation : str
+        ``"cubic"`` or ``"quintic"`` B-spline on prefiltered coefficients.
+    max_iterations : int
+        IC-GN iteration limit per point.
+    tolerance : float
+        Convergence: norm of the parameter update, gradients scaled by the subset half-width
+        [pixel].
+    zncc_min : float
+        Points below this ZNCC are flagged ``low_correlation`` and do not propagate.
+    search_radius : int
+        Half-width of the integer-pixel search window for seeds [pixel].
+    min_texture : float
+        Subsets whose intensity standard deviation is below this fraction of the image's are
+        flagged ``no_texture``.
+    border : int
+        Margin [pixel] subsets must keep from the image edges (reference and deformed): the
+        B-spline interpolant is less accurate within a few pixels of an edge (errors up to
+        ~0.003 px at 2-3 px from it). Subsets closer are flagged ``subset_outside_image``.
+    threads : int
+        numba threads (at most 2 on the shared machine; 0 = min(2, available)).
+    """
+
+    subset_size: int = 31
+    step: int = 10
+    shape: Literal["affine", "quadratic"] = "affine"
+    interpolation: Literal["cubic", "quintic"] = "quintic"
+    max_iterations: int = 40
+    tolerance: float = 1e-4
+    zncc_min: float = 0.8
+    search_radius: int = 48
+    min_texture: float = 0.05
+    border: int = 4
+    threads: int = 0
+
+    def __post_init__(self) -> None:
+        s = self.subset_size
+        if isinstance(s, bool) or not isinstance(s, (int, np.integer)) or s < 7 or s % 2 == 0:
+            raise ParameterError(
+                f"subset_size={s!r}: expected an odd integer >= 7 (the subset is centred on "
+                f"its point); use {s + 1 if isinstance(s, (int, np.integer)) and s >= 6 else 31}"
+            )
+        if not isinstance(self.step, (int, np.integer)) or self.step < 1:
+            raise ParameterError(f"step={self.step!r}: expected an integer >= 1 pixel")
+        if self.shape not in _SHAPES:
+            raise ParameterError(
+                f"shape={self.shape!r}: expected 'affine' (first order) or 'quadratic' (second order)"
+            )
+        if self.interpolation not in ("cubic", "quintic"):
+            raise ParameterError(
+                f"interpolation={self.interpolation!r}: expected 'cubic' or 'quintic' (B-spline)"
+            )
+        if not (0.0 < self.tolerance < 1.0):
+            raise ParameterError(f"tolerance={self.tolerance!r}: expected 0 < tolerance < 1 pixel")
+        if not (-1.0 <= self.zncc_min < 1.0):
+            raise ParameterError(f"zncc_min={self.zncc_min!r}: expected a value in [-1, 1)")
+        if self.max_iterations < 1:
+            raise ParameterError(f"max_iterations={self.max_iterations!r}: expected >= 1")
+        if not isinstance(self.border, (int, np.integer)) or self.border < 0:
+            raise ParameterError(f"border={self.border!r}: expected an integer >= 0 pixel")
+        if self.search_radius < 0:
+            raise ParameterError(f"search_radius={self.search_radius!r}: expected >= 0 pixel")
+
+    @property
+    def half(self) -> int:
+        return self.subset_size // 2
+
+    @property
+    def quadratic(self) -> bool:
+        return _SHAPES[self.shape]
+
+
+def set_threads(threads: int = 0) -> int:
+    """Set numba's thread count to ``threads`` (0: min(2, available)); returns it."""
+    import numba
+
+    avail = numba.config.NUMBA_NUM_THREADS
+    n = min(avail, 2) if not threads else max(1, min(int(threads), avail))
+    numba.set_num_threads(n)
+    return n
+
+
+def check_image(image, name: str) -> np.ndarray:
+    """A 2D numeric image as an array, or a BadInputError naming ``name``."""
+    arr = np.asarray(image)
+    if arr.ndim == 3 and arr.shape[2] in (3, 4):
+        raise BadInputError(
+            f"{name}: expected a single-channel (grey) image, got shape {arr.shape} (colour); "
+            "convert it to grey first, e.g. cv2.cvtColor(img, cv2.COLOR_BGR2GRAY)"
+        )
+    if arr.ndim != 2:
+        raise BadInputError(f"{name}: expected a 2D image (rows, columns), got shape {arr.shape}")
+    if arr.dtype.kind not in "uif" or arr.dtype == np.bool_:
+        raise BadInputError(f"{name}: expected numeric pixels, got dtype {arr.dtype}")
+    if min(arr.shape) < 8:
+        raise BadInputError(f"{name}: image {arr.shape} is too small (need at least 8x8 pixels)")
+    if arr.dtype.kind == "f" and np.isinf(arr).any():
+        raise BadInputError(
+            f"{name}: contains infinite pixel values; replace them by NaN (flagged) or finite values"
+        )
+    return arr
+
+
+def check_pair(reference: np.ndarray, deformed: np.ndarray, what: str = "deformed image") -> None:
+    """Sizes and dtypes must agree."""
+    if reference.shape != deformed.shape:
+        raise BadInputError(
+            f"{what}: size {deformed.shape[1]}x{deformed.shape[0]} (width x height) differs from "
+            f"the reference {reference.shape[1]}x{reference.shape[0]}; crop or resize so that both "
+            "images have the same size"
+        )
+    if reference.dtype != deformed.dtype:
+        raise BadInputError(
+            f"{what}: pixel type {deformed.dtype} differs from the reference's {reference.dtype}; "
+            "images of one sequence must come from the same camera setting - convert both to the "
+            "same type (e.g. .astype(np.float64)) if that is intended"
+        )
+
+
+def _integral_invalid(valid: np.ndarray) -> np.ndarray:
+    inv = (~valid).astype(np.int64)
+    out = np.zeros((inv.shape[0] + 1, inv.shape[1] + 1), dtype=np.int64)
+    out[1:, 1:] = inv.cumsum(0).cumsum(1)
+    return out
+
+
+@dataclass
+class MatchResult:
+    """Raw per-point output of :meth:`SubsetCorrelator.match`.
+
+    ``params`` (N, 12) shape parameters (layout of :mod:`jointwear.dic._icgn`), ``zncc`` (N,),
+    ``iterations`` (N,), ``flag`` (N,) int8.
+    """
+
+    params: np.ndarray
+    zncc: np.ndarray
+    iterations: np.ndarray
+    flag: np.ndarray
+
+    @property
+    def ok(self) -> np.ndarray:
+        return self.flag == _icgn.FLAG_OK
+
+
+class SubsetCorrelator:
+    """Reference image prepared once for correlating many deformed images.
+
+    Parameters
+    ----------
+    reference : ndarray (H, W)
+        Reference image (any numeric type; NaN marks invalid pixels).
+    points : ndarray (N, 2), optional
+        Subset centres ``(x, y)`` [pixel] (x = column, y = row). Non-integer centres are
+        sampled on the reference interpolant.
+    roi : (x_min, y_min, x_max, y_max), optional
+        Region [pixel, inclusive] that grid subsets must lie in (default: the whole image).
+    params : CorrelationParams, optional
+        All options; keyword arguments (``subset_size=...``) override its fields.
+    """
+
+    def __init__(
+        self,
+        reference: np.ndarray,
+        *,
+        points: np.ndarray | None = None,
+        roi: Sequence[float] | None = None,
+        params: CorrelationParams | None = None,
+        _graph: tuple[np.ndarray, np.ndarray] | None = None,
+        **options,
+    ) -> None:
+        base = params or CorrelationParams()
+        if options:
+            known = set(asdict(base))
+            unknown = sorted(set(options) - known)
+            if unknown:
+                raise ParameterError(
+                    f"unknown correlation option(s) {', '.join(unknown)}; known: "
+                    f"{', '.join(sorted(known))}"
+                )
+            base = CorrelationParams(**{**asdict(base), **options})
+        self.params = base
+        self.reference_raw = check_image(reference, "reference image")
+        self.ref = prefilter(self.reference_raw, base.interpolation)
+        self._ref_invalid = _integral_invalid(self.ref.valid)
+        h, w = self.ref.shape
+        valid_vals = self.ref.image[self.ref.valid]
+        if valid_vals.size == 0:
+            raise BadInputError("reference image: every pixel is NaN")
+        self.image_std = float(np.std(valid_vals))
+        self.grid: tuple[np.ndarray, np.ndarray] | None = None
+        if points is not None:
+            pts = np.asarray(points, dtype=np.float64)
+            if pts.ndim == 1 and pts.size == 2:
+                pts = pts[None, :]
+            if pts.ndim != 2 or pts.shape[1] != 2 or pts.shape[0] == 0:
+                raise BadInputError(
+                    f"points: expected an (N, 2) array of (x, y) pixel positions, got shape "
+                    f"{np.shape(points)}"
+                )
+            if roi is not None:
+                raise ParameterError("give either points or roi, not both")
+            self.centres = np.ascontiguousarray(pts)
+        else:
+            half = base.half
+            b = base.border
+            if roi is None:
+                x_min, y_min, x_max, y_max = b, b, w - 1 - b, h - 1 - b
+            else:
+                try:
+                    x_min, y_min, x_max, y_max = (int(round(float(v))) for v in roi)
+                except (TypeError, ValueError):
+                    raise ParameterError(
+                        f"roi={roi!r}: expected (x_min, y_min, x_max, y_max) in pixels"
+                    ) from None
+                if not (0 <= x_min < x_max <= w - 1 and 0 <= y_min < y_max <= h - 1):
+                    raise ParameterError(
+                        f"roi={tuple(roi)!r} must satisfy 0 <= x_min < x_max <= {w - 1} and "
+                        f"0 <= y_min < y_max <= {h - 1} (image of {w}x{h} pixels)"
+                    )
+            x_min, y_min = max(x_min, b), max(y_min, b)
+            x_max, y_max = min(x_max, w - 1 - b), min(y_max, h - 1 - b)
+            xs = np.arange(x_min + half, x_max - half + 1, base.step, dtype=float)
+            ys = np.arange(y_min + half, y_max - half + 1, base.step, dtype=float)
+            if xs.size == 0 or ys.size == 0:
+                raise ParameterError(
+                    f"no subset of {base.subset_size} pixels fits in the region "
+                    f"x {x_min}..{x_max}, y {y_min}..{y_max}; enlarge the roi or reduce subset_size"
+                )
+            # centre the grid in the region
+            xs += (x_max - half - xs[-1]) // 2
+            ys += (y_max - half - ys[-1]) // 2
+            self.grid = (xs, ys)
+            X, Y = np.meshgrid(xs, ys)
+            self.centres = np.ascontiguousarray(np.column_stack([X.ravel(), Y.ravel()]))
+        if _graph is not None and len(_graph[0]) == self.n_points + 1:
+            self._nb_ptr, self._nb_idx = _graph
+        else:
+            self._neighbours()
+        self._texture = None
+
+    # ------------------------------------------------------------------ layout
+    @property
+    def graph(self) -> tuple[np.ndarray, np.ndarray]:
+        """Neighbour graph of the points (CSR: pointer, indices)."""
+        return self._nb_ptr, self._nb_idx
+
+    @property
+    def n_points(self) -> int:
+        return self.centres.shape[0]
+
+    def _neighbours(self) -> None:
+        n = self.n_points
+        if self.grid is not None:
+            nx, ny = self.grid[0].size, self.grid[1].size
+            idx = np.arange(n).reshape(ny, nx)
+            lists = []
+            for dy, dx in ((-1, 0), (1, 0), (0, -1), (0, 1)):
+                src = idx[max(0, -dy) : ny - max(0, dy), max(0, -dx) : nx - max(0, dx)]
+                dst = idx[max(0, dy) : ny - max(0, -dy), max(0, dx) : nx - max(0, -dx)]
+                lists.append(np.column_stack([src.ravel(), dst.ravel()]))
+            pairs = np.concatenate(lists) if lists else np.zeros((0, 2), int)
+        elif n > 1:
+            from scipy.spatial import cKDTree
+
+            k = min(8, n - 1)
+            _, nb = cKDTree(self.centres).query(self.centres, k=k + 1)
+            src = np.repeat(np.arange(n), k)
+            dst = nb[:, 1:].ravel()
+            pairs = np.column_stack([src, dst])
+            pairs = np.unique(np.concatenate([pairs, pairs[:, ::-1]]), axis=0)
+        else:
+            pairs = np.zeros((0, 2), int)
+        order = np.argsort(pairs[:, 0], kind="stable")
+        pairs = pairs[order]
+        self._nb_idx = np.ascontiguousarray(pairs[:, 1].astype(np.int64))
+        counts = np.bincount(pairs[:, 0], minlength=n) if len(pairs) else np.zeros(n, int)
+        self._nb_ptr = np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
+
+    def _texture_and_usable(self) -> tuple[np.ndarray, np.ndarray]:
+        if self._texture is None:
+            from scipy import ndimage
+
+            half = self.params.half
+            img = np.where(self.ref.valid, self.ref.image, 0.0)
+            size = 2 * half + 1
+            m1 = ndimage.uniform_filter(img, size, mode="nearest")
+            m2 = ndimage.uniform_filter(img * img, size, mode="nearest")
+            std = np.sqrt(np.maximum(m2 - m1 * m1, 0.0))
+            h, w = self.ref.shape
+            c = self.centres
+            b = self.params.border
+            inside = (
+                np.isfinite(c).all(axis=1)
+                & (c[:, 0] - half >= b)
+                & (c[:, 1] - half >= b)
+                & (c[:, 0] + half <= w - 1 - b)
+                & (c[:, 1] + half <= h - 1 - b)
+            )
+            ix = np.clip(np.nan_to_num(np.rint(c[:, 0])), 0, w - 1).astype(int)
+            iy = np.clip(np.nan_to_num(np.rint(c[:, 1])), 0, h - 1).astype(int)
+            tex = np.where(inside, std[iy, ix], 0.0)
+            bad = ndimage.uniform_filter((~self.ref.valid).astype(float), size, mode="nearest")
+            usable = inside & (tex > self.params.min_texture * self.image_std) & (bad[iy, ix] == 0)
+            self._texture = (tex, usable)
+        return self._texture
+
+    # ------------------------------------------------------------------ matching
+    def _prepare_deformed(self, deformed) -> tuple[SplineImage, np.ndarray, np.ndarray]:
+        if isinstance(deformed, SplineImage):
+            spl = deformed
+            raw = deformed.image
+        else:
+            raw = check_image(deformed, "deformed image")
+            check_pair(self.reference_raw, raw)
+            spl = prefilter(raw, self.params.interpolation)
+        if spl.order != self.ref.order:
+            raise ParameterError("deformed SplineImage was prefiltered with another interpolation")
+        inv = _integral_invalid(spl.valid) if not spl.valid.all() else np.zeros((1, 1), np.int64)
+        return spl, inv, raw
+
+    def _kernel_args(self, dspl, dinv):
+        r = self.ref
+        return (r.image, r.gx, r.gy, r.coef, self._ref_invalid, dspl.coef, dinv, r.order)
+
+    def _run_many(self, dspl, dinv, P, active, st):
+        p = self.params
+        _icgn.icgn_many(
+            *self._kernel_args(dspl, dinv),
+            self.centres,
+            P,
+            active,
+            p.half,
+            p.quadratic,
+            p.max_iterations,
+            p.tolerance,
+            p.min_texture * self.image_std,
+            float(max(p.half, 5)),
+            float(p.border),
+            p.zncc_min,
+            st.zncc,
+            st.iterations,
+            st.flag,
+        )
+
+    def _propagate(self, dspl, dinv, st, done, group, n_groups):
+        p = self.params
+        _icgn.rg_propagate(
+            n_groups,
+            group,
+            *self._kernel_args(dspl, dinv),
+            self.centres,
+            self._nb_ptr,
+            self._nb_idx,
+            st.params,
+            p.half,
+            p.quadratic,
+            p.max_iterations,
+            p.tolerance,
+            p.min_texture * self.image_std,
+            float(max(p.half, 5)),
+            float(p.border),
+            p.zncc_min,
+            st.zncc,
+            st.iterations,
+            st.flag,
+            done,
+        )
+
+    def _retry_failed(self, dspl, dinv, st, done, group) -> None:
+        """Give failed (but structurally fine) points one more chance from other neighbours."""
+        retry = np.isin(
+            st.flag, (_icgn.FLAG_NOT_CONVERGED, _icgn.FLAG_LOW_CORRELATION, _icgn.FLAG_DIVERGED)
+        )
+        unreached = ~done
+        if (retry | unreached).any() and st.ok.any():
+            saved = (st.params.copy(), st.zncc.copy(), st.iterations.copy(), st.flag.copy())
+            done[retry] = False
+            self._propagate(dspl, dinv, st, done, group, 0)
+            back = retry & ~done  # not reached again: keep the first attempt
+            st.params[back], st.zncc[back] = saved[0][back], saved[1][back]
+            st.iterations[back], st.flag[back] = saved[2][back], saved[3][back]
+            done[back] = True
+
+    def _seed(self, dspl, dinv, raw_def, st, done, i, guess=(0.0, 0.0)) -> bool:
+        """Try point ``i`` as a seed: integer search (plain, then rotated), then IC-GN.
+
+        If every attempt fails, the point keeps the outcome of the plain attempt.
+        """
+        from jointwear.dic._guess import integer_search
+
+        p = self.params
+        xc, yc = self.centres[i]
+        active = np.zeros(self.n_points, bool)
+        active[i] = True
+
+        def attempt(tu, tv, ang):
+            th = math.radians(ang)
+            P0 = np.zeros(12)
+            P0[0], P0[6] = tu, tv
+            P0[1], P0[2] = math.cos(th) - 1.0, -math.sin(th)
+            P0[7], P0[8] = math.sin(th), math.cos(th) - 1.0
+            st.params[i] = P0
+            self._run_many(dspl, dinv, st.params, active, st)
+            return st.flag[i] == _icgn.FLAG_OK
+
+        u, v, peak, _ = integer_search(self.ref, raw_def, xc, yc, p.half, p.search_radius, guess)
+        done[i] = True
+        if attempt(u, v, 0.0) if np.isfinite(peak) else attempt(guess[0], guess[1], 0.0):
+            return True
+        first = (st.params[i].copy(), st.zncc[i], st.iterations[i], st.flag[i])
+        structural = (_icgn.FLAG_OUTSIDE, _icgn.FLAG_NO_TEXTURE, _icgn.FLAG_INVALID_PIXELS)
+        if first[3] not in structural:
+            # rotated templates: the part may have turned
+            scored = []
+            for a in np.arange(-180.0, 180.0, 7.5):
+                if a == 0.0:
+                    continue
+                r = integer_search(
+                    self.ref, raw_def, xc, yc, p.half, p.search_radius, guess, (float(a),)
+                )
+                if np.isfinite(r[2]):
+                    scored.append((r[2], r[0], r[1], float(a)))
+            scored.sort(reverse=True)
+            for _, tu, tv, ang in scored[:3]:
+                if attempt(tu, tv, ang):
+                    return True
+        st.params[i], st.zncc[i], st.iterations[i], st.flag[i] = first
+        return False
+
+    def match(
+        self,
+        deformed,
+        *,
+        initial_guess: np.ndarray | None = None,
+        seed_points: np.ndarray | None = None,
+    ) -> MatchResult:
+        """Correlate ``deformed`` against the reference; raw per-point arrays.
+
+        See :meth:`correlate` for the parameters.
+        """
+        set_threads(self.params.threads)
+        dspl, dinv, raw_def = self._prepare_deformed(deformed)
+        n = self.n_points
+        st = MatchResult(
+            params=np.zeros((n, 12)),
+            zncc=np.full(n, np.nan),
+            iterations=np.zeros(n, dtype=np.int32),
+            flag=np.full(n, _icgn.FLAG_NOT_REACHED, dtype=np.int8),
+        )
+        done = np.zeros(n, dtype=np.bool_)
+        group = np.zeros(n, dtype=np.int64)
+        if initial_guess is not None:
+            st.params[:] = self._guess_array(initial_guess)
+            active = np.isfinite(st.params).all(axis=1)
+            st.params[~active] = 0.0
+            self._run_many(dspl, dinv, st.params, active, st)
+            done[active] = True
+            self._retry_failed(dspl, dinv, st, done, group)
+            return st
+        tex, usable = self._texture_and_usable()
+        if seed_points is not None:
+            seeds = np.asarray(seed_points, dtype=float).reshape(-1, 2)
+            d = np.hypot(
+                self.centres[:, None, 0] - seeds[None, :, 0],
+                self.centres[:, None, 1] - seeds[None, :, 1],
+            )
+            group = np.argmin(d, axis=1).astype(np.int64)
+            n_groups = seeds.shape[0]
+            candidates = []
+            for g in range(n_groups):
+                order = np.argsort(d[:, g])
+                cand = [int(j) for j in order[:20] if usable[j]][:5]
+                candidates.append(cand)
+        else:
+            import numba
+
+            from jointwear.dic._guess import pick_seeds
+
+            n_groups = int(min(2 * numba.get_num_threads(), max(1, n // 64)))
+            group, candidates = pick_seeds(self.centres, usable, tex, n_groups)
+        for g in range(n_groups):
+            for i in candidates[g]:
+                if self._seed(dspl, dinv, raw_def, st, done, i):
+                    break
+        self._propagate(dspl, dinv, st, done, group, n_groups)
+        # points of bands whose seeds failed, and failed points: global pass
+        self._retry_failed(dspl, dinv, st, done, group)
+        # disconnected leftovers: new seeds among them (a few attempts)
+        for _ in range(5):
+            left = np.flatnonzero(~done & usable)
+            if left.size == 0:
+                break
+            best = left[np.argmax(tex[left])]
+            ok = self._seed(dspl, dinv, raw_def, st, done, int(best))
+            done[best] = True
+            if ok:
+                self._propagate(dspl, dinv, st, done, group, 0)
+        self._fill_unreached(dspl, dinv, st, done)
+        return st
+
+    def _fill_unreached(self, dspl, dinv, st, done) -> None:
+        """Points never reached: one attempt from the nearest good point's extrapolated
+        parameters (or zero), so that each gets a real outcome and flag."""
+        rest = ~done
+        if not rest.any():
+            return
+        P0 = np.zeros((self.n_points, 12))
+        good = np.flatnonzero(st.ok)
+        if good.size:
+            from scipy.spatial import cKDTree
+
+            idx = np.flatnonzero(rest & np.isfinite(self.centres).all(axis=1))
+            if idx.size:
+                _, near = cKDTree(self.centres[good]).query(self.centres[idx])
+                src = good[near]
+                for j, i in zip(idx, src, strict=True):
+                    d = self.centres[j] - self.centres[i]
+                    _icgn._extrapolate(st.params[i], d[0], d[1], P0[j])
+        sub = MatchResult(P0, st.zncc.copy(), st.iterations.copy(), st.flag.copy())
+        self._run_many(dspl, dinv, P0, rest, sub)
+        st.params[rest] = P0[rest]
+        st.zncc[rest] = sub.zncc[rest]
+        st.iterations[rest] = sub.iterations[rest]
+        st.flag[rest] = sub.flag[rest]
+        done[rest] = True
+
+    def _guess_array(self, guess) -> np.ndarray:
+        g = np.asarray(guess, dtype=float)
+        n = self.n_points
+        if g.ndim == 1 and g.size in (2, 6, 12):
+            g = np.broadcast_to(g, (n, g.size))
+        if g.ndim != 2 or g.shape[0] != n or g.shape[1] not in (2, 6, 12):
+            raise BadInputError(
+                f"initial_guess: expected shape ({n}, 2) displacements (u, v) [pixel], ({n}, 6) "
+                f"affine (u, du/dx, du/dy, v, dv/dx, dv/dy) or ({n}, 12) shape parameters; got "
+                f"{g.shape}"
+            )
+        out = np.zeros((n, 12))
+        if g.shape[1] == 2:
+            out[:, 0], out[:, 6] = g[:, 0], g[:, 1]
+        elif g.shape[1] == 6:
+            out[:, _icgn.AFFINE_INDEX] = g
+        else:
+            out[:] = g
+        return out
+
+    def correlate(
+        self,
+        deformed,
+        *,
+        initial_guess: np.ndarray | None = None,
+        seed_points: np.ndarray | None = None,
+    ) -> xr.Dataset:
+        """Correlate a deformed image with the prepared reference.
+
+        Parameters
+        ----------
+        deformed : ndarray (H, W)
+            Deformed image, same size and dtype as the reference.
+        initial_guess : ndarray, optional
+            Per-point guesses: (N, 2) ``(u, v)`` [pixel], (N, 6) affine or (N, 12) parameters;
+            a single row is broadcast. Rows with NaN are not refined (flagged).
+        seed_points : ndarray (K, 2), optional
+            Positions ``(x, y)`` [pixel] to start the propagation from (default: automatic,
+            well-textured points in bands of rows).
+
+        Returns
+        -------
+        Dataset
+            See :func:`jointwear.dic.correlate`.
+        """
+        res = self.match(deformed, initial_guess=initial_guess, seed_points=seed_points)
+        return self.to_dataset(res)
+
+    # ------------------------------------------------------------------ output
+    def to_dataset(self, res: MatchResult, *, time: float | None = None) -> xr.Dataset:
+        """Package a :class:`MatchResult` as an xarray Dataset (grid ``(y, x)`` or ``point``)."""
+        return result_dataset(
+            self.centres, res.params, res.zncc, res.iterations, res.flag, self.params, self.grid
+        )
+
+
+_GRAD_NAMES = [
+    ("u", 0, "pixel", "displacement along x (image columns, right)"),
+    ("du_dx", 1, "1", "displacement gradient du/dx"),
+    ("du_dy", 2, "1", "displacement gradient du/dy"),
+    ("v", 6, "pixel", "displacement along y (image rows, down)"),
+    ("dv_dx", 7, "1", "displacement gradient dv/dx"),
+    ("dv_dy", 8, "1", "displacement gradient dv/dy"),
+]
+_SECOND = [
+    ("d2u_dx2", 3, "pixel-1", "second derivative d2u/dx2"),
+    ("d2u_dxdy", 4, "pixel-1", "second derivative d2u/dxdy"),
+    ("d2u_dy2", 5, "pixel-1", "second derivative d2u/dy2"),
+    ("d2v_dx2", 9, "pixel-1", "second derivative d2v/dx2"),
+    ("d2v_dxdy", 10, "pixel-1", "second derivative d2v/dxdy"),
+    ("d2v_dy2", 11, "pixel-1", "second derivative d2v/dy2"),
+]
+
+
+def result_dataset(centres, P, zncc, iterations, flag, params: CorrelationParams, grid=None):
+    """Per-point arrays -> Dataset following the data contract (leading dims allowed)."""
+    P = np.asarray(P, float)
+    ok = np.asarray(flag) == _icgn.FLAG_OK
+    lead = P.shape[:-2]
+    lead_dims = ("time",) if len(lead) == 1 else ()
+    if grid is not None:
+        xs, ys = grid
+        dims = (*lead_dims, "y", "x")
+        shape = (*lead, ys.size, xs.size)
+        coords = {
+            "x": ("x", xs, {"units": "pixel", "long_name": "subset centre column (reference)"}),
+            "y": ("y", ys, {"units": "pixel", "long_name": "subset centre row (reference)"}),
+        }
+    else:
+        dims = (*lead_dims, "point")
+        shape = (*lead, centres.shape[0])
+        coords = {
+            "point": ("point", np.arange(centres.shape[0]), {"long_name": "point of interest"}),
+            "x": ("point", centres[:, 0], {"units": "pixel", "long_name": "subset centre column"}),
+            "y": ("point", centres[:, 1], {"units": "pixel", "long_name": "subset centre row"}),
+        }
+    data = {}
+    names = _GRAD_NAMES + (_SECOND if params.quadratic else [])
+    for name, k, units, long in names:
+        vals = np.where(ok, P[..., k], np.nan).reshape(shape)
+        data[name] = xr.DataArray(vals, dims=dims, attrs={"units": units, "long_name": long})
+    data["zncc"] = xr.DataArray(
+        np.asarray(zncc, float).reshape(shape),
+        dims=dims,
+        attrs={"units": "1", "long_name": "zero-normalised cross-correlation coefficient (final)"},
+    )
+    data["iterations"] = xr.DataArray(
+        np.asarray(iterations, np.int32).reshape(shape),
+        dims=dims,
+        attrs={"units": "1", "long_name": "IC-GN iterations"},
+    )
+    data["converged"] = xr.DataArray(
+        ok.astype(np.int8).reshape(shape),
+        dims=dims,
+        attrs={
+            "units": "1",
+            "long_name": "IC-GN converged to an accepted match",
+            "flag_values": np.array([0, 1], np.int8),
+            "flag_meanings": "no yes",
+        },
+    )
+    data["flag"] = xr.DataArray(
+        np.asarray(flag, np.int8).reshape(shape),
+        dims=dims,
+        attrs={
+            "units": "1",
+            "long_name": "correlation quality flag",
+            "flag_values": _icgn.FLAG_VALUES,
+            "flag_meanings": _icgn.FLAG_MEANINGS,
+        },
+    )
+    ds = xr.Dataset(data, coords=coords)
+    ds["u"].attrs["ancillary_variables"] = "zncc flag"
+    ds["v"].attrs["ancillary_variables"] = "zncc flag"
+    ds.attrs.update(
+        {
+            "title": "2D subset DIC displacement field",
+            "dic_criterion": "ZNSSD (IC-GN)",
+            "dic_subset_size_pixel": int(params.subset_size),
+            "dic_step_pixel": int(params.step),
+            "dic_shape_function": params.shape,
+            "dic_interpolation": f"{params.interpolation} B-spline (prefiltered)",
+            "dic_tolerance_pixel": float(params.tolerance),
+            "dic_zncc_min": float(params.zncc_min),
+            "displacement_convention": (
+                "Lagrangian: the subset centred at (x, y) of the reference moved by (u, v); x to "
+                "the right, y down, pixel centres at integers"
+            ),
+        }
+    )
+    return ds
