@@ -4,7 +4,8 @@ Wear maps
     Both maps are converted to the canonical angle convention (a map that does not state its
     convention is refused), restricted to the axial range both cover, and brought onto one
     grid: ``theta`` uniform over [0, 360) with the coarser of the two angular steps, ``z`` the
-    layers of the map with fewer layers inside the overlap. A map sampled much more finely than
+    layers of the map with more layers inside the overlap (no layer of either map is skipped
+    over; the other map is interpolated linearly between its layers). A map sampled much more finely than
     the common grid (an instrument's 18000 points per layer) is first averaged over each grid
     cell (periodic box mean of one grid step), so the comparison is not aliased; otherwise
     values are interpolated linearly (periodically in theta, linearly in z, never
@@ -296,7 +297,7 @@ def align_wear_maps(
         )
     in_s = zs[(zs >= lo - tol) & (zs <= hi + tol)]
     in_m = zm[(zm >= lo - tol) & (zm <= hi + tol)]
-    z_src = "measurement" if in_m.size <= in_s.size else "simulation"
+    z_src = "measurement" if in_m.size >= in_s.size else "simulation"
     z_tgt = in_m if z_src == "measurement" else in_s
     if z_tgt.size == 0:
         raise BadInputError("no layer of either map lies in the overlapping axial range")

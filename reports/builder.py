@@ -216,6 +216,7 @@ def _context(
     inputs: Sequence[ReportInput],
     verification: Sequence[xr.Dataset],
     missing: Sequence[str],
+    notes: Sequence[str],
     title: str,
     command: str | None,
     parameters: dict[str, Any] | None,
@@ -240,6 +241,7 @@ def _context(
         "failed": c.failed(),
         "decisions": [r._asdict() for r in c.decisions.itertuples(index=False)],
         "missing": missing,
+        "notes": list(notes),
         "metrics": _metrics_rows(c),
         "alignment": _alignment(c),
         "k": f"{c.criteria.k:g}",
@@ -321,6 +323,7 @@ def render_html(
     inputs: Sequence[ReportInput] = (),
     verification: Sequence[xr.Dataset] = (),
     missing: Sequence[str] = (),
+    notes: Sequence[str] = (),
     title: str = DEFAULT_TITLE,
     command: str | None = None,
     parameters: dict[str, Any] | None = None,
@@ -341,6 +344,7 @@ def render_html(
             inputs=inputs,
             verification=verification,
             missing=missing,
+            notes=notes,
             title=title,
             command=command,
             parameters=parameters,
@@ -358,6 +362,7 @@ def build_report(
     inputs: Sequence[ReportInput] = (),
     verification: Sequence[xr.Dataset] = (),
     missing: Sequence[str] = (),
+    notes: Sequence[str] = (),
     title: str = DEFAULT_TITLE,
     command: str | None = None,
     parameters: dict[str, Any] | None = None,
@@ -377,6 +382,8 @@ def build_report(
         Verification data (e.g. convergence studies) to plot.
     missing : sequence of str
         Parts of the chain that were not available, stated plainly in the decision card.
+    notes : sequence of str
+        Further statements for the reader (e.g. how the data were made), shown with the card.
     title : str
         Report title.
     command : str, optional
@@ -396,6 +403,7 @@ def build_report(
         inputs=inputs,
         verification=verification,
         missing=missing,
+        notes=notes,
         title=title,
         command=command,
         parameters=parameters,
@@ -432,6 +440,7 @@ def write_pdf(
     inputs: Sequence[ReportInput] = (),
     verification: Sequence[xr.Dataset] = (),
     missing: Sequence[str] = (),
+    notes: Sequence[str] = (),
     title: str = DEFAULT_TITLE,
 ) -> Path:
     """Write the report as a PDF with matplotlib only (no browser needed). Deterministic."""
@@ -451,6 +460,8 @@ def write_pdf(
         lines.append(f"      {r.value}   [{r.criterion}; {r.basis}]")
     for m in [*missing, *c.notes]:
         lines += ["", f"Not covered: {m}"]
+    for m in notes:
+        lines += ["", f"Note: {m}"]
     metric_lines = []
     for r in c.metrics.itertuples():
         value, units = format_value(float(r.value), str(r.units))

@@ -76,12 +76,16 @@ def test_overlap_cycles_units_and_interpolation_statement():
     sim = syn.sim_wear()  # z in +-7.5 mm, snapshots 0, 2e5, 4e5
     meas = syn.meas_wear(cycles=3e5, units="um")  # z in +-6 mm, stated in micrometres
     al = align_wear_maps(sim, meas)
-    assert al.sizes["z"] == 13
+    assert al.sizes["z"] == 16  # the 20 simulated layers 0.79 mm apart inside +-6 mm
+    assert float(np.abs(al["z"]).max()) <= 6e-3
     np.testing.assert_allclose(al.attrs["z_overlap_m"], [-6e-3, 6e-3])
     assert al.attrs["cycles_sim"] == 3e5 and al.attrs["cycles_meas"] == 3e5
     assert "linear interpolation between the two nearest snapshots" in al.attrs["cycles_selection"]
     assert "box mean" in al.attrs["interpolation"]
-    assert "linear interpolation in z" in al.attrs["interpolation"]
+    assert "measurement: periodic box mean" in al.attrs["interpolation"]
+    assert al.attrs["interpolation"].endswith(
+        "linear interpolation in z between layers; no extrapolation"
+    )
     assert float(np.abs(al["wear_depth_diff"]).max()) < 0.02 * 30e-6
     far = syn.meas_wear()
     far = far.assign_coords(z=far["z"] + 20e-3)

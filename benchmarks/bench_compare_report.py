@@ -1,0 +1,63 @@
+"""Benchmark of jointwear.compare and jointwear.reports at the reference study's sizes.
+
+Figures: time to align a simulated wear map (20 layers x 200 points, 3 snapshots) with an
+instrument map (13 layers x 18000 points, other angle convention); time of the full comparison
+(wear + motion: variable-step simulation vs 50 frames/s over 2 s); time to render the HTML
+report (figures included) and its size. Medians of repeated runs; the machine is shared, so
+the load average is recorded with the figures.
+"""
+
+from __future__ import annotations
+
+import sys
+import tempfile
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "compare"))
+
+import _jw_synth as syn  # noqa: E402
+from _common import median_time, write_results  # noqa: E402
+
+from jointwear.compare import align_wear_maps, compare  # noqa: E402
+from jointwear.reports import build_report, render_html  # noqa: E402
+
+
+def main() -> None:
+    sim_w = syn.sim_wear(n_layers=20, n_points=200)
+    meas_w = syn.meas_wear(n_points=18000, u=1e-6)
+    sim_m = syn.sim_motion(duration=1.2)
+    meas_m = syn.meas_motion(duration=2.0, u=0.002)
+    t_align, _ = median_time(lambda: align_wear_maps(sim_w, meas_w), repeat=5)
+    t_compare, _ = median_time(lambda: compare([sim_w, sim_m], [meas_w, meas_m]), repeat=5)
+    result = compare([sim_w, sim_m], [meas_w, meas_m])
+    t_render, _ = median_time(lambda: render_html(result, command="bench"), repeat=3)
+    with tempfile.TemporaryDirectory() as tmp:
+        path = build_report(result, Path(tmp) / "r.html", command="bench")
+        size = path.stat().st_size
+        t_pdf, _ = median_time(
+            lambda: build_report(
+                result, Path(tmp) / "r2.html", command="bench", pdf=Path(tmp) / "r.pdf"
+            ),
+            repeat=3,
+        )
+    write_results(
+        "compare_report",
+        {
+            "align_wear_maps_20x200_vs_13x18000_s": round(t_align, 4),
+            "compare_wear_and_motion_s": round(t_compare, 4),
+            "render_html_report_s": round(t_render, 3),
+            "html_and_pdf_report_s": round(t_pdf, 3),
+            "html_report_bytes": size,
+            "sizes": {
+                "sim_wear": "3 snapshots x 20 layers x 200 points",
+                "measured_wear": "13 layers x 18000 points",
+                "sim_motion_samples": int(sim_m.sizes["time"]),
+                "measured_motion_frames": int(meas_m.sizes["time"]),
+            },
+        },
+    )
+
+
+if __name__ == "__main__":
+    main()
