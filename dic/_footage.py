@@ -114,6 +114,9 @@ class TrackConfig:
     world_origin : [x, y, z]
         Mechanism-frame position of the world origin (the calibration board's first inner
         corner), used to place ``centroid_mechanism`` [m].
+    workers : int
+        Processes working on chunks in parallel (1: sequential, tracking carried across
+        chunks; >1: each chunk starts from SIFT features of the reference images).
     """
 
     subset_size: int = 21
@@ -127,12 +130,15 @@ class TrackConfig:
     sigma_px: float = 0.0
     duplicate_threshold: float = 0.05
     world_origin: list[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
+    workers: int = 1
 
     def __post_init__(self) -> None:
         if self.subset_size < 7 or self.subset_size % 2 == 0:
             raise ParameterError(
                 f"track.subset_size={self.subset_size}: expected an odd integer >= 7"
             )
+        if self.workers < 1:
+            raise ParameterError(f"track.workers={self.workers}: expected >= 1")
         if self.step < 1 or self.chunk_size < 1 or self.min_points < 3:
             raise ParameterError("track.step and chunk_size must be >= 1, min_points >= 3")
         if self.velocity_window % 2 == 0 or self.velocity_window <= self.velocity_order:
@@ -494,13 +500,134 @@ def track_footage(
                     "calibration made for these cameras at this resolution"
                 )
     n_total = L.n_frames if max_frames is None else min(L.n_frames, max_frames)
+    t_start = _time.perf_counter()
+    (_, t0, ref_l), ref_r = _reference_frames(L, R)
+    states = _setup_states(L, R, bodies, calibration, cfg, ref_l, ref_r)
+    times: list[float] = []
+    flags: list[int] = []
+    duplicates: list[int] = []
+    from jointwear.progress import progress_bar
+
+    def save(status: str) -> xr.Dataset:
+        ds = _assemble(states, times, flags, duplicates, L, R, cfg, calibration, status)
+        if out is not None and times:
+            _write(ds, out, inputs, cfg, bodies)
+        return ds
+
+    try:
+        with progress_bar("tracking frames", n_total, enabled=progress) as bar:
+            task = bar.tasks[0].id
+            if cfg.workers <= 1:
+                frames = _paired_frames(L, R, 0, n_total)
+                prev = None
+                for k, (i, t, img_l, img_r) in enumerate(frames):
+                    dup = prev is not None and _is_duplicate(img_l, prev, cfg)
+                    prev = img_l
+                    flags.append(
+                        _process_frame(states, t, img_l, img_r, dup, cfg, calibration, False)
+                    )
+                    times.append(t)
+                    if dup:
+                        duplicates.append(i)
+                    bar.update(task, advance=1)
+                    if (k + 1) % cfg.chunk_size == 0:
+                        save("partial")
+            else:
+                import multiprocessing
+                from concurrent.futures import ProcessPoolExecutor
+
+                ranges = [
+                    (a, min(a + cfg.chunk_size, n_total)) for a in range(0, n_total, cfg.chunk_size)
+                ]
+                # spawn: forking a process that already runs OpenMP/numba threads is unsafe
+                ctx = multiprocessing.get_context("spawn")
+                with ProcessPoolExecutor(max_workers=cfg.workers, mp_context=ctx) as pool:
+                    futures = [
+                        pool.submit(_run_chunk, L, R, bodies, calibration, cfg, a, b)
+                        for a, b in ranges
+                    ]
+                    for fut in futures:
+                        part = fut.result()
+                        for st in states:
+                            for key, vals in part["rows"][st.spec.name].items():
+                                st.rows.setdefault(key, []).extend(vals)
+                        times.extend(part["times"])
+                        flags.extend(part["flags"])
+                        duplicates.extend(part["duplicates"])
+                        bar.update(task, advance=len(part["times"]))
+                        if part["error"]:
+                            raise BadInputError(part["error"])
+                        save("partial")
+    except (BadInputError, KeyboardInterrupt) as exc:
+        status = f"stopped after {len(times)} frames: {exc}"
+        if out is not None and times:
+            save(status)
+            raise BadInputError(
+                f"{exc} - the {len(times)} frames processed before are saved in '{out}'"
+            ) from None
+        raise
+    result = _assemble(states, times, flags, duplicates, L, R, cfg, calibration, "complete")
+    result.attrs["wall_time_s"] = _time.perf_counter() - t_start
+    result.attrs["workers"] = cfg.workers
+    if out is not None:
+        _write(result, out, inputs, cfg, bodies)
+    return result
+
+
+def _reference_frames(L: FrameSource, R: FrameSource | None):
+    first_l = next(L.frames(0, 1))
+    ref_r = next(R.frames(0, 1))[2] if R is not None else None
+    return first_l, ref_r
+
+
+def _paired_frames(L: FrameSource, R: FrameSource | None, start: int, stop: int):
+    gen_l = L.frames(start, stop)
+    if R is None:
+        for i, t, img in gen_l:
+            yield i, t, img, None
+        return
+    for (i, t, img), (_, _, img_r) in zip(gen_l, R.frames(start, stop), strict=False):
+        yield i, t, img, img_r
+
+
+def _is_duplicate(img: np.ndarray, prev: np.ndarray, cfg: TrackConfig) -> bool:
+    return float(np.mean(np.abs(img - prev))) < cfg.duplicate_threshold
+
+
+def _run_chunk(L, R, bodies, calibration, cfg, start: int, stop: int) -> dict:
+    """Worker: track frames ``start <= i < stop`` independently (SIFT start, own references)."""
+    (_, _, ref_l), ref_r = _reference_frames(L, R)
+    states = _setup_states(L, R, bodies, calibration, cfg, ref_l, ref_r)
+    times, flags, duplicates = [], [], []
+    error = ""
+    prev = None
+    try:
+        for i, t, img_l, img_r in _paired_frames(L, R, max(start - 1, 0), stop):
+            if i < start:  # the frame before the chunk: only for the duplicate check
+                prev = img_l
+                continue
+            dup = prev is not None and _is_duplicate(img_l, prev, cfg)
+            prev = img_l
+            reinit = i == start and start > 0
+            flags.append(_process_frame(states, t, img_l, img_r, dup, cfg, calibration, reinit))
+            times.append(t)
+            if dup:
+                duplicates.append(i)
+    except BadInputError as exc:
+        error = str(exc)
+    return {
+        "times": times,
+        "flags": flags,
+        "duplicates": duplicates,
+        "rows": {st.spec.name: st.rows for st in states},
+        "error": error,
+    }
+
+
+def _setup_states(L, R, bodies, calibration, cfg, ref_l, ref_r) -> list[_BodyState]:
+    """Subsets of every body, stereo correspondence and reference 3D points."""
     half = cfg.subset_size // 2
     w, h = L.size
-    # ---- reference frames -----------------------------------------------------------------
-    gen_l = L.frames(0, n_total)
-    gen_r = R.frames(0, n_total) if R is not None else None
-    _, t0, ref_l = next(gen_l)
-    ref_r = next(gen_r)[2] if gen_r is not None else None
     noise = _noise_sigma(ref_l)
     states: list[_BodyState] = []
     for spec in bodies:
@@ -536,7 +663,6 @@ def track_footage(
                 )
             guess = _homography_guess(H, pts)
             pos_r, zn, good = lt.track(ref_r, point_guess=guess)
-            lt.history.clear()
             epi = epipolar_distance(calibration, pts, np.where(np.isfinite(pos_r), pos_r, 0.0))
             good &= epi < cfg.max_epipolar_px
             if good.sum() < cfg.min_points:
@@ -548,112 +674,81 @@ def track_footage(
             pts, pos_r, sig = pts[good], pos_r[good], sig[good]
             lt = _CameraBodyTracker(ref_l, pts, cfg, f"left/{spec.name}")
             rt = _CameraBodyTracker(ref_r, pos_r, cfg, f"right/{spec.name}")
-            lt.polygon = poly
             X, _, _ = triangulate(calibration, pts, pos_r, sigma_px=sig)
             ref = X
         else:
             rt = None
             ref = pts.copy()
-        st = _BodyState(spec, lt, rt, ref, sig, _body_point(spec, ref, cfg))
-        states.append(st)
+        lt.polygon = poly
+        states.append(_BodyState(spec, lt, rt, ref, sig, _body_point(spec, ref, cfg)))
+    return states
 
-    # ---- frames ---------------------------------------------------------------------------
-    times: list[float] = []
-    flags: list[int] = []
-    duplicates: list[int] = []
-    prev_l: np.ndarray | None = None
-    status = "complete"
-    t_start = _time.perf_counter()
-    from jointwear.progress import progress_bar
 
-    def frames_iter():
-        yield 0, t0, ref_l, ref_r
-        if gen_r is None:
-            for i, t, img in gen_l:
-                yield i, t, img, None
+def _process_frame(states, t, img_l, img_r, dup, cfg, calibration, reinit) -> int:
+    """Track every body in one frame (appending to each state's rows); the frame's flag."""
+    flag = FRAME_FLAGS["duplicated"] if dup else 0
+    for st in states:
+        d = st.ref3d.shape[1]
+        n = len(st.ref3d)
+        if dup:
+            # a repeated image carries no new information (and a wrong time)
+            _append_row(
+                st,
+                np.full((d, d), np.nan),
+                np.full(d, np.nan),
+                np.full(d, np.nan),
+                np.full(d, np.nan),
+                0,
+                np.nan,
+                np.full((n, d), np.nan, np.float32),
+                np.full((n, d), np.nan, np.float32),
+                np.full(n, np.nan, np.float32),
+            )
+            continue
+        res = None
+        if not reinit:
+            res = _track_body(st, img_l, img_r, t, cfg, calibration)
+        if res is None or not res[0]:
+            # chunk start or lost: initialise from SIFT features of the reference images
+            gl_guess = st.left.reinit_guess(img_l)
+            gr_guess = st.right.reinit_guess(img_r) if st.right is not None else None
+            if gl_guess is not None and (st.right is None or gr_guess is not None):
+                res = _track_body(st, img_l, img_r, t, cfg, calibration, gl_guess, gr_guess)
+        ok_pose, Rm, tv, inl, rms, cur, cov, pl, pr, zn = res
+        if ok_pose:
+            st.left.commit(np.where(inl[:, None], pl, np.nan), t)
+            if st.right is not None:
+                st.right.commit(np.where(inl[:, None], pr, np.nan), t)
         else:
-            for (i, t, img), (_, _, img_r) in zip(gen_l, gen_r, strict=False):
-                yield i, t, img, img_r
-
-    result: xr.Dataset | None = None
-    try:
-        with progress_bar("tracking frames", n_total, enabled=progress) as bar:
-            task = bar.tasks[0].id
-            for i, t, img_l, img_r in frames_iter():
-                flag = 0
-                if (
-                    prev_l is not None
-                    and float(np.mean(np.abs(img_l - prev_l))) < cfg.duplicate_threshold
-                ):
-                    flag |= FRAME_FLAGS["duplicated"]
-                    duplicates.append(i)
-                prev_l = img_l
-                for st in states:
-                    if flag & FRAME_FLAGS["duplicated"]:
-                        # a repeated image carries no new information (and a wrong time)
-                        d = st.ref3d.shape[1]
-                        nan_pose = (np.full((d, d), np.nan), np.full(d, np.nan))
-                        _append_row(
-                            st,
-                            *nan_pose,
-                            np.full(d, np.nan),
-                            np.full(d, np.nan),
-                            0,
-                            np.nan,
-                            np.full(st.ref3d.shape, np.nan, dtype=np.float32),
-                        )
-                        continue
-                    ok_pose, Rm, tv, inl, rms, cur, cov, pl, pr = _track_body(
-                        st, img_l, img_r, t, cfg, calibration
-                    )
-                    if not ok_pose:
-                        # lost: re-initialise from SIFT features of the reference images
-                        gl_guess = st.left.reinit_guess(img_l)
-                        gr_guess = st.right.reinit_guess(img_r) if st.right is not None else None
-                        if gl_guess is not None and (st.right is None or gr_guess is not None):
-                            ok_pose, Rm, tv, inl, rms, cur, cov, pl, pr = _track_body(
-                                st, img_l, img_r, t, cfg, calibration, gl_guess, gr_guess
-                            )
-                    if ok_pose:
-                        st.left.commit(np.where(inl[:, None], pl, np.nan), t)
-                        if st.right is not None:
-                            st.right.commit(np.where(inl[:, None], pr, np.nan), t)
-                    else:
-                        flag |= FRAME_FLAGS["tracking_failed"]
-                    poi = Rm @ st.point_of_interest + tv
-                    n_in = int(np.sum(inl))
-                    if st.right is not None and ok_pose:
-                        # propagated: point scatter of the fit / sqrt(n) and triangulation cov
-                        cov_mean = np.nanmean(cov[inl], axis=0) / max(n_in, 1)
-                        u = np.sqrt(np.maximum(np.diag(cov_mean), (rms**2 / 3) / max(n_in - 1, 1)))
-                    else:
-                        u = np.full(st.ref3d.shape[1], rms / np.sqrt(max(n_in - 1, 1)))
-                    _append_row(st, Rm, tv, poi, u, n_in, rms, cur.astype(np.float32))
-                times.append(t)
-                flags.append(flag)
-                bar.update(task, advance=1)
-                if out is not None and (len(times) % cfg.chunk_size == 0):
-                    result = _assemble(
-                        states, times, flags, duplicates, L, R, cfg, calibration, "partial"
-                    )
-                    _write(result, out, inputs, cfg, bodies)
-    except (BadInputError, KeyboardInterrupt) as exc:
-        status = f"stopped after {len(times)} frames: {exc}"
-        if out is not None and times:
-            result = _assemble(states, times, flags, duplicates, L, R, cfg, calibration, status)
-            _write(result, out, inputs, cfg, bodies)
-            raise BadInputError(
-                f"{exc} - the {len(times)} frames processed before are saved in '{out}'"
-            ) from None
-        raise
-    result = _assemble(states, times, flags, duplicates, L, R, cfg, calibration, status)
-    result.attrs["wall_time_s"] = _time.perf_counter() - t_start
-    if out is not None:
-        _write(result, out, inputs, cfg, bodies)
-    return result
+            flag |= FRAME_FLAGS["tracking_failed"]
+        poi = Rm @ st.point_of_interest + tv
+        n_in = int(np.sum(inl))
+        if cov is not None:
+            pu = np.sqrt(np.einsum("nii->ni", cov))
+        else:
+            pu = np.full((n, d), st.sigma_px[:, None] if d == 2 else np.nan)
+        if st.right is not None and ok_pose:
+            # propagated: mean triangulation covariance / n, or the fit scatter if larger
+            cov_mean = np.nanmean(cov[inl], axis=0) / max(n_in, 1)
+            u = np.sqrt(np.maximum(np.diag(cov_mean), (rms**2 / 3) / max(n_in - 1, 1)))
+        else:
+            u = np.full(d, rms / np.sqrt(max(n_in - 1, 1)))
+        _append_row(
+            st,
+            Rm,
+            tv,
+            poi,
+            u,
+            n_in,
+            rms,
+            cur.astype(np.float32),
+            pu.astype(np.float32),
+            zn.astype(np.float32),
+        )
+    return flag
 
 
-def _append_row(st, Rm, tv, poi, u, n_in, rms, cur) -> None:
+def _append_row(st, Rm, tv, poi, u, n_in, rms, cur, cur_u, zncc) -> None:
     row = st.rows
     for key, val in (
         ("R", Rm),
@@ -663,6 +758,8 @@ def _append_row(st, Rm, tv, poi, u, n_in, rms, cur) -> None:
         ("n", n_in),
         ("rms", rms),
         ("points", cur),
+        ("points_u", cur_u),
+        ("zncc", zncc),
     ):
         row.setdefault(key, []).append(val)
 
@@ -671,9 +768,11 @@ def _track_body(st, img_l, img_r, t, cfg, calibration, guess_l=None, guess_r=Non
     """Correlate one body in both cameras, triangulate and fit its pose."""
     pl, zl, gl = st.left.track(img_l, point_guess=guess_l, t=t)
     pr, cov = None, None
+    zn = zl
     if st.right is not None:
         pr, zr, gr = st.right.track(img_r, point_guess=guess_r, t=t)
         good = gl & gr
+        zn = np.fmin(zl, zr)
         pl2 = np.where(good[:, None], pl, np.nan)
         pr2 = np.where(good[:, None], pr, np.nan)
         cur, cov, _ = triangulate(calibration, pl2, pr2, sigma_px=st.sigma_px)
@@ -684,18 +783,9 @@ def _track_body(st, img_l, img_r, t, cfg, calibration, guess_l=None, guess_r=Non
     try:
         Rm, tv, inl, rms = fit_rigid_robust(st.ref3d, cur, min_points=cfg.min_points)
     except BadInputError:
-        return (
-            False,
-            np.full((d, d), np.nan),
-            np.full(d, np.nan),
-            good & False,
-            np.nan,
-            cur,
-            cov,
-            pl,
-            pr,
-        )
-    return True, Rm, tv, inl, rms, cur, cov, pl, pr
+        nan = np.full(d, np.nan)
+        return False, np.full((d, d), np.nan), nan, good & False, np.nan, cur, cov, pl, pr, zn
+    return True, Rm, tv, inl, rms, cur, cov, pl, pr, zn
 
 
 def _write(ds: xr.Dataset, out, inputs, cfg, bodies) -> None:
@@ -778,7 +868,29 @@ def _assemble(states, times, flags, duplicates, L, R, cfg, calibration, status) 
         data[f"{name}_points"] = (
             ("time", f"{name}_point", f"{name}_point_axis"),
             pts,
-            {"units": unit, "long_name": f"tracked subset centres of the {name} (world frame)"},
+            {
+                "units": unit,
+                "long_name": f"tracked subset centres of the {name} (world frame)",
+                "ancillary_variables": f"{name}_points_u",
+            },
+        )
+        data[f"{name}_points_u"] = (
+            ("time", f"{name}_point", f"{name}_point_axis"),
+            np.asarray(rows["points_u"], dtype=np.float32),
+            {"units": unit, "long_name": f"standard uncertainty of {name}_points (propagated)"},
+        )
+        data[f"{name}_zncc"] = (
+            ("time", f"{name}_point"),
+            np.asarray(rows["zncc"], dtype=np.float32),
+            {"units": "1", "long_name": f"ZNCC of the {name}'s subsets (lower of the two cameras)"},
+        )
+        data[f"{name}_displacement"] = (
+            ("time", f"{name}_point", f"{name}_point_axis"),
+            pts - pts[:1],
+            {
+                "units": unit,
+                "long_name": f"displacement of the {name}'s subsets since the reference frame",
+            },
         )
         coords[f"{name}_row"] = (f"{name}_row", np.arange(d))
         coords[f"{name}_col"] = (f"{name}_col", np.arange(d))

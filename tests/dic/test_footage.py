@@ -293,3 +293,26 @@ def test_bodies_file_errors(tmp_path):
     with pytest.raises(ParameterError, match="role"):
         read_bodies(p)
     assert TrackConfig().velocity_window == 9
+
+
+def test_parallel_chunks_match_sequential(small):
+    # two worker processes, each chunk starting from SIFT features: same poses as sequential
+    cfg, written, out = small
+    tc, bodies = read_bodies(written["bodies"])
+    cal = VirtualRig(cfg).calibration
+    runs = {}
+    for workers in (1, 2):
+        c = dataclasses.replace(tc, workers=workers, chunk_size=3)
+        runs[workers] = track_footage(
+            written["left_images"],
+            written["right_images"],
+            fps=50,
+            bodies=bodies,
+            calibration=cal,
+            config=c,
+            max_frames=6,
+        )
+    a, b = runs[1]["follower_position"].values, runs[2]["follower_position"].values
+    assert a.shape == b.shape == (6, 3)
+    assert np.allclose(a, b, atol=1e-8, equal_nan=True)
+    assert runs[2].attrs["duplicated_frames"] == "[4]" and runs[2].attrs["workers"] == 2
