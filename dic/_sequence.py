@@ -6,7 +6,7 @@
     Colour frames are converted to grey.
 
 ``correlate_sequence(frames, *, reference="absolute", points=None, roi=None, times=None,
-frame_rate=None, update_zncc=0.9, progress=False, params=None, **options) -> xr.Dataset``
+frame_rate=None, update_zncc=0.9, update_every=None, progress=False, params=None, **options)``
     Tracks the subsets of frame 0 through the sequence. ``absolute``: every frame is correlated
     with frame 0, the guess being the previous frame's result. ``incremental``: the reference
     moves forward (to the last good frame) whenever the median ZNCC drops below ``update_zncc``
@@ -164,6 +164,7 @@ def correlate_sequence(
     times: Sequence[float] | None = None,
     frame_rate: float | None = None,
     update_zncc: float = 0.9,
+    update_every: int | None = None,
     progress: bool | None = False,
     params=None,
     **options,
@@ -185,6 +186,9 @@ def correlate_sequence(
         ``time`` attributes).
     update_zncc : float
         Incremental mode: median ZNCC below which the reference is moved forward.
+    update_every : int, optional
+        Incremental mode: also move the reference forward after this many frames (1: every
+        frame is correlated with the previous one).
     progress : bool
         Show a progress bar on stderr.
     params : CorrelationParams, optional
@@ -201,6 +205,8 @@ def correlate_sequence(
     from jointwear.dic._subset import SubsetCorrelator, check_image, check_pair, result_dataset
     from jointwear.progress import progress_bar
 
+    if update_every is not None and (not isinstance(update_every, int) or update_every < 1):
+        raise ParameterError(f"update_every={update_every!r}: expected an integer >= 1 frame")
     if reference not in ("absolute", "incremental"):
         raise ParameterError(
             f"reference={reference!r}: expected 'absolute' (always frame 0) or 'incremental'"
@@ -258,25 +264,28 @@ def correlate_sequence(
                 res = res2
         return res
 
+    def move_reference(new_m):
+        """The reference becomes frame ``new_m``: subsets centred at the tracked positions."""
+        P_new = P[new_m].copy()
+        good = Fl[new_m] == _icgn.FLAG_OK
+        centres = base.centres + np.column_stack([P_new[:, 0], P_new[:, 6]])
+        centres[~good] = np.nan
+        c = SubsetCorrelator(frame_list[new_m], points=centres, params=prm, _graph=base.graph)
+        return c, P_new, np.zeros((n, 12)), new_m
+
     with progress_bar("correlating frames", total=n_t - 1, enabled=progress) as bar:
         task = bar.tasks[0].id
         for k in range(1, n_t):
             img = frame_list[k]
+            due = update_every is not None and k - m > update_every
+            if reference == "incremental" and k - 1 > m and due:
+                corr, P_ref, P_prev_inc, m = move_reference(k - 1)
             res = run(corr, img, P_prev_inc)
             if reference == "incremental" and k - 1 > m:
                 okk = res.ok & tracked
                 med = np.nanmedian(res.zncc[okk]) if okk.any() else -1.0
                 if med < update_zncc or okk.sum() < 0.9 * tracked.sum():
-                    # move the reference to the previous frame
-                    m = k - 1
-                    P_ref = P[m].copy()
-                    good = Fl[m] == _icgn.FLAG_OK
-                    centres = base.centres + np.column_stack([P_ref[:, 0], P_ref[:, 6]])
-                    centres[~good] = np.nan
-                    corr = SubsetCorrelator(
-                        frame_list[m], points=centres, params=prm, _graph=base.graph
-                    )
-                    P_prev_inc = np.zeros((n, 12))
+                    corr, P_ref, P_prev_inc, m = move_reference(k - 1)
                     res = run(corr, img, P_prev_inc)
             ok = res.ok
             P_prev_inc = np.where(ok[:, None], res.params, P_prev_inc)
