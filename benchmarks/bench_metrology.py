@@ -25,9 +25,20 @@ from jointwear.metrology import assess, cylindricity, read_scan, wear_map  # noq
 CONV = ("+y", "counterclockwise")
 
 
+def cpu_time(fn, repeat: int = 3) -> float:
+    """Median CPU time of ``fn()`` in this process [s] (less sensitive to a loaded machine)."""
+    fn()
+    times = []
+    for _ in range(repeat):
+        t0 = time.process_time()
+        fn()
+        times.append(time.process_time() - t0)
+    return sorted(times)[len(times) // 2]
+
+
 def main() -> None:
     sc = generate(n_layers=13, n_points=18000, seed=0, convention=CONV)
-    before = generate(n_layers=13, n_points=18000, seed=0, convention=CONV, wear=None)
+    before = generate(n_layers=13, n_points=18000, seed=0, noise_seed=1, convention=CONV, wear=None)
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
         write(sc, tmp / "folder", layout="folder")
@@ -63,6 +74,27 @@ def main() -> None:
             subprocess.run(cmd, check=True, capture_output=True)
             times.append(time.perf_counter() - t0)
         t_cli = sorted(times)[1]
+        times = []
+        for _ in range(3):
+            t0 = time.perf_counter()
+            subprocess.run(
+                [sys.executable, "-m", "jointwear", "--version"], check=True, capture_output=True
+            )
+            times.append(time.perf_counter() - t0)
+        t_start = sorted(times)[1]
+
+        def in_process_command():
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                return assess(io.load(nc), filter_upr=50)
+
+        t_cmd_inproc, _ = median_time(in_process_command, repeat=3)
+        cpu = {
+            "import_folder": cpu_time(lambda: read_scan(tmp / "folder", convention=CONV)),
+            "cylindricity_MZ": cpu_time(lambda: cylindricity(da, reference="MZ"), repeat=5),
+            "assess_all_references": cpu_time(full),
+            "load_and_assess_filter50": cpu_time(in_process_command),
+        }
         b = before.truth[["radius"]]
         w = sc.truth[["radius"]]
         t_wear, _ = median_time(lambda: wear_map(w, b), repeat=3)
@@ -79,6 +111,9 @@ def main() -> None:
             "assess_all_references_s": round(t_assess, 4),
             "assess_filter50_outliers_s": round(t_assess_f, 4),
             "assess_command_wall_s": round(t_cli, 3),
+            "cli_startup_wall_s (python -m jointwear --version)": round(t_start, 3),
+            "load_nc_and_assess_filter50_in_process_s": round(t_cmd_inproc, 4),
+            "cpu_time_s (process_time, medians)": {k: round(v, 4) for k, v in cpu.items()},
             "wear_map_with_before_s": round(t_wear, 4),
             "wear_map_without_before_s": round(t_wear_nob, 4),
             "wear_map_with_registration_s": round(t_reg, 4),

@@ -95,6 +95,13 @@ def plot_wear_map(
     for i in layers:
         row = np.append(w[i], w[i][0])
         pax.plot(tt, row, lw=1.2, label=f"z = {z[i] * 1e3:+.1f} mm")
+    from matplotlib.ticker import MaxNLocator
+
+    sel = w[layers]
+    pax.set_rlim(min(0.0, float(np.nanmin(sel))), float(np.nanmax(sel)) or 1.0)
+    pax.yaxis.set_major_locator(MaxNLocator(4))
+    pax.set_rlabel_position(112.5)
+    pax.tick_params(axis="y", labelsize=7)
     pax.set_title("wear depth per layer [µm]\n(bearing frame: +x right, +y up)", fontsize=9)
     pax.legend(loc="lower left", bbox_to_anchor=(-0.25, -0.2), fontsize=8)
     if title:

@@ -43,6 +43,8 @@ from jointwear.metrology.form import cylinder_zone
 
 __all__ = ["wear_map", "worn_volume", "register_angle"]
 
+_SCALE_FLOOR = 1e-11  # [m]
+
 
 def _radius_var(ds: xr.Dataset | xr.DataArray, what: str) -> tuple[xr.DataArray, str]:
     if isinstance(ds, xr.DataArray):
@@ -209,15 +211,14 @@ def _robust_reference(
             break
         rm = resid[mask]
         med = np.median(rm)
-        scale = 1.4826 * np.median(np.abs(rm - med))
-        if scale == 0:
-            scale = np.sqrt(np.mean((rm - med) ** 2)) or 1e-15
+        # floor: 10 pm, far below any instrument's resolution (noise-free synthetic data)
+        scale = max(1.4826 * np.median(np.abs(rm - med)), _SCALE_FLOOR)
         new = finite & (np.abs(resid - med) <= threshold * scale)
         if shape is not None and theta_deg is not None:
             sm = _smooth_theta(resid.reshape(shape), win)
             smm = sm.ravel()[mask]
             smed = np.nanmedian(smm)
-            sscale = 1.4826 * np.nanmedian(np.abs(smm - smed)) or scale
+            sscale = max(1.4826 * np.nanmedian(np.abs(smm - smed)), _SCALE_FLOOR)
             region = ~(np.abs(sm - smed) > threshold * sscale)
             region = _dilate(region, theta_deg, margin_deg)
             new &= region.ravel()

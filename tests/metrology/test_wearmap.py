@@ -117,3 +117,10 @@ def test_exact_centring_with_large_set_up_offsets():
     assert exact.attrs["centring"].startswith("exact")
     lim = wear_map(worn.truth[["radius"]], before.truth[["radius"]], exact_centring=False)
     assert np.sqrt(np.mean((lim["wear_depth"].values - truth) ** 2)) > 2 * rms
+
+
+def test_noise_free_before_scan_is_not_degenerate():
+    before = R + FORM
+    out = wear_map(_scan(before + WEAR), _scan(before))
+    # only the faint tails of the wear patch (taken as unworn) bias the reference, by < 1 nm
+    np.testing.assert_allclose(out["wear_depth"].values, WEAR, atol=1e-9)
