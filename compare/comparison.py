@@ -367,8 +367,11 @@ def _wear_metrics(
         rows.add("cylindricity_stated", "value_sim", float(cs), "m")
         rows.add("cylindricity_stated", "value_meas", float(cd), "m")
         rows.add("cylindricity_stated", "E", float(cs) - float(cd), "m")
-    if us is not None or ud is not None:
-        u_tot = np.sqrt((0 if us is None else us**2) + (0 if ud is None else ud**2))
+    u_model = np.hypot(
+        criteria.wear_u_input_rel * s, us if us is not None else criteria.wear_u_num_rel * s
+    )
+    if us is not None or ud is not None or np.any(u_model > 0):
+        u_tot = np.sqrt(u_model**2 + (0 if ud is None else ud**2))
         ok = np.isfinite(s - d) & np.isfinite(u_tot)
         frac = float(np.mean(np.abs(s - d)[ok] <= criteria.k * u_tot[ok])) if ok.any() else np.nan
         rows.add(q, "fraction_within_U_val", frac, "m")
@@ -418,8 +421,12 @@ def _motion_metrics(
                 if uname in al:
                     uv = al[uname].sel(axis=c).values if c else al[uname].values
                     u[side] = np.asarray(uv, dtype=float)[ok]
-            if u:
-                u_tot = np.sqrt(sum(v**2 for v in u.values()))
+            u_model = np.hypot(
+                criteria.motion_u_input_rel * s,
+                u["sim"] if "sim" in u else criteria.motion_u_num_rel * s,
+            )
+            if "meas" in u or np.any(u_model > 0):
+                u_tot = np.sqrt(u_model**2 + u.get("meas", 0.0) ** 2)
                 good = np.isfinite(u_tot)
                 rows.add(
                     q,

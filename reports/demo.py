@@ -62,7 +62,7 @@ class DemoSize:
     rig_duration: float  # recorded time [s]
 
 
-FULL = DemoSize(4e5, (1e5, 2e5, 4e5), 16, 120, 18000, 1.5, (640, 512), 0.6)
+FULL = DemoSize(2e5, (5e4, 1e5, 2e5), 10, 90, 18000, 1.5, (640, 512), 0.6)
 QUICK = DemoSize(5e4, (2e4, 5e4), 8, 72, 3600, 1.2, None, 0.0)
 
 
@@ -308,6 +308,12 @@ def _measure_motion(
     return out, None
 
 
+def _in_plane(ds: xr.Dataset) -> xr.Dataset:
+    """The DIC record's follower velocity, in-plane components only (see the demo notes)."""
+    keep = [v for v in ("follower_velocity", "follower_velocity_u") if v in ds]
+    return ds[keep].sel(axis=["x", "y"])
+
+
 def run_demo(out: Path, *, quick: bool = False) -> Path:
     """Run the whole chain on the embedded default data and write a validation report.
 
@@ -376,8 +382,24 @@ def run_demo(out: Path, *, quick: bool = False) -> Path:
         raise ValidationFailed("the demo could not compare anything: " + "; ".join(missing))
     sim_ds = [io.load(p) for p in sims]
     meas_ds = [io.load(p) for _, p in meas]
+    compared = [
+        _in_plane(d) if role == "DIC" else d for (role, _), d in zip(meas, meas_ds, strict=True)
+    ]
+    if dic_path is not None:
+        notes.append(
+            "Motion: only the in-plane follower velocity (x, y) is a validation target. The "
+            "virtual rig prescribes the out-of-plane motion of joint C as one sinusoid (the first "
+            "harmonic of the simulated motion), so its z component is not a measurement of the "
+            "mechanism; tracked positions are in the calibration's world frame (the board), not "
+            "the mechanism frame, and are not compared."
+        )
     criteria = Criteria(**DEMO_CRITERIA)
-    result = compare(sim_ds, meas_ds, criteria=criteria)
+    result = compare(
+        sim_ds,
+        compared,
+        criteria=criteria,
+        variables=["follower_velocity"] if dic_path is not None else None,
+    )
     save_comparison(
         result,
         out / "metrics.nc",

@@ -120,6 +120,14 @@ def test_vv20_decision_flips_with_measurement_uncertainty():
         return bool(rows.passed.iloc[0])
 
     assert verdict(ok) and not verdict(bad)
+    # point by point: a huge measurement uncertainty covers every point, a tiny one almost none
+    assert compare(sim, syn.meas_wear(scale=1.2, u=1e-3)).value(
+        "wear_depth", "fraction_within_U_val"
+    ) == pytest.approx(1.0)
+    assert (
+        compare(sim, syn.meas_wear(scale=1.2, u=1e-9)).value("wear_depth", "fraction_within_U_val")
+        < 0.1
+    )
     # input uncertainty enters u_val in quadrature
     c = compare(sim, syn.meas_wear(scale=1.2, u=3.0e-6), criteria=Criteria(wear_u_input_rel=0.1))
     s = c.value("max_wear_depth", "value_sim")
