@@ -174,7 +174,8 @@ def _design(theta_rad: np.ndarray, z: np.ndarray | None) -> _Basis:
 def _ls(G: _Basis, r: np.ndarray) -> tuple[np.ndarray, float]:
     A = np.vstack([G.cols, np.ones((1, r.size))])
     # normal equations: the basis (cos, sin, z cos, z sin, 1) with centred z is well conditioned
-    sol = np.linalg.solve(A @ A.T, A @ r)
+    # einsum, not BLAS: threaded BLAS on tall-skinny products is slow on a busy machine
+    sol = np.linalg.solve(np.einsum("jn,kn->jk", A, A), np.einsum("jn,n->j", A, r))
     return sol[:-1], float(sol[-1])
 
 
@@ -431,7 +432,7 @@ def circle_zones(
     for i in range(nl):
         sel = g == i
         A = np.column_stack([c[sel], sn[sel], np.ones(sel.sum())])
-        sol = np.linalg.solve(A.T @ A, A.T @ rs[sel])
+        sol = np.linalg.solve(np.einsum("nj,nk->jk", A, A), np.einsum("nj,n->j", A, rs[sel]))
         p[i] = sol[:2]
     e0 = rs - c * p[g, 0] - sn * p[g, 1]
     sectors = _Sectors(t, g, 64)

@@ -197,16 +197,16 @@ def _robust_reference(
                 f"{what}: only {int(mask.sum())} unworn points left to fit the reference; "
                 "pass a before-wear scan, a larger threshold, or an explicit unworn mask"
             )
-        Xm = X[mask]
-        XtX = Xm.T @ Xm
+        Xw = X * mask[:, None]  # weights instead of fancy indexing: no copies of rows
+        XtX = np.einsum("nj,nk->jk", Xw, X)
         try:
-            b = np.linalg.solve(XtX, Xm.T @ d[mask])
+            b = np.linalg.solve(XtX, np.einsum("nj,n->j", Xw, np.where(mask, d, 0.0)))
         except np.linalg.LinAlgError:
             raise BadInputError(
                 f"{what}: the unworn points do not determine the reference (they cover too "
                 "little of the circumference); pass a before-wear scan or an explicit unworn mask"
             ) from None
-        resid = d - X @ b
+        resid = d - np.einsum("nj,j->n", X, b)
         if unworn is not None:
             break
         rm = resid[mask]
@@ -226,10 +226,11 @@ def _robust_reference(
         mask = new
         if changed <= 1e-4 * mask.size:
             break
-    resid = d - X @ b
+    resid = d - np.einsum("nj,j->n", X, b)
     s2 = float(np.mean(resid[mask] ** 2) * mask.sum() / max(mask.sum() - X.shape[1], 1))
-    cov = np.linalg.inv(X[mask].T @ X[mask]) * s2
-    var_fit = np.einsum("ij,jk,ik->i", X, cov, X)
+    Xw = X * mask[:, None]
+    cov = np.linalg.inv(np.einsum("nj,nk->jk", Xw, X)) * s2
+    var_fit = np.einsum("nj,jk,nk->n", X, cov, X)
     return resid, mask, var_fit, s2, n_iter
 
 
@@ -265,16 +266,16 @@ def _refine_offset(
     from scipy.optimize import minimize_scalar
 
     Xm = X[mask]
-    lhs = Xm.T @ Xm
+    lhs = np.einsum("nj,nk->jk", Xm, Xm)
 
     def cost(off: float) -> float:
         d = sign * (rw - _rotate(th, thb, rbz, off)).ravel()[mask]
-        b = np.linalg.solve(lhs, Xm.T @ d)
-        return float(np.mean((d - Xm @ b) ** 2))
+        b = np.linalg.solve(lhs, np.einsum("nj,n->j", Xm, d))
+        return float(np.mean((d - np.einsum("nj,j->n", Xm, b)) ** 2))
 
     step = max(4.0 * 360.0 / max(thb.size, 1), 2.0)
     res = minimize_scalar(
-        cost, bounds=(offset - step, offset + step), method="bounded", options={"xatol": 1e-4}
+        cost, bounds=(offset - step, offset + step), method="bounded", options={"xatol": 1e-3}
     )
     return float(res.x) if res.fun <= cost(offset) else offset
 
