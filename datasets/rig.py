@@ -300,7 +300,7 @@ class VirtualRig:
                 np.array([-c.journal_size / 2, -c.journal_size / 2, 0.0]),
                 (c.journal_size,) * 2,
             ),
-            ("crank", np.array([0.015, -0.01, 0.0]), (0.07, 0.02)),
+            ("crank", np.array([0.015, -0.015, 0.0]), (0.075, 0.03)),
         ]
         out = []
         for i, (body, origin, size) in enumerate(specs):
