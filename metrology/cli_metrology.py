@@ -331,5 +331,7 @@ def register(app: typer.Typer) -> None:
                     if len(worn) == 1
                     else plot.with_name(f"{target.stem}{plot.suffix or '.png'}")
                 )
-                plot_wear_map(ds, path=fig_path)
+                import matplotlib.pyplot as plt
+
+                plt.close(plot_wear_map(ds, path=fig_path))
                 typer.echo(f"wrote {fig_path}")

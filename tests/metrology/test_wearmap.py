@@ -124,3 +124,22 @@ def test_noise_free_before_scan_is_not_degenerate():
     out = wear_map(_scan(before + WEAR), _scan(before))
     # only the faint tails of the wear patch (taken as unworn) bias the reference, by < 1 nm
     np.testing.assert_allclose(out["wear_depth"].values, WEAR, atol=1e-9)
+
+
+def test_plot_wear_map(tmp_path):
+    import matplotlib.pyplot as plt
+
+    from jointwear.metrology.plot import plot_wear_map
+
+    out = wear_map(_scan(R + WEAR))
+    fig = plot_wear_map(out, layers=[0, -1], path=tmp_path / "w.png", title="t")
+    ax, *rest = fig.axes
+    assert "0 along -x, clockwise" in ax.get_xlabel()
+    polar = [a for a in fig.axes if a.name == "polar"][0]
+    assert len(polar.lines) == 2
+    assert (tmp_path / "w.png").stat().st_size > 5000
+    plt.close(fig)
+    with pytest.raises(BadInputError, match="out of range"):
+        plot_wear_map(out, layers=[99])
+    with pytest.raises(BadInputError, match="expected wear_depth over"):
+        plot_wear_map(out["wear_depth"].isel(z=0))
