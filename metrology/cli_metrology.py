@@ -114,6 +114,15 @@ def register(app: typer.Typer) -> None:
             bool,
             typer.Option("--batch", help="Each entry of each PATH folder is a separate scan."),
         ] = False,
+        pattern: Annotated[
+            str,
+            typer.Option(
+                "--pattern", help="Glob of the per-layer files in a folder, e.g. '*.txt'."
+            ),
+        ] = "*",
+        instrument: Annotated[
+            str | None, typer.Option("--instrument", help="Instrument name for 'source'.")
+        ] = None,
     ) -> None:
         """Import roundness/cylindricity text exports into contract netCDF files."""
         from jointwear import io
@@ -156,7 +165,10 @@ def register(app: typer.Typer) -> None:
             expected_points=expected_points,
             allow_partial=allow_partial,
             resample=resample,
+            pattern=pattern,
         )
+        if instrument is not None:
+            opts["instrument"] = instrument
         if units is not None:
             opts["units"] = units
         for item, target in zip(items, targets, strict=True):

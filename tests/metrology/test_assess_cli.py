@@ -183,3 +183,23 @@ def test_cli_batch_import_and_generator(tmp_path, capsys):
     assert sorted(p.name for p in out.iterdir()) == ["s0.nc", "s1.nc"]
     assert main(["metrology", "assess", str(out / "s0.nc"), str(out / "s1.nc")]) == 0
     assert capsys.readouterr().out.count("bore") == 2
+
+
+def test_cli_pattern_skips_other_files(tmp_path, scan, capsys):
+    write(scan, tmp_path / "s", layout="folder")
+    (tmp_path / "s" / "README.md").write_text("Bearing 7, measured by Anna\n")
+    args = [
+        "metrology",
+        "import",
+        str(tmp_path / "s"),
+        "--out",
+        str(tmp_path / "x.nc"),
+        "--angle-zero",
+        "+y",
+        "--angle-direction",
+        "ccw",
+    ]
+    assert main(args) == 3
+    assert "README.md': no table of numbers" in capsys.readouterr().err
+    assert main([*args, "--pattern", "layer*.txt", "--instrument", "Talyrond 565H"]) == 0
+    assert io.load(tmp_path / "x.nc").attrs["source"] == "measurement: Talyrond 565H"
