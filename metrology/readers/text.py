@@ -649,7 +649,8 @@ def parse_file(path: str | Path, fmt: TextFormat = TextFormat()) -> ParsedFile:
                     break
         if units is not None:
             guessed["units"] = f"{units} (from the header)"
-            unit_factor(units, where=f"'{path}' header")
+            ln_no = next((i + 1 for i, ln in enumerate(lines[:hl]) if units in ln), max(hl, 1))
+            unit_factor(units, where=f"'{path}' line {ln_no}")
     return ParsedFile(
         path=str(path),
         data=data,

@@ -145,7 +145,7 @@ BAD = {
     ),
     "units": (
         "Units: furlong\n0.0\t1.0\n1.0\t2.0\n2.0\t3.0\n",
-        r"unit 'furlong' is not known.*units=",
+        r"line 1: unit 'furlong' is not known.*units=",
     ),
     "empty": ("", r"is empty \(line 1\).*re-export"),
     "blank": ("\n\n   \n", r"is empty"),
