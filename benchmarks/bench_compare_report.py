@@ -1,16 +1,20 @@
 """Benchmark of jointwear.compare and jointwear.reports at the reference study's sizes.
 
-Figures: time to align a simulated wear map (20 layers x 200 points, 3 snapshots) with an
+Figures: wall and CPU time to align a simulated wear map (20 layers x 200 points, 3 snapshots) with an
 instrument map (13 layers x 18000 points, other angle convention); time of the full comparison
 (wear + motion: variable-step simulation vs 50 frames/s over 2 s); time to render the HTML
-report (figures included) and its size. Medians of repeated runs; the machine is shared, so
+report (figures included) and its size; wall and CPU time of ``jointwear demo --quick`` and
+of the full ``jointwear demo`` (one run each, in a subprocess). Medians of repeated runs; the machine is shared, so
 the load average is recorded with the figures.
 """
 
 from __future__ import annotations
 
+import resource
+import subprocess
 import sys
 import tempfile
+import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
@@ -21,6 +25,29 @@ from _common import median_time, write_results  # noqa: E402
 
 from jointwear.compare import align_wear_maps, compare  # noqa: E402
 from jointwear.reports import build_report, render_html  # noqa: E402
+
+
+def cpu_time(fn, repeat: int = 3) -> float:
+    """Median CPU time of ``fn()`` in this process [s] (less sensitive to a shared machine)."""
+    times = []
+    for _ in range(repeat):
+        t0 = time.process_time()
+        fn()
+        times.append(time.process_time() - t0)
+    return sorted(times)[len(times) // 2]
+
+
+def demo_run(quick: bool) -> dict[str, float]:
+    """Wall and CPU time of one ``jointwear demo`` run in a subprocess [s]."""
+    with tempfile.TemporaryDirectory() as tmp:
+        before = resource.getrusage(resource.RUSAGE_CHILDREN)
+        t0 = time.perf_counter()
+        args = [sys.executable, "-m", "jointwear", "demo", "--out", tmp]
+        code = subprocess.run([*args, "--quick"] if quick else args, capture_output=True).returncode
+        wall = time.perf_counter() - t0
+        after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    return {"wall_s": round(wall, 1), "cpu_s": round(cpu, 1), "exit_code": code}
 
 
 def main() -> None:
@@ -41,9 +68,16 @@ def main() -> None:
             ),
             repeat=3,
         )
+    cpu = {
+        "align_wear_maps_cpu_s": round(cpu_time(lambda: align_wear_maps(sim_w, meas_w)), 4),
+        "render_html_report_cpu_s": round(cpu_time(lambda: render_html(result, command="b")), 3),
+    }
+    demos = {"demo_quick": demo_run(True), "demo_full": demo_run(False)}
     write_results(
         "compare_report",
         {
+            **cpu,
+            **demos,
             "align_wear_maps_20x200_vs_13x18000_s": round(t_align, 4),
             "compare_wear_and_motion_s": round(t_compare, 4),
             "render_html_report_s": round(t_render, 3),

@@ -36,10 +36,11 @@ from jointwear.errors import BadInputError, ConventionError
 
 __all__ = ["align_wear_maps", "align_time_series", "MOTION_VARIABLES", "to_metres"]
 
-#: time-series variables compared when both sides have them (contract names)
+#: time-series variables compared by default when both sides have them (contract names).
+#: Positions (``follower_position``) are left out: they depend on where each record puts its
+#: origin (a DIC calibration's world frame is the board's); ask for them explicitly.
 MOTION_VARIABLES = (
     "follower_velocity",
-    "follower_position",
     "journal_offset",
     "journal_displacement",
     "contact_force",

@@ -57,6 +57,14 @@ def register(app: typer.Typer) -> None:
                 "--method", help="Motion alignment: auto, crank_angle, cross_correlation."
             ),
         ] = "auto",
+        variables: Annotated[
+            list[str] | None,
+            typer.Option(
+                "--variable",
+                help="Motion variable to compare (repeatable; default: follower_velocity, "
+                "journal_offset, journal_displacement, contact_force when both sides have them).",
+            ),
+        ] = None,
         strict: Annotated[
             bool, typer.Option("--strict", help="Exit with code 1 if a criterion fails.")
         ] = False,
@@ -80,7 +88,13 @@ def register(app: typer.Typer) -> None:
         sims = [io.load(p) for p in sim_paths]
         meass = [io.load(p) for p in meas_paths]
         result = compare(
-            sims, meass, criteria=crit, cycles=cycles, period_s=period, motion_method=method
+            sims,
+            meass,
+            criteria=crit,
+            cycles=cycles,
+            period_s=period,
+            motion_method=method,
+            variables=variables or None,
         )
         save_comparison(result, out, inputs=[*sim_paths, *meas_paths], parents=[*sims, *meass])
         if table is not None:

@@ -245,7 +245,9 @@ def _split(objs: xr.Dataset | Sequence[xr.Dataset]) -> tuple[xr.Dataset | None, 
             ds = ds.to_dataset(name=ds.name or "wear_depth")
         if "wear_depth" in ds.data_vars and wear is None:
             wear = ds
-        if "time" in ds.coords and any(v in ds.data_vars for v in MOTION_VARIABLES):
+        if "time" in ds.coords and any(
+            v in ds.data_vars for v in (*MOTION_VARIABLES, "follower_position")
+        ):
             if motion is None:
                 motion = ds
     return wear, motion

@@ -77,6 +77,14 @@ def _template(name: str) -> str:
     return (resources.files("jointwear.reports") / "templates" / name).read_text(encoding="utf-8")
 
 
+def _cycles(value: Any) -> str:
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        return "(not stated)"
+    return f"{v:.4g}" if np.isfinite(v) else "(not stated)"
+
+
 def _alignment(c: Comparison) -> list[tuple[str, str]]:
     out: list[tuple[str, str]] = []
     if c.wear is not None:
@@ -97,11 +105,11 @@ def _alignment(c: Comparison) -> list[tuple[str, str]]:
                     )
                 )
         if "cycles_selection" in a:
-            cs, cm = float(a.get("cycles_sim", np.nan)), float(a.get("cycles_meas", np.nan))
+            cs, cm = _cycles(a.get("cycles_sim")), _cycles(a.get("cycles_meas"))
             out.append(
                 (
                     "crank cycles",
-                    f"simulation {cs:.4g}, measurement {cm:.4g} ({a['cycles_selection']})",
+                    f"simulation {cs}, measurement {cm} ({a['cycles_selection']})",
                 )
             )
     if c.motion is not None:
@@ -270,8 +278,8 @@ def _context(
         a = c.wear.attrs
         ctx["wear_caption"] = (
             f"{c.wear.sizes['z']} layers × {c.wear.sizes['theta']} angles, canonical angle "
-            f"convention; simulation after {float(a.get('cycles_sim', np.nan)):.4g} cycles, "
-            f"measurement after {float(a.get('cycles_meas', np.nan)):.4g} cycles"
+            f"convention; simulation after {_cycles(a.get('cycles_sim'))} cycles, "
+            f"measurement after {_cycles(a.get('cycles_meas'))} cycles"
         )
     else:
         ctx["wear_png"] = None
@@ -507,6 +515,7 @@ def report_from_files(
     command: str | None = None,
     cycles: float | None = None,
     period_s: float | None = None,
+    variables: Sequence[str] | None = None,
 ) -> tuple[Path, Comparison]:
     """Build a report from files: simulation, metrology and DIC netCDF, or a saved comparison.
 
@@ -527,6 +536,8 @@ def report_from_files(
         See :func:`build_report`.
     cycles, period_s : float, optional
         Passed to :func:`jointwear.compare.compare`.
+    variables : sequence of str, optional
+        Motion variables to compare (default: see :data:`jointwear.compare.MOTION_VARIABLES`).
 
     Returns
     -------
@@ -562,7 +573,12 @@ def report_from_files(
         if not dic:
             missing.append("motion: no DIC file was given (--dic)")
         result = compare(
-            sims, [*metros, *dics], criteria=criteria, cycles=cycles, period_s=period_s
+            sims,
+            [*metros, *dics],
+            criteria=criteria,
+            cycles=cycles,
+            period_s=period_s,
+            variables=variables,
         )
     vers = [io.load(p, validate=False) for p in verification]
     inputs += [

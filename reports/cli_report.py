@@ -51,6 +51,10 @@ def register(app: typer.Typer) -> None:
             float | None,
             typer.Option("--period", help="Crank period in seconds (if no crank angle)."),
         ] = None,
+        variables: Annotated[
+            list[str] | None,
+            typer.Option("--variable", help="Motion variable to compare (repeatable)."),
+        ] = None,
         strict: Annotated[
             bool, typer.Option("--strict", help="Exit with code 1 if a criterion fails.")
         ] = False,
@@ -76,6 +80,7 @@ def register(app: typer.Typer) -> None:
             pdf=pdf,
             cycles=cycles,
             period_s=period,
+            variables=variables or None,
         )
         for row in result.decisions.itertuples():
             typer.echo(f"{'PASS' if row.passed else 'FAIL'}  {row.quantity}: {row.value}")
