@@ -126,7 +126,7 @@ def worn_volume(
     return float(radius * np.sum(w * h))
 
 
-def _basis(z: np.ndarray, theta_deg: np.ndarray, shape: str) -> np.ndarray:
+def _basis(z: np.ndarray, theta_deg: np.ndarray, shape: str):
     nz, nt = z.size, theta_deg.size
     t = np.radians(theta_deg)
     c = np.broadcast_to(np.cos(t)[None, :], (nz, nt)).ravel()
@@ -136,14 +136,40 @@ def _basis(z: np.ndarray, theta_deg: np.ndarray, shape: str) -> np.ndarray:
         span = max(np.ptp(zc), 1e-12)
         zz = np.broadcast_to((zc / span)[:, None], (nz, nt)).ravel()
         return np.column_stack([np.ones(nz * nt), c, s, zz * c, zz * s])
-    # one circle per layer: block columns (1, cos, sin) for each layer
-    X = np.zeros((nz * nt, 3 * nz))
-    for i in range(nz):
-        sl = slice(i * nt, (i + 1) * nt)
-        X[sl, 3 * i] = 1.0
-        X[sl, 3 * i + 1] = c[sl]
-        X[sl, 3 * i + 2] = s[sl]
-    return X
+    return _LayerBasis(nz, np.stack([np.ones(nt), np.cos(t), np.sin(t)]))
+
+
+class _LayerBasis:
+    """One circle (1, cos, sin) per layer: a block-diagonal basis kept as its shared block."""
+
+    def __init__(self, nz: int, block: np.ndarray):
+        self.nz = nz
+        self.block = block  # (3, nt)
+        self.shape = (nz * block.shape[1], 3 * nz)
+
+
+def _lsq(X, d: np.ndarray, mask: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Least squares of d on the masked rows: (coefficients, fitted values, normal matrix)."""
+    if isinstance(X, _LayerBasis):
+        B = X.block
+        m = mask.reshape(X.nz, -1).astype(float)
+        dd = np.where(mask, d, 0.0).reshape(X.nz, -1)
+        G = np.einsum("ln,jn,kn->ljk", m, B, B)
+        rhs = np.einsum("ln,jn->lj", dd * m, B)
+        b = np.linalg.solve(G, rhs[..., None])[..., 0]
+        return b, np.einsum("lj,jn->ln", b, B).ravel(), G
+    Xw = X * mask[:, None]  # weights instead of fancy indexing: no copies of rows
+    G = np.einsum("nj,nk->jk", Xw, X)
+    b = np.linalg.solve(G, np.einsum("nj,n->j", Xw, np.where(mask, d, 0.0)))
+    return b, np.einsum("nj,j->n", X, b), G
+
+
+def _fit_variance(X, G: np.ndarray, s2: float) -> np.ndarray:
+    """Variance of the fitted reference at every point [m^2]."""
+    cov = np.linalg.inv(G) * s2
+    if isinstance(X, _LayerBasis):
+        return np.einsum("jn,ljk,kn->ln", X.block, cov, X.block).ravel()
+    return np.einsum("nj,jk,nk->n", X, cov, X)
 
 
 def _smooth_theta(v: np.ndarray, win: int) -> np.ndarray:
@@ -197,16 +223,14 @@ def _robust_reference(
                 f"{what}: only {int(mask.sum())} unworn points left to fit the reference; "
                 "pass a before-wear scan, a larger threshold, or an explicit unworn mask"
             )
-        Xw = X * mask[:, None]  # weights instead of fancy indexing: no copies of rows
-        XtX = np.einsum("nj,nk->jk", Xw, X)
         try:
-            b = np.linalg.solve(XtX, np.einsum("nj,n->j", Xw, np.where(mask, d, 0.0)))
+            b, fitted, G = _lsq(X, d, mask)
         except np.linalg.LinAlgError:
             raise BadInputError(
                 f"{what}: the unworn points do not determine the reference (they cover too "
                 "little of the circumference); pass a before-wear scan or an explicit unworn mask"
             ) from None
-        resid = d - np.einsum("nj,j->n", X, b)
+        resid = d - fitted
         if unworn is not None:
             break
         rm = resid[mask]
@@ -226,11 +250,10 @@ def _robust_reference(
         mask = new
         if changed <= 1e-4 * mask.size:
             break
-    resid = d - np.einsum("nj,j->n", X, b)
+    b, fitted, G = _lsq(X, d, mask)
+    resid = d - fitted
     s2 = float(np.mean(resid[mask] ** 2) * mask.sum() / max(mask.sum() - X.shape[1], 1))
-    Xw = X * mask[:, None]
-    cov = np.linalg.inv(np.einsum("nj,nk->jk", Xw, X)) * s2
-    var_fit = np.einsum("nj,jk,nk->n", X, cov, X)
+    var_fit = _fit_variance(X, G, s2)
     return resid, mask, var_fit, s2, n_iter
 
 
@@ -393,6 +416,7 @@ def wear_map(
     rw = np.asarray(w.values, dtype=float)
     sign = 1.0 if surface == "bore" else -1.0
     X = _basis(z, th, shape)
+    Xcyl = X if shape == "cylinder" else _basis(z, th, "cylinder")
     mask_in = None
     if unworn is not None:
         mask_in = np.asarray(unworn, dtype=bool)
@@ -440,7 +464,7 @@ def wear_map(
             offset += register_angle(wz, bz, exclude=excl)
             unw = ~excl.ravel()
             for _ in range(3):
-                new_off = _refine_offset(rw, rbz, th, thb, X, sign, offset, unw)
+                new_off = _refine_offset(rw, rbz, th, thb, Xcyl, sign, offset, unw)
                 rb_i = _rotate(th, thb, rbz, new_off)
                 _, unw, _, _, _ = _robust_reference(
                     sign * (rw - rb_i).ravel(),

@@ -143,3 +143,17 @@ def test_plot_wear_map(tmp_path):
         plot_wear_map(out, layers=[99])
     with pytest.raises(BadInputError, match="expected wear_depth over"):
         plot_wear_map(out["wear_depth"].isel(z=0))
+
+
+def test_circle_per_layer_reference():
+    """Layer centres that do not lie on a straight axis: only one circle per layer fits them."""
+    rng = np.random.default_rng(4)
+    sigma = 0.03e-6
+    ex = rng.uniform(-5e-6, 5e-6, (NZ, 1))
+    ey = rng.uniform(-5e-6, 5e-6, (NZ, 1))
+    worn = R + ex * np.cos(RAD) + ey * np.sin(RAD) + WEAR + sigma * rng.standard_normal(WEAR.shape)
+    circ = wear_map(_scan(worn), shape="circle")
+    assert np.sqrt(np.mean((circ["wear_depth"].values - WEAR) ** 2)) < 1.05 * sigma
+    assert "circle per layer" in circ.attrs["wear_reference"]
+    cyl = wear_map(_scan(worn), shape="cylinder")
+    assert np.sqrt(np.mean((cyl["wear_depth"].values - WEAR) ** 2)) > 10 * sigma
