@@ -4,7 +4,7 @@ Signatures
 ----------
 ``correlate(reference, deformed, *, points=None, roi=None, subset_size=31, step=10,
 shape="affine", interpolation="quintic", initial_guess=None, search_radius=48, seed_points=None,
-zncc_min=0.8, tolerance=1e-4, max_iterations=40, threads=0) -> xr.Dataset``
+zncc_min=0.8, tolerance=1e-3, max_iterations=40, threads=0) -> xr.Dataset``
     One image pair. ``points`` ``(N, 2)`` subset centres ``(x, y)`` [pixel] give a ``point``
     dimension with ``x``, ``y`` coordinates; otherwise a grid over ``roi`` with spacing ``step``
     gives ``(y, x)`` dimensions. ``initial_guess`` ``(N, 2)`` ``(u, v)`` [pixel], ``(N, 6)``
@@ -64,7 +64,7 @@ def correlate(
     search_radius: int = 48,
     seed_points: np.ndarray | None = None,
     zncc_min: float = 0.8,
-    tolerance: float = 1e-4,
+    tolerance: float = 1e-3,
     max_iterations: int = 40,
     threads: int = 0,
 ) -> xr.Dataset:

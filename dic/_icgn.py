@@ -251,7 +251,10 @@ def _compose_inverse(p, dp, quadratic):
 
 @njit(cache=True)
 def _box_has_invalid(integral, x0, y0, x1, y1):
-    """True if any invalid pixel in [x0, x1] x [y0, y1] (integral image of invalid counts)."""
+    """True if any invalid pixel in [x0, x1] x [y0, y1] (integral image of invalid counts;
+    a (1, 1) table means that every pixel is valid)."""
+    if integral.shape[0] == 1:
+        return False
     h = integral.shape[0] - 1
     w = integral.shape[1] - 1
     if x0 < 0:
@@ -1077,6 +1080,38 @@ def icgn_many(
             zncc[i] = z
             iters[i] = it
             flags[i] = fl
+
+
+@njit(cache=True, parallel=True)
+def subset_std(img, invalid, centres, half, border):
+    """Standard deviation of the reference subset at every centre (NaN: unusable centre)."""
+    H, W = img.shape
+    n = centres.shape[0]
+    out = np.full(n, np.nan)
+    size = 2 * half + 1
+    for i in prange(n):
+        xc = centres[i, 0]
+        yc = centres[i, 1]
+        if not (math.isfinite(xc) and math.isfinite(yc)):
+            continue
+        if xc - half < border or yc - half < border:
+            continue
+        if xc + half > W - 1 - border or yc + half > H - 1 - border:
+            continue
+        x0 = int(round(xc)) - half
+        y0 = int(round(yc)) - half
+        if _box_has_invalid(invalid, x0, y0, x0 + size - 1, y0 + size - 1):
+            continue
+        s = 0.0
+        s2 = 0.0
+        for r in range(size):
+            for c in range(size):
+                v = img[y0 + r, x0 + c]
+                s += v
+                s2 += v * v
+        m = s / (size * size)
+        out[i] = math.sqrt(max(s2 / (size * size) - m * m, 0.0))
+    return out
 
 
 # ---------------------------------------------------------------- reliability-guided propagation

@@ -16,7 +16,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 __all__ = ["SplineImage", "prefilter", "interp_value", "interp_value_grad", "PAD"]
 
@@ -56,41 +56,203 @@ class SplineImage:
         return self.image.shape  # type: ignore[return-value]
 
 
-def prefilter(image: np.ndarray, interpolation: str = "cubic") -> SplineImage:
+def prefilter(
+    image: np.ndarray, interpolation: str = "quintic", *, gradients: bool = True
+) -> SplineImage:
     """Compute B-spline coefficients and node gradients of ``image`` (done once per image).
+
+    ``gradients=False`` skips the node gradients (deformed images do not need them; ``gx``,
+    ``gy`` are then empty arrays).
 
     Non-finite pixels are replaced by the image mean for the prefilter (their neighbourhood is
     flagged by the correlation, never trusted).
     """
-    from scipy import ndimage
-
     order = _ORDERS[interpolation]
-    img = np.asarray(image, dtype=np.float64)
+    img = np.ascontiguousarray(image, dtype=np.float64)
     valid = np.isfinite(img)
-    work = img if valid.all() else np.where(valid, img, np.nanmean(img) if valid.any() else 0.0)
-    coef = ndimage.spline_filter(work, order=order, mode="mirror", output=np.float64)
-    coef = np.ascontiguousarray(np.pad(coef, PAD, mode="reflect"))
-    gx, gy = _node_gradients(coef, order, img.shape[0], img.shape[1])
-    return SplineImage(
-        image=np.ascontiguousarray(img), coef=coef, gx=gx, gy=gy, order=order, valid=valid
-    )
+    all_valid = bool(valid.all())
+    work = img if all_valid else np.where(valid, img, np.nanmean(img) if valid.any() else 0.0)
+    coef = np.empty((img.shape[0] + 2 * PAD, img.shape[1] + 2 * PAD))
+    _prefilter_2d(work, order, coef)
+    if gradients:
+        gx = np.empty(img.shape)
+        gy = np.empty(img.shape)
+        _node_gradients(coef, order, gx, gy)
+    else:
+        gx = gy = np.empty((0, 0))
+    return SplineImage(image=img, coef=coef, gx=gx, gy=gy, order=order, valid=valid)
 
 
-def _node_gradients(coef: np.ndarray, order: int, h: int, w: int):
+# poles of the cubic and quintic B-spline prefilters (Unser 1999; Thevenaz et al. 2000)
+_Z3 = (np.sqrt(3.0) - 2.0,)
+_Z5 = (
+    np.sqrt(135.0 / 2.0 - np.sqrt(17745.0 / 4.0)) + np.sqrt(105.0 / 4.0) - 13.0 / 2.0,
+    np.sqrt(135.0 / 2.0 + np.sqrt(17745.0 / 4.0)) - np.sqrt(105.0 / 4.0) - 13.0 / 2.0,
+)
+
+
+@njit(cache=True)
+def _filter_line(c, z1, z2, npoles):
+    """In-place recursive B-spline prefilter of one line, mirror boundary (s[-k] = s[k])."""
+    n = c.shape[0]
+    if n == 1:
+        return
+    lam = (1.0 - z1) * (1.0 - 1.0 / z1)
+    if npoles == 2:
+        lam *= (1.0 - z2) * (1.0 - 1.0 / z2)
+    for i in range(n):
+        c[i] *= lam
+    for q in range(npoles):
+        z = z1 if q == 0 else z2
+        # causal initialisation (mirror boundary), truncated at 1e-14 relative
+        horizon = int(math.ceil(math.log(1e-14) / math.log(abs(z))))
+        if horizon < n:
+            zn = z
+            s = c[0]
+            for k in range(1, horizon):
+                s += zn * c[k]
+                zn *= z
+            c[0] = s
+        else:
+            zn = z
+            iz = 1.0 / z
+            z2n = z ** (n - 1)
+            s = c[0] + z2n * c[n - 1]
+            z2n *= z2n * iz
+            for k in range(1, n - 1):
+                s += (zn + z2n) * c[k]
+                zn *= z
+                z2n *= iz
+            c[0] = s / (1.0 - zn * zn)
+        for k in range(1, n):
+            c[k] += z * c[k - 1]
+        c[n - 1] = (z / (z * z - 1.0)) * (z * c[n - 2] + c[n - 1])
+        for k in range(n - 2, -1, -1):
+            c[k] = z * (c[k + 1] - c[k])
+
+
+@njit(cache=True)
+def _filter_columns(c, j0, j1, z1, z2, npoles):
+    """In-place prefilter along axis 0 of columns j0..j1-1, row by row (cache friendly)."""
+    n = c.shape[0]
+    if n == 1:
+        return
+    lam = (1.0 - z1) * (1.0 - 1.0 / z1)
+    if npoles == 2:
+        lam *= (1.0 - z2) * (1.0 - 1.0 / z2)
+    for i in range(n):
+        for j in range(j0, j1):
+            c[i, j] *= lam
+    acc = np.empty(j1 - j0)
+    for q in range(npoles):
+        z = z1 if q == 0 else z2
+        horizon = int(math.ceil(math.log(1e-14) / math.log(abs(z))))
+        if horizon < n:
+            for j in range(j0, j1):
+                acc[j - j0] = c[0, j]
+            zn = z
+            for k in range(1, horizon):
+                for j in range(j0, j1):
+                    acc[j - j0] += zn * c[k, j]
+                zn *= z
+            for j in range(j0, j1):
+                c[0, j] = acc[j - j0]
+        else:
+            for j in range(j0, j1):
+                col = c[:, j].copy()
+                zn = z
+                iz = 1.0 / z
+                z2n = z ** (n - 1)
+                s = col[0] + z2n * col[n - 1]
+                z2n *= z2n * iz
+                for k in range(1, n - 1):
+                    s += (zn + z2n) * col[k]
+                    zn *= z
+                    z2n *= iz
+                c[0, j] = s / (1.0 - zn * zn)
+        for k in range(1, n):
+            for j in range(j0, j1):
+                c[k, j] += z * c[k - 1, j]
+        g = z / (z * z - 1.0)
+        for j in range(j0, j1):
+            c[n - 1, j] = g * (z * c[n - 2, j] + c[n - 1, j])
+        for k in range(n - 2, -1, -1):
+            for j in range(j0, j1):
+                c[k, j] = z * (c[k + 1, j] - c[k, j])
+
+
+@njit(cache=True, parallel=True)
+def _prefilter_2d(img, order, out):
+    """B-spline coefficients of ``img`` written into ``out`` with a mirrored border of PAD."""
+    h, w = img.shape
+    if order == 3:
+        z1 = math.sqrt(3.0) - 2.0
+        z2 = 0.0
+        npoles = 1
+    else:
+        a = math.sqrt(17745.0 / 4.0)
+        b = math.sqrt(105.0 / 4.0)
+        z1 = math.sqrt(135.0 / 2.0 - a) + b - 13.0 / 2.0
+        z2 = math.sqrt(135.0 / 2.0 + a) - b - 13.0 / 2.0
+        npoles = 2
+    tmp = np.empty((h, w))
+    for i in prange(h):
+        line = img[i].copy()
+        _filter_line(line, z1, z2, npoles)
+        tmp[i] = line
+    nb = (w + 63) // 64
+    for blk in prange(nb):
+        _filter_columns(tmp, blk * 64, min(w, blk * 64 + 64), z1, z2, npoles)
+    # mirrored padding (reflect without repeating the edge sample)
+    for i in prange(h + 2 * PAD):
+        si = i - PAD
+        if si < 0:
+            si = -si
+        elif si > h - 1:
+            si = 2 * (h - 1) - si
+        for j in range(w + 2 * PAD):
+            sj = j - PAD
+            if sj < 0:
+                sj = -sj
+            elif sj > w - 1:
+                sj = 2 * (w - 1) - sj
+            out[i, j] = tmp[si, sj]
+
+
+@njit(cache=True, parallel=True)
+def _node_gradients(coef, order, gx, gy):
+    """Exact derivatives of the interpolant at the pixel nodes [grey level / pixel]."""
+    h, w = gx.shape
     if order == 3:
         val = np.array([1.0, 4.0, 1.0]) / 6.0
         der = np.array([-0.5, 0.0, 0.5])
     else:
         val = np.array([1.0, 26.0, 66.0, 26.0, 1.0]) / 120.0
         der = np.array([-1.0, -10.0, 0.0, 10.0, 1.0]) / 24.0
-    r = len(val) // 2
-    c = coef[PAD - r : PAD + h + r, PAD - r : PAD + w + r]
-    # separable: derivative along x, value along y (and vice versa)
-    tx = sum(der[k] * c[:, k : k + w] for k in range(len(der)))
-    gx = sum(val[k] * tx[k : k + h, :] for k in range(len(val)))
-    ty = sum(val[k] * c[:, k : k + w] for k in range(len(val)))
-    gy = sum(der[k] * ty[k : k + h, :] for k in range(len(der)))
-    return np.ascontiguousarray(gx), np.ascontiguousarray(gy)
+    r = val.shape[0] // 2
+    # separable: along x first (value and derivative filters) on rows -r..h+r, then along y
+    tv = np.empty((h + 2 * r, w))
+    td = np.empty((h + 2 * r, w))
+    for i in prange(h + 2 * r):
+        row = coef[i + PAD - r]
+        for j in range(w):
+            sv = 0.0
+            sd = 0.0
+            for b in range(2 * r + 1):
+                cv = row[j + PAD - r + b]
+                sv += val[b] * cv
+                sd += der[b] * cv
+            tv[i, j] = sv
+            td[i, j] = sd
+    for i in prange(h):
+        for j in range(w):
+            sx = 0.0
+            sy = 0.0
+            for a in range(2 * r + 1):
+                sx += val[a] * td[i + a, j]
+                sy += der[a] * tv[i + a, j]
+            gx[i, j] = sx
+            gy[i, j] = sy
 
 
 @njit(cache=True, inline="always")
