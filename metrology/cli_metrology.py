@@ -347,3 +347,30 @@ def register(app: typer.Typer) -> None:
 
                 plt.close(plot_wear_map(ds, path=fig_path))
                 typer.echo(f"wrote {fig_path}")
+
+    @app.command("plot")
+    def plot_cmd(
+        wear: Annotated[Path, typer.Argument(help="Wear map (.nc) with wear_depth(z, theta).")],
+        out: Annotated[
+            Path, typer.Option("--out", "-o", help="Figure file (PNG, PDF, SVG).")
+        ] = Path("wear_map.png"),
+        layers: Annotated[
+            str | None,
+            typer.Option("--layers", help="Comma-separated layer indices for the polar plot."),
+        ] = None,
+        title: Annotated[str | None, typer.Option("--title", help="Figure title.")] = None,
+    ) -> None:
+        """Plot a wear map: unrolled angle x z map and per-layer polar plot."""
+        import matplotlib.pyplot as plt
+
+        from jointwear import io
+        from jointwear.errors import BadInputError
+        from jointwear.metrology.plot import plot_wear_map
+
+        ds = io.load(wear)
+        try:
+            idx = [int(v) for v in layers.split(",")] if layers else None
+        except ValueError:
+            raise BadInputError(f"--layers {layers!r}: expected integers like 0,6,12") from None
+        plt.close(plot_wear_map(ds, layers=idx, path=out, title=title))
+        typer.echo(f"wrote {out}")

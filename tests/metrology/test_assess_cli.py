@@ -138,6 +138,11 @@ def test_cli_end_to_end(tmp_path, scan, capsys):
     assert w["theta"].attrs["angle_zero"] == "-x"
     assert float(w["wear_depth"].max()) == pytest.approx(20e-6, abs=3e-6)
     assert (tmp_path / "wear.png").stat().st_size > 10_000
+    assert (
+        main(["metrology", "plot", str(wear), "--out", str(tmp_path / "p.svg"), "--layers", "0,4"])
+        == 0
+    )
+    assert (tmp_path / "p.svg").read_text().lstrip().startswith("<?xml")
 
 
 def test_cli_batch_import_and_generator(tmp_path, capsys):
