@@ -53,3 +53,13 @@ def test_compare_cli_exit_codes(files, tmp_path, capsys):
     unstated = ["compare", str(files["sim_wear"]), str(files["meas_unstated"]), "-o", str(out)]
     assert main(unstated) == 3
     assert "angle_zero" in capsys.readouterr().err
+
+
+def test_compare_cli_motion_variables(files, tmp_path, capsys):
+    out = tmp_path / "m.nc"
+    argv = ["compare", str(files["sim_motion"]), str(files["meas_motion"]), "-o", str(out)]
+    assert main([*argv, "--variable", "follower_velocity"]) == 0
+    text = capsys.readouterr().out
+    assert "follower velocity z history" in text and "wear map" not in text
+    assert main([*argv, "--variable", "journal_offset"]) == 3
+    assert "journal_offset are not in both" in capsys.readouterr().err

@@ -151,3 +151,32 @@ def test_report_cli_html_pdf_and_comparison(report_files, tmp_path, capsys):
     # usage errors
     assert main(["report", "--out", str(out2)]) == 3
     assert "no simulation given" in capsys.readouterr().err
+
+
+def test_verification_figures_and_pdf_determinism(built, tmp_path):
+    import numpy as np
+    import xarray as xr
+
+    from jointwear.reports import render_html, write_pdf
+
+    _, result = built
+    # a convergence study: error ~ h^2 over four grid sizes
+    h = np.array([4.0, 2.0, 1.0, 0.5])
+    conv = xr.Dataset(
+        {
+            "wear_error": (
+                "grid_step",
+                1e-6 * h**2,
+                {"units": "m", "long_name": "error of max depth"},
+            )
+        },
+        coords={"grid_step": ("grid_step", h, {"units": "degree"})},
+    )
+    page = _Page()
+    page.feed(render_html(result, verification=[conv], command="t"))
+    assert page.h2 == EXPECTED_SECTIONS
+    # polar plots, motion and the verification figure
+    assert page.tags.get("svg", 0) == 3
+    a = write_pdf(result, tmp_path / "a.pdf", verification=[conv])
+    b = write_pdf(result, tmp_path / "b.pdf", verification=[conv])
+    assert a.read_bytes() == b.read_bytes() and a.read_bytes().startswith(b"%PDF")
