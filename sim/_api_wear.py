@@ -15,6 +15,7 @@ from jointwear.sim.wear import (
     WearSettings,
     calibrate_kw,
     default_snapshots,
+    halved_schedule,
     simulate_wear,
 )
 from jointwear.sim.wearmap import (
@@ -35,6 +36,7 @@ __all__ = [
     "default_snapshots",
     "KwCalibration",
     "calibrate_kw",
+    "halved_schedule",
     "BearingGrid",
     "wear_map_dataset",
     "worn_volume",

@@ -34,6 +34,7 @@ docs/sim-wear.md for how the default was obtained.
 from __future__ import annotations
 
 import dataclasses
+import json
 import math
 import pickle
 from collections.abc import Callable, Mapping, Sequence
@@ -60,10 +61,11 @@ __all__ = [
     "default_snapshots",
     "KwCalibration",
     "calibrate_kw",
+    "halved_schedule",
 ]
 
 #: Default Archard wear coefficient [m²/N = m³/(N m)]; derivation in docs/sim-wear.md.
-DEFAULT_KW: float = 1.0e-14
+DEFAULT_KW: float = 9.0e-16
 
 #: Accepted range of kw [m²/N]. Above 1e-11 (1e-2 mm³/(N m), beyond severe dry wear) the bore of
 #: the study would wear through in hours; below 1e-20 nothing measurable wears in any lifetime.
@@ -104,12 +106,16 @@ class WearSettings:
     ----------
     kw : float
         Archard wear coefficient [m²/N]; default :data:`DEFAULT_KW`.
-    scheme : {"adaptive", "fixed"}
-        Update-interval control (see module docstring).
+    scheme : {"adaptive", "fixed", "schedule"}
+        Update-interval control (see module docstring); ``"schedule"`` uses the intervals of
+        ``schedule`` in order (e.g. an adaptive run's ``update_dn`` with every interval halved,
+        to check its convergence).
     dn : int
         Cycles per update for ``"fixed"``; the first interval for ``"adaptive"``.
     tol : float
         Adaptive: allowed relative change of the wear-rate field per update.
+    schedule : tuple of int
+        ``"schedule"``: the update intervals [cycles], the last one repeated.
     dn_min, dn_max : int
         Adaptive: bounds of the interval [cycles].
     max_increment : float or None
@@ -122,15 +128,16 @@ class WearSettings:
         Adaptive: reject an update whose rate change exceeds ``reject_factor * tol``.
     estimate_noise : bool
         Adaptive: measure the cycle-to-cycle variability of the wear-rate field on the initial
-        profile (one extra cycle) and subtract it from the rate change, so that non-periodic
-        dynamics (impacts) do not force the interval down to ``dn_min``.
+        profile (two extra cycles) and remove it (in quadrature) from the rate change, so that
+        non-periodic dynamics (impacts) do not force the interval down to ``dn_min``.
     noise_floor : float
         Adaptive: a further relative rate change to be ignored (added to the estimate).
     """
 
     kw: float = DEFAULT_KW
-    scheme: Literal["adaptive", "fixed"] = "adaptive"
+    scheme: Literal["adaptive", "fixed", "schedule"] = "adaptive"
     dn: int = 200
+    schedule: tuple[int, ...] = ()
     tol: float = 0.1
     dn_min: int = 1
     dn_max: int = 200_000
@@ -143,8 +150,21 @@ class WearSettings:
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "kw", _check_kw(self.kw))
-        if self.scheme not in ("adaptive", "fixed"):
-            raise ParameterError(f"wear scheme must be 'adaptive' or 'fixed', got {self.scheme!r}")
+        if self.scheme not in ("adaptive", "fixed", "schedule"):
+            raise ParameterError(
+                f"wear scheme must be 'adaptive', 'fixed' or 'schedule', got {self.scheme!r}"
+            )
+        try:
+            sched = tuple(int(v) for v in self.schedule)
+        except (TypeError, ValueError):
+            raise ParameterError(
+                "wear.schedule must be a list of whole numbers of cycles"
+            ) from None
+        if any(v < 1 or v != w for v, w in zip(sched, self.schedule, strict=True)):
+            raise ParameterError("wear.schedule must hold whole numbers of cycles >= 1")
+        if self.scheme == "schedule" and not sched:
+            raise ParameterError("wear.scheme = 'schedule' needs a non-empty wear.schedule")
+        object.__setattr__(self, "schedule", sched)
         for name in ("dn", "dn_min", "dn_max"):
             v = getattr(self, name)
             if isinstance(v, float) and v.is_integer():
@@ -418,6 +438,9 @@ class WearRun:
         """(dn to use now, dn proposed before clipping to the next stop)."""
         st = self.settings
         dn = int(self._s["dn_next"])
+        if st.scheme == "schedule":
+            k = sum(1 for item in self._s["history"] if item[3] == 1)
+            dn = st.schedule[min(k, len(st.schedule) - 1)]
         if st.max_increment is not None:
             rmax = float(np.max(rate))
             if rmax > 0:
@@ -442,10 +465,19 @@ class WearRun:
                 s["h"], s["state"], st.initial_settle_cycles
             )
             if adaptive and st.estimate_noise:
-                again, work, state, n2 = self._measure(s["h"], s["state"], 0.0)
-                s["noise"] = self._rate_change(again, s["rate"])
-                s["rate"], s["work_rate"], s["state"] = again, work, state
-                n_sim += n2
+                # two more cycles on the same profile: their rate fields differ only by the
+                # cycle-to-cycle variability of the dynamics (rms of the three pair changes)
+                rates, works = [s["rate"]], [s["work_rate"]]
+                for _ in range(2):
+                    r, w, s["state"], n2 = self._measure(s["h"], s["state"], 0.0)
+                    rates.append(r)
+                    works.append(w)
+                    n_sim += n2
+                pairs = [(0, 1), (1, 2), (0, 2)]
+                s["noise"] = float(
+                    np.sqrt(np.mean([self._rate_change(rates[j], rates[i]) ** 2 for i, j in pairs]))
+                )
+                s["rate"], s["work_rate"] = rates[-1], works[-1]
             s["cycles_simulated"] += n_sim
             self._s = s
             self._save()
@@ -457,7 +489,9 @@ class WearRun:
         h_new = old["h"] + dn * old["rate"]
         rate_new, work_new, state_new, n_sim = self._measure(h_new, old["state"], st.settle_cycles)
         eta_raw = self._rate_change(rate_new, old["rate"])
-        eta = max(0.0, eta_raw - old["noise"] - st.noise_floor)
+        # variability adds in quadrature to the change caused by the profile update
+        eta = math.sqrt(max(0.0, eta_raw**2 - old["noise"] ** 2)) - st.noise_floor
+        eta = max(0.0, eta)
         s = dict(old)
         s["cycles_simulated"] = old["cycles_simulated"] + n_sim
         if adaptive and eta > st.reject_factor * st.tol and dn > st.dn_min:
@@ -574,7 +608,7 @@ class WearRun:
         attrs = {
             "kw_m2_per_N": kw,
             "wear_scheme": st.scheme,
-            "wear_settings": to_jsonable(st),
+            "wear_settings": json.dumps(to_jsonable(st), sort_keys=True),
             "cycles_target": self.target,
             "cycles_done": s["done"],
             "cycles_simulated": s["cycles_simulated"],
@@ -589,6 +623,18 @@ class WearRun:
         return wear_map_dataset(
             maps, cyc, self.grid, cylindricity=cylindricity, extra=extra, attrs=attrs
         )
+
+
+def halved_schedule(ds: xr.Dataset) -> tuple[int, ...]:
+    """The accepted update intervals of a wear map with each one split in two halves.
+
+    ``WearSettings(scheme="schedule", schedule=halved_schedule(ds))`` repeats the run of ``ds``
+    with half the update interval everywhere (the snapshots fall on the same cycles): the
+    difference of the two results measures the convergence in dN.
+    """
+    acc = np.asarray(ds["update_accepted"].values) == 1
+    seq = np.asarray(ds["update_dn"].values)[acc].astype(int)
+    return tuple(int(x) for d in seq for x in (d // 2, d - d // 2) if x > 0)
 
 
 def simulate_wear(
@@ -683,7 +729,8 @@ class KwCalibration:
     kw_linear : float
         The linear estimate ``kw_sim * measured / simulated`` [m²/N].
     quantity : str
-        What was matched: ``"max_depth"`` [m], ``"volume"`` [m³] or ``"map"`` (least-squares scale).
+        What was matched: ``"max_depth"`` [m], ``"volume"`` [m³], ``"cylindricity"`` [m] or
+        ``"map"`` (least-squares scale).
     cycles : float
         Cycle count at which the measurement was compared.
     measured : float
@@ -756,6 +803,13 @@ def _quantity(sim: xr.Dataset, quantity: str, cycles: float, measured: Any) -> t
         return float(measured), float(_at_cycles(sim["max_wear_depth"], cycles))
     if quantity == "volume":
         return float(measured), float(_at_cycles(sim["worn_volume"], cycles))
+    if quantity == "cylindricity":
+        value = float(_at_cycles(sim["cylindricity"], cycles))
+        if not np.isfinite(value):
+            raise BadInputError(
+                "the simulated map has no cylindricity (jointwear.metrology is not available)"
+            )
+        return float(measured), value
     m, s = _map_on(measured, _at_cycles(sim["wear_depth"], cycles))
     if not np.any(s > 0):
         raise BadInputError("the simulated map shows no wear where the measurement has data")
@@ -768,7 +822,7 @@ def calibrate_kw(
     simulated: xr.Dataset,
     measured: float | xr.DataArray | xr.Dataset,
     *,
-    quantity: Literal["max_depth", "volume", "map"] | None = None,
+    quantity: Literal["max_depth", "volume", "cylindricity", "map"] | None = None,
     cycles: float | None = None,
     resimulate: Callable[[float], xr.Dataset] | None = None,
     rtol: float = 0.02,
@@ -789,9 +843,11 @@ def calibrate_kw(
         A wear map from :func:`simulate_wear` (carries ``kw_m2_per_N``).
     measured : float or DataArray or Dataset
         Measured maximum depth [m] (``quantity="max_depth"``), worn volume [m³]
-        (``"volume"``), or a measured wear map ``wear_depth(z, theta)`` [m] with a stated angle
+        (``"volume"``), growth of the bore's cylindricity [m] (``"cylindricity"``: measured
+        after minus before, the simulated bore starting as a perfect cylinder), or a measured
+        wear map ``wear_depth(z, theta)`` [m] with a stated angle
         convention (``"map"``: least-squares scale of the simulated map onto it).
-    quantity : {"max_depth", "volume", "map"}, optional
+    quantity : {"max_depth", "volume", "cylindricity", "map"}, optional
         Default ``"map"`` for a map, else ``"max_depth"``.
     cycles : float, optional
         Cycle count of the measurement; default the map's ``cycles`` coordinate/attribute, or
@@ -809,8 +865,10 @@ def calibrate_kw(
         measured = measured["wear_depth"]
     is_map = isinstance(measured, xr.DataArray)
     quantity = quantity or ("map" if is_map else "max_depth")
-    if quantity not in ("max_depth", "volume", "map"):
-        raise BadInputError(f"quantity must be 'max_depth', 'volume' or 'map', got {quantity!r}")
+    if quantity not in ("max_depth", "volume", "cylindricity", "map"):
+        raise BadInputError(
+            f"quantity must be 'max_depth', 'volume', 'cylindricity' or 'map', got {quantity!r}"
+        )
     if is_map:
         if quantity != "map":
             raise BadInputError(f"a measured map needs quantity='map', got {quantity!r}")

@@ -273,8 +273,12 @@ def test_bad_kw_is_refused(kw, match):
 
 
 def test_bad_settings_and_targets():
-    with pytest.raises(ParameterError, match="scheme must be 'adaptive' or 'fixed'"):
+    with pytest.raises(ParameterError, match="scheme must be .adaptive., .fixed. or .schedule."):
         WearSettings(scheme="implicit")
+    with pytest.raises(ParameterError, match="needs a non-empty wear.schedule"):
+        WearSettings(scheme="schedule")
+    with pytest.raises(ParameterError, match="whole numbers of cycles >= 1"):
+        WearSettings(scheme="schedule", schedule=(10, 0))
     with pytest.raises(ParameterError, match="dn_min = 10 exceeds"):
         WearSettings(dn_min=10, dn_max=5)
     with pytest.raises(ParameterError, match=r"wear\.tol must be in \(0, 1\)"):
