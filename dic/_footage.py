@@ -832,26 +832,27 @@ def _assemble(states, times, flags, duplicates, L, R, cfg, calibration, status) 
     for st in states:
         rows = st.rows
         name = st.spec.name
+        img = "" if stereo else "_image"  # one camera: pixels, not the contract's metres
         poi = np.asarray(rows["poi"], dtype=float)
         poi_u = np.asarray(rows["poi_u"], dtype=float)
         poi_v = np.where(valid_time[:, None], poi, np.nan)
         vel, gain = time_derivative(t, poi_v, window=cfg.velocity_window, order=cfg.velocity_order)
         vel_u = gain[:, None] * np.nanmedian(poi_u, axis=0)[None, :]
-        data[f"{name}_position"] = (
+        data[f"{name}{img}_position"] = (
             ("time", "axis"),
             poi,
             {
                 "units": unit,
                 "long_name": f"position of the {name}'s point of interest (world frame)",
-                "ancillary_variables": f"{name}_position_u",
+                "ancillary_variables": f"{name}{img}_position_u",
             },
         )
-        data[f"{name}_position_u"] = (
+        data[f"{name}{img}_position_u"] = (
             ("time", "axis"),
             poi_u,
-            {"units": unit, "long_name": f"standard uncertainty of {name}_position"},
+            {"units": unit, "long_name": f"standard uncertainty of {name}{img}_position"},
         )
-        data[f"{name}_velocity"] = (
+        data[f"{name}{img}_velocity"] = (
             ("time", "axis"),
             vel,
             {"units": f"{unit} s-1", "long_name": f"velocity of the {name}'s point of interest"},
@@ -912,13 +913,11 @@ def _assemble(states, times, flags, duplicates, L, R, cfg, calibration, status) 
             attrs_extra[f"{name}_noise_floor_z_per_point_m"] = floor
             attrs_extra[f"{name}_noise_floor_z_body_m"] = floor / np.sqrt(len(st.ref3d))
         role = st.spec.role
-        if role == "follower":
+        if role == "follower" and stereo:
             data["follower_position"] = (
                 ("time", "axis"),
                 poi,
-                C.variable_attrs("follower_position", ancillary_variables="follower_position_u")
-                if stereo
-                else {"units": unit, "long_name": "follower centre of mass in the image"},
+                C.variable_attrs("follower_position", ancillary_variables="follower_position_u"),
             )
             data["follower_position_u"] = (
                 ("time", "axis"),
@@ -931,40 +930,40 @@ def _assemble(states, times, flags, duplicates, L, R, cfg, calibration, status) 
                 C.variable_attrs(
                     "follower_velocity",
                     ancillary_variables="follower_velocity_u",
-                    method=f"Savitzky-Golay on frame times, window {cfg.velocity_window} samples, order {cfg.velocity_order}",
-                )
-                if stereo
-                else {
-                    "units": f"{unit} s-1",
-                    "long_name": "follower centre of mass velocity in the image",
-                },
+                    method=f"Savitzky-Golay on frame times, window {cfg.velocity_window} "
+                    f"samples, order {cfg.velocity_order}",
+                ),
             )
             data["follower_velocity_u"] = (
                 ("time", "axis"),
                 vel_u,
                 {
                     "units": f"{unit} s-1",
-                    "long_name": "standard uncertainty of follower_velocity (noise propagated through the differentiator)",
+                    "long_name": "standard uncertainty of follower_velocity (noise propagated "
+                    "through the differentiator)",
                 },
             )
         elif role == "journal":
             disp = poi - poi[:1]
-            data["journal_displacement"] = (
+            jname = "journal_displacement" if stereo else "journal_image_displacement"
+            data[jname] = (
                 ("time", "axis"),
                 disp,
                 {
                     "units": unit,
                     "long_name": "displacement of the journal since the reference frame (z = out of plane)",
-                    "ancillary_variables": "journal_displacement_u",
+                    "ancillary_variables": f"{jname}_u",
                 },
             )
-            data["journal_displacement_u"] = (
+            data[f"{jname}_u"] = (
                 ("time", "axis"),
                 poi_u * np.sqrt(2),
                 {"units": unit, "long_name": "standard uncertainty of journal_displacement"},
             )
         elif role == "crank":
             ang = np.unwrap(rotation_angle_z(np.asarray(rows["R"], dtype=float)))
+            if not stereo:  # image y points down: a counter-clockwise turn looks clockwise
+                ang = -ang
             ang = ang + np.deg2rad(st.spec.reference_angle_deg)
             data["crank_angle"] = (
                 "time",

@@ -338,3 +338,20 @@ def test_crank_angle_tracked(tmp_path):
     assert np.ptp(np.degrees(truth["crank_angle"].values)) > 70
     assert np.max(np.abs(err)) < 0.02
     assert ds["crank_angle"].attrs["units"] == "rad"
+
+
+def test_single_camera_tracks_in_pixels(small, tmp_path):
+    cfg, written, out = small
+    tc, bodies = read_bodies(written["bodies"])
+    target = tmp_path / "mono.nc"
+    ds = track_footage(
+        written["left_images"], fps=50, bodies=bodies, config=tc, max_frames=4, out=target
+    )
+    assert (
+        "follower_velocity" not in ds
+        and ds["follower_image_velocity"].attrs["units"] == "pixel s-1"
+    )
+    # the follower moves by pixels to tens of pixels per frame in the image
+    step = np.linalg.norm(np.diff(ds["follower_image_position"].values, axis=0), axis=1)
+    assert np.all(step > 1) and step.sum() > 20
+    assert io.load(target).attrs["world_frame"] == "left image (pixels)"
