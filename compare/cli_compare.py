@@ -103,6 +103,15 @@ def register(app: typer.Typer) -> None:
         for row in result.decisions.itertuples():
             mark = "PASS" if row.passed else "FAIL"
             typer.echo(f"{mark}  {row.quantity}: {row.value}  [{row.criterion}]")
+        if result.wear is not None:
+            typer.echo(f"wear maps: {result.wear.attrs['interpolation']}")
+        if result.motion is not None:
+            a = result.motion.attrs
+            typer.echo(
+                f"motion aligned by {a['alignment_method'].replace('_', ' ')}: shift "
+                f"{a['time_shift_s'] * 1e3:+.2f} ms ({a['time_shift_deg']:+.1f} degree of crank "
+                f"angle) over {a['n_cycles']:g} cycle(s)"
+            )
         for note in result.notes:
             typer.echo(f"note: {note}")
         typer.echo(f"metrics: {out}")

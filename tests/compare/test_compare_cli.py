@@ -61,5 +61,6 @@ def test_compare_cli_motion_variables(files, tmp_path, capsys):
     assert main([*argv, "--variable", "follower_velocity"]) == 0
     text = capsys.readouterr().out
     assert "follower velocity z history" in text and "wear map" not in text
+    assert "motion aligned by crank angle: shift -111.41 ms (-80.2 degree" in text
     assert main([*argv, "--variable", "journal_offset"]) == 3
     assert "journal_offset are not in both" in capsys.readouterr().err
