@@ -233,7 +233,9 @@ def _context(
 
     n = len(c.decisions)
     n_pass = int(c.decisions["passed"].sum()) if n else 0
-    missing = [*missing, *c.notes]
+    # the comparison's own notes ("motion not compared: ...") unless the caller already said why
+    covered = {m.split(":", 1)[0].split()[0].lower() for m in missing if m.strip()}
+    missing = [*missing, *(n for n in c.notes if n.split()[0].lower() not in covered)]
     ctx: dict[str, Any] = {
         "version": __version__,
         "title": title,
