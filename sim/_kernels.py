@@ -112,6 +112,14 @@ def _node(n, m, J0, u, P, H, ZL, Nd):
 
 
 @njit(cache=True)
+def _dl(t, P):
+    """Penetration of a node tuple from :func:`_node`, -1 beyond the journal's ends."""
+    if abs(t[7]) > 0.5 * P[LJ]:
+        return -1.0
+    return t[0]
+
+
+@njit(cache=True)
 def _node_delta(n, m, J0, u, P, H, ZL, Nd):
     d = _node(n, m, J0, u, P, H, ZL, Nd)
     if abs(d[7]) > 0.5 * P[LJ]:
@@ -211,31 +219,41 @@ def _contact(
         # climb from the node facing the eccentricity to the nearest local maximum of the
         # penetration on each side; keep the deeper one (on a worn profile the journal can
         # bridge a narrow groove and touch both flanks: the deeper flank carries the slice)
-        c0 = _node_delta(n, m0, J0, u, P, H, ZL, Nd)
-        cp = _node_delta(n, m0 + 1, J0, u, P, H, ZL, Nd)
-        cm = _node_delta(n, m0 - 1, J0, u, P, H, ZL, Nd)
+        t0 = _node(n, m0, J0, u, P, H, ZL, Nd)
+        tp = _node(n, m0 + 1, J0, u, P, H, ZL, Nd)
+        tm = _node(n, m0 - 1, J0, u, P, H, ZL, Nd)
+        c0, cp, cm = _dl(t0, P), _dl(tp, P), _dl(tm, P)
         ms, dm, d0, dp = m0, cm, c0, cp
+        nm, n0, npp = tm, t0, tp
         found = False
         if cp > c0:
-            r, a0, a1, a2 = m0 + 1, c0, cp, _node_delta(n, m0 + 2, J0, u, P, H, ZL, Nd)
+            r, b0, b1 = m0 + 1, t0, tp
+            b2 = _node(n, m0 + 2, J0, u, P, H, ZL, Nd)
+            a0, a1, a2 = c0, cp, _dl(b2, P)
             for _ in range(Nd // 2):
                 if a2 <= a1:
                     break
                 r += 1
-                a0, a1 = a1, a2
-                a2 = _node_delta(n, r + 1, J0, u, P, H, ZL, Nd)
+                a0, a1, b0, b1 = a1, a2, b1, b2
+                b2 = _node(n, r + 1, J0, u, P, H, ZL, Nd)
+                a2 = _dl(b2, P)
             ms, dm, d0, dp = r, a0, a1, a2
+            nm, n0, npp = b0, b1, b2
             found = True
         if cm > c0:
-            r, a0, a1, a2 = m0 - 1, c0, cm, _node_delta(n, m0 - 2, J0, u, P, H, ZL, Nd)
+            r, b0, b1 = m0 - 1, t0, tm
+            b2 = _node(n, m0 - 2, J0, u, P, H, ZL, Nd)
+            a0, a1, a2 = c0, cm, _dl(b2, P)
             for _ in range(Nd // 2):
                 if a2 <= a1:
                     break
                 r -= 1
-                a0, a1 = a1, a2
-                a2 = _node_delta(n, r - 1, J0, u, P, H, ZL, Nd)
+                a0, a1, b0, b1 = a1, a2, b1, b2
+                b2 = _node(n, r - 1, J0, u, P, H, ZL, Nd)
+                a2 = _dl(b2, P)
             if not found or a1 > d0:
                 ms, dm, d0, dp = r, a2, a1, a0
+                nm, n0, npp = b2, b1, b0
         if IP[PER_POINT] == 0:
             # parabola through the three nodes around the maximum
             b = 0.5 * (dp - dm)
@@ -257,9 +275,6 @@ def _contact(
             lm = 0.5 * x * (x - 1.0)
             l0 = 1.0 - x * x
             lp = 0.5 * x * (x + 1.0)
-            nm = _node(n, ms - 1, J0, u, P, H, ZL, Nd)
-            n0 = _node(n, ms, J0, u, P, H, ZL, Nd)
-            npp = _node(n, ms + 1, J0, u, P, H, ZL, Nd)
             cx = lm * nm[1] + l0 * n0[1] + lp * npp[1]
             cy = lm * nm[2] + l0 * n0[2] + lp * npp[2]
             cz = lm * nm[3] + l0 * n0[3] + lp * npp[3]
@@ -277,9 +292,9 @@ def _contact(
             vm = vimp[n]
             if vm <= 0.0:
                 vm = rate if rate > vfloor else vfloor
-            fel = WL[n] * K * dstar**nexp
+            fel = WL[n] * K * (dstar * math.sqrt(dstar) if nexp == 1.5 else dstar**nexp)
             fn = fel * ln_factor(rate, vm, ce)
-            energy += WL[n] * K * dstar ** (nexp + 1.0) / (nexp + 1.0)
+            energy += fel * dstar / (nexp + 1.0)
             # normal force on the bearing, distributed on the three nodes (exactly conservative)
             for k in range(3):
                 nd = nm if k == 0 else (n0 if k == 1 else npp)
