@@ -10,6 +10,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from jointwear import io
+from jointwear.cli import main
+from jointwear.errors import BadInputError
 from jointwear.params import replace_nested
 from jointwear.sim import (
     DEFAULT_KW,
@@ -115,3 +118,31 @@ def test_resume_with_the_dynamics_is_identical(tmp_path):
     ).run()
     np.testing.assert_array_equal(resumed["wear_depth"].values, full["wear_depth"].values)
     np.testing.assert_array_equal(resumed["normal_work"].values, full["normal_work"].values)
+
+
+def test_resume_refuses_changed_simulator_parameters(tmp_path):
+    params = replace_nested(PARAMS, **{"joint.n_layers": 6, "joint.n_points": 60})
+    settings = WearSettings(kw=DEFAULT_KW, scheme="fixed", dn=500, settle_cycles=0.5)
+    ckpt = tmp_path / "d.ckpt"
+    WearRun(DynamicContact(params), settings, cycles=500, snapshots=[], checkpoint=ckpt).run()
+    other = replace_nested(params, **{"joint.journal_radius": 7.4e-3})
+    with pytest.raises(BadInputError, match=r"contact\.parameters\.joint\.journal_radius: 0\.0075"):
+        WearRun.resume(ckpt, DynamicContact(other), settings, cycles=1000)
+
+
+def test_cli_with_the_dynamics_and_a_parameter_file(tmp_path):
+    toml = tmp_path / "p.toml"
+    toml.write_text(
+        "[joint]\nn_layers = 6\nn_points = 60\n\n"
+        '[wear]\nkw = 4.5e-14\nscheme = "fixed"\ndn = 500\nsettle_cycles = 0.5\n'
+    )
+    out = tmp_path / "w.nc"
+    code = main(["sim", "wear", "--cycles", "1000", "--out", str(out), "--params", str(toml)])
+    assert code == 0
+    ds = io.load(out)
+    assert ds.sizes["z"] == 6 and ds.sizes["theta"] == 60
+    assert ds.attrs["kw_m2_per_N"] == 4.5e-14
+    assert ds.attrs["contact_model"] == "dynamics"
+    np.testing.assert_allclose(ds["worn_volume"].values, ds["archard_volume"].values, rtol=0.01)
+    prov = io.parse_provenance(ds)
+    assert prov["parameters"]["contact"]["parameters"]["joint"]["n_points"] == 60
