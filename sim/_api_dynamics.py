@@ -8,6 +8,7 @@ from jointwear.sim.dynamics import (
     initial_state,
     point_area,
     run_cycles,
+    wear_depth_on_grid,
 )
 from jointwear.sim.friction import friction_coefficient
 from jointwear.sim.mechanism import loop_closure
@@ -37,6 +38,7 @@ __all__ = [
     "SimState",
     "initial_state",
     "point_area",
+    "wear_depth_on_grid",
     "CONTACT_MODES",
     "contact_constant",
     "contact_stiffness",

@@ -26,6 +26,17 @@ def register(app: typer.Typer) -> None:
         base: Annotated[
             str, typer.Option("--base", help="Named parameter set the overrides apply to.")
         ] = "zhang2023",
+        wear: Annotated[
+            Path | None,
+            typer.Option(
+                "--wear",
+                help="netCDF file with a wear_depth map (z, theta) to simulate the worn bearing.",
+            ),
+        ] = None,
+        wear_cycles: Annotated[
+            float | None,
+            typer.Option("--wear-cycles", help="Snapshot of the wear map (default: the last)."),
+        ] = None,
         progress: Annotated[
             bool, typer.Option("--progress/--no-progress", help="Progress bar on stderr.")
         ] = True,
@@ -55,6 +66,18 @@ def register(app: typer.Typer) -> None:
         io.check_writable(out)
         source = f"jointwear {__version__} (sim.dynamics)"
         inputs = [params] if params is not None else []
+        depth = None
+        if wear is not None:
+            from jointwear.sim.dynamics import wear_depth_on_grid
+
+            worn = io.load(wear, validate=False)
+            if "wear_depth" not in worn:
+                raise BadInputError(f"--wear '{wear}' has no 'wear_depth' variable")
+            try:
+                depth = wear_depth_on_grid(worn["wear_depth"], p, cycles=wear_cycles)
+            except BadInputError as exc:
+                raise BadInputError(f"--wear '{wear}': {exc}") from None
+            inputs.append(wear)
         with progress_bar(
             f"crank cycles ({p.name})", total=cycles, enabled=None if progress else False
         ) as bar:
@@ -64,7 +87,7 @@ def register(app: typer.Typer) -> None:
                 bar.update(task, completed=fraction * cycles)
 
             try:
-                result = run_cycles(p, cycles=cycles, progress=report)
+                result = run_cycles(p, cycles=cycles, wear_depth=depth, progress=report)
             except SimulationError as exc:
                 if exc.partial is not None:
                     partial = out.with_name(out.stem + ".partial.nc")

@@ -22,7 +22,14 @@ from jointwear.sim.contact import contact_constant
 from jointwear.sim.mechanism import loop_closure, quaternion_to_matrix, rotation_xzy_angles
 from jointwear.sim.parameters import SimParameters
 
-__all__ = ["SimState", "CycleResult", "run_cycles", "initial_state", "CONTACT_MODES"]
+__all__ = [
+    "SimState",
+    "CycleResult",
+    "run_cycles",
+    "initial_state",
+    "CONTACT_MODES",
+    "wear_depth_on_grid",
+]
 
 #: Contact modes recorded in ``contact_mode`` (flag value -> meaning).
 CONTACT_MODES: dict[int, str] = {
@@ -215,6 +222,62 @@ def point_area(params: SimParameters, wear_depth: np.ndarray | None = None) -> n
     j = params.joint
     dz = w * j.bearing_width
     return dz[:, None] * (j.bearing_radius + h) * (2 * math.pi / j.n_points)
+
+
+def wear_depth_on_grid(
+    wear_depth: xr.DataArray, params: SimParameters, *, cycles: float | None = None
+) -> np.ndarray:
+    """Resample a wear map onto the simulation grid (Nl, Nd) for ``run_cycles(wear_depth=...)``.
+
+    Parameters
+    ----------
+    wear_depth : DataArray
+        Wear depth [m] over ``z`` [m] and ``theta`` [degree] (any stated angle convention; it
+        is converted to the canonical one), optionally with a ``cycles`` dimension.
+    params : SimParameters
+        Gives the grid: layer n at z = wb/2 - n wb/(Nl-1), point m at m 360/Nd degrees.
+    cycles : float, optional
+        Snapshot to take along ``cycles`` (nearest); default the last.
+
+    Returns
+    -------
+    ndarray (Nl, Nd)
+        Linear interpolation in z (layers outside the map's z range take its edge values) and
+        periodic linear interpolation in theta.
+    """
+    da = wear_depth
+    if not isinstance(da, xr.DataArray):
+        raise BadInputError("wear_depth must be an xarray DataArray over (z, theta)")
+    if "cycles" in da.dims:
+        da = da.isel(cycles=-1) if cycles is None else da.sel(cycles=cycles, method="nearest")
+    missing = [d for d in ("z", "theta") if d not in da.dims]
+    if missing or da.ndim != 2:
+        raise BadInputError(
+            f"wear_depth map has dims {da.dims}, expected (z, theta) [+ cycles]; missing "
+            f"{', '.join(missing) or 'nothing'}"
+        )
+    units = da.attrs.get("units")
+    if units not in (None, "m"):
+        raise BadInputError(f"wear_depth map has units {units!r}, expected 'm'")
+    da = conventions.to_canonical(da).transpose("z", "theta").sortby("z")
+    th = np.asarray(da.theta.values, dtype=float)
+    z = np.asarray(da.z.values, dtype=float)
+    vals = np.asarray(da.values, dtype=float)
+    if not np.all(np.isfinite(vals)):
+        raise BadInputError("wear_depth map contains NaN or infinite values")
+    th_ext = np.concatenate([th[-1:] - 360.0, th, th[:1] + 360.0])
+    v_ext = np.concatenate([vals[:, -1:], vals, vals[:, :1]], axis=1)
+    j = params.joint
+    tgt_th = np.arange(j.n_points) * 360.0 / j.n_points
+    tgt_z, _ = _layers(params)
+    by_theta = np.stack([np.interp(tgt_th, th_ext, row) for row in v_ext])  # (nz, Nd)
+    if z.size == 1:
+        return np.repeat(by_theta, j.n_layers, axis=0)
+    zc = np.clip(tgt_z, z[0], z[-1])
+    out = np.empty((j.n_layers, j.n_points))
+    for m in range(j.n_points):
+        out[:, m] = np.interp(zc, z, by_theta[:, m])
+    return out
 
 
 _ANG = {"clearance": np.array([1, 1, 0, 0, 1, 1, 1, 1, 0, 0, 0], dtype=np.int64)}

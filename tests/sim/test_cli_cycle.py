@@ -45,3 +45,33 @@ def test_cycle_failure_keeps_partial(tmp_path, capsys):
     assert "crank angle" in err and "x.partial.nc" in err
     assert not out.exists()
     assert io.load(tmp_path / "x.partial.nc").sizes["time"] > 0
+
+
+def test_cycle_with_a_wear_map(tmp_path, capsys):
+    import xarray as xr
+
+    from jointwear.conventions import theta_coord, z_coord
+
+    depth = xr.DataArray(
+        np.full((5, 36), 20e-6),
+        coords={
+            "z": z_coord(np.linspace(-7.5e-3, 7.5e-3, 5)),
+            "theta": theta_coord(np.arange(0, 360, 10.0)),
+        },
+        dims=("z", "theta"),
+        attrs={"units": "m", "long_name": "wear depth"},
+    )
+    wear = tmp_path / "wear.nc"
+    io.save(xr.Dataset({"wear_depth": depth}), wear)
+    out = tmp_path / "worn.nc"
+    code = main(["sim", "cycle", "--cycles", "0.1", "--out", str(out), "--wear", str(wear)])
+    assert code == 0, capsys.readouterr().err
+    ds = io.load(out)
+    k = ds.contact_stiffness.values
+    k0 = 3.5794574116e10
+    assert np.allclose(k[k > 0] / k0, np.sqrt((8e-3 + 20e-6) / 8e-3), rtol=1e-6)
+    assert any("wear.nc" in str(i) for i in io.parse_provenance(ds)["inputs"])
+    bad = tmp_path / "bad.nc"
+    io.save(xr.Dataset({"other": depth}), bad)
+    assert main(["sim", "cycle", "--out", str(out), "--wear", str(bad)]) == 3
+    assert "has no 'wear_depth'" in capsys.readouterr().err

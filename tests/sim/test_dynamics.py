@@ -238,3 +238,35 @@ def test_recording_does_not_change_the_solution_and_reports_progress():
     np.testing.assert_array_equal(a.wear_work, b.wear_work)
     np.testing.assert_array_equal(a.state.y, b.state.y)
     assert seen == sorted(seen) and seen[-1] == 1.0 and len(seen) == 5
+
+
+def test_wear_map_resampled_onto_the_grid_in_the_canonical_convention():
+    from jointwear.conventions import AngleConvention, theta_coord, z_coord
+    from jointwear.errors import ConventionError
+    from jointwear.sim import wear_depth_on_grid
+
+    # a measured-style map: 13 layers 1 mm apart, 1 degree steps, 0 deg along +x, ccw
+    psi = np.arange(360.0)  # physical angle, ccw from +x
+    z = np.linspace(-6e-3, 6e-3, 13)
+
+    def truth(psi_deg, z_m):
+        return 10e-6 + 20e-6 * np.cos(np.radians(psi_deg - 30.0)) * (1 + z_m / 0.01)
+
+    da = xr.DataArray(
+        truth(psi[None, :], z[:, None]),
+        coords={"z": z_coord(z), "theta": theta_coord(psi, AngleConvention("+x", "ccw"))},
+        dims=("z", "theta"),
+        attrs={"units": "m"},
+    )
+    h = wear_depth_on_grid(da, BASE)
+    assert h.shape == (20, 200)
+    phi = np.arange(200) * 1.8  # canonical: from -x, clockwise
+    zn = np.clip(7.5e-3 - np.arange(20) * 15e-3 / 19, -6e-3, 6e-3)
+    expected = truth(180.0 - phi[None, :], zn[:, None])
+    np.testing.assert_allclose(h, expected, atol=2e-9)
+    stacked = xr.concat([da * 0, da], dim="cycles").assign_coords(cycles=[0.0, 1e5])
+    np.testing.assert_allclose(wear_depth_on_grid(stacked, BASE), h)
+    np.testing.assert_allclose(wear_depth_on_grid(stacked, BASE, cycles=0.0), 0.0)
+    da.theta.attrs.pop("angle_zero")
+    with pytest.raises(ConventionError, match="does not state its angle convention"):
+        wear_depth_on_grid(da, BASE)
