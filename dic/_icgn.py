@@ -1082,14 +1082,80 @@ def icgn_many(
             flags[i] = fl
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True)
+def icgn_serial(
+    ref_img,
+    ref_gx,
+    ref_gy,
+    ref_coef,
+    ref_invalid,
+    def_coef,
+    def_invalid,
+    order,
+    centres,
+    P,
+    active,
+    half,
+    quadratic,
+    max_iter,
+    tol,
+    min_std,
+    max_shift,
+    border,
+    zncc_min,
+    zncc,
+    iters,
+    flags,
+):
+    """As :func:`icgn_many` on one thread (for a handful of points, e.g. seeds)."""
+    n = centres.shape[0]
+    n_chunks = min(n, 64)
+    for ch in range(n_chunks):
+        work = make_work(half)
+        p = np.empty(12)
+        for i in range(ch, n, n_chunks):
+            if not active[i]:
+                continue
+            for q in range(12):
+                p[q] = P[i, q]
+            z, it, fl = solve_point(
+                ref_img,
+                ref_gx,
+                ref_gy,
+                ref_coef,
+                ref_invalid,
+                def_coef,
+                def_invalid,
+                order,
+                centres[i, 0],
+                centres[i, 1],
+                half,
+                quadratic,
+                p,
+                max_iter,
+                tol,
+                min_std,
+                max_shift,
+                border,
+                work,
+            )
+            if fl == FLAG_OK and not (z >= zncc_min):
+                fl = FLAG_LOW_CORRELATION
+            for q in range(12):
+                P[i, q] = p[q]
+            zncc[i] = z
+            iters[i] = it
+            flags[i] = fl
+
+
+@njit(cache=True)
 def subset_std(img, invalid, centres, half, border):
     """Standard deviation of the reference subset at every centre (NaN: unusable centre)."""
     H, W = img.shape
     n = centres.shape[0]
     out = np.full(n, np.nan)
     size = 2 * half + 1
-    for i in prange(n):
+    for i in range(n):
         xc = centres[i, 0]
         yc = centres[i, 1]
         if not (math.isfinite(xc) and math.isfinite(yc)):

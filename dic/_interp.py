@@ -16,7 +16,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
 __all__ = ["SplineImage", "prefilter", "interp_value", "interp_value_grad", "PAD"]
 
@@ -181,7 +181,7 @@ def _filter_columns(c, j0, j1, z1, z2, npoles):
                 c[k, j] = z * (c[k + 1, j] - c[k, j])
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True)
 def _prefilter_2d(img, order, out):
     """B-spline coefficients of ``img`` written into ``out`` with a mirrored border of PAD."""
     h, w = img.shape
@@ -196,15 +196,15 @@ def _prefilter_2d(img, order, out):
         z2 = math.sqrt(135.0 / 2.0 + a) - b - 13.0 / 2.0
         npoles = 2
     tmp = np.empty((h, w))
-    for i in prange(h):
+    for i in range(h):
         line = img[i].copy()
         _filter_line(line, z1, z2, npoles)
         tmp[i] = line
     nb = (w + 63) // 64
-    for blk in prange(nb):
+    for blk in range(nb):
         _filter_columns(tmp, blk * 64, min(w, blk * 64 + 64), z1, z2, npoles)
     # mirrored padding (reflect without repeating the edge sample)
-    for i in prange(h + 2 * PAD):
+    for i in range(h + 2 * PAD):
         si = i - PAD
         if si < 0:
             si = -si
@@ -219,7 +219,7 @@ def _prefilter_2d(img, order, out):
             out[i, j] = tmp[si, sj]
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True)
 def _node_gradients(coef, order, gx, gy):
     """Exact derivatives of the interpolant at the pixel nodes [grey level / pixel]."""
     h, w = gx.shape
@@ -233,7 +233,7 @@ def _node_gradients(coef, order, gx, gy):
     # separable: along x first (value and derivative filters) on rows -r..h+r, then along y
     tv = np.empty((h + 2 * r, w))
     td = np.empty((h + 2 * r, w))
-    for i in prange(h + 2 * r):
+    for i in range(h + 2 * r):
         row = coef[i + PAD - r]
         for j in range(w):
             sv = 0.0
@@ -244,7 +244,7 @@ def _node_gradients(coef, order, gx, gy):
                 sd += der[b] * cv
             tv[i, j] = sv
             td[i, j] = sd
-    for i in prange(h):
+    for i in range(h):
         for j in range(w):
             sx = 0.0
             sy = 0.0

@@ -99,5 +99,5 @@ def save_quicklook(ds: xr.Dataset, path: str | Path, **kwargs) -> Path:
     path = Path(path)
     fig = plot_displacement(ds, **kwargs)
     with atomic_path(path) as tmp:
-        fig.savefig(tmp, dpi=110, format=path.suffix.lstrip(".") or "png")
+        fig.savefig(tmp, dpi=90, format=path.suffix.lstrip(".") or "png")
     return path

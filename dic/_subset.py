@@ -367,9 +367,10 @@ class SubsetCorrelator:
         r = self.ref
         return (r.image, r.gx, r.gy, r.coef, self._ref_invalid, dspl.coef, dinv, r.order)
 
-    def _run_many(self, dspl, dinv, P, active, st):
+    def _run_many(self, dspl, dinv, P, active, st, serial=False):
         p = self.params
-        _icgn.icgn_many(
+        kernel = _icgn.icgn_serial if serial else _icgn.icgn_many
+        kernel(
             *self._kernel_args(dspl, dinv),
             self.centres,
             P,
@@ -445,7 +446,7 @@ class SubsetCorrelator:
             P0[1], P0[2] = math.cos(th) - 1.0, -math.sin(th)
             P0[7], P0[8] = math.sin(th), math.cos(th) - 1.0
             st.params[i] = P0
-            self._run_many(dspl, dinv, st.params, active, st)
+            self._run_many(dspl, dinv, st.params, active, st, serial=True)
             return st.flag[i] == _icgn.FLAG_OK
 
         u, v, peak, _ = integer_search(self.ref, raw_def, xc, yc, p.half, p.search_radius, guess)

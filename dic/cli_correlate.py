@@ -110,7 +110,6 @@ def register(app: typer.Typer) -> None:
         roi_vals = _parse_roi(roi)
         seeds = _parse_points(seed)
         t0 = _time.perf_counter()
-        background = None
         if deformed is None:
             if not reference.exists():
                 raise BadInputError(f"'{reference}' does not exist")
@@ -124,7 +123,6 @@ def register(app: typer.Typer) -> None:
                 params=params,
             )
             inputs = [reference] if reference.is_file() else []
-            background = frames[-1]
         else:
             ref_img = read_image(reference)
             def_img = read_image(deformed)
@@ -135,7 +133,6 @@ def register(app: typer.Typer) -> None:
                 ds = corr.correlate(def_img, seed_points=seeds)
                 bar.update(task, advance=1)
             inputs = [reference, deformed]
-            background = ref_img
         elapsed = _time.perf_counter() - t0
         save(
             ds,
@@ -150,6 +147,6 @@ def register(app: typer.Typer) -> None:
             f"{float(ds['zncc'].where(ds['flag'] == 0).median()):.4f}, {elapsed:.2f} s"
         )
         if plot is not None:
-            save_quicklook(ds, plot, background=background, title=reference.name)
+            save_quicklook(ds, plot, title=reference.name)
             msg += f"; figure {plot}"
         typer.echo(msg)
