@@ -16,6 +16,7 @@ from jointwear.sim.wear import (
     calibrate_kw,
     default_snapshots,
     halved_schedule,
+    resimulator,
     simulate_wear,
 )
 from jointwear.sim.wearmap import (
@@ -37,6 +38,7 @@ __all__ = [
     "KwCalibration",
     "calibrate_kw",
     "halved_schedule",
+    "resimulator",
     "BearingGrid",
     "wear_map_dataset",
     "worn_volume",

@@ -295,3 +295,27 @@ def describe_any(model: Any) -> dict[str, Any]:
     if hasattr(model, "describe"):
         return model.describe()
     return {"model": type(model).__name__}
+
+
+def contact_from_description(desc: dict[str, Any]) -> Any:
+    """Rebuild a contact model from its ``describe()`` record (as stored in provenance)."""
+    from jointwear.params import from_mapping
+
+    model = desc.get("model")
+    if model == "dynamics":
+        from jointwear.sim import SimParameters
+
+        return DynamicContact(from_mapping(SimParameters, desc["parameters"], where="parameters"))
+    if model in ("winkler", "constant"):
+        args = {k: v for k, v in desc.items() if k != "model"}
+        args["grid"] = BearingGrid(**args["grid"])
+        if model == "winkler":
+            args["load"] = tuple(args["load"])
+            args["load_angle_deg"] = tuple(args["load_angle_deg"])
+            return WinklerContact(**args)
+        args["pressure"] = np.asarray(args["pressure"], dtype=float)
+        return ConstantContact(**args)
+    raise ParameterError(
+        f"contact model {model!r} cannot be rebuilt from its description; "
+        "pass the model (or a resimulate function) explicitly"
+    )

@@ -86,7 +86,82 @@ def demo_winkler_contact(grid: Any) -> Any:
 
 
 def register(app: typer.Typer) -> None:
-    """Add ``jointwear sim wear`` to the ``sim`` group."""
+    """Add ``jointwear sim wear`` and ``jointwear sim calibrate-kw`` to the ``sim`` group."""
+
+    @app.command("calibrate-kw")
+    def calibrate(
+        simulated: Annotated[
+            Path, typer.Argument(help="Wear map written by 'jointwear sim wear'.")
+        ],
+        max_depth_um: Annotated[
+            float | None, typer.Option("--max-depth-um", help="Measured maximum wear depth [µm].")
+        ] = None,
+        volume_mm3: Annotated[
+            float | None, typer.Option("--volume-mm3", help="Measured worn volume [mm³].")
+        ] = None,
+        cylindricity_um: Annotated[
+            float | None,
+            typer.Option(
+                "--cylindricity-um", help="Measured growth of the bore's cylindricity [µm]."
+            ),
+        ] = None,
+        measured_map: Annotated[
+            Path | None,
+            typer.Option("--map", help="Measured wear map (netCDF with wear_depth(z, theta))."),
+        ] = None,
+        cycles: Annotated[
+            float | None,
+            typer.Option("--cycles", help="Cycle count of the measurement (default: last)."),
+        ] = None,
+        resimulate: Annotated[
+            bool,
+            typer.Option(
+                "--resimulate/--linear",
+                help="Check the linear estimate by re-simulating (default) or stop at it.",
+            ),
+        ] = True,
+        rtol: Annotated[
+            float, typer.Option("--rtol", help="Relative tolerance of the re-simulated match.")
+        ] = 0.02,
+    ) -> None:
+        """Estimate the wear coefficient kw from a measured wear depth, volume, cylindricity or map."""
+        from jointwear import io
+        from jointwear.errors import BadInputError
+        from jointwear.sim.wear import calibrate_kw, resimulator
+
+        given = {
+            "max_depth": None if max_depth_um is None else max_depth_um * 1e-6,
+            "volume": None if volume_mm3 is None else volume_mm3 * 1e-9,
+            "cylindricity": None if cylindricity_um is None else cylindricity_um * 1e-6,
+            "map": None if measured_map is None else io.load(measured_map),
+        }
+        chosen = {k: v for k, v in given.items() if v is not None}
+        if len(chosen) != 1:
+            raise BadInputError(
+                "give exactly one measurement: --max-depth-um, --volume-mm3, --cylindricity-um "
+                f"or --map (got {len(chosen)})"
+            )
+        ((quantity, measured),) = chosen.items()
+        sim = io.load(simulated)
+        cal = calibrate_kw(
+            sim,
+            measured,
+            quantity=quantity,
+            cycles=cycles,
+            resimulate=resimulator(sim) if resimulate else None,
+            rtol=rtol,
+        )
+        typer.echo(f"kw (linear estimate): {cal.kw_linear:.4g} m²/N")
+        if cal.linearity_error is not None:
+            typer.echo(
+                f"re-simulated with it: {100 * cal.linearity_error:+.1f} % off the measurement "
+                "(wear is not exactly linear in kw)"
+            )
+            state = "converged" if cal.converged else "NOT converged"
+            typer.echo(
+                f"kw (calibrated, {state} after {len(cal.iterations) - 1} re-simulations): "
+                f"{cal.kw:.4g} m²/N"
+            )
 
     @app.command("wear")
     def wear(

@@ -62,6 +62,7 @@ __all__ = [
     "KwCalibration",
     "calibrate_kw",
     "halved_schedule",
+    "resimulator",
 ]
 
 #: Default Archard wear coefficient [m²/N = m³/(N m)]; derivation in docs/sim-wear.md.
@@ -623,6 +624,40 @@ class WearRun:
         return wear_map_dataset(
             maps, cyc, self.grid, cylindricity=cylindricity, extra=extra, attrs=attrs
         )
+
+
+def resimulator(ds: xr.Dataset) -> Callable[[float], xr.Dataset]:
+    """A function ``f(kw) -> Dataset`` that repeats the run of the wear map ``ds`` with another kw.
+
+    The contact model and wear settings are rebuilt from the provenance ``ds`` carries (as
+    written by ``jointwear sim wear`` or :func:`jointwear.io.save` with
+    ``parameters={"contact": model.describe(), "wear": settings}``); the re-run stores the same
+    snapshots. Use it as ``calibrate_kw(..., resimulate=resimulator(ds))``.
+    """
+    from jointwear.io import parse_provenance
+    from jointwear.params import from_mapping
+    from jointwear.sim._wear_contact import contact_from_description
+
+    params = parse_provenance(ds).get("parameters") or {}
+    if "contact" not in params or "wear" not in params:
+        raise BadInputError(
+            "the wear map does not record its contact model and wear settings in its provenance "
+            "(written by 'jointwear sim wear'?); pass a resimulate function instead"
+        )
+    contact = contact_from_description(params["contact"])
+    settings = from_mapping(WearSettings, params["wear"], where="wear")
+    snaps = [float(c) for c in np.asarray(ds["cycles"].values)]
+    target = max(snaps)
+
+    def run(kw: float) -> xr.Dataset:
+        return simulate_wear(
+            contact=contact,
+            cycles=target,
+            settings=dataclasses.replace(settings, kw=kw),
+            snapshots=snaps,
+        )
+
+    return run
 
 
 def halved_schedule(ds: xr.Dataset) -> tuple[int, ...]:

@@ -145,3 +145,23 @@ def test_ctrl_c_leaves_valid_partial_output_and_resume_is_identical(tmp_path):
     assert resumed.attrs["status"] == "complete"
     for name in ("wear_depth", "worn_volume", "normal_work", "update_dn", "update_rate_change"):
         np.testing.assert_array_equal(resumed[name].values, full[name].values)
+
+
+def test_calibrate_kw_command_recovers_the_kw_of_a_run(tmp_path, capsys):
+    base = ["sim", "wear", "--contact", "winkler", "--layers", "6", "--points", "48"]
+    sim, truth = tmp_path / "sim.nc", tmp_path / "truth.nc"
+    assert main([*base, "--kw", "1e-13", "--cycles", "3e4", "--out", str(sim)]) == 0
+    assert main([*base, "--kw", "3e-13", "--cycles", "3e4", "--out", str(truth)]) == 0
+    depth_um = float(io.load(truth)["max_wear_depth"][-1]) * 1e6
+    capsys.readouterr()
+    code = main(
+        ["sim", "calibrate-kw", str(sim), "--max-depth-um", f"{depth_um:.6f}", "--rtol", "0.01"]
+    )
+    assert code == 0
+    out = capsys.readouterr().out
+    linear = float(out.split("kw (linear estimate): ")[1].split()[0])
+    calibrated = float(out.split("re-simulations): ")[1].split()[0])
+    assert abs(linear / 3e-13 - 1) > 0.05  # profile feedback: the linear guess is off
+    assert calibrated == pytest.approx(3e-13, rel=0.03)
+    assert main(["sim", "calibrate-kw", str(sim)]) == 3
+    assert "give exactly one measurement" in capsys.readouterr().err
