@@ -41,7 +41,8 @@ D_FN, D_FT, D_FMAG = 34, 35, 36
 D_MODE, D_PEN, D_PENAX, D_K, D_ENERGY, D_NSLICE, D_TH2DOT = 37, 38, 39, 40, 41, 42, 43
 D_QUAT = 44
 D_FAX = 48
-ND_DIAG = 49
+D_BEAR_POS, D_JOUR_POS = 49, 52
+ND_DIAG = 55
 # ---- info (per evaluation) -------------------------------------------------------------------
 I_PEN, I_CONTACT, I_BAD = 0, 1, 2
 NINFO = 4
@@ -710,6 +711,9 @@ def _eval_clearance(
             q3 / n,
         )
         diag[D_FAX] = fax
+        for i in range(3):
+            diag[D_BEAR_POS + i] = Og[i]
+            diag[D_JOUR_POS + i] = Cj[i]
 
 
 @njit(cache=True)
@@ -757,6 +761,10 @@ def _eval_ideal(t, y, P, IP, dy, diag):
         diag[D_FOLL_OMEGA + 2] = w3
         diag[D_TH2] = th2
         diag[D_TH3] = th3
+        diag[D_BEAR_POS], diag[D_BEAR_POS + 1] = l4 + l3 * c3, l3 * s3
+        diag[D_JOUR_POS], diag[D_JOUR_POS + 1] = Bx + l2 * c2, By + l2 * s2
+        diag[D_BEAR_POS + 2] = P[JOFF]
+        diag[D_JOUR_POS + 2] = P[JOFF]
         diag[D_AXIS + 2] = 1.0
         # joint reaction at C (force on the follower) from the two rotational equations
         Ia = P[I3Z] + 0.25 * m3 * l3 * l3

@@ -551,6 +551,16 @@ def _dataset(params: SimParameters, t_rel: np.ndarray, diag: np.ndarray, t0: flo
                 frame="bearing frame: z along the bearing axis, -x = theta 0 direction",
             ),
         ),
+        "bearing_centre_position": (
+            axis,
+            _vec(diag, kn.D_BEAR_POS),
+            {"units": "m", "long_name": "position of the bearing centre of joint C, global frame"},
+        ),
+        "journal_centre_position": (
+            axis,
+            _vec(diag, kn.D_JOUR_POS),
+            {"units": "m", "long_name": "position of the journal centre of joint C, global frame"},
+        ),
         "journal_axis": (
             axis,
             _vec(diag, kn.D_AXIS),

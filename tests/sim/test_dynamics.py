@@ -136,6 +136,16 @@ def test_record_follows_contract_and_wear_work_balances():
     for name, var in ds.variables.items():
         if name != "axis":
             assert "units" in var.attrs and "long_name" in var.attrs, name
+    # joint C in the global frame: the bearing turns about D at fixed distance, the journal
+    # sits on the coupler L2 from B, and their distance is the journal offset's length
+    bc, jc = ds.bearing_centre_position.values, ds.journal_centre_position.values
+    np.testing.assert_allclose(np.linalg.norm(bc - [0.3, 0, 0], axis=1), math.hypot(0.3, 0.01))
+    b = 2 * ds.crank_position.values
+    np.testing.assert_allclose(np.linalg.norm((jc - b)[:, :2], axis=1), 0.4)
+    np.testing.assert_allclose(jc[:, 2], 0.01)
+    np.testing.assert_allclose(
+        np.linalg.norm(jc - bc, axis=1), np.linalg.norm(ds.journal_offset.values, axis=1)
+    )
     # wear work: non-negative, balances the normal work, and sits where the journal pressed
     assert r.wear_work.shape == r.point_area.shape == (20, 200)
     assert (r.wear_work >= 0).all()
