@@ -232,7 +232,7 @@ def register(app: typer.Typer) -> None:
     ) -> None:
         """Simulate Archard wear of joint C over many cycles; checkpoint after every update."""
         from jointwear import io
-        from jointwear.errors import BadInputError
+        from jointwear.errors import BadInputError, SimulationError
         from jointwear.params import to_jsonable
         from jointwear.progress import progress_bar
         from jointwear.sim.wear import WearRun
@@ -298,9 +298,8 @@ def register(app: typer.Typer) -> None:
             try:
                 ds = run.run()
             except KeyboardInterrupt:
-                ds = run.to_dataset()
                 io.save(
-                    ds,
+                    run.to_dataset(),
                     out,
                     inputs=inputs,
                     parameters=provenance_params,
@@ -312,6 +311,18 @@ def register(app: typer.Typer) -> None:
                     err=True,
                 )
                 raise
+            except SimulationError as exc:
+                io.save(
+                    run.to_dataset(),
+                    out,
+                    inputs=inputs,
+                    parameters=provenance_params,
+                    source="jointwear 0.1 (sim.wear)",
+                )
+                raise SimulationError(
+                    f"{exc} [wear run stopped after {run.cycles_done} cycles; the wear map so far "
+                    f"is in {out}, the last good state in {ckpt}]"
+                ) from exc
         io.save(
             ds, out, inputs=inputs, parameters=provenance_params, source="jointwear 0.1 (sim.wear)"
         )

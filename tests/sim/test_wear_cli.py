@@ -165,3 +165,35 @@ def test_calibrate_kw_command_recovers_the_kw_of_a_run(tmp_path, capsys):
     assert calibrated == pytest.approx(3e-13, rel=0.03)
     assert main(["sim", "calibrate-kw", str(sim)]) == 3
     assert "give exactly one measurement" in capsys.readouterr().err
+
+
+def test_a_failing_simulation_leaves_partial_output_and_checkpoint(tmp_path, monkeypatch, capsys):
+    from jointwear.errors import SimulationError
+    from jointwear.sim import cli_wear
+
+    real = cli_wear.demo_winkler_contact
+
+    class Failing:
+        def __init__(self, grid):
+            self.inner = real(grid)
+            self.grid = self.inner.grid
+            self.calls = 0
+
+        def describe(self):
+            return self.inner.describe()
+
+        def run(self, wear_depth, *, cycles, state, progress=None):
+            self.calls += 1
+            if self.calls > 8:
+                raise SimulationError("simulation stopped at t = 1 s: the step size collapsed")
+            return self.inner.run(wear_depth, cycles=cycles, state=state)
+
+    monkeypatch.setattr(cli_wear, "demo_winkler_contact", Failing)
+    out = tmp_path / "w.nc"
+    code = main(["sim", "wear", *SMALL, "--cycles", "1e5", "--out", str(out)])
+    assert code == 3
+    err = capsys.readouterr().err
+    assert "step size collapsed" in err and "wear map so far" in err
+    partial = io.load(out)
+    assert partial.attrs["status"] == "partial"
+    assert (tmp_path / "w.nc.ckpt").exists()
