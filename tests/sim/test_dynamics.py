@@ -280,3 +280,16 @@ def test_wear_map_resampled_onto_the_grid_in_the_canonical_convention():
     da.theta.attrs.pop("angle_zero")
     with pytest.raises(ConventionError, match="does not state its angle convention"):
         wear_depth_on_grid(da, BASE)
+
+
+def test_bearing_carrier_does_not_change_planar_motion():
+    # with joint C in the links' plane the motion is planar and only the relative motion of
+    # journal and bearing matters: the carrier (follower or coupler) must not change it
+    out = []
+    for carrier in ("follower", "coupler"):
+        p = replace_nested(BASE, **{"mechanism.bearing_on": carrier, "mechanism.joint_offset": 0.0})
+        r = run_cycles(p, cycles=1.0)
+        ecc = np.linalg.norm(r.dataset.journal_offset.values, axis=1)
+        out.append((r.normal_impulse, float(r.dataset.contact_force.mean()), ecc.mean()))
+        assert np.abs(r.dataset.follower_position.sel(axis="z")).max() < 1e-9
+    np.testing.assert_allclose(out[0], out[1], rtol=0.02)
