@@ -372,7 +372,15 @@ class WearRun:
         try:
             with open(path, "rb") as fh:
                 payload = pickle.load(fh)
-        except (OSError, pickle.UnpicklingError, EOFError, AttributeError, ImportError) as exc:
+        except (
+            OSError,
+            pickle.UnpicklingError,
+            EOFError,
+            AttributeError,
+            ImportError,
+            TypeError,
+            ValueError,
+        ) as exc:
             raise BadInputError(
                 f"checkpoint '{path}' could not be read ({exc}); start over without --resume"
             ) from None
