@@ -184,3 +184,27 @@ def test_cli_folder_sequence(tmp_path):
     ok = ds.flag.values[-1] == 0
     assert ok.mean() > 0.9
     assert np.max(np.abs(ds.u.values[-1][ok] - last[ok])) < 0.01
+
+
+def test_video_frames_are_read_as_grey_with_their_frame_rate(tmp_path, sequence):
+    import cv2
+
+    _, frames = sequence
+    path = tmp_path / "clip.avi"
+    writer = cv2.VideoWriter(str(path), cv2.VideoWriter_fourcc(*"MJPG"), 25.0, (128, 128))
+    if not writer.isOpened():
+        pytest.skip("this OpenCV build cannot write MJPG video")
+    for f in frames[:3]:
+        writer.write(cv2.cvtColor(f, cv2.COLOR_GRAY2BGR))
+    writer.release()
+    got, fps = read_frames(path)
+    assert len(got) == 3 and got[0].shape == (128, 128) and got[0].ndim == 2
+    assert fps == pytest.approx(25.0)
+    # lossy (JPEG) frames still correlate: the first drift step of 0.8 px, -0.4 px, 4 degrees
+    ds = correlate_sequence(path, roi=(24, 24, 103, 103), subset_size=21, step=20)
+    np.testing.assert_allclose(ds.time.values, [0.0, 0.04, 0.08])
+    assert (ds.flag.values[1] == 0).mean() > 0.8
+    empty = tmp_path / "empty.mp4"
+    empty.write_bytes(b"")
+    with pytest.raises(BadInputError, match="could not be opened"):
+        read_frames(empty)
