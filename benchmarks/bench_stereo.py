@@ -1,7 +1,7 @@
 """Benchmark: 10 s of 50 frames/s stereo footage (two 1280 x 1024 cameras, ~200 points/frame).
 
 Renders one crank revolution of the virtual rig (25 frame pairs; the motion is 0.5 s periodic)
-and writes it 20 times into two lossless FFV1 videos (500 frame pairs = 10 s), then times
+and writes it 20 times into two lossless raw-grey AVI videos (500 frame pairs = 10 s), then times
 ``track_footage`` (decoding, stereo DIC of the follower and journal patches, triangulation,
 rigid fits, velocities) and checks the accuracy against the ground truth.
 
@@ -22,6 +22,8 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from _common import median_time, write_results  # noqa: E402
+
+CODEC = "GREY"  # raw 8-bit grey AVI: lossless and the fastest to decode (4 ms vs 38 ms for FFV1)
 
 
 def make_footage(folder: Path, seconds: float = 10.0):
@@ -91,7 +93,7 @@ def main() -> None:
         write_results(
             "stereo",
             {
-                "footage": f"{args.seconds:g} s at 50 frames/s, two 1280x1024 FFV1 videos",
+                "footage": f"{args.seconds:g} s at 50 frames/s, two 1280x1024 {CODEC} AVI videos",
                 "frame_pairs": n_frames,
                 "points_per_frame_median": n_points,
                 "workers": args.workers,

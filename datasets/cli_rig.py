@@ -24,7 +24,9 @@ def register(app: typer.Typer) -> None:
         noise: Annotated[float, typer.Option(help="Sensor noise (grey levels).")] = 1.0,
         blur: Annotated[float, typer.Option(help="Optical blur sigma (px).")] = 0.6,
         exposure: Annotated[float, typer.Option(help="Brightness gain.")] = 1.0,
-        codec: Annotated[str, typer.Option(help="ffv1 (lossless), png, mjpg or mp4v.")] = "ffv1",
+        codec: Annotated[
+            str, typer.Option(help="ffv1, png or grey (lossless), mjpg or mp4v (lossy).")
+        ] = "ffv1",
         video: Annotated[bool, typer.Option(help="Write videos.")] = True,
         images: Annotated[bool, typer.Option(help="Write image folders.")] = True,
         drop: Annotated[

@@ -50,11 +50,14 @@ __all__ = [
 L1, L2, L3, L4 = 0.10, 0.40, 0.30, 0.30
 
 #: Video codecs the bundled OpenCV/FFmpeg can write here: name -> (fourcc, extension, lossless).
+#: Decoding one 1280 x 1024 grey frame here: grey (raw) 4 ms, mp4v 5 ms, mjpg 7 ms, png 21 ms,
+#: ffv1 38 ms; mjpg and mp4v as written by OpenCV are lossy (errors of 30+ grey levels on speckle).
 CODECS: dict[str, tuple[str, str, bool]] = {
     "ffv1": ("FFV1", ".avi", True),
     "mjpg": ("MJPG", ".avi", False),
     "mp4v": ("mp4v", ".mp4", False),
     "png": ("png ", ".avi", True),
+    "grey": ("GREY", ".avi", True),
 }
 
 
