@@ -335,6 +335,8 @@ def register(app: typer.Typer) -> None:
             fig = plot_wear_map(ds, kind="both")
             with io.atomic_path(figure) as tmp:
                 fig.savefig(tmp, dpi=110, format="png")
+        if "convergence_warning" in ds.attrs:
+            typer.echo(f"warning: {ds.attrs['convergence_warning']}", err=True)
         typer.echo(
             f"{out}: {run.cycles_done} cycles, max depth "
             f"{float(ds['max_wear_depth'][-1]) * 1e6:.2f} µm, worn volume "

@@ -72,6 +72,10 @@ DEFAULT_KW: float = 9.0e-16
 #: the study would wear through in hours; below 1e-20 nothing measurable wears in any lifetime.
 KW_RANGE: tuple[float, float] = (1.0e-20, 1.0e-11)
 
+#: Relative change of the wear-rate field over one accepted update above which the result is
+#: flagged as not converged in dN (``convergence_warning`` attribute).
+UNRESOLVED_RATE_CHANGE: float = 0.5
+
 _CHECKPOINT_FORMAT = "jointwear.sim.wear checkpoint v1"
 
 
@@ -551,6 +555,29 @@ class WearRun:
             pass
         return self.to_dataset()
 
+    def convergence_warning(self) -> str | None:
+        """A message if an accepted update changed the wear-rate field too much, else None.
+
+        A rate change beyond :data:`UNRESOLVED_RATE_CHANGE` (noise removed) means the update
+        interval was too large for the profile feedback: the explicit update overshoots and the
+        result is not converged in dN (the adaptive scheme rejects such updates).
+        """
+        hist = np.array(self._s["history"], dtype=float).reshape(-1, 4)
+        acc = hist[hist[:, 3] == 1]
+        if not len(acc):
+            return None
+        noise = float(self._s.get("noise", 0.0))
+        eta = np.sqrt(np.maximum(acc[:, 2] ** 2 - noise**2, 0.0))
+        worst = int(np.argmax(eta))
+        if eta[worst] <= UNRESOLVED_RATE_CHANGE:
+            return None
+        return (
+            f"the wear-rate field changed by {100 * eta[worst]:.0f} % over the update of "
+            f"{int(acc[worst, 1])} cycles starting at {int(acc[worst, 0])} cycles: the update "
+            "interval is too large to resolve the profile feedback and the result is not "
+            "converged; use the adaptive scheme or a smaller dN"
+        )
+
     # --- output -----------------------------------------------------------------------------
     def to_dataset(self, *, cylindricity: bool = True) -> xr.Dataset:
         """The wear map so far: snapshots, worn volume, cylindricity, the update history.
@@ -629,6 +656,9 @@ class WearRun:
             f"each preceded by {st.settle_cycles:g} settling cycle(s) whose wear is discarded",
             "contact_model": str(describe_any(self.contact).get("model", "?")),
         }
+        warning = self.convergence_warning()
+        if warning:
+            attrs["convergence_warning"] = warning
         return wear_map_dataset(
             maps, cyc, self.grid, cylindricity=cylindricity, extra=extra, attrs=attrs
         )

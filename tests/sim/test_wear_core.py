@@ -162,6 +162,8 @@ def test_too_large_fixed_interval_is_unstable_and_the_adaptive_scheme_avoids_it(
     # fixed 4 n_crit: the rate field flips at every update and the profile zig-zags
     assert np.all(big["update_rate_change"].values > 1.0)
     assert roughness(h_big) > 4 * roughness(h_ref)
+    assert "too large to resolve the profile feedback" in big.attrs["convergence_warning"]
+    assert "convergence_warning" not in ada.attrs and "convergence_warning" not in ref.attrs
     # adaptive: rejects the oversize interval, stays smooth and converged
     assert int((ada["update_accepted"] == 0).sum()) >= 1
     acc = ada["update_accepted"].values == 1

@@ -146,3 +146,11 @@ def test_cli_with_the_dynamics_and_a_parameter_file(tmp_path):
     np.testing.assert_allclose(ds["worn_volume"].values, ds["archard_volume"].values, rtol=0.01)
     prov = io.parse_provenance(ds)
     assert prov["parameters"]["contact"]["parameters"]["joint"]["n_points"] == 60
+
+
+def test_too_large_fixed_interval_is_flagged_and_overshoots(base):
+    # two updates for the study-equivalent 10^6 cycles: the rate field flips, wear overshoots
+    big = _run(scheme="fixed", dn=int(N_EQ / SCALE / 2))
+    assert float(big["max_wear_depth"][-1]) > 1.2 * float(base["max_wear_depth"][-1])
+    assert "not converged" in big.attrs["convergence_warning"]
+    assert "convergence_warning" not in base.attrs
