@@ -51,7 +51,13 @@ __all__ = [
 ]
 
 #: Frame quality flags (bit mask) of the ``frame_flag`` output variable.
-FRAME_FLAGS = {"ok": 0, "duplicated": 1, "after_gap": 2, "tracking_failed": 4}
+FRAME_FLAGS = {
+    "ok": 0,
+    "duplicated": 1,
+    "after_gap": 2,
+    "tracking_failed": 4,
+    "crank_step_gap": 8,
+}
 
 
 @dataclass(frozen=True, eq=False)
@@ -965,6 +971,20 @@ def _assemble(states, times, flags, duplicates, L, R, cfg, calibration, status) 
             if not stereo:  # image y points down: a counter-clockwise turn looks clockwise
                 ang = -ang
             ang = ang + np.deg2rad(st.spec.reference_angle_deg)
+            # a crank turning at constant speed also reveals frames lost without a time gap
+            # (constant-rate video containers): a step of about k >= 2 median steps
+            step = np.diff(ang)
+            ok = np.isfinite(step)
+            if ok.sum() >= 3:
+                med = np.median(step[ok])
+                if abs(med) > 1e-6:
+                    k = np.rint(step / med)
+                    jumps = np.flatnonzero(ok & (k >= 2) & (np.abs(step / med - k) < 0.25)) + 1
+                    jumps = [int(j) for j in jumps if not flag_arr[j] & FRAME_FLAGS["after_gap"]]
+                    flag_arr[jumps] |= FRAME_FLAGS["crank_step_gap"]
+                    attrs_extra["dropped_frames_from_crank"] = json.dumps(
+                        {str(j): int(k[j - 1] - 1) for j in jumps}
+                    )
             data["crank_angle"] = (
                 "time",
                 ang,
@@ -979,8 +999,8 @@ def _assemble(states, times, flags, duplicates, L, R, cfg, calibration, status) 
         {
             "units": "1",
             "long_name": "frame quality flags (bit mask)",
-            "flag_masks": np.array([1, 2, 4], dtype=np.int8),
-            "flag_meanings": "duplicated after_gap tracking_failed",
+            "flag_masks": np.array([1, 2, 4, 8], dtype=np.int8),
+            "flag_meanings": "duplicated after_gap tracking_failed crank_step_gap",
         },
     )
     ds = xr.Dataset(data, coords=coords)

@@ -320,26 +320,37 @@ def test_parallel_chunks_match_sequential(small):
     assert runs[2].attrs["workers"] == 2
 
 
-def test_crank_angle_tracked(tmp_path):
-    # a wider view that includes the crank (0.65 mm/px); the crank turns 14.4 degrees per frame
-    cfg = RigConfig(width=960, height=768, duration=0.12, look_at=(0.15, 0.08, 0.0), fov_width=0.62)
-    w = generate_rig(tmp_path, cfg, video=False, images=True, calibration_images=False)
+def test_crank_angle_tracked_and_reveals_frames_lost_in_a_video(tmp_path):
+    # a wider view that includes the crank (0.65 mm/px); the crank turns 14.4 degrees per frame;
+    # frame 3 is lost in a constant-rate video (no time gap to see)
+    cfg = RigConfig(
+        width=960,
+        height=768,
+        duration=0.14,
+        look_at=(0.15, 0.08, 0.0),
+        fov_width=0.62,
+        drop_frames=(3,),
+    )
+    w = generate_rig(tmp_path, cfg, video=True, images=False, calibration_images=False)
     tc, bodies = read_bodies(w["bodies"])
     tc = dataclasses.replace(tc, world_origin=[0.0, 0.0, 0.0], subset_size=15, step=6)
     crank = [b for b in bodies if b.role == "crank"]
     ds = track_footage(
-        w["left_images"],
-        w["right_images"],
-        fps=cfg.fps,
+        w["left_video"],
+        w["right_video"],
         bodies=crank,
         calibration=VirtualRig(cfg).calibration,
         config=tc,
     )
     truth = io.load(w["truth"])
-    err = np.degrees(ds["crank_angle"].values - truth["crank_angle"].values)
-    assert np.ptp(np.degrees(truth["crank_angle"].values)) > 70
+    recorded = truth["frame_recorded"].values == 1
+    true_angle = truth["crank_angle"].values[recorded]
+    err = np.degrees(ds["crank_angle"].values - true_angle)
+    assert np.ptp(np.degrees(true_angle)) > 70
     assert np.max(np.abs(err)) < 0.02
     assert ds["crank_angle"].attrs["units"] == "rad"
+    assert ds.attrs["dropped_frames_from_crank"] == '{"3": 1}'
+    assert ds["frame_flag"].values[3] & 8
 
 
 def test_single_camera_tracks_in_pixels(small, tmp_path):
