@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from jointwear import conventions
 from jointwear.errors import BadInputError, ParameterError
@@ -303,3 +305,25 @@ def test_max_increment_caps_the_depth_step():
     rate = 1e-14 * 1e6 * 0.02
     assert np.all(ds["update_dn"].values * rate <= 1e-7 * (1 + 1e-12))
     assert float(ds["max_wear_depth"][-1]) == pytest.approx(20_000 * rate, rel=1e-12)
+
+
+@settings(max_examples=25, deadline=None)
+@given(
+    dn=st.integers(1, 5000),
+    target=st.integers(1, 20_000),
+    snaps=st.lists(st.integers(1, 20_000), max_size=4),
+)
+def test_closed_form_holds_for_any_interval_and_snapshots(dn, target, snaps):
+    model = ConstantContact(BearingGrid(3, 8), pressure=2e6, sliding=0.01)
+    snaps = [s for s in snaps if s <= target]
+    ds = simulate_wear(
+        contact=model,
+        cycles=target,
+        snapshots=snaps,
+        settings=WearSettings(kw=1e-14, scheme="fixed", dn=dn),
+    )
+    expected_cycles = sorted(set(snaps) | {target})
+    np.testing.assert_array_equal(ds["cycles"].values, expected_cycles)
+    np.testing.assert_allclose(
+        ds["max_wear_depth"].values, np.array(expected_cycles) * 1e-14 * 2e6 * 0.01, rtol=1e-12
+    )
