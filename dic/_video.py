@@ -193,7 +193,8 @@ def open_frames(
         if not ok or img is None:
             raise BadInputError(
                 f"{what} '{path}': the '{suffix[1:]}' container opened but its video stream "
-                f"(codec '{codec}') could not be decoded by OpenCV's bundled FFmpeg; {_ADVICE}"
+                f"(codec '{codec}') could not be decoded by OpenCV's bundled FFmpeg (a codec it "
+                f"lacks, or a damaged/truncated file); {_ADVICE}"
             )
         n = int(cap.get(cv2.CAP_PROP_FRAME_COUNT))
         rate = float(cap.get(cv2.CAP_PROP_FPS))

@@ -234,6 +234,19 @@ def test_bad_footage_errors(small, tmp_path):
         BadInputError, match=r"could not open this 'mp4' container.*ffmpeg -i IN -c:v ffv1"
     ):
         open_frames(bad)
+    # a container that opens but whose stream cannot be decoded (truncated FFV1)
+    w = cv2.VideoWriter(
+        str(tmp_path / "t.avi"), cv2.VideoWriter_fourcc(*"FFV1"), 50, (64, 48), False
+    )
+    for k in range(5):
+        w.write(np.random.default_rng(k).integers(0, 255, (48, 64), dtype=np.uint8))
+    w.release()
+    (tmp_path / "cut.avi").write_bytes((tmp_path / "t.avi").read_bytes()[:6000])
+    with pytest.raises(
+        BadInputError,
+        match=r"'avi' container opened but its video stream \(codec 'ffv1'\) could not be decoded",
+    ):
+        open_frames(tmp_path / "cut.avi")
     with pytest.raises(BadInputError, match="unsupported file type '.txt'"):
         (tmp_path / "a.txt").write_text("x")
         open_frames(tmp_path / "a.txt")
