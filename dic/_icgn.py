@@ -338,6 +338,17 @@ def _load_reference(
     return FLAG_OK, fn
 
 
+@njit(cache=True)
+def _store_sigma(w, fn, zncc, n, n_params, hinv_u, hinv_v):
+    """Standard uncertainty of u and v from the residual (Gauss-Newton covariance
+    ``s2 H^-1``, ``s2 = fn^2 ZNSSD / (n - n_params)`` in reference grey levels), kept in the
+    scratch ``w[3, 4:6]``."""
+    znssd = max(2.0 * (1.0 - zncc), 0.0)
+    s2 = fn * fn * znssd / max(n - n_params, 1)
+    w[3, 4] = math.sqrt(s2 * hinv_u)
+    w[3, 5] = math.sqrt(s2 * hinv_v)
+
+
 @njit(cache=True, fastmath=_FM)
 def _solve_generic(
     ref_img,
@@ -362,10 +373,7 @@ def _solve_generic(
     gx,
     gy,
     g,
-    wx,
-    wy,
-    dwx,
-    dwy,
+    w,
 ):
     """Generic (affine or quadratic, any order) IC-GN for one subset; see :func:`solve_point`."""
     H, W = ref_img.shape
@@ -374,7 +382,8 @@ def _solve_generic(
     size = 2 * half + 1
     n = size * size
     np_ = 12 if quadratic else 6
-    w = np.empty((4, 6))
+    wx = w[0]
+    wy = w[1]
     flag0, fn = _load_reference(
         ref_img,
         ref_gx,
@@ -570,6 +579,7 @@ def _solve_generic(
             norm += q * q * (dp[3] ** 2 + dp[5] ** 2 + dp[9] ** 2 + dp[11] ** 2)
             norm += hh**4 * (dp[4] ** 2 + dp[10] ** 2)
         if math.sqrt(norm) < tol:
+            _store_sigma(w, fn, zncc, n, np_, Hinv[0, 0], Hinv[np_ // 2, np_ // 2])
             return zncc, it, FLAG_OK
     return zncc, it, FLAG_NOT_CONVERGED
 
@@ -924,6 +934,7 @@ def _solve_affine(
         norm = dp[0] * dp[0] + dp[6] * dp[6]
         norm += hh2 * (dp[1] * dp[1] + dp[2] * dp[2] + dp[7] * dp[7] + dp[8] * dp[8])
         if math.sqrt(norm) < tol:
+            _store_sigma(w, fn, zncc, n, 6, Hinv[0, 0], Hinv[3, 3])
             return zncc, it, FLAG_OK
     return zncc, it, FLAG_NOT_CONVERGED
 
@@ -962,6 +973,8 @@ def solve_point(
     ``work`` comes from :func:`make_work`. Returns ``(zncc, iterations, flag)``.
     """
     f, gx, gy, g, w = work
+    w[3, 4] = np.nan
+    w[3, 5] = np.nan
     if quadratic:
         return _solve_generic(
             ref_img,
@@ -986,10 +999,7 @@ def solve_point(
             gx,
             gy,
             g,
-            w[0],
-            w[1],
-            w[2],
-            w[3],
+            w,
         )
     return _solve_affine(
         ref_img,
@@ -1040,6 +1050,7 @@ def icgn_many(
     zncc,
     iters,
     flags,
+    sigma,
 ):
     """Refine every active point from its initial parameters ``P[i]`` (in place), in parallel."""
     n = centres.shape[0]
@@ -1080,6 +1091,8 @@ def icgn_many(
             zncc[i] = z
             iters[i] = it
             flags[i] = fl
+            sigma[i, 0] = work[4][3, 4]
+            sigma[i, 1] = work[4][3, 5]
 
 
 @njit(cache=True)
@@ -1106,6 +1119,7 @@ def icgn_serial(
     zncc,
     iters,
     flags,
+    sigma,
 ):
     """As :func:`icgn_many` on one thread (for a handful of points, e.g. seeds)."""
     n = centres.shape[0]
@@ -1146,6 +1160,8 @@ def icgn_serial(
             zncc[i] = z
             iters[i] = it
             flags[i] = fl
+            sigma[i, 0] = work[4][3, 4]
+            sigma[i, 1] = work[4][3, 5]
 
 
 @njit(cache=True)
@@ -1266,6 +1282,7 @@ def _propagate_group(
     zncc,
     iters,
     flags,
+    sigma,
     done,
 ):
     n = centres.shape[0]
@@ -1312,6 +1329,8 @@ def _propagate_group(
             zncc[j] = z
             iters[j] = it
             flags[j] = fl
+            sigma[j, 0] = work[4][3, 4]
+            sigma[j, 1] = work[4][3, 5]
             if fl == FLAG_OK:
                 size = _heap_push(keys, vals, size, z, j)
 
@@ -1343,6 +1362,7 @@ def rg_propagate(
     zncc,
     iters,
     flags,
+    sigma,
     done,
 ):
     """Reliability-guided propagation: from the solved (``done`` and ok) points of each group,
@@ -1376,6 +1396,7 @@ def rg_propagate(
             zncc,
             iters,
             flags,
+            sigma,
             done,
         )
         return
@@ -1406,5 +1427,6 @@ def rg_propagate(
             zncc,
             iters,
             flags,
+            sigma,
             done,
         )

@@ -244,9 +244,11 @@ def correlate_sequence(
     Z = np.full((n_t, n), np.nan)
     It = np.zeros((n_t, n), dtype=np.int32)
     Fl = np.full((n_t, n), _icgn.FLAG_NOT_REACHED, dtype=np.int8)
+    S = np.full((n_t, n, 2), np.nan)
     ref_frame = np.zeros(n_t, dtype=np.int32)
     r0 = base.match(first, initial_guess=np.zeros((n, 2)))
     P[0], Z[0], It[0], Fl[0] = r0.params, r0.zncc, r0.iterations, r0.flag
+    S[0] = np.where(r0.ok[:, None], 0.0, np.nan)  # the reference against itself
     tracked = r0.ok.copy()
 
     corr = base
@@ -291,15 +293,18 @@ def correlate_sequence(
             P_prev_inc = np.where(ok[:, None], res.params, P_prev_inc)
             if m == 0:
                 P[k] = res.params
+                S[k] = res.sigma
             else:
                 P[k] = _compose(res.params, P_ref)
+                # independent increments: variances add
+                S[k] = np.sqrt(res.sigma**2 + S[m] ** 2)
             Z[k], It[k], Fl[k] = res.zncc, res.iterations, res.flag
             lost = ~np.isfinite(corr.centres).all(axis=1)
             Fl[k][lost] = _icgn.FLAG_NOT_REACHED
             ref_frame[k] = m
             bar.update(task, advance=1)
 
-    ds = result_dataset(base.centres, P, Z, It, Fl, prm, base.grid)
+    ds = result_dataset(base.centres, P, Z, It, Fl, prm, base.grid, sigma=S)
     if reference == "incremental" and prm.quadratic:
         for name in ("d2u_dx2", "d2u_dxdy", "d2u_dy2", "d2v_dx2", "d2v_dxdy", "d2v_dy2"):
             later = ref_frame > 0

@@ -188,13 +188,19 @@ class MatchResult:
     """Raw per-point output of :meth:`SubsetCorrelator.match`.
 
     ``params`` (N, 12) shape parameters (layout of :mod:`jointwear.dic._icgn`), ``zncc`` (N,),
-    ``iterations`` (N,), ``flag`` (N,) int8.
+    ``iterations`` (N,), ``flag`` (N,) int8, ``sigma`` (N, 2) standard uncertainty of (u, v)
+    [pixel] from the match residual (NaN unless ok).
     """
 
     params: np.ndarray
     zncc: np.ndarray
     iterations: np.ndarray
     flag: np.ndarray
+    sigma: np.ndarray | None = None
+
+    def __post_init__(self) -> None:
+        if self.sigma is None:
+            self.sigma = np.full((len(self.zncc), 2), np.nan)
 
     @property
     def ok(self) -> np.ndarray:
@@ -386,6 +392,7 @@ class SubsetCorrelator:
             st.zncc,
             st.iterations,
             st.flag,
+            st.sigma,
         )
 
     def _propagate(self, dspl, dinv, st, done, group, n_groups):
@@ -409,6 +416,7 @@ class SubsetCorrelator:
             st.zncc,
             st.iterations,
             st.flag,
+            st.sigma,
             done,
         )
 
@@ -419,12 +427,19 @@ class SubsetCorrelator:
         )
         unreached = ~done
         if (retry | unreached).any() and st.ok.any():
-            saved = (st.params.copy(), st.zncc.copy(), st.iterations.copy(), st.flag.copy())
+            saved = (
+                st.params.copy(),
+                st.zncc.copy(),
+                st.iterations.copy(),
+                st.flag.copy(),
+                st.sigma.copy(),
+            )
             done[retry] = False
             self._propagate(dspl, dinv, st, done, group, 0)
             back = retry & ~done  # not reached again: keep the first attempt
             st.params[back], st.zncc[back] = saved[0][back], saved[1][back]
             st.iterations[back], st.flag[back] = saved[2][back], saved[3][back]
+            st.sigma[back] = saved[4][back]
             done[back] = True
 
     def _seed(self, dspl, dinv, raw_def, st, done, i, guess=(0.0, 0.0)) -> bool:
@@ -453,7 +468,7 @@ class SubsetCorrelator:
         done[i] = True
         if attempt(u, v, 0.0) if np.isfinite(peak) else attempt(guess[0], guess[1], 0.0):
             return True
-        first = (st.params[i].copy(), st.zncc[i], st.iterations[i], st.flag[i])
+        first = (st.params[i].copy(), st.zncc[i], st.iterations[i], st.flag[i], st.sigma[i].copy())
         structural = (_icgn.FLAG_OUTSIDE, _icgn.FLAG_NO_TEXTURE, _icgn.FLAG_INVALID_PIXELS)
         if first[3] not in structural:
             # rotated templates: the part may have turned
@@ -470,7 +485,7 @@ class SubsetCorrelator:
             for _, tu, tv, ang in scored[:3]:
                 if attempt(tu, tv, ang):
                     return True
-        st.params[i], st.zncc[i], st.iterations[i], st.flag[i] = first
+        st.params[i], st.zncc[i], st.iterations[i], st.flag[i], st.sigma[i] = first
         return False
 
     def match(
@@ -564,6 +579,7 @@ class SubsetCorrelator:
                     _icgn._extrapolate(st.params[i], d[0], d[1], P0[j])
         sub = MatchResult(P0, st.zncc.copy(), st.iterations.copy(), st.flag.copy())
         self._run_many(dspl, dinv, P0, rest, sub)
+        st.sigma[rest] = sub.sigma[rest]
         st.params[rest] = P0[rest]
         st.zncc[rest] = sub.zncc[rest]
         st.iterations[rest] = sub.iterations[rest]
@@ -622,7 +638,14 @@ class SubsetCorrelator:
     def to_dataset(self, res: MatchResult, *, time: float | None = None) -> xr.Dataset:
         """Package a :class:`MatchResult` as an xarray Dataset (grid ``(y, x)`` or ``point``)."""
         return result_dataset(
-            self.centres, res.params, res.zncc, res.iterations, res.flag, self.params, self.grid
+            self.centres,
+            res.params,
+            res.zncc,
+            res.iterations,
+            res.flag,
+            self.params,
+            self.grid,
+            sigma=res.sigma,
         )
 
 
@@ -644,8 +667,13 @@ _SECOND = [
 ]
 
 
-def result_dataset(centres, P, zncc, iterations, flag, params: CorrelationParams, grid=None):
-    """Per-point arrays -> Dataset following the data contract (leading dims allowed)."""
+def result_dataset(
+    centres, P, zncc, iterations, flag, params: CorrelationParams, grid=None, sigma=None
+):
+    """Per-point arrays -> Dataset following the data contract (leading dims allowed).
+
+    ``sigma`` (..., N, 2): standard uncertainty of (u, v) [pixel] -> ``u_u``, ``v_u``.
+    """
     P = np.asarray(P, float)
     ok = np.asarray(flag) == _icgn.FLAG_OK
     lead = P.shape[:-2]
@@ -701,9 +729,22 @@ def result_dataset(centres, P, zncc, iterations, flag, params: CorrelationParams
             "flag_meanings": _icgn.FLAG_MEANINGS,
         },
     )
+    if sigma is not None:
+        sig = np.asarray(sigma, float)
+        for k, name in enumerate(("u", "v")):
+            data[f"{name}_u"] = xr.DataArray(
+                np.where(ok, sig[..., k], np.nan).reshape(shape),
+                dims=dims,
+                attrs={
+                    "units": "pixel",
+                    "long_name": f"standard uncertainty of {name} from the match residual "
+                    "(image noise; excludes interpolation bias)",
+                },
+            )
     ds = xr.Dataset(data, coords=coords)
-    ds["u"].attrs["ancillary_variables"] = "zncc flag"
-    ds["v"].attrs["ancillary_variables"] = "zncc flag"
+    for name in ("u", "v"):
+        extra = f" {name}_u" if sigma is not None else ""
+        ds[name].attrs["ancillary_variables"] = f"zncc flag{extra}"
     ds.attrs.update(
         {
             "title": "2D subset DIC displacement field",

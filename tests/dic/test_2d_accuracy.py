@@ -84,6 +84,12 @@ def test_noise_error_matches_the_theoretical_floor():
     std_v = float(np.std(ev))
     assert 0.7 * floor_u < std_u < 1.3 * floor_u
     assert 0.7 * floor_v < std_v < 1.3 * floor_v
+    # the per-point standard uncertainty estimated from the match residual agrees
+    pred_u = math.sqrt(np.mean(ds.u_u.values**2))
+    pred_v = math.sqrt(np.mean(ds.v_u.values**2))
+    assert 0.75 * std_u < pred_u < 1.3 * std_u
+    assert 0.75 * std_v < pred_v < 1.3 * std_v
+    assert ds.u.attrs["ancillary_variables"] == "zncc flag u_u"
 
 
 def test_affine_strain_and_rotation_recovered():
