@@ -31,6 +31,7 @@ __all__ = [
     "bore_radius",
     "bore_cylindricity",
     "plot_wear_map",
+    "plot_wear_history",
 ]
 
 
@@ -348,5 +349,66 @@ def plot_wear_map(
         title = f"simulated wear after {n_shown:.3g} cycles"
     if title:
         fig.suptitle(title)
+    fig.tight_layout()
+    return fig
+
+
+def plot_wear_history(
+    ds: xr.Dataset,
+    *,
+    measured_cylindricity: dict[float, float] | None = None,
+    title: str | None = None,
+):
+    """Plot wear growth over the cycles and the update intervals used.
+
+    Parameters
+    ----------
+    ds : Dataset
+        A wear map from :func:`jointwear.sim.simulate_wear` (snapshots and ``update_*``).
+    measured_cylindricity : dict, optional
+        Measured growth of the bore's cylindricity [m] by cycle count, drawn as markers.
+    title : str, optional
+        Figure title.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Left: maximum depth and cylindricity [µm] versus cycles; right: dN per update.
+    """
+    import matplotlib.pyplot as plt
+
+    fig, (a, b) = plt.subplots(1, 2, figsize=(10, 3.8))
+    cyc = np.asarray(ds["cycles"].values, dtype=float)
+    a.plot(cyc, ds["max_wear_depth"].values * 1e6, "o-", label="max wear depth")
+    if "cylindricity" in ds and np.any(np.isfinite(ds["cylindricity"].values)):
+        a.plot(cyc, ds["cylindricity"].values * 1e6, "s--", label="cylindricity of the bore")
+    if measured_cylindricity:
+        mc = sorted(measured_cylindricity.items())
+        a.plot(
+            [c for c, _ in mc],
+            [v * 1e6 for _, v in mc],
+            "k*",
+            markersize=11,
+            label="measured cylindricity growth",
+        )
+    a.set_xlabel("cycles")
+    a.set_ylabel("µm")
+    a.set_xlim(left=0)
+    a.set_ylim(bottom=0)
+    a.legend(fontsize=8)
+    a.grid(alpha=0.3)
+    if "update_dn" in ds:
+        acc = np.asarray(ds["update_accepted"].values) == 1
+        start = np.asarray(ds["update_start"].values, dtype=float)
+        dn = np.asarray(ds["update_dn"].values, dtype=float)
+        b.step(start[acc], dn[acc], where="post", label="accepted")
+        if np.any(~acc):
+            b.plot(start[~acc], dn[~acc], "rx", label="rejected")
+        b.set_yscale("log")
+        b.set_xlabel("cycles")
+        b.set_ylabel("cycles per update dN")
+        b.legend(fontsize=8)
+        b.grid(alpha=0.3)
+    fig.suptitle(title or "wear growth and update intervals")
     fig.tight_layout()
     return fig

@@ -11,6 +11,7 @@ from jointwear.sim import (
     BearingGrid,
     ConstantContact,
     WearSettings,
+    plot_wear_history,
     plot_wear_map,
     simulate_wear,
     wear_map_dataset,
@@ -84,6 +85,20 @@ def test_plot_wear_map(kind, tmp_path):
         assert not polar
         mesh = fig.axes[0].collections[0]
         assert mesh.get_array().max() == pytest.approx(0.2, rel=1e-9)  # µm
+    import matplotlib.pyplot as plt
+
+    plt.close(fig)
+
+
+def test_plot_wear_history(tmp_path):
+    ds = _run(np.full(GRID.shape, 1e6), cycles=5000)
+    fig = plot_wear_history(ds, measured_cylindricity={2000: 1e-7})
+    left, right = fig.axes
+    x, y = left.get_lines()[0].get_data()
+    np.testing.assert_allclose(x, ds["cycles"].values)
+    np.testing.assert_allclose(y, ds["max_wear_depth"].values * 1e6)
+    assert right.get_yscale() == "log"
+    fig.savefig(tmp_path / "h.png")
     import matplotlib.pyplot as plt
 
     plt.close(fig)
