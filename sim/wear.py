@@ -22,8 +22,12 @@ contact, the load moves elsewhere, and the profile oscillates and roughens (unst
 updates, ``eta = ||r_new - r_old|| / ||r_old||`` (area-weighted L2 norm). For explicit Euler the
 local error of an update, relative to its depth increment, is ``eta / 2``; the next interval is
 ``dN * 0.9 tol / eta`` (at most doubled, at least 0.2x), and an update whose ``eta`` exceeds
-``reject_factor * tol`` is rejected and redone with a smaller interval. The interval sequence is
-reported in the output (``update_*`` variables).
+``reject_factor * tol`` is rejected and redone with a smaller interval. Impacts make the dynamics
+slightly non-periodic: the cycle-to-cycle variability of the rate field is measured on the initial
+profile and removed from ``eta`` in quadrature. ``scheme="schedule"`` replays a list of intervals
+(:func:`halved_schedule` for convergence checks). The interval sequence is reported in the output
+(``update_*`` variables); accepted updates that changed the rate field by more than
+:data:`UNRESOLVED_RATE_CHANGE` set the ``convergence_warning`` attribute.
 
 kw
 --
@@ -456,11 +460,9 @@ class WearRun:
             dn = st.schedule[min(k, len(st.schedule) - 1)]
         if st.max_increment is not None:
             rmax = float(np.max(rate))
-            if rmax > 0:
-                dn = min(
-                    dn,
-                    max(st.dn_min if st.scheme == "adaptive" else 1, int(st.max_increment / rmax)),
-                )
+            if rmax > 0:  # cap the deepest increment (never below dn_min in the adaptive scheme)
+                floor = st.dn_min if st.scheme == "adaptive" else 1
+                dn = min(dn, max(floor, int(st.max_increment / rmax)))
         dn = max(1, dn)
         return min(dn, stop - self._s["done"]), dn
 
