@@ -159,3 +159,39 @@ def test_points_initial_guess_and_reused_reference():
     np.testing.assert_allclose(ds2.u.values, -1.3, atol=0.003)
     np.testing.assert_allclose(ds2.v.values, 0.8, atol=0.003)
     assert (ds2.iterations.values >= 1).all() and (ds2.converged.values == 1).all()
+
+
+def test_large_translation_found_from_given_seed_points_only():
+    # 30 px away: outside a 10-px search window around the reference position, found when
+    # the seed search is centred well (seed point) and the window is wide enough
+    field = sp.RigidField((30.4, -12.6))
+    pair = sp.speckle_pair((128, 128), field, seed=6)
+    narrow = correlate(pair.reference, pair.deformed, subset_size=21, step=10, search_radius=10)
+    assert (narrow.flag.values == 0).mean() < 0.2
+    wide = correlate(
+        pair.reference,
+        pair.deformed,
+        subset_size=21,
+        step=10,
+        search_radius=40,
+        seed_points=np.array([[50.0, 60.0]]),
+    )
+    ok = wide.flag.values == 0
+    X, Y = np.meshgrid(wide.x.values, wide.y.values)
+    margin = 10 + 4  # half subset + border
+    inside = (X + 30.4 >= margin) & (X + 30.4 <= 127 - margin)
+    inside &= (Y - 12.6 >= margin) & (Y - 12.6 <= 127 - margin)
+    assert inside.sum() > 20 and ok[inside].all()
+    assert (wide.flag.values[~inside] != 0).all()  # carried out of the image: flagged
+    eu, ev = _errors(wide, pair)
+    assert np.max(np.abs(eu[ok])) < 0.01 and np.max(np.abs(ev[ok])) < 0.01
+
+
+def test_guess_rows_with_nan_are_filled_from_neighbours():
+    pair = sp.speckle_pair((96, 96), sp.RigidField((1.7, 0.9)), seed=8)
+    corr = SubsetCorrelator(pair.reference, subset_size=21, step=10)
+    guess = np.tile([1.5, 1.0], (corr.n_points, 1))
+    guess[::3] = np.nan
+    ds = corr.correlate(pair.deformed, initial_guess=guess)
+    assert (ds.flag.values == 0).all()
+    np.testing.assert_allclose(ds.u.values, 1.7, atol=0.005)
