@@ -217,21 +217,25 @@ def _match_sigma(img: np.ndarray, pts: np.ndarray, half: int, noise: float) -> n
     return out
 
 
-def _sift_homography(
-    ref: np.ndarray, img: np.ndarray, poly: np.ndarray, *, calibration=None, margin: int = 10
-) -> np.ndarray | None:
-    """Homography from the reference region to ``img`` by SIFT + RANSAC (epipolar-filtered)."""
+def _sift_features(img: np.ndarray, poly: np.ndarray | None = None, margin: int = 10):
+    """SIFT keypoints and descriptors of ``img`` (inside ``poly`` grown by ``margin`` px)."""
     import cv2
 
-    def u8(a):
-        return np.clip(a, 0, 255).astype(np.uint8)
+    mask = None
+    if poly is not None:
+        mask = np.zeros(img.shape, np.uint8)
+        cv2.fillPoly(mask, [np.rint(poly).astype(np.int32)], 255)
+        mask = cv2.dilate(mask, np.ones((2 * margin + 1,) * 2, np.uint8))
+    u8 = np.clip(np.nan_to_num(img), 0, 255).astype(np.uint8)
+    return cv2.SIFT_create().detectAndCompute(u8, mask)
 
-    mask = np.zeros(ref.shape, np.uint8)
-    cv2.fillPoly(mask, [np.rint(poly).astype(np.int32)], 255)
-    mask = cv2.dilate(mask, np.ones((2 * margin + 1,) * 2, np.uint8))
-    sift = cv2.SIFT_create(nfeatures=2000)
-    k1, d1 = sift.detectAndCompute(u8(ref), mask)
-    k2, d2 = sift.detectAndCompute(u8(img), None)
+
+def _sift_homography(ref_features, target_features, *, calibration=None) -> np.ndarray | None:
+    """Homography from a reference region to a target image by SIFT matching (ratio test,
+    epipolar filter when ``calibration`` is given) and RANSAC."""
+    import cv2
+
+    (k1, d1), (k2, d2) = ref_features, target_features
     if d1 is None or d2 is None or len(k1) < 8 or len(k2) < 8:
         return None
     matches = cv2.BFMatcher(cv2.NORM_L2).knnMatch(d1, d2, k=2)
@@ -290,7 +294,10 @@ class _CameraBodyTracker:
         crop = _crop(ref, self.origin, side)
         self.ref_crop = crop
         params = CorrelationParams(
-            subset_size=cfg.subset_size, zncc_min=cfg.zncc_min, threads=1, search_radius=8
+            subset_size=cfg.subset_size,
+            zncc_min=cfg.zncc_min,
+            threads=1 if cfg.workers > 1 else 0,  # 0: up to 2 numba threads
+            search_radius=8,
         )
         self.corr = SubsetCorrelator(crop, points=self.ref_pts - self.origin, params=params)
         self.history: list[tuple[float, np.ndarray]] = []  # (time, positions)
@@ -302,6 +309,7 @@ class _CameraBodyTracker:
         self._window = cv2.createHanningWindow((side // 2, side // 2), cv2.CV_32F)
         self.ref_image = ref
         self.polygon = None
+        self._ref_features = None
 
     def _predict(self, t: float) -> np.ndarray:
         """Positions (N, 2) predicted at time ``t`` by Lagrange extrapolation (degree <= 2) of
@@ -319,10 +327,13 @@ class _CameraBodyTracker:
             out += w * Xj
         return out
 
-    def reinit_guess(self, img: np.ndarray) -> np.ndarray | None:
-        """Per-point affine guesses from SIFT features (reference -> img), for lost tracking."""
-        poly = self.polygon if self.polygon is not None else _hull(self.ref_pts)
-        H = _sift_homography(self.ref_image, img, poly)
+    def reinit_guess(self, img: np.ndarray, features=None) -> np.ndarray | None:
+        """Per-point affine guesses from SIFT features (reference -> img), for lost tracking
+        and chunk starts; ``features`` of ``img`` may be passed (shared between bodies)."""
+        if self._ref_features is None:
+            poly = self.polygon if self.polygon is not None else _hull(self.ref_pts)
+            self._ref_features = _sift_features(self.ref_image, poly)
+        H = _sift_homography(self._ref_features, features or _sift_features(img))
         return None if H is None else _homography_guess(H, self.ref_pts)
 
     def track(self, img: np.ndarray, point_guess: np.ndarray | None = None, t: float = 0.0):
@@ -643,6 +654,7 @@ def _setup_states(L, R, bodies, calibration, cfg, ref_l, ref_r) -> list[_BodySta
     half = cfg.subset_size // 2
     w, h = L.size
     noise = _noise_sigma(ref_l)
+    right_features = _sift_features(ref_r) if R is not None else None
     states: list[_BodyState] = []
     for spec in bodies:
         poly = np.asarray(spec.polygon, dtype=float)
@@ -667,7 +679,9 @@ def _setup_states(L, R, bodies, calibration, cfg, ref_l, ref_r) -> list[_BodySta
             else _match_sigma(ref_l, pts, half, noise)
         )
         if R is not None:
-            H = _sift_homography(ref_l, ref_r, poly, calibration=calibration)
+            H = _sift_homography(
+                _sift_features(ref_l, poly), right_features, calibration=calibration
+            )
             if H is None:
                 raise BadInputError(
                     f"body '{spec.name}': its region could not be found in the right reference "
@@ -701,6 +715,13 @@ def _setup_states(L, R, bodies, calibration, cfg, ref_l, ref_r) -> list[_BodySta
 def _process_frame(states, t, img_l, img_r, dup, cfg, calibration, reinit) -> int:
     """Track every body in one frame (appending to each state's rows); the frame's flag."""
     flag = FRAME_FLAGS["duplicated"] if dup else 0
+    features: dict[str, Any] = {}
+
+    def feats(name: str, img: np.ndarray):
+        if name not in features:
+            features[name] = _sift_features(img)
+        return features[name]
+
     for st in states:
         d = st.ref3d.shape[1]
         n = len(st.ref3d)
@@ -724,8 +745,12 @@ def _process_frame(states, t, img_l, img_r, dup, cfg, calibration, reinit) -> in
             res = _track_body(st, img_l, img_r, t, cfg, calibration)
         if res is None or not res[0]:
             # chunk start or lost: initialise from SIFT features of the reference images
-            gl_guess = st.left.reinit_guess(img_l)
-            gr_guess = st.right.reinit_guess(img_r) if st.right is not None else None
+            gl_guess = st.left.reinit_guess(img_l, feats("left", img_l))
+            gr_guess = (
+                st.right.reinit_guess(img_r, feats("right", img_r))
+                if st.right is not None
+                else None
+            )
             if gl_guess is not None and (st.right is None or gr_guess is not None):
                 res = _track_body(st, img_l, img_r, t, cfg, calibration, gl_guess, gr_guess)
         ok_pose, Rm, tv, inl, rms, cur, cov, pl, pr, zn = res
