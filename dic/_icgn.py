@@ -731,7 +731,6 @@ def _sample_quintic(coef, x_start, y_start, a11, a12, a21, a22, half, f, gx, gy,
     """As :func:`_sample_cubic` with the quintic B-spline."""
     for i in range(9):
         acc[i] = 0.0
-    wy = np.empty(6)
     k = 0
     for r in range(-half, half + 1):
         rr = float(r)
@@ -742,43 +741,47 @@ def _sample_quintic(coef, x_start, y_start, a11, a12, a21, a22, half, f, gx, gy,
         for c in range(-half, half + 1):
             ix = int(xw)
             iy = int(yw)
+            # quintic B-spline weights (x 120), Horner form
             t = xw - ix
             s = 1.0 - t
-            t2 = t * t
-            t4 = t2 * t2
             s2 = s * s
+            t2 = t * t
             w0 = s2 * s2 * s
-            w5 = t4 * t
-            # quintic B-spline weights (x 120)
-            w1 = 26.0 - 50.0 * t + 20.0 * t2 + 20.0 * t2 * t - 20.0 * t4 + 5.0 * w5
-            w2 = 66.0 - 60.0 * t2 + 30.0 * t4 - 10.0 * w5
-            w3 = 26.0 + 50.0 * t + 20.0 * t2 - 20.0 * t2 * t - 20.0 * t4 + 10.0 * w5
-            w4 = 1.0 + 5.0 * t + 10.0 * t2 + 10.0 * t2 * t + 5.0 * t4 - 5.0 * w5
+            w5 = t2 * t2 * t
+            w1 = 26.0 + t * (-50.0 + t * (20.0 + t * (20.0 + t * (-20.0 + 5.0 * t))))
+            w2 = 66.0 + t2 * (-60.0 + t2 * (30.0 - 10.0 * t))
+            w3 = 26.0 + t * (50.0 + t * (20.0 + t * (-20.0 + t * (-20.0 + 10.0 * t))))
+            w4 = 1.0 + t * (5.0 + t * (10.0 + t * (10.0 + t * (5.0 - 5.0 * t))))
             t = yw - iy
             s = 1.0 - t
-            t2 = t * t
-            t4 = t2 * t2
             s2 = s * s
-            wy[5] = t4 * t
-            wy[0] = s2 * s2 * s
-            wy[1] = 26.0 - 50.0 * t + 20.0 * t2 + 20.0 * t2 * t - 20.0 * t4 + 5.0 * wy[5]
-            wy[2] = 66.0 - 60.0 * t2 + 30.0 * t4 - 10.0 * wy[5]
-            wy[3] = 26.0 + 50.0 * t + 20.0 * t2 - 20.0 * t2 * t - 20.0 * t4 + 10.0 * wy[5]
-            wy[4] = 1.0 + 5.0 * t + 10.0 * t2 + 10.0 * t2 * t + 5.0 * t4 - 5.0 * wy[5]
+            t2 = t * t
+            v0 = s2 * s2 * s
+            v5 = t2 * t2 * t
+            v1 = 26.0 + t * (-50.0 + t * (20.0 + t * (20.0 + t * (-20.0 + 5.0 * t))))
+            v2 = 66.0 + t2 * (-60.0 + t2 * (30.0 - 10.0 * t))
+            v3 = 26.0 + t * (50.0 + t * (20.0 + t * (-20.0 + t * (-20.0 + 10.0 * t))))
+            v4 = 1.0 + t * (5.0 + t * (10.0 + t * (10.0 + t * (5.0 - 5.0 * t))))
             bx = ix + PAD - 2
             by = iy + PAD - 2
-            gv = 0.0
-            for q5 in range(6):
-                row = coef[by + q5]
-                gv += wy[q5] * (
-                    w0 * row[bx]
-                    + w1 * row[bx + 1]
-                    + w2 * row[bx + 2]
-                    + w3 * row[bx + 3]
-                    + w4 * row[bx + 4]
-                    + w5 * row[bx + 5]
-                )
-            gv *= 1.0 / 14400.0
+            r0 = coef[by]
+            r1 = coef[by + 1]
+            r2 = coef[by + 2]
+            r3 = coef[by + 3]
+            r4 = coef[by + 4]
+            r5 = coef[by + 5]
+            h0 = v0 * r0[bx] + v1 * r1[bx] + v2 * r2[bx] + v3 * r3[bx] + v4 * r4[bx] + v5 * r5[bx]
+            b1 = bx + 1
+            h1 = v0 * r0[b1] + v1 * r1[b1] + v2 * r2[b1] + v3 * r3[b1] + v4 * r4[b1] + v5 * r5[b1]
+            b2 = bx + 2
+            h2 = v0 * r0[b2] + v1 * r1[b2] + v2 * r2[b2] + v3 * r3[b2] + v4 * r4[b2] + v5 * r5[b2]
+            b3 = bx + 3
+            h3 = v0 * r0[b3] + v1 * r1[b3] + v2 * r2[b3] + v3 * r3[b3] + v4 * r4[b3] + v5 * r5[b3]
+            b4 = bx + 4
+            h4 = v0 * r0[b4] + v1 * r1[b4] + v2 * r2[b4] + v3 * r3[b4] + v4 * r4[b4] + v5 * r5[b4]
+            b5 = bx + 5
+            h5 = v0 * r0[b5] + v1 * r1[b5] + v2 * r2[b5] + v3 * r3[b5] + v4 * r4[b5] + v5 * r5[b5]
+            gv = (w0 * h0 + w1 * h1 + w2 * h2 + w3 * h3 + w4 * h4 + w5 * h5) * (1.0 / 14400.0)
             sg += gv
             sgg += gv * gv
             sgf += gv * f[k]
