@@ -94,15 +94,15 @@ def register(app: typer.Typer) -> None:
             Path, typer.Argument(help="Wear map written by 'jointwear sim wear'.")
         ],
         max_depth_um: Annotated[
-            float | None, typer.Option("--max-depth-um", help="Measured maximum wear depth [µm].")
+            float | None, typer.Option("--max-depth-um", help="Measured maximum wear depth \\[µm].")
         ] = None,
         volume_mm3: Annotated[
-            float | None, typer.Option("--volume-mm3", help="Measured worn volume [mm³].")
+            float | None, typer.Option("--volume-mm3", help="Measured worn volume \\[mm³].")
         ] = None,
         cylindricity_um: Annotated[
             float | None,
             typer.Option(
-                "--cylindricity-um", help="Measured growth of the bore's cylindricity [µm]."
+                "--cylindricity-um", help="Measured growth of the bore's cylindricity \\[µm]."
             ),
         ] = None,
         measured_map: Annotated[
@@ -169,13 +169,15 @@ def register(app: typer.Typer) -> None:
         cycles: Annotated[float, typer.Option("--cycles", help="Target number of cycles.")] = 1e6,
         kw: Annotated[
             float | None,
-            typer.Option("--kw", help="Archard wear coefficient [m²/N = m³/(N m)]."),
+            typer.Option(
+                "--kw", help="Archard wear coefficient \\[m²/N = m³/(N m)]; default 9e-16."
+            ),
         ] = None,
         params: Annotated[
             Path | None,
             typer.Option(
                 "--params",
-                help="TOML file: simulator parameters, and a [wear] table (kw, scheme, dn, tol, ...).",
+                help="TOML file: simulator parameters, and a \\[wear] table (kw, scheme, dn, tol, ...).",
             ),
         ] = None,
         resume: Annotated[
@@ -193,7 +195,11 @@ def register(app: typer.Typer) -> None:
             ),
         ] = None,
         scheme: Annotated[
-            str | None, typer.Option("--scheme", help="Update interval: adaptive or fixed.")
+            str | None,
+            typer.Option(
+                "--scheme",
+                help="Update interval: adaptive, fixed, or schedule (intervals from the \\[wear] table).",
+            ),
         ] = None,
         dn: Annotated[
             int | None,

@@ -197,3 +197,10 @@ def test_a_failing_simulation_leaves_partial_output_and_checkpoint(tmp_path, mon
     partial = io.load(out)
     assert partial.attrs["status"] == "partial"
     assert (tmp_path / "w.nc.ckpt").exists()
+
+
+def test_help_states_the_default_kw(capsys):
+    from jointwear.sim import DEFAULT_KW
+
+    assert main(["sim", "wear", "--help"]) == 0
+    assert f"default {DEFAULT_KW:g}" in capsys.readouterr().out
