@@ -16,34 +16,34 @@ def register(app: typer.Typer) -> None:
     @app.command("speckle")
     def speckle_cmd(
         out: Annotated[Path, typer.Argument(help="Output folder.")],
-        size: Annotated[str, typer.Option("--size", help="WIDTHxHEIGHT [pixel].")] = "512x512",
+        size: Annotated[str, typer.Option("--size", help="WIDTHxHEIGHT (pixels).")] = "512x512",
         field: Annotated[
             str, typer.Option("--field", help="rigid, affine, rotation or sinusoidal.")
         ] = "rigid",
-        u: Annotated[float, typer.Option("--u", help="Translation along x [pixel].")] = 1.5,
-        v: Annotated[float, typer.Option("--v", help="Translation along y [pixel].")] = -0.7,
+        u: Annotated[float, typer.Option("--u", help="Translation along x (pixels).")] = 1.5,
+        v: Annotated[float, typer.Option("--v", help="Translation along y (pixels).")] = -0.7,
         theta_deg: Annotated[
-            float, typer.Option("--theta-deg", help="Rotation [degree], +x towards +y.")
+            float, typer.Option("--theta-deg", help="Rotation (degrees), +x towards +y.")
         ] = 0.0,
         strain: Annotated[
             float, typer.Option("--strain", help="Affine: normal strain exx = -eyy/2.")
         ] = 0.01,
         amplitude: Annotated[
-            float, typer.Option("--amplitude", help="Sinusoidal: amplitude of u [pixel].")
+            float, typer.Option("--amplitude", help="Sinusoidal: amplitude of u (pixels).")
         ] = 2.0,
         wavelength: Annotated[
-            float, typer.Option("--wavelength", help="Sinusoidal: wavelength [pixel].")
+            float, typer.Option("--wavelength", help="Sinusoidal: wavelength (pixels).")
         ] = 128.0,
         frames: Annotated[
             int, typer.Option("--frames", help="Number of deformed frames (field ramps up).")
         ] = 1,
         speckle_size: Annotated[
-            float, typer.Option("--speckle-size", help="Speckle diameter [pixel].")
+            float, typer.Option("--speckle-size", help="Speckle diameter (pixels).")
         ] = 5.0,
         density: Annotated[float, typer.Option("--density", help="Area fraction.")] = 0.6,
         contrast: Annotated[float, typer.Option("--contrast", help="0..1 of full scale.")] = 0.8,
-        noise: Annotated[float, typer.Option("--noise", help="Noise std [grey levels].")] = 0.0,
-        blur: Annotated[float, typer.Option("--blur", help="Gaussian PSF std [pixel].")] = 0.0,
+        noise: Annotated[float, typer.Option("--noise", help="Noise std (grey levels).")] = 0.0,
+        blur: Annotated[float, typer.Option("--blur", help="Gaussian PSF std (pixels).")] = 0.0,
         bit_depth: Annotated[int, typer.Option("--bit-depth", help="8 or up to 16.")] = 8,
         seed: Annotated[int, typer.Option("--seed", help="Random seed.")] = 0,
     ) -> None:

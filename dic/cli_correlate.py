@@ -19,7 +19,7 @@ def _parse_roi(text: str | None):
         vals = []
     if len(vals) != 4:
         raise BadInputError(
-            f"--roi {text!r}: expected four numbers x_min,y_min,x_max,y_max [pixel]"
+            f"--roi {text!r}: expected four numbers x_min,y_min,x_max,y_max (pixels)"
         )
     return vals
 
@@ -53,10 +53,10 @@ def register(app: typer.Typer) -> None:
         ] = None,
         out: Annotated[Path, typer.Option("--out", help="Output netCDF file.")] = Path("field.nc"),
         roi: Annotated[
-            str | None, typer.Option("--roi", help="Region x_min,y_min,x_max,y_max [pixel].")
+            str | None, typer.Option("--roi", help="Region x_min,y_min,x_max,y_max (pixels).")
         ] = None,
-        subset: Annotated[int, typer.Option("--subset", help="Subset size [pixel], odd.")] = 31,
-        step: Annotated[int, typer.Option("--step", help="Grid step [pixel].")] = 10,
+        subset: Annotated[int, typer.Option("--subset", help="Subset size (pixels), odd.")] = 31,
+        step: Annotated[int, typer.Option("--step", help="Grid step (pixels).")] = 10,
         shape: Annotated[
             str, typer.Option("--shape", help="Shape function: affine or quadratic.")
         ] = "affine",
@@ -64,11 +64,11 @@ def register(app: typer.Typer) -> None:
             str, typer.Option("--interpolation", help="B-spline: quintic or cubic.")
         ] = "quintic",
         search_radius: Annotated[
-            int, typer.Option("--search-radius", help="Seed search half-width [pixel].")
+            int, typer.Option("--search-radius", help="Seed search half-width (pixels).")
         ] = 48,
         seed: Annotated[
             list[str] | None,
-            typer.Option("--seed", help="Seed point x,y [pixel] (repeatable)."),
+            typer.Option("--seed", help="Seed point x,y (pixels) (repeatable)."),
         ] = None,
         zncc_min: Annotated[
             float, typer.Option("--zncc-min", help="Flag matches below this ZNCC.")
@@ -85,7 +85,7 @@ def register(app: typer.Typer) -> None:
         ] = None,
         threads: Annotated[int, typer.Option("--threads", help="numba threads (0: auto).")] = 0,
     ) -> None:
-        """Subset DIC (ZNSSD, IC-GN): displacement u, v [pixel] on a grid, written to netCDF."""
+        """Subset DIC (ZNSSD, IC-GN): displacement u, v (pixels) on a grid, written to netCDF."""
         import time as _time
 
         from jointwear._version import __version__
