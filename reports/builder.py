@@ -59,7 +59,7 @@ class ReportInput:
     dataset: xr.Dataset | None = None
 
 
-def format_value(value: float, units: str) -> tuple[str, str]:
+def format_value(value: float, units: str, *, digits: int = 4) -> tuple[str, str]:
     """A number and its unit for display: lengths in µm, volumes in mm³, others as given."""
     if value is None or not np.isfinite(value):
         return "n/a", units
@@ -69,8 +69,8 @@ def format_value(value: float, units: str) -> tuple[str, str]:
     if v == 0:
         return "0", shown
     if abs(v) >= 1e-3 and abs(v) < 1e5:
-        return f"{v:.4g}", shown
-    return f"{v:.3e}", shown
+        return f"{v:.{digits}g}", shown
+    return f"{v:.{digits - 1}e}", shown
 
 
 def _template(name: str) -> str:
@@ -160,7 +160,7 @@ def _budget(c: Comparison) -> tuple[list[dict[str, Any]], list[str]]:
         units = str(sub.loc["value_sim", "units"])
         cells = []
         for key in ("value_sim", "value_meas", "E", "u_num", "u_input", "u_D", "u_val", "U_val"):
-            v, u = format_value(float(sub.loc[key, "value"]), units)
+            v, u = format_value(float(sub.loc[key, "value"]), units, digits=3)
             cells.append(f"{v} {u}".strip())
         passed = abs(float(sub.loc["E", "value"])) <= float(sub.loc["U_val", "value"])
         budget.append({"quantity": str(q), "cells": cells, "passed": passed})
@@ -179,11 +179,11 @@ def _uncertainty_sources(crit: Criteria) -> list[tuple[str, str]]:
         (
             "u_num (numerical)",
             "the simulation's stated standard uncertainty (<name>_u) if any, else "
-            f"{crit.wear_u_num_rel:g}·|S| (wear) and {crit.motion_u_num_rel:g}·|S| (motion)",
+            f"{crit.wear_u_num_rel:.3g}·|S| (wear) and {crit.motion_u_num_rel:.3g}·|S| (motion)",
         ),
         (
             "u_input (model inputs)",
-            f"{crit.wear_u_input_rel:g}·|S| (wear) and {crit.motion_u_input_rel:g}·|S| (motion), "
+            f"{crit.wear_u_input_rel:.3g}·|S| (wear) and {crit.motion_u_input_rel:.3g}·|S| (motion), "
             "from the criteria file; 0 means not assessed",
         ),
     ]

@@ -60,10 +60,11 @@ class DemoSize:
     motion_cycles: float
     rig_size: tuple[int, int] | None  # stereo footage (width, height) [px]; None = no footage
     rig_duration: float  # recorded time [s]
+    verification_tols: tuple[float, ...]  # coarser wear-update tolerances for the study
 
 
-FULL = DemoSize(2e5, (5e4, 1e5, 2e5), 10, 90, 18000, 1.5, (640, 512), 0.6)
-QUICK = DemoSize(5e4, (2e4, 5e4), 8, 72, 3600, 1.2, None, 0.0)
+FULL = DemoSize(2e5, (2e5,), 10, 90, 18000, 1.5, (640, 512), 0.6, (0.4, 0.2))
+QUICK = DemoSize(5e4, (5e4,), 8, 72, 3600, 1.2, None, 0.0, ())
 
 
 def _say(msg: str) -> None:
@@ -80,9 +81,74 @@ def _available(module: str, *names: str) -> bool:
     return all(hasattr(mod, n) for n in names)
 
 
-def _simulate(folder: Path, size: DemoSize) -> tuple[Path, Path, Any]:
+def wear_verification(
+    params: Any, size: DemoSize, main: xr.Dataset, main_tol: float
+) -> tuple[xr.Dataset, float]:
+    """Convergence of the simulated wear with the cycle-update tolerance (verification).
+
+    The wear run is repeated with coarser tolerances of the adaptive update interval
+    (``WearSettings.tol``). The update is explicit Euler in the cycle count (first order), so by
+    Richardson extrapolation the error of the finest run is about its difference to the next
+    coarser one; that relative difference (the larger of maximum depth and worn volume) is used
+    as the relative numerical standard uncertainty ``u_num`` of the simulated wear quantities.
+
+    Returns
+    -------
+    (Dataset, float)
+        ``max_wear_depth`` [m] and ``worn_volume`` [m³] over ``update_tolerance`` [1], and the
+        relative numerical uncertainty [1].
+    """
+    from jointwear.sim import WearSettings, simulate_wear
+
+    tols = [*size.verification_tols, main_tol]
+    depth, volume = [], []
+    for tol in size.verification_tols:
+        run = simulate_wear(
+            params,
+            cycles=size.cycles,
+            snapshots=list(size.snapshots),
+            settings=WearSettings(tol=tol),
+        )
+        depth.append(float(run["max_wear_depth"][-1]))
+        volume.append(float(run["worn_volume"][-1]))
+    depth.append(float(main["max_wear_depth"][-1]))
+    volume.append(float(main["worn_volume"][-1]))
+    rel = max(abs(depth[-1] - depth[-2]) / depth[-1], abs(volume[-1] - volume[-2]) / volume[-1])
+    ds = xr.Dataset(
+        {
+            "max_wear_depth": (
+                "update_tolerance",
+                depth,
+                {"units": "m", "long_name": "largest simulated wear depth"},
+            ),
+            "worn_volume": (
+                "update_tolerance",
+                volume,
+                {"units": "m3", "long_name": "simulated worn volume"},
+            ),
+        },
+        coords={
+            "update_tolerance": (
+                "update_tolerance",
+                tols,
+                {
+                    "units": "1",
+                    "long_name": "tolerance of the adaptive wear-update interval (WearSettings.tol)",
+                },
+            )
+        },
+        attrs={
+            "title": "verification: simulated wear versus the cycle-update tolerance",
+            "u_num_rel": rel,
+            "cycles": size.cycles,
+        },
+    )
+    return ds, rel
+
+
+def _simulate(folder: Path, size: DemoSize) -> tuple[Path, Path, Any, Path | None, float]:
     from jointwear.params import replace_nested
-    from jointwear.sim import PARAMETER_SETS, run_cycles, simulate_wear
+    from jointwear.sim import PARAMETER_SETS, WearSettings, run_cycles, simulate_wear
 
     params = replace_nested(
         PARAMETER_SETS["zhang2023"],
@@ -101,6 +167,23 @@ def _simulate(folder: Path, size: DemoSize) -> tuple[Path, Path, Any]:
         f"max depth {float(wear['max_wear_depth'][-1]) * 1e6:.1f} µm "
         f"({time.perf_counter() - t0:.0f} s)"
     )
+    verification_path, u_num_rel = None, 0.0
+    if size.verification_tols:
+        t0 = time.perf_counter()
+        ver, u_num_rel = wear_verification(params, size, wear, WearSettings().tol)
+        verification_path = io.save(
+            ver,
+            folder / "sim_verification.nc",
+            parameters={
+                "simulation": params,
+                "update_tolerances": list(ver["update_tolerance"].values),
+            },
+            source="jointwear (sim.wear) via jointwear demo",
+        )
+        _say(
+            f"  verification: update tolerances {', '.join(f'{t:g}' for t in ver['update_tolerance'].values)}"
+            f" -> numerical uncertainty {u_num_rel:.1%} ({time.perf_counter() - t0:.0f} s)"
+        )
     t0 = time.perf_counter()
     motion = run_cycles(params, cycles=size.motion_cycles).dataset
     keep = [
@@ -123,7 +206,7 @@ def _simulate(folder: Path, size: DemoSize) -> tuple[Path, Path, Any]:
     _say(
         f"  simulated motion: {size.motion_cycles:g} crank cycles ({time.perf_counter() - t0:.0f} s)"
     )
-    return sim_wear, sim_motion, params
+    return sim_wear, sim_motion, params, verification_path, u_num_rel
 
 
 def measured_wear_function(sim_wear: xr.Dataset) -> Any:
@@ -355,10 +438,22 @@ def run_demo(out: Path, *, quick: bool = False) -> Path:
     ]
     sims: list[Path] = []
     meas: list[tuple[str, Path]] = []
-    sim_wear_path = sim_motion_path = None
+    sim_wear_path = sim_motion_path = verification_path = None
+    u_num_rel = 0.0
     if _available("jointwear.sim", "simulate_wear", "run_cycles", "PARAMETER_SETS"):
-        sim_wear_path, sim_motion_path, _ = _simulate(out, size)
+        sim_wear_path, sim_motion_path, _, verification_path, u_num_rel = _simulate(out, size)
         sims += [sim_wear_path, sim_motion_path]
+        if verification_path is not None:
+            notes.append(
+                "Numerical uncertainty of the simulated wear: the wear run was repeated with "
+                "coarser tolerances of the adaptive cycle-update interval (Verification); the "
+                f"relative change between the two finest runs, {u_num_rel:.1%}, is used as u_num "
+                "(first-order update, Richardson estimate)."
+            )
+        else:
+            missing.append(
+                "verification: the convergence study of the wear update is skipped with --quick"
+            )
     else:
         missing.append("simulation: jointwear.sim is not available, nothing was simulated")
     if (
@@ -393,7 +488,7 @@ def run_demo(out: Path, *, quick: bool = False) -> Path:
             "mechanism; tracked positions are in the calibration's world frame (the board), not "
             "the mechanism frame, and are not compared."
         )
-    criteria = Criteria(**DEMO_CRITERIA)
+    criteria = Criteria(**DEMO_CRITERIA, wear_u_num_rel=u_num_rel)
     result = compare(
         sim_ds,
         compared,
@@ -408,10 +503,15 @@ def run_demo(out: Path, *, quick: bool = False) -> Path:
     )
     inputs = [ReportInput("simulation", p, d) for p, d in zip(sims, sim_ds, strict=True)]
     inputs += [ReportInput(role, p, d) for (role, p), d in zip(meas, meas_ds, strict=True)]
+    verification = []
+    if verification_path is not None:
+        verification = [io.load(verification_path)]
+        inputs.append(ReportInput("verification", verification_path, verification[0]))
     report = build_report(
         result,
         out / "report.html",
         inputs=inputs,
+        verification=verification,
         missing=missing,
         notes=notes,
         title="jointwear demo: wear of the clearance joint, simulation against measurement",

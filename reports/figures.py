@@ -209,13 +209,19 @@ def motion_figure(motion: xr.Dataset, *, k: float = 2.0) -> Any:
     return fig
 
 
+_DISPLAY = {"m": (1e6, "µm"), "m3": (1e9, "mm³")}
+
+
 def verification_figure(datasets: Sequence[xr.Dataset]) -> Any | None:
     """Convergence plots of verification data: every 1-D variable against its dimension.
 
-    Log-log axes when both are positive (the slope is the observed order of convergence).
-    Returns None when there is nothing to plot.
+    Logarithmic x axis when the refinement parameter is positive (tolerances, grid steps), and
+    a logarithmic y axis too when the values are positive and span more than a decade (then the
+    slope is the observed order of convergence). Lengths in µm, volumes in mm³. Returns None
+    when there is nothing to plot.
     """
     import matplotlib
+    from matplotlib.ticker import ScalarFormatter
 
     series = []
     for ds in datasets:
@@ -230,16 +236,24 @@ def verification_figure(datasets: Sequence[xr.Dataset]) -> Any | None:
     with matplotlib.rc_context(_RC):
         ncol = min(3, len(series))
         nrow = int(np.ceil(len(series) / ncol))
-        fig = _figure(3.4 * ncol, 2.7 * nrow)
+        fig = _figure(max(9.5, 3.4 * ncol), 2.9 * nrow)
         for k, (name, dim, x, y, attrs, ds) in enumerate(series):
             ax = fig.add_subplot(nrow, ncol, k + 1)
-            ax.plot(x, y, marker="o", color=SIM_COLOUR, lw=1.0, ms=3)
-            if np.all(x > 0) and np.all(y > 0):
+            factor, units = _DISPLAY.get(str(attrs.get("units", "")), (1.0, attrs.get("units", "")))
+            ax.plot(x, y * factor, marker="o", color=SIM_COLOUR, lw=1.0, ms=3)
+            if np.all(x > 0):
                 ax.set_xscale("log")
+                ax.xaxis.set_major_formatter(ScalarFormatter())
+                ax.xaxis.set_minor_formatter(ScalarFormatter())
+                ax.set_xticks(np.unique(x))
+                ax.tick_params(axis="x", which="minor", labelbottom=False)
+            if np.all(y > 0) and y.max() / y.min() > 10:
                 ax.set_yscale("log")
+            else:
+                ax.ticklabel_format(axis="y", useOffset=False, style="plain")
             xu = ds[dim].attrs.get("units", "") if dim in ds.coords else ""
-            ax.set_xlabel(f"{dim}" + (f" [{xu}]" if xu else ""))
-            ax.set_ylabel(f"{name} [{attrs.get('units', '')}]")
+            ax.set_xlabel(f"{dim}" + (f" [{xu}]" if xu and xu != "1" else ""))
+            ax.set_ylabel(f"{name} [{units}]")
             ax.set_title(str(attrs.get("long_name", name))[:60])
             ax.grid(True, which="both", lw=0.3, alpha=0.5)
     return fig
