@@ -147,6 +147,314 @@ def _cross_acc(ax, ay, az, bx, by, bz, out, k, s):
     out[k + 2] += s * (ax * by - ay * bx)
 
 
+_GL_T = (0.5 - 0.5 * math.sqrt(0.6), 0.5, 0.5 + 0.5 * math.sqrt(0.6))
+_GL_W = (5.0 / 18.0, 8.0 / 18.0, 5.0 / 18.0)
+
+
+@njit(cache=True)
+def _seg(a, b, nexp):
+    """Integrals over an axial interval where the penetration runs linearly from a to b.
+
+    With p = max(delta, 0) and t in [0, 1]: returns J0 = int (1-t) p^n, J1 = int t p^n,
+    G = int p^(n+1)/(n+1) and the fraction of the interval in contact. J0, J1 are the exact
+    derivatives of G with respect to a and b, so forces built from them are conservative.
+    """
+    if a <= 0.0 and b <= 0.0:
+        return 0.0, 0.0, 0.0, 0.0
+    d = b - a
+    big = a if a > b else b
+    if abs(d) <= 1e-3 * big:  # both positive and nearly equal: Gauss-Legendre, no cancellation
+        j0 = 0.0
+        j1 = 0.0
+        g = 0.0
+        for k in range(3):
+            t = _GL_T[k]
+            uu = a + d * t
+            f = uu**nexp
+            j0 += _GL_W[k] * (1.0 - t) * f
+            j1 += _GL_W[k] * t * f
+            g += _GL_W[k] * uu * f / (nexp + 1.0)
+        return j0, j1, g, 1.0
+    swap = d < 0.0
+    if swap:
+        a, b = b, a
+        d = -d
+    lo = a if a > 0.0 else 0.0
+    hi = b
+    n1 = nexp + 1.0
+    n2 = nexp + 2.0
+    ph1, pl1 = hi**n1, lo**n1
+    ph2, pl2 = hi**n2, lo**n2
+    j0 = (b * (ph1 - pl1) / n1 - (ph2 - pl2) / n2) / (d * d)
+    j1 = ((ph2 - pl2) / n2 - a * (ph1 - pl1) / n1) / (d * d)
+    g = (ph2 - pl2) / (n1 * n2 * d)
+    frac = (hi - lo) / d
+    if swap:
+        return j1, j0, g, frac
+    return j0, j1, g, frac
+
+
+@njit(cache=True)
+def _search(n, m0, J0, u, P, H, ZL, Nd):
+    """Deepest node of layer n near node m0: (ms, delta at ms-1, ms, ms+1, their node tuples)."""
+    # climb from the node facing the eccentricity to the nearest local maximum of the
+    # penetration on each side; keep the deeper one (on a worn profile the journal can
+    # bridge a narrow groove and touch both flanks: the deeper flank carries the slice)
+    t0 = _node(n, m0, J0, u, P, H, ZL, Nd)
+    tp = _node(n, m0 + 1, J0, u, P, H, ZL, Nd)
+    tm = _node(n, m0 - 1, J0, u, P, H, ZL, Nd)
+    c0, cp, cm = _dl(t0, P), _dl(tp, P), _dl(tm, P)
+    ms, dm, d0, dp = m0, cm, c0, cp
+    nm, n0, npp = tm, t0, tp
+    found = False
+    if cp > c0:
+        r, b0, b1 = m0 + 1, t0, tp
+        b2 = _node(n, m0 + 2, J0, u, P, H, ZL, Nd)
+        a0, a1, a2 = c0, cp, _dl(b2, P)
+        for _ in range(Nd // 2):
+            if a2 <= a1:
+                break
+            r += 1
+            a0, a1, b0, b1 = a1, a2, b1, b2
+            b2 = _node(n, r + 1, J0, u, P, H, ZL, Nd)
+            a2 = _dl(b2, P)
+        ms, dm, d0, dp = r, a0, a1, a2
+        nm, n0, npp = b0, b1, b2
+        found = True
+    if cm > c0:
+        r, b0, b1 = m0 - 1, t0, tm
+        b2 = _node(n, m0 - 2, J0, u, P, H, ZL, Nd)
+        a0, a1, a2 = c0, cm, _dl(b2, P)
+        for _ in range(Nd // 2):
+            if a2 <= a1:
+                break
+            r -= 1
+            a0, a1, b0, b1 = a1, a2, b1, b2
+            b2 = _node(n, r - 1, J0, u, P, H, ZL, Nd)
+            a2 = _dl(b2, P)
+        if not found or a1 > d0:
+            ms, dm, d0, dp = r, a2, a1, a0
+            nm, n0, npp = b2, b1, b0
+    return ms, dm, d0, dp, nm, n0, npp
+
+
+@njit(cache=True)
+def _slices(
+    J0, u, V0, W, P, IP, H, HMIN, ZL, AREA, vimp, srate, son, wrench, acc, hstep, WW, acc_out
+):
+    """Grid-independent radial contact: axial slices with the penetration linear in between.
+
+    Each layer gives its deepest penetration (parabola through three nodes); between adjacent
+    layers the penetration is taken linear in z, so the joint-level law K delta^n is integrated
+    exactly over the contact length (an edge contact shorter than a layer spacing gets its true
+    length). The elastic force on each layer is the derivative of that integral (conservative),
+    applied along the layer's deepest normal; L-N damping and friction act per layer.
+    Returns (energy, normal force sum, max penetration, K at the deepest layer, contacting
+    layers, opposite-sides flag, contact length fraction).
+    """
+    Nl = IP[NL]
+    Nd = IP[ND]
+    nexp = P[NEXP]
+    ce = P[CE]
+    vfloor = P[VFLOOR]
+    muon = P[MUON]
+    uz = u[2]
+    lam = 1.0 / (Nl - 1)
+    # one scratch block per call: bound, in-plane axis point, reach, results per layer
+    scr = np.empty((Nl, 8))
+    dest = scr[:, 0]
+    axs = scr[:, 1]
+    ays = scr[:, 2]
+    sd = scr[:, 3]  # signed deepest penetration of each layer
+    sx = scr[:, 4]  # parabola vertex offset (node units)
+    kk = scr[:, 5]
+    fel = scr[:, 6]
+    reach = scr[:, 7]  # 1 = the journal spans this layer, 2 = and it was searched
+    geo = np.empty((Nl, 3, 6))  # the three nodes around the deepest: point (3), normal (3)
+    sm = np.empty(Nl, dtype=np.int64)
+    for n in range(Nl):
+        fel[n] = 0.0
+        s0 = (ZL[n] - J0[2]) / uz
+        if abs(s0) > 0.5 * P[LJ]:
+            dest[n] = -1.0
+            reach[n] = 0.0
+            continue
+        reach[n] = 1.0
+        ax = J0[0] + s0 * u[0]
+        ay = J0[1] + s0 * u[1]
+        axs[n] = ax
+        ays[n] = ay
+        dest[n] = uz * math.sqrt(ax * ax + ay * ay) + P[RJ] - uz * (P[RB] + HMIN[n])
+    pen = -1.0
+    for n in range(Nl):
+        act = dest[n] > 0.0 or (n > 0 and dest[n - 1] > 0.0) or (n < Nl - 1 and dest[n + 1] > 0.0)
+        if not (act and reach[n] > 0.0):
+            sd[n] = dest[n] if dest[n] < 0.0 else -1e-12
+            if sd[n] > pen:
+                pen = sd[n]
+            continue
+        phi0 = math.atan2(ays[n], -axs[n])
+        if phi0 < 0.0:
+            phi0 += 2.0 * math.pi
+        m0 = int(round(phi0 / P[DPHI])) % Nd
+        ms, dm, d0, dp, nm, n0, npp = _search(n, m0, J0, u, P, H, ZL, Nd)
+        b = 0.5 * (dp - dm)
+        dd = 2.0 * d0 - dp - dm
+        x = 0.0
+        if dd > 1e-300:
+            x = b / dd
+            if x > 1.0:
+                x = 1.0
+            elif x < -1.0:
+                x = -1.0
+        sd[n] = d0 + b * x - 0.5 * dd * x * x
+        if sd[n] > pen:
+            pen = sd[n]
+        sx[n] = x
+        sm[n] = ms
+        for q in range(6):
+            geo[n, 0, q] = nm[1 + q]
+            geo[n, 1, q] = n0[1 + q]
+            geo[n, 2, q] = npp[1 + q]
+        lm = 0.5 * x * (x - 1.0)
+        l0 = 1.0 - x * x
+        lp = 0.5 * x * (x + 1.0)
+        hc = lm * H[n, (ms - 1) % Nd] + l0 * H[n, ms % Nd] + lp * H[n, (ms + 1) % Nd]
+        kk[n] = _stiffness(P, IP, hc)
+        reach[n] = 2.0
+    # elastic force per layer from the exact integral over each interval
+    energy = 0.0
+    clen = 0.0
+    for n in range(Nl - 1):
+        a = sd[n]
+        bb = sd[n + 1]
+        if a <= 0.0 and bb <= 0.0:
+            continue
+        j0, j1, g, frac = _seg(a, bb, nexp)
+        fel[n] += lam * kk[n] * j0
+        fel[n + 1] += lam * kk[n + 1] * j1
+        energy += lam * 0.5 * (kk[n] + kk[n + 1]) * g
+        clen += lam * frac
+    fnsum = 0.0
+    kdeep = 0.0
+    dmax = -1.0
+    nslice = 0
+    two = False
+    have0 = False
+    f0x, f0y, f0z = 0.0, 0.0, 0.0
+    for n in range(Nl):
+        if fel[n] <= 0.0 or reach[n] != 2.0:
+            son[n] = 0
+            continue
+        x = sx[n]
+        lw0 = 0.5 * x * (x - 1.0)
+        lw1 = 1.0 - x * x
+        lw2 = 0.5 * x * (x + 1.0)
+        cx = lw0 * geo[n, 0, 0] + lw1 * geo[n, 1, 0] + lw2 * geo[n, 2, 0]
+        cy = lw0 * geo[n, 0, 1] + lw1 * geo[n, 1, 1] + lw2 * geo[n, 2, 1]
+        cz = lw0 * geo[n, 0, 2] + lw1 * geo[n, 1, 2] + lw2 * geo[n, 2, 2]
+        nx = lw0 * geo[n, 0, 3] + lw1 * geo[n, 1, 3] + lw2 * geo[n, 2, 3]
+        ny = lw0 * geo[n, 0, 4] + lw1 * geo[n, 1, 4] + lw2 * geo[n, 2, 4]
+        nz = lw0 * geo[n, 0, 5] + lw1 * geo[n, 1, 5] + lw2 * geo[n, 2, 5]
+        nn = math.sqrt(nx * nx + ny * ny + nz * nz)
+        hx, hy, hz = nx / nn, ny / nn, nz / nn
+        vx = V0[0] + W[1] * cz - W[2] * cy
+        vy = V0[1] + W[2] * cx - W[0] * cz
+        vz = V0[2] + W[0] * cy - W[1] * cx
+        rate = vx * hx + vy * hy + vz * hz
+        vm = vimp[n]
+        if vm <= 0.0:
+            vm = rate if rate > vfloor else vfloor
+        fn = fel[n] * ln_factor(rate, vm, ce)
+        for k in range(3):
+            lk = lw0 if k == 0 else (lw1 if k == 1 else lw2)
+            sk = fn * lk
+            for q in range(3):
+                wrench[q] += sk * geo[n, k, 3 + q]
+                wrench[6 + q] += sk * geo[n, k, 3 + q]
+            _cross_acc(
+                geo[n, k, 0],
+                geo[n, k, 1],
+                geo[n, k, 2],
+                geo[n, k, 3],
+                geo[n, k, 4],
+                geo[n, k, 5],
+                wrench,
+                3,
+                sk,
+            )
+        fnsum += fn
+        tx = vx - rate * hx
+        ty = vy - rate * hy
+        tz = vz - rate * hz
+        vt = math.sqrt(tx * tx + ty * ty + tz * tz)
+        if muon > 0.0 and vt > 0.0:
+            mu = friction_coefficient(vt, P[MUS], P[MUD], P[VS], P[VD])
+            sk = mu * fn / vt
+            wrench[0] += sk * tx
+            wrench[1] += sk * ty
+            wrench[2] += sk * tz
+            wrench[9] += sk * tx
+            wrench[10] += sk * ty
+            wrench[11] += sk * tz
+            _cross_acc(cx, cy, cz, tx, ty, tz, wrench, 3, sk)
+        srate[n] = rate
+        son[n] = 1
+        if acc:
+            _spread(n, sm[n], sd[n], fn, vt, hstep, J0, u, P, H, ZL, Nd, AREA, WW)
+            acc_out[0] += fn * vt * hstep
+            acc_out[2] += fn * hstep
+        nslice += 1
+        if sd[n] > dmax:
+            dmax = sd[n]
+            kdeep = kk[n]
+        if not have0:
+            f0x, f0y, f0z = hx, hy, hz
+            have0 = True
+        elif f0x * hx + f0y * hy + f0z * hz < 0.0:
+            two = True
+    return energy, fnsum, pen, kdeep, nslice, two, clen
+
+
+@njit(cache=True)
+def _spread(n, ms, dstar, fn, vt, hstep, J0, u, P, H, ZL, Nd, AREA, WW):
+    """Spread a layer's normal force over its contiguous penetrating nodes, weights sqrt(delta),
+    adding p |v_t| dt to WW[0] and |v_t| dt to WW[1]; every node is evaluated once."""
+    half = Nd // 2
+    buf = np.empty(2 * half + 1)
+    d0 = _node_delta(n, ms, J0, u, P, H, ZL, Nd)
+    lo = ms
+    hi = ms
+    if d0 > 0.0:
+        while lo - ms > -half:
+            dk = _node_delta(n, lo - 1, J0, u, P, H, ZL, Nd)
+            if dk <= 0.0:
+                break
+            lo -= 1
+            buf[lo - ms + half] = dk
+        while hi - ms < half:
+            dk = _node_delta(n, hi + 1, J0, u, P, H, ZL, Nd)
+            if dk <= 0.0:
+                break
+            hi += 1
+            buf[hi - ms + half] = dk
+    buf[half] = d0
+    wsum = 0.0
+    for mm in range(lo, hi + 1):
+        dk = buf[mm - ms + half]
+        if dk > 0.0:
+            wsum += math.sqrt(dk) * AREA[n, mm % Nd]
+    if wsum > 0.0:
+        for mm in range(lo, hi + 1):
+            dk = buf[mm - ms + half]
+            if dk > 0.0:
+                WW[0, n, mm % Nd] += fn * math.sqrt(dk) / wsum * vt * hstep
+                WW[1, n, mm % Nd] += vt * hstep
+    else:  # in contact between nodes or only through the neighbouring interval
+        WW[0, n, ms % Nd] += fn / AREA[n, ms % Nd] * vt * hstep
+        WW[1, n, ms % Nd] += vt * hstep
+
+
 @njit(cache=True)
 def _contact(
     J0,
@@ -198,7 +506,7 @@ def _contact(
     K = 0.0
     hx, hy, hz = 0.0, 0.0, 0.0
     dstar = 0.0
-    for n in range(Nl):
+    for n in range(Nl if IP[PER_POINT] == 1 else 0):
         z = ZL[n]
         s0 = (z - J0[2]) / uz
         if abs(s0) > 0.5 * P[LJ]:
@@ -217,102 +525,53 @@ def _contact(
         if phi0 < 0.0:
             phi0 += 2.0 * math.pi
         m0 = int(round(phi0 / P[DPHI])) % Nd
-        # climb from the node facing the eccentricity to the nearest local maximum of the
-        # penetration on each side; keep the deeper one (on a worn profile the journal can
-        # bridge a narrow groove and touch both flanks: the deeper flank carries the slice)
-        t0 = _node(n, m0, J0, u, P, H, ZL, Nd)
-        tp = _node(n, m0 + 1, J0, u, P, H, ZL, Nd)
-        tm = _node(n, m0 - 1, J0, u, P, H, ZL, Nd)
-        c0, cp, cm = _dl(t0, P), _dl(tp, P), _dl(tm, P)
-        ms, dm, d0, dp = m0, cm, c0, cp
-        nm, n0, npp = tm, t0, tp
-        found = False
-        if cp > c0:
-            r, b0, b1 = m0 + 1, t0, tp
-            b2 = _node(n, m0 + 2, J0, u, P, H, ZL, Nd)
-            a0, a1, a2 = c0, cp, _dl(b2, P)
-            for _ in range(Nd // 2):
-                if a2 <= a1:
-                    break
-                r += 1
-                a0, a1, b0, b1 = a1, a2, b1, b2
-                b2 = _node(n, r + 1, J0, u, P, H, ZL, Nd)
-                a2 = _dl(b2, P)
-            ms, dm, d0, dp = r, a0, a1, a2
-            nm, n0, npp = b0, b1, b2
-            found = True
-        if cm > c0:
-            r, b0, b1 = m0 - 1, t0, tm
-            b2 = _node(n, m0 - 2, J0, u, P, H, ZL, Nd)
-            a0, a1, a2 = c0, cm, _dl(b2, P)
-            for _ in range(Nd // 2):
-                if a2 <= a1:
-                    break
-                r -= 1
-                a0, a1, b0, b1 = a1, a2, b1, b2
-                b2 = _node(n, r - 1, J0, u, P, H, ZL, Nd)
-                a2 = _dl(b2, P)
-            if not found or a1 > d0:
-                ms, dm, d0, dp = r, a2, a1, a0
-                nm, n0, npp = b2, b1, b0
-        if IP[PER_POINT] == 0:
-            # parabola through the three nodes around the maximum
-            b = 0.5 * (dp - dm)
-            dd = 2.0 * d0 - dp - dm
-            if dd > 1e-300:
-                x = b / dd
-                if x > 1.0:
-                    x = 1.0
-                elif x < -1.0:
-                    x = -1.0
-            else:
-                x = 0.0
-            dstar = d0 + b * x - 0.5 * dd * x * x
-            if dstar > pen_rad:
-                pen_rad = dstar
-            if dstar <= 0.0:
-                son[n] = 0
+        ms, _dm, d0, _dp, _nm, _n0, _np = _search(n, m0, J0, u, P, H, ZL, Nd)
+        # the study's literal form: a full L-N force at every penetrating node
+        if d0 > pen_rad:
+            pen_rad = d0
+        if d0 <= 0.0:
+            son[n] = 0
+            continue
+        lo = ms
+        while lo - ms > -Nd // 2 and _node_delta(n, lo - 1, J0, u, P, H, ZL, Nd) > 0.0:
+            lo -= 1
+        hi = ms
+        while hi - ms < Nd // 2 and _node_delta(n, hi + 1, J0, u, P, H, ZL, Nd) > 0.0:
+            hi += 1
+        hx, hy, hz = 0.0, 0.0, 0.0
+        rate0 = 0.0
+        kdk = 0.0
+        dstar = d0
+        for mm in range(lo, hi + 1):
+            nd = _node(n, mm, J0, u, P, H, ZL, Nd)
+            dk = nd[0]
+            if dk <= 0.0:
                 continue
-            lm = 0.5 * x * (x - 1.0)
-            l0 = 1.0 - x * x
-            lp = 0.5 * x * (x + 1.0)
-            cx = lm * nm[1] + l0 * n0[1] + lp * npp[1]
-            cy = lm * nm[2] + l0 * n0[2] + lp * npp[2]
-            cz = lm * nm[3] + l0 * n0[3] + lp * npp[3]
-            nx = lm * nm[4] + l0 * n0[4] + lp * npp[4]
-            ny = lm * nm[5] + l0 * n0[5] + lp * npp[5]
-            nz = lm * nm[6] + l0 * n0[6] + lp * npp[6]
-            nn = math.sqrt(nx * nx + ny * ny + nz * nz)
-            hx, hy, hz = nx / nn, ny / nn, nz / nn
-            hc = lm * H[n, (ms - 1) % Nd] + l0 * H[n, ms % Nd] + lp * H[n, (ms + 1) % Nd]
-            K = _stiffness(P, IP, hc)
-            vx = V0[0] + W[1] * cz - W[2] * cy
-            vy = V0[1] + W[2] * cx - W[0] * cz
-            vz = V0[2] + W[0] * cy - W[1] * cx
-            rate = vx * hx + vy * hy + vz * hz
+            K = _stiffness(P, IP, H[n, mm % Nd])
+            vx = V0[0] + W[1] * nd[3] - W[2] * nd[2]
+            vy = V0[1] + W[2] * nd[1] - W[0] * nd[3]
+            vz = V0[2] + W[0] * nd[2] - W[1] * nd[1]
+            rate = vx * nd[4] + vy * nd[5] + vz * nd[6]
+            if mm == ms:
+                rate0 = rate
+                hx, hy, hz = nd[4], nd[5], nd[6]
+                kdk = K
             vm = vimp[n]
             if vm <= 0.0:
                 vm = rate if rate > vfloor else vfloor
-            fel = WL[n] * K * (dstar * math.sqrt(dstar) if nexp == 1.5 else dstar**nexp)
-            fn = fel * ln_factor(rate, vm, ce)
-            energy += fel * dstar / (nexp + 1.0)
-            # normal force on the bearing, distributed on the three nodes (exactly conservative)
-            for k in range(3):
-                nd = nm if k == 0 else (n0 if k == 1 else npp)
-                lk = lm if k == 0 else (l0 if k == 1 else lp)
-                s = fn * lk
-                wrench[0] += s * nd[4]
-                wrench[1] += s * nd[5]
-                wrench[2] += s * nd[6]
-                wrench[6] += s * nd[4]
-                wrench[7] += s * nd[5]
-                wrench[8] += s * nd[6]
-                _cross_acc(nd[1], nd[2], nd[3], nd[4], nd[5], nd[6], wrench, 3, s)
+            fn = K * dk**nexp * ln_factor(rate, vm, ce)
+            energy += K * dk ** (nexp + 1.0) / (nexp + 1.0)
+            wrench[0] += fn * nd[4]
+            wrench[1] += fn * nd[5]
+            wrench[2] += fn * nd[6]
+            wrench[6] += fn * nd[4]
+            wrench[7] += fn * nd[5]
+            wrench[8] += fn * nd[6]
+            _cross_acc(nd[1], nd[2], nd[3], nd[4], nd[5], nd[6], wrench, 3, fn)
             fnsum += fn
-            # friction on the bearing along the journal's sliding velocity
-            tx = vx - rate * hx
-            ty = vy - rate * hy
-            tz = vz - rate * hz
+            tx = vx - rate * nd[4]
+            ty = vy - rate * nd[5]
+            tz = vz - rate * nd[6]
             vt = math.sqrt(tx * tx + ty * ty + tz * tz)
             if muon > 0.0 and vt > 0.0:
                 mu = friction_coefficient(vt, P[MUS], P[MUD], P[VS], P[VD])
@@ -323,111 +582,15 @@ def _contact(
                 wrench[9] += s * tx
                 wrench[10] += s * ty
                 wrench[11] += s * tz
-                _cross_acc(cx, cy, cz, tx, ty, tz, wrench, 3, s)
-            srate[n] = rate
-            son[n] = 1
+                _cross_acc(nd[1], nd[2], nd[3], tx, ty, tz, wrench, 3, s)
             if acc:
-                # pressure spread over the contiguous penetrating nodes, weights sqrt(delta);
-                # every node is evaluated once (buf[k] holds node lo + k)
-                half = Nd // 2
-                buf = np.empty(2 * half + 1)
-                lo = ms
-                while lo - ms > -half:
-                    dk = _node_delta(n, lo - 1, J0, u, P, H, ZL, Nd)
-                    if dk <= 0.0:
-                        break
-                    lo -= 1
-                    buf[lo - ms + half] = dk
-                hi = ms
-                while hi - ms < half:
-                    dk = _node_delta(n, hi + 1, J0, u, P, H, ZL, Nd)
-                    if dk <= 0.0:
-                        break
-                    hi += 1
-                    buf[hi - ms + half] = dk
-                buf[half] = d0
-                wsum = 0.0
-                for mm in range(lo, hi + 1):
-                    dk = buf[mm - ms + half]
-                    if dk > 0.0:
-                        wsum += math.sqrt(dk) * AREA[n, mm % Nd]
-                if wsum > 0.0:
-                    for mm in range(lo, hi + 1):
-                        dk = buf[mm - ms + half]
-                        if dk > 0.0:
-                            WW[0, n, mm % Nd] += fn * math.sqrt(dk) / wsum * vt * hstep
-                            WW[1, n, mm % Nd] += vt * hstep
-                else:
-                    WW[0, n, ms % Nd] += fn / AREA[n, ms % Nd] * vt * hstep
-                    WW[1, n, ms % Nd] += vt * hstep
+                WW[0, n, mm % Nd] += fn / AREA[n, mm % Nd] * vt * hstep
+                WW[1, n, mm % Nd] += vt * hstep
                 acc_out[0] += fn * vt * hstep
                 acc_out[2] += fn * hstep
-        else:
-            # the study's literal form: a full L-N force at every penetrating node
-            if d0 > pen_rad:
-                pen_rad = d0
-            if d0 <= 0.0:
-                son[n] = 0
-                continue
-            lo = ms
-            while lo - ms > -Nd // 2 and _node_delta(n, lo - 1, J0, u, P, H, ZL, Nd) > 0.0:
-                lo -= 1
-            hi = ms
-            while hi - ms < Nd // 2 and _node_delta(n, hi + 1, J0, u, P, H, ZL, Nd) > 0.0:
-                hi += 1
-            hx, hy, hz = 0.0, 0.0, 0.0
-            rate0 = 0.0
-            kdk = 0.0
-            dstar = d0
-            for mm in range(lo, hi + 1):
-                nd = _node(n, mm, J0, u, P, H, ZL, Nd)
-                dk = nd[0]
-                if dk <= 0.0:
-                    continue
-                K = _stiffness(P, IP, H[n, mm % Nd])
-                vx = V0[0] + W[1] * nd[3] - W[2] * nd[2]
-                vy = V0[1] + W[2] * nd[1] - W[0] * nd[3]
-                vz = V0[2] + W[0] * nd[2] - W[1] * nd[1]
-                rate = vx * nd[4] + vy * nd[5] + vz * nd[6]
-                if mm == ms:
-                    rate0 = rate
-                    hx, hy, hz = nd[4], nd[5], nd[6]
-                    kdk = K
-                vm = vimp[n]
-                if vm <= 0.0:
-                    vm = rate if rate > vfloor else vfloor
-                fn = K * dk**nexp * ln_factor(rate, vm, ce)
-                energy += K * dk ** (nexp + 1.0) / (nexp + 1.0)
-                wrench[0] += fn * nd[4]
-                wrench[1] += fn * nd[5]
-                wrench[2] += fn * nd[6]
-                wrench[6] += fn * nd[4]
-                wrench[7] += fn * nd[5]
-                wrench[8] += fn * nd[6]
-                _cross_acc(nd[1], nd[2], nd[3], nd[4], nd[5], nd[6], wrench, 3, fn)
-                fnsum += fn
-                tx = vx - rate * nd[4]
-                ty = vy - rate * nd[5]
-                tz = vz - rate * nd[6]
-                vt = math.sqrt(tx * tx + ty * ty + tz * tz)
-                if muon > 0.0 and vt > 0.0:
-                    mu = friction_coefficient(vt, P[MUS], P[MUD], P[VS], P[VD])
-                    s = mu * fn / vt
-                    wrench[0] += s * tx
-                    wrench[1] += s * ty
-                    wrench[2] += s * tz
-                    wrench[9] += s * tx
-                    wrench[10] += s * ty
-                    wrench[11] += s * tz
-                    _cross_acc(nd[1], nd[2], nd[3], tx, ty, tz, wrench, 3, s)
-                if acc:
-                    WW[0, n, mm % Nd] += fn / AREA[n, mm % Nd] * vt * hstep
-                    WW[1, n, mm % Nd] += vt * hstep
-                    acc_out[0] += fn * vt * hstep
-                    acc_out[2] += fn * hstep
-            K = kdk
-            srate[n] = rate0
-            son[n] = 1
+        K = kdk
+        srate[n] = rate0
+        son[n] = 1
         # contact statistics (modes)
         nslice += 1
         wcontact += WL[n]
@@ -439,6 +602,27 @@ def _contact(
             have0 = True
         elif fn0x * hx + fn0y * hy + fn0z * hz < 0.0:
             two = True
+    if IP[PER_POINT] == 0:
+        energy, fnsum, pen_rad, kdeep, nslice, two, wcontact = _slices(
+            J0,
+            u,
+            V0,
+            W,
+            P,
+            IP,
+            H,
+            HMIN,
+            ZL,
+            AREA,
+            vimp,
+            srate,
+            son,
+            wrench,
+            acc,
+            hstep,
+            WW,
+            acc_out,
+        )
     # ---- axial stops: journal shoulders against the bearing end faces ----
     pen_ax = -1.0
     fax = 0.0

@@ -94,7 +94,9 @@ def test_energy_conserved_without_driver_friction_damping(bearing_on):
 def _summary(params):
     r = run_cycles(params, cycles=1.0)
     fv = r.dataset.follower_velocity.values
+    touching = r.dataset.contact_mode.values > 0
     return {
+        "median_penetration": float(np.median(r.dataset.penetration.values[touching])),
         "impulse": r.normal_impulse,
         "mean_force": float(r.dataset.contact_force.mean()),
         "velocity_rms": float(np.sqrt((fv**2).sum(axis=1).mean())),
@@ -111,6 +113,11 @@ def test_grid_independence(reference_cycle):
     for key in ("impulse", "mean_force"):
         assert fine[key] == pytest.approx(reference_cycle[key], rel=0.02), key
     assert reference_cycle["mean_force"] > 10.0
+    # most contacts are edge contacts of the tilted journal, shorter than a layer spacing: the
+    # penetration (hence pressure and stiffness) must not depend on the layer spacing either
+    assert fine["median_penetration"] == pytest.approx(
+        reference_cycle["median_penetration"], rel=0.1
+    )
 
 
 def test_tolerance_convergence(reference_cycle):
