@@ -198,3 +198,18 @@ def test_save_load_round_trip(tmp_path):
     assert list(back.decisions.quantity) == list(c.decisions.quantity)
     assert back.wear.attrs["interpolation"] == c.wear.attrs["interpolation"]
     assert back.motion.attrs["time_shift_s"] == pytest.approx(c.motion.attrs["time_shift_s"])
+
+
+def test_time_series_bad_inputs():
+    sim = syn.sim_motion(duration=1.2)
+    with pytest.raises(BadInputError, match="less than one crank cycle"):
+        align_time_series(syn.sim_motion(duration=0.3), syn.meas_motion())
+    other = syn.meas_motion()
+    other["follower_velocity"].attrs["units"] = "mm s-1"
+    with pytest.raises(ConventionError, match="units 'm s-1' in the simulation and 'mm s-1'"):
+        align_time_series(sim, other)
+    with pytest.raises(BadInputError, match="method must be"):
+        align_time_series(sim, syn.meas_motion(), method="fft")
+    # a measurement shorter than a cycle is used whole, and the attributes say so
+    short = align_time_series(sim, syn.meas_motion(duration=0.3))
+    assert short.sizes["time"] == 15 and "less than one whole cycle" in short.attrs["interpolation"]
