@@ -524,7 +524,7 @@ def report_from_files(
     Parameters
     ----------
     out : path
-        HTML report to write.
+        HTML report to write (a ``.pdf`` name writes the PDF version only).
     sim, metrology, dic : sequence of path
         Simulated wear map / motion files, measured wear map files (``jointwear metrology``),
         measured motion files (``jointwear dic``).
@@ -586,6 +586,11 @@ def report_from_files(
     inputs += [
         ReportInput("verification", Path(p), d) for p, d in zip(verification, vers, strict=True)
     ]
+    if Path(out).suffix.lower() == ".pdf":  # PDF only (no browser at hand)
+        path = write_pdf(
+            result, out, inputs=inputs, verification=vers, missing=missing, title=title
+        )
+        return path, result
     path = build_report(
         result,
         out,

@@ -14,9 +14,10 @@ def register(app: typer.Typer) -> None:
     @app.callback(invoke_without_command=True)
     def report(
         ctx: typer.Context,
-        out: Annotated[Path, typer.Option("--out", "-o", help="HTML report to write.")] = Path(
-            "report.html"
-        ),
+        out: Annotated[
+            Path,
+            typer.Option("--out", "-o", help="HTML report to write (.pdf: the PDF version only)."),
+        ] = Path("report.html"),
         sim: Annotated[
             list[Path] | None,
             typer.Option("--sim", help="Simulated wear map and/or motion (.nc); repeatable."),

@@ -148,6 +148,10 @@ def test_report_cli_html_pdf_and_comparison(report_files, tmp_path, capsys):
     out2 = tmp_path / "r2.html"
     assert main(["report", "--comparison", str(metrics), "--out", str(out2)]) == 0
     assert parse(out2).h2 == EXPECTED_SECTIONS
+    # a .pdf name writes the PDF version only
+    out3 = tmp_path / "only.pdf"
+    assert main(["report", "--comparison", str(metrics), "--out", str(out3)]) == 0
+    assert out3.read_bytes().startswith(b"%PDF")
     # usage errors
     assert main(["report", "--out", str(out2)]) == 3
     assert "no simulation given" in capsys.readouterr().err
