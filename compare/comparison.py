@@ -528,11 +528,13 @@ def compare(
             "nothing to compare: give a wear map (wear_depth over z, theta) and/or a motion "
             "record (follower_velocity, journal_offset, ... over time) on both sides"
         )
+    card = pd.DataFrame(decisions, columns=DECISION_COLUMNS)
+    card["passed"] = card["passed"].astype(bool)
     return Comparison(
         wear=wear,
         motion=motion,
         metrics=rows.frame(),
-        decisions=pd.DataFrame(decisions, columns=DECISION_COLUMNS),
+        decisions=card,
         notes=tuple(notes),
         criteria=criteria,
     )
@@ -651,7 +653,7 @@ def load_comparison(source: str | Path | xr.Dataset) -> Comparison:
         wear=wear,
         motion=motion,
         metrics=pd.DataFrame(metric_rows, columns=METRIC_COLUMNS),
-        decisions=pd.DataFrame(decision_rows, columns=DECISION_COLUMNS),
+        decisions=pd.DataFrame(decision_rows, columns=DECISION_COLUMNS).astype({"passed": bool}),
         notes=notes,
         criteria=crit,
     )
