@@ -8,6 +8,7 @@ from jointwear.reports.builder import (
     report_from_files,
     write_pdf,
 )
+from jointwear.reports.demo import run_demo
 
 __all__ = [
     "ReportInput",
@@ -16,4 +17,5 @@ __all__ = [
     "render_html",
     "report_from_files",
     "write_pdf",
+    "run_demo",
 ]
