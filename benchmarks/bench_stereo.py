@@ -91,7 +91,7 @@ def main() -> None:
         jz_t = truth["journal_displacement"].sel(axis="z").values
         z_rms = float(np.sqrt(np.nanmean((jz - jz_t) ** 2)))
         write_results(
-            "stereo",
+            "stereo" if args.workers == 1 else f"stereo_workers{args.workers}",
             {
                 "footage": f"{args.seconds:g} s at 50 frames/s, two 1280x1024 {CODEC} AVI videos",
                 "frame_pairs": n_frames,

@@ -141,6 +141,12 @@ def register(app: typer.Typer) -> None:
         plot: Annotated[
             Path | None, typer.Option(help="Also write the velocity/displacement plot.")
         ] = None,
+        workers: Annotated[
+            int | None, typer.Option(help="Worker processes for chunks (overrides the TOML).")
+        ] = None,
+        chunk_size: Annotated[
+            int | None, typer.Option(help="Frames per chunk (overrides the TOML).")
+        ] = None,
     ) -> None:
         """Track the bodies of rig footage: poses, follower velocity, journal out-of-plane motion.
 
@@ -153,6 +159,14 @@ def register(app: typer.Typer) -> None:
 
         io.check_writable(out)
         cfg, specs = read_bodies(bodies)
+        if workers is not None or chunk_size is not None:
+            import dataclasses
+
+            cfg = dataclasses.replace(
+                cfg,
+                workers=cfg.workers if workers is None else workers,
+                chunk_size=cfg.chunk_size if chunk_size is None else chunk_size,
+            )
         cal = read_calibration(calibration) if calibration is not None else None
         inputs = [p for p in (left, right, bodies, calibration) if p is not None]
         ds = track_footage(
