@@ -381,3 +381,14 @@ def test_single_camera_tracks_in_pixels(small, tmp_path):
     step = np.linalg.norm(np.diff(ds["follower_image_position"].values, axis=0), axis=1)
     assert np.all(step > 1) and step.sum() > 20
     assert io.load(target).attrs["world_frame"] == "left image (pixels)"
+
+
+def test_plot_needs_motion_variables():
+    import xarray as xr
+
+    from jointwear.dic import plot_body_motion
+
+    with pytest.raises(
+        BadInputError, match="neither 'follower_velocity' nor 'journal_displacement'"
+    ):
+        plot_body_motion(xr.Dataset())
