@@ -29,7 +29,6 @@ from collections.abc import Sequence
 
 import numpy as np
 import xarray as xr
-from scipy.optimize import minimize_scalar
 
 from jointwear import conventions
 from jointwear.errors import BadInputError, ConventionError
@@ -602,6 +601,8 @@ def align_time_series(
                     continue
                 total += float(np.mean((x - x.mean()) / sd * mz[ok]))
             return total
+
+        from scipy.optimize import minimize_scalar
 
         grid = np.linspace(0.0, period, 720, endpoint=False)
         scores = np.array([score(t) for t in grid])
