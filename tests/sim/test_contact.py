@@ -165,3 +165,35 @@ def test_per_point_summation_is_grid_dependent():
     ]
     assert pens[1] < 0.9 * pens[0]
     assert slice_pen[1] == pytest.approx(slice_pen[0], rel=0.05)
+
+
+def test_axial_stops_bound_the_journal_and_conserve_energy():
+    # bearing (follower tip) thrown along the joint axis: no gravity, crank held, no friction
+    p = replace_nested(
+        BASE,
+        **{
+            "mechanism.crank_speed_rpm": 0.0,
+            "mechanism.gravity": 0.0,
+            "friction.enabled": False,
+            "contact.restitution": 1.0,
+            "solver.output_interval": 1e-6,
+            "solver.rtol": 1e-8,
+            "solver.atol": 1e-11,
+        },
+    )
+    st = initial_state(p)
+    y = st.y.copy()
+    y[3] = 0.0
+    y[8:] = [0.05 / 0.3, 0.0, 0.0]  # follower turns about its x axis: tip moves along z
+    ds = run_cycles(p, state=dataclasses.replace(st, y=y), duration=0.03).dataset
+    oz = ds.journal_offset.sel(axis="z").values
+    # the shoulders sit +-(wb + ca)/2 from the journal centre: play +-0.5 mm, less the tilt of
+    # the 9.5 mm thrust circle (about 16 um here), plus the contact penetration (about 5 um)
+    assert 0.47e-3 < -oz.min() < 0.5e-3
+    assert 0.47e-3 < oz.max() < 0.5e-3
+    axial = ds.contact_mode.values == 4
+    assert axial.sum() > 100 and (ds.contact_mode.values[~axial] == 0).all()
+    assert (ds.axial_force.values[axial] > 0).all()
+    assert (np.abs(oz[axial]) > 0.47e-3).all()
+    e = ds.mechanical_energy.values
+    assert np.abs(e - e[0]).max() / e[0] < 1e-4
