@@ -8,6 +8,7 @@ chunk by chunk (progress, errors with the partial record) and builds the Dataset
 from __future__ import annotations
 
 import dataclasses
+import json
 import math
 from collections.abc import Callable
 
@@ -650,5 +651,5 @@ def _dataset(params: SimParameters, t_rel: np.ndarray, diag: np.ndarray, t0: flo
     ds.attrs["contact_formulation"] = params.contact.formulation
     ds.attrs["contact_stiffness_model"] = params.contact.stiffness
     ds.attrs["bearing_on"] = params.mechanism.bearing_on
-    ds.attrs["parameters_json"] = __import__("json").dumps(to_jsonable(params))
+    ds.attrs["parameters_json"] = json.dumps(to_jsonable(params))
     return ds
