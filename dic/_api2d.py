@@ -21,6 +21,10 @@ points=None, roi=None, update_zncc=0.9, progress=False, **options) -> xr.Dataset
     A sequence (3D array, list of images, folder of images or video file): accumulated
     displacements of the reference points over ``time``.
 
+``plot_displacement(ds, *, time=-1, background=None, arrows=True, title=None) -> Figure`` and
+``save_quicklook(ds, path, **kwargs)``
+    Quick-look figure: colour maps of u and v with arrows, invalid points masked.
+
 Output variables
 ----------------
 ``u``, ``v`` [pixel] (x right, y down; NaN where the flag is not ``ok``), ``du_dx``, ``du_dy``,
@@ -37,6 +41,7 @@ from collections.abc import Sequence
 import numpy as np
 import xarray as xr
 
+from jointwear.dic._quicklook import plot_displacement, save_quicklook
 from jointwear.dic._sequence import correlate_sequence, read_frames
 from jointwear.dic._subset import CorrelationParams, MatchResult, SubsetCorrelator
 
@@ -47,6 +52,8 @@ __all__ = [
     "MatchResult",
     "correlate_sequence",
     "read_frames",
+    "plot_displacement",
+    "save_quicklook",
 ]
 
 

@@ -39,26 +39,20 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from jointwear.dic._interp import PAD, interp_value, interp_value_grad
-
-FLAG_OK = 0
-FLAG_NOT_CONVERGED = 1
-FLAG_LOW_CORRELATION = 2
-FLAG_OUTSIDE = 3
-FLAG_NO_TEXTURE = 4
-FLAG_INVALID_PIXELS = 5
-FLAG_NOT_REACHED = 6
-FLAG_DIVERGED = 7
-
-FLAG_MEANINGS = (
-    "ok not_converged low_correlation subset_outside_image no_texture invalid_pixels "
-    "not_reached diverged"
+from jointwear.dic._flags import (
+    AFFINE_INDEX,
+    FLAG_DIVERGED,
+    FLAG_INVALID_PIXELS,
+    FLAG_LOW_CORRELATION,
+    FLAG_NO_TEXTURE,
+    FLAG_NOT_CONVERGED,
+    FLAG_OK,
+    FLAG_OUTSIDE,
 )
-FLAG_VALUES = np.arange(8, dtype=np.int8)
+from jointwear.dic._interp import PAD, interp_value, interp_value_grad
 
 _FM = {"nsz", "arcp", "contract", "reassoc"}  # fastmath without no-NaN/no-inf assumptions
 
-AFFINE_INDEX = np.array([0, 1, 2, 6, 7, 8])
 QUADRATIC_INDEX = np.arange(12)
 
 

@@ -201,7 +201,7 @@ def correlate_sequence(
         ``converged``, ``flag`` over ``time`` and ``point`` (or ``y``, ``x``), and
         ``reference_frame``.
     """
-    from jointwear.dic import _icgn
+    from jointwear.dic import _flags as _icgn
     from jointwear.dic._subset import SubsetCorrelator, check_image, check_pair, result_dataset
     from jointwear.progress import progress_bar
 

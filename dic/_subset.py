@@ -26,18 +26,20 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import asdict, dataclass
-from typing import Literal
+from typing import TYPE_CHECKING, Literal
 
 import numpy as np
 import xarray as xr
 
-from jointwear.dic import _icgn
-from jointwear.dic._interp import SplineImage, prefilter
+from jointwear.dic import _flags
 from jointwear.errors import BadInputError, ParameterError
+
+if TYPE_CHECKING:
+    from jointwear.dic._interp import SplineImage
 
 __all__ = ["CorrelationParams", "SubsetCorrelator", "MatchResult", "FLAG_MEANINGS"]
 
-FLAG_MEANINGS = _icgn.FLAG_MEANINGS
+FLAG_MEANINGS = _flags.FLAG_MEANINGS
 
 _SHAPES = {"affine": False, "first": False, "quadratic": True, "second": True}
 
@@ -204,7 +206,7 @@ class MatchResult:
 
     @property
     def ok(self) -> np.ndarray:
-        return self.flag == _icgn.FLAG_OK
+        return self.flag == _flags.FLAG_OK
 
 
 class SubsetCorrelator:
@@ -244,6 +246,8 @@ class SubsetCorrelator:
                 )
             base = CorrelationParams(**{**asdict(base), **options})
         self.params = base
+        from jointwear.dic._interp import prefilter
+
         self.reference_raw = check_image(reference, "reference image")
         self.ref = prefilter(self.reference_raw, base.interpolation)
         self._ref_invalid = _integral_invalid(self.ref.valid)
@@ -343,6 +347,8 @@ class SubsetCorrelator:
 
     def _texture_and_usable(self) -> tuple[np.ndarray, np.ndarray]:
         """Intensity std of every reference subset, and which points can be seeds."""
+        from jointwear.dic import _icgn
+
         if self._texture is None:
             tex = _icgn.subset_std(
                 self.ref.image,
@@ -357,6 +363,8 @@ class SubsetCorrelator:
 
     # ------------------------------------------------------------------ matching
     def _prepare_deformed(self, deformed) -> tuple[SplineImage, np.ndarray, np.ndarray]:
+        from jointwear.dic._interp import SplineImage, prefilter
+
         if isinstance(deformed, SplineImage):
             spl = deformed
             raw = deformed.image
@@ -374,6 +382,8 @@ class SubsetCorrelator:
         return (r.image, r.gx, r.gy, r.coef, self._ref_invalid, dspl.coef, dinv, r.order)
 
     def _run_many(self, dspl, dinv, P, active, st, serial=False):
+        from jointwear.dic import _icgn
+
         p = self.params
         kernel = _icgn.icgn_serial if serial else _icgn.icgn_many
         kernel(
@@ -396,6 +406,8 @@ class SubsetCorrelator:
         )
 
     def _propagate(self, dspl, dinv, st, done, group, n_groups):
+        from jointwear.dic import _icgn
+
         p = self.params
         _icgn.rg_propagate(
             n_groups,
@@ -423,7 +435,7 @@ class SubsetCorrelator:
     def _retry_failed(self, dspl, dinv, st, done, group) -> None:
         """Give failed (but structurally fine) points one more chance from other neighbours."""
         retry = np.isin(
-            st.flag, (_icgn.FLAG_NOT_CONVERGED, _icgn.FLAG_LOW_CORRELATION, _icgn.FLAG_DIVERGED)
+            st.flag, (_flags.FLAG_NOT_CONVERGED, _flags.FLAG_LOW_CORRELATION, _flags.FLAG_DIVERGED)
         )
         unreached = ~done
         if (retry | unreached).any() and st.ok.any():
@@ -462,14 +474,14 @@ class SubsetCorrelator:
             P0[7], P0[8] = math.sin(th), math.cos(th) - 1.0
             st.params[i] = P0
             self._run_many(dspl, dinv, st.params, active, st, serial=True)
-            return st.flag[i] == _icgn.FLAG_OK
+            return st.flag[i] == _flags.FLAG_OK
 
         u, v, peak, _ = integer_search(self.ref, raw_def, xc, yc, p.half, p.search_radius, guess)
         done[i] = True
         if attempt(u, v, 0.0) if np.isfinite(peak) else attempt(guess[0], guess[1], 0.0):
             return True
         first = (st.params[i].copy(), st.zncc[i], st.iterations[i], st.flag[i], st.sigma[i].copy())
-        structural = (_icgn.FLAG_OUTSIDE, _icgn.FLAG_NO_TEXTURE, _icgn.FLAG_INVALID_PIXELS)
+        structural = (_flags.FLAG_OUTSIDE, _flags.FLAG_NO_TEXTURE, _flags.FLAG_INVALID_PIXELS)
         if first[3] not in structural:
             # rotated templates: the part may have turned
             scored = []
@@ -506,7 +518,7 @@ class SubsetCorrelator:
             params=np.zeros((n, 12)),
             zncc=np.full(n, np.nan),
             iterations=np.zeros(n, dtype=np.int32),
-            flag=np.full(n, _icgn.FLAG_NOT_REACHED, dtype=np.int8),
+            flag=np.full(n, _flags.FLAG_NOT_REACHED, dtype=np.int8),
         )
         done = np.zeros(n, dtype=np.bool_)
         group = np.zeros(n, dtype=np.int64)
@@ -574,9 +586,11 @@ class SubsetCorrelator:
             if idx.size:
                 _, near = cKDTree(self.centres[good]).query(self.centres[idx])
                 src = good[near]
+                from jointwear.dic._icgn import _extrapolate
+
                 for j, i in zip(idx, src, strict=True):
                     d = self.centres[j] - self.centres[i]
-                    _icgn._extrapolate(st.params[i], d[0], d[1], P0[j])
+                    _extrapolate(st.params[i], d[0], d[1], P0[j])
         sub = MatchResult(P0, st.zncc.copy(), st.iterations.copy(), st.flag.copy())
         self._run_many(dspl, dinv, P0, rest, sub)
         st.sigma[rest] = sub.sigma[rest]
@@ -601,7 +615,7 @@ class SubsetCorrelator:
         if g.shape[1] == 2:
             out[:, 0], out[:, 6] = g[:, 0], g[:, 1]
         elif g.shape[1] == 6:
-            out[:, _icgn.AFFINE_INDEX] = g
+            out[:, _flags.AFFINE_INDEX] = g
         else:
             out[:] = g
         return out
@@ -675,7 +689,7 @@ def result_dataset(
     ``sigma`` (..., N, 2): standard uncertainty of (u, v) [pixel] -> ``u_u``, ``v_u``.
     """
     P = np.asarray(P, float)
-    ok = np.asarray(flag) == _icgn.FLAG_OK
+    ok = np.asarray(flag) == _flags.FLAG_OK
     lead = P.shape[:-2]
     lead_dims = ("time",) if len(lead) == 1 else ()
     if grid is not None:
@@ -725,8 +739,8 @@ def result_dataset(
         attrs={
             "units": "1",
             "long_name": "correlation quality flag",
-            "flag_values": _icgn.FLAG_VALUES,
-            "flag_meanings": _icgn.FLAG_MEANINGS,
+            "flag_values": _flags.FLAG_VALUES,
+            "flag_meanings": _flags.FLAG_MEANINGS,
         },
     )
     if sigma is not None:
