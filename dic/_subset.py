@@ -635,7 +635,8 @@ class SubsetCorrelator:
             Deformed image, same size and dtype as the reference.
         initial_guess : ndarray, optional
             Per-point guesses: (N, 2) ``(u, v)`` [pixel], (N, 6) affine or (N, 12) parameters;
-            a single row is broadcast. Rows with NaN are filled by propagation from converged neighbours.
+            a single row is broadcast. Rows with NaN are filled by propagation from converged
+            neighbours.
         seed_points : ndarray (K, 2), optional
             Positions ``(x, y)`` [pixel] to start the propagation from (default: automatic,
             well-textured points in bands of rows).
