@@ -76,7 +76,7 @@ def _coerce(value: Any, tp: Any, where: str) -> Any:
                 raise ParameterError(f"{where}: expected {len(args)} values, got {len(value)}")
             return tuple(
                 _coerce(v, a, f"{where}[{i}]")
-                for i, (v, a) in enumerate(zip(args, value, strict=True))
+                for i, (v, a) in enumerate(zip(value, args, strict=True))
             )
         inner = args[0] if args else Any
         out = [_coerce(v, inner, f"{where}[{i}]") for i, v in enumerate(value)]

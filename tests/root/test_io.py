@@ -140,3 +140,11 @@ def test_atomic_path_other_file_types(tmp_path):
         tmp.write_text("broken")
         raise ValueError("boom")
     assert target.read_text() == "<html></html>"
+
+
+def test_written_files_get_normal_permissions(tmp_path):
+    path = tmp_path / "perm.nc"
+    io.save(_dataset(), path)
+    umask = os.umask(0)
+    os.umask(umask)
+    assert (path.stat().st_mode & 0o777) == (0o666 & ~umask)

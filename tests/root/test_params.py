@@ -66,3 +66,17 @@ def test_replace_nested_and_json():
     }
     with pytest.raises(ParameterError, match="unknown parameter 'jiont'"):
         replace_nested(Params(), **{"jiont.layers": 1})
+
+
+@dataclasses.dataclass(frozen=True)
+class WithTuple:
+    pair: tuple[int, float] = (1, 2.0)
+
+
+def test_fixed_length_tuple_fields():
+    p = from_mapping(WithTuple, {"pair": [3, 4.5]})
+    assert p.pair == (3, 4.5)
+    with pytest.raises(ParameterError, match="pair: expected 2 values, got 3"):
+        from_mapping(WithTuple, {"pair": [1, 2.0, 3.0]})
+    with pytest.raises(ParameterError, match=r"pair\[0\]: expected an integer"):
+        from_mapping(WithTuple, {"pair": ["a", 2.0]})
