@@ -49,7 +49,7 @@ from jointwear.dic._flags import (
     FLAG_OK,
     FLAG_OUTSIDE,
 )
-from jointwear.dic._interp import PAD, interp_value, interp_value_grad
+from jointwear.dic._interp import PAD, interp_value_grad
 
 _FM = {"nsz", "arcp", "contract", "reassoc"}  # fastmath without no-NaN/no-inf assumptions
 
@@ -341,241 +341,6 @@ def _store_sigma(w, fn, zncc, n, n_params, hinv_u, hinv_v):
     s2 = fn * fn * znssd / max(n - n_params, 1)
     w[3, 4] = math.sqrt(s2 * hinv_u)
     w[3, 5] = math.sqrt(s2 * hinv_v)
-
-
-@njit(cache=True, fastmath=_FM)
-def _solve_generic(
-    ref_img,
-    ref_gx,
-    ref_gy,
-    ref_coef,
-    ref_invalid,
-    def_coef,
-    def_invalid,
-    order,
-    xc,
-    yc,
-    half,
-    quadratic,
-    p,
-    max_iter,
-    tol,
-    min_std,
-    max_shift,
-    border,
-    f,
-    gx,
-    gy,
-    g,
-    w,
-):
-    """Generic (affine or quadratic, any order) IC-GN for one subset; see :func:`solve_point`."""
-    H, W = ref_img.shape
-    Hd = def_coef.shape[0] - 2 * PAD
-    Wd = def_coef.shape[1] - 2 * PAD
-    size = 2 * half + 1
-    n = size * size
-    np_ = 12 if quadratic else 6
-    wx = w[0]
-    wy = w[1]
-    flag0, fn = _load_reference(
-        ref_img,
-        ref_gx,
-        ref_gy,
-        ref_coef,
-        ref_invalid,
-        order,
-        xc,
-        yc,
-        half,
-        min_std,
-        border,
-        f,
-        gx,
-        gy,
-        w,
-    )
-    if flag0 != FLAG_OK:
-        return np.nan, 0, flag0
-    # ---- Hessian (Gauss-Newton, steepest-descent images built on the fly)
-    Hm = np.zeros((np_, np_))
-    J = np.empty(np_)
-    k = 0
-    for r in range(-half, half + 1):
-        for c in range(-half, half + 1):
-            a = gx[k]
-            b = gy[k]
-            if quadratic:
-                J[0] = a
-                J[1] = a * c
-                J[2] = a * r
-                J[3] = 0.5 * a * c * c
-                J[4] = a * c * r
-                J[5] = 0.5 * a * r * r
-                J[6] = b
-                J[7] = b * c
-                J[8] = b * r
-                J[9] = 0.5 * b * c * c
-                J[10] = b * c * r
-                J[11] = 0.5 * b * r * r
-            else:
-                J[0] = a
-                J[1] = a * c
-                J[2] = a * r
-                J[3] = b
-                J[4] = b * c
-                J[5] = b * r
-            for i in range(np_):
-                ji = J[i]
-                for j in range(i + 1):
-                    Hm[i, j] += ji * J[j]
-            k += 1
-    for i in range(np_):
-        for j in range(i + 1, np_):
-            Hm[i, j] = Hm[j, i]
-    Hinv = np.eye(np_)
-    if not _solve_spd(Hm.copy(), Hinv, np_):
-        return np.nan, 0, FLAG_NO_TEXTURE
-    # ---- iterations
-    bvec = np.zeros(np_)
-    dp = np.zeros(12)
-    p_start_u = p[0]
-    p_start_v = p[6]
-    zncc = np.nan
-    it = 0
-    hh = float(half)
-    while it < max_iter:
-        it += 1
-        # warped positions: check the bounding box of the corners (affine: exact; quadratic:
-        # the extreme is at a corner or edge midpoint, checked below on the fly)
-        xmin = 1e300
-        xmax = -1e300
-        ymin = 1e300
-        ymax = -1e300
-        for r in (-half, 0, half):
-            for c in (-half, 0, half):
-                xw = xc + c + p[0] + p[1] * c + p[2] * r
-                yw = yc + r + p[6] + p[7] * c + p[8] * r
-                if quadratic:
-                    xw += 0.5 * p[3] * c * c + p[4] * c * r + 0.5 * p[5] * r * r
-                    yw += 0.5 * p[9] * c * c + p[10] * c * r + 0.5 * p[11] * r * r
-                xmin = min(xmin, xw)
-                xmax = max(xmax, xw)
-                ymin = min(ymin, yw)
-                ymax = max(ymax, yw)
-        if not (
-            xmin >= border
-            and ymin >= border
-            and xmax <= Wd - 1 - border
-            and ymax <= Hd - 1 - border
-        ):
-            return np.nan, it, FLAG_OUTSIDE
-        if def_invalid.shape[0] > 1 and _box_has_invalid(
-            def_invalid,
-            int(math.floor(xmin)) - 2,
-            int(math.floor(ymin)) - 2,
-            int(math.ceil(xmax)) + 2,
-            int(math.ceil(ymax)) + 2,
-        ):
-            return np.nan, it, FLAG_INVALID_PIXELS
-        gm = 0.0
-        k = 0
-        for r in range(-half, half + 1):
-            bx = xc + p[0] + p[2] * r
-            by = yc + r + p[6] + p[8] * r
-            if quadratic:
-                bx += 0.5 * p[5] * r * r
-                by += 0.5 * p[11] * r * r
-            for c in range(-half, half + 1):
-                xw = bx + c * (1.0 + p[1])
-                yw = by + p[7] * c
-                if quadratic:
-                    xw += 0.5 * p[3] * c * c + p[4] * c * r
-                    yw += 0.5 * p[9] * c * c + p[10] * c * r
-                    # quadratic warps may bulge beyond the corner box
-                    if xw < border or yw < border or xw > Wd - 1 - border or yw > Hd - 1 - border:
-                        return np.nan, it, FLAG_OUTSIDE
-                v = interp_value(def_coef, order, xw, yw, wx, wy)
-                g[k] = v
-                gm += v
-                k += 1
-        gm /= n
-        gn = 0.0
-        cross = 0.0
-        for k in range(n):
-            d = g[k] - gm
-            g[k] = d
-            gn += d * d
-            cross += d * f[k]
-        gn = math.sqrt(gn)
-        if gn <= 0.0:
-            return np.nan, it, FLAG_NO_TEXTURE
-        zncc = cross / (fn * gn)
-        ratio = fn / gn
-        for i in range(np_):
-            bvec[i] = 0.0
-        k = 0
-        for r in range(-half, half + 1):
-            for c in range(-half, half + 1):
-                e = f[k] - ratio * g[k]
-                a = gx[k] * e
-                b = gy[k] * e
-                bvec[0] += a
-                bvec[1] += a * c
-                bvec[2] += a * r
-                if quadratic:
-                    bvec[3] += 0.5 * a * c * c
-                    bvec[4] += a * c * r
-                    bvec[5] += 0.5 * a * r * r
-                    bvec[6] += b
-                    bvec[7] += b * c
-                    bvec[8] += b * r
-                    bvec[9] += 0.5 * b * c * c
-                    bvec[10] += b * c * r
-                    bvec[11] += 0.5 * b * r * r
-                else:
-                    bvec[3] += b
-                    bvec[4] += b * c
-                    bvec[5] += b * r
-                k += 1
-        # dp = -Hinv b
-        if quadratic:
-            for i in range(12):
-                s = 0.0
-                for j in range(12):
-                    s += Hinv[i, j] * bvec[j]
-                dp[i] = -s
-        else:
-            tmp = np.zeros(6)
-            for i in range(6):
-                s = 0.0
-                for j in range(6):
-                    s += Hinv[i, j] * bvec[j]
-                tmp[i] = -s
-            dp[0] = tmp[0]
-            dp[1] = tmp[1]
-            dp[2] = tmp[2]
-            dp[6] = tmp[3]
-            dp[7] = tmp[4]
-            dp[8] = tmp[5]
-        if not _compose_inverse(p, dp, quadratic):
-            return zncc, it, FLAG_DIVERGED
-        ok = True
-        for i in range(12):
-            if not math.isfinite(p[i]):
-                ok = False
-        if not ok or abs(p[0] - p_start_u) > max_shift or abs(p[6] - p_start_v) > max_shift:
-            return np.nan, it, FLAG_DIVERGED
-        norm = dp[0] * dp[0] + dp[6] * dp[6]
-        norm += hh * hh * (dp[1] * dp[1] + dp[2] * dp[2] + dp[7] * dp[7] + dp[8] * dp[8])
-        if quadratic:
-            q = 0.5 * hh * hh
-            norm += q * q * (dp[3] ** 2 + dp[5] ** 2 + dp[9] ** 2 + dp[11] ** 2)
-            norm += hh**4 * (dp[4] ** 2 + dp[10] ** 2)
-        if math.sqrt(norm) < tol:
-            _store_sigma(w, fn, zncc, n, np_, Hinv[0, 0], Hinv[np_ // 2, np_ // 2])
-            return zncc, it, FLAG_OK
-    return zncc, it, FLAG_NOT_CONVERGED
 
 
 @njit(cache=True, fastmath=_FM)
@@ -936,6 +701,264 @@ def _solve_affine(
     return zncc, it, FLAG_NOT_CONVERGED
 
 
+@njit(cache=True, inline="always")
+def _interp_point(coef, order, xw, yw):
+    """B-spline value at (xw, yw) >= 0 [pixel] (cubic or quintic, Horner weights)."""
+    ix = int(xw)
+    iy = int(yw)
+    if order == 3:
+        t = xw - ix
+        s = 1.0 - t
+        t2 = t * t
+        t3 = t2 * t
+        w0 = s * s * s
+        w1 = 4.0 - 6.0 * t2 + 3.0 * t3
+        w2 = 1.0 + 3.0 * (t + t2 - t3)
+        w3 = t3
+        t = yw - iy
+        s = 1.0 - t
+        t2 = t * t
+        t3 = t2 * t
+        bx = ix + PAD - 1
+        by = iy + PAD - 1
+        r0 = coef[by]
+        r1 = coef[by + 1]
+        r2 = coef[by + 2]
+        r3 = coef[by + 3]
+        return (
+            s * s * s * (w0 * r0[bx] + w1 * r0[bx + 1] + w2 * r0[bx + 2] + w3 * r0[bx + 3])
+            + (4.0 - 6.0 * t2 + 3.0 * t3)
+            * (w0 * r1[bx] + w1 * r1[bx + 1] + w2 * r1[bx + 2] + w3 * r1[bx + 3])
+            + (1.0 + 3.0 * (t + t2 - t3))
+            * (w0 * r2[bx] + w1 * r2[bx + 1] + w2 * r2[bx + 2] + w3 * r2[bx + 3])
+            + t3 * (w0 * r3[bx] + w1 * r3[bx + 1] + w2 * r3[bx + 2] + w3 * r3[bx + 3])
+        ) * (1.0 / 36.0)
+    t = xw - ix
+    s = 1.0 - t
+    s2 = s * s
+    t2 = t * t
+    w0 = s2 * s2 * s
+    w5 = t2 * t2 * t
+    w1 = 26.0 + t * (-50.0 + t * (20.0 + t * (20.0 + t * (-20.0 + 5.0 * t))))
+    w2 = 66.0 + t2 * (-60.0 + t2 * (30.0 - 10.0 * t))
+    w3 = 26.0 + t * (50.0 + t * (20.0 + t * (-20.0 + t * (-20.0 + 10.0 * t))))
+    w4 = 1.0 + t * (5.0 + t * (10.0 + t * (10.0 + t * (5.0 - 5.0 * t))))
+    t = yw - iy
+    s = 1.0 - t
+    s2 = s * s
+    t2 = t * t
+    v0 = s2 * s2 * s
+    v5 = t2 * t2 * t
+    v1 = 26.0 + t * (-50.0 + t * (20.0 + t * (20.0 + t * (-20.0 + 5.0 * t))))
+    v2 = 66.0 + t2 * (-60.0 + t2 * (30.0 - 10.0 * t))
+    v3 = 26.0 + t * (50.0 + t * (20.0 + t * (-20.0 + t * (-20.0 + 10.0 * t))))
+    v4 = 1.0 + t * (5.0 + t * (10.0 + t * (10.0 + t * (5.0 - 5.0 * t))))
+    bx = ix + PAD - 2
+    by = iy + PAD - 2
+    r0 = coef[by]
+    r1 = coef[by + 1]
+    r2 = coef[by + 2]
+    r3 = coef[by + 3]
+    r4 = coef[by + 4]
+    r5 = coef[by + 5]
+    acc = 0.0
+    for q in range(6):
+        b = bx + q
+        h = v0 * r0[b] + v1 * r1[b] + v2 * r2[b] + v3 * r3[b] + v4 * r4[b] + v5 * r5[b]
+        wq = (
+            w0
+            if q == 0
+            else (w1 if q == 1 else (w2 if q == 2 else (w3 if q == 3 else (w4 if q == 4 else w5))))
+        )
+        acc += wq * h
+    return acc * (1.0 / 14400.0)
+
+
+@njit(cache=True, fastmath=_FM)
+def _solve_quadratic(
+    ref_img,
+    ref_gx,
+    ref_gy,
+    ref_coef,
+    ref_invalid,
+    def_coef,
+    def_invalid,
+    order,
+    xc,
+    yc,
+    half,
+    p,
+    max_iter,
+    tol,
+    min_std,
+    max_shift,
+    border,
+    f,
+    gx,
+    gy,
+    w,
+):
+    """Second-order IC-GN for one subset, one sampling pass per iteration (as
+    :func:`_solve_affine`, with the 12-parameter Jacobian and 6x6 warp composition)."""
+    Hd = def_coef.shape[0] - 2 * PAD
+    Wd = def_coef.shape[1] - 2 * PAD
+    n = (2 * half + 1) ** 2
+    flag0, fn = _load_reference(
+        ref_img,
+        ref_gx,
+        ref_gy,
+        ref_coef,
+        ref_invalid,
+        order,
+        xc,
+        yc,
+        half,
+        min_std,
+        border,
+        f,
+        gx,
+        gy,
+        w,
+    )
+    if flag0 != FLAG_OK:
+        return np.nan, 0, flag0
+    Hm = np.zeros((12, 12))
+    J = np.empty(12)
+    jf = np.zeros(12)
+    js = np.zeros(12)
+    k = 0
+    for r in range(-half, half + 1):
+        for c in range(-half, half + 1):
+            a = gx[k]
+            b = gy[k]
+            J[0] = a
+            J[1] = a * c
+            J[2] = a * r
+            J[3] = 0.5 * a * c * c
+            J[4] = a * c * r
+            J[5] = 0.5 * a * r * r
+            J[6] = b
+            J[7] = b * c
+            J[8] = b * r
+            J[9] = 0.5 * b * c * c
+            J[10] = b * c * r
+            J[11] = 0.5 * b * r * r
+            fk = f[k]
+            for i in range(12):
+                ji = J[i]
+                jf[i] += ji * fk
+                js[i] += ji
+                for j in range(i + 1):
+                    Hm[i, j] += ji * J[j]
+            k += 1
+    for i in range(12):
+        for j in range(i + 1, 12):
+            Hm[i, j] = Hm[j, i]
+    Hinv = np.eye(12)
+    if not _solve_spd(Hm, Hinv, 12):
+        return np.nan, 0, FLAG_NO_TEXTURE
+    jg = np.empty(12)
+    e = np.empty(12)
+    dp = np.zeros(12)
+    p_start_u = p[0]
+    p_start_v = p[6]
+    zncc = np.nan
+    it = 0
+    hh = float(half)
+    lo = float(border)
+    hix = Wd - 1.0 - border
+    hiy = Hd - 1.0 - border
+    while it < max_iter:
+        it += 1
+        for i in range(12):
+            jg[i] = 0.0
+        sg = sgg = sgf = 0.0
+        xmin = 1e300
+        xmax = -1e300
+        ymin = 1e300
+        ymax = -1e300
+        k = 0
+        for r in range(-half, half + 1):
+            rr = float(r)
+            ra = rb = rac = rbc = racc = rbcc = 0.0
+            for c in range(-half, half + 1):
+                cc = float(c)
+                xw = xc + cc + p[0] + p[1] * cc + p[2] * rr
+                xw += 0.5 * p[3] * cc * cc + p[4] * cc * rr + 0.5 * p[5] * rr * rr
+                yw = yc + rr + p[6] + p[7] * cc + p[8] * rr
+                yw += 0.5 * p[9] * cc * cc + p[10] * cc * rr + 0.5 * p[11] * rr * rr
+                if not (xw >= lo and yw >= lo and xw <= hix and yw <= hiy):
+                    return np.nan, it, FLAG_OUTSIDE
+                xmin = min(xmin, xw)
+                xmax = max(xmax, xw)
+                ymin = min(ymin, yw)
+                ymax = max(ymax, yw)
+                gv = _interp_point(def_coef, order, xw, yw)
+                sg += gv
+                sgg += gv * gv
+                sgf += gv * f[k]
+                qa = gx[k] * gv
+                qb = gy[k] * gv
+                ra += qa
+                rac += qa * cc
+                racc += qa * cc * cc
+                rb += qb
+                rbc += qb * cc
+                rbcc += qb * cc * cc
+                k += 1
+            jg[0] += ra
+            jg[1] += rac
+            jg[2] += ra * rr
+            jg[3] += 0.5 * racc
+            jg[4] += rac * rr
+            jg[5] += 0.5 * ra * rr * rr
+            jg[6] += rb
+            jg[7] += rbc
+            jg[8] += rb * rr
+            jg[9] += 0.5 * rbcc
+            jg[10] += rbc * rr
+            jg[11] += 0.5 * rb * rr * rr
+        if def_invalid.shape[0] > 1 and _box_has_invalid(
+            def_invalid,
+            int(math.floor(xmin)) - 3,
+            int(math.floor(ymin)) - 3,
+            int(math.ceil(xmax)) + 3,
+            int(math.ceil(ymax)) + 3,
+        ):
+            return np.nan, it, FLAG_INVALID_PIXELS
+        gm = sg / n
+        gn2 = sgg - n * gm * gm
+        if not gn2 > 1e-300:
+            return np.nan, it, FLAG_NO_TEXTURE
+        gn = math.sqrt(gn2)
+        zncc = sgf / (fn * gn)
+        ratio = fn / gn
+        for j in range(12):
+            e[j] = jf[j] - ratio * (jg[j] - gm * js[j])
+        for i in range(12):
+            s = 0.0
+            for j in range(12):
+                s += Hinv[i, j] * e[j]
+            dp[i] = -s
+        if not _compose_quadratic(p, dp):
+            return zncc, it, FLAG_DIVERGED
+        ok = True
+        for i in range(12):
+            if not math.isfinite(p[i]):
+                ok = False
+        if not ok or abs(p[0] - p_start_u) > max_shift or abs(p[6] - p_start_v) > max_shift:
+            return np.nan, it, FLAG_DIVERGED
+        norm = dp[0] * dp[0] + dp[6] * dp[6]
+        norm += hh * hh * (dp[1] * dp[1] + dp[2] * dp[2] + dp[7] * dp[7] + dp[8] * dp[8])
+        q = 0.5 * hh * hh
+        norm += q * q * (dp[3] ** 2 + dp[5] ** 2 + dp[9] ** 2 + dp[11] ** 2)
+        norm += hh**4 * (dp[4] ** 2 + dp[10] ** 2)
+        if math.sqrt(norm) < tol:
+            _store_sigma(w, fn, zncc, n, 12, Hinv[0, 0], Hinv[6, 6])
+            return zncc, it, FLAG_OK
+    return zncc, it, FLAG_NOT_CONVERGED
+
+
 @njit(cache=True)
 def make_work(half):
     """Scratch arrays for :func:`solve_point` (one set per thread/chunk)."""
@@ -973,7 +996,7 @@ def solve_point(
     w[3, 4] = np.nan
     w[3, 5] = np.nan
     if quadratic:
-        return _solve_generic(
+        return _solve_quadratic(
             ref_img,
             ref_gx,
             ref_gy,
@@ -985,7 +1008,6 @@ def solve_point(
             xc,
             yc,
             half,
-            quadratic,
             p,
             max_iter,
             tol,
@@ -995,7 +1017,6 @@ def solve_point(
             f,
             gx,
             gy,
-            g,
             w,
         )
     return _solve_affine(
