@@ -151,6 +151,7 @@ def test_cli_with_the_dynamics_and_a_parameter_file(tmp_path):
 def test_too_large_fixed_interval_is_flagged_and_overshoots(base):
     # two updates for the study-equivalent 10^6 cycles: the rate field flips, wear overshoots
     big = _run(scheme="fixed", dn=int(N_EQ / SCALE / 2))
-    assert float(big["max_wear_depth"][-1]) > 1.2 * float(base["max_wear_depth"][-1])
+    assert float(big["max_wear_depth"][-1]) > 1.1 * float(base["max_wear_depth"][-1])
+    assert np.all(big["update_rate_change"].values > 0.5)
     assert "not converged" in big.attrs["convergence_warning"]
     assert "convergence_warning" not in base.attrs
