@@ -512,6 +512,12 @@ def compare(
     if s_wear is not None and m_wear is not None:
         wear = align_wear_maps(s_wear, m_wear, cycles=cycles, theta_step_deg=theta_step_deg)
         _wear_metrics(wear, rows, decisions, criteria)
+        if cycles is None and not np.isfinite(float(wear.attrs.get("cycles_meas", np.nan))):
+            notes.append(
+                "wear cycles: the measured map does not state after how many crank cycles it was "
+                f"taken; it was compared with the simulation after {wear.attrs['cycles_sim']:g} "
+                "cycles (its last snapshot) - give cycles= / --cycles, or a 'cycles' attribute"
+            )
     elif s_wear is not None or m_wear is not None:
         side = "measurement" if s_wear is not None else "simulation"
         notes.append(f"wear maps not compared: the {side} has no wear map (wear_depth)")

@@ -235,7 +235,9 @@ def _context(
     n_pass = int(c.decisions["passed"].sum()) if n else 0
     # the comparison's own notes ("motion not compared: ...") unless the caller already said why
     covered = {m.split(":", 1)[0].split()[0].lower() for m in missing if m.strip()}
-    missing = [*missing, *(n for n in c.notes if n.split()[0].lower() not in covered)]
+    gaps = [n for n in c.notes if "not compared" in n]
+    missing = [*missing, *(n for n in gaps if n.split()[0].lower() not in covered)]
+    notes = [*notes, *(n for n in c.notes if n not in gaps)]
     ctx: dict[str, Any] = {
         "version": __version__,
         "title": title,

@@ -96,6 +96,15 @@ def test_overlap_cycles_units_and_interpolation_statement():
         align_wear_maps(sim, syn.meas_wear(cycles=9e5))
 
 
+def test_unstated_measurement_cycles_are_noted():
+    meas = syn.meas_wear()
+    del meas.attrs["cycles"]
+    c = compare(syn.sim_wear(), meas)
+    assert c.wear.attrs["cycles_sim"] == 4e5
+    assert any("does not state after how many crank cycles" in n for n in c.notes)
+    assert not any("cycles" in n for n in compare(syn.sim_wear(), syn.meas_wear()).notes)
+
+
 def test_scaled_measurement_volume_and_depth_errors():
     c = compare(syn.sim_wear(), syn.meas_wear(scale=2.0))
     assert c.value("worn_volume", "relative_error") == pytest.approx(-0.5, abs=5e-3)
