@@ -43,7 +43,7 @@ def test_demo_recovers_the_imposed_difference(demo_run):
     # the "measured" bearing is the simulated wear turned by +6 degree and 10 % deeper: the
     # location of the maximum moves by about -6 degree (72-point simulation grid: 5 degree
     # steps; the metrology reference fit and the extra lobe add a little)
-    assert c.value("wear_depth", "max_angle_error") == pytest.approx(-MEASURED_ROTATION_DEG, abs=4)
+    assert c.value("wear_depth", "max_angle_error") == pytest.approx(-MEASURED_ROTATION_DEG, abs=5)
     assert c.value("wear_depth", "pearson_r") > 0.6
     ratio = c.value("worn_volume", "value_meas") / c.value("worn_volume", "value_sim")
     assert 0.9 < ratio < 1.4 and MEASURED_SCALE == 1.10
