@@ -51,6 +51,10 @@ from jointwear.dic._flags import (
 )
 from jointwear.dic._interp import PAD, interp_value_grad
 
+# a subset still below this ZNCC after this many iterations is not going to match
+_HOPELESS_AFTER = 10
+_HOPELESS_ZNCC = 0.5
+
 _FM = {"nsz", "arcp", "contract", "reassoc"}  # fastmath without no-NaN/no-inf assumptions
 
 QUADRATIC_INDEX = np.arange(12)
@@ -677,6 +681,8 @@ def _solve_affine(
             return np.nan, it, FLAG_NO_TEXTURE
         gn = math.sqrt(gn2)
         zncc = acc[2] / (fn * gn)
+        if it >= _HOPELESS_AFTER and not (zncc >= _HOPELESS_ZNCC):
+            return zncc, it, FLAG_NOT_CONVERGED  # far from any match: stop early
         ratio = fn / gn
         for j in range(6):
             e[j] = jf[j] - ratio * (acc[3 + j] - gm * js[j])
@@ -932,6 +938,8 @@ def _solve_quadratic(
             return np.nan, it, FLAG_NO_TEXTURE
         gn = math.sqrt(gn2)
         zncc = sgf / (fn * gn)
+        if it >= _HOPELESS_AFTER and not (zncc >= _HOPELESS_ZNCC):
+            return zncc, it, FLAG_NOT_CONVERGED  # far from any match: stop early
         ratio = fn / gn
         for j in range(12):
             e[j] = jf[j] - ratio * (jg[j] - gm * js[j])
