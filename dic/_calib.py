@@ -18,6 +18,7 @@ board on the mechanism's plane and z becomes the rig's out-of-plane direction.
 
 from __future__ import annotations
 
+import json
 import re
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
@@ -219,6 +220,8 @@ class StereoCalibration:
         Reprojection RMS per accepted view and camera [pixel].
     views_used, views_rejected : int
         Number of calibration views accepted and rejected.
+    rejected : tuple of str
+        Why each rejected view was rejected.
     source : str
         Where the calibration came from (``"jointwear calibrate"``, ``"opencv:<file>"``,
         ``"vic3d:<file>"``).
@@ -234,6 +237,7 @@ class StereoCalibration:
     views_rejected: int = 0
     source: str = ""
     world_frame: str = "left camera frame (x right, y down, z along the optical axis)"
+    rejected: tuple[str, ...] = ()
 
     @property
     def cameras(self) -> dict[str, Camera]:
@@ -270,6 +274,7 @@ class StereoCalibration:
             views_rejected=self.views_rejected,
             source=self.source,
             world_frame=description,
+            rejected=self.rejected,
         )
 
     # ---- xarray ----------------------------------------------------------------------------
@@ -338,6 +343,7 @@ class StereoCalibration:
                 "views_rejected": int(self.views_rejected),
                 "calibration_source": self.source,
                 "world_frame": self.world_frame,
+                "rejected_views": json.dumps(list(self.rejected)),
             }
         )
         return ds
@@ -378,6 +384,7 @@ class StereoCalibration:
             views_rejected=int(ds.attrs.get("views_rejected", 0)),
             source=str(ds.attrs.get("calibration_source", "")),
             world_frame=str(ds.attrs.get("world_frame", "")),
+            rejected=tuple(_json_list(ds.attrs.get("rejected_views", "[]"))),
         )
 
     def save(self, path: str | Path, *, inputs=(), parameters: Any = None) -> Path:
@@ -391,6 +398,16 @@ class StereoCalibration:
             parameters=parameters,
             source="jointwear (dic.calibrate)",
         )
+
+
+def _json_list(value: Any) -> list[str]:
+    if isinstance(value, (list, tuple)):
+        return [str(v) for v in value]
+    try:
+        out = json.loads(value)
+    except (TypeError, ValueError):
+        return []
+    return [str(v) for v in out] if isinstance(out, list) else []
 
 
 # ---- rotations ------------------------------------------------------------------------------

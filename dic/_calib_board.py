@@ -311,6 +311,7 @@ def calibrate_stereo(
         views_used=len(views),
         views_rejected=n_total - len(views),
         source="jointwear calibrate",
+        rejected=tuple(reasons),
     )
     if world_view is not None:
         if not 0 <= world_view < n_total:

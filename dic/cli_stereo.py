@@ -84,6 +84,8 @@ def register(app: typer.Typer) -> None:
             f"{cal.rms:.3f} px, baseline {cal.baseline * 1e3:.2f} mm, focal "
             f"{cal.left.focal[0]:.1f}/{cal.right.focal[0]:.1f} px -> {out}"
         )
+        for reason in cal.rejected:
+            typer.echo(f"  rejected {reason}")
 
     @app.command("import-calibration")
     def import_calibration(

@@ -82,6 +82,15 @@ def test_too_few_views(boards, board):
         calibrate_stereo([blank] * 3, [blank] * 2, board)
 
 
+def test_rejected_views_are_counted_with_their_reason(boards, board):
+    blank = np.zeros_like(boards[0][0])
+    lefts = [b[0] for b in boards[:7]] + [blank]
+    rights = [b[1] for b in boards[:7]] + [boards[7][1]]
+    cal = calibrate_stereo(lefts, rights, board)
+    assert cal.views_used == 7 and cal.views_rejected == 1
+    assert cal.rejected == ("view 7: board not found (left)",)
+
+
 def test_save_and_read_round_trip(tmp_path, calibration):
     path = calibration.save(tmp_path / "cal.nc")
     back = read_calibration(path)
@@ -91,6 +100,7 @@ def test_save_and_read_round_trip(tmp_path, calibration):
         assert np.allclose(a.rotation, b.rotation) and np.allclose(a.translation, b.translation)
     assert back.rms == pytest.approx(calibration.rms)
     assert back.views_used == calibration.views_used
+    assert back.rejected == calibration.rejected
 
 
 def test_undistortion_inverts_distortion():
