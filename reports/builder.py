@@ -316,8 +316,9 @@ def _context(
     ctx["no_budget"] = none
     vfig = figures.verification_figure(verification) if verification else None
     ctx["verification_svg"] = figures.svg_markup(vfig, "verification") if vfig is not None else None
-    ctx["verification_missing"] = (
-        "No verification data (convergence study) was supplied with the simulation."
+    ctx["verification_missing"] = next(
+        (m for m in missing if m.lower().startswith("verification")),
+        "No verification data (convergence study) was supplied with the simulation.",
     )
     records, as_of = _input_records(inputs)
     ctx["inputs"] = records
