@@ -4,7 +4,7 @@ Signatures
 ----------
 ``correlate(reference, deformed, *, points=None, roi=None, subset_size=31, step=10,
 shape="affine", interpolation="quintic", initial_guess=None, search_radius=48, seed_points=None,
-zncc_min=0.8, tolerance=1e-3, max_iterations=40, threads=0) -> xr.Dataset``
+zncc_min=0.8, tolerance=1e-3, max_iterations=40, border=4, threads=0) -> xr.Dataset``
     One image pair. ``points`` ``(N, 2)`` subset centres ``(x, y)`` [pixel] give a ``point``
     dimension with ``x``, ``y`` coordinates; otherwise a grid over ``roi`` with spacing ``step``
     gives ``(y, x)`` dimensions. ``initial_guess`` ``(N, 2)`` ``(u, v)`` [pixel], ``(N, 6)``
@@ -73,6 +73,7 @@ def correlate(
     zncc_min: float = 0.8,
     tolerance: float = 1e-3,
     max_iterations: int = 40,
+    border: int = 4,
     threads: int = 0,
 ) -> xr.Dataset:
     """Subset DIC between two images (ZNSSD criterion, IC-GN on B-spline interpolation).
@@ -109,6 +110,9 @@ def correlate(
         IC-GN convergence threshold on the parameter update [pixel].
     max_iterations : int
         IC-GN iteration limit.
+    border : int
+        Margin [pixel] subsets keep from the image edges, where the B-spline interpolant is
+        less exact.
     threads : int
         numba threads (0: min(2, available)).
 
@@ -134,6 +138,7 @@ def correlate(
         zncc_min=zncc_min,
         tolerance=tolerance,
         max_iterations=max_iterations,
+        border=border,
         threads=threads,
     )
     corr = SubsetCorrelator(reference, points=points, roi=roi, params=params)
