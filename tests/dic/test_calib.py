@@ -208,3 +208,21 @@ def test_vic3d_import(tmp_path):
         read_vic3d_calibration(path)
     with pytest.raises(BadInputError, match="looks like a VIC-3D calibration"):
         read_calibration(path)
+
+
+def test_import_calibration_cli(tmp_path, rig, capsys):
+    from jointwear.cli import main
+
+    path = tmp_path / "cal.xml"
+    path.write_text(_vic_xml(rig.calibration, (640, 512)))
+    out = tmp_path / "imported.nc"
+    assert (
+        main(["dic", "import-calibration", str(path), "--format", "vic3d", "--out", str(out)]) == 0
+    )
+    cal = read_calibration(out)
+    X = np.array([[0.3, 0.2, 0.0]])
+    assert np.allclose(cal.right.project(X), rig.calibration.right.project(X), atol=1e-6)
+    assert cal.source == "vic3d:cal.xml"
+    # OpenCV files need the unit of T: exit code 3 and a message saying so
+    assert main(["dic", "import-calibration", str(path), "--format", "opencv"]) == 3
+    assert "--length-unit is required" in capsys.readouterr().err
