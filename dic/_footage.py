@@ -68,9 +68,10 @@ class BodySpec:
     ----------
     name : str
         Body name (``follower``, ``journal``, ``crank``, ...).
-    role : {"follower", "journal", "crank", "other"}
+    role : {"follower", "journal", "bearing", "crank", "other"}
         What the body is: the follower's centroid velocity, the journal's displacement and the
-        crank's angle go into the contract variables.
+        crank's angle go into the contract variables; with a journal and a bearing (whose
+        ``centroid`` is the bearing centre) the journal's offset in the bearing frame is given.
     polygon : list of [x, y]
         Region of interest in the left reference image [pixel] (3 or more vertices).
     centroid : [x, y, z] or None
@@ -84,7 +85,7 @@ class BodySpec:
     """
 
     name: str
-    role: Literal["follower", "journal", "crank", "other"] = "other"
+    role: Literal["follower", "journal", "bearing", "crank", "other"] = "other"
     polygon: list[list[float]] = field(default_factory=list)
     centroid: list[float] | None = None
     centroid_mechanism: list[float] | None = None
@@ -1018,6 +1019,21 @@ def _assemble(states, times, flags, duplicates, L, R, cfg, calibration, status) 
                     note=f"rotation of the tracked crank about the world z axis plus reference_angle_deg = {st.spec.reference_angle_deg}",
                 ),
             )
+    roles = {st.spec.role: st for st in states}
+    if stereo and "journal" in roles and "bearing" in roles:
+        rb = np.asarray(roles["bearing"].rows["R"], dtype=float)
+        pb = np.asarray(roles["bearing"].rows["poi"], dtype=float)
+        pj = np.asarray(roles["journal"].rows["poi"], dtype=float)
+        offset = np.einsum("nji,nj->ni", rb, pj - pb)  # R_b^T (p_j - p_b)
+        data["journal_offset"] = (
+            ("time", "axis"),
+            offset,
+            C.variable_attrs(
+                "journal_offset",
+                note="journal point of interest minus bearing centre, in the bearing frame "
+                "(world axes at the reference frame, turning with the bearing body)",
+            ),
+        )
     data["frame_flag"] = (
         "time",
         flag_arr,

@@ -392,3 +392,28 @@ def test_plot_needs_motion_variables():
         BadInputError, match="neither 'follower_velocity' nor 'journal_displacement'"
     ):
         plot_body_motion(xr.Dataset())
+
+
+def test_journal_offset_in_the_bearing_frame(small):
+    # declare the follower plate a "bearing" body centred at its centre of mass: the journal
+    # cap's offset in that moving frame is compared with the ground truth
+    cfg, written, out = small
+    tc, bodies = read_bodies(written["bodies"])
+    tc = dataclasses.replace(tc, world_origin=[0.0, 0.0, 0.0])
+    bodies = [dataclasses.replace(b, role="bearing") if b.role == "follower" else b for b in bodies]
+    ds = track_footage(
+        written["left_images"],
+        written["right_images"],
+        fps=50,
+        bodies=bodies,
+        calibration=VirtualRig(cfg).calibration,
+        config=tc,
+        max_frames=4,
+    )
+    truth = io.load(written["truth"]).isel(time=slice(0, 4))
+    rot = truth["body_rotation"].sel(body="follower").values
+    rel = np.einsum("nij,kj->nik", rot, rot[0])  # rotation since the first frame
+    d = truth["journal_position"].values - truth["follower_position"].values
+    expected = np.einsum("nji,nj->ni", rel, d)
+    assert ds["journal_offset"].attrs["units"] == "m"
+    assert np.max(np.abs(ds["journal_offset"].values - expected)) < 3e-5
