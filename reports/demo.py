@@ -32,7 +32,7 @@ import numpy as np
 import xarray as xr
 
 from jointwear import io
-from jointwear.errors import ValidationFailed
+from jointwear.errors import JointwearError, ValidationFailed
 
 __all__ = ["run_demo", "DemoSize", "DEMO_CRITERIA"]
 
@@ -468,7 +468,11 @@ def run_demo(out: Path, *, quick: bool = False) -> Path:
             "wear maps: the metrology chain (jointwear.metrology, jointwear.datasets.instruments) "
             "is not available, so no measured wear map was made"
         )
-    dic_path, dic_missing = _measure_motion(out, size, sim_motion_path)
+    try:
+        dic_path, dic_missing = _measure_motion(out, size, sim_motion_path)
+    except JointwearError as exc:  # the footage chain failed: say so, keep the rest
+        dic_path, dic_missing = None, f"motion: the stereo DIC chain failed ({exc})"
+        _say(f"  {dic_missing}")
     if dic_path is not None:
         meas.append(("DIC", dic_path))
     if dic_missing:
