@@ -208,3 +208,39 @@ def test_video_frames_are_read_as_grey_with_their_frame_rate(tmp_path, sequence)
     empty.write_bytes(b"")
     with pytest.raises(BadInputError, match="could not be opened"):
         read_frames(empty)
+
+
+def test_quicklook_for_points_and_sequences(sequence, tmp_path):
+    from jointwear.dic import correlate, plot_displacement, save_quicklook
+
+    fields, frames = sequence
+    pts = np.array([[40.0, 40.0], [64.0, 64.0], [90.0, 50.0], [2.0, 2.0]])
+    ds = correlate(frames[0], frames[1], points=pts, subset_size=21)
+    assert ds.flag.values[-1] == 3  # too close to the corner: flagged, still plotted
+    fig = plot_displacement(ds, title="points")
+    axes = fig.axes[:2]
+    assert [a.get_title() for a in axes] == ["u (x right, y down)", "v (x right, y down)"]
+    legend = axes[0].get_legend()
+    assert legend is not None and "invalid (1)" in legend.get_texts()[0].get_text()
+    assert "3/4 points ok" in fig._suptitle.get_text()
+    seq = correlate_sequence(frames[:3], roi=(24, 24, 103, 103), subset_size=21, step=16)
+    path = save_quicklook(seq, tmp_path / "seq.png", time=-1)
+    assert path.read_bytes()[:4] == b"\x89PNG"
+
+
+def test_cli_rejects_a_malformed_roi(tmp_path, capsys):
+    data = tmp_path / "s"
+    assert main(["datasets", "speckle", str(data), "--size", "64x64"]) == 0
+    code = main(
+        [
+            "dic",
+            "correlate",
+            str(data / "reference.png"),
+            str(data / "deformed.png"),
+            "--roi",
+            "1,2,3",
+            "--out",
+            str(tmp_path / "f.nc"),
+        ]
+    )
+    assert code == 3
