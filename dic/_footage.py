@@ -581,6 +581,8 @@ def track_footage(
                         duplicates.extend(part["duplicates"])
                         bar.update(task, advance=len(part["times"]))
                         if part["error"]:
+                            for other in futures:
+                                other.cancel()  # chunks not started yet
                             raise BadInputError(part["error"])
                         save("partial")
     except (BadInputError, KeyboardInterrupt) as exc:
