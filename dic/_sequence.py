@@ -261,7 +261,13 @@ def correlate_sequence(
         res = correlator.match(img, initial_guess=guess)
         if res.ok.sum() < 0.5 * max(1, tracked.sum()):
             # the guesses were poor (jump between frames): search again from seeds
-            res2 = correlator.match(img)
+            known = np.isfinite(guess_inc).all(axis=1)
+            centre = (
+                (float(np.median(guess_inc[known, 0])), float(np.median(guess_inc[known, 6])))
+                if known.any()
+                else (0.0, 0.0)
+            )
+            res2 = correlator.match(img, search_centre=centre)
             if res2.ok.sum() > res.ok.sum():
                 res = res2
         return res

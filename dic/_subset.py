@@ -506,8 +506,12 @@ class SubsetCorrelator:
         *,
         initial_guess: np.ndarray | None = None,
         seed_points: np.ndarray | None = None,
+        search_centre: tuple[float, float] = (0.0, 0.0),
     ) -> MatchResult:
         """Correlate ``deformed`` against the reference; raw per-point arrays.
+
+        ``search_centre`` ``(u, v)`` [pixel] centres the seeds' integer search window (default:
+        no displacement); otherwise see :meth:`correlate` for the parameters.
 
         See :meth:`correlate` for the parameters.
         """
@@ -553,7 +557,7 @@ class SubsetCorrelator:
             group, candidates = pick_seeds(self.centres, usable, tex, n_groups)
         for g in range(n_groups):
             for i in candidates[g]:
-                if self._seed(dspl, dinv, raw_def, st, done, i):
+                if self._seed(dspl, dinv, raw_def, st, done, i, search_centre):
                     break
         self._propagate(dspl, dinv, st, done, group, n_groups)
         # points of bands whose seeds failed, and failed points: global pass
@@ -564,7 +568,7 @@ class SubsetCorrelator:
             if left.size == 0:
                 break
             best = left[np.argmax(tex[left])]
-            ok = self._seed(dspl, dinv, raw_def, st, done, int(best))
+            ok = self._seed(dspl, dinv, raw_def, st, done, int(best), search_centre)
             done[best] = True
             if ok:
                 self._propagate(dspl, dinv, st, done, group, 0)

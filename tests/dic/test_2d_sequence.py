@@ -244,3 +244,15 @@ def test_cli_rejects_a_malformed_roi(tmp_path, capsys):
         ]
     )
     assert code == 3
+
+
+def test_jumps_larger_than_the_search_window_are_followed_from_frame_to_frame():
+    # 30 px per frame: frame 2 lies 60 px away, beyond the 48 px search radius around the
+    # reference position; the search is re-centred on the previous frame's motion
+    fields = [None, sp.RigidField((30.0, 2.0)), sp.RigidField((60.0, 4.0))]
+    frames = sp.speckle_sequence((96, 200), fields, seed=12)
+    ds = correlate_sequence(frames, roi=(4, 4, 110, 91), subset_size=21, step=12)
+    ok = ds.flag.values[2] == 0
+    assert ok.mean() > 0.6
+    np.testing.assert_allclose(ds.u.values[2][ok], 60.0, atol=0.01)
+    np.testing.assert_allclose(ds.v.values[2][ok], 4.0, atol=0.01)
