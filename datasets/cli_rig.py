@@ -36,6 +36,13 @@ def register(app: typer.Typer) -> None:
             list[int] | None, typer.Option(help="Frame index to duplicate (repeatable).")
         ] = None,
         seed: Annotated[int, typer.Option(help="Random seed.")] = 0,
+        motion: Annotated[
+            Path | None,
+            typer.Option(
+                help="Motion from data (.nc, e.g. simulator output with crank_angle and "
+                "follower_position) instead of the analytic one."
+            ),
+        ] = None,
     ) -> None:
         """Render what the rig's two cameras would record, board images and the ground truth."""
         from jointwear.datasets.rig import RigConfig, generate_rig
@@ -53,6 +60,11 @@ def register(app: typer.Typer) -> None:
             drop_frames=tuple(drop or ()),
             duplicate_frames=tuple(duplicate or ()),
         )
-        written = generate_rig(out, cfg, video=video, images=images, codec=codec)
+        motion_ds = None
+        if motion is not None:
+            from jointwear import io
+
+            motion_ds = io.load(motion)
+        written = generate_rig(out, cfg, video=video, images=images, codec=codec, motion=motion_ds)
         for key, path in written.items():
             typer.echo(f"{key}: {path}")

@@ -40,6 +40,7 @@ from jointwear.errors import BadInputError
 
 __all__ = [
     "RigConfig",
+    "PrescribedMotion",
     "VirtualRig",
     "fourbar_pose",
     "speckle_texture",
@@ -137,13 +138,58 @@ def _ry(b: float) -> np.ndarray:
     return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
 
 
-def fourbar_pose(t: float, cfg: RigConfig) -> dict[str, Any]:
+@dataclass(frozen=True, eq=False)
+class PrescribedMotion:
+    """Motion taken from data (e.g. a simulator output) instead of the analytic default.
+
+    ``crank_angle(t)`` [rad] and ``z_c(t)`` [m] (out-of-plane position of joint C) are
+    callables; None keeps the analytic one (constant crank speed, sinusoidal z).
+    """
+
+    crank_angle: Any = None
+    z_c: Any = None
+
+    @classmethod
+    def from_dataset(cls, ds: xr.Dataset) -> PrescribedMotion:
+        """Cubic-spline interpolants of a Dataset's ``crank_angle`` [rad] and of the
+        out-of-plane motion of joint C, from ``journal_position``/``journal_displacement``
+        (z) or, for a follower hanging on its spherical joint, twice ``follower_position`` z."""
+        from scipy.interpolate import CubicSpline
+
+        if "time" not in ds.coords or ds.sizes.get("time", 0) < 4:
+            raise BadInputError("motion dataset needs a 'time' coordinate with at least 4 samples")
+        t = np.asarray(ds["time"].values, dtype=float)
+        theta = z = None
+        if "crank_angle" in ds:
+            theta = CubicSpline(t, np.unwrap(np.asarray(ds["crank_angle"].values, dtype=float)))
+        for name, factor in (
+            ("journal_position", 1.0),
+            ("journal_displacement", 1.0),
+            ("follower_position", 2.0),
+        ):
+            if name in ds and "axis" in ds[name].dims:
+                z = CubicSpline(t, factor * np.asarray(ds[name].sel(axis="z").values, dtype=float))
+                break
+        if theta is None and z is None:
+            raise BadInputError(
+                "motion dataset has neither 'crank_angle' nor an out-of-plane motion "
+                "('journal_position', 'journal_displacement' or 'follower_position' with axis z)"
+            )
+        return cls(theta, z)
+
+
+def fourbar_pose(
+    t: float, cfg: RigConfig, motion: PrescribedMotion | None = None
+) -> dict[str, Any]:
     """Poses of the rig's bodies at time ``t`` [s] (mechanism frame).
 
     Returns a dict with ``crank_angle`` [rad], ``B``, ``C`` (joint positions [m]), and per body
     ``(R, p)``: rotation and origin of the body frame (``X = R x_body + p``).
     """
-    th1 = np.deg2rad(cfg.crank_angle0_deg) + cfg.omega * t
+    if motion is not None and motion.crank_angle is not None:
+        th1 = float(motion.crank_angle(t))
+    else:
+        th1 = np.deg2rad(cfg.crank_angle0_deg) + cfg.omega * t
     B = np.array([L1 * np.cos(th1), L1 * np.sin(th1)])
     D = np.array([L4, 0.0])
     d = np.linalg.norm(D - B)
@@ -153,7 +199,10 @@ def fourbar_pose(t: float, cfg: RigConfig) -> dict[str, Any]:
     C = B + a * e + h * np.array([-e[1], e[0]])
     phi3 = np.arctan2(C[1] - D[1], C[0] - D[0])
     phi2 = np.arctan2(C[1] - B[1], C[0] - B[0])
-    zc = cfg.z_amplitude * np.sin(cfg.omega * t + np.deg2rad(cfg.z_phase_deg))
+    if motion is not None and motion.z_c is not None:
+        zc = float(motion.z_c(t))
+    else:
+        zc = cfg.z_amplitude * np.sin(cfg.omega * t + np.deg2rad(cfg.z_phase_deg))
     psi = np.arcsin(np.clip(zc / L3, -1, 1))
     R_f = _rz(phi3) @ _ry(-psi)
     C3 = np.array([D[0], D[1], 0.0]) + L3 * R_f[:, 0]
@@ -168,8 +217,8 @@ def fourbar_pose(t: float, cfg: RigConfig) -> dict[str, Any]:
     }
 
 
-def _truth_state(t: float, cfg: RigConfig) -> dict[str, np.ndarray]:
-    p = fourbar_pose(t, cfg)
+def _truth_state(t: float, cfg: RigConfig, motion=None) -> dict[str, np.ndarray]:
+    p = fourbar_pose(t, cfg, motion)
     return {
         "follower_position": p["follower_centroid"],
         "journal_position": p["journal"][1],
@@ -177,9 +226,11 @@ def _truth_state(t: float, cfg: RigConfig) -> dict[str, np.ndarray]:
     }
 
 
-def _truth_derivative(t: float, cfg: RigConfig, key: str, h: float = 1e-5) -> np.ndarray:
+def _truth_derivative(
+    t: float, cfg: RigConfig, key: str, motion=None, h: float = 1e-5
+) -> np.ndarray:
     """4th-order central difference of an analytic quantity (truncation error ~1e-12 m/s)."""
-    f = [_truth_state(t + k * h, cfg)[key] for k in (-2, -1, 1, 2)]
+    f = [_truth_state(t + k * h, cfg, motion)[key] for k in (-2, -1, 1, 2)]
     return (f[0] - 8 * f[1] + 8 * f[2] - f[3]) / (12 * h)
 
 
@@ -251,8 +302,16 @@ class VirtualRig:
         Rig parameters (see :class:`RigConfig`).
     """
 
-    def __init__(self, config: RigConfig | None = None) -> None:
+    def __init__(
+        self,
+        config: RigConfig | None = None,
+        *,
+        motion: PrescribedMotion | xr.Dataset | None = None,
+    ) -> None:
         self.config = cfg = config or RigConfig()
+        if isinstance(motion, xr.Dataset):
+            motion = PrescribedMotion.from_dataset(motion)
+        self.motion = motion
         f = cfg.focal_px
         target = np.asarray(cfg.look_at, dtype=float)
         cams = {}
@@ -357,7 +416,7 @@ class VirtualRig:
         w, h = cam.image_size
         img = np.full((h, w), c.background / 255.0, dtype=np.float32)
         depth = np.full((h, w), np.inf)
-        pose = fourbar_pose(t, c)
+        pose = fourbar_pose(t, c, self.motion)
         C = cam.centre
         for patch in self.patches:
             R, p = pose[patch.body]
@@ -512,7 +571,7 @@ class VirtualRig:
     def body_rois(self, *, shrink_px: float = 6.0) -> dict[str, list[list[float]]]:
         """Polygons [pixel] of each patch in the left reference image (frame 0), shrunk inwards."""
         cam = self.calibration.left
-        pose = fourbar_pose(0.0, self.config)
+        pose = fourbar_pose(0.0, self.config, self.motion)
         out = {}
         w, h = cam.image_size
         for patch in self.patches:
@@ -532,12 +591,13 @@ class VirtualRig:
 
         c = self.config
         t = self.frame_times() if times is None else np.asarray(times, dtype=float)
-        fp = np.array([_truth_state(ti, c)["follower_position"] for ti in t])
-        fv = np.array([_truth_derivative(ti, c, "follower_position") for ti in t])
-        jp = np.array([_truth_state(ti, c)["journal_position"] for ti in t])
-        jv = np.array([_truth_derivative(ti, c, "journal_position") for ti in t])
-        ca = np.array([_truth_state(ti, c)["crank_angle"][0] for ti in t])
-        poses = [fourbar_pose(ti, c) for ti in t]
+        m = self.motion
+        fp = np.array([_truth_state(ti, c, m)["follower_position"] for ti in t])
+        fv = np.array([_truth_derivative(ti, c, "follower_position", m) for ti in t])
+        jp = np.array([_truth_state(ti, c, m)["journal_position"] for ti in t])
+        jv = np.array([_truth_derivative(ti, c, "journal_position", m) for ti in t])
+        ca = np.array([_truth_state(ti, c, m)["crank_angle"][0] for ti in t])
+        poses = [fourbar_pose(ti, c, m) for ti in t]
         bodies = [p.body for p in self.patches]
         rot = np.array([[pp[b][0] for b in bodies] for pp in poses])
         org = np.array([[pp[b][1] for b in bodies] for pp in poses])
@@ -600,6 +660,9 @@ class VirtualRig:
                 "noise_floor_z_per_point_m_at_0p01px": self.noise_floor_z(0.01),
                 "world_board_origin_m": self.world_board_origin().tolist(),
                 "rendering": "exact ray casting + bicubic sampling of a band-limited speckle texture",
+                "motion": "analytic four-bar kinematics, z_c = z_amplitude sin(omega t + z_phase)"
+                if self.motion is None
+                else "prescribed from data (cubic splines of crank_angle and/or z of joint C)",
             }
         )
         return ds
@@ -642,6 +705,7 @@ def generate_rig(
     images: bool = True,
     codec: str = "ffv1",
     calibration_images: bool = True,
+    motion: PrescribedMotion | xr.Dataset | None = None,
 ) -> dict[str, Path]:
     """Render the virtual rig to ``out``: footage, board images, ground truth and ROI file.
 
@@ -649,6 +713,9 @@ def generate_rig(
     number is missing), ``left<ext>``/``right<ext>`` videos, ``calibration/left|right/board_XX.png``
     (the last view is the world-frame board lying on the mechanism plane), ``truth.nc`` (ground
     truth with provenance) and ``bodies.toml`` (regions of interest for ``jointwear dic track``).
+
+    ``motion`` (a :class:`PrescribedMotion` or a Dataset such as a simulator output with
+    ``crank_angle`` and ``follower_position``/``journal_position``) replaces the analytic motion.
 
     Returns
     -------
@@ -661,7 +728,7 @@ def generate_rig(
 
     if codec not in CODECS:
         raise BadInputError(f"codec {codec!r} is not available; choose one of {', '.join(CODECS)}")
-    rig = VirtualRig(config)
+    rig = VirtualRig(config, motion=motion)
     c = rig.config
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
@@ -725,7 +792,7 @@ def generate_rig(
 def _write_bodies_toml(rig: VirtualRig, path: Path) -> Path:
     rois = rig.body_rois()
     c = rig.config
-    pose0 = fourbar_pose(0.0, c)
+    pose0 = fourbar_pose(0.0, c, rig.motion)
     lines = [
         "# Regions of interest for `jointwear dic track`, written by `jointwear datasets rig`.",
         "# Polygons in pixels of the left camera's first frame.",

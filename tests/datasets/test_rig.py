@@ -101,3 +101,37 @@ def test_codecs_round_trip(tmp_path, codec):
     assert len(back) == 3
     if CODECS[codec][2]:  # lossless
         assert all(np.array_equal(a, b) for a, b in zip(frames, back, strict=True))
+
+
+def test_prescribed_motion_from_a_dataset():
+    import xarray as xr
+
+    from jointwear.datasets.rig import PrescribedMotion
+
+    t = np.linspace(0.0, 0.6, 61)
+    theta = 0.3 + 3.0 * t + 0.5 * t**2  # a crank speeding up [rad]
+    zf = 1e-3 * np.sin(5.0 * t)  # follower centre of mass out of plane [m]
+    ds = xr.Dataset(
+        {
+            "crank_angle": ("time", theta, {"units": "rad"}),
+            "follower_position": (
+                ("time", "axis"),
+                np.column_stack([0 * t, 0 * t, zf]),
+                {"units": "m"},
+            ),
+        },
+        coords={"time": t, "axis": ["x", "y", "z"]},
+    )
+    rig = VirtualRig(RigConfig(width=160, height=128, duration=0.4), motion=ds)
+    g = rig.ground_truth()
+    tt = g["time"].values
+    assert np.allclose(g["crank_angle"].values, 0.3 + 3.0 * tt + 0.5 * tt**2, atol=1e-9)
+    # the follower hangs on D: its centre of mass moves half as much out of plane as joint C
+    assert np.allclose(
+        g["follower_position"].sel(axis="z").values, 1e-3 * np.sin(5.0 * tt), atol=1e-9
+    )
+    assert "prescribed" in g.attrs["motion"]
+    with pytest.raises(BadInputError, match="neither 'crank_angle' nor an out-of-plane motion"):
+        PrescribedMotion.from_dataset(
+            ds[["crank_angle"]].drop_vars("crank_angle").assign(x=("time", t))
+        )
