@@ -383,15 +383,18 @@ def _parse_header(lines: Sequence[str], delim: str, ncols: int) -> tuple[dict[st
         if delim != " " and toks and toks[-1] == "":
             toks = toks[:-1]
         if i == last:
-            cand = toks
-            if delim == " " and len(toks) != ncols:
-                cand = [t for t in re.split(r"\s{2,}|\t", s) if t]
-            if len(cand) == ncols and not all(_NUM_RE.match(t) for t in cand):
-                kv = _KV_RE.match(s)
-                kv_like = bool(kv and kv.group(2) and re.search(r"[:=]", s))
-                if (ncols > 1 and (delim != " " or not kv_like)) or (ncols == 1 and not kv):
-                    names = cand
-                    continue
+            kv = _KV_RE.match(s)
+            kv_like = bool(kv and kv.group(2) and re.search(r"[:=]", s))
+            wide_split = [t for t in re.split(r"\s{2,}|\t", s) if t]
+            if delim == " " and ncols > 1 and len(wide_split) == ncols:
+                cand, ok = wide_split, True  # names separated by 2+ spaces may contain spaces
+            elif delim == " ":
+                cand, ok = toks, not kv_like
+            else:
+                cand, ok = toks, ncols > 1 or not kv
+            if ok and len(cand) == ncols and not all(_NUM_RE.match(t) for t in cand):
+                names = cand
+                continue
         m = _KV_RE.match(s)
         if m and m.group(2):
             meta[m.group(1).strip()] = m.group(2).strip()
@@ -453,6 +456,31 @@ def _guess_angle_kind(col: np.ndarray) -> str:
     return "angle_deg"
 
 
+def _first_run(c: np.ndarray) -> int:
+    """Length of the first run of equal values."""
+    change = np.flatnonzero(c[1:] != c[:-1])
+    return int(change[0]) + 1 if change.size else c.size
+
+
+def _runs(c: np.ndarray) -> bool:
+    """True if ``c`` consists of a few long runs of equal values (a z column)."""
+    n = c.size
+    if n < 8:
+        return False
+    changes = int(np.count_nonzero(c[1:] != c[:-1]))
+    return changes + 1 <= max(1, n // 8) and _first_run(c) >= 4
+
+
+def _xy_like(a: np.ndarray, b: np.ndarray) -> bool:
+    """Cartesian points around the origin: both coordinates change sign, similar spread."""
+    if not (np.any(a < 0) and np.any(a > 0) and np.any(b < 0) and np.any(b > 0)):
+        return False
+    sa, sb = np.ptp(a), np.ptp(b)
+    r = np.hypot(a, b)
+    # points on a (nearly) round profile: the distance from the origin hardly varies
+    return bool(min(sa, sb) > 0.5 * max(sa, sb) and np.ptp(r) < 0.2 * np.mean(r))
+
+
 def _looks_monotonic(c: np.ndarray) -> bool:
     d = np.diff(c)
     if d.size == 0:
@@ -488,13 +516,15 @@ def _guess_columns(
         return (kinds[0] or _value_kind(data[:, 0]),), units
     if ncol == 2:
         a, b = data[:, 0], data[:, 1]
+        if kinds[0] is None and _runs(a):
+            kinds[0] = "z"  # (z, value): a long file without an angle column
         if kinds[0] is None:
             if _looks_monotonic(a):
                 kinds[0] = _guess_angle_kind(a)
-            elif np.any(a < 0) and np.any(b < 0) and np.any(a > 0) and np.any(b > 0):
+            elif _xy_like(a, b):
                 kinds[0], kinds[1] = "x", "y"
-            else:
-                kinds[0] = _guess_angle_kind(a)
+            else:  # two value columns: a wide file of two layers without an angle column
+                kinds[0] = _value_kind(data)
         if kinds[1] is None:
             kinds[1] = "y" if kinds[0] == "x" else _value_kind(b)
         return tuple(kinds), units  # type: ignore[arg-type]
@@ -503,22 +533,34 @@ def _guess_columns(
     few0 = np.unique(c0[np.isfinite(c0)]).size <= max(2, data.shape[0] // 8)
     if ncol == 3 and kinds == [None, None, None]:
         c2 = data[:, 2]
-        if few0:
-            kinds = ["z", _guess_angle_kind(data[:, 1]), _value_kind(data[:, 2])]
+        if few0 and _runs(c0):
+            first = data[: _first_run(c0)]
+            if _xy_like(first[:, 1], first[:, 2]):
+                kinds = ["z", "x", "y"]
+            else:
+                kinds = ["z", _guess_angle_kind(first[:, 1]), _value_kind(data[:, 2])]
         elif np.unique(c2[np.isfinite(c2)]).size <= max(2, data.shape[0] // 8):
             kinds = ["x", "y", "z"]
-        elif _looks_monotonic(c0) and np.all(np.abs(c0 - np.round(c0)) < 1e-9):
+        elif (
+            _looks_monotonic(c0)
+            and np.all(np.abs(c0 - np.round(c0)) < 1e-9)
+            and _looks_monotonic(data[:, 1])
+        ):
             kinds = ["index", _guess_angle_kind(data[:, 1]), _value_kind(data[:, 2])]
-        else:
+        elif _looks_monotonic(c0):
             kinds = [_guess_angle_kind(c0), _value_kind(data[:, 1]), _value_kind(data[:, 2])]
+        else:  # three value columns: a wide file without an angle column
+            vk3 = _value_kind(data)
+            kinds = [vk3, vk3, vk3]
         return tuple(kinds), units  # type: ignore[arg-type]
     # wide: angle + one value column per layer
-    if kinds[0] is None:
-        kinds[0] = _guess_angle_kind(c0) if _looks_monotonic(c0) else "deviation"
-    vk = next((k for k in kinds[1:] if k in ("radius", "deviation")), None) or _value_kind(
-        data[:, 1:]
+    if kinds[0] is None and _looks_monotonic(c0):
+        kinds[0] = _guess_angle_kind(c0)
+    start = 0 if kinds[0] is None else 1  # no angle column: every column is a layer
+    vk = next((k for k in kinds[start:] if k in ("radius", "deviation")), None) or _value_kind(
+        data[:, start:]
     )
-    for i in range(1, ncol):
+    for i in range(ncol):
         if kinds[i] is None:
             kinds[i] = vk
     return tuple(kinds), units  # type: ignore[arg-type]
