@@ -19,8 +19,8 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
+import jointwear.compare.metrics as mt
 from jointwear import io
-from jointwear.compare import metrics as mt
 from jointwear.compare.align import MOTION_VARIABLES, align_time_series, align_wear_maps
 from jointwear.errors import BadInputError, ParameterError
 from jointwear.params import from_mapping, read_toml

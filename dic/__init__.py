@@ -1,7 +1,7 @@
 """Digital image correlation (``jointwear.dic``): 2D subset DIC, stereo DIC, footage tracking."""
 
-from jointwear.dic import _api2d, _api3d
-from jointwear.dic._api2d import *  # noqa: F403
-from jointwear.dic._api3d import *  # noqa: F403
+from jointwear._lazy import lazy_api
 
-__all__ = [*_api2d.__all__, *_api3d.__all__]
+# Public names come from the modules below; they are imported on first use (PEP 562) so that
+# the command line starts fast.
+__getattr__, __dir__ = lazy_api(__name__, ["jointwear.dic._api2d", "jointwear.dic._api3d"])

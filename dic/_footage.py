@@ -927,7 +927,7 @@ def _assemble(states, times, flags, duplicates, L, R, cfg, calibration, status) 
             np.asarray(rows["zncc"], dtype=np.float32),
             {"units": "1", "long_name": f"ZNCC of the {name}'s subsets (lower of the two cameras)"},
         )
-        data[f"{name}_displacement"] = (
+        data[f"{name}_subset_displacement"] = (
             ("time", f"{name}_point", f"{name}_point_axis"),
             pts - pts[:1],
             {

@@ -31,7 +31,7 @@ from typing import TYPE_CHECKING, Literal
 import numpy as np
 import xarray as xr
 
-from jointwear.dic import _flags
+import jointwear.dic._flags as _flags
 from jointwear.errors import BadInputError, ParameterError
 
 if TYPE_CHECKING:

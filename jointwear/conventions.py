@@ -61,6 +61,10 @@ VARIABLES: dict[str, tuple[str, str]] = {
     "follower_velocity": ("m s-1", "velocity of the follower centre of mass"),
     "follower_position": ("m", "position of the follower centre of mass"),
     "journal_offset": ("m", "journal centre relative to the bearing centre, bearing frame"),
+    "journal_displacement": (
+        "m",
+        "displacement of the journal (or its cap) from its first position",
+    ),
     "contact_force": ("N", "magnitude of the resultant contact force in joint C"),
     "crank_angle": ("rad", "crank angle from +x, counter-clockwise"),
     "displacement": ("m", "displacement of a tracked point"),

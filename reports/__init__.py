@@ -1,4 +1,7 @@
 """Validation reports (``jointwear.reports``): self-contained HTML with figures, and the demo."""
 
-from jointwear.reports._api import *  # noqa: F403
-from jointwear.reports._api import __all__  # noqa: F401
+from jointwear._lazy import lazy_api
+
+# Public names come from the modules below; they are imported on first use (PEP 562) so that
+# the command line starts fast.
+__getattr__, __dir__ = lazy_api(__name__, ["jointwear.reports._api"])

@@ -1,11 +1,13 @@
 """Simulator of the spatial four-bar linkage with a 3D revolute clearance joint (``jointwear.sim``).
 
-Dynamics, contact and friction live in the modules listed by :mod:`jointwear.sim._api_dynamics`;
-Archard wear with cycle updates in :mod:`jointwear.sim._api_wear`.
+Dynamics, contact and friction: :mod:`jointwear.sim._api_dynamics`; Archard wear with cycle
+updates: :mod:`jointwear.sim._api_wear`.
 """
 
-from jointwear.sim import _api_dynamics, _api_wear
-from jointwear.sim._api_dynamics import *  # noqa: F403
-from jointwear.sim._api_wear import *  # noqa: F403
+from jointwear._lazy import lazy_api
 
-__all__ = [*_api_dynamics.__all__, *_api_wear.__all__]
+# Public names come from the modules below; they are imported on first use (PEP 562) so that
+# the command line starts fast.
+__getattr__, __dir__ = lazy_api(
+    __name__, ["jointwear.sim._api_dynamics", "jointwear.sim._api_wear"]
+)

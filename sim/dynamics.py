@@ -15,10 +15,10 @@ from collections.abc import Callable
 import numpy as np
 import xarray as xr
 
+import jointwear.sim._kernels as kn
 from jointwear import conventions
 from jointwear.errors import BadInputError, ParameterError, SimulationError
 from jointwear.params import to_jsonable
-from jointwear.sim import _kernels as kn
 from jointwear.sim.contact import contact_constant
 from jointwear.sim.mechanism import loop_closure, quaternion_to_matrix, rotation_xzy_angles
 from jointwear.sim.parameters import SimParameters

@@ -417,3 +417,20 @@ def test_journal_offset_in_the_bearing_frame(small):
     expected = np.einsum("nji,nj->ni", rel, d)
     assert ds["journal_offset"].attrs["units"] == "m"
     assert np.max(np.abs(ds["journal_offset"].values - expected)) < 3e-5
+
+
+def test_per_subset_and_body_displacements_do_not_collide(small, tmp_path):
+    """The journal body's per-subset field and its body-level displacement are both kept."""
+    cfg, written, out = small
+    tc, bodies = read_bodies(written["bodies"])
+    ds = track_footage(
+        written["left_images"],
+        fps=50,
+        bodies=bodies,
+        config=tc,
+        max_frames=3,
+        out=tmp_path / "mono2.nc",
+    )
+    assert "journal_subset_displacement" in ds
+    assert ds["journal_subset_displacement"].ndim == 3
+    assert ds["journal_image_displacement"].dims == ("time", "axis")

@@ -1,0 +1,50 @@
+"""Subpackages re-export their public API lazily; the CLI starts without heavy imports."""
+
+from __future__ import annotations
+
+import importlib
+import inspect
+import subprocess
+import sys
+
+import pytest
+
+PACKAGES = [
+    "jointwear.sim",
+    "jointwear.dic",
+    "jointwear.metrology",
+    "jointwear.compare",
+    "jointwear.reports",
+]
+
+
+def test_cli_starts_without_numerical_stack():
+    code = (
+        "import sys, jointwear.cli; "
+        "print(sorted(m for m in ('numba', 'scipy', 'xarray', 'cv2', 'matplotlib') if m in sys.modules))"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "[]"
+
+
+@pytest.mark.parametrize("package", PACKAGES)
+def test_every_exported_name_resolves_to_the_api_object(package):
+    pkg = importlib.import_module(package)
+    names = pkg.__all__
+    assert names and len(names) == len(set(names))
+    for name in names:
+        obj = getattr(pkg, name)
+        # a public name never resolves to a submodule that happens to share it
+        assert not inspect.ismodule(obj), f"{package}.{name} is a module"
+    assert set(names) <= set(dir(pkg))
+    with pytest.raises(AttributeError, match="has no attribute 'no_such_name'"):
+        pkg.no_such_name  # noqa: B018
+
+
+def test_function_shadowing_a_submodule():
+    from jointwear.metrology import assess
+
+    assert callable(assess) and not inspect.ismodule(assess)
+    import jointwear.metrology as m
+
+    assert m.assess is assess
