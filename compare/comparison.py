@@ -49,6 +49,11 @@ class Criteria:
         Coverage factor of the expanded validation uncertainty ``U_val = k u_val`` [1].
     wear_nrmse_max : float
         Largest acceptable normalised RMSE of the wear map [1].
+    wear_r_min : float
+        Smallest acceptable Pearson correlation between the simulated and measured wear maps
+        [1]. Together with ``wear_nrmse_max`` it makes the shape criterion: a low NRMSE alone
+        is also reached by a simulation that predicts almost no wear against a peaky
+        measurement.
     max_angle_error_deg : float
         Largest acceptable error of the angle of maximum wear [degree].
     max_z_error_m : float
@@ -68,6 +73,7 @@ class Criteria:
 
     k: float = 2.0
     wear_nrmse_max: float = 0.25
+    wear_r_min: float = 0.5
     max_angle_error_deg: float = 30.0
     max_z_error_m: float = 3.0e-3
     relative_error_max: float = 0.30
@@ -276,12 +282,18 @@ def _wear_metrics(
     ang = float(mt.wrap_angle_deg(ts - td))
     rows.add(q, "max_angle_error", ang, "m")
     rows.add(q, "max_z_error", zs - zd, "m")
+    r = mt.pearson_r(s, d)
     decisions.append(
         {
             "quantity": "wear map shape",
-            "criterion": f"NRMSE <= {criteria.wear_nrmse_max:g}",
-            "value": f"NRMSE = {nr:.3g}",
-            "passed": bool(np.isfinite(nr) and nr <= criteria.wear_nrmse_max),
+            "criterion": f"NRMSE <= {criteria.wear_nrmse_max:g} and r >= {criteria.wear_r_min:g}",
+            "value": f"NRMSE = {nr:.3g}, r = {r:.3g}",
+            "passed": bool(
+                np.isfinite(nr)
+                and nr <= criteria.wear_nrmse_max
+                and np.isfinite(r)
+                and r >= criteria.wear_r_min
+            ),
             "basis": "threshold",
         }
     )

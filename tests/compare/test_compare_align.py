@@ -222,3 +222,41 @@ def test_time_series_bad_inputs():
     # a measurement shorter than a cycle is used whole, and the attributes say so
     short = align_time_series(sim, syn.meas_motion(duration=0.3))
     assert short.sizes["time"] == 15 and "less than one whole cycle" in short.attrs["interpolation"]
+
+
+def _shape_verdict(c):
+    row = c.decisions[c.decisions.quantity == "wear map shape"]
+    return bool(row.passed.iloc[0]), str(row.criterion.iloc[0])
+
+
+def test_shape_criterion_needs_correlation_not_only_low_nrmse():
+    """A simulation predicting almost no wear must not pass the shape check on NRMSE alone."""
+    meas = syn.meas_wear()
+    flat = syn.sim_wear()
+    flat["wear_depth"] = flat["wear_depth"] * 0.0 + 3e-6  # uniform, featureless prediction
+    c = compare(flat, meas)
+    nr = c.value("wear_depth", "nrmse")
+    assert nr <= Criteria().wear_nrmse_max  # NRMSE alone would have passed it
+    assert (
+        not np.isfinite(c.value("wear_depth", "pearson_r"))
+        or c.value("wear_depth", "pearson_r") < Criteria().wear_r_min
+    )
+    passed, criterion = _shape_verdict(c)
+    assert not passed and "r >= 0.5" in criterion
+    # the same physical field passes, and the threshold on r is what decides
+    assert _shape_verdict(compare(syn.sim_wear(), meas))[0]
+    r_rot = compare(syn.sim_wear(rotate_deg=60.0), meas).value("wear_depth", "pearson_r")
+    assert _shape_verdict(
+        compare(
+            syn.sim_wear(rotate_deg=60.0),
+            meas,
+            criteria=Criteria(wear_r_min=r_rot - 0.01, wear_nrmse_max=10),
+        )
+    )[0]
+    assert not _shape_verdict(
+        compare(
+            syn.sim_wear(rotate_deg=60.0),
+            meas,
+            criteria=Criteria(wear_r_min=r_rot + 0.01, wear_nrmse_max=10),
+        )
+    )[0]
