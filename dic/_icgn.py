@@ -1052,6 +1052,75 @@ def solve_point(
     )
 
 
+@njit(cache=True, inline="always")
+def _refine_chunk(
+    ch,
+    n_chunks,
+    ref_img,
+    ref_gx,
+    ref_gy,
+    ref_coef,
+    ref_invalid,
+    def_coef,
+    def_invalid,
+    order,
+    centres,
+    P,
+    active,
+    half,
+    quadratic,
+    max_iter,
+    tol,
+    min_std,
+    max_shift,
+    border,
+    zncc_min,
+    zncc,
+    iters,
+    flags,
+    sigma,
+):
+    """Refine the active points ``ch, ch + n_chunks, ...`` from ``P[i]`` (in place)."""
+    n = centres.shape[0]
+    work = make_work(half)
+    p = np.empty(12)
+    for i in range(ch, n, n_chunks):
+        if not active[i]:
+            continue
+        for q in range(12):
+            p[q] = P[i, q]
+        z, it, fl = solve_point(
+            ref_img,
+            ref_gx,
+            ref_gy,
+            ref_coef,
+            ref_invalid,
+            def_coef,
+            def_invalid,
+            order,
+            centres[i, 0],
+            centres[i, 1],
+            half,
+            quadratic,
+            p,
+            max_iter,
+            tol,
+            min_std,
+            max_shift,
+            border,
+            work,
+        )
+        if fl == FLAG_OK and not (z >= zncc_min):
+            fl = FLAG_LOW_CORRELATION
+        for q in range(12):
+            P[i, q] = p[q]
+        zncc[i] = z
+        iters[i] = it
+        flags[i] = fl
+        sigma[i, 0] = work[4][3, 4]
+        sigma[i, 1] = work[4][3, 5]
+
+
 @njit(cache=True, parallel=True)
 def icgn_many(
     ref_img,
@@ -1079,46 +1148,35 @@ def icgn_many(
     sigma,
 ):
     """Refine every active point from its initial parameters ``P[i]`` (in place), in parallel."""
-    n = centres.shape[0]
-    n_chunks = min(n, 64)
+    n_chunks = min(centres.shape[0], 64)
     for ch in prange(n_chunks):
-        work = make_work(half)
-        p = np.empty(12)
-        for i in range(ch, n, n_chunks):
-            if not active[i]:
-                continue
-            for q in range(12):
-                p[q] = P[i, q]
-            z, it, fl = solve_point(
-                ref_img,
-                ref_gx,
-                ref_gy,
-                ref_coef,
-                ref_invalid,
-                def_coef,
-                def_invalid,
-                order,
-                centres[i, 0],
-                centres[i, 1],
-                half,
-                quadratic,
-                p,
-                max_iter,
-                tol,
-                min_std,
-                max_shift,
-                border,
-                work,
-            )
-            if fl == FLAG_OK and not (z >= zncc_min):
-                fl = FLAG_LOW_CORRELATION
-            for q in range(12):
-                P[i, q] = p[q]
-            zncc[i] = z
-            iters[i] = it
-            flags[i] = fl
-            sigma[i, 0] = work[4][3, 4]
-            sigma[i, 1] = work[4][3, 5]
+        _refine_chunk(
+            ch,
+            n_chunks,
+            ref_img,
+            ref_gx,
+            ref_gy,
+            ref_coef,
+            ref_invalid,
+            def_coef,
+            def_invalid,
+            order,
+            centres,
+            P,
+            active,
+            half,
+            quadratic,
+            max_iter,
+            tol,
+            min_std,
+            max_shift,
+            border,
+            zncc_min,
+            zncc,
+            iters,
+            flags,
+            sigma,
+        )
 
 
 @njit(cache=True)
@@ -1148,46 +1206,35 @@ def icgn_serial(
     sigma,
 ):
     """As :func:`icgn_many` on one thread (for a handful of points, e.g. seeds)."""
-    n = centres.shape[0]
-    n_chunks = min(n, 64)
+    n_chunks = min(centres.shape[0], 64)
     for ch in range(n_chunks):
-        work = make_work(half)
-        p = np.empty(12)
-        for i in range(ch, n, n_chunks):
-            if not active[i]:
-                continue
-            for q in range(12):
-                p[q] = P[i, q]
-            z, it, fl = solve_point(
-                ref_img,
-                ref_gx,
-                ref_gy,
-                ref_coef,
-                ref_invalid,
-                def_coef,
-                def_invalid,
-                order,
-                centres[i, 0],
-                centres[i, 1],
-                half,
-                quadratic,
-                p,
-                max_iter,
-                tol,
-                min_std,
-                max_shift,
-                border,
-                work,
-            )
-            if fl == FLAG_OK and not (z >= zncc_min):
-                fl = FLAG_LOW_CORRELATION
-            for q in range(12):
-                P[i, q] = p[q]
-            zncc[i] = z
-            iters[i] = it
-            flags[i] = fl
-            sigma[i, 0] = work[4][3, 4]
-            sigma[i, 1] = work[4][3, 5]
+        _refine_chunk(
+            ch,
+            n_chunks,
+            ref_img,
+            ref_gx,
+            ref_gy,
+            ref_coef,
+            ref_invalid,
+            def_coef,
+            def_invalid,
+            order,
+            centres,
+            P,
+            active,
+            half,
+            quadratic,
+            max_iter,
+            tol,
+            min_std,
+            max_shift,
+            border,
+            zncc_min,
+            zncc,
+            iters,
+            flags,
+            sigma,
+        )
 
 
 @njit(cache=True)
