@@ -151,6 +151,28 @@ _GL_T = (0.5 - 0.5 * math.sqrt(0.6), 0.5, 0.5 + 0.5 * math.sqrt(0.6))
 _GL_W = (5.0 / 18.0, 8.0 / 18.0, 5.0 / 18.0)
 
 
+@njit(cache=True, inline="always")
+def _apply_friction(wrench, px, py, pz, tx, ty, tz, fn, muon, P):
+    """Add the friction of eq. 12 at a contact to ``wrench``; return the sliding speed |v_t|.
+
+    (tx, ty, tz) is the relative tangential velocity at the contact point (px, py, pz), fn the
+    normal force [N]; the force mu(|v_t|) fn along v_t goes into both force slots and its
+    moment into the moment slot, exactly as the contact branches did inline.
+    """
+    vt = math.sqrt(tx * tx + ty * ty + tz * tz)
+    if muon > 0.0 and vt > 0.0:
+        mu = friction_coefficient(vt, P[MUS], P[MUD], P[VS], P[VD])
+        s = mu * fn / vt
+        wrench[0] += s * tx
+        wrench[1] += s * ty
+        wrench[2] += s * tz
+        wrench[9] += s * tx
+        wrench[10] += s * ty
+        wrench[11] += s * tz
+        _cross_acc(px, py, pz, tx, ty, tz, wrench, 3, s)
+    return vt
+
+
 @njit(cache=True)
 def _seg(a, b, nexp):
     """Integrals over an axial interval where the penetration runs linearly from a to b.
@@ -387,17 +409,7 @@ def _slices(
         tx = vx - rate * hx
         ty = vy - rate * hy
         tz = vz - rate * hz
-        vt = math.sqrt(tx * tx + ty * ty + tz * tz)
-        if muon > 0.0 and vt > 0.0:
-            mu = friction_coefficient(vt, P[MUS], P[MUD], P[VS], P[VD])
-            sk = mu * fn / vt
-            wrench[0] += sk * tx
-            wrench[1] += sk * ty
-            wrench[2] += sk * tz
-            wrench[9] += sk * tx
-            wrench[10] += sk * ty
-            wrench[11] += sk * tz
-            _cross_acc(cx, cy, cz, tx, ty, tz, wrench, 3, sk)
+        vt = _apply_friction(wrench, cx, cy, cz, tx, ty, tz, fn, muon, P)
         srate[n] = rate
         son[n] = 1
         if acc:
@@ -572,17 +584,7 @@ def _contact(
             tx = vx - rate * nd[4]
             ty = vy - rate * nd[5]
             tz = vz - rate * nd[6]
-            vt = math.sqrt(tx * tx + ty * ty + tz * tz)
-            if muon > 0.0 and vt > 0.0:
-                mu = friction_coefficient(vt, P[MUS], P[MUD], P[VS], P[VD])
-                s = mu * fn / vt
-                wrench[0] += s * tx
-                wrench[1] += s * ty
-                wrench[2] += s * tz
-                wrench[9] += s * tx
-                wrench[10] += s * ty
-                wrench[11] += s * tz
-                _cross_acc(nd[1], nd[2], nd[3], tx, ty, tz, wrench, 3, s)
+            vt = _apply_friction(wrench, nd[1], nd[2], nd[3], tx, ty, tz, fn, muon, P)
             if acc:
                 WW[0, n, mm % Nd] += fn / AREA[n, mm % Nd] * vt * hstep
                 WW[1, n, mm % Nd] += vt * hstep
@@ -668,17 +670,7 @@ def _contact(
         wrench[8] += s * u[2]
         _cross_acc(xx, xy, xz, u[0], u[1], u[2], wrench, 3, s)
         tx, ty, tz = vx - vn * u[0], vy - vn * u[1], vz - vn * u[2]
-        vt = math.sqrt(tx * tx + ty * ty + tz * tz)
-        if muon > 0.0 and vt > 0.0:
-            mu = friction_coefficient(vt, P[MUS], P[MUD], P[VS], P[VD])
-            s = mu * fn / vt
-            wrench[0] += s * tx
-            wrench[1] += s * ty
-            wrench[2] += s * tz
-            wrench[9] += s * tx
-            wrench[10] += s * ty
-            wrench[11] += s * tz
-            _cross_acc(xx, xy, xz, tx, ty, tz, wrench, 3, s)
+        vt = _apply_friction(wrench, xx, xy, xz, tx, ty, tz, fn, muon, P)
         srate[k] = rate
         son[k] = 1
         fax += fn
