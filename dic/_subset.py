@@ -357,7 +357,7 @@ class SubsetCorrelator:
                 self.params.half,
                 self.params.border,
             )
-            usable = np.isfinite(tex) & (tex > self.params.min_texture * self.image_std)
+            usable = np.isfinite(tex) & (tex > self._min_subset_std)
             self._texture = (np.nan_to_num(tex), usable)
         return self._texture
 
@@ -381,24 +381,36 @@ class SubsetCorrelator:
         r = self.ref
         return (r.image, r.gx, r.gy, r.coef, self._ref_invalid, dspl.coef, dinv, r.order)
 
+    @property
+    def _min_subset_std(self) -> float:
+        """Smallest subset intensity std that counts as texture [grey levels]."""
+        return self.params.min_texture * self.image_std
+
+    def _solver_options(self) -> tuple:
+        """IC-GN options in the kernels' order: half, quadratic, max_iter, tol, min_std,
+        max_shift, border, zncc_min."""
+        p = self.params
+        return (
+            p.half,
+            p.quadratic,
+            p.max_iterations,
+            p.tolerance,
+            self._min_subset_std,
+            float(max(p.half, 5)),
+            float(p.border),
+            p.zncc_min,
+        )
+
     def _run_many(self, dspl, dinv, P, active, st, serial=False):
         from jointwear.dic import _icgn
 
-        p = self.params
         kernel = _icgn.icgn_serial if serial else _icgn.icgn_many
         kernel(
             *self._kernel_args(dspl, dinv),
             self.centres,
             P,
             active,
-            p.half,
-            p.quadratic,
-            p.max_iterations,
-            p.tolerance,
-            p.min_texture * self.image_std,
-            float(max(p.half, 5)),
-            float(p.border),
-            p.zncc_min,
+            *self._solver_options(),
             st.zncc,
             st.iterations,
             st.flag,
@@ -408,7 +420,6 @@ class SubsetCorrelator:
     def _propagate(self, dspl, dinv, st, done, group, n_groups):
         from jointwear.dic import _icgn
 
-        p = self.params
         _icgn.rg_propagate(
             n_groups,
             group,
@@ -417,14 +428,7 @@ class SubsetCorrelator:
             self._nb_ptr,
             self._nb_idx,
             st.params,
-            p.half,
-            p.quadratic,
-            p.max_iterations,
-            p.tolerance,
-            p.min_texture * self.image_std,
-            float(max(p.half, 5)),
-            float(p.border),
-            p.zncc_min,
+            *self._solver_options(),
             st.zncc,
             st.iterations,
             st.flag,
