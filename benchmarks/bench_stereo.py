@@ -40,7 +40,7 @@ def make_footage(folder: Path, seconds: float = 10.0):
         frames = [rig.render(cam, t, frame_index=k) for k, t in enumerate(times)]
         path = folder / f"{cam}.avi"
         w = cv2.VideoWriter(
-            str(path), cv2.VideoWriter_fourcc(*"FFV1"), cfg.fps, (cfg.width, cfg.height), False
+            str(path), cv2.VideoWriter_fourcc(*CODEC), cfg.fps, (cfg.width, cfg.height), False
         )
         for k in range(n_total):
             w.write(frames[k % len(frames)])

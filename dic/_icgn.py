@@ -592,14 +592,8 @@ def _solve_affine(
     gy,
     w,
 ):
-    """Affine IC-GN for one subset, one sampling pass per iteration (see :func:`solve_point`).
-
-    Uses ``sum J (f - fm - fn/gn (g - gm)) = Jf - fn/gn (Jg - gm Js)`` with ``Jf``, ``Js``
-    fixed per subset, so each iteration samples the deformed subset once and accumulates.
-    """
-    Hd = def_coef.shape[0] - 2 * PAD
-    Wd = def_coef.shape[1] - 2 * PAD
-    n = (2 * half + 1) ** 2
+    """Affine IC-GN for one subset, one sampling pass per iteration (see :func:`solve_point`):
+    the reference subset and its Hessian, then :func:`_iterate_affine`."""
     flag0, fn = _load_reference(
         ref_img,
         ref_gx,
@@ -619,13 +613,39 @@ def _solve_affine(
     )
     if flag0 != FLAG_OK:
         return np.nan, 0, flag0
-    Hm = np.empty((6, 6))
+    Hinv = np.eye(6)
     jf = np.zeros(6)
     js = np.zeros(6)
-    _hessian_affine(f, gx, gy, half, Hm, jf, js)
-    Hinv = np.eye(6)
-    if not _solve_spd(Hm, Hinv, 6):
+    if not _affine_system(f, gx, gy, half, Hinv, jf, js):
         return np.nan, 0, FLAG_NO_TEXTURE
+    return _iterate_affine(
+        f, gx, gy, fn, Hinv, jf, js, def_coef, def_invalid, order, xc, yc, half, p, max_iter,
+        tol, max_shift, border, w,
+    )  # fmt: skip
+
+
+@njit(cache=True, nogil=True)
+def _affine_system(f, gx, gy, half, Hinv, jf, js):
+    """Inverse Gauss-Newton Hessian (into ``Hinv``, which must hold the identity), ``sum J f``
+    and ``sum J``; False when the Hessian is singular (no texture)."""
+    Hm = np.empty((6, 6))
+    _hessian_affine(f, gx, gy, half, Hm, jf, js)
+    return _solve_spd(Hm, Hinv, 6)
+
+
+@njit(cache=True, nogil=True)
+def _iterate_affine(
+    f, gx, gy, fn, Hinv, jf, js, def_coef, def_invalid, order, xc, yc, half, p, max_iter, tol,
+    max_shift, border, w,
+):  # fmt: skip
+    """Gauss-Newton iterations of the affine IC-GN from the loaded reference subset.
+
+    Uses ``sum J (f - fm - fn/gn (g - gm)) = Jf - fn/gn (Jg - gm Js)`` with ``Jf``, ``Js``
+    fixed per subset, so each iteration samples the deformed subset once and accumulates.
+    """
+    Hd = def_coef.shape[0] - 2 * PAD
+    Wd = def_coef.shape[1] - 2 * PAD
+    n = (2 * half + 1) ** 2
     acc = np.empty(9)
     e = np.empty(6)
     dp = np.zeros(12)
@@ -1235,6 +1255,70 @@ def icgn_serial(
             flags,
             sigma,
         )
+
+
+@njit(cache=True, nogil=True)
+def affine_references(
+    ref_img, ref_gx, ref_gy, ref_coef, ref_invalid, order, centres, half, min_std, border,
+    F, GX, GY, HINV, JF, JS, FN, FLAG0,
+):  # fmt: skip
+    """Load every reference subset once for :func:`icgn_affine_loaded`: zero-mean values
+    ``F`` (n, m), gradients ``GX``, ``GY``, norms ``FN``, inverse Hessians ``HINV`` (n, 6, 6),
+    ``JF``/``JS`` (n, 6) and the loading outcome ``FLAG0`` (n,)."""
+    w = np.empty((4, 6))
+    for i in range(centres.shape[0]):
+        fl, fn = _load_reference(
+            ref_img, ref_gx, ref_gy, ref_coef, ref_invalid, order, centres[i, 0], centres[i, 1],
+            half, min_std, border, F[i], GX[i], GY[i], w,
+        )  # fmt: skip
+        FN[i] = fn
+        for a in range(6):
+            for b in range(6):
+                HINV[i, a, b] = 1.0 if a == b else 0.0
+            JF[i, a] = 0.0
+            JS[i, a] = 0.0
+        if fl == FLAG_OK and not _affine_system(F[i], GX[i], GY[i], half, HINV[i], JF[i], JS[i]):
+            fl = FLAG_NO_TEXTURE
+        FLAG0[i] = fl
+
+
+@njit(cache=True, nogil=True)
+def icgn_affine_loaded(
+    F, GX, GY, HINV, JF, JS, FN, FLAG0, def_coef, def_invalid, order, centres, P, active,
+    half, max_iter, tol, max_shift, border, zncc_min, zncc, iters, flags, sigma,
+):  # fmt: skip
+    """As :func:`icgn_serial` (affine shape) with the reference subsets preloaded by
+    :func:`affine_references`: a tracker matching the same subsets in many frames skips the
+    per-frame loading and Hessian. Runs without the GIL (one thread per call)."""
+    w = np.empty((4, 6))
+    p = np.empty(12)
+    for i in range(centres.shape[0]):
+        if not active[i]:
+            continue
+        if FLAG0[i] != FLAG_OK:
+            zncc[i] = np.nan
+            iters[i] = 0
+            flags[i] = FLAG0[i]
+            sigma[i, 0] = np.nan
+            sigma[i, 1] = np.nan
+            continue
+        for q in range(12):
+            p[q] = P[i, q]
+        w[3, 4] = np.nan
+        w[3, 5] = np.nan
+        z, it, fl = _iterate_affine(
+            F[i], GX[i], GY[i], FN[i], HINV[i], JF[i], JS[i], def_coef, def_invalid, order,
+            centres[i, 0], centres[i, 1], half, p, max_iter, tol, max_shift, border, w,
+        )  # fmt: skip
+        if fl == FLAG_OK and not (z >= zncc_min):
+            fl = FLAG_LOW_CORRELATION
+        for q in range(12):
+            P[i, q] = p[q]
+        zncc[i] = z
+        iters[i] = it
+        flags[i] = fl
+        sigma[i, 0] = w[3, 4]
+        sigma[i, 1] = w[3, 5]
 
 
 @njit(cache=True)

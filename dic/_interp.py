@@ -18,7 +18,14 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-__all__ = ["SplineImage", "prefilter", "interp_value", "interp_value_grad", "PAD"]
+__all__ = [
+    "SplineImage",
+    "prefilter",
+    "prefilter_region",
+    "interp_value",
+    "interp_value_grad",
+    "PAD",
+]
 
 #: mirrored coefficients added on every side (quintic needs 3 beyond the last node)
 PAD = 4
@@ -83,6 +90,128 @@ def prefilter(
     return SplineImage(image=img, coef=coef, gx=gx, gy=gy, order=order, valid=valid)
 
 
+def prefilter_region(
+    image: np.ndarray,
+    interpolation: str,
+    centres: np.ndarray,
+    radius: float,
+    *,
+    workspace: dict | None = None,
+) -> SplineImage:
+    """B-spline coefficients of ``image`` computed only near some points (no node gradients).
+
+    Tracking a few hundred subsets in a large frame needs the spline only where the warped
+    subsets can reach. The recursive prefilter is run on the row and column spans that cover
+    the squares of half-width ``radius`` [pixel] around ``centres`` (N, 2) (x, y), widened by
+    the filter's decay length, so the coefficients inside the squares equal those of
+    :func:`prefilter` on the whole image to about 1e-7 of the intensity range; coefficients
+    elsewhere are NaN, so a subset that strays outside gives NaN (a failed match), never a
+    wrong value. The cost scales with the covered area instead of the image's.
+
+    ``radius`` must include the subset's warped half-width, the largest displacement the
+    solver may still add (``max_shift``) and the spline support (3 pixels).
+
+    ``workspace``: a dict kept by the caller between calls on same-sized images; the arrays
+    are then reused (the returned coefficients live in it until the next call).
+    """
+    order = _ORDERS[interpolation]
+    img = np.ascontiguousarray(image)
+    if img.dtype not in (np.float32, np.float64):
+        img = img.astype(np.float64)
+    valid = np.isfinite(img)
+    all_valid = bool(valid.all())
+    fill = 0.0 if all_valid else (float(np.nanmean(img)) if valid.any() else 0.0)
+    c = np.ascontiguousarray(centres, dtype=np.float64).reshape(-1, 2)
+    c = c[np.all(np.isfinite(c), axis=1)]
+    ws = {} if workspace is None else workspace
+    shape = (img.shape[0] + 2 * PAD, img.shape[1] + 2 * PAD)
+    if ws.get("coef") is None or ws["coef"].shape != shape:
+        ws["coef"] = np.empty(shape)
+        ws["tmp"] = np.empty(img.shape)
+    coef = ws["coef"]
+    coef.fill(np.nan)
+    # decay length of the slowest pole to 1e-7 (cubic 12, quintic 20 pixels)
+    z = abs(_Z3[0]) if order == 3 else abs(_Z5[0])
+    margin = int(math.ceil(math.log(1e-7) / math.log(z)))
+    _prefilter_spans(img, order, coef, ws["tmp"], c, int(math.ceil(radius)), margin, fill)
+    empty = np.empty((0, 0))
+    return SplineImage(image=img, coef=coef, gx=empty, gy=empty, order=order, valid=valid)
+
+
+@njit(cache=True, nogil=True)
+def _prefilter_spans(img, order, out, tmp, centres, r, m, fill):
+    """Prefilter over the spans covering squares of half-width r around centres (x, y).
+
+    Rows are filtered over every square grown by r + m around a centre, columns over the
+    columns within r of a centre and the rows within r + m of it: the row pass is then exact
+    (to the decay length m) wherever the column pass reads it, and the column pass wherever
+    the kernel reads the result.
+    """
+    h, w = img.shape
+    z1, z2, npoles = _poles(order)
+    row_lo = np.full(h, w, np.int64)
+    row_hi = np.full(h, -1, np.int64)
+    col_lo = np.full(w, h, np.int64)
+    col_hi = np.full(w, -1, np.int64)
+    for k in range(centres.shape[0]):
+        cx = int(round(centres[k, 0]))
+        cy = int(round(centres[k, 1]))
+        rm = r + m
+        for y in range(max(cy - rm, 0), min(cy + rm, h - 1) + 1):
+            row_lo[y] = min(row_lo[y], max(cx - rm, 0))
+            row_hi[y] = max(row_hi[y], min(cx + rm, w - 1))
+        for x in range(max(cx - r, 0), min(cx + r, w - 1) + 1):
+            col_lo[x] = min(col_lo[x], max(cy - rm, 0))
+            col_hi[x] = max(col_hi[x], min(cy + rm, h - 1))
+    line = np.empty(max(h, w))
+    for y in range(h):
+        a = row_lo[y]
+        b = row_hi[y] + 1
+        if b <= a:
+            continue
+        for x in range(a, b):
+            v = img[y, x]
+            line[x - a] = v if math.isfinite(v) else fill
+        seg = line[: b - a]
+        _filter_line(seg, z1, z2, npoles)
+        for x in range(a, b):
+            tmp[y, x] = seg[x - a]
+    for x in range(w):
+        a = col_lo[x]
+        b = col_hi[x] + 1
+        if b <= a:
+            continue
+        for y in range(a, b):
+            line[y - a] = tmp[y, x]
+        seg = line[: b - a]
+        _filter_line(seg, z1, z2, npoles)
+        for y in range(a, b):
+            out[y + PAD, x + PAD] = seg[y - a]
+    # mirrored padding (reflect without repeating the edge sample), as in _prefilter_2d
+    for k in range(1, PAD + 1):
+        for x in range(w + 2 * PAD):
+            out[PAD - k, x] = out[PAD + k, x]
+            out[PAD + h - 1 + k, x] = out[PAD + h - 1 - k, x]
+    for y in range(h + 2 * PAD):
+        for k in range(1, PAD + 1):
+            out[y, PAD - k] = out[y, PAD + k]
+            out[y, PAD + w - 1 + k] = out[y, PAD + w - 1 - k]
+
+
+@njit(cache=True, inline="always")
+def _poles(order):
+    """Poles of the cubic (one) or quintic (two) B-spline prefilter, and their count."""
+    if order == 3:
+        return math.sqrt(3.0) - 2.0, 0.0, 1
+    a = math.sqrt(17745.0 / 4.0)
+    b = math.sqrt(105.0 / 4.0)
+    return (
+        math.sqrt(135.0 / 2.0 - a) + b - 13.0 / 2.0,
+        math.sqrt(135.0 / 2.0 + a) - b - 13.0 / 2.0,
+        2,
+    )
+
+
 # poles of the cubic and quintic B-spline prefilters (Unser 1999; Thevenaz et al. 2000)
 _Z3 = (np.sqrt(3.0) - 2.0,)
 _Z5 = (
@@ -91,7 +220,7 @@ _Z5 = (
 )
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _filter_line(c, z1, z2, npoles):
     """In-place recursive B-spline prefilter of one line, mirror boundary (s[-k] = s[k])."""
     n = c.shape[0]
@@ -181,20 +310,11 @@ def _filter_columns(c, j0, j1, z1, z2, npoles):
                 c[k, j] = z * (c[k + 1, j] - c[k, j])
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _prefilter_2d(img, order, out):
     """B-spline coefficients of ``img`` written into ``out`` with a mirrored border of PAD."""
     h, w = img.shape
-    if order == 3:
-        z1 = math.sqrt(3.0) - 2.0
-        z2 = 0.0
-        npoles = 1
-    else:
-        a = math.sqrt(17745.0 / 4.0)
-        b = math.sqrt(105.0 / 4.0)
-        z1 = math.sqrt(135.0 / 2.0 - a) + b - 13.0 / 2.0
-        z2 = math.sqrt(135.0 / 2.0 + a) - b - 13.0 / 2.0
-        npoles = 2
+    z1, z2, npoles = _poles(order)
     tmp = np.empty((h, w))
     for i in range(h):
         line = img[i].copy()

@@ -257,6 +257,7 @@ class SubsetCorrelator:
             raise BadInputError("reference image: every pixel is NaN")
         self.image_std = float(np.std(valid_vals))
         self.grid: tuple[np.ndarray, np.ndarray] | None = None
+        self._loaded: tuple | None = None  # reference subsets kept by preload_references()
         if points is not None:
             pts = np.asarray(points, dtype=np.float64)
             if pts.ndim == 1 and pts.size == 2:
@@ -401,9 +402,43 @@ class SubsetCorrelator:
             p.zncc_min,
         )
 
+    def preload_references(self) -> None:
+        """Keep every reference subset, its gradients and Gauss-Newton matrix in memory.
+
+        For matching the same points in many images (tracking): each later :meth:`match`
+        then skips loading them (the IC-GN's per-point set-up, as costly as one or two
+        iterations, and far more for points off the pixel grid, whose reference values are
+        interpolated). Memory: 3 x 8 bytes x subset_size^2 per point, so meant for hundreds or
+        thousands of points, not for dense fields. Affine shape only; the kernel then runs on
+        one thread without holding the GIL, so several correlators can work in threads.
+        """
+        from jointwear.dic import _icgn
+
+        if self.params.quadratic:
+            raise ParameterError("preload_references: only the affine shape function")
+        n, m = self.n_points, self.params.subset_size**2
+        F, GX, GY = np.empty((n, m)), np.empty((n, m)), np.empty((n, m))
+        HINV, JF, JS = np.empty((n, 6, 6)), np.empty((n, 6)), np.empty((n, 6))
+        FN, FLAG0 = np.empty(n), np.empty(n, dtype=np.int8)
+        r = self.ref
+        _icgn.affine_references(
+            r.image, r.gx, r.gy, r.coef, self._ref_invalid, r.order, self.centres,
+            self.params.half, self._min_subset_std, float(self.params.border),
+            F, GX, GY, HINV, JF, JS, FN, FLAG0,
+        )  # fmt: skip
+        self._loaded = (F, GX, GY, HINV, JF, JS, FN, FLAG0)
+
     def _run_many(self, dspl, dinv, P, active, st, serial=False):
         from jointwear.dic import _icgn
 
+        if self._loaded is not None:
+            opts = self._solver_options()
+            _icgn.icgn_affine_loaded(
+                *self._loaded, dspl.coef, dinv, self.ref.order, self.centres, P, active,
+                opts[0], opts[2], opts[3], opts[5], opts[6], opts[7],
+                st.zncc, st.iterations, st.flag, st.sigma,
+            )  # fmt: skip
+            return
         kernel = _icgn.icgn_serial if serial else _icgn.icgn_many
         kernel(
             *self._kernel_args(dspl, dinv),

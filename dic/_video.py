@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+import queue
 import re
-from collections.abc import Iterator
+import threading
+from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -11,7 +13,17 @@ import numpy as np
 
 from jointwear.errors import BadInputError
 
-__all__ = ["FrameSource", "open_frames", "check_stereo_pair", "IMAGE_SUFFIXES", "VIDEO_SUFFIXES"]
+__all__ = [
+    "FrameSource",
+    "open_frames",
+    "check_stereo_pair",
+    "prefetch",
+    "IMAGE_SUFFIXES",
+    "VIDEO_SUFFIXES",
+]
+
+#: codec pixel formats that are already grey (decoded without a colour conversion)
+_GREY_PIXEL_FORMATS = ("Y800", "GREY", "Y8  ")
 
 IMAGE_SUFFIXES = (".png", ".tif", ".tiff", ".bmp", ".jpg", ".jpeg", ".pgm")
 VIDEO_SUFFIXES = (".avi", ".mp4", ".mkv", ".mov", ".m4v", ".mpg", ".mpeg", ".wmv", ".webm")
@@ -64,10 +76,12 @@ class FrameSource:
         return np.arange(self.n_frames) / self.fps
 
     def frames(
-        self, start: int = 0, stop: int | None = None
+        self, start: int = 0, stop: int | None = None, *, native: bool = False
     ) -> Iterator[tuple[int, float, np.ndarray]]:
         """Yield ``(index, time [s], grey float32 image)`` for frames ``start <= index < stop``.
 
+        ``native=True`` yields the grey frames in their stored type (uint8, uint16, ...)
+        instead of float32: a caller that crops regions first saves converting whole frames.
         Video times come from the container's presentation timestamps when available.
         Unreadable frames raise :class:`~jointwear.errors.BadInputError` naming the frame.
         """
@@ -83,10 +97,14 @@ class FrameSource:
                         f"image '{self.files[i]}' (frame {i}) could not be read; replace or "
                         "remove the file"
                     )
-                yield i, float(times[i]), _to_gray(img)
+                yield i, float(times[i]), _to_gray(img, native)
             return
         cap = cv2.VideoCapture(str(self.path))
         try:
+            pix = _fourcc_name(cap.get(cv2.CAP_PROP_CODEC_PIXEL_FORMAT))
+            if pix in _GREY_PIXEL_FORMATS:
+                # a grey stream: take the decoded plane as is (no grey -> BGR -> grey)
+                cap.set(cv2.CAP_PROP_CONVERT_RGB, 0)
             if start:
                 cap.set(cv2.CAP_PROP_POS_FRAMES, start)
             i = start
@@ -103,20 +121,79 @@ class FrameSource:
                     return
                 pts = cap.get(cv2.CAP_PROP_POS_MSEC) / 1000.0
                 t = pts if pts > 0 or i == 0 else i / self.fps
-                yield i, float(t), _to_gray(img)
+                yield i, float(t), _to_gray(img, native)
                 i += 1
         finally:
             cap.release()
 
 
-def _to_gray(img: np.ndarray) -> np.ndarray:
+def _to_gray(img: np.ndarray, native: bool = False) -> np.ndarray:
     import cv2
 
     if img.ndim == 3:
-        if img.shape[2] == 4:
-            img = img[:, :, :3]
-        img = cv2.cvtColor(img, cv2.COLOR_BGR2GRAY)
-    return img.astype(np.float32)
+        if img.shape[2] == 1:
+            img = img[:, :, 0]
+        else:
+            if img.shape[2] == 4:
+                img = img[:, :, :3]
+            img = cv2.cvtColor(np.ascontiguousarray(img), cv2.COLOR_BGR2GRAY)
+    return img if native else img.astype(np.float32)
+
+
+class _Failure:
+    def __init__(self, exc: BaseException) -> None:
+        self.exc = exc
+
+
+_DONE = object()
+
+
+def prefetch(items: Iterable, depth: int = 3) -> Iterator:
+    """Iterate ``items`` (e.g. decoded frames) in a background thread, ``depth`` ahead.
+
+    Decoding then overlaps the caller's work (OpenCV releases the GIL while it decodes). An
+    exception raised while producing an item is raised here, at that item; closing this
+    iterator early stops the thread.
+    """
+    q: queue.Queue = queue.Queue(maxsize=max(int(depth), 1))
+    stop = threading.Event()
+
+    def put(item) -> bool:
+        while not stop.is_set():
+            try:
+                q.put(item, timeout=0.1)
+                return True
+            except queue.Full:
+                continue
+        return False
+
+    def work() -> None:
+        it = iter(items)
+        try:
+            for item in it:
+                if not put(item):
+                    break
+        except BaseException as exc:  # handed to the consumer
+            put(_Failure(exc))
+        finally:
+            close = getattr(it, "close", None)
+            if close is not None:
+                close()
+            put(_DONE)
+
+    thread = threading.Thread(target=work, name="jointwear-prefetch", daemon=True)
+    thread.start()
+    try:
+        while True:
+            item = q.get()
+            if item is _DONE:
+                return
+            if isinstance(item, _Failure):
+                raise item.exc
+            yield item
+    finally:
+        stop.set()
+        thread.join(timeout=5.0)
 
 
 def _natural_key(p: Path):
