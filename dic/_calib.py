@@ -145,8 +145,8 @@ class Camera:
     def pixels_to_normalized(self, uv: np.ndarray, *, iterations: int = 8) -> np.ndarray:
         """Undistort pixel coordinates (N, 2) to normalised coordinates (inverse of the model).
 
-        Fixed-point iteration followed by Newton steps; accurate to ~1e-12 for the distortion
-        of measurement lenses.
+        Fixed-point iteration followed by Newton steps with the model's exact Jacobian;
+        accurate to ~1e-12 for the distortion of measurement lenses. NaN rows stay NaN.
         """
         uv = np.asarray(uv, dtype=float)
         K = self.matrix
@@ -155,28 +155,10 @@ class Camera:
         target = np.stack([xd, yd], axis=-1)
         if not np.any(self.distortion):
             return target
-        k1, k2, p1, p2, k3, k4, k5, k6 = self.distortion
-        xy = target.copy()
-        for _ in range(iterations):
-            x, y = xy[..., 0], xy[..., 1]
-            r2 = x * x + y * y
-            radial = (1 + r2 * (k1 + r2 * (k2 + r2 * k3))) / (1 + r2 * (k4 + r2 * (k5 + r2 * k6)))
-            dx = 2 * p1 * x * y + p2 * (r2 + 2 * x * x)
-            dy = p1 * (r2 + 2 * y * y) + 2 * p2 * x * y
-            xy = np.stack([(target[..., 0] - dx) / radial, (target[..., 1] - dy) / radial], -1)
-        eps = 1e-7
-        for _ in range(3):  # Newton polish with a finite-difference Jacobian
-            f0 = self.distort_normalized(xy) - target
-            fx = (self.distort_normalized(xy + [eps, 0.0]) - target - f0) / eps
-            fy = (self.distort_normalized(xy + [0.0, eps]) - target - f0) / eps
-            a, c = fx[..., 0], fx[..., 1]
-            b, d = fy[..., 0], fy[..., 1]
-            det = a * d - b * c
-            det = np.where(np.abs(det) < 1e-12, 1e-12, det)
-            step_x = (d * f0[..., 0] - b * f0[..., 1]) / det
-            step_y = (-c * f0[..., 0] + a * f0[..., 1]) / det
-            xy = xy - np.stack([step_x, step_y], -1)
-        return xy
+        flat = np.ascontiguousarray(target.reshape(-1, 2))
+        out = np.empty_like(flat)
+        _undistort(flat, np.asarray(self.distortion, dtype=float), int(iterations), out)
+        return out.reshape(target.shape)
 
     # ---- projection -------------------------------------------------------------------------
     def world_to_camera(self, X: np.ndarray) -> np.ndarray:
@@ -653,3 +635,67 @@ def _check_enough_views(n_ok: int, n_total: int, minimum: int, reasons: list[str
             f"needed ({detail}); record more views with the whole board visible to both "
             "cameras, tilted by 20-45 degrees in different directions and filling the field of view"
         )
+
+
+def _undistort_impl(target, dist, iterations, out):
+    """Invert the distortion model for each row of ``target`` (distorted normalised x, y)."""
+    k1, k2, p1, p2, k3, k4, k5, k6 = (
+        dist[0],
+        dist[1],
+        dist[2],
+        dist[3],
+        dist[4],
+        dist[5],
+        dist[6],
+        dist[7],
+    )
+    for i in range(target.shape[0]):
+        tx = target[i, 0]
+        ty = target[i, 1]
+        if not (np.isfinite(tx) and np.isfinite(ty)):
+            out[i, 0] = np.nan
+            out[i, 1] = np.nan
+            continue
+        x = tx
+        y = ty
+        for _ in range(iterations):  # fixed point: x = (target - tangential) / radial
+            r2 = x * x + y * y
+            radial = (1 + r2 * (k1 + r2 * (k2 + r2 * k3))) / (1 + r2 * (k4 + r2 * (k5 + r2 * k6)))
+            dx = 2 * p1 * x * y + p2 * (r2 + 2 * x * x)
+            dy = p1 * (r2 + 2 * y * y) + 2 * p2 * x * y
+            x = (tx - dx) / radial
+            y = (ty - dy) / radial
+        for _ in range(6):  # Newton polish with the exact Jacobian
+            r2 = x * x + y * y
+            num = 1 + r2 * (k1 + r2 * (k2 + r2 * k3))
+            den = 1 + r2 * (k4 + r2 * (k5 + r2 * k6))
+            radial = num / den
+            dnum = k1 + r2 * (2 * k2 + 3 * k3 * r2)
+            dden = k4 + r2 * (2 * k5 + 3 * k6 * r2)
+            drad = (dnum * den - num * dden) / (den * den)  # d radial / d r2
+            fx = x * radial + 2 * p1 * x * y + p2 * (r2 + 2 * x * x) - tx
+            fy = y * radial + p1 * (r2 + 2 * y * y) + 2 * p2 * x * y - ty
+            a = radial + 2 * x * x * drad + 2 * p1 * y + 6 * p2 * x
+            b = 2 * x * y * drad + 2 * p1 * x + 2 * p2 * y
+            c = b
+            d = radial + 2 * y * y * drad + 6 * p1 * y + 2 * p2 * x
+            det = a * d - b * c
+            if abs(det) < 1e-12:
+                break
+            sx = (d * fx - b * fy) / det
+            sy = (-c * fx + a * fy) / det
+            x -= sx
+            y -= sy
+            if abs(sx) + abs(sy) < 1e-16:
+                break
+        out[i, 0] = x
+        out[i, 1] = y
+
+
+def _undistort(target, dist, iterations, out):
+    """Compiled on first use (numba), so importing the calibration module stays light."""
+    global _undistort
+    from numba import njit
+
+    _undistort = njit(cache=True, nogil=True)(_undistort_impl)
+    _undistort(target, dist, iterations, out)

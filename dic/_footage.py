@@ -234,12 +234,21 @@ def _sift_features(img: np.ndarray, poly: np.ndarray | None = None, margin: int 
     """SIFT keypoints and descriptors of ``img`` (inside ``poly`` grown by ``margin`` px)."""
     import cv2
 
-    mask = None
-    if poly is not None:
-        mask = np.zeros(img.shape, np.uint8)
-        cv2.fillPoly(mask, [np.rint(poly).astype(np.int32)], 255)
-        mask = cv2.dilate(mask, np.ones((2 * margin + 1,) * 2, np.uint8))
-    return cv2.SIFT_create().detectAndCompute(_as_uint8(img), mask)
+    if poly is None:
+        return cv2.SIFT_create().detectAndCompute(_as_uint8(img), None)
+    # the region's bounding box only (a mask alone still builds the whole image's pyramid)
+    h, w = img.shape
+    pad = margin + 16
+    x0, y0 = np.clip(np.floor(poly.min(0)).astype(int) - pad, 0, None)
+    x1, y1 = np.ceil(poly.max(0)).astype(int) + pad + 1
+    x1, y1 = min(x1, w), min(y1, h)
+    mask = np.zeros((y1 - y0, x1 - x0), np.uint8)
+    cv2.fillPoly(mask, [np.rint(poly - [x0, y0]).astype(np.int32)], 255)
+    mask = cv2.dilate(mask, np.ones((2 * margin + 1,) * 2, np.uint8))
+    kps, desc = cv2.SIFT_create().detectAndCompute(_as_uint8(img[y0:y1, x0:x1]), mask)
+    for kp in kps:
+        kp.pt = (kp.pt[0] + x0, kp.pt[1] + y0)
+    return kps, desc
 
 
 def _as_uint8(img: np.ndarray) -> np.ndarray:
@@ -325,6 +334,7 @@ class _CameraBodyTracker:
             interpolation=cfg.interpolation,
         )
         self._workspace: dict = {}  # reused prefilter buffers
+        self._probes = _spread_points(self.ref_pts, 12)  # correct predictions (see track)
         self.corr = SubsetCorrelator(crop, points=self.ref_pts - self.origin, params=params)
         self.corr.preload_references()  # the same subsets are matched in every frame
         self._max_shift = float(self.corr._solver_options()[5])
@@ -437,10 +447,12 @@ class _CameraBodyTracker:
         gx_row = np.abs(1.0 + guess[:, 1]) + np.abs(guess[:, 2])
         gy_row = np.abs(guess[:, 4]) + np.abs(1.0 + guess[:, 5])
         reach = self.corr.params.half * float(np.nanmax(np.maximum(gx_row, gy_row), initial=1.0))
-        radius = reach + self._max_shift + 4.0
+        radius = reach + self._max_shift + _PROBE_ALLOWANCE + 4.0
         spl = prefilter_region(
             cur, self.corr.params.interpolation, centres, radius, workspace=self._workspace
         )
+        if point_guess is None:
+            guess = self._probe_correction(spl, guess)
         res = self.corr.match(spl, initial_guess=guess)
         pos = np.column_stack(
             [P[:, 0] + res.params[:, 0] + off[0], P[:, 1] + res.params[:, 6] + off[1]]
@@ -448,6 +460,52 @@ class _CameraBodyTracker:
         good = res.ok & (res.zncc >= self.corr.params.zncc_min)
         pos[~good] = np.nan
         return pos, res.zncc, good
+
+    def _probe_correction(self, spl, guess: np.ndarray) -> np.ndarray:
+        """Correct the predicted guesses by the affine map that takes a few well-spread probe
+        subsets from their guesses to their matches.
+
+        The prediction (extrapolation plus a phase-correlation shift) is typically a few pixels
+        off, mostly as a small rotation that a translation cannot fix; corrected, the other
+        subsets start within a fraction of a pixel and converge in two or three iterations
+        instead of five or six. Corrections larger than the prefiltered margin are refused.
+        """
+        import cv2
+
+        idx = self._probes
+        if len(idx) < 4:
+            return guess
+        sub = self.corr._match_some(spl, guess, idx)
+        ok = sub.ok & (sub.zncc >= self.corr.params.zncc_min)
+        if ok.sum() < 4:
+            return guess
+        C = self.corr.centres
+        g_pos = C[idx] + guess[idx][:, [0, 3]]
+        r_pos = C[idx] + sub.params[:, [0, 6]]
+        M, _ = cv2.estimateAffine2D(g_pos[ok], r_pos[ok], method=cv2.LMEDS)
+        if M is None:
+            return guess
+        pos = C + guess[:, [0, 3]]
+        new_pos = pos @ M[:, :2].T + M[:, 2]
+        if not np.nanmax(np.abs(new_pos - pos), initial=0.0) <= _PROBE_ALLOWANCE:
+            return guess
+        # compose the deformation gradients: (I + grad_new) = M (I + grad_guess)
+        J = np.empty((len(guess), 2, 2))
+        J[:, 0, 0], J[:, 0, 1] = 1.0 + guess[:, 1], guess[:, 2]
+        J[:, 1, 0], J[:, 1, 1] = guess[:, 4], 1.0 + guess[:, 5]
+        Jn = M[:, :2] @ J
+        out = np.column_stack(
+            [
+                new_pos[:, 0] - C[:, 0],
+                Jn[:, 0, 0] - 1.0,
+                Jn[:, 0, 1],
+                new_pos[:, 1] - C[:, 1],
+                Jn[:, 1, 0],
+                Jn[:, 1, 1] - 1.0,
+            ]
+        )
+        out[idx[ok]] = sub.params[ok][:, [0, 1, 2, 6, 7, 8]]  # probes start from their match
+        return out
 
     def commit(self, pos: np.ndarray, t: float) -> None:
         """Remember the positions found at time ``t`` [s] for the next prediction."""
@@ -459,8 +517,39 @@ class _CameraBodyTracker:
             A, _ = cv2.estimateAffine2D(self.ref_pts[ok], pos[ok], method=cv2.LMEDS)
             if A is not None:
                 filled[~ok] = self.ref_pts[~ok] @ A[:, :2].T + A[:, 2]
-            self.history.append((t, filled))
-            self.history = self.history[-3:]
+            # kept in time order; a frame tracked again (re-initialised) replaces its entry
+            hist = [h for h in self.history if h[0] != t] + [(t, filled)]
+            self.history = sorted(hist, key=lambda h: h[0])[-3:]
+
+    def forget_after(self, t: float) -> None:
+        """Drop what was committed for frames later than ``t`` [s] (a speculative frame
+        tracked before an earlier one had to be re-initialised)."""
+        self.history = [h for h in self.history if h[0] <= t]
+
+    def track_and_commit(self, img: np.ndarray, t: float, point_guess=None):
+        """:meth:`track`, then remember the matched positions for the next prediction."""
+        pos, zncc, good = self.track(img, point_guess=point_guess, t=t)
+        self.commit(pos, t)
+        return pos, zncc, good
+
+
+#: largest correction of a prediction by the probe subsets [pixel] (prefiltered margin)
+_PROBE_ALLOWANCE = 6.0
+
+
+def _spread_points(pts: np.ndarray, k: int) -> np.ndarray:
+    """Indices of ``k`` well-spread points (farthest-point sampling from the centroid's
+    nearest); none when there are fewer than ``3 k`` points (the probes would not pay)."""
+    n = len(pts)
+    if n < 3 * k:
+        return np.zeros(0, dtype=np.int64)
+    chosen = [int(np.argmin(np.hypot(*(pts - pts.mean(0)).T)))]
+    d = np.hypot(*(pts - pts[chosen[0]]).T)
+    for _ in range(k - 1):
+        j = int(np.argmax(d))
+        chosen.append(j)
+        d = np.minimum(d, np.hypot(*(pts - pts[j]).T))
+    return np.asarray(chosen, dtype=np.int64)
 
 
 def _hull(pts: np.ndarray) -> np.ndarray:
@@ -591,18 +680,13 @@ def track_footage(
             task = bar.tasks[0].id
             if cfg.workers <= 1:
                 frames = prefetch(_paired_frames(L, R, 0, n_total))  # decoding overlaps
-                prev = None
-                for k, (i, t, img_l, img_r) in enumerate(frames):
-                    dup = prev is not None and _is_duplicate(img_l, prev, cfg)
-                    prev = img_l
-                    flags.append(
-                        _process_frame(states, t, img_l, img_r, dup, cfg, calibration, False, pool)
-                    )
+                for i, t, flag, dup in _run_frames(states, frames, cfg, calibration, pool):
+                    flags.append(flag)
                     times.append(t)
                     if dup:
                         duplicates.append(i)
                     bar.update(task, advance=1)
-                    if (k + 1) % cfg.chunk_size == 0:
+                    if len(times) % cfg.chunk_size == 0:
                         save("partial")
             else:
                 import multiprocessing
@@ -683,16 +767,13 @@ def _run_chunk(L, R, bodies, calibration, cfg, start: int, stop: int) -> dict:
     states = _setup_states(L, R, bodies, calibration, cfg, ref_l, ref_r)
     times, flags, duplicates = [], [], []
     error = ""
-    prev = None
     try:
-        for i, t, img_l, img_r in _paired_frames(L, R, max(start - 1, 0), stop):
-            if i < start:  # the frame before the chunk: only for the duplicate check
-                prev = img_l
-                continue
-            dup = prev is not None and _is_duplicate(img_l, prev, cfg)
-            prev = img_l
-            reinit = i == start and start > 0
-            flags.append(_process_frame(states, t, img_l, img_r, dup, cfg, calibration, reinit))
+        frames = _paired_frames(L, R, max(start - 1, 0), stop)
+        # the frame before the chunk serves only the duplicate check
+        for i, t, flag, dup in _run_frames(
+            states, frames, cfg, calibration, None, first=start, reinit_first=start > 0
+        ):
+            flags.append(flag)
             times.append(t)
             if dup:
                 duplicates.append(i)
@@ -770,24 +851,78 @@ def _setup_states(L, R, bodies, calibration, cfg, ref_l, ref_r) -> list[_BodySta
     return states
 
 
-def _process_frame(states, t, img_l, img_r, dup, cfg, calibration, reinit, pool=None) -> int:
-    """Track every body in one frame (appending to each state's rows); the frame's flag.
+def _run_frames(states, frames, cfg, calibration, pool, *, first=0, reinit_first=False):
+    """Track every body through ``frames`` (index, time, left, right); yields ``(index,
+    time, flag, duplicate)`` per frame, the rows appended to each state.
 
-    With a thread ``pool`` the bodies' left and right trackers run concurrently.
+    Pipelined: while the main thread triangulates and fits the poses of frame k, the pool
+    already tracks frame k + 1 (each tracker predicts from the positions it matched itself).
+    If frame k needs a re-initialisation (tracking lost), frame k + 1's speculative results
+    are discarded and it is tracked again from the repaired history.
     """
+    pending = None
+    prev_img = None
+    it = iter(frames)
+    while True:
+        try:
+            i, t, img_l, img_r = next(it)
+        except StopIteration:
+            break
+        except BaseException:
+            # an unreadable frame: the frame tracked before it is still finished and kept
+            if pending is not None:
+                pending["results"] = _wait(pending["jobs"])
+                flag, _ = _finish_frame(states, pending, cfg, calibration, None)
+                yield pending["i"], pending["t"], flag, pending["dup"]
+            raise
+        if i < first:
+            prev_img = img_l
+            continue
+        dup = prev_img is not None and _is_duplicate(img_l, prev_img, cfg)
+        prev_img = img_l
+        reinit = reinit_first and i == first
+        if pending is not None:
+            pending["results"] = _wait(pending["jobs"])
+        cur = {"i": i, "t": t, "img_l": img_l, "img_r": img_r, "dup": dup, "reinit": reinit}
+        cur["jobs"] = None if dup or reinit else _start_tracks(states, t, img_l, img_r, pool)
+        if pending is not None:
+            flag, rolled_back = _finish_frame(states, pending, cfg, calibration, cur)
+            if rolled_back and cur["jobs"] is not None:
+                cur["jobs"] = _start_tracks(states, t, img_l, img_r, pool)
+            yield pending["i"], pending["t"], flag, pending["dup"]
+        pending = cur
+    if pending is not None:
+        pending["results"] = _wait(pending["jobs"])
+        flag, _ = _finish_frame(states, pending, cfg, calibration, None)
+        yield pending["i"], pending["t"], flag, pending["dup"]
+
+
+def _start_tracks(states, t, img_l, img_r, pool):
+    """Submit every body's left and right tracking (with commit) of one frame."""
+    run = pool.submit if pool is not None else _Immediate
+    return [
+        (
+            run(st.left.track_and_commit, img_l, t),
+            run(st.right.track_and_commit, img_r, t) if st.right is not None else None,
+        )
+        for st in states
+    ]
+
+
+def _wait(jobs):
+    if jobs is None:
+        return None
+    return [(jl.result(), jr.result() if jr is not None else None) for jl, jr in jobs]
+
+
+def _finish_frame(states, fr, cfg, calibration, speculative) -> tuple[int, bool]:
+    """Poses of one tracked frame (appending to each state's rows); the frame's flag and
+    whether the ``speculative`` next frame's tracking had to be discarded."""
+    t, img_l, img_r = fr["t"], fr["img_l"], fr["img_r"]
+    dup, reinit, tracked = fr["dup"], fr["reinit"], fr["results"]
     flag = FRAME_FLAGS["duplicated"] if dup else 0
     features: dict[str, Any] = {}
-    tracked: list = [None] * len(states)
-    if not dup and not reinit:
-        run = pool.submit if pool is not None else _Immediate
-        jobs = [
-            (
-                run(st.left.track, img_l, None, t),
-                run(st.right.track, img_r, None, t) if st.right is not None else None,
-            )
-            for st in states
-        ]
-        tracked = [(jl.result(), jr.result() if jr is not None else None) for jl, jr in jobs]
+    rolled_back = False
 
     def feats(name: str, img: np.ndarray):
         if name not in features:
@@ -817,6 +952,13 @@ def _process_frame(states, t, img_l, img_r, dup, cfg, calibration, reinit, pool=
             res = _body_pose(st, *tracked[k], cfg, calibration)
         if res is None or not res[0]:
             # chunk start or lost: initialise from SIFT features of the reference images
+            if speculative is not None and speculative["jobs"] is not None and not rolled_back:
+                _wait(speculative["jobs"])  # the next frame was tracked from this one
+                for other in states:
+                    for tr in (other.left, other.right):
+                        if tr is not None:
+                            tr.forget_after(t)
+                rolled_back = True
             gl_guess = st.left.reinit_guess(img_l, feats("left", img_l))
             gr_guess = (
                 st.right.reinit_guess(img_r, feats("right", img_r))
@@ -825,13 +967,18 @@ def _process_frame(states, t, img_l, img_r, dup, cfg, calibration, reinit, pool=
             )
             if gl_guess is not None and (st.right is None or gr_guess is not None):
                 res = _track_body(st, img_l, img_r, t, cfg, calibration, gl_guess, gr_guess)
+                if res[0]:
+                    st.left.commit(np.where(res[3][:, None], res[7], np.nan), t)
+                    if st.right is not None:
+                        st.right.commit(np.where(res[3][:, None], res[8], np.nan), t)
+        if res is None:  # lost, and no SIFT guess either
+            res = _failed_pose(d, n)
         ok_pose, Rm, tv, inl, rms, cur, cov, pl, pr, zn = res
-        if ok_pose:
-            st.left.commit(np.where(inl[:, None], pl, np.nan), t)
-            if st.right is not None:
-                st.right.commit(np.where(inl[:, None], pr, np.nan), t)
-        else:
+        if not ok_pose:
             flag |= FRAME_FLAGS["tracking_failed"]
+            for tr in (st.left, st.right):  # predict the next frame from the last good ones
+                if tr is not None:
+                    tr.history = [h for h in tr.history if h[0] != t]
         poi = Rm @ st.point_of_interest + tv
         n_in = int(np.sum(inl))
         if cov is not None:
@@ -856,7 +1003,14 @@ def _process_frame(states, t, img_l, img_r, dup, cfg, calibration, reinit, pool=
             pu.astype(np.float32),
             zn.astype(np.float32),
         )
-    return flag
+    return flag, rolled_back
+
+
+def _failed_pose(d: int, n: int) -> tuple:
+    """What :func:`_body_pose` gives for a body that could not be tracked."""
+    nan = np.full(d, np.nan)
+    return (False, np.full((d, d), np.nan), nan, np.zeros(n, bool), np.nan,
+            np.full((n, d), np.nan), None, None, None, np.full(n, np.nan))  # fmt: skip
 
 
 def _append_row(st, Rm, tv, poi, u, n_in, rms, cur, cur_u, zncc) -> None:

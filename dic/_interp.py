@@ -126,20 +126,48 @@ def prefilter_region(
     ws = {} if workspace is None else workspace
     shape = (img.shape[0] + 2 * PAD, img.shape[1] + 2 * PAD)
     if ws.get("coef") is None or ws["coef"].shape != shape:
-        ws["coef"] = np.empty(shape)
+        ws["coef"] = np.full(shape, np.nan)
         ws["tmp"] = np.empty(img.shape)
+        ws["row_lo"] = np.full(img.shape[0], img.shape[1], np.int64)
+        ws["row_hi"] = np.full(img.shape[0], -1, np.int64)
+    else:  # back to NaN where the previous call wrote (cheaper than refilling everything)
+        _reset_spans(ws["coef"], ws["row_lo"], ws["row_hi"])
     coef = ws["coef"]
-    coef.fill(np.nan)
     # decay length of the slowest pole to 1e-7 (cubic 12, quintic 20 pixels)
     z = abs(_Z3[0]) if order == 3 else abs(_Z5[0])
     margin = int(math.ceil(math.log(1e-7) / math.log(z)))
-    _prefilter_spans(img, order, coef, ws["tmp"], c, int(math.ceil(radius)), margin, fill)
+    _prefilter_spans(
+        img,
+        order,
+        coef,
+        ws["tmp"],
+        c,
+        int(math.ceil(radius)),
+        margin,
+        fill,
+        ws["row_lo"],
+        ws["row_hi"],
+    )
     empty = np.empty((0, 0))
     return SplineImage(image=img, coef=coef, gx=empty, gy=empty, order=order, valid=valid)
 
 
 @njit(cache=True, nogil=True)
-def _prefilter_spans(img, order, out, tmp, centres, r, m, fill):
+def _reset_spans(out, row_lo, row_hi):
+    """NaN where :func:`_prefilter_spans` wrote with these row spans (and the padding)."""
+    h = row_lo.shape[0]
+    for y in range(h):
+        for x in range(row_lo[y], row_hi[y] + 1):
+            out[y + PAD, x + PAD] = np.nan
+    for k in range(PAD):
+        out[k, :] = np.nan
+        out[h + PAD + k, :] = np.nan
+        out[:, k] = np.nan
+        out[:, out.shape[1] - 1 - k] = np.nan
+
+
+@njit(cache=True, nogil=True)
+def _prefilter_spans(img, order, out, tmp, centres, r, m, fill, row_lo, row_hi):
     """Prefilter over the spans covering squares of half-width r around centres (x, y).
 
     Rows are filtered over every square grown by r + m around a centre, columns over the
@@ -149,8 +177,8 @@ def _prefilter_spans(img, order, out, tmp, centres, r, m, fill):
     """
     h, w = img.shape
     z1, z2, npoles = _poles(order)
-    row_lo = np.full(h, w, np.int64)
-    row_hi = np.full(h, -1, np.int64)
+    row_lo[:] = w  # the row spans are returned (the next call resets them)
+    row_hi[:] = -1
     col_lo = np.full(w, h, np.int64)
     col_hi = np.full(w, -1, np.int64)
     for k in range(centres.shape[0]):

@@ -89,24 +89,17 @@ def triangulate(
     ul = _undistorted_pixels(L, uvl[ok])
     ur = _undistorted_pixels(R, uvr[ok])
     H = cv2.triangulatePoints(L.projection_matrix, R.projection_matrix, ul.T, ur.T)
-    Xk = (H[:3] / H[3]).T
-    for _ in range(iterations):
-        pl, Jl = _project_undistorted(L, Xk)
-        pr, Jr = _project_undistorted(R, Xk)
-        r = np.concatenate([ul - pl, ur - pr], axis=1)  # (m, 4)
-        J = np.concatenate([Jl, Jr], axis=1)  # (m, 4, 3)
-        JtJ = np.einsum("nij,nik->njk", J, J)
-        Jtr = np.einsum("nij,ni->nj", J, r)
-        Xk = Xk + np.linalg.solve(JtJ, Jtr[..., None])[..., 0]
-    pl, Jl = _project_undistorted(L, Xk)
-    pr, Jr = _project_undistorted(R, Xk)
-    r = np.concatenate([ul - pl, ur - pr], axis=1)
-    J = np.concatenate([Jl, Jr], axis=1)
-    JtJ = np.einsum("nij,nik->njk", J, J)
-    sig = np.broadcast_to(np.asarray(sigma_px, dtype=float), (n,))[ok]
-    X[ok] = Xk
-    cov[ok] = np.linalg.inv(JtJ) * (sig**2)[:, None, None]
-    rep[ok] = np.sqrt(np.mean(r**2, axis=1))
+    Xk = np.ascontiguousarray((H[:3] / H[3]).T)
+    sig = np.ascontiguousarray(np.broadcast_to(np.asarray(sigma_px, dtype=float), (n,))[ok])
+    m = len(Xk)
+    Xo, covo, repo = np.empty((m, 3)), np.empty((m, 3, 3)), np.empty(m)
+    _refine_points(
+        ul, ur, L.matrix, L.rotation, L.translation, R.matrix, R.rotation, R.translation,
+        Xk, int(iterations), sig, Xo, covo, repo,
+    )  # fmt: skip
+    X[ok] = Xo
+    cov[ok] = covo
+    rep[ok] = repo
     return X, cov, rep
 
 
@@ -133,3 +126,65 @@ def stereo_noise_floor(calibration: StereoCalibration, point: np.ndarray, sigma_
     Z = float(calibration.left.world_to_camera(np.asarray(point, dtype=float).reshape(1, 3))[0, 2])
     f = float(np.mean(calibration.left.focal))
     return Z**2 / (f * calibration.baseline) * np.sqrt(2.0) * sigma_px
+
+
+def _project_jacobian(K, Rw, t, X, J, k0):
+    """Undistorted pixel projection of X (3,) into a camera; its Jacobian into rows k0, k0+1
+    of J (4, 3). Returns (u, v)."""
+    xc = Rw[0, 0] * X[0] + Rw[0, 1] * X[1] + Rw[0, 2] * X[2] + t[0]
+    yc = Rw[1, 0] * X[0] + Rw[1, 1] * X[1] + Rw[1, 2] * X[2] + t[1]
+    zc = Rw[2, 0] * X[0] + Rw[2, 1] * X[1] + Rw[2, 2] * X[2] + t[2]
+    fx, s, cx, fy, cy = K[0, 0], K[0, 1], K[0, 2], K[1, 1], K[1, 2]
+    u = (fx * xc + s * yc) / zc + cx
+    v = fy * yc / zc + cy
+    # d(u, v)/d(xc, yc, zc), then times the rotation (d Xc / d X = R)
+    a0, a1, a2 = fx / zc, s / zc, -(fx * xc + s * yc) / (zc * zc)
+    b1, b2 = fy / zc, -fy * yc / (zc * zc)
+    for j in range(3):
+        J[k0, j] = a0 * Rw[0, j] + a1 * Rw[1, j] + a2 * Rw[2, j]
+        J[k0 + 1, j] = b1 * Rw[1, j] + b2 * Rw[2, j]
+    return u, v
+
+
+def _refine_points_impl(ul, ur, KL, RL, tL, KR, RR, tR, X0, iterations, sig, X, cov, rep):
+    """Gauss-Newton refinement of each point's reprojection error in both undistorted
+    images, then its covariance ``sigma^2 (J^T J)^-1`` and RMS residual."""
+    J = np.empty((4, 3))
+    r = np.empty(4)
+    A = np.empty((3, 3))
+    b = np.empty(3)
+    for i in range(X0.shape[0]):
+        x = X0[i].copy()
+        for it in range(iterations + 1):
+            u0, v0 = _project_jacobian(KL, RL, tL, x, J, 0)
+            u1, v1 = _project_jacobian(KR, RR, tR, x, J, 2)
+            r[0], r[1] = ul[i, 0] - u0, ul[i, 1] - v0
+            r[2], r[3] = ur[i, 0] - u1, ur[i, 1] - v1
+            for p in range(3):
+                b[p] = 0.0
+                for q in range(3):
+                    A[p, q] = 0.0
+                for k in range(4):
+                    b[p] += J[k, p] * r[k]
+                    for q in range(3):
+                        A[p, q] += J[k, p] * J[k, q]
+            if it == iterations:
+                break
+            x += np.linalg.solve(A, b)
+        X[i] = x
+        Ai = np.linalg.inv(A)
+        s2 = sig[i] * sig[i]
+        for p in range(3):
+            for q in range(3):
+                cov[i, p, q] = Ai[p, q] * s2
+        rep[i] = np.sqrt((r[0] ** 2 + r[1] ** 2 + r[2] ** 2 + r[3] ** 2) / 4.0)
+
+
+def _refine_points(*args):
+    """Compiled on first use (numba), so importing this module stays light."""
+    global _refine_points, _project_jacobian
+    from numba import njit
+
+    _project_jacobian = njit(cache=True, inline="always")(_project_jacobian)
+    _refine_points = njit(cache=True, nogil=True)(_refine_points_impl)
+    _refine_points(*args)

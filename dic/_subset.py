@@ -614,6 +614,27 @@ class SubsetCorrelator:
         self._fill_unreached(dspl, dinv, st, done)
         return st
 
+    def _match_some(self, deformed, guess: np.ndarray, idx: np.ndarray) -> MatchResult:
+        """Refine only the points ``idx`` from ``guess`` (N, 6) affine guesses; no retries.
+
+        Returns their results (len(idx) rows). Used by trackers to correct a prediction from
+        a few probe points before matching all of them.
+        """
+        dspl, dinv, _ = self._prepare_deformed(deformed)
+        n = self.n_points
+        st = MatchResult(
+            params=self._guess_array(guess),
+            zncc=np.full(n, np.nan),
+            iterations=np.zeros(n, dtype=np.int32),
+            flag=np.full(n, _flags.FLAG_NOT_REACHED, dtype=np.int8),
+        )
+        active = np.zeros(n, dtype=np.bool_)
+        active[idx] = True
+        active &= np.isfinite(st.params).all(axis=1)
+        st.params[~active] = 0.0
+        self._run_many(dspl, dinv, st.params, active, st)
+        return MatchResult(st.params[idx], st.zncc[idx], st.iterations[idx], st.flag[idx])
+
     def _fill_unreached(self, dspl, dinv, st, done) -> None:
         """Points never reached: one attempt from the nearest good point's extrapolated
         parameters (or zero), so that each gets a real outcome and flag."""

@@ -113,6 +113,15 @@ def test_undistortion_inverts_distortion():
     xy = rng.uniform(-0.3, 0.3, (500, 2))
     uv = cam.normalized_to_pixels(xy)
     assert np.max(np.abs(cam.pixels_to_normalized(uv) - xy)) < 1e-10
+    # the rational model (k4..k6) too, and NaN rows stay NaN without disturbing the others
+    rational = Camera(
+        cam.matrix, [0.3, -0.1, 5e-4, 1e-3, 0.02, 0.2, -0.05, 0.01], image_size=(1280, 1024)
+    )
+    uv = rational.normalized_to_pixels(xy)
+    uv[7] = np.nan
+    back = rational.pixels_to_normalized(uv)
+    assert np.isnan(back[7]).all()
+    assert np.max(np.abs(np.delete(back, 7, 0) - np.delete(xy, 7, 0))) < 1e-10
 
 
 def test_cardan_round_trip():
