@@ -379,31 +379,44 @@ class _CameraBodyTracker:
         H = _sift_homography(self._ref_features, features or _sift_features(img))
         return None if H is None else _homography_guess(H, self.ref_pts)
 
-    def track(self, img: np.ndarray, point_guess: np.ndarray | None = None, t: float = 0.0):
+    def track(
+        self,
+        img: np.ndarray,
+        point_guess: np.ndarray | None = None,
+        t: float = 0.0,
+        predicted: np.ndarray | None = None,
+    ):
         """Correlate the subsets in ``img`` (time ``t`` [s]); ``point_guess`` (N, 6) affine
-        guesses (reference image coordinates) replace the prediction. Returns positions (N, 2),
-        ZNCC and the ok mask."""
+        guesses (reference image coordinates) replace the prediction; ``predicted`` (N, 2)
+        positions [pixel] known to a fraction of a pixel (the right camera's, from the left
+        camera's matches; NaN where unknown) replace the extrapolation and its corrections.
+        Returns positions (N, 2), ZNCC and the ok mask."""
         import cv2
 
         P = self.ref_pts
         identity = np.hstack([np.eye(2), np.zeros((2, 1))])
+        known = None
         if point_guess is not None:
             q0 = P + point_guess[:, [0, 3]]
             A, _ = cv2.estimateAffine2D(P, q0, method=cv2.LMEDS)
             A = identity if A is None else A
         else:
-            pred = self._predict(t)
+            if predicted is not None:
+                known = np.all(np.isfinite(predicted), axis=1)
+                if known.sum() < max(3, len(P) // 2):
+                    known = None  # too few: the tracker's own prediction instead
+            pred = predicted if known is not None else self._predict(t)
             ok = np.all(np.isfinite(pred), axis=1)
             A = None
             if ok.sum() >= 3:
-                A, _ = cv2.estimateAffine2D(P[ok], pred[ok], method=cv2.LMEDS)
+                A = _affine_fit(P[ok], pred[ok])
             A = identity if A is None else A
         # where the reference crop's centre goes, and the current crop
         c_new = A[:, :2] @ self.centre + A[:, 2]
         origin = np.floor(c_new - self.side / 2).astype(int)
         cur = _crop(img, origin, self.side)
         shift = np.zeros(2)
-        if point_guess is None and self.history:
+        if point_guess is None and known is None and self.history:
             # correct the translation by phase correlation of the warped reference crop
             # (reduced: a correction to a pixel or two is all the IC-GN needs)
             sc = self._pc_scale
@@ -427,6 +440,8 @@ class _CameraBodyTracker:
             guess = point_guess.astype(float).copy()
         else:
             q = P @ A[:, :2].T + A[:, 2] + shift
+            if known is not None:
+                q[known] = predicted[known]
             guess = np.column_stack(
                 [
                     q[:, 0] - P[:, 0],
@@ -451,8 +466,13 @@ class _CameraBodyTracker:
         spl = prefilter_region(
             cur, self.corr.params.interpolation, centres, radius, workspace=self._workspace
         )
-        if point_guess is None:
-            guess = self._probe_correction(spl, guess)
+        if point_guess is None and known is None:
+            guess, moved = self._probe_correction(spl, guess)
+            if moved > _PROBE_ALLOWANCE:  # beyond the prefiltered margin: prefilter again
+                centres = self.corr.centres + guess[:, [0, 3]]
+                spl = prefilter_region(
+                    cur, self.corr.params.interpolation, centres, radius, workspace=self._workspace
+                )
         res = self.corr.match(spl, initial_guess=guess)
         pos = np.column_stack(
             [P[:, 0] + res.params[:, 0] + off[0], P[:, 1] + res.params[:, 6] + off[1]]
@@ -468,27 +488,27 @@ class _CameraBodyTracker:
         The prediction (extrapolation plus a phase-correlation shift) is typically a few pixels
         off, mostly as a small rotation that a translation cannot fix; corrected, the other
         subsets start within a fraction of a pixel and converge in two or three iterations
-        instead of five or six. Corrections larger than the prefiltered margin are refused.
+        instead of five or six. Returns the guesses and the largest correction [pixel].
         """
-        import cv2
 
         idx = self._probes
         if len(idx) < 4:
-            return guess
+            return guess, 0.0
         sub = self.corr._match_some(spl, guess, idx)
         ok = sub.ok & (sub.zncc >= self.corr.params.zncc_min)
         if ok.sum() < 4:
-            return guess
+            return guess, 0.0
         C = self.corr.centres
         g_pos = C[idx] + guess[idx][:, [0, 3]]
         r_pos = C[idx] + sub.params[:, [0, 6]]
-        M, _ = cv2.estimateAffine2D(g_pos[ok], r_pos[ok], method=cv2.LMEDS)
+        M = _affine_fit(g_pos[ok], r_pos[ok])
         if M is None:
-            return guess
+            return guess, 0.0
         pos = C + guess[:, [0, 3]]
         new_pos = pos @ M[:, :2].T + M[:, 2]
-        if not np.nanmax(np.abs(new_pos - pos), initial=0.0) <= _PROBE_ALLOWANCE:
-            return guess
+        moved = float(np.nanmax(np.abs(new_pos - pos), initial=0.0))
+        if not moved <= 4.0 * self._max_shift:  # not a correction: a failed fit
+            return guess, 0.0
         # compose the deformation gradients: (I + grad_new) = M (I + grad_guess)
         J = np.empty((len(guess), 2, 2))
         J[:, 0, 0], J[:, 0, 1] = 1.0 + guess[:, 1], guess[:, 2]
@@ -505,16 +525,15 @@ class _CameraBodyTracker:
             ]
         )
         out[idx[ok]] = sub.params[ok][:, [0, 1, 2, 6, 7, 8]]  # probes start from their match
-        return out
+        return out, moved
 
     def commit(self, pos: np.ndarray, t: float) -> None:
         """Remember the positions found at time ``t`` [s] for the next prediction."""
-        import cv2
 
         ok = np.all(np.isfinite(pos), axis=1)
         if ok.sum() >= 3:
             filled = pos.copy()
-            A, _ = cv2.estimateAffine2D(self.ref_pts[ok], pos[ok], method=cv2.LMEDS)
+            A = _affine_fit(self.ref_pts[ok], pos[ok])
             if A is not None:
                 filled[~ok] = self.ref_pts[~ok] @ A[:, :2].T + A[:, 2]
             # kept in time order; a frame tracked again (re-initialised) replaces its entry
@@ -526,11 +545,31 @@ class _CameraBodyTracker:
         tracked before an earlier one had to be re-initialised)."""
         self.history = [h for h in self.history if h[0] <= t]
 
-    def track_and_commit(self, img: np.ndarray, t: float, point_guess=None):
+    def track_and_commit(self, img: np.ndarray, t: float, predicted=None):
         """:meth:`track`, then remember the matched positions for the next prediction."""
-        pos, zncc, good = self.track(img, point_guess=point_guess, t=t)
+        pos, zncc, good = self.track(img, t=t, predicted=predicted)
         self.commit(pos, t)
         return pos, zncc, good
+
+
+def _affine_fit(P: np.ndarray, Q: np.ndarray) -> np.ndarray | None:
+    """Affine map (2, 3) with ``Q ~ A [P; 1]``: least squares, then again without the points
+    whose residual exceeds 3 times the median (and 0.5 pixel) - the rare wrong match - which
+    is all these well-matched point sets need (a fraction of LMedS's cost). None when the
+    points do not determine a map."""
+    X = np.column_stack([P, np.ones(len(P))])
+    keep = np.ones(len(P), dtype=bool)
+    A = None
+    for _ in range(2):
+        if keep.sum() < 3:
+            return A
+        sol, _, rank, _ = np.linalg.lstsq(X[keep], Q[keep], rcond=None)
+        if rank < 3:
+            return A
+        A = sol.T
+        res = np.hypot(*(X @ sol - Q).T)
+        keep = res <= max(3.0 * float(np.median(res[keep])), 0.5)
+    return A
 
 
 #: largest correction of a prediction by the probe subsets [pixel] (prefiltered margin)
@@ -855,10 +894,13 @@ def _run_frames(states, frames, cfg, calibration, pool, *, first=0, reinit_first
     """Track every body through ``frames`` (index, time, left, right); yields ``(index,
     time, flag, duplicate)`` per frame, the rows appended to each state.
 
-    Pipelined: while the main thread triangulates and fits the poses of frame k, the pool
-    already tracks frame k + 1 (each tracker predicts from the positions it matched itself).
-    If frame k needs a re-initialisation (tracking lost), frame k + 1's speculative results
-    are discarded and it is tracked again from the repaired history.
+    Pipelined over two frames: the left trackers of frame k + 1 run while the right trackers
+    of frame k and the main thread's poses of frame k do. Each left tracker predicts from its
+    own matches (extrapolation, phase correlation, probe subsets); each right tracker starts
+    from the left matches of the same frame carried to the right image at the depths of the
+    previous frame's triangulated points, a fraction of a pixel off. If frame k needs a
+    re-initialisation (tracking lost), frame k + 1's left tracking, already started, is
+    discarded and done again from the repaired history.
     """
     pending = None
     prev_img = None
@@ -871,7 +913,7 @@ def _run_frames(states, frames, cfg, calibration, pool, *, first=0, reinit_first
         except BaseException:
             # an unreadable frame: the frame tracked before it is still finished and kept
             if pending is not None:
-                pending["results"] = _wait(pending["jobs"])
+                pending["results"] = _wait(pending)
                 flag, _ = _finish_frame(states, pending, cfg, calibration, None)
                 yield pending["i"], pending["t"], flag, pending["dup"]
             raise
@@ -881,38 +923,89 @@ def _run_frames(states, frames, cfg, calibration, pool, *, first=0, reinit_first
         dup = prev_img is not None and _is_duplicate(img_l, prev_img, cfg)
         prev_img = img_l
         reinit = reinit_first and i == first
-        if pending is not None:
-            pending["results"] = _wait(pending["jobs"])
         cur = {"i": i, "t": t, "img_l": img_l, "img_r": img_r, "dup": dup, "reinit": reinit}
-        cur["jobs"] = None if dup or reinit else _start_tracks(states, t, img_l, img_r, pool)
+        track = not dup and not reinit
+        cur["left"] = _start_left(states, cur, pool, pending) if track else None
+        cur["right"] = None
         if pending is not None:
+            pending["results"] = _wait(pending)
             flag, rolled_back = _finish_frame(states, pending, cfg, calibration, cur)
-            if rolled_back and cur["jobs"] is not None:
-                cur["jobs"] = _start_tracks(states, t, img_l, img_r, pool)
+            if rolled_back and track:
+                cur["left"] = _start_left(states, cur, pool, None)
             yield pending["i"], pending["t"], flag, pending["dup"]
+        if track:
+            cur["right"] = _start_right(states, cur, pool, calibration)
         pending = cur
     if pending is not None:
-        pending["results"] = _wait(pending["jobs"])
+        pending["results"] = _wait(pending)
         flag, _ = _finish_frame(states, pending, cfg, calibration, None)
         yield pending["i"], pending["t"], flag, pending["dup"]
 
 
-def _start_tracks(states, t, img_l, img_r, pool):
-    """Submit every body's left and right tracking (with commit) of one frame."""
+def _start_left(states, fr, pool, prev):
+    """Submit every body's left tracking (with commit) of one frame, each after the same
+    tracker's job for the previous frame ``prev`` (still running perhaps: it predicts from
+    it)."""
     run = pool.submit if pool is not None else _Immediate
+    before = prev["left"] if prev is not None and prev["left"] is not None else [None] * len(states)
     return [
-        (
-            run(st.left.track_and_commit, img_l, t),
-            run(st.right.track_and_commit, img_r, t) if st.right is not None else None,
-        )
-        for st in states
+        run(_after, dep, st.left.track_and_commit, fr["img_l"], fr["t"])
+        for st, dep in zip(states, before, strict=True)
     ]
 
 
-def _wait(jobs):
-    if jobs is None:
+def _after(dep, fn, *args):
+    """``fn(*args)`` once the future ``dep`` (an earlier job, or None) is done."""
+    if dep is not None:
+        dep.result()
+    return fn(*args)
+
+
+def _start_right(states, fr, pool, calibration):
+    """Submit every body's right tracking of one frame, each after its left tracking."""
+    run = pool.submit if pool is not None else _Immediate
+    jobs = []
+    for st, left in zip(states, fr["left"], strict=True):
+        if st.right is None:
+            jobs.append(None)
+            continue
+        last = st.rows.get("points") or []
+        X_prev = last[-2:] if len(last) >= 2 else None
+        jobs.append(run(_track_right, st, fr["img_r"], fr["t"], left, X_prev, calibration))
+    return jobs
+
+
+def _track_right(st, img_r, t, left, X_prev, calibration):
+    """The right camera's tracking, started from the left matches of the same frame."""
+    pred = None
+    if X_prev is not None and calibration is not None:
+        pred = _stereo_prediction(calibration, left.result()[0], X_prev)
+    return st.right.track_and_commit(img_r, t, predicted=pred)
+
+
+def _stereo_prediction(calibration, uv_left: np.ndarray, X_prev: np.ndarray) -> np.ndarray:
+    """Right-image positions (N, 2) of left-image matches ``uv_left`` (N, 2) assumed at the
+    depths (left camera) of the previous frame's points ``X_prev`` (N, 3) [m]; NaN where
+    either is unknown. A body moving Δz between frames shifts the prediction along the
+    epipolar line by f B Δz / Z² (a fraction of a pixel at tens of frames per second)."""
+    L, R = calibration.left, calibration.right
+    X2, X1 = (np.asarray(X, dtype=float) for X in X_prev)
+    z1 = X1 @ L.rotation[2] + L.translation[2]
+    z = 2.0 * z1 - (X2 @ L.rotation[2] + L.translation[2])  # linear in time
+    xn = L.pixels_to_normalized(np.asarray(uv_left, dtype=float))
+    Xc = np.column_stack([xn * z[:, None], z])
+    return R.project((Xc - L.translation) @ L.rotation)
+
+
+def _wait(fr):
+    """The (left, right) tracking results of a frame (None when it was not tracked)."""
+    if fr["left"] is None:
         return None
-    return [(jl.result(), jr.result() if jr is not None else None) for jl, jr in jobs]
+    rights = fr["right"] or [None] * len(fr["left"])
+    return [
+        (jl.result(), jr.result() if jr is not None else None)
+        for jl, jr in zip(fr["left"], rights, strict=True)
+    ]
 
 
 def _finish_frame(states, fr, cfg, calibration, speculative) -> tuple[int, bool]:
@@ -952,8 +1045,8 @@ def _finish_frame(states, fr, cfg, calibration, speculative) -> tuple[int, bool]
             res = _body_pose(st, *tracked[k], cfg, calibration)
         if res is None or not res[0]:
             # chunk start or lost: initialise from SIFT features of the reference images
-            if speculative is not None and speculative["jobs"] is not None and not rolled_back:
-                _wait(speculative["jobs"])  # the next frame was tracked from this one
+            if speculative is not None and speculative["left"] is not None and not rolled_back:
+                _wait(speculative)  # the next frame's left tracking started from this one
                 for other in states:
                     for tr in (other.left, other.right):
                         if tr is not None:

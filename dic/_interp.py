@@ -127,7 +127,7 @@ def prefilter_region(
     shape = (img.shape[0] + 2 * PAD, img.shape[1] + 2 * PAD)
     if ws.get("coef") is None or ws["coef"].shape != shape:
         ws["coef"] = np.full(shape, np.nan)
-        ws["tmp"] = np.empty(img.shape)
+        ws["tmp"] = np.zeros(img.shape)  # finite scratch (see _prefilter_spans)
         ws["row_lo"] = np.full(img.shape[0], img.shape[1], np.int64)
         ws["row_hi"] = np.full(img.shape[0], -1, np.int64)
     else:  # back to NaN where the previous call wrote (cheaper than refilling everything)
@@ -204,17 +204,25 @@ def _prefilter_spans(img, order, out, tmp, centres, r, m, fill, row_lo, row_hi):
         _filter_line(seg, z1, z2, npoles)
         for x in range(a, b):
             tmp[y, x] = seg[x - a]
-    for x in range(w):
-        a = col_lo[x]
-        b = col_hi[x] + 1
-        if b <= a:
+    # columns in blocks of 16 over the union of their spans (row-major, cache friendly); the
+    # rows a column does not need hold finite scratch values (``tmp`` starts as zeros) whose
+    # influence has decayed (length m) where the column's own span begins
+    blk = 16
+    for x0 in range(0, w, blk):
+        x1 = min(x0 + blk, w)
+        a = h
+        b = -1
+        for x in range(x0, x1):
+            if col_hi[x] >= col_lo[x]:
+                a = min(a, col_lo[x])
+                b = max(b, col_hi[x])
+        if b < a:
             continue
-        for y in range(a, b):
-            line[y - a] = tmp[y, x]
-        seg = line[: b - a]
-        _filter_line(seg, z1, z2, npoles)
-        for y in range(a, b):
-            out[y + PAD, x + PAD] = seg[y - a]
+        _filter_columns(tmp[a : b + 1], x0, x1, z1, z2, npoles)
+        for y in range(a, b + 1):
+            for x in range(x0, x1):
+                if col_lo[x] <= y <= col_hi[x]:
+                    out[y + PAD, x + PAD] = tmp[y, x]
     # mirrored padding (reflect without repeating the edge sample), as in _prefilter_2d
     for k in range(1, PAD + 1):
         for x in range(w + 2 * PAD):
@@ -288,7 +296,7 @@ def _filter_line(c, z1, z2, npoles):
             c[k] = z * (c[k + 1] - c[k])
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _filter_columns(c, j0, j1, z1, z2, npoles):
     """In-place prefilter along axis 0 of columns j0..j1-1, row by row (cache friendly)."""
     n = c.shape[0]
