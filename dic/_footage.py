@@ -344,8 +344,8 @@ class _CameraBodyTracker:
         self._fill = float(np.nanmedian(crop))
         filled = np.where(np.isnan(crop), self._fill, crop).astype(np.float32)
         # phase correlation (translation correction of the prediction) on a reduced crop of
-        # at most ~160 pixels: the IC-GN needs the start within a few pixels, no better
-        self._pc_scale = max(2, int(np.ceil(side / 160)))
+        # at most _PC_MAX pixels: the probes and IC-GN need the start within a few pixels
+        self._pc_scale = max(2, int(np.ceil(side / _PC_MAX)))
         n_pc = side // self._pc_scale
         self._pc_size = (n_pc, n_pc)
         self._ref_small = cv2.resize(filled, self._pc_size, interpolation=cv2.INTER_AREA)
@@ -572,6 +572,9 @@ def _affine_fit(P: np.ndarray, Q: np.ndarray) -> np.ndarray | None:
     return A
 
 
+#: side of the reduced crops of the phase correlation [pixel]
+_PC_MAX = 160
+
 #: largest correction of a prediction by the probe subsets [pixel] (prefiltered margin)
 _PROBE_ALLOWANCE = 6.0
 
@@ -795,9 +798,10 @@ def _paired_frames(L: FrameSource, R: FrameSource | None, start: int, stop: int)
 
 
 def _is_duplicate(img: np.ndarray, prev: np.ndarray, cfg: TrackConfig) -> bool:
-    """Mean absolute difference on every 4th pixel of every 4th row below the threshold."""
-    a = img[::4, ::4].astype(np.float32)
-    return float(np.mean(np.abs(a - prev[::4, ::4]))) < cfg.duplicate_threshold
+    """Mean absolute difference on every 8th pixel of every 8th row (20 000 samples in a
+    megapixel frame) below the threshold."""
+    a = img[::8, ::8].astype(np.float32)
+    return float(np.mean(np.abs(a - prev[::8, ::8]))) < cfg.duplicate_threshold
 
 
 def _run_chunk(L, R, bodies, calibration, cfg, start: int, stop: int) -> dict:
@@ -829,10 +833,20 @@ def _run_chunk(L, R, bodies, calibration, cfg, start: int, stop: int) -> dict:
 
 def _setup_states(L, R, bodies, calibration, cfg, ref_l, ref_r) -> list[_BodyState]:
     """Subsets of every body, stereo correspondence and reference 3D points."""
+    # the right image's features are computed in a thread beside the left work
+    pool = ThreadPoolExecutor(max_workers=1) if R is not None else None
+    try:
+        return _setup_bodies(L, R, bodies, calibration, cfg, ref_l, ref_r, pool)
+    finally:
+        if pool is not None:
+            pool.shutdown(cancel_futures=True)
+
+
+def _setup_bodies(L, R, bodies, calibration, cfg, ref_l, ref_r, pool) -> list[_BodyState]:
     half = cfg.subset_size // 2
     w, h = L.size
+    right_features = pool.submit(_sift_features, ref_r) if pool is not None else None
     noise = _noise_sigma(ref_l)
-    right_features = _sift_features(ref_r) if R is not None else None
     states: list[_BodyState] = []
     for spec in bodies:
         poly = np.asarray(spec.polygon, dtype=float)
@@ -858,7 +872,7 @@ def _setup_states(L, R, bodies, calibration, cfg, ref_l, ref_r) -> list[_BodySta
         )
         if R is not None:
             H = _sift_homography(
-                _sift_features(ref_l, poly), right_features, calibration=calibration
+                _sift_features(ref_l, poly), right_features.result(), calibration=calibration
             )
             if H is None:
                 raise BadInputError(
