@@ -139,3 +139,22 @@ def test_features_of_deep_images_are_scaled_not_clipped():
     assert np.corrcoef(u8.ravel(), img16.ravel())[0, 1] > 0.99  # clipping would flatten it
     grey = np.arange(256, dtype=np.uint8).reshape(16, 16)
     assert _as_uint8(grey) is grey
+
+
+def test_stereo_prediction_is_exact_for_points_moving_linearly_in_depth():
+    # the right camera's start: left matches carried to the right image at depths
+    # extrapolated from the two previous frames; exact when the depth changes linearly
+    from jointwear.datasets.rig import RigConfig, VirtualRig
+    from jointwear.dic._footage import _stereo_prediction
+
+    cal = VirtualRig(RigConfig(width=640, height=512)).calibration
+    rng = np.random.default_rng(4)
+    X0 = np.column_stack([rng.uniform(0.1, 0.3, 30), rng.uniform(0.15, 0.3, 30), np.zeros(30)])
+    v = np.array([2e-3, -1e-3, 1.5e-3])  # m per frame, with an out-of-plane part
+    frames = [X0 + k * v for k in range(3)]
+    uv_left = cal.left.project(frames[2])
+    pred = _stereo_prediction(cal, uv_left, frames[:2])
+    np.testing.assert_allclose(pred, cal.right.project(frames[2]), atol=1e-6)
+    # unknown points stay unknown
+    uv_left[3] = np.nan
+    assert np.isnan(_stereo_prediction(cal, uv_left, frames[:2])[3]).all()
