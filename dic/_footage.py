@@ -462,11 +462,12 @@ class _CameraBodyTracker:
         gx_row = np.abs(1.0 + guess[:, 1]) + np.abs(guess[:, 2])
         gy_row = np.abs(guess[:, 4]) + np.abs(1.0 + guess[:, 5])
         reach = self.corr.params.half * float(np.nanmax(np.maximum(gx_row, gy_row), initial=1.0))
-        radius = reach + self._max_shift + _PROBE_ALLOWANCE + 4.0
+        probes = point_guess is None and known is None
+        radius = reach + self._max_shift + 4.0 + (_PROBE_ALLOWANCE if probes else 0.0)
         spl = prefilter_region(
             cur, self.corr.params.interpolation, centres, radius, workspace=self._workspace
         )
-        if point_guess is None and known is None:
+        if probes:
             guess, moved = self._probe_correction(spl, guess)
             if moved > _PROBE_ALLOWANCE:  # beyond the prefiltered margin: prefilter again
                 centres = self.corr.centres + guess[:, [0, 3]]
@@ -557,16 +558,22 @@ def _affine_fit(P: np.ndarray, Q: np.ndarray) -> np.ndarray | None:
     whose residual exceeds 3 times the median (and 0.5 pixel) - the rare wrong match - which
     is all these well-matched point sets need (a fraction of LMedS's cost). None when the
     points do not determine a map."""
-    X = np.column_stack([P, np.ones(len(P))])
+    # normal equations on coordinates centred on P's mean (well conditioned, and a 3 x 3
+    # solve is far cheaper than lstsq's SVD for these few-hundred-point sets)
+    c = P.mean(axis=0)
+    X = np.column_stack([P - c, np.ones(len(P))])
     keep = np.ones(len(P), dtype=bool)
     A = None
     for _ in range(2):
         if keep.sum() < 3:
             return A
-        sol, _, rank, _ = np.linalg.lstsq(X[keep], Q[keep], rcond=None)
-        if rank < 3:
+        Xk = X[keep]
+        N = Xk.T @ Xk
+        if not abs(np.linalg.det(N)) > 1e-12 * np.trace(N) ** 3:  # collinear points
             return A
-        A = sol.T
+        sol = np.linalg.solve(N, Xk.T @ Q[keep])  # (3, 2)
+        A = sol.T.copy()
+        A[:, 2] -= A[:, :2] @ c  # back to uncentred coordinates
         res = np.hypot(*(X @ sol - Q).T)
         keep = res <= max(3.0 * float(np.median(res[keep])), 0.5)
     return A
