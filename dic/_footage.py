@@ -414,7 +414,13 @@ class _CameraBodyTracker:
         # where the reference crop's centre goes, and the current crop
         c_new = A[:, :2] @ self.centre + A[:, 2]
         origin = np.floor(c_new - self.side / 2).astype(int)
-        cur = _crop(img, origin, self.side)
+        h, w = img.shape
+        x0, y0 = int(origin[0]), int(origin[1])
+        inside = x0 >= 0 and y0 >= 0 and x0 + self.side <= w and y0 + self.side <= h
+        # a crop inside the frame is used in place (no copy); otherwise NaN-padded
+        cur = img[y0 : y0 + self.side, x0 : x0 + self.side] if inside else None
+        if cur is None:
+            cur = _crop(img, origin, self.side)
         shift = np.zeros(2)
         if point_guess is None and known is None and self.history:
             # correct the translation by phase correlation of the warped reference crop
@@ -431,8 +437,12 @@ class _CameraBodyTracker:
                 borderMode=cv2.BORDER_CONSTANT,
                 borderValue=fill,
             )
-            b = cur if not np.isnan(cur).any() else np.where(np.isnan(cur), fill, cur)
-            b = cv2.resize(b, self._pc_size, interpolation=cv2.INTER_AREA)
+            if inside:
+                b = cv2.resize(cur, self._pc_size, interpolation=cv2.INTER_AREA)
+                b = b.astype(np.float32)
+            else:
+                b = np.where(np.isnan(cur), fill, cur)
+                b = cv2.resize(b, self._pc_size, interpolation=cv2.INTER_AREA)
             (dx, dy), resp = cv2.phaseCorrelate(warped, b, self._window)
             if resp > 0.05 and sc * np.hypot(dx, dy) < self.side / 3:
                 shift = sc * np.array([dx, dy])
@@ -464,15 +474,27 @@ class _CameraBodyTracker:
         reach = self.corr.params.half * float(np.nanmax(np.maximum(gx_row, gy_row), initial=1.0))
         probes = point_guess is None and known is None
         radius = reach + self._max_shift + 4.0 + (_PROBE_ALLOWANCE if probes else 0.0)
+        window = (x0, y0, self.side, self.side) if inside else None
+        frame = img if inside else cur
         spl = prefilter_region(
-            cur, self.corr.params.interpolation, centres, radius, workspace=self._workspace
+            frame,
+            self.corr.params.interpolation,
+            centres,
+            radius,
+            workspace=self._workspace,
+            window=window,
         )
         if probes:
             guess, moved = self._probe_correction(spl, guess)
             if moved > _PROBE_ALLOWANCE:  # beyond the prefiltered margin: prefilter again
                 centres = self.corr.centres + guess[:, [0, 3]]
                 spl = prefilter_region(
-                    cur, self.corr.params.interpolation, centres, radius, workspace=self._workspace
+                    frame,
+                    self.corr.params.interpolation,
+                    centres,
+                    radius,
+                    workspace=self._workspace,
+                    window=window,
                 )
         res = self.corr.match(spl, initial_guess=guess)
         pos = np.column_stack(

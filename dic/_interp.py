@@ -97,6 +97,7 @@ def prefilter_region(
     radius: float,
     *,
     workspace: dict | None = None,
+    window: tuple[int, int, int, int] | None = None,
 ) -> SplineImage:
     """B-spline coefficients of ``image`` computed only near some points (no node gradients).
 
@@ -113,23 +114,47 @@ def prefilter_region(
 
     ``workspace``: a dict kept by the caller between calls on same-sized images; the arrays
     are then reused (the returned coefficients live in it until the next call).
+
+    ``window`` ``(x0, y0, width, height)`` [pixel]: work on that rectangle of ``image`` (which
+    must lie inside it) as if it had been cropped, without copying or converting the frame;
+    ``centres`` are then in window coordinates. Integer frames (uint8, uint16) are read as is.
     """
     order = _ORDERS[interpolation]
-    img = np.ascontiguousarray(image)
-    if img.dtype not in (np.float32, np.float64):
-        img = img.astype(np.float64)
-    valid = np.isfinite(img)
-    all_valid = bool(valid.all())
-    fill = 0.0 if all_valid else (float(np.nanmean(img)) if valid.any() else 0.0)
+    if window is not None:
+        x0, y0, ww, wh = (int(v) for v in window)
+        H, W = image.shape
+        if x0 < 0 or y0 < 0 or x0 + ww > W or y0 + wh > H or ww < 1 or wh < 1:
+            raise ValueError(f"window {window} does not lie inside the {W}x{H} image")
+        img = image
+        view = image[y0 : y0 + wh, x0 : x0 + ww]
+    else:
+        x0 = y0 = 0
+        img = np.ascontiguousarray(image)
+        if img.dtype not in (np.float32, np.float64):
+            img = img.astype(np.float64)
+        view = img
+        wh, ww = img.shape
+    if np.issubdtype(view.dtype, np.integer):
+        ws_valid = (workspace or {}).get("valid_all")
+        valid = ws_valid if ws_valid is not None and ws_valid.shape == view.shape else None
+        if valid is None:
+            valid = np.ones(view.shape, dtype=bool)
+            if workspace is not None:
+                workspace["valid_all"] = valid
+        all_valid = True
+    else:
+        valid = np.isfinite(view)
+        all_valid = bool(valid.all())
+    fill = 0.0 if all_valid else (float(np.nanmean(view)) if valid.any() else 0.0)
     c = np.ascontiguousarray(centres, dtype=np.float64).reshape(-1, 2)
     c = c[np.all(np.isfinite(c), axis=1)]
     ws = {} if workspace is None else workspace
-    shape = (img.shape[0] + 2 * PAD, img.shape[1] + 2 * PAD)
+    shape = (wh + 2 * PAD, ww + 2 * PAD)
     if ws.get("coef") is None or ws["coef"].shape != shape:
         ws["coef"] = np.full(shape, np.nan)
-        ws["tmp"] = np.zeros(img.shape)  # finite scratch (see _prefilter_spans)
-        ws["row_lo"] = np.full(img.shape[0], img.shape[1], np.int64)
-        ws["row_hi"] = np.full(img.shape[0], -1, np.int64)
+        ws["tmp"] = np.zeros((wh, ww))  # finite scratch (see _prefilter_spans)
+        ws["row_lo"] = np.full(wh, ww, np.int64)
+        ws["row_hi"] = np.full(wh, -1, np.int64)
     else:  # back to NaN where the previous call wrote (cheaper than refilling everything)
         _reset_spans(ws["coef"], ws["row_lo"], ws["row_hi"])
     coef = ws["coef"]
@@ -138,6 +163,10 @@ def prefilter_region(
     margin = int(math.ceil(math.log(1e-7) / math.log(z)))
     _prefilter_spans(
         img,
+        y0,
+        x0,
+        wh,
+        ww,
         order,
         coef,
         ws["tmp"],
@@ -149,7 +178,7 @@ def prefilter_region(
         ws["row_hi"],
     )
     empty = np.empty((0, 0))
-    return SplineImage(image=img, coef=coef, gx=empty, gy=empty, order=order, valid=valid)
+    return SplineImage(image=view, coef=coef, gx=empty, gy=empty, order=order, valid=valid)
 
 
 @njit(cache=True, nogil=True)
@@ -167,15 +196,15 @@ def _reset_spans(out, row_lo, row_hi):
 
 
 @njit(cache=True, nogil=True)
-def _prefilter_spans(img, order, out, tmp, centres, r, m, fill, row_lo, row_hi):
-    """Prefilter over the spans covering squares of half-width r around centres (x, y).
+def _prefilter_spans(img, oy, ox, h, w, order, out, tmp, centres, r, m, fill, row_lo, row_hi):
+    """Prefilter the h x w window at (ox, oy) of img over the spans covering squares of
+    half-width r around centres (x, y, window coordinates).
 
     Rows are filtered over every square grown by r + m around a centre, columns over the
     columns within r of a centre and the rows within r + m of it: the row pass is then exact
     (to the decay length m) wherever the column pass reads it, and the column pass wherever
     the kernel reads the result.
     """
-    h, w = img.shape
     z1, z2, npoles = _poles(order)
     row_lo[:] = w  # the row spans are returned (the next call resets them)
     row_hi[:] = -1
@@ -198,7 +227,7 @@ def _prefilter_spans(img, order, out, tmp, centres, r, m, fill, row_lo, row_hi):
         if b <= a:
             continue
         for x in range(a, b):
-            v = img[y, x]
+            v = float(img[y + oy, x + ox])
             line[x - a] = v if math.isfinite(v) else fill
         seg = line[: b - a]
         _filter_line(seg, z1, z2, npoles)

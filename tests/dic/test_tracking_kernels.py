@@ -158,3 +158,18 @@ def test_stereo_prediction_is_exact_for_points_moving_linearly_in_depth():
     # unknown points stay unknown
     uv_left[3] = np.nan
     assert np.isnan(_stereo_prediction(cal, uv_left, frames[:2])[3]).all()
+
+
+def test_region_prefilter_on_a_window_of_an_integer_frame_equals_the_cropped_float_one():
+    rng = np.random.default_rng(5)
+    frame = rng.integers(0, 256, (120, 160), dtype=np.uint8)
+    x0, y0, w, h = 30, 20, 90, 80
+    centres = np.array([[40.0, 30.0], [60.5, 47.2]])
+    a = _interp.prefilter_region(frame[y0 : y0 + h, x0 : x0 + w].astype(np.float32), "cubic",
+                                 centres, 12)  # fmt: skip
+    b = _interp.prefilter_region(frame, "cubic", centres, 12, window=(x0, y0, w, h))
+    np.testing.assert_array_equal(np.isnan(a.coef), np.isnan(b.coef))
+    np.testing.assert_allclose(b.coef[~np.isnan(b.coef)], a.coef[~np.isnan(a.coef)], atol=1e-9)
+    assert b.valid.shape == (h, w) and b.valid.all()
+    with pytest.raises(ValueError, match="inside"):
+        _interp.prefilter_region(frame, "cubic", centres, 12, window=(100, 20, 90, 80))
