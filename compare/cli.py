@@ -4,7 +4,11 @@ from __future__ import annotations
 
 import typer
 
-from jointwear._cli import discover_commands
+from jointwear._cli import CommandGroup, discover_commands
 
-app = typer.Typer(help="Compare simulation and measurement on a common grid.", no_args_is_help=True)
+app = typer.Typer(
+    help="Compare simulation and measurement on a common grid.",
+    no_args_is_help=True,
+    cls=CommandGroup,
+)
 discover_commands(app, "jointwear.compare")

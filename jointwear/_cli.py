@@ -5,9 +5,21 @@ from __future__ import annotations
 import importlib
 import pkgutil
 
+import click
 import typer
+from typer.core import TyperGroup
 
-__all__ = ["discover_commands"]
+__all__ = ["discover_commands", "CommandGroup"]
+
+
+class CommandGroup(TyperGroup):
+    """A group whose callback is the command itself (``jointwear compare A B``): while it has
+    no sub-commands its usage line shows no ``COMMAND [ARGS]...``."""
+
+    def collect_usage_pieces(self, ctx: click.Context) -> list[str]:
+        if self.commands:
+            return super().collect_usage_pieces(ctx)
+        return click.Command.collect_usage_pieces(self, ctx)
 
 
 def discover_commands(app: typer.Typer, package: str) -> None:

@@ -26,6 +26,15 @@ def test_help_lists_groups(capsys):
         assert group in out
 
 
+def test_single_command_groups_show_no_subcommand_usage(capsys):
+    # `jointwear compare A B` and `jointwear report` are commands; groups with sub-commands
+    # (sim) still say COMMAND
+    for group, has_sub in (("compare", False), ("report", False), ("sim", True)):
+        assert main([group, "--help"]) == 0
+        usage = next(line for line in capsys.readouterr().out.splitlines() if "Usage:" in line)
+        assert ("COMMAND [ARGS]" in usage) == has_sub, usage
+
+
 def test_usage_error_exit_code(capsys):
     assert main(["no-such-command"]) == 2
 
