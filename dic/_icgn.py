@@ -1073,6 +1073,20 @@ def solve_point(
 
 
 @njit(cache=True, inline="always")
+def _store_point(i, p, z, it, fl, w, zncc_min, P, zncc, iters, flags, sigma):
+    """Write point ``i``'s outcome (low ZNCC flagged) and its u, v uncertainty from ``w``."""
+    if fl == FLAG_OK and not (z >= zncc_min):
+        fl = FLAG_LOW_CORRELATION
+    for q in range(12):
+        P[i, q] = p[q]
+    zncc[i] = z
+    iters[i] = it
+    flags[i] = fl
+    sigma[i, 0] = w[3, 4]
+    sigma[i, 1] = w[3, 5]
+
+
+@njit(cache=True, inline="always")
 def _refine_chunk(
     ch,
     n_chunks,
@@ -1130,15 +1144,7 @@ def _refine_chunk(
             border,
             work,
         )
-        if fl == FLAG_OK and not (z >= zncc_min):
-            fl = FLAG_LOW_CORRELATION
-        for q in range(12):
-            P[i, q] = p[q]
-        zncc[i] = z
-        iters[i] = it
-        flags[i] = fl
-        sigma[i, 0] = work[4][3, 4]
-        sigma[i, 1] = work[4][3, 5]
+        _store_point(i, p, z, it, fl, work[4], zncc_min, P, zncc, iters, flags, sigma)
 
 
 @njit(cache=True, parallel=True)
@@ -1310,15 +1316,7 @@ def icgn_affine_loaded(
             F[i], GX[i], GY[i], FN[i], HINV[i], JF[i], JS[i], def_coef, def_invalid, order,
             centres[i, 0], centres[i, 1], half, p, max_iter, tol, max_shift, border, w,
         )  # fmt: skip
-        if fl == FLAG_OK and not (z >= zncc_min):
-            fl = FLAG_LOW_CORRELATION
-        for q in range(12):
-            P[i, q] = p[q]
-        zncc[i] = z
-        iters[i] = it
-        flags[i] = fl
-        sigma[i, 0] = w[3, 4]
-        sigma[i, 1] = w[3, 5]
+        _store_point(i, p, z, it, fl, w, zncc_min, P, zncc, iters, flags, sigma)
 
 
 @njit(cache=True)

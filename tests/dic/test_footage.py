@@ -103,6 +103,22 @@ def small(tmp_path_factory):
     return cfg, written, out
 
 
+def _track_small(small, *, config=None, max_frames=None, folders=None, **options):
+    """Track the small rig's image sequences (``folders``: other left/right folders)."""
+    cfg, written, _ = small
+    tc, bodies = read_bodies(written["bodies"])
+    f = folders or {"left": written["left_images"], "right": written["right_images"]}
+    return track_footage(
+        f["left"],
+        f["right"],
+        fps=50,
+        bodies=bodies,
+        calibration=VirtualRig(cfg).calibration,
+        config=dataclasses.replace(tc, **options) if config is None else config,
+        max_frames=max_frames,
+    )
+
+
 def test_cli_chain_calibrate_track_plot(small):
     from jointwear.cli import main
 
@@ -310,21 +326,7 @@ def test_bodies_file_errors(tmp_path):
 
 def test_parallel_chunks_match_sequential(small):
     # two worker processes, each chunk starting from SIFT features: same poses as sequential
-    cfg, written, out = small
-    tc, bodies = read_bodies(written["bodies"])
-    cal = VirtualRig(cfg).calibration
-    runs = {}
-    for workers in (1, 2):
-        c = dataclasses.replace(tc, workers=workers, chunk_size=2)
-        runs[workers] = track_footage(
-            written["left_images"],
-            written["right_images"],
-            fps=50,
-            bodies=bodies,
-            calibration=cal,
-            config=c,
-            max_frames=4,
-        )
+    runs = {w: _track_small(small, max_frames=4, workers=w, chunk_size=2) for w in (1, 2)}
     a, b = runs[1]["follower_position"].values, runs[2]["follower_position"].values
     assert a.shape == b.shape == (4, 3)
     # IC-GN stops within ~1e-3 px of the optimum: different starting guesses (previous frame
@@ -452,20 +454,10 @@ def test_a_blank_frame_is_flagged_and_tracking_resumes_after_it(small, tmp_path)
         f4 = sorted((tmp_path / cam).iterdir())[4]
         img = cv2.imread(str(f4), cv2.IMREAD_UNCHANGED)
         cv2.imwrite(str(f4), np.full_like(img, 128))
-    tc, bodies = read_bodies(written["bodies"])
-    cal = VirtualRig(cfg).calibration
-    runs = {}
-    for name, folder in (("clean", written), ("blank", {k: tmp_path / k[:-7] for k in written})):
-        runs[name] = track_footage(
-            folder["left_images"],
-            folder["right_images"],
-            fps=50,
-            bodies=bodies,
-            calibration=cal,
-            config=tc,
-            max_frames=8,
-        )
-    blank, clean = runs["blank"], runs["clean"]
+    clean = _track_small(small, max_frames=8)
+    blank = _track_small(
+        small, max_frames=8, folders={"left": tmp_path / "left", "right": tmp_path / "right"}
+    )
     flags = blank["frame_flag"].values
     assert flags[4] & FRAME_FLAGS["tracking_failed"]
     assert np.isnan(blank["follower_position"].values[4]).all()
@@ -482,20 +474,8 @@ def test_lost_tracking_is_reinitialised_and_the_speculative_next_frame_redone(sm
     # discarded and tracked again, and every pose equals the undisturbed run's
     import jointwear.dic._footage as footage
 
-    cfg, written, out = small
-    tc, bodies = read_bodies(written["bodies"])
-    cal = VirtualRig(cfg).calibration
-
     def run():
-        return track_footage(
-            written["left_images"],
-            written["right_images"],
-            fps=50,
-            bodies=bodies,
-            calibration=cal,
-            config=tc,
-            max_frames=7,
-        )
+        return _track_small(small, max_frames=7)
 
     clean = run()
     t1 = float(clean["time"].values[1])
