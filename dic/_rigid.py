@@ -78,21 +78,87 @@ def fit_rigid_robust(
         raise BadInputError(
             f"rigid fit: only {ok.sum()} valid points, at least {min_points} needed"
         )
-    inl = ok.copy()
+    d = P.shape[1]
+    R = np.empty((d, d))
+    t = np.empty(d)
+    inl = np.empty(len(P), dtype=np.bool_)
+    rms = _robust_rigid(
+        np.ascontiguousarray(P), np.ascontiguousarray(Q), ok, float(threshold), int(iterations),
+        int(min_points), R, t, inl,
+    )  # fmt: skip
+    return R, t, inl, float(rms)
+
+
+def _kabsch_impl(P, Q, mask, R, t):
+    """Least-squares rotation R and translation t with Q ~ R P + t over the ``mask`` rows."""
+    d = P.shape[1]
+    m = 0
+    cp = np.zeros(d)
+    cq = np.zeros(d)
+    for i in range(P.shape[0]):
+        if mask[i]:
+            m += 1
+            for k in range(d):
+                cp[k] += P[i, k]
+                cq[k] += Q[i, k]
+    cp /= m
+    cq /= m
+    H = np.zeros((d, d))
+    for i in range(P.shape[0]):
+        if mask[i]:
+            for a in range(d):
+                for b in range(d):
+                    H[a, b] += (P[i, a] - cp[a]) * (Q[i, b] - cq[b])
+    U, _, Vt = np.linalg.svd(H)
+    D = np.eye(d)
+    D[d - 1, d - 1] = np.sign(np.linalg.det(Vt.T @ U.T))
+    R[:, :] = Vt.T @ D @ U.T
+    t[:] = cq - R @ cp
+
+
+def _robust_rigid_impl(P, Q, ok, threshold, iterations, min_points, R, t, inl):
+    """The iterations of :func:`fit_rigid_robust` (fit, MAD limit, refit); returns the RMS."""
+    n = P.shape[0]
+    inl[:] = ok
+    res = np.empty(n)
+
+    def residuals():
+        for i in range(n):
+            if ok[i]:
+                s = 0.0
+                for a in range(P.shape[1]):
+                    e = Q[i, a] - t[a]
+                    for b in range(P.shape[1]):
+                        e -= R[a, b] * P[i, b]
+                    s += e * e
+                res[i] = np.sqrt(s)
+            else:
+                res[i] = np.inf
+
     for _ in range(iterations):
-        R, t = fit_rigid(P[inl], Q[inl])
-        res = np.full(len(P), np.inf)
-        res[ok] = np.linalg.norm(Q[ok] - (P[ok] @ R.T + t), axis=1)
-        med = np.median(res[inl])
-        mad = np.median(np.abs(res[inl] - med))
-        limit = med + threshold * 1.4826 * max(mad, 1e-12) + 1e-12
-        new = ok & (res <= max(limit, 1e-9))
-        if new.sum() < min_points or np.array_equal(new, inl):
+        _kabsch(P, Q, inl, R, t)
+        residuals()
+        r_in = res[inl]
+        med = np.median(r_in)
+        mad = np.median(np.abs(r_in - med))
+        limit = max(med + threshold * 1.4826 * max(mad, 1e-12) + 1e-12, 1e-9)
+        new = ok & (res <= limit)
+        if new.sum() < min_points or np.all(new == inl):
             break
-        inl = new
-    R, t = fit_rigid(P[inl], Q[inl])
-    res = np.linalg.norm(Q[inl] - (P[inl] @ R.T + t), axis=1)
-    return R, t, inl, float(np.sqrt(np.mean(res**2)))
+        inl[:] = new
+    _kabsch(P, Q, inl, R, t)
+    residuals()
+    return np.sqrt(np.mean(res[inl] ** 2))
+
+
+def _robust_rigid(*args):
+    """Compiled on first use (numba), so importing this module stays light."""
+    global _robust_rigid, _kabsch
+    from numba import njit
+
+    _kabsch = njit(cache=True)(_kabsch_impl)
+    _robust_rigid = njit(cache=True)(_robust_rigid_impl)
+    return _robust_rigid(*args)
 
 
 def rotation_angle_z(R: np.ndarray) -> np.ndarray:
