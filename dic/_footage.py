@@ -673,6 +673,7 @@ def track_footage(
     out: str | Path | None = None,
     progress: bool = False,
     inputs: tuple = (),
+    resume: bool = False,
 ) -> xr.Dataset:
     """Track rigid bodies through rig footage; body poses, follower velocity, journal motion.
 
@@ -691,10 +692,20 @@ def track_footage(
     max_frames : int, optional
         Process only the first frames.
     out : path, optional
-        netCDF written after every chunk (atomic): a run that stops keeps what was computed
-        (``status`` attribute says where and why it stopped).
+        netCDF written after every chunk (atomic; a chunk's write is skipped while writes would
+        take more than a tenth of the run): a run that stops keeps what was computed (``status``
+        attribute says where and why it stopped).
     progress : bool
         Progress bar on stderr.
+    inputs : tuple of path
+        Input files recorded (with sha256) in the output's provenance.
+    resume : bool
+        Continue the partial result in ``out`` (a run that was interrupted or stopped): its
+        frames are kept and tracking restarts at the next frame from SIFT features of the
+        reference images, as a parallel chunk does. The footage, bodies and tracking options
+        must be those of the partial run (``workers``/``chunk_size`` may differ); otherwise a
+        :class:`~jointwear.errors.BadInputError` says what differs. A complete ``out`` is
+        returned as it is.
 
     Returns
     -------
@@ -730,17 +741,37 @@ def track_footage(
     n_total = L.n_frames if max_frames is None else min(L.n_frames, max_frames)
     t_start = _time.perf_counter()
     (_, t0, ref_l), ref_r = _reference_frames(L, R)
+    previous = _load_partial(out, L, R, cfg, bodies) if resume else None
+    if previous is not None and previous.attrs.get("status") == "complete":
+        return previous
     states = _setup_states(L, R, bodies, calibration, cfg, ref_l, ref_r)
     times: list[float] = []
     flags: list[int] = []
     duplicates: list[int] = []
+    if previous is not None:
+        _restore_rows(previous, states, times, flags, duplicates, R is not None, out)
+    start = len(times)
+    if start >= n_total:
+        return _finish_result(
+            states, times, flags, duplicates, L, R, cfg, calibration, out, inputs, bodies, t_start
+        )
     from jointwear.progress import progress_bar
 
-    def save(status: str) -> xr.Dataset:
+    # partial results are rewritten whole after a chunk, so on a long recording each write
+    # costs more; a chunk's write is skipped while the previous write took more than
+    # 1/_CHECKPOINT_OVERHEAD of the time since, keeping the writes' share of the run bounded
+    last_write = {"end": _time.perf_counter(), "cost": 0.0}
+
+    def save(status: str, *, force: bool = False) -> None:
+        if out is None or not times:
+            return
+        now = _time.perf_counter()
+        if not force and (now - last_write["end"]) * _CHECKPOINT_OVERHEAD < last_write["cost"]:
+            return
         ds = _assemble(states, times, flags, duplicates, L, R, cfg, calibration, status)
-        if out is not None and times:
-            _write(ds, out, inputs, cfg, bodies)
-        return ds
+        _write(ds, out, inputs, cfg, bodies)
+        last_write["end"] = _time.perf_counter()
+        last_write["cost"] = last_write["end"] - now
 
     # one process: the cameras' and bodies' trackers of a frame run in threads (their
     # kernels release the GIL); several processes: one thread each
@@ -749,9 +780,13 @@ def track_footage(
     try:
         with progress_bar("tracking frames", n_total, enabled=progress) as bar:
             task = bar.tasks[0].id
+            bar.update(task, advance=start)
             if cfg.workers <= 1:
-                frames = prefetch(_paired_frames(L, R, 0, n_total))  # decoding overlaps
-                for i, t, flag, dup in _run_frames(states, frames, cfg, calibration, pool):
+                # decoding overlaps; a resumed run starts one frame early for the duplicate check
+                frames = prefetch(_paired_frames(L, R, max(start - 1, 0), n_total))
+                for i, t, flag, dup in _run_frames(
+                    states, frames, cfg, calibration, pool, first=start, reinit_first=start > 0
+                ):
                     flags.append(flag)
                     times.append(t)
                     if dup:
@@ -764,7 +799,8 @@ def track_footage(
                 from concurrent.futures import ProcessPoolExecutor
 
                 ranges = [
-                    (a, min(a + cfg.chunk_size, n_total)) for a in range(0, n_total, cfg.chunk_size)
+                    (a, min(a + cfg.chunk_size, n_total))
+                    for a in range(start, n_total, cfg.chunk_size)
                 ]
                 # spawn: forking a process that already runs OpenMP/numba threads is unsafe
                 ctx = multiprocessing.get_context("spawn")
@@ -793,7 +829,7 @@ def track_footage(
             pool = None
         status = f"stopped after {len(times)} frames: {exc}"
         if out is not None and times:
-            save(status)
+            save(status, force=True)
             raise BadInputError(
                 f"{exc} - the {len(times)} frames processed before are saved in '{out}'"
             ) from None
@@ -801,12 +837,105 @@ def track_footage(
     finally:
         if pool is not None:
             pool.shutdown()
+    return _finish_result(
+        states, times, flags, duplicates, L, R, cfg, calibration, out, inputs, bodies, t_start
+    )
+
+
+def _finish_result(
+    states, times, flags, duplicates, L, R, cfg, calibration, out, inputs, bodies, t_start
+) -> xr.Dataset:
     result = _assemble(states, times, flags, duplicates, L, R, cfg, calibration, "complete")
     result.attrs["wall_time_s"] = _time.perf_counter() - t_start
     result.attrs["workers"] = cfg.workers
     if out is not None:
         _write(result, out, inputs, cfg, bodies)
     return result
+
+
+#: tracking options that may change between a partial run and its resumption
+_RESUMABLE_CHANGES = ("workers", "chunk_size")
+
+
+def _load_partial(out, L: FrameSource, R: FrameSource | None, cfg, bodies) -> xr.Dataset | None:
+    """The partial result in ``out`` to resume, after checking it belongs to this run."""
+    from jointwear import io
+
+    if out is None:
+        raise BadInputError("resume needs the output file of the interrupted run (out=..., --out)")
+    out = Path(out)
+    if not out.exists():
+        return None  # nothing to resume: a fresh run
+    prev = io.load(out)
+    what = f"'{out}'"
+    if prev.attrs.get("title") != "jointwear rig footage tracking":
+        raise BadInputError(f"{what} is not a `jointwear dic track` result; cannot resume it")
+    problems = []
+    for name, src in (("left", L), ("right", R)):
+        want = str(src.path) if src is not None else ""
+        if str(prev.attrs.get(f"{name}_footage", "")) != want:
+            problems.append(
+                f"{name} footage was '{prev.attrs.get(f'{name}_footage', '')}', now '{want}'"
+            )
+    params = io.parse_provenance(prev).get("parameters", {})
+    old_track = {k: v for k, v in params.get("track", {}).items() if k not in _RESUMABLE_CHANGES}
+    new_track = {k: v for k, v in asdict(cfg).items() if k not in _RESUMABLE_CHANGES}
+    new_track = json.loads(json.dumps(new_track))
+    for key in sorted(set(old_track) | set(new_track)):
+        if old_track.get(key) != new_track.get(key):
+            problems.append(f"track.{key} was {old_track.get(key)!r}, now {new_track.get(key)!r}")
+    new_bodies = json.loads(json.dumps([asdict(b) for b in bodies]))
+    if params.get("bodies") != new_bodies:
+        problems.append("the bodies (regions of interest) differ")
+    if problems:
+        raise BadInputError(
+            f"cannot resume {what}: it was made with other inputs or options ("
+            + "; ".join(problems)
+            + "); run again with the same ones, or without resume to start afresh"
+        )
+    return prev
+
+
+def _restore_rows(prev: xr.Dataset, states, times, flags, duplicates, stereo: bool, out) -> None:
+    """Fill the states' rows, times, flags and duplicates from a partial result."""
+    img = "" if stereo else "_image"
+    for st in states:
+        name = st.spec.name
+        pts = prev[f"{name}_points"].values
+        n_ref = len(st.ref3d)
+        if pts.shape[1] != n_ref or not np.allclose(
+            pts[0],
+            st.ref3d,
+            atol=1e-6 * max(1.0, float(np.nanmax(np.abs(st.ref3d)))),
+            equal_nan=True,
+        ):
+            raise BadInputError(
+                f"cannot resume '{out}': body '{name}' has {pts.shape[1]} subsets there but "
+                f"{n_ref} (or other reference positions) now; the reference frames or the "
+                "calibration differ - run again without resume"
+            )
+        d = st.ref3d.shape[1]
+        columns = {
+            "R": prev[f"{name}_rotation"].values,
+            "t": np.full((prev.sizes["time"], d), np.nan),
+            "poi": prev[f"{name}{img}_position"].values,
+            "poi_u": prev[f"{name}{img}_position_u"].values,
+            "n": prev[f"{name}_n_points"].values,
+            "rms": prev[f"{name}_fit_rms"].values,
+            "points": pts,
+            "points_u": prev[f"{name}_points_u"].values,
+            "zncc": prev[f"{name}_zncc"].values,
+        }
+        st.rows = {key: list(val) for key, val in columns.items()}
+    times.extend(float(t) for t in prev["time"].values)
+    raw = FRAME_FLAGS["duplicated"] | FRAME_FLAGS["tracking_failed"]  # the others are derived
+    flags.extend(int(f) & raw for f in prev["frame_flag"].values)
+    dup = prev.attrs.get("duplicated_frames", "[]")
+    duplicates.extend(int(i) for i in (json.loads(dup) if isinstance(dup, str) else dup))
+
+
+#: largest share of a tracking run spent writing partial results (see track_footage's save)
+_CHECKPOINT_OVERHEAD = 0.1
 
 
 def _reference_frames(L: FrameSource, R: FrameSource | None):

@@ -2,7 +2,7 @@
 
 ``read_frames(source, *, start=0, stop=None, stride=1) -> (list of 2D arrays, frame_rate|None)``
     ``source``: a 3D array (time, rows, columns), a list of 2D arrays or image paths, a folder
-    of images (sorted by name; png, tif, tiff, bmp, jpg, jpeg, pgm) or a video file (OpenCV).
+    of images (in frame-number order; png, tif, tiff, bmp, jpg, jpeg, pgm) or a video file (OpenCV).
     Colour frames are converted to grey.
 
 ``correlate_sequence(frames, *, reference="absolute", points=None, roi=None, times=None,
@@ -68,7 +68,7 @@ def read_frames(
     ----------
     source : ndarray, sequence, str or Path
         3D array ``(time, rows, columns)``, list of 2D arrays or image paths, a folder of images
-        (sorted by name) or a video file.
+        (in frame-number order), a glob pattern (``"images/*_0.tif"``) or a video file.
     start, stop, stride : int
         Frame selection (like ``range``).
     """
@@ -84,16 +84,15 @@ def read_frames(
             )
         return [np.asarray(f) for f in source[sel]], None
     if isinstance(source, (str, Path)):
+        from jointwear.dic._video import _GLOB_CHARS, list_image_sequence
+
         path = Path(source)
+        if path.is_dir() or (not path.exists() and _GLOB_CHARS.search(path.name)):
+            # sorted by the frame number in the names (frame_9 before frame_10)
+            files, _ = list_image_sequence(source, what="frames source")
+            return [read_image(p) for p in files[sel]], None
         if not path.exists():
             raise BadInputError(f"frames source '{path}' does not exist")
-        if path.is_dir():
-            files = sorted(p for p in path.iterdir() if p.suffix.lower() in IMAGE_SUFFIXES)
-            if not files:
-                raise BadInputError(
-                    f"folder '{path}' holds no images ({', '.join(IMAGE_SUFFIXES)})"
-                )
-            return [read_image(p) for p in files[sel]], None
         if path.suffix.lower() in IMAGE_SUFFIXES:
             raise BadInputError(
                 f"'{path}' is a single image; give a folder, a video or a list of images"

@@ -17,6 +17,7 @@ __all__ = [
     "FrameSource",
     "open_frames",
     "check_stereo_pair",
+    "list_image_sequence",
     "prefetch",
     "IMAGE_SUFFIXES",
     "VIDEO_SUFFIXES",
@@ -25,7 +26,7 @@ __all__ = [
 #: codec pixel formats that are already grey (decoded without a colour conversion)
 _GREY_PIXEL_FORMATS = ("Y800", "GREY", "Y8  ")
 
-IMAGE_SUFFIXES = (".png", ".tif", ".tiff", ".bmp", ".jpg", ".jpeg", ".pgm")
+IMAGE_SUFFIXES = (".png", ".tif", ".tiff", ".bmp", ".jpg", ".jpeg", ".pgm", ".ppm")
 VIDEO_SUFFIXES = (".avi", ".mp4", ".mkv", ".mov", ".m4v", ".mpg", ".mpeg", ".wmv", ".webm")
 _ADVICE = (
     "convert it to a format OpenCV's bundled FFmpeg reads, losslessly if possible, e.g. "
@@ -42,12 +43,12 @@ def _fourcc_name(code: float) -> str:
 
 @dataclass
 class FrameSource:
-    """A camera's footage: a video file or a folder of numbered images.
+    """A camera's footage: a video file, numbered images or a multi-page TIFF.
 
     Attributes
     ----------
     path : Path
-    kind : {"video", "images"}
+    kind : {"video", "images", "stack"}
     fps : float
         Nominal frame rate [1/s].
     size : (width, height)
@@ -97,7 +98,27 @@ class FrameSource:
                         f"image '{self.files[i]}' (frame {i}) could not be read; replace or "
                         "remove the file"
                     )
+                self._check_size(img, f"image '{self.files[i]}' (frame {i})")
                 yield i, float(times[i]), _to_gray(img, native)
+            return
+        if self.kind == "stack":
+            times = self.nominal_times()
+            for first in range(start, stop, _STACK_BATCH):
+                count = min(_STACK_BATCH, stop - first)
+                ok, pages = cv2.imreadmulti(
+                    str(self.path), start=first, count=count, flags=cv2.IMREAD_UNCHANGED
+                )
+                if not ok or len(pages) != count:
+                    got = len(pages) if ok else 0
+                    raise BadInputError(
+                        f"TIFF stack '{self.path}': page {first + got} of {self.n_frames} could "
+                        "not be read (truncated or damaged file); re-export the stack or "
+                        "process the pages before it"
+                    )
+                for k, img in enumerate(pages):
+                    i = first + k
+                    self._check_size(img, f"TIFF stack '{self.path}' page {i}")
+                    yield i, float(times[i]), _to_gray(img, native)
             return
         cap = cv2.VideoCapture(str(self.path))
         try:
@@ -125,6 +146,46 @@ class FrameSource:
                 i += 1
         finally:
             cap.release()
+
+    def _check_size(self, img: np.ndarray, name: str) -> None:
+        if (img.shape[1], img.shape[0]) != tuple(self.size):
+            raise BadInputError(
+                f"{name} is {img.shape[1]} x {img.shape[0]} px but the sequence started with "
+                f"{self.size[0]} x {self.size[1]} px; every frame of a camera must have the "
+                "same size"
+            )
+
+
+#: pages of a multi-page TIFF read per call (each call seeks from the file's first page)
+_STACK_BATCH = 64
+
+
+def _open_tiff_stack(path: Path, fps: float | None, what: str) -> FrameSource:
+    """A multi-page TIFF (one page per frame, as high-speed camera software exports them)."""
+    import cv2
+
+    try:
+        n = int(cv2.imcount(str(path), cv2.IMREAD_UNCHANGED))
+        ok, pages = cv2.imreadmulti(str(path), start=0, count=1, flags=cv2.IMREAD_UNCHANGED)
+    except cv2.error:
+        n, ok, pages = 0, False, []
+    if n < 1 or not ok or not pages:
+        raise BadInputError(
+            f"{what} '{path}' could not be read as a TIFF (one image, or one page per frame); "
+            "check that the file is complete, or export the footage as numbered images"
+        )
+    if n == 1:
+        raise BadInputError(
+            f"{what} '{path}' is a single image; give a video, a multi-page TIFF, a folder of "
+            "numbered images or a pattern such as 'folder/*_0.tif'"
+        )
+    if fps is None or not fps > 0:
+        raise BadInputError(
+            f"{what} '{path}' is a multi-page TIFF ({n} pages): give the frame rate (fps=..., "
+            "CLI --fps)"
+        )
+    first = pages[0]
+    return FrameSource(path, "stack", float(fps), (first.shape[1], first.shape[0]), n, codec="TIFF")
 
 
 def _to_gray(img: np.ndarray, native: bool = False) -> np.ndarray:
@@ -200,16 +261,108 @@ def _natural_key(p: Path):
     return [int(s) if s.isdigit() else s for s in re.split(r"(\d+)", p.name)]
 
 
-def open_frames(
-    path: str | Path, *, fps: float | None = None, what: str = "footage"
-) -> FrameSource:
-    """Open a video file or a folder of images.
+_GLOB_CHARS = re.compile(r"[*?\[]")
+
+
+def _frame_numbers(files: list[Path]) -> tuple[np.ndarray | None, str]:
+    """The frame counter in the file names, and a note on other numbers that vary.
+
+    Names are split into their digit groups. When every name has the same number of groups, the
+    counter is the group that takes the most distinct values (a camera index such as VIC-3D's
+    ``name_0001_0.tif`` / ``name_0001_1.tif`` takes few); otherwise the last group. ``None``
+    when the names carry no usable numbers (then the files are numbered in sorted order).
+    """
+    groups = [re.findall(r"\d+", p.stem) for p in files]
+    if not all(groups):
+        return None, ""
+    n = {len(g) for g in groups}
+    if len(n) == 1 and len(files) > 1:
+        cols = np.array([[int(v) for v in g] for g in groups])
+        distinct = [len(np.unique(cols[:, j])) for j in range(cols.shape[1])]
+        best = max(range(len(distinct)), key=lambda j: (distinct[j], j))
+        others = [
+            f"digit group {j + 1} takes {distinct[j]} values"
+            for j in range(len(distinct))
+            if j != best and 1 < distinct[j]
+        ]
+        return cols[:, best], "; ".join(others)
+    return np.array([int(g[-1]) for g in groups]), ""
+
+
+def list_image_sequence(
+    path: str | Path, *, what: str = "footage"
+) -> tuple[list[Path], np.ndarray]:
+    """Image files of one camera's sequence, in frame order, with their frame numbers.
 
     Parameters
     ----------
-    path : path
-        Video file (mp4, avi, mkv, ...) or folder of images (png, tif, bmp, jpg) named with a
-        frame number (``frame_000123.png``); gaps in the numbering are dropped frames.
+    path : path or str
+        A folder of images (png, tif, bmp, jpg, pgm), or a glob pattern selecting one camera's
+        images in a folder that holds several (``"images/*_0.tif"``, as VIC-3D names them).
+    what : str
+        Name used in messages.
+
+    Returns
+    -------
+    files : list of Path
+        Sorted by frame number (by name when the names carry no number).
+    numbers : ndarray of int
+        The frame counter read from the names (gaps = dropped frames), or 0, 1, 2, ... when the
+        names carry no number.
+    """
+    path_str = str(path)
+    p = Path(path_str)
+    if p.is_dir():
+        files = [q for q in p.iterdir() if q.suffix.lower() in IMAGE_SUFFIXES and q.is_file()]
+        where = f"folder '{p}'"
+    elif _GLOB_CHARS.search(p.name) and p.parent.is_dir():
+        files = [q for q in p.parent.glob(p.name) if q.is_file()]
+        where = f"pattern '{path_str}'"
+        non_images = [q for q in files if q.suffix.lower() not in IMAGE_SUFFIXES]
+        if non_images:
+            raise BadInputError(
+                f"{what} {where} matches {len(non_images)} file(s) that are not images "
+                f"(e.g. '{non_images[0].name}'); narrow the pattern to "
+                f"{', '.join(IMAGE_SUFFIXES)} files"
+            )
+    else:
+        raise BadInputError(f"{what} '{path_str}' does not exist")
+    if not files:
+        raise BadInputError(f"{what} {where} holds no images ({', '.join(IMAGE_SUFFIXES)})")
+    files.sort(key=_natural_key)
+    numbers, note = _frame_numbers(files)
+    if numbers is None:
+        return files, np.arange(len(files))
+    order = np.argsort(numbers, kind="stable")
+    files = [files[i] for i in order]
+    numbers = numbers[order]
+    dup = np.flatnonzero(np.diff(numbers) == 0)
+    if dup.size:
+        k = int(dup[0])
+        hint = f" ({note})" if note else ""
+        raise BadInputError(
+            f"{what} {where} holds {len(files)} images but only {len(np.unique(numbers))} "
+            f"distinct frame numbers: '{files[k].name}' and '{files[k + 1].name}' both read as "
+            f"frame {numbers[k]}{hint}. If the folder holds several cameras' images (e.g. "
+            "'name_0001_0.tif' and 'name_0001_1.tif'), select one camera with a pattern such "
+            "as 'folder/*_0.tif'; otherwise remove the duplicate files"
+        )
+    return files, numbers
+
+
+def open_frames(
+    path: str | Path, *, fps: float | None = None, what: str = "footage"
+) -> FrameSource:
+    """Open a camera's footage: a video file, an image sequence or a multi-page TIFF.
+
+    Parameters
+    ----------
+    path : path or str
+        Video file (mp4, avi, mkv, ...); folder of images (png, tif, bmp, jpg, pgm) named with
+        a frame number (``frame_000123.png``; gaps in the numbering are dropped frames); a glob
+        pattern selecting one camera's images in a shared folder (``"images/*_0.tif"``); or a
+        multi-page TIFF with one page per frame. See :func:`list_image_sequence` for how the
+        frame number is found in the names.
     fps : float, optional
         Frame rate [1/s]. Required for image sequences; for videos it overrides the
         container's rate.
@@ -218,31 +371,20 @@ def open_frames(
     """
     import cv2
 
+    path_str = str(path)
     path = Path(path)
-    if not path.exists():
-        raise BadInputError(f"{what} '{path}' does not exist")
-    if path.is_dir():
-        files = sorted(
-            (p for p in path.iterdir() if p.suffix.lower() in IMAGE_SUFFIXES), key=_natural_key
-        )
-        if not files:
-            raise BadInputError(
-                f"{what} folder '{path}' holds no images ({', '.join(IMAGE_SUFFIXES)})"
-            )
+    if path.is_dir() or (not path.exists() and _GLOB_CHARS.search(path.name)):
+        files, numbers = list_image_sequence(path_str, what=what)
         if fps is None or not fps > 0:
             raise BadInputError(
-                f"{what} '{path}' is an image sequence: give the frame rate (fps=..., CLI --fps)"
+                f"{what} '{path_str}' is an image sequence: give the frame rate (fps=..., CLI "
+                "--fps)"
             )
-        nums = []
-        for p in files:
-            m = re.findall(r"\d+", p.stem)
-            nums.append(int(m[-1]) if m else -1)
-        numbers = np.array(nums)
-        if np.any(numbers < 0) or len(np.unique(numbers)) != len(numbers):
-            numbers = np.arange(len(files))
         first = cv2.imread(str(files[0]), cv2.IMREAD_UNCHANGED)
         if first is None:
-            raise BadInputError(f"image '{files[0]}' could not be read")
+            raise BadInputError(
+                f"image '{files[0]}' could not be read by OpenCV; replace or remove the file"
+            )
         return FrameSource(
             path,
             "images",
@@ -252,6 +394,10 @@ def open_frames(
             files=files,
             frame_numbers=numbers,
         )
+    if not path.exists():
+        raise BadInputError(f"{what} '{path}' does not exist")
+    if path.suffix.lower() in (".tif", ".tiff"):
+        return _open_tiff_stack(path, fps, what)
     suffix = path.suffix.lower()
     if suffix not in VIDEO_SUFFIXES:
         raise BadInputError(

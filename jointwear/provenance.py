@@ -42,8 +42,18 @@ def utc_now() -> str:
     return _dt.datetime.now(_dt.UTC).strftime("%Y-%m-%dT%H:%M:%SZ")
 
 
+#: digests of files already hashed in this process, keyed by what identifies their content
+#: cheaply (path, inode, size, modification time): a long run that re-saves its output after
+#: every chunk of work hashes gigabytes of input footage once, not at every save
+_DIGESTS: dict[tuple, str] = {}
+
+
 def sha256_file(path: str | Path, *, chunk: int = 1 << 20) -> str:
-    """SHA-256 hex digest of a file (a folder: digest of its files' names and digests)."""
+    """SHA-256 hex digest of a file (a folder: digest of its files' names and digests).
+
+    A file's digest is remembered for the process while its size and modification time stay
+    the same.
+    """
     path = Path(path)
     h = hashlib.sha256()
     if path.is_dir():
@@ -51,10 +61,15 @@ def sha256_file(path: str | Path, *, chunk: int = 1 << 20) -> str:
             h.update(str(sub.relative_to(path)).encode())
             h.update(sha256_file(sub).encode())
         return h.hexdigest()
-    with path.open("rb") as fh:
-        while block := fh.read(chunk):
-            h.update(block)
-    return h.hexdigest()
+    st = path.stat()
+    key = (str(path.resolve()), st.st_ino, st.st_size, st.st_mtime_ns)
+    digest = _DIGESTS.get(key)
+    if digest is None:
+        with path.open("rb") as fh:
+            while block := fh.read(chunk):
+                h.update(block)
+        digest = _DIGESTS[key] = h.hexdigest()
+    return digest
 
 
 def software_versions() -> dict[str, str]:
@@ -105,6 +120,15 @@ def build_provenance(
         rec: dict[str, Any] = {"path": str(p.resolve())}
         if p.exists():
             rec["sha256"] = sha256_file(p)
+        elif any(c in p.name for c in "*?[") and p.parent.is_dir():
+            # a glob pattern (one camera's images in a shared folder): the matched files
+            matched = sorted(q for q in p.parent.glob(p.name) if q.is_file())
+            h = hashlib.sha256()
+            for q in matched:
+                h.update(q.name.encode())
+                h.update(sha256_file(q).encode())
+            rec["sha256"] = h.hexdigest()
+            rec["files"] = len(matched)
         records.append(rec)
     prov: dict[str, Any] = {
         "created": utc_now(),

@@ -528,3 +528,60 @@ def test_sixteen_bit_image_sequences_track_like_eight_bit(small, tmp_path):
     np.testing.assert_allclose(
         sixteen["follower_position"].values, eight["follower_position"].values, atol=3e-6
     )
+
+
+def test_resume_continues_a_stopped_run(small, tmp_path):
+    import shutil
+
+    cfg, written, out = small
+    for cam in ("left", "right"):
+        shutil.copytree(written[f"{cam}_images"], tmp_path / cam)
+    files = sorted((tmp_path / "left").iterdir())
+    good = files[6].read_bytes()
+    files[6].write_bytes(b"not a png")
+    tc, bodies = read_bodies(written["bodies"])
+    cal = VirtualRig(cfg).calibration
+    target = tmp_path / "motion.nc"
+    run = dict(fps=50, bodies=bodies, calibration=cal, out=target)
+    with pytest.raises(BadInputError, match="6 frames processed before are saved"):
+        track_footage(tmp_path / "left", tmp_path / "right", config=tc, **run)
+    partial = io.load(target)
+    assert partial.sizes["time"] == 6
+    files[6].write_bytes(good)  # the frame is repaired
+    # other tracking options than the partial run's: refused, naming the option
+    with pytest.raises(BadInputError, match=r"cannot resume.*track.subset_size was 21, now 25"):
+        track_footage(
+            tmp_path / "left",
+            tmp_path / "right",
+            config=dataclasses.replace(tc, subset_size=25),
+            resume=True,
+            **run,
+        )
+    resumed = track_footage(
+        tmp_path / "left",
+        tmp_path / "right",
+        config=dataclasses.replace(tc, chunk_size=3),  # chunking may change
+        resume=True,
+        **run,
+    )
+    whole = _track_small(small)
+    assert resumed.attrs["status"] == "complete"
+    assert resumed.sizes["time"] == whole.sizes["time"] == len(files)
+    # the kept frames are the partial run's, bit for bit
+    assert np.array_equal(
+        resumed["follower_position"].values[:6],
+        partial["follower_position"].values,
+        equal_nan=True,  # frame 3 is a duplicate: no position
+    )
+    # the resumed frames start again from the reference features (as a parallel chunk does):
+    # the same poses as the uninterrupted run to within the IC-GN stopping tolerance
+    d = resumed["follower_position"].values - whole["follower_position"].values
+    assert np.nanmax(np.abs(d)) < 3e-6
+    assert np.array_equal(np.isnan(d), np.isnan(whole["follower_position"].values))
+    assert resumed.attrs["duplicated_frames"] == whole.attrs["duplicated_frames"] == "[4]"
+    assert np.array_equal(resumed["frame_flag"].values, whole["frame_flag"].values)
+    # a complete result is returned as it is
+    again = track_footage(tmp_path / "left", tmp_path / "right", config=tc, resume=True, **run)
+    assert np.array_equal(
+        again["follower_velocity"].values, resumed["follower_velocity"].values, equal_nan=True
+    )

@@ -148,3 +148,21 @@ def test_written_files_get_normal_permissions(tmp_path):
     umask = os.umask(0)
     os.umask(umask)
     assert (path.stat().st_mode & 0o777) == (0o666 & ~umask)
+
+
+def test_input_digests_follow_file_changes_and_patterns(tmp_path):
+    from jointwear.provenance import build_provenance, sha256_file
+
+    f = tmp_path / "frame_0001_0.png"
+    f.write_bytes(b"a" * 100)
+    assert sha256_file(f) == hashlib.sha256(b"a" * 100).hexdigest()
+    # same size, new content and modification time: hashed again, not taken from the memo
+    f.write_bytes(b"b" * 100)
+    os.utime(f, ns=(1, 2_000_000_000))
+    assert sha256_file(f) == hashlib.sha256(b"b" * 100).hexdigest()
+    # a glob pattern (one camera's images in a shared folder) records its matched files
+    (tmp_path / "frame_0001_1.png").write_bytes(b"c")
+    rec = build_provenance(inputs=[tmp_path / "*_0.png"])["inputs"][0]
+    assert rec["files"] == 1
+    expected = hashlib.sha256(b"frame_0001_0.png" + sha256_file(f).encode()).hexdigest()
+    assert rec["sha256"] == expected
