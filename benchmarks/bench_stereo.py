@@ -3,7 +3,10 @@
 Renders one crank revolution of the virtual rig (25 frame pairs; the motion is 0.5 s periodic)
 and writes it 20 times into two lossless raw-grey AVI videos (500 frame pairs = 10 s), then times
 ``track_footage`` (decoding, stereo DIC of the follower and journal patches, triangulation,
-rigid fits, velocities) and checks the accuracy against the ground truth.
+rigid fits, velocities), once in memory and once writing the result file as
+``jointwear dic track --out`` does (partial results after chunks, inputs hashed for the
+provenance), checks the accuracy against the ground truth and reports the result's size per
+frame (what grows in memory with the recording's length) and the peak resident memory.
 
 Run: ``python benchmarks/bench_stereo.py [--repeat N] [--workers W]``.
 """
@@ -13,6 +16,7 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import os
+import resource
 import sys
 import tempfile
 import time
@@ -83,6 +87,27 @@ def main() -> None:
 
         med, times = median_time(run, repeat=args.repeat, warmup=args.warmup)
         ds = result["ds"]
+
+        # the command-line path: the result file is written during the run (partial results
+        # after chunks of 50 frames, with the inputs' sha256 in its provenance)
+        out = folder / "motion.nc"
+        inputs = (paths["left"], paths["right"], bodies_path)
+        tc_cli = dataclasses.replace(tc, chunk_size=50)
+
+        def run_with_output():
+            out.unlink(missing_ok=True)
+            track_footage(
+                paths["left"],
+                paths["right"],
+                bodies=bodies,
+                calibration=rig.calibration,
+                config=tc_cli,
+                out=out,
+                inputs=inputs,
+            )
+
+        med_out, times_out = median_time(run_with_output, repeat=args.repeat, warmup=0)
+        result_mb = ds.nbytes / 1e6
         n_frames = ds.sizes["time"]
         n_points = int(np.median(ds["follower_n_points"] + ds["journal_n_points"]))
         v, vt = ds["follower_velocity"].values, truth["follower_velocity"].values
@@ -104,6 +129,12 @@ def main() -> None:
                 "cpu_time_s_runs_main_process": [round(t, 2) for t in result["cpu"]],
                 "note": "the machine is shared (see load average): CPU time is what the run "
                 "needed, wall time what it took here",
+                "wall_time_s_median_writing_output": round(med_out, 2),
+                "wall_time_s_runs_writing_output": [round(t, 2) for t in times_out],
+                "output_file_mb": round(out.stat().st_size / 1e6, 1),
+                "result_bytes_per_frame_pair": round(result_mb * 1e6 / n_frames),
+                "result_mb_for_10_minutes_extrapolated": round(result_mb * 30000 / n_frames),
+                "peak_rss_mb": round(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024),
                 "realtime_factor": round(args.seconds / med, 3),
                 "frames_per_second": round(n_frames / med, 1),
                 "target_s": 10.0,
