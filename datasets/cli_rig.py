@@ -36,6 +36,17 @@ def register(app: typer.Typer) -> None:
             list[int] | None, typer.Option(help="Frame index to duplicate (repeatable).")
         ] = None,
         seed: Annotated[int, typer.Option(help="Random seed.")] = 0,
+        board: Annotated[
+            str,
+            typer.Option(
+                help="Calibration board: chessboard, or charuco (10 x 8 squares of 25 mm, "
+                "18.75 mm DICT_5X5_100 markers)."
+            ),
+        ] = "chessboard",
+        board_legacy: Annotated[
+            bool,
+            typer.Option(help="ChArUco in the layout of OpenCV < 4.6 (boards printed from it)."),
+        ] = False,
         motion: Annotated[
             Path | None,
             typer.Option(
@@ -59,6 +70,8 @@ def register(app: typer.Typer) -> None:
             seed=seed,
             drop_frames=tuple(drop or ()),
             duplicate_frames=tuple(duplicate or ()),
+            board_kind=board,
+            board_legacy=board_legacy,
         )
         motion_ds = None
         if motion is not None:

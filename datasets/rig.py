@@ -102,6 +102,10 @@ class RigConfig:
     board_squares: tuple[int, int] = (10, 8)
     board_square_size: float = 0.025
     board_views: int = 12
+    board_kind: str = "chessboard"
+    board_marker_size: float = 0.01875
+    board_dictionary: str = "DICT_5X5_100"
+    board_legacy: bool = False
 
     def __post_init__(self) -> None:
         if self.width < 64 or self.height < 64:
@@ -110,6 +114,10 @@ class RigConfig:
             raise BadInputError("rig fps and duration must be positive")
         if self.motion_blur_samples < 1:
             raise BadInputError("motion_blur_samples must be >= 1")
+        if self.board_kind not in ("chessboard", "charuco"):
+            raise BadInputError(
+                f"board_kind {self.board_kind!r}: expected 'chessboard' or 'charuco'"
+            )
 
     @property
     def focal_px(self) -> float:
@@ -516,10 +524,33 @@ class VirtualRig:
         s = self.config.board_square_size
         return origin + R @ np.array([s, s, 0.0])
 
+    def _charuco_texture(self) -> tuple[np.ndarray, float]:
+        """The ChArUco board as OpenCV draws it (1-square white margin), box-filtered down to
+        about the camera's pixel footprint; and its texel size [m]."""
+        import cv2
+
+        if getattr(self, "_charuco_tex", None) is None:
+            c = self.config
+            sx, sy = c.board_squares
+            d = cv2.aruco.getPredefinedDictionary(getattr(cv2.aruco, c.board_dictionary.upper()))
+            board = cv2.aruco.CharucoBoard((sx, sy), c.board_square_size, c.board_marker_size, d)
+            board.setLegacyPattern(bool(c.board_legacy))
+            fine = 240  # texels per square, drawn
+            img = board.generateImage(((sx + 2) * fine, (sy + 2) * fine), marginSize=fine)
+            per_square = max(int(round(c.board_square_size / self.pixel_footprint)), 8)
+            per_square = min(per_square, fine)
+            img = cv2.resize(
+                img, ((sx + 2) * per_square, (sy + 2) * per_square), interpolation=cv2.INTER_AREA
+            )
+            self._charuco_tex = (img.astype(np.float32) / 255.0, c.board_square_size / per_square)
+        return self._charuco_tex
+
     def render_board(
         self, camera: str, R: np.ndarray, origin: np.ndarray, *, index: int = 0
     ) -> np.ndarray:
-        """Image of a chessboard (squares ``board_squares``, 1-square white margin)."""
+        """Image of the calibration board (squares ``board_squares``, 1-square white margin):
+        a chessboard rendered analytically (pixel-footprint anti-aliasing) or a ChArUco board
+        (``board_kind="charuco"``) drawn by OpenCV and mapped onto the board plane."""
         import cv2
 
         c = self.config
@@ -544,14 +575,26 @@ class VirtualRig:
             sign = np.where(k % 2 == 0, 1.0, -1.0)
             return np.clip(sign * np.minimum(frac, 1 - frac) * s / np.maximum(wpx, 1e-12), -1, 1)
 
-        gx_u = np.abs(np.gradient(bx, axis=1)) + np.abs(np.gradient(bx, axis=0))
-        gy_u = np.abs(np.gradient(by, axis=1)) + np.abs(np.gradient(by, axis=0))
-        val = 0.5 + 0.5 * tri(bx, 0.5 * gx_u) * tri(by, 0.5 * gy_u)
         white, black = 0.9, 0.08
-        img = black + (white - black) * val
         inside = (bx >= 0) & (bx <= sx * s) & (by >= 0) & (by <= sy * s)
         margin = (bx >= -s) & (bx <= (sx + 1) * s) & (by >= -s) & (by <= (sy + 1) * s) & ~inside
-        out = np.where(inside, img, np.where(margin, white, c.background / 255.0))
+        if c.board_kind == "charuco":
+            tex, texel = self._charuco_texture()
+            # texel centres: board coordinate (k + 0.5) * texel - s for texel k
+            mx = ((bx + s) / texel - 0.5).astype(np.float32)
+            my = ((by + s) / texel - 0.5).astype(np.float32)
+            val = cv2.remap(
+                tex, np.nan_to_num(mx, nan=-10.0), np.nan_to_num(my, nan=-10.0),
+                cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT, borderValue=1.0,
+            )  # fmt: skip
+            img = black + (white - black) * val
+            out = np.where(inside | margin, img, c.background / 255.0)
+        else:
+            gx_u = np.abs(np.gradient(bx, axis=1)) + np.abs(np.gradient(bx, axis=0))
+            gy_u = np.abs(np.gradient(by, axis=1)) + np.abs(np.gradient(by, axis=0))
+            val = 0.5 + 0.5 * tri(bx, 0.5 * gx_u) * tri(by, 0.5 * gy_u)
+            img = black + (white - black) * val
+            out = np.where(inside, img, np.where(margin, white, c.background / 255.0))
         out = np.where(tt > 0, out, c.background / 255.0)
         out = (out * 255.0 * c.exposure).astype(np.float32)
         if c.blur_sigma_px > 0:

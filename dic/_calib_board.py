@@ -69,16 +69,21 @@ class CalibrationBoard:
         pts = np.stack([gx.ravel(), gy.ravel(), np.zeros(gx.size)], axis=1)
         return pts * self.square_size
 
-    def _charuco(self):
+    def _charuco(self, legacy: bool = False):
+        """OpenCV's board; ``legacy``: the layout of OpenCV < 4.6 (and of boards printed from
+        it), which differs from the current one when ``squares_y`` is even."""
         import cv2
 
         name = self.dictionary.upper()
         if not hasattr(cv2.aruco, name):
             raise BadInputError(f"ArUco dictionary {self.dictionary!r} is unknown to OpenCV")
         d = cv2.aruco.getPredefinedDictionary(getattr(cv2.aruco, name))
-        return cv2.aruco.CharucoBoard(
+        board = cv2.aruco.CharucoBoard(
             (self.squares_x, self.squares_y), self.square_size, self.marker_size, d
         )
+        if legacy:
+            board.setLegacyPattern(True)
+        return board
 
 
 def detect_board(
@@ -113,11 +118,15 @@ def detect_board(
         if (corners[-1] - corners[0]) @ np.array([1.0, 1.0]) < 0:
             corners = corners[::-1].copy()
         return np.arange(len(corners)), corners
-    detector = cv2.aruco.CharucoDetector(board._charuco())
-    ch_corners, ch_ids, _, _ = detector.detectBoard(img)
-    if ch_ids is None or len(ch_ids) < 6:
-        return None
-    return ch_ids.ravel().astype(int), ch_corners.reshape(-1, 2).astype(np.float64)
+    # boards printed from OpenCV < 4.6 (or tools following it) with an even number of rows
+    # place their markers differently; their corners sit at the same board positions
+    layouts = (False, True) if board.squares_y % 2 == 0 else (False,)
+    for legacy in layouts:
+        detector = cv2.aruco.CharucoDetector(board._charuco(legacy))
+        ch_corners, ch_ids, _, _ = detector.detectBoard(img)
+        if ch_ids is not None and len(ch_ids) >= 6:
+            return ch_ids.ravel().astype(int), ch_corners.reshape(-1, 2).astype(np.float64)
+    return None
 
 
 def _read_gray(item, what: str) -> np.ndarray:
