@@ -28,6 +28,19 @@ _GREY_PIXEL_FORMATS = ("Y800", "GREY", "Y8  ")
 
 IMAGE_SUFFIXES = (".png", ".tif", ".tiff", ".bmp", ".jpg", ".jpeg", ".pgm", ".ppm")
 VIDEO_SUFFIXES = (".avi", ".mp4", ".mkv", ".mov", ".m4v", ".mpg", ".mpeg", ".wmv", ".webm")
+#: high-speed camera recording formats users meet (not readable by OpenCV)
+_CAMERA_RAW_FORMATS = {
+    ".cine": "Phantom (Vision Research)",
+    ".mraw": "Photron",
+    ".cih": "Photron",
+    ".cihx": "Photron",
+    ".seq": "NorPix StreamPix",
+    ".raw": "a camera",
+    ".tdms": "NI LabVIEW",
+    ".dng": "a raw-photo",
+    ".nef": "a raw-photo",
+    ".cr2": "a raw-photo",
+}
 _ADVICE = (
     "convert it to a format OpenCV's bundled FFmpeg reads, losslessly if possible, e.g. "
     "`ffmpeg -i IN -c:v ffv1 OUT.avi` (lossless) or export an image sequence (`ffmpeg -i IN "
@@ -400,9 +413,18 @@ def open_frames(
         return _open_tiff_stack(path, fps, what)
     suffix = path.suffix.lower()
     if suffix not in VIDEO_SUFFIXES:
+        camera = _CAMERA_RAW_FORMATS.get(suffix)
+        hint = (
+            f"'{suffix}' is {camera}'s own format, which OpenCV cannot read: export the "
+            "recording from the camera software as a numbered 8/16-bit TIFF sequence (or a "
+            "multi-page TIFF) and pass that; "
+            if camera
+            else ""
+        )
         raise BadInputError(
-            f"{what} '{path}': unsupported file type '{suffix}'; give a video "
-            f"({', '.join(VIDEO_SUFFIXES)}) or a folder of images ({', '.join(IMAGE_SUFFIXES)})"
+            f"{what} '{path}': unsupported file type '{suffix}'; {hint}give a video "
+            f"({', '.join(VIDEO_SUFFIXES)}), a multi-page TIFF, a folder of images "
+            f"({', '.join(IMAGE_SUFFIXES)}) or a pattern such as 'folder/*_0.tif'"
         )
     cap = cv2.VideoCapture(str(path), cv2.CAP_FFMPEG)
     try:

@@ -95,3 +95,10 @@ def test_frame_of_another_size_is_named(tmp_path):
     src = open_frames(tmp_path / "seq", fps=50.0)
     with pytest.raises(BadInputError, match=r"img_003.png' \(frame 3\) is 10 x 10 px"):
         list(src.frames())
+
+
+def test_high_speed_camera_formats_get_export_advice(tmp_path):
+    path = tmp_path / "run1.cine"
+    path.write_bytes(b"CI" + bytes(100))
+    with pytest.raises(BadInputError, match=r"Phantom.*export the recording.*TIFF sequence"):
+        open_frames(path, fps=1000.0)
