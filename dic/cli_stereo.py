@@ -9,21 +9,10 @@ import typer
 
 
 def _image_list(path: Path, what: str) -> list[Path]:
-    from jointwear.dic._video import IMAGE_SUFFIXES
-    from jointwear.errors import BadInputError
+    """Board images of one camera: a folder, or a pattern such as 'cal/*_0.tif'."""
+    from jointwear.dic._video import list_image_sequence
 
-    if not path.exists():
-        raise BadInputError(f"{what} '{path}' does not exist")
-    if path.is_dir():
-        from jointwear.dic._video import _natural_key
-
-        files = sorted(
-            (p for p in path.iterdir() if p.suffix.lower() in IMAGE_SUFFIXES), key=_natural_key
-        )
-        if not files:
-            raise BadInputError(f"{what} folder '{path}' holds no images")
-        return files
-    raise BadInputError(f"{what} '{path}' must be a folder of images")
+    return list_image_sequence(path, what=what)[0]
 
 
 def _video_frames(path: Path, every: int, what: str) -> list:
@@ -38,9 +27,19 @@ def register(app: typer.Typer) -> None:
 
     @app.command("calibrate")
     def calibrate(
-        left: Annotated[Path, typer.Option("--left", help="Left board images (folder) or video.")],
+        left: Annotated[
+            Path,
+            typer.Option(
+                "--left",
+                help="Left board images (folder or quoted pattern 'cal/*_0.tif') or video.",
+            ),
+        ],
         right: Annotated[
-            Path, typer.Option("--right", help="Right board images (folder) or video.")
+            Path,
+            typer.Option(
+                "--right",
+                help="Right board images (folder or quoted pattern 'cal/*_1.tif') or video.",
+            ),
         ],
         out: Annotated[Path, typer.Option("--out", "-o", help="Calibration file (.nc).")] = Path(
             "calibration.nc"
@@ -67,7 +66,7 @@ def register(app: typer.Typer) -> None:
         b = CalibrationBoard(
             board, squares[0], squares[1], square_mm * 1e-3, marker_mm * 1e-3, dictionary
         )
-        if left.is_dir():
+        if left.is_dir() or not left.exists():  # a folder, or a pattern like 'cal/*_0.tif'
             lefts, rights = (
                 _image_list(left, "left calibration"),
                 _image_list(right, "right calibration"),
@@ -121,12 +120,19 @@ def register(app: typer.Typer) -> None:
 
     @app.command("track")
     def track(
-        left: Annotated[Path, typer.Option("--left", help="Left video or image folder.")],
+        left: Annotated[
+            Path,
+            typer.Option(
+                "--left",
+                help="Left video, image folder, quoted pattern ('images/*_0.tif') or multi-page TIFF.",
+            ),
+        ],
         bodies: Annotated[
             Path, typer.Option("--bodies", help="TOML file with the regions of interest.")
         ],
         right: Annotated[
-            Path | None, typer.Option("--right", help="Right video or image folder.")
+            Path | None,
+            typer.Option("--right", help="Right footage, as --left (omit for one camera)."),
         ] = None,
         calibration: Annotated[
             Path | None, typer.Option("--calibration", "-c", help="Stereo calibration (.nc).")
@@ -149,6 +155,13 @@ def register(app: typer.Typer) -> None:
         chunk_size: Annotated[
             int | None, typer.Option(help="Frames per chunk (overrides the TOML).")
         ] = None,
+        resume: Annotated[
+            bool,
+            typer.Option(
+                help="Continue the partial result in --out of a run that stopped (same footage, "
+                "bodies and options)."
+            ),
+        ] = False,
     ) -> None:
         """Track the bodies of rig footage: poses, follower velocity, journal out-of-plane motion.
 
@@ -182,6 +195,7 @@ def register(app: typer.Typer) -> None:
             out=out,
             progress=True,
             inputs=tuple(inputs),
+            resume=resume,
         )
         dup = ds.attrs.get("duplicated_frames", "[]")
         typer.echo(

@@ -585,3 +585,59 @@ def test_resume_continues_a_stopped_run(small, tmp_path):
     assert np.array_equal(
         again["follower_velocity"].values, resumed["follower_velocity"].values, equal_nan=True
     )
+
+
+def test_cli_shared_folders_patterns_and_resume(small, tmp_path, capsys):
+    """Both cameras' images in one folder, named as VIC-3D does (name_<frame>_<camera>), selected
+    with patterns; a run stopped by a damaged frame is resumed from its partial result."""
+    import shutil
+
+    from jointwear.cli import main
+
+    cfg, written, out = small
+    cal_dir, run_dir = tmp_path / "cal", tmp_path / "run"
+    cal_dir.mkdir()
+    run_dir.mkdir()
+    for c, cam in enumerate(("left", "right")):
+        for i, f in enumerate(sorted((out / "calibration" / cam).iterdir())):
+            shutil.copy(f, cal_dir / f"CalB_{i + 1:04d}_{c}.png")
+        for f in sorted(written[f"{cam}_images"].iterdir()):
+            k = int(f.stem.split("_")[1])  # frame_000006 -> 6 (the dropped frame has no file)
+            shutil.copy(f, run_dir / f"Run-{k:04d}_{c}.png")
+    cal = tmp_path / "cal.nc"
+    args = ["--squares", *map(str, cfg.board_squares), "--square-mm", "25", "--out", str(cal)]
+    args += ["--world-view", str(cfg.board_views)]  # the board on the mechanism plane
+    both = ["--left", str(cal_dir / "*_0.png"), "--right", str(cal_dir / "*_1.png")]
+    assert main(["dic", "calibrate", *both, *args]) == 0
+    assert "calibrated from 8 views (0 rejected)" in capsys.readouterr().out
+    # the folder alone holds two cameras: refused with the pattern to use
+    assert main(["dic", "calibrate", "--left", str(cal_dir), "--right", str(cal_dir), *args]) == 3
+    assert "'folder/*_0.tif'" in capsys.readouterr().err
+
+    motion = tmp_path / "motion.nc"
+    track = ["dic", "track", "--left", str(run_dir / "*_0.png"), "--right"]
+    track += [str(run_dir / "*_1.png"), "--fps", "50", "--bodies", str(written["bodies"])]
+    track += ["-c", str(cal), "--out", str(motion)]
+    damaged = run_dir / "Run-0008_0.png"
+    good = damaged.read_bytes()
+    damaged.write_bytes(b"broken")
+    assert main(track) == 3
+    assert "frames processed before are saved" in capsys.readouterr().err
+    partial = io.load(motion)
+    assert partial.attrs["status"].startswith("stopped after 7 frames")  # frames 0-5, 7
+    damaged.write_bytes(good)
+    assert main([*track, "--resume"]) == 0
+    ds = io.load(motion)
+    assert (
+        ds.attrs["status"] == "complete" and ds.sizes["time"] == len(list(run_dir.iterdir())) // 2
+    )
+    # the dropped frame 6 is seen in the names' numbering; the duplicate 4 in the content
+    assert ds.attrs["dropped_frames_estimated"] == 1 and ds.attrs["duplicated_frames"] == "[4]"
+    # world frame = the board on the mechanism plane: positions against the truth
+    truth = io.load(written["truth"])
+    t = truth.sel(time=ds["time"].values)
+    origin = np.asarray(truth.attrs["world_board_origin_m"])
+    ok = np.all(np.isfinite(ds["follower_position"].values), axis=1)
+    assert ok.sum() == ds.sizes["time"] - 1  # all but the duplicated frame
+    perr = ds["follower_position"].values[ok] - (t["follower_position"].values[ok] - origin)
+    assert np.max(np.abs(perr)) < 3e-5
