@@ -396,8 +396,11 @@ def _json_list(value: Any) -> list[str]:
 def cardan_to_matrix(alpha_deg: float, beta_deg: float, gamma_deg: float) -> np.ndarray:
     """Rotation matrix ``Rz(gamma) @ Ry(beta) @ Rx(alpha)`` from Cardan angles [degree].
 
-    This is the convention of VIC-3D's ``cal.xml`` orientation (as implemented by Sandia's
-    DICe reader): the matrix takes world coordinates to camera coordinates.
+    This is the convention of the ``<orientation>`` of VIC-3D's ``cal.xml``/project files: the
+    matrix takes world coordinates to camera coordinates (``Xc = R X + t``). Sandia's DICe
+    builds the same matrix from a VIC-3D file (``eulers_to_rotation_matrix``), SDynPy's VIC-3D
+    reader its transpose as the camera-to-world matrix; real VIC-3D stereo matches fit it to
+    0.05 px (see :func:`read_vic3d_calibration`).
     """
     a, b, g = np.deg2rad([alpha_deg, beta_deg, gamma_deg])
     ca, sa, cb, sb, cg, sg = np.cos(a), np.sin(a), np.cos(b), np.sin(b), np.cos(g), np.sin(g)
@@ -416,6 +419,96 @@ def matrix_to_cardan(R: np.ndarray) -> tuple[float, float, float]:
 
 
 # ---- importers ------------------------------------------------------------------------------
+def _length_scale(length_unit: str | float) -> float:
+    """Metres per unit of ``length_unit`` (a unit name, or a number of metres per unit)."""
+    if isinstance(length_unit, str) and length_unit.strip() in _LENGTH_UNITS:
+        return _LENGTH_UNITS[length_unit.strip()]
+    try:
+        scale = float(length_unit)
+    except (TypeError, ValueError):
+        scale = float("nan")
+    if not (np.isfinite(scale) and scale > 0):
+        raise BadInputError(
+            f"length_unit {length_unit!r} is not known; use one of {', '.join(_LENGTH_UNITS)} "
+            "(the unit the calibration board's square size was given in), or the number of "
+            "metres per unit of T (e.g. 0.025 when T is in squares of a 25 mm board)"
+        )
+    return scale
+
+
+def _check_rotation(R: Any, where: str) -> np.ndarray:
+    """A proper rotation matrix from a 3x3 matrix or a Rodrigues vector, or a clear error."""
+    import cv2
+
+    arr = np.asarray(R, dtype=float)
+    if arr.size == 3:
+        if not np.all(np.isfinite(arr)):
+            raise BadInputError(
+                f"{where}: the Rodrigues rotation vector {arr.ravel()} is not finite"
+            )
+        arr = cv2.Rodrigues(arr.reshape(3, 1))[0]
+    if arr.shape != (3, 3) or not np.all(np.isfinite(arr)):
+        raise BadInputError(
+            f"{where}: expected a finite 3x3 rotation matrix or a 3-element Rodrigues vector, "
+            f"got shape {arr.shape}"
+        )
+    err = float(np.max(np.abs(arr @ arr.T - np.eye(3))))
+    det = float(np.linalg.det(arr))
+    if err > 1e-6 or abs(det - 1) > 1e-6:
+        kind = (
+            "a reflection (det = -1)" if det < 0 else f"not orthonormal (|R R^T - I| = {err:.2g})"
+        )
+        raise BadInputError(
+            f"{where} is not a rotation matrix: {kind}, det = {det:.6g}; check that the key holds "
+            "stereoCalibrate's R (left-to-right rotation), not R1/R2/P1/P2 or a transposed copy"
+        )
+    return arr
+
+
+#: Distortion vector lengths OpenCV writes (k1 k2 p1 p2 [k3 [k4 k5 k6 [s1..s4 [tauX tauY]]]]).
+_OPENCV_DIST_SIZES = (4, 5, 8, 12, 14)
+
+
+def _opencv_distortion(d: Any, where: str) -> np.ndarray:
+    arr = np.asarray(d, dtype=float).ravel()
+    if arr.size not in _OPENCV_DIST_SIZES:
+        raise BadInputError(
+            f"{where}: a distortion vector of {arr.size} coefficients; OpenCV writes 4, 5, 8, 12 "
+            "or 14 (k1 k2 p1 p2 [k3 [k4 k5 k6 [s1 s2 s3 s4 [tauX tauY]]]])"
+        )
+    if not np.all(np.isfinite(arr)):
+        raise BadInputError(f"{where}: the distortion coefficients {arr.tolist()} are not finite")
+    if arr.size > 8 and np.any(arr[8:] != 0):
+        raise BadInputError(
+            f"{where}: non-zero thin-prism/tilt coefficients (s1..s4, tauX, tauY = "
+            f"{arr[8:].tolist()}); jointwear's camera model has k1, k2, p1, p2, k3, k4, k5, k6 "
+            "only - recalibrate without CALIB_THIN_PRISM_MODEL/CALIB_TILTED_MODEL"
+        )
+    return arr[:8]
+
+
+def _check_lens(cam: Camera, where: str) -> None:
+    """Refuse a lens model whose radial mapping folds back within the image (undistortion would
+    be ambiguous): r_d = r * radial(r) must increase up to the farthest image corner."""
+    w, h = cam.image_size
+    K = cam.matrix
+    corners = np.array([[0, 0], [w, 0], [0, h], [w, h]], dtype=float) - K[:2, 2]
+    r_max = 1.05 * float(np.max(np.hypot(corners[:, 0] / K[0, 0], corners[:, 1] / K[1, 1])))
+    r = np.linspace(0.0, r_max, 2001)
+    k1, k2, _, _, k3, k4, k5, k6 = cam.distortion
+    r2 = r * r
+    rd = r * (1 + r2 * (k1 + r2 * (k2 + r2 * k3))) / (1 + r2 * (k4 + r2 * (k5 + r2 * k6)))
+    bad = np.flatnonzero(np.diff(rd) <= 0)
+    if bad.size:
+        r_fold = float(r[bad[0]])
+        raise BadInputError(
+            f"{where}: the lens distortion folds back at {r_fold:.3f} (normalised radius), inside "
+            f"the {w}x{h} px image (corner at {r_max / 1.05:.3f}); the coefficients "
+            f"{cam.distortion.tolist()} cannot be those of this camera - check the file and the "
+            "image size"
+        )
+
+
 _OPENCV_KEYS = {
     "K1": ("K1", "M1", "cameraMatrix1", "camera_matrix_left", "left_camera_matrix"),
     "D1": ("D1", "dist1", "distCoeffs1", "distortion_left", "left_distortion"),
@@ -426,44 +519,23 @@ _OPENCV_KEYS = {
 }
 
 
-def read_opencv_calibration(
-    path: str | Path,
-    *,
-    length_unit: str,
-    image_size: tuple[int, int] | None = None,
-) -> StereoCalibration:
-    """Import a stereo calibration saved by OpenCV (``cv::FileStorage`` YAML or XML).
+def _fs_array(node: Any) -> np.ndarray | None:
+    """A cv::FileNode as an array: an ``opencv-matrix``, a sequence of numbers or a number."""
+    if node.isSeq():
+        vals = [node.at(i).real() for i in range(node.size())]
+        return np.asarray(vals, dtype=float)
+    if node.isReal() or node.isInt():
+        return np.asarray([node.real()], dtype=float)
+    mat = node.mat()
+    return None if mat is None else np.asarray(mat, dtype=float)
 
-    The file holds the two intrinsic matrices and distortion vectors and ``stereoCalibrate``'s
-    ``R``, ``T`` (left-camera to right-camera). Accepted names: ``K1/M1/cameraMatrix1``,
-    ``D1/dist1/distCoeffs1``, ``K2/M2/cameraMatrix2``, ``D2/dist2/distCoeffs2``, ``R``, ``T``, and
-    ``image_width``/``image_height`` or ``image_size``/``imageSize``.
 
-    Parameters
-    ----------
-    path : path
-        The ``.yml``/``.yaml``/``.xml`` file.
-    length_unit : {"m", "mm", "cm", "um", "in"}
-        Unit of ``T`` (OpenCV uses whatever unit the board square size was given in; the file
-        does not say, so it must be stated).
-    image_size : (width, height), optional
-        Image size [pixel] when the file does not hold it.
-
-    Returns
-    -------
-    StereoCalibration
-        World frame = left camera frame.
-    """
+def _read_opencv_file(path: Path) -> tuple[dict[str, tuple[np.ndarray, str]], Any]:
+    """Keys of :data:`_OPENCV_KEYS` found in one FileStorage file, and its image size (or None)."""
     import cv2
 
-    path = Path(path)
     if not path.exists():
         raise BadInputError(f"OpenCV calibration file '{path}' does not exist")
-    if length_unit not in _LENGTH_UNITS:
-        raise BadInputError(
-            f"length_unit {length_unit!r} is not known; use one of {', '.join(_LENGTH_UNITS)} "
-            "(the unit the calibration board's square size was given in)"
-        )
     try:
         fs = cv2.FileStorage(str(path), cv2.FILE_STORAGE_READ)
         ok = fs.isOpened()
@@ -474,132 +546,339 @@ def read_opencv_calibration(
             f"'{path}' could not be read as an OpenCV FileStorage YAML/XML file; check that it "
             "starts with '%YAML:1.0' or '<?xml' and was written by cv::FileStorage"
         )
+    found: dict[str, tuple[np.ndarray, str]] = {}
+    size = None
     try:
-        found: dict[str, np.ndarray] = {}
         for key, names in _OPENCV_KEYS.items():
             for name in names:
                 node = fs.getNode(name)
                 if not node.empty():
-                    mat = node.mat()
-                    if mat is not None:
-                        found[key] = np.asarray(mat, dtype=float)
+                    arr = _fs_array(node)
+                    if arr is not None:
+                        found[key] = (arr, name)
                         break
-        size = image_size
-        if size is None:
-            w, h = fs.getNode("image_width"), fs.getNode("image_height")
-            if not w.empty() and not h.empty():
-                size = (int(w.real()), int(h.real()))
-            for name in ("image_size", "imageSize"):
-                node = fs.getNode(name)
-                if size is None and not node.empty():
-                    if node.isSeq():
-                        size = (int(node.at(0).real()), int(node.at(1).real()))
-                    else:
-                        m = node.mat()
-                        if m is not None:
-                            m = np.asarray(m).ravel()
-                            size = (int(m[0]), int(m[1]))
+        w, h = fs.getNode("image_width"), fs.getNode("image_height")
+        if not w.empty() and not h.empty():
+            size = (int(w.real()), int(h.real()))
+        for name in ("image_size", "imageSize"):
+            node = fs.getNode(name)
+            if size is None and not node.empty():
+                arr = _fs_array(node)
+                if arr is not None and arr.size >= 2:
+                    size = (int(arr.ravel()[0]), int(arr.ravel()[1]))
     finally:
         fs.release()
+    return found, size
+
+
+def read_opencv_calibration(
+    path: str | Path | list[str | Path] | tuple[str | Path, ...],
+    *,
+    length_unit: str | float,
+    image_size: tuple[int, int] | None = None,
+    extrinsics: str | Path | None = None,
+) -> StereoCalibration:
+    """Import a stereo calibration saved by OpenCV (``cv::FileStorage`` YAML or XML).
+
+    The file(s) hold the two intrinsic matrices and distortion vectors and ``stereoCalibrate``'s
+    ``R``, ``T`` (left-camera to right-camera: ``X_right = R X_left + T``). They may be split over
+    two files as OpenCV's ``stereo_calib`` sample writes them: ``intrinsics.yml`` (``M1 D1 M2
+    D2``) and ``extrinsics.yml`` (``R T R1 R2 P1 P2 Q``; the rectification entries are not used).
+    Accepted names: ``K1/M1/cameraMatrix1``, ``D1/dist1/distCoeffs1``, ``K2/M2/cameraMatrix2``,
+    ``D2/dist2/distCoeffs2``, ``R`` (3x3 matrix or Rodrigues vector), ``T``, and
+    ``image_width``/``image_height`` or ``image_size``/``imageSize``. Distortion vectors of 4, 5,
+    8, 12 or 14 coefficients are accepted; thin-prism and tilt terms must be zero.
+
+    Parameters
+    ----------
+    path : path, or list/tuple of paths
+        The ``.yml``/``.yaml``/``.xml``/``.json`` file, or several files whose keys are merged
+        (a key found in two files must have the same value in both).
+    length_unit : {"m", "mm", "cm", "um", "in"} or float
+        Unit of ``T``: OpenCV uses whatever unit the board square size was given in; the file
+        does not say, so it must be stated. A number is taken as metres per unit (e.g. ``0.025``
+        when ``stereo_calib`` ran with its default square size 1 on a 25 mm board).
+    image_size : (width, height), optional
+        Image size [pixel] when the files do not hold it (``stereo_calib`` does not write it).
+    extrinsics : path, optional
+        A further file to merge (the ``extrinsics.yml`` of ``stereo_calib``).
+
+    Returns
+    -------
+    StereoCalibration
+        World frame = left camera frame; translations in metres.
+    """
+    paths = [Path(p) for p in (path if isinstance(path, (list, tuple)) else [path])]
+    if extrinsics is not None:
+        paths.append(Path(extrinsics))
+    if not paths:
+        raise BadInputError("read_opencv_calibration: no file given")
+    scale = _length_scale(length_unit)
+    found: dict[str, tuple[np.ndarray, str, Path]] = {}
+    holds: dict[Path, list[str]] = {}
+    size = image_size
+    for p in paths:
+        keys, file_size = _read_opencv_file(p)
+        holds[p] = [name for _, name in keys.values()]
+        for key, (arr, name) in keys.items():
+            if key in found:
+                prev, prev_name, prev_path = found[key]
+                if prev.shape != arr.shape or not np.allclose(prev, arr, rtol=1e-9, atol=0):
+                    raise BadInputError(
+                        f"OpenCV calibration: {key} differs between '{prev_path}' ({prev_name}) "
+                        f"and '{p}' ({name}); pass files from one calibration only"
+                    )
+                continue
+            found[key] = (arr, name, p)
+        if size is None and file_size is not None:
+            size = file_size
+    names = " + ".join(f"'{p}'" for p in paths)
     missing = [k for k in _OPENCV_KEYS if k not in found]
     if missing:
+        held = "; ".join(
+            f"'{p.name}' holds {', '.join(h) if h else 'none of them'}" for p, h in holds.items()
+        )
         raise BadInputError(
-            f"OpenCV calibration '{path}' lacks {', '.join(missing)} (looked for "
+            f"OpenCV calibration {names} lacks {', '.join(missing)} (looked for "
             + "; ".join(f"{k}: {'/'.join(_OPENCV_KEYS[k])}" for k in missing)
-            + "); it must hold both cameras' matrices and distortion and stereoCalibrate's R and T"
+            + f"; {held}); it must hold both cameras' matrices and distortion and "
+            "stereoCalibrate's R and T - OpenCV's stereo_calib sample writes them to two files, "
+            "intrinsics.yml (M1 D1 M2 D2) and extrinsics.yml (R T): pass both"
         )
     if size is None:
         raise BadInputError(
-            f"OpenCV calibration '{path}' does not state the image size; pass image_size="
+            f"OpenCV calibration {names} does not state the image size; pass image_size="
             "(width, height) (CLI: --image-size W H)"
         )
-    R = found["R"]
-    if R.shape == (3, 1) or R.shape == (1, 3):
-        R = cv2.Rodrigues(R)[0]
-    T = found["T"].ravel() * _LENGTH_UNITS[length_unit]
-    left = Camera(found["K1"], found["D1"].ravel(), np.eye(3), np.zeros(3), size)
-    right = Camera(found["K2"], found["D2"].ravel(), R, T, size)
-    return StereoCalibration(left, right, source=f"opencv:{path.name}")
+    size = _check_image_size(size, f"OpenCV calibration {names}")
+
+    def where(key: str) -> str:
+        return f"OpenCV calibration '{found[key][2]}', {found[key][1]}"
+
+    mats = {}
+    for key in ("K1", "K2"):
+        K = found[key][0]
+        if K.shape != (3, 3) or not np.all(np.isfinite(K)):
+            raise BadInputError(
+                f"{where(key)}: expected a finite 3x3 camera matrix, got shape {K.shape}"
+            )
+        mats[key] = K
+    D1 = _opencv_distortion(found["D1"][0], where("D1"))
+    D2 = _opencv_distortion(found["D2"][0], where("D2"))
+    R = _check_rotation(found["R"][0], where("R"))
+    T = found["T"][0].ravel()
+    if T.size != 3 or not np.all(np.isfinite(T)):
+        raise BadInputError(f"{where('T')}: expected 3 finite values, got {T.tolist()}")
+    try:
+        left = Camera(mats["K1"], D1, np.eye(3), np.zeros(3), size)
+        right = Camera(mats["K2"], D2, R, T * scale, size)
+    except BadInputError as exc:
+        raise BadInputError(f"OpenCV calibration {names}: {exc}") from None
+    _check_lens(left, f"OpenCV calibration {names}, left camera")
+    _check_lens(right, f"OpenCV calibration {names}, right camera")
+    return StereoCalibration(left, right, source="opencv:" + "+".join(p.name for p in paths))
 
 
-_FLOAT = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
+def _check_image_size(size: Any, what: str) -> tuple[int, int]:
+    try:
+        w, h = (float(v) for v in size)
+    except (TypeError, ValueError):
+        raise BadInputError(f"{what}: image size {size!r} is not (width, height)") from None
+    if not (
+        np.isfinite(w) and np.isfinite(h) and w >= 1 and h >= 1 and w == int(w) and h == int(h)
+    ):
+        raise BadInputError(
+            f"{what}: image size {size!r} is not a positive whole (width, height) in pixels"
+        )
+    return int(w), int(h)
+
+
+def _vic3d_numbers(text: str | None, where: str) -> list[float]:
+    out = []
+    for tok in (text or "").replace(",", " ").split():
+        try:
+            out.append(float(tok))
+        except ValueError:
+            raise BadInputError(f"{where}: {tok!r} is not a number") from None
+    return out
+
+
+def _vic3d_root(path: Path) -> ET.Element:
+    """The XML of a VIC-3D cal.xml, project XML or ``.z3d`` project (zip holding project.xml),
+    with tag and attribute names lower-cased."""
+    import zipfile
+
+    if not path.exists():
+        raise BadInputError(f"VIC-3D calibration file '{path}' does not exist")
+    if zipfile.is_zipfile(path):
+        with zipfile.ZipFile(path) as zf:
+            xmls = [n for n in zf.namelist() if n.lower().endswith(".xml")]
+            xmls.sort(key=lambda n: (Path(n).name.lower() != "project.xml", len(n)))
+            if not xmls:
+                raise BadInputError(
+                    f"VIC-3D project '{path}' is a zip archive without an XML file (expected "
+                    "project.xml inside a .z3d); export the calibration as cal.xml from VIC-3D"
+                )
+            data = zf.read(xmls[0])
+            label = f"'{path}' ({xmls[0]})"
+    else:
+        data = path.read_bytes()
+        label = f"'{path}'"
+    data = re.sub(rb"<!DOCTYPE[^>\[]*(\[[^\]]*\])?\s*>", b"", data, count=1)
+    try:
+        root = ET.fromstring(data)
+    except ET.ParseError as exc:
+        raise BadInputError(
+            f"{label} is not well-formed XML ({exc}); is it a VIC-3D cal.xml or project file?"
+        ) from None
+    for el in root.iter():
+        if isinstance(el.tag, str):
+            el.tag = el.tag.rsplit("}", 1)[-1].lower()
+        el.attrib = {k.lower(): v for k, v in el.attrib.items()}
+    return root
 
 
 def read_vic3d_calibration(
     path: str | Path, *, image_size: tuple[int, int] | None = None
 ) -> StereoCalibration:
-    """Import the calibration of a VIC-3D project or calibration file (``cal.xml``/``.z3d`` XML).
+    """Import the calibration of a VIC-3D project or calibration file (``cal.xml``, project XML
+    or ``.z3d``).
 
-    VIC-3D stores, per camera, ``cx cy fx fy fs k1 k2 k3`` [pixel, pixel, pixel, pixel, pixel,
-    1, 1, 1] followed by ``<orientation>alpha beta gamma tx ty tz</orientation>`` with the
-    Cardan angles in degrees (world-to-camera rotation ``Rz(gamma) Ry(beta) Rx(alpha)``) and the
-    translation in millimetres. ``fs`` is taken as the skew term of the intrinsic matrix and
-    k1..k3 as radial coefficients of r², r⁴, r⁶ on normalised coordinates (the Brown model);
-    this is the reading of Sandia's DICe importer, which also has ``fs`` multiply the
-    normalised y. The image size is read from ``<polygonmask width= height=>`` when present.
+    VIC-3D stores, per ``<camera id=...>``, ``cx cy fx fy fs k1 k2 k3`` [pixel, pixel, pixel,
+    pixel, pixel, 1, 1, 1] followed by ``<orientation>alpha beta gamma tx ty tz</orientation>``
+    [degree, mm] (newer projects: ``<intrinsics>cx cy fx fy fs</intrinsics>``, ``<distortion>k1
+    k2 k3</distortion>`` and ``<orientation>``). They are read as:
+
+    * world-to-camera extrinsics ``Xc = R X + t`` with ``R = Rz(gamma) Ry(beta) Rx(alpha)``
+      (:func:`cardan_to_matrix`) and ``t = (tx, ty, tz)`` in millimetres (converted to metres);
+    * ``fs`` is the skew entry ``K[0, 1]`` of the intrinsic matrix [pixel] (``u = fx x_d + fs
+      y_d + cx``), not an angle;
+    * ``k1, k2, k3`` distort normalised coordinates radially,
+      ``x_d = x (1 + k1 r^2 + k2 r^4 + k3 r^6)`` with ``r^2 = x^2 + y^2`` - exactly OpenCV's
+      ``(k1, k2, 0, 0, k3)``, so the camera model is represented without fitting.
+
+    Evidence: with this reading, real image matches made by VIC-3D and by DICe with real VIC-3D
+    files triangulate to 0.02-0.05 px RMS (DICe's ``stereo_d_spec`` regression data: 0.054 px
+    over 27 points; VIC-3D's own start-point matches in DICe's ``stereo_list`` project: 0.025 px),
+    whereas any other rotation order or a camera-to-world reading gives 5-8 px. DICe imports
+    these coefficients as odd powers of the radius (``K1R1_K2R2_K3R3``, a radial displacement
+    ``k1 r + k2 r^2 + k3 r^3``), which leaves 82 px on the ``stereo_d_spec`` matches and makes
+    ``k1`` a copy of the focal length: that reading is not used.
+
+    The image size is read from ``<polygonmask width= height=>`` when present. Camera ``0``
+    becomes the ``left`` camera and camera ``1`` the ``right`` one, whatever their physical
+    placement (in VIC-3D's own example rigs camera 0 sits on the right, at +x).
+
+    Parameters
+    ----------
+    path : path
+        VIC-3D ``cal.xml``, project XML, ``.z3d`` project, or a file holding just the
+        ``<calibration>`` element. Tag case does not matter.
+    image_size : (width, height), optional
+        Image size [pixel], needed when the file has no ``<polygonmask>``.
 
     Returns
     -------
     StereoCalibration
-        Cameras in VIC-3D's world frame (converted to metres); camera 0 is the left camera.
+        Cameras in VIC-3D's world frame (converted to metres).
     """
     path = Path(path)
-    if not path.exists():
-        raise BadInputError(f"VIC-3D calibration file '{path}' does not exist")
-    text = path.read_text(encoding="latin-1", errors="replace")
-    text_nodoctype = re.sub(r"<!DOCTYPE[^>]*>", "", text)
-    try:
-        root = ET.fromstring(text_nodoctype)
-    except ET.ParseError as exc:
-        raise BadInputError(
-            f"'{path}' is not well-formed XML ({exc}); is it a VIC-3D cal.xml?"
-        ) from None
-    cams: dict[int, Camera] = {}
-    size = image_size
-    if size is None:
-        for node in root.iter():
-            if node.tag.lower() == "polygonmask" and "width" in node.attrib:
-                size = (int(float(node.attrib["width"])), int(float(node.attrib["height"])))
-                break
-    for node in root.iter():
-        if node.tag.lower() != "camera":
-            continue
-        ident = node.attrib.get("id", node.attrib.get("ID"))
-        orient = next((c for c in node if c.tag.lower() == "orientation"), None)
-        intr = [float(v) for v in re.findall(_FLOAT, node.text or "")]
-        if ident is None or orient is None or len(intr) < 8:
+    root = _vic3d_root(path)
+    cal = next((el for el in root.iter("calibration") if el.find(".//camera") is not None), root)
+    nodes = list(cal.iter("camera"))
+    cams: dict[str, tuple] = {}
+    for node in nodes:
+        ident = node.attrib.get("id")
+        where = f"VIC-3D calibration '{path}', camera {ident}"
+        orient = node.find("orientation")
+        intr_el, dist_el = node.find("intrinsics"), node.find("distortion")
+        intr = _vic3d_numbers(intr_el.text if intr_el is not None else node.text, where)
+        if ident is None or orient is None or len(intr) not in (5, 8):
             raise BadInputError(
-                f"VIC-3D calibration '{path}': a <camera> element must hold an id, eight "
-                "intrinsic values 'cx cy fx fy fs k1 k2 k3' and an <orientation> with 'alpha "
-                f"beta gamma tx ty tz'; found id={ident!r}, {len(intr)} values"
+                f"VIC-3D calibration '{path}': a <camera> element must hold an id, the eight "
+                "intrinsic values 'cx cy fx fy fs k1 k2 k3' (or <intrinsics>cx cy fx fy fs"
+                "</intrinsics> and <distortion>k1 k2 k3</distortion>) and an <orientation> with "
+                f"'alpha beta gamma tx ty tz'; found id={ident!r}, {len(intr)} intrinsic values"
+                f"{'' if orient is not None else ', no <orientation>'}"
             )
-        ext = [float(v) for v in re.findall(_FLOAT, orient.text or "")]
+        kappa = intr[5:8] if len(intr) == 8 else [0.0, 0.0, 0.0]
+        if dist_el is not None:
+            dist = _vic3d_numbers(dist_el.text, where + " <distortion>")
+            if len(dist) > 3:
+                raise BadInputError(
+                    f"{where}: <distortion> holds {len(dist)} values; jointwear knows VIC-3D's "
+                    "radial k1 k2 k3 (r^2, r^4, r^6) only - export the calibration as cal.xml "
+                    "(camera values 'cx cy fx fy fs k1 k2 k3'), or recalibrate without the "
+                    "extra distortion terms"
+                )
+            dist = dist + [0.0] * (3 - len(dist))
+            if len(intr) == 8 and not np.allclose(dist, kappa):
+                raise BadInputError(
+                    f"{where}: the distortion {dist} in <distortion> differs from the k1 k2 k3 "
+                    f"{kappa} after the intrinsics; the file is inconsistent"
+                )
+            kappa = dist
+        ext = _vic3d_numbers(orient.text, where + " <orientation>")
         if len(ext) != 6:
             raise BadInputError(
-                f"VIC-3D calibration '{path}', camera {ident}: <orientation> must hold 6 values "
-                f"(alpha beta gamma [deg], tx ty tz [mm]); found {len(ext)}"
+                f"{where}: <orientation> must hold 6 values (alpha beta gamma [deg], tx ty tz "
+                f"[mm]); found {len(ext)}"
             )
-        cx, cy, fx, fy, fs, k1, k2, k3 = intr[:8]
+        names = ("cx", "cy", "fx", "fy", "fs", "k1", "k2", "k3", "alpha", "beta", "gamma")
+        values = [*intr[:5], *kappa, *ext]
+        bad = [
+            n for n, v in zip((*names, "tx", "ty", "tz"), values, strict=True) if not np.isfinite(v)
+        ]
+        if bad:
+            raise BadInputError(
+                f"{where}: {', '.join(bad)} not finite (NaN/inf); the calibration in the file is "
+                "incomplete - recalibrate or export the calibration again from VIC-3D"
+            )
+        cx, cy, fx, fy, fs = intr[:5]
+        if fx <= 0 or fy <= 0:
+            raise BadInputError(f"{where}: focal lengths fx={fx}, fy={fy} must be positive [pixel]")
+        if ident in cams:
+            raise BadInputError(f"VIC-3D calibration '{path}': camera id {ident!r} appears twice")
         K = np.array([[fx, fs, cx], [0, fy, cy], [0, 0, 1.0]])
-        dist = np.array([k1, k2, 0.0, 0.0, k3])
-        R = cardan_to_matrix(*ext[:3])
-        t = np.array(ext[3:]) * 1e-3
-        cams[int(ident)] = (K, dist, R, t)
+        dist = np.array([kappa[0], kappa[1], 0.0, 0.0, kappa[2]])
+        cams[ident] = (K, dist, cardan_to_matrix(*ext[:3]), np.array(ext[3:]) * 1e-3)
     if len(cams) != 2:
         raise BadInputError(
-            f"VIC-3D calibration '{path}': expected 2 <camera> elements, found {len(cams)}; "
-            "export the stereo system's calibration (cal.xml) from VIC-3D"
+            f"VIC-3D calibration '{path}': expected 2 <camera> elements, found {len(cams)}"
+            + (f" (ids {', '.join(cams)})" if cams else "")
+            + "; export the stereo system's calibration (cal.xml) from VIC-3D"
         )
+    size = image_size
+    if size is None:
+        for node in root.iter("polygonmask"):
+            if "width" in node.attrib and "height" in node.attrib:
+                size = (node.attrib["width"], node.attrib["height"])
+                break
     if size is None:
         raise BadInputError(
             f"VIC-3D calibration '{path}' does not state the image size (no <polygonmask "
             "width= height=>); pass image_size=(width, height) (CLI: --image-size W H)"
         )
-    ids = sorted(cams)
-    left = Camera(*cams[ids[0]], size)
-    right = Camera(*cams[ids[1]], size)
+    size = _check_image_size(size, f"VIC-3D calibration '{path}'")
+    ids = sorted(cams, key=lambda s: (0, int(s)) if s.strip().lstrip("-").isdigit() else (1, s))
+    out = []
+    for ident, name in zip(ids, ("left", "right"), strict=True):
+        K = cams[ident][0]
+        where = f"VIC-3D calibration '{path}', camera {ident} ({name})"
+        if not (0 <= K[0, 2] <= size[0] and 0 <= K[1, 2] <= size[1]):
+            raise BadInputError(
+                f"{where}: principal point ({K[0, 2]:.1f}, {K[1, 2]:.1f}) px lies outside the "
+                f"{size[0]}x{size[1]} px image; the image size is wrong (pass the size of the "
+                "images VIC-3D calibrated with: --image-size W H)"
+            )
+        cam = Camera(*cams[ident], size)
+        _check_lens(cam, where)
+        out.append(cam)
     return StereoCalibration(
-        left, right, source=f"vic3d:{path.name}", world_frame="VIC-3D world frame"
+        out[0],
+        out[1],
+        source=f"vic3d:{path.name}",
+        world_frame="VIC-3D world frame (file in millimetres, here metres)",
     )
 
 
@@ -618,7 +897,7 @@ def read_calibration(path: str | Path) -> StereoCalibration:
             "`jointwear dic import-calibration --format opencv --length-unit mm` "
             "(or read_opencv_calibration)"
         )
-    if path.suffix.lower() == ".xml":
+    if path.suffix.lower() in (".xml", ".z3d"):
         raise BadInputError(
             f"'{path}' looks like a VIC-3D calibration; import it first with "
             "`jointwear dic import-calibration --format vic3d` (or read_vic3d_calibration)"
