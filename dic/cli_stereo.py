@@ -88,35 +88,58 @@ def register(app: typer.Typer) -> None:
 
     @app.command("import-calibration")
     def import_calibration(
-        path: Annotated[Path, typer.Argument(help="OpenCV YAML/XML or VIC-3D cal.xml file.")],
+        paths: Annotated[
+            list[Path],
+            typer.Argument(
+                help="OpenCV YAML/XML file(s) (stereo_calib: intrinsics.yml extrinsics.yml) or "
+                "one VIC-3D cal.xml / project XML / .z3d.",
+                show_default=False,
+            ),
+        ],
         fmt: Annotated[str, typer.Option("--format", help="opencv or vic3d.")],
         out: Annotated[Path, typer.Option("--out", "-o", help="Calibration file (.nc).")] = Path(
             "calibration.nc"
         ),
         length_unit: Annotated[
-            str | None, typer.Option(help="OpenCV: unit of T (m, mm, cm, um, in).")
+            str | None,
+            typer.Option(help="OpenCV: unit of T (m, mm, cm, um, in, or metres per unit)."),
         ] = None,
         image_size: Annotated[
             tuple[int, int] | None, typer.Option(help="Image width and height (px) if absent.")
+        ] = None,
+        extrinsics: Annotated[
+            Path | None,
+            typer.Option(
+                "--extrinsics", help="OpenCV: a second file with R and T (extrinsics.yml)."
+            ),
         ] = None,
     ) -> None:
         """Import a calibration made elsewhere (OpenCV FileStorage, VIC-3D) as a jointwear file."""
         from jointwear.dic._calib import read_opencv_calibration, read_vic3d_calibration
         from jointwear.errors import BadInputError
 
+        inputs = [*paths, *([extrinsics] if extrinsics is not None else [])]
         if fmt == "opencv":
             if length_unit is None:
                 raise BadInputError(
                     "--length-unit is required for OpenCV files (the unit of T, i.e. of the board "
-                    "square size used when calibrating: m, mm, cm, um or in)"
+                    "square size used when calibrating: m, mm, cm, um or in, or metres per unit)"
                 )
-            cal = read_opencv_calibration(path, length_unit=length_unit, image_size=image_size)
+            cal = read_opencv_calibration(inputs, length_unit=length_unit, image_size=image_size)
         elif fmt == "vic3d":
-            cal = read_vic3d_calibration(path, image_size=image_size)
+            if len(inputs) != 1:
+                raise BadInputError(
+                    f"--format vic3d takes one file (cal.xml, project XML or .z3d), got "
+                    f"{len(inputs)}: {', '.join(str(p) for p in inputs)}"
+                )
+            cal = read_vic3d_calibration(inputs[0], image_size=image_size)
         else:
             raise BadInputError(f"--format {fmt!r}: expected 'opencv' or 'vic3d'")
-        cal.save(out, inputs=[path], parameters={"format": fmt, "length_unit": length_unit})
-        typer.echo(f"imported {fmt} calibration (baseline {cal.baseline * 1e3:.2f} mm) -> {out}")
+        cal.save(out, inputs=inputs, parameters={"format": fmt, "length_unit": length_unit})
+        typer.echo(
+            f"imported {fmt} calibration ({cal.left.image_size[0]}x{cal.left.image_size[1]} px, "
+            f"baseline {cal.baseline * 1e3:.2f} mm) -> {out}"
+        )
 
     @app.command("track")
     def track(
