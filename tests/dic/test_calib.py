@@ -235,3 +235,381 @@ def test_import_calibration_cli(tmp_path, rig, capsys):
     # OpenCV files need the unit of T: exit code 3 and a message saying so
     assert main(["dic", "import-calibration", str(path), "--format", "opencv"]) == 3
     assert "--length-unit is required" in capsys.readouterr().err
+
+
+# ---- VIC-3D conventions checked against independent data -----------------------------------
+# Published reference numbers (facts to test against, not copied code) from Sandia's DICe
+# repository (github.com/dicengine/dice):
+#  * tests/regression/stereo_d_spec/cal.xml: a real VIC-3D calibration (per camera
+#    "cx cy fx fy fs k1 k2 k3" and <orientation>alpha beta gamma tx ty tz</orientation>);
+#  * tests/regression/stereo_d_spec/gold/DICe_solution_0.txt: DICe's image matches between the
+#    two cameras' images, COORDINATE_X/Y in camera 0 and CROSS_CORR_Q/R = disparity (the point
+#    is at (x + q, y + r) in camera 1, as VIC-3D's q, r); rows with MATCH 0;
+#  * tests/regression/stereo_list/cal.xml (= tests/component/cal/cal_a.xml): a real VIC-3D
+#    project; its <startpoint> entries hold VIC-3D's own automatic matches ("ref" guess in
+#    StaticB_0001_0.tif, "auto" guess in StaticB_0001_1.tif), its <coordinatetransformation
+#    name="OriginYAxis"> and, in <plotdata>, the X/Y/Z [mm] ranges VIC-3D showed for the data.
+_DSPEC_CAMERAS = (
+    "9.550537385e+02 6.452301624e+02 6.636033383e+03 6.636440175e+03 -5.693077075e-04 "
+    "-1.957515272e-04 8.739544595e-01 -2.691426143e+01",
+    "1.799332210e+02 9.415993919e+00 -5.775865407e-02 -5.820738494e+01 1.641145944e-01 "
+    "2.016820788e+01",
+    "9.713275619e+02 6.157965508e+02 6.609847619e+03 6.609166930e+03 7.051020868e-01 "
+    "-5.225966870e-03 1.077694686e+00 -3.005404073e+01",
+    "-1.799418875e+02 -9.416050875e+00 4.747312256e-02 5.984373321e+01 2.184759676e-01 "
+    "2.104719884e+01",
+)
+_DSPEC_MATCHES = np.array(  # x, y (camera 0), q, r [pixel]
+    [
+        [124, 624, -57.077, -44.673],
+        [124, 124, -54.752, -63.960],
+        [324, 324, -40.255, -52.329],
+        [424, 824, -36.508, -39.168],
+        [524, 124, -28.382, -52.008],
+        [624, 924, -27.957, -39.370],
+        [724, 124, -21.501, -46.232],
+        [924, 924, -22.388, -43.065],
+        [1024, 124, -19.007, -37.712],
+        [1224, 924, -25.866, -46.980],
+        [1324, 124, -25.478, -29.393],
+        [1424, 524, -31.247, -37.753],
+    ]
+)
+_CALA_CAMERAS = (
+    "6.389130236e+02 4.072947410e+02 2.468528613e+03 2.468253027e+03 -1.711976745e-01 "
+    "6.384132162e-02 0.000000000e+00 0.000000000e+00",
+    "1.799648062e+02 9.015158049e+00 3.368301490e-02 -6.322727157e+01 -3.371514296e-01 "
+    "1.870517821e+01",
+    "6.286069607e+02 3.945705260e+02 2.377107751e+03 2.376915841e+03 8.978417541e-02 "
+    "6.198448417e-02 0.000000000e+00 0.000000000e+00",
+    "-1.799590220e+02 -9.015133814e+00 -3.968800176e-02 6.484254707e+01 -8.762002049e-01 "
+    "1.534897551e+01",
+)
+_CALA_MATCHES = np.array(  # VIC-3D start points: camera 0 (x, y), camera 1 (x, y) [pixel]
+    [
+        [456, 121, 516.716, 104.7],
+        [544, 369, 571.169, 350.874],
+        [609, 326, 648.066, 309.293],
+        [611, 242, 637.642, 227.563],
+    ]
+)
+
+
+def _vic_file(cameras, size=None, root="project") -> str:
+    cams = "".join(
+        f'  <camera id="{i}">{cameras[2 * i]}<orientation>{cameras[2 * i + 1]}</orientation>\n'
+        "  </camera>\n"
+        for i in range(2)
+    )
+    cal = f'<calibration lri="calibration">\n{cams}</calibration>\n'
+    mask = (
+        f'<projectaois lri="projectaois"><aoinode><polygonmask width="{size[0]}" '
+        f'height="{size[1]}" lri="polygonmask"/></aoinode></projectaois>\n'
+        if size
+        else ""
+    )
+    head = '<?xml version="1.0" encoding="ISO-8859-1"?>\n<!DOCTYPE vpml>\n'
+    if root == "calibration":
+        return head + cal
+    return head + f'<project dir="C:/Users/x/cal">\n{cal}{mask}</project>\n'
+
+
+def _reprojection_rms(cal, uv0, uv1):
+    from jointwear.dic._stereo import triangulate
+
+    X, _, rep = triangulate(cal, uv0, uv1)
+    return float(np.sqrt(np.mean(rep**2))), X
+
+
+def test_vic3d_reading_reproduces_dice_stereo_matches(tmp_path):
+    # The decisive test: real matches between the two images of a real VIC-3D rig must
+    # triangulate (rays meet) with the cameras read from its cal.xml.
+    path = tmp_path / "cal.xml"
+    path.write_text(_vic_file(_DSPEC_CAMERAS), encoding="latin-1")
+    cal = read_vic3d_calibration(path, image_size=(1920, 1200))
+    uv0 = _DSPEC_MATCHES[:, :2]
+    uv1 = uv0 + _DSPEC_MATCHES[:, 2:]
+    rms, X = _reprojection_rms(cal, uv0, uv1)
+    assert rms < 0.08  # 0.054 px
+    # geometry: 123.2 mm baseline, the specimen ~368 mm in front of the cameras (VIC-3D world
+    # z towards the cameras), camera 0 at +x
+    assert cal.baseline == pytest.approx(0.12321, abs=5e-5)
+    assert np.all((X[:, 2] > -0.370) & (X[:, 2] < -0.365))
+    assert cal.left.centre[0] == pytest.approx(0.0607, abs=1e-3)
+    assert cal.right.centre[0] == pytest.approx(-0.0625, abs=1e-3)
+    # the skew is K[0, 1] in pixels, the distortion OpenCV's (k1, k2, 0, 0, k3)
+    assert cal.right.matrix[0, 1] == pytest.approx(0.7051020868)
+    assert np.allclose(cal.left.distortion[:5], [-1.957515272e-4, 0.8739544595, 0, 0, -26.91426143])
+
+    # the same matches refute the other readings: camera-to-world extrinsics, the transposed
+    # rotation, and DICe's K1R1_K2R2_K3R3 (displacement k1 r + k2 r^2 + k3 r^3)
+    def rebuilt(R_of, t_of):
+        cams = [
+            Camera(c.matrix, c.distortion, R_of(c), t_of(c), c.image_size)
+            for c in cal.cameras.values()
+        ]
+        return StereoCalibration(*cams)
+
+    inverse = rebuilt(lambda c: c.rotation.T, lambda c: -c.rotation.T @ c.translation)
+    transposed = rebuilt(lambda c: c.rotation.T, lambda c: c.translation)
+    assert _reprojection_rms(inverse, uv0, uv1)[0] > 3
+    assert _reprojection_rms(transposed, uv0, uv1)[0] > 3
+
+    def undistort_k1r1(cam, uv):
+        K, (k1, k2, _, _, k3) = cam.matrix, cam.distortion[:5]
+        yd = (uv[:, 1] - K[1, 2]) / K[1, 1]
+        xd = (uv[:, 0] - K[0, 2] - K[0, 1] * yd) / K[0, 0]
+        x, y = xd.copy(), yd.copy()
+        for _ in range(200):
+            r = np.hypot(x, y)
+            f = 1 + k1 + k2 * r + k3 * r * r
+            x, y = xd / f, yd / f
+        return np.stack([K[0, 0] * x + K[0, 1] * y + K[0, 2], K[1, 1] * y + K[1, 2]], axis=1)
+
+    pinhole = rebuilt(lambda c: c.rotation, lambda c: c.translation)
+    pinhole = StereoCalibration(
+        *(
+            Camera(c.matrix, np.zeros(5), c.rotation, c.translation, c.image_size)
+            for c in pinhole.cameras.values()
+        )
+    )
+    dice = _reprojection_rms(
+        pinhole, undistort_k1r1(cal.left, uv0), undistort_k1r1(cal.right, uv1)
+    )[0]
+    assert dice > 10  # 82 px
+
+
+def test_vic3d_reading_reproduces_vic3d_start_points(tmp_path):
+    path = tmp_path / "cal_a.xml"
+    path.write_text(_vic_file(_CALA_CAMERAS, (1280, 800)), encoding="latin-1")
+    cal = read_vic3d_calibration(path)
+    assert cal.left.image_size == (1280, 800)
+    rms, X = _reprojection_rms(cal, _CALA_MATCHES[:, :2], _CALA_MATCHES[:, 2:])
+    assert rms < 0.05  # 0.024 px
+    # VIC-3D's user frame "OriginYAxis" (angles [deg] as <orientation>, translation [mm]) puts
+    # these points inside the X, Y, Z ranges VIC-3D displayed for the project's data
+    P = X * 1e3 @ cardan_to_matrix(-10.171, 11.6143, 0.634145).T + [94.6272, 92.5599, 369.084]
+    lo, hi = np.array([-14.4737, -32.1463, -22.8467]), np.array([56.0786, 79.9236, 9.28465])
+    assert np.all((P > lo) & (P < hi))
+
+
+def test_vic3d_file_variants(tmp_path):
+    ref_path = tmp_path / "cal.xml"
+    ref_path.write_text(_vic_file(_CALA_CAMERAS, (1280, 800)))
+    ref = read_vic3d_calibration(ref_path)
+
+    def same(cal):
+        for name in ("left", "right"):
+            a, b = cal.cameras[name], ref.cameras[name]
+            assert np.allclose(a.matrix, b.matrix) and np.allclose(a.distortion, b.distortion)
+            assert np.allclose(a.rotation, b.rotation) and np.allclose(a.translation, b.translation)
+            assert a.image_size == b.image_size
+
+    # upper-case tags and attributes
+    upper = tmp_path / "upper.xml"
+    text = _vic_file(_CALA_CAMERAS, (1280, 800))
+    for tag in ("project", "calibration", "camera", "orientation", "projectaois", "aoinode"):
+        text = text.replace(f"<{tag}", f"<{tag.upper()}").replace(f"</{tag}", f"</{tag.upper()}")
+    text = text.replace("<polygonmask width", "<POLYGONMASK WIDTH").replace("height=", "HEIGHT=")
+    text = text.replace(' id="', ' ID="')
+    upper.write_text(text)
+    same(read_vic3d_calibration(upper))
+    # a file holding only the <calibration> element: image size from the caller
+    only = tmp_path / "only.xml"
+    only.write_text(_vic_file(_CALA_CAMERAS, root="calibration"))
+    with pytest.raises(
+        BadInputError, match=r"only.xml' does not state the image size.*--image-size"
+    ):
+        read_vic3d_calibration(only)
+    same(read_vic3d_calibration(only, image_size=(1280, 800)))
+    # a .z3d project (zip holding project.xml) in the newer layout with <intrinsics> and
+    # <distortion> elements
+    import zipfile
+
+    cams = ""
+    for i in range(2):
+        v = _CALA_CAMERAS[2 * i].split()
+        cams += (
+            f'<camera id="{i}"><intrinsics>{" ".join(v[:5])}</intrinsics>'
+            f"<distortion>{v[5]}</distortion><orientation>{_CALA_CAMERAS[2 * i + 1]}"
+            "</orientation></camera>"
+        )
+    project = (
+        f"<project><calibration>{cams}</calibration><projectaois><aoinode>"
+        '<polygonmask width="1280" height="800"/></aoinode></projectaois></project>'
+    )
+    z3d = tmp_path / "test.z3d"
+    with zipfile.ZipFile(z3d, "w") as zf:
+        zf.writestr("project.xml", project)
+    same(read_vic3d_calibration(z3d))
+    with pytest.raises(BadInputError, match="looks like a VIC-3D calibration"):
+        read_calibration(z3d)
+
+
+def test_vic3d_bad_files(tmp_path):
+    path = tmp_path / "cal.xml"
+
+    def fails(cameras, match, **kw):
+        path.write_text(_vic_file(cameras, kw.pop("size", (1280, 800))))
+        with pytest.raises(BadInputError, match=match):
+            read_vic3d_calibration(path, **kw)
+
+    nan = list(_CALA_CAMERAS)
+    nan[2] = nan[2].replace("2.377107751e+03", "nan")
+    fails(nan, r"cal.xml', camera 1: fx not finite \(NaN/inf\)")
+    short = list(_CALA_CAMERAS)
+    short[3] = "1 2 3"
+    fails(short, r"camera 1: <orientation> must hold 6 values .* found 3")
+    text = list(_CALA_CAMERAS)
+    text[0] = text[0].replace("6.389130236e+02", "x638")
+    fails(text, r"camera 0: 'x638' is not a number")
+    # principal point outside the stated image: wrong image size (e.g. binned images)
+    fails(
+        _CALA_CAMERAS,
+        r"principal point \(638.9, 407.3\) px lies outside the 640x400",
+        size=(640, 400),
+    )
+    # a distortion that folds back inside the image cannot be a real lens
+    fold = list(_CALA_CAMERAS)
+    fold[0] = fold[0].replace("6.384132162e-02", "-5.0")
+    fails(fold, r"camera 0 \(left\): the lens distortion folds back")
+    # three cameras, and a <distortion> with terms jointwear does not know
+    path.write_text(
+        _vic_file(_CALA_CAMERAS).replace(
+            "</calibration>",
+            f'<camera id="2">{_CALA_CAMERAS[0]}<orientation>'
+            f"{_CALA_CAMERAS[1]}</orientation></camera></calibration>",
+        )
+    )
+    with pytest.raises(
+        BadInputError, match=r"expected 2 <camera> elements, found 3 \(ids 0, 1, 2\)"
+    ):
+        read_vic3d_calibration(path, image_size=(1280, 800))
+    path.write_text(
+        "<calibration><camera id='0'><intrinsics>1 2 3 4 0</intrinsics><distortion>0.1 0 0 0.01"
+        " 0.02</distortion><orientation>0 0 0 0 0 0</orientation></camera></calibration>"
+    )
+    with pytest.raises(BadInputError, match=r"<distortion> holds 5 values"):
+        read_vic3d_calibration(path, image_size=(1280, 800))
+    path.write_text("<project><calibration><camera id='0'>1 2 3")
+    with pytest.raises(BadInputError, match="cal.xml' is not well-formed XML"):
+        read_vic3d_calibration(path)
+    with pytest.raises(BadInputError, match="does not exist"):
+        read_vic3d_calibration(tmp_path / "missing.xml")
+
+
+# ---- OpenCV files as people have them ---------------------------------------------------------
+def _write_fs(path, **entries):
+    import cv2
+
+    fs = cv2.FileStorage(str(path), cv2.FILE_STORAGE_WRITE)
+    for key, value in entries.items():
+        fs.write(key, value)
+    fs.release()
+
+
+def _stereo_calib_files(tmp_path, true, D1=None, R=None):
+    """intrinsics.yml and extrinsics.yml as OpenCV's samples/cpp/stereo_calib.cpp writes them
+    (T in millimetres here)."""
+    import cv2
+
+    Rlr, T = true.relative_pose
+    T_mm = T.reshape(3, 1) * 1e3
+    d1 = true.left.distortion[:5].reshape(1, 5) if D1 is None else D1
+    d2 = true.right.distortion[:5].reshape(1, 5)
+    R1, R2, P1, P2, Q, _, _ = cv2.stereoRectify(
+        true.left.matrix, d1[:, :5], true.right.matrix, d2, (640, 512), Rlr, T_mm
+    )
+    intr, extr = tmp_path / "intrinsics.yml", tmp_path / "extrinsics.yml"
+    _write_fs(intr, M1=true.left.matrix, D1=d1, M2=true.right.matrix, D2=d2)
+    _write_fs(extr, R=Rlr if R is None else R, T=T_mm, R1=R1, R2=R2, P1=P1, P2=P2, Q=Q)
+    return intr, extr
+
+
+def test_opencv_two_files_like_stereo_calib(tmp_path, rig):
+    true = rig.calibration
+    intr, extr = _stereo_calib_files(tmp_path, true)
+    X = np.array([[0.3, 0.2, 0.0], [0.1, 0.35, 0.01]])
+    Xl = true.left.world_to_camera(X)
+    for cal in (
+        read_opencv_calibration([intr, extr], length_unit="mm", image_size=(640, 512)),
+        read_opencv_calibration(intr, extrinsics=extr, length_unit="mm", image_size=(640, 512)),
+        read_opencv_calibration((extr, intr), length_unit=1e-3, image_size=(640, 512)),
+    ):
+        assert cal.baseline == pytest.approx(true.baseline, rel=1e-12)
+        assert np.allclose(cal.left.project(Xl), true.left.project(X), atol=1e-9)
+        assert np.allclose(cal.right.project(Xl), true.right.project(X), atol=1e-9)
+        assert cal.source in (
+            "opencv:intrinsics.yml+extrinsics.yml",
+            "opencv:extrinsics.yml+intrinsics.yml",
+        )
+    # which file lacks what
+    with pytest.raises(BadInputError, match=r"lacks R, T .*'intrinsics.yml' holds M1, D1, M2, D2"):
+        read_opencv_calibration(intr, length_unit="mm", image_size=(640, 512))
+    with pytest.raises(BadInputError, match=r"lacks K1, D1, K2, D2 .*'extrinsics.yml' holds R, T"):
+        read_opencv_calibration(extr, length_unit="mm", image_size=(640, 512))
+    # stereo_calib writes no image size
+    with pytest.raises(BadInputError, match=r"does not state the image size.*--image-size W H"):
+        read_opencv_calibration([intr, extr], length_unit="mm")
+    # the same key with two values in two files
+    other = tmp_path / "other.yml"
+    _write_fs(other, M1=true.left.matrix * 1.01, R=true.relative_pose[0], T=np.ones((3, 1)))
+    with pytest.raises(BadInputError, match=r"K1 differs between .*intrinsics.yml' \(M1\) and"):
+        read_opencv_calibration([intr, other], length_unit="mm", image_size=(640, 512))
+
+
+def test_opencv_distortion_lengths_and_rotation_forms(tmp_path, rig):
+    import cv2
+
+    true = rig.calibration
+    d = true.left.distortion
+    X = np.array([[0.3, 0.2, 0.0]])
+    for n in (4, 5, 8, 12, 14):
+        dn = np.zeros((1, n))
+        dn[0, : min(n, 8)] = d[: min(n, 8)]
+        sub = tmp_path / f"d{n}"
+        sub.mkdir()
+        intr, extr = _stereo_calib_files(sub, true, D1=dn)
+        cal = read_opencv_calibration([intr, extr], length_unit="mm", image_size=(640, 512))
+        ref = d.copy()
+        ref[min(n, 8) :] = 0
+        assert np.allclose(cal.left.distortion, ref)
+    # R as a Rodrigues vector
+    rvec = cv2.Rodrigues(true.relative_pose[0])[0]
+    intr, extr = _stereo_calib_files(tmp_path, true, R=rvec)
+    cal = read_opencv_calibration([intr, extr], length_unit="mm", image_size=(640, 512))
+    Xl = true.left.world_to_camera(X)
+    assert np.allclose(cal.right.project(Xl), true.right.project(X), atol=1e-6)
+    # refused: other vector lengths, non-zero thin-prism terms, matrices that are not rotations
+    for D1, match in (
+        (np.zeros((1, 6)), r"D1: a distortion vector of 6 coefficients; OpenCV writes 4, 5, 8, 12"),
+        (np.r_[d, 1e-3, 0, 0, 0].reshape(1, 12), r"non-zero thin-prism/tilt coefficients"),
+    ):
+        intr, extr = _stereo_calib_files(tmp_path, true, D1=D1)
+        with pytest.raises(BadInputError, match=match):
+            read_opencv_calibration([intr, extr], length_unit="mm", image_size=(640, 512))
+    for R, match in (
+        (np.diag([1.0, 1.0, -1.0]), r"extrinsics.yml', R is not a rotation matrix: a reflection"),
+        (true.relative_pose[0] * 1.01, r"R is not a rotation matrix: not orthonormal"),
+    ):
+        intr, extr = _stereo_calib_files(tmp_path, true, R=R)
+        with pytest.raises(BadInputError, match=match):
+            read_opencv_calibration([intr, extr], length_unit="mm", image_size=(640, 512))
+
+
+def test_import_calibration_cli_two_opencv_files(tmp_path, rig, capsys):
+    from jointwear.cli import main
+
+    true = rig.calibration
+    intr, extr = _stereo_calib_files(tmp_path, true)
+    out = tmp_path / "imported.nc"
+    args = ["--format", "opencv", "--length-unit", "mm", "--image-size", "640", "512", "-o"]
+    assert main(["dic", "import-calibration", str(intr), str(extr), *args, str(out)]) == 0
+    assert read_calibration(out).baseline == pytest.approx(true.baseline, rel=1e-12)
+    out2 = tmp_path / "imported2.nc"
+    cmd = ["dic", "import-calibration", str(intr), "--extrinsics", str(extr), *args, str(out2)]
+    assert main(cmd) == 0
+    assert read_calibration(out2).baseline == pytest.approx(true.baseline, rel=1e-12)
+    capsys.readouterr()
+    assert main(["dic", "import-calibration", str(intr), *args, str(out2)]) == 3
+    assert "lacks R, T" in capsys.readouterr().err
