@@ -758,12 +758,15 @@ def read_vic3d_calibration(
       ``(k1, k2, 0, 0, k3)``, so the camera model is represented without fitting.
 
     Evidence: with this reading, real image matches made by VIC-3D and by DICe with real VIC-3D
-    files triangulate to 0.02-0.05 px RMS (DICe's ``stereo_d_spec`` regression data: 0.054 px
-    over 27 points; VIC-3D's own start-point matches in DICe's ``stereo_list`` project: 0.025 px),
-    whereas any other rotation order or a camera-to-world reading gives 5-8 px. DICe imports
-    these coefficients as odd powers of the radius (``K1R1_K2R2_K3R3``, a radial displacement
-    ``k1 r + k2 r^2 + k3 r^3``), which leaves 82 px on the ``stereo_d_spec`` matches and makes
-    ``k1`` a copy of the focal length: that reading is not used.
+    files triangulate to 0.02-0.06 px RMS (DICe's ``stereo_d_spec`` regression data: 0.054 px
+    over 27 points; VIC-3D's own start-point matches in DICe's ``stereo_list`` project: 0.024 px),
+    whereas another rotation order, the transposed rotation or a camera-to-world reading gives
+    5-10 px. DICe imports these coefficients as odd powers of the radius (``K1R1_K2R2_K3R3``, a
+    radial displacement ``k1 r + k2 r^2 + k3 r^3``), which leaves 82 px on the ``stereo_d_spec``
+    matches and makes ``k1`` indistinguishable from a focal-length change: that reading is not
+    used. The skew unit and the direction of the distortion (distorting, not undistorting) are
+    not decided by those matches (< 0.02 px either way); they follow DICe's code and the usual
+    camera model.
 
     The image size is read from ``<polygonmask width= height=>`` when present. Camera ``0``
     becomes the ``left`` camera and camera ``1`` the ``right`` one, whatever their physical

@@ -330,7 +330,7 @@ def test_vic3d_reading_reproduces_dice_stereo_matches(tmp_path):
     uv0 = _DSPEC_MATCHES[:, :2]
     uv1 = uv0 + _DSPEC_MATCHES[:, 2:]
     rms, X = _reprojection_rms(cal, uv0, uv1)
-    assert rms < 0.08  # 0.054 px
+    assert rms < 0.08  # 0.062 px (0.054 px over all 27 matched rows of the gold file)
     # geometry: 123.2 mm baseline, the specimen ~368 mm in front of the cameras (VIC-3D world
     # z towards the cameras), camera 0 at +x
     assert cal.baseline == pytest.approx(0.12321, abs=5e-5)
@@ -352,8 +352,8 @@ def test_vic3d_reading_reproduces_dice_stereo_matches(tmp_path):
 
     inverse = rebuilt(lambda c: c.rotation.T, lambda c: -c.rotation.T @ c.translation)
     transposed = rebuilt(lambda c: c.rotation.T, lambda c: c.translation)
-    assert _reprojection_rms(inverse, uv0, uv1)[0] > 3
-    assert _reprojection_rms(transposed, uv0, uv1)[0] > 3
+    assert _reprojection_rms(inverse, uv0, uv1)[0] > 3  # 9.0 px
+    assert _reprojection_rms(transposed, uv0, uv1)[0] > 3  # 9.7 px
 
     def undistort_k1r1(cam, uv):
         K, (k1, k2, _, _, k3) = cam.matrix, cam.distortion[:5]
