@@ -454,6 +454,9 @@ def _check_rotation(R: Any, where: str) -> np.ndarray:
         )
     err = float(np.max(np.abs(arr @ arr.T - np.eye(3))))
     det = float(np.linalg.det(arr))
+    if err <= 1e-5 and det > 0:  # rounded when written: the nearest rotation
+        U, _, Vt = np.linalg.svd(arr)
+        return U @ Vt
     if err > 1e-6 or abs(det - 1) > 1e-6:
         kind = (
             "a reflection (det = -1)" if det < 0 else f"not orthonormal (|R R^T - I| = {err:.2g})"
@@ -489,11 +492,11 @@ def _opencv_distortion(d: Any, where: str) -> np.ndarray:
 
 def _check_lens(cam: Camera, where: str) -> None:
     """Refuse a lens model whose radial mapping folds back within the image (undistortion would
-    be ambiguous): r_d = r * radial(r) must increase up to the farthest image corner."""
+    be ambiguous there): r_d = r * radial(r) must increase up to the farthest image corner."""
     w, h = cam.image_size
     K = cam.matrix
     corners = np.array([[0, 0], [w, 0], [0, h], [w, h]], dtype=float) - K[:2, 2]
-    r_max = 1.05 * float(np.max(np.hypot(corners[:, 0] / K[0, 0], corners[:, 1] / K[1, 1])))
+    r_max = float(np.max(np.hypot(corners[:, 0] / K[0, 0], corners[:, 1] / K[1, 1])))
     r = np.linspace(0.0, r_max, 2001)
     k1, k2, _, _, k3, k4, k5, k6 = cam.distortion
     r2 = r * r
@@ -503,7 +506,7 @@ def _check_lens(cam: Camera, where: str) -> None:
         r_fold = float(r[bad[0]])
         raise BadInputError(
             f"{where}: the lens distortion folds back at {r_fold:.3f} (normalised radius), inside "
-            f"the {w}x{h} px image (corner at {r_max / 1.05:.3f}); the coefficients "
+            f"the {w}x{h} px image (corner at {r_max:.3f}); the coefficients "
             f"{cam.distortion.tolist()} cannot be those of this camera - check the file and the "
             "image size"
         )

@@ -580,6 +580,11 @@ def test_opencv_distortion_lengths_and_rotation_forms(tmp_path, rig):
     cal = read_opencv_calibration([intr, extr], length_unit="mm", image_size=(640, 512))
     Xl = true.left.world_to_camera(X)
     assert np.allclose(cal.right.project(Xl), true.right.project(X), atol=1e-6)
+    # R rounded when written (7 decimals) is taken as the nearest rotation
+    intr, extr = _stereo_calib_files(tmp_path, true, R=np.round(true.relative_pose[0], 7))
+    cal = read_opencv_calibration([intr, extr], length_unit="mm", image_size=(640, 512))
+    assert np.allclose(cal.right.rotation @ cal.right.rotation.T, np.eye(3), atol=1e-12)
+    assert np.allclose(cal.right.project(Xl), true.right.project(X), atol=1e-3)
     # refused: other vector lengths, non-zero thin-prism terms, matrices that are not rotations
     for D1, match in (
         (np.zeros((1, 6)), r"D1: a distortion vector of 6 coefficients; OpenCV writes 4, 5, 8, 12"),
