@@ -767,9 +767,11 @@ def read_vic3d_calibration(
     5-10 px. DICe imports these coefficients as odd powers of the radius (``K1R1_K2R2_K3R3``, a
     radial displacement ``k1 r + k2 r^2 + k3 r^3``), which leaves 82 px on the ``stereo_d_spec``
     matches and makes ``k1`` indistinguishable from a focal-length change: that reading is not
-    used. The skew unit and the direction of the distortion (distorting, not undistorting) are
-    not decided by those matches (< 0.02 px either way); they follow DICe's code and the usual
-    camera model.
+    used. In the plane-fit frame stored in that VIC-3D project the flat specimen comes out within
+    0.11 mm of Z = 0 (VIC-3D's own points: -0.014..0.020 mm); ``fs`` read as an angle in degrees
+    would spread it over 1.8 mm. Whether k1..k3 distort or undistort is not decided by these
+    data (< 0.02 px either way, the distorting form fitting slightly better); it follows the
+    usual camera model.
 
     The image size is read from ``<polygonmask width= height=>`` when present. Camera ``0``
     becomes the ``left`` camera and camera ``1`` the ``right`` one, whatever their physical

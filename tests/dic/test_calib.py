@@ -242,6 +242,8 @@ def test_import_calibration_cli(tmp_path, rig, capsys):
 # repository (github.com/dicengine/dice):
 #  * tests/regression/stereo_d_spec/cal.xml: a real VIC-3D calibration (per camera
 #    "cx cy fx fy fs k1 k2 k3" and <orientation>alpha beta gamma tx ty tz</orientation>);
+#    The same project's <coordinatetransformation name="GT4OriginXAxis"> is VIC-3D's plane fit
+#    to the flat specimen: in that frame VIC-3D's own reference Z spans -0.014..0.020 mm;
 #  * tests/regression/stereo_d_spec/gold/DICe_solution_0.txt: DICe's image matches between the
 #    two cameras' images, COORDINATE_X/Y in camera 0 and CROSS_CORR_Q/R = disparity (the point
 #    is at (x + q, y + r) in camera 1, as VIC-3D's q, r); rows with MATCH 0;
@@ -340,6 +342,34 @@ def test_vic3d_reading_reproduces_dice_stereo_matches(tmp_path):
     # the skew is K[0, 1] in pixels, the distortion OpenCV's (k1, k2, 0, 0, k3)
     assert cal.right.matrix[0, 1] == pytest.approx(0.7051020868)
     assert np.allclose(cal.left.distortion[:5], [-1.957515272e-4, 0.8739544595, 0, 0, -26.91426143])
+
+    # in VIC-3D's plane-fit frame the specimen is flat: |Z| < 0.11 mm here (VIC-3D: -0.014..0.020
+    # mm over its own points; the 0.03-0.1 mm difference is 0.2-0.6 px of disparity). Reading fs
+    # as a skew angle in degrees instead of pixels tilts the plane by 1.8 mm.
+    def plane_z(X):
+        R = cardan_to_matrix(-0.420005, 0.636599, 0.0196829)
+        return (X * 1e3 @ R.T + [33.3455, -24.7042, 367.299])[:, 2]
+
+    assert np.all(np.abs(plane_z(X)) < 0.15)
+    degrees = StereoCalibration(
+        *(
+            Camera(
+                c.matrix
+                + [
+                    [0, c.matrix[0, 0] * np.tan(np.radians(c.matrix[0, 1])) - c.matrix[0, 1], 0],
+                    [0, 0, 0],
+                    [0, 0, 0],
+                ],
+                c.distortion,
+                c.rotation,
+                c.translation,
+                c.image_size,
+            )
+            for c in cal.cameras.values()
+        )
+    )
+    z_deg = plane_z(_reprojection_rms(degrees, uv0, uv1)[1])
+    assert np.ptp(z_deg) > 1.0
 
     # the same matches refute the other readings: camera-to-world extrinsics, the transposed
     # rotation, and DICe's K1R1_K2R2_K3R3 (displacement k1 r + k2 r^2 + k3 r^3)
