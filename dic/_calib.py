@@ -525,8 +525,15 @@ _OPENCV_KEYS = {
 def _fs_array(node: Any) -> np.ndarray | None:
     """A cv::FileNode as an array: an ``opencv-matrix``, a sequence of numbers or a number."""
     if node.isSeq():
-        vals = [node.at(i).real() for i in range(node.size())]
-        return np.asarray(vals, dtype=float)
+        items = [node.at(i) for i in range(node.size())]
+        if items and all(item.isSeq() for item in items):  # nested lists: rows of a matrix
+            rows = [_fs_array(item) for item in items]
+            if any(r is None for r in rows) or len({r.size for r in rows}) != 1:
+                return None
+            return np.stack([r.ravel() for r in rows])
+        if not all(item.isReal() or item.isInt() for item in items):
+            return None
+        return np.asarray([item.real() for item in items], dtype=float)
     if node.isReal() or node.isInt():
         return np.asarray([node.real()], dtype=float)
     mat = node.mat()

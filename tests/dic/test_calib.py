@@ -610,6 +610,17 @@ def test_opencv_distortion_lengths_and_rotation_forms(tmp_path, rig):
     cal = read_opencv_calibration([intr, extr], length_unit="mm", image_size=(640, 512))
     Xl = true.left.world_to_camera(X)
     assert np.allclose(cal.right.project(Xl), true.right.project(X), atol=1e-6)
+    # a hand-written YAML: plain (nested) lists instead of opencv-matrix nodes
+    hand = tmp_path / "hand.yml"
+    hand.write_text(
+        "%YAML:1.0\n---\nK1: [[1000, 0, 320], [0, 1000, 240], [0, 0, 1]]\nD1: [0.1, 0, 0, 0]\n"
+        "K2: [[1000, 0, 320], [0, 1000, 240], [0, 0, 1]]\nD2: [0.1, 0, 0, 0, 0]\n"
+        "R: [0.0, 0.2, 0.0]\nT: [-100, 0, 10]\nimage_width: 640\nimage_height: 480\n"
+    )
+    cal = read_opencv_calibration(hand, length_unit="mm")
+    assert cal.left.matrix[0, 2] == 320 and cal.left.image_size == (640, 480)
+    assert cal.right.rotation == pytest.approx(cv2.Rodrigues(np.array([0.0, 0.2, 0.0]))[0])
+    assert cal.baseline == pytest.approx(np.hypot(0.1, 0.01))
     # R rounded when written (7 decimals) is taken as the nearest rotation
     intr, extr = _stereo_calib_files(tmp_path, true, R=np.round(true.relative_pose[0], 7))
     cal = read_opencv_calibration([intr, extr], length_unit="mm", image_size=(640, 512))
