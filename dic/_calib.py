@@ -756,8 +756,10 @@ def read_vic3d_calibration(
 
     VIC-3D stores, per ``<camera id=...>``, ``cx cy fx fy fs k1 k2 k3`` [pixel, pixel, pixel,
     pixel, pixel, 1, 1, 1] followed by ``<orientation>alpha beta gamma tx ty tz</orientation>``
-    [degree, mm] (newer projects: ``<intrinsics>cx cy fx fy fs</intrinsics>``, ``<distortion>k1
-    k2 k3</distortion>`` and ``<orientation>``). They are read as:
+    [degree, mm]. Newer ``.z3d`` projects split them into ``<intrinsics>cx cy fx fy fs
+    </intrinsics>``, ``<distortion>`` and ``<orientation>`` (the element names SDynPy's VIC-3D
+    reader uses); ``<distortion>`` is taken to hold ``k1 [k2 [k3]]`` and more values are refused.
+    They are read as:
 
     * world-to-camera extrinsics ``Xc = R X + t`` with ``R = Rz(gamma) Ry(beta) Rx(alpha)``
       (:func:`cardan_to_matrix`) and ``t = (tx, ty, tz)`` in millimetres (converted to metres);
@@ -782,7 +784,7 @@ def read_vic3d_calibration(
 
     The image size is read from ``<polygonmask width= height=>`` when present. Camera ``0``
     becomes the ``left`` camera and camera ``1`` the ``right`` one, whatever their physical
-    placement (in VIC-3D's own example rigs camera 0 sits on the right, at +x).
+    placement (in the two real VIC-3D rigs checked, camera 0 sits on the right, at +x).
 
     Parameters
     ----------
