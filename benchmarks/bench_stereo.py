@@ -92,7 +92,9 @@ def main() -> None:
         # after chunks of 50 frames, with the inputs' sha256 in its provenance)
         out = folder / "motion.nc"
         inputs = (paths["left"], paths["right"], bodies_path)
-        tc_cli = dataclasses.replace(tc, chunk_size=50)
+        # (the command line's default chunks of 50 frames; worker processes keep their chunks
+        # of 250 frames, since each chunk re-prepares the references)
+        tc_cli = dataclasses.replace(tc, chunk_size=50) if args.workers == 1 else tc
 
         def run_with_output():
             out.unlink(missing_ok=True)
