@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import importlib
 import pkgutil
+from typing import Any
 
-import click
 import typer
 from typer.core import TyperGroup
 
@@ -16,10 +16,12 @@ class CommandGroup(TyperGroup):
     """A group whose callback is the command itself (``jointwear compare A B``): while it has
     no sub-commands its usage line shows no ``COMMAND [ARGS]...``."""
 
-    def collect_usage_pieces(self, ctx: click.Context) -> list[str]:
-        if self.commands:
-            return super().collect_usage_pieces(ctx)
-        return click.Command.collect_usage_pieces(self, ctx)
+    def collect_usage_pieces(self, ctx: Any) -> list[str]:
+        # (Click itself is not imported: Typer >= 0.26 vendors it and no longer installs it)
+        pieces = super().collect_usage_pieces(ctx)
+        if not self.commands and pieces and pieces[-1] == self.subcommand_metavar:
+            pieces = pieces[:-1]
+        return pieces
 
 
 def discover_commands(app: typer.Typer, package: str) -> None:
