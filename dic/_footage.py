@@ -877,15 +877,14 @@ def _load_partial(out, L: FrameSource, R: FrameSource | None, cfg, bodies) -> xr
             problems.append(
                 f"{name} footage was '{prev.attrs.get(f'{name}_footage', '')}', now '{want}'"
             )
-    params = io.parse_provenance(prev).get("parameters", {})
-    old_track = {k: v for k, v in params.get("track", {}).items() if k not in _RESUMABLE_CHANGES}
-    new_track = {k: v for k, v in asdict(cfg).items() if k not in _RESUMABLE_CHANGES}
-    new_track = json.loads(json.dumps(new_track))
+    old = io.parse_provenance(prev).get("parameters", {})
+    new = json.loads(json.dumps(_parameters(cfg, bodies)))  # as the file records them
+    old_track = {k: v for k, v in old.get("track", {}).items() if k not in _RESUMABLE_CHANGES}
+    new_track = {k: v for k, v in new["track"].items() if k not in _RESUMABLE_CHANGES}
     for key in sorted(set(old_track) | set(new_track)):
         if old_track.get(key) != new_track.get(key):
             problems.append(f"track.{key} was {old_track.get(key)!r}, now {new_track.get(key)!r}")
-    new_bodies = json.loads(json.dumps([asdict(b) for b in bodies]))
-    if params.get("bodies") != new_bodies:
+    if old.get("bodies") != new["bodies"]:
         problems.append("the bodies (regions of interest) differ")
     if problems:
         raise BadInputError(
@@ -914,10 +913,8 @@ def _restore_rows(prev: xr.Dataset, states, times, flags, duplicates, stereo: bo
                 f"{n_ref} (or other reference positions) now; the reference frames or the "
                 "calibration differ - run again without resume"
             )
-        d = st.ref3d.shape[1]
         columns = {
             "R": prev[f"{name}_rotation"].values,
-            "t": np.full((prev.sizes["time"], d), np.nan),
             "poi": prev[f"{name}{img}_position"].values,
             "poi_u": prev[f"{name}{img}_position_u"].values,
             "n": prev[f"{name}_n_points"].values,
@@ -1204,7 +1201,6 @@ def _finish_frame(states, fr, cfg, calibration, speculative) -> tuple[int, bool]
                 np.full((d, d), np.nan),
                 np.full(d, np.nan),
                 np.full(d, np.nan),
-                np.full(d, np.nan),
                 0,
                 np.nan,
                 np.full((n, d), np.nan, np.float32),
@@ -1259,7 +1255,6 @@ def _finish_frame(states, fr, cfg, calibration, speculative) -> tuple[int, bool]
         _append_row(
             st,
             Rm,
-            tv,
             poi,
             u,
             n_in,
@@ -1278,11 +1273,10 @@ def _failed_pose(d: int, n: int) -> tuple:
             np.full((n, d), np.nan), None, None, None, np.full(n, np.nan))  # fmt: skip
 
 
-def _append_row(st, Rm, tv, poi, u, n_in, rms, cur, cur_u, zncc) -> None:
+def _append_row(st, Rm, poi, u, n_in, rms, cur, cur_u, zncc) -> None:
     row = st.rows
     for key, val in (
         ("R", Rm),
-        ("t", tv),
         ("poi", poi),
         ("poi_u", u),
         ("n", n_in),
@@ -1335,6 +1329,11 @@ def _body_pose(st, left, right, cfg, calibration):
     return True, Rm, tv, inl, rms, cur, cov, pl, pr, zn
 
 
+def _parameters(cfg: TrackConfig, bodies) -> dict[str, Any]:
+    """The parameters recorded in a tracking result's provenance (and checked on resume)."""
+    return {"track": asdict(cfg), "bodies": [asdict(b) for b in bodies]}
+
+
 def _write(ds: xr.Dataset, out, inputs, cfg, bodies) -> None:
     from jointwear import io
 
@@ -1342,7 +1341,7 @@ def _write(ds: xr.Dataset, out, inputs, cfg, bodies) -> None:
         ds,
         out,
         inputs=inputs,
-        parameters={"track": asdict(cfg), "bodies": [asdict(b) for b in bodies]},
+        parameters=_parameters(cfg, bodies),
         source="jointwear (dic.track)",
     )
 
