@@ -84,10 +84,10 @@ def read_frames(
             )
         return [np.asarray(f) for f in source[sel]], None
     if isinstance(source, (str, Path)):
-        from jointwear.dic._video import _GLOB_CHARS, list_image_sequence
+        from jointwear.dic._video import is_image_sequence, list_image_sequence
 
         path = Path(source)
-        if path.is_dir() or (not path.exists() and _GLOB_CHARS.search(path.name)):
+        if is_image_sequence(source):
             # sorted by the frame number in the names (frame_9 before frame_10)
             files, _ = list_image_sequence(source, what="frames source")
             return [read_image(p) for p in files[sel]], None

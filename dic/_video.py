@@ -17,6 +17,7 @@ __all__ = [
     "FrameSource",
     "open_frames",
     "check_stereo_pair",
+    "is_image_sequence",
     "list_image_sequence",
     "prefetch",
     "IMAGE_SUFFIXES",
@@ -277,6 +278,13 @@ def _natural_key(p: Path):
 _GLOB_CHARS = re.compile(r"[*?\[]")
 
 
+def is_image_sequence(path: str | Path) -> bool:
+    """Whether ``path`` names an image sequence: a folder, or a glob pattern (``"images/*_0.tif"``)
+    that is not itself an existing file's name."""
+    p = Path(path)
+    return p.is_dir() or (not p.exists() and _GLOB_CHARS.search(p.name) is not None)
+
+
 def _frame_numbers(files: list[Path]) -> tuple[np.ndarray | None, str]:
     """The frame counter in the file names, and a note on other numbers that vary.
 
@@ -386,7 +394,7 @@ def open_frames(
 
     path_str = str(path)
     path = Path(path)
-    if path.is_dir() or (not path.exists() and _GLOB_CHARS.search(path.name)):
+    if is_image_sequence(path_str):
         files, numbers = list_image_sequence(path_str, what=what)
         if fps is None or not fps > 0:
             raise BadInputError(

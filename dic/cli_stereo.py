@@ -61,12 +61,13 @@ def register(app: typer.Typer) -> None:
         """Calibrate a stereo pair from simultaneous views of a chessboard or ChArUco board."""
         from jointwear import io
         from jointwear.dic._calib_board import CalibrationBoard, calibrate_stereo
+        from jointwear.dic._video import is_image_sequence
 
         io.check_writable(out)
         b = CalibrationBoard(
             board, squares[0], squares[1], square_mm * 1e-3, marker_mm * 1e-3, dictionary
         )
-        if left.is_dir() or not left.exists():  # a folder, or a pattern like 'cal/*_0.tif'
+        if is_image_sequence(left):  # a folder, or a pattern like 'cal/*_0.tif'
             lefts, rights = (
                 _image_list(left, "left calibration"),
                 _image_list(right, "right calibration"),
