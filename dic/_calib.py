@@ -841,11 +841,10 @@ def read_vic3d_calibration(
                 f"{where}: <orientation> must hold 6 values (alpha beta gamma [deg], tx ty tz "
                 f"[mm]); found {len(ext)}"
             )
-        names = ("cx", "cy", "fx", "fy", "fs", "k1", "k2", "k3", "alpha", "beta", "gamma")
+        names = ("cx", "cy", "fx", "fy", "fs", "k1", "k2", "k3", "alpha", "beta", "gamma", "tx",
+                 "ty", "tz")  # fmt: skip
         values = [*intr[:5], *kappa, *ext]
-        bad = [
-            n for n, v in zip((*names, "tx", "ty", "tz"), values, strict=True) if not np.isfinite(v)
-        ]
+        bad = [n for n, v in zip(names, values, strict=True) if not np.isfinite(v)]
         if bad:
             raise BadInputError(
                 f"{where}: {', '.join(bad)} not finite (NaN/inf); the calibration in the file is "

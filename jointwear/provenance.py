@@ -55,12 +55,10 @@ def sha256_file(path: str | Path, *, chunk: int = 1 << 20) -> str:
     the same.
     """
     path = Path(path)
-    h = hashlib.sha256()
     if path.is_dir():
-        for sub in sorted(p for p in path.rglob("*") if p.is_file()):
-            h.update(str(sub.relative_to(path)).encode())
-            h.update(sha256_file(sub).encode())
-        return h.hexdigest()
+        files = sorted(p for p in path.rglob("*") if p.is_file())
+        return _files_digest((str(sub.relative_to(path)), sub) for sub in files)
+    h = hashlib.sha256()
     st = path.stat()
     key = (str(path.resolve()), st.st_ino, st.st_size, st.st_mtime_ns)
     digest = _DIGESTS.get(key)
@@ -70,6 +68,15 @@ def sha256_file(path: str | Path, *, chunk: int = 1 << 20) -> str:
                 h.update(block)
         digest = _DIGESTS[key] = h.hexdigest()
     return digest
+
+
+def _files_digest(named_files) -> str:
+    """SHA-256 over ``(name, path)`` pairs: each name followed by its file's digest."""
+    h = hashlib.sha256()
+    for name, path in named_files:
+        h.update(name.encode())
+        h.update(sha256_file(path).encode())
+    return h.hexdigest()
 
 
 def software_versions() -> dict[str, str]:
@@ -123,11 +130,7 @@ def build_provenance(
         elif any(c in p.name for c in "*?[") and p.parent.is_dir():
             # a glob pattern (one camera's images in a shared folder): the matched files
             matched = sorted(q for q in p.parent.glob(p.name) if q.is_file())
-            h = hashlib.sha256()
-            for q in matched:
-                h.update(q.name.encode())
-                h.update(sha256_file(q).encode())
-            rec["sha256"] = h.hexdigest()
+            rec["sha256"] = _files_digest((q.name, q) for q in matched)
             rec["files"] = len(matched)
         records.append(rec)
     prov: dict[str, Any] = {
