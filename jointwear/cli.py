@@ -52,6 +52,7 @@ def _root(
 
 
 def _register_groups() -> None:
+    from jointwear.cli_import import app as import_app
     from jointwear.compare.cli import app as compare_app
     from jointwear.datasets.cli import app as datasets_app
     from jointwear.dic.cli import app as dic_app
@@ -65,6 +66,7 @@ def _register_groups() -> None:
     app.add_typer(compare_app, name="compare")
     app.add_typer(report_app, name="report")
     app.add_typer(datasets_app, name="datasets")
+    app.add_typer(import_app, name="import")
 
 
 @app.command()

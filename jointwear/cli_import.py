@@ -1,0 +1,186 @@
+"""``jointwear import``: bring motion and wear maps from other simulators and instruments in."""
+
+from __future__ import annotations
+
+from enum import StrEnum
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+app = typer.Typer(
+    help="Import your own data (CSV or CF netCDF from other simulators and instruments).",
+    no_args_is_help=True,
+)
+
+
+class Origin(StrEnum):
+    """What the numbers of an imported file are."""
+
+    simulated = "simulated"
+    measured = "measured"
+    synthetic = "synthetic"
+
+
+class Direction(StrEnum):
+    """Which way theta grows, seen from +z."""
+
+    clockwise = "clockwise"
+    counterclockwise = "counterclockwise"
+
+
+_ORIGIN = typer.Option(
+    "--origin",
+    help="What the numbers are: simulated, measured or synthetic (required for CSV).",
+)
+_TOOL = typer.Option("--tool", help="The program that wrote the file, e.g. 'Adams 2024'.")
+_OUT = typer.Option("--out", "-o", help="The jointwear netCDF file to write.")
+
+
+def _names(text: str, option: str, count: tuple[int, int]) -> list[str]:
+    from jointwear.errors import ParameterError
+
+    names = [n.strip() for n in text.split(",") if n.strip()]
+    if not count[0] <= len(names) <= count[1]:
+        raise ParameterError(
+            f"{option}: expected {count[0]}-{count[1]} comma-separated names, got {text!r}"
+        )
+    return names
+
+
+def _save(ds, out: Path, source: Path) -> None:
+    from jointwear import io
+
+    io.save(ds, out, inputs=[source], parameters={"external": True, **ds.attrs})
+    typer.echo(f"wrote {out} ({ds.attrs['data_origin']}, from {source.name})")
+
+
+@app.command("motion")
+def motion(
+    file: Annotated[Path, typer.Argument(help="CSV table (header row) or CF netCDF file.")],
+    out: Annotated[Path, _OUT],
+    origin: Annotated[Origin | None, _ORIGIN] = None,
+    velocity_unit: Annotated[
+        str | None, typer.Option("--velocity-unit", help="Unit of the velocity columns, e.g. mm/s.")
+    ] = None,
+    time_unit: Annotated[str, typer.Option("--time-unit", help="Unit of the time column.")] = "s",
+    time_column: Annotated[
+        str, typer.Option("--time-column", help="Name of the time column.")
+    ] = "time",
+    velocity_columns: Annotated[
+        str,
+        typer.Option("--velocity-columns", help="Velocity column names x,y[,z] (bearing frame)."),
+    ] = "vx,vy,vz",
+    tool: Annotated[str | None, _TOOL] = None,
+) -> None:
+    """Import a follower motion history: time and velocity columns with stated units."""
+    from jointwear import external
+    from jointwear.errors import ParameterError
+
+    origin = origin.value if origin else None
+
+    if file.suffix.lower() in (".nc", ".nc4", ".cdf"):
+        ds = external.import_cf(file, data_origin=origin, tool=tool)
+        if "follower_velocity" not in ds:
+            raise ParameterError(f"'{file}' has no variable 'follower_velocity'")
+    else:
+        if velocity_unit is None:
+            raise ParameterError(
+                "--velocity-unit: give the unit of the velocity columns (e.g. mm/s)"
+            )
+        if origin is None:
+            raise ParameterError(
+                "--origin: say what the numbers are: simulated, measured or synthetic"
+            )
+        ds = external.import_motion(
+            file,
+            velocity_unit=velocity_unit,
+            time_unit=time_unit,
+            time_column=time_column,
+            velocity_columns=_names(velocity_columns, "--velocity-columns", (2, 3)),
+            data_origin=origin,
+            tool=tool,
+        )
+    _save(ds, out, file)
+
+
+@app.command("wearmap")
+def wearmap(
+    file: Annotated[Path, typer.Argument(help="CSV table (theta, z, depth per row) or CF netCDF.")],
+    out: Annotated[Path, _OUT],
+    origin: Annotated[Origin | None, _ORIGIN] = None,
+    angle_zero: Annotated[
+        str | None,
+        typer.Option(
+            "--angle-zero", help="Where theta = 0 points: +x, -x, +y, -y or degrees from +x."
+        ),
+    ] = None,
+    angle_direction: Annotated[
+        Direction | None,
+        typer.Option("--angle-direction", help="clockwise or counterclockwise, seen from +z."),
+    ] = None,
+    theta_unit: Annotated[str | None, typer.Option("--theta-unit", help="deg or rad.")] = None,
+    z_unit: Annotated[str | None, typer.Option("--z-unit", help="Unit of z, e.g. mm.")] = None,
+    depth_unit: Annotated[
+        str | None, typer.Option("--depth-unit", help="Unit of depth, e.g. um.")
+    ] = None,
+    columns: Annotated[
+        str, typer.Option("--columns", help="Names of the theta, z and depth columns.")
+    ] = "theta,z,wear_depth",
+    z_mid_width: Annotated[
+        float,
+        typer.Option("--z-mid-width", help="z of the bearing mid-width in the file [z unit]."),
+    ] = 0.0,
+    cycles: Annotated[
+        float | None, typer.Option("--cycles", help="Crank cycles the map belongs to.")
+    ] = None,
+    tool: Annotated[str | None, _TOOL] = None,
+) -> None:
+    """Import a wear map (depth positive where material was removed) with stated units and angle convention."""
+    from jointwear import external
+    from jointwear.errors import ParameterError
+
+    origin = origin.value if origin else None
+    angle_direction = angle_direction.value if angle_direction else None
+    if file.suffix.lower() in (".nc", ".nc4", ".cdf"):
+        ds = external.import_cf(
+            file,
+            data_origin=origin,
+            angle_zero=angle_zero,
+            angle_direction=angle_direction,
+            tool=tool,
+        )
+        if "wear_depth" not in ds:
+            raise ParameterError(f"'{file}' has no variable 'wear_depth'")
+    else:
+        missing = [
+            flag
+            for flag, value in (
+                ("--origin", origin),
+                ("--angle-zero", angle_zero),
+                ("--angle-direction", angle_direction),
+                ("--theta-unit", theta_unit),
+                ("--z-unit", z_unit),
+                ("--depth-unit", depth_unit),
+            )
+            if value is None
+        ]
+        if missing:
+            raise ParameterError(
+                f"a CSV wear map needs {', '.join(missing)}: jointwear never guesses units or where "
+                "theta = 0 is"
+            )
+        ds = external.import_wear_map(
+            file,
+            theta_unit=theta_unit,
+            z_unit=z_unit,
+            depth_unit=depth_unit,
+            angle_zero=angle_zero,
+            angle_direction=angle_direction,
+            data_origin=origin,
+            columns=_names(columns, "--columns", (3, 3)),
+            z_mid_width=z_mid_width,
+            cycles=cycles,
+            tool=tool,
+        )
+    _save(ds, out, file)

@@ -1,0 +1,474 @@
+"""Bring a user's own data in: motion and wear maps from other simulators and instruments.
+
+Other multibody codes (Adams, RecurDyn, Simpack, MATLAB scripts) and other measurement tools
+export motion histories and wear maps as CSV or as CF netCDF. These functions turn such files into
+datasets that follow the jointwear data contract (``docs/conventions.md``), so that ``compare``
+and ``report`` treat them exactly like jointwear's own results.
+
+Nothing is guessed: the units of every column and, for wear maps, the angle convention must be
+stated (the functions refuse a file whose units or convention are not given), and the caller
+says what the numbers are (``data_origin``: ``"simulated"``, ``"measured"`` or ``"synthetic"``).
+The imported dataset records the file (with its sha256) and ``external = "yes"`` in its
+provenance; its ``source`` names the tool the user gave.
+
+Units are converted with pint, so any unit pint knows is accepted (``mm/s``, ``m s-1``, ``um``,
+``µm``, ``inch``, ``deg``, ``rad``, ...); a unit of the wrong kind (a length given for a
+velocity) is an error that names the option.
+"""
+
+from __future__ import annotations
+
+import csv
+import re
+from collections.abc import Sequence
+from functools import cache
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+import xarray as xr
+
+from jointwear import conventions
+from jointwear.errors import BadInputError, ParameterError
+
+__all__ = [
+    "DATA_ORIGINS",
+    "to_si",
+    "read_table",
+    "import_motion",
+    "import_wear_map",
+    "import_cf",
+]
+
+#: What the numbers of a file are (global attribute ``data_origin``).
+DATA_ORIGINS = ("measured", "synthetic", "simulated")
+
+#: SI unit of each kind of quantity an import converts to.
+_SI = {"length": "m", "velocity": "m/s", "time": "s", "angle": "degree", "force": "N"}
+_DIMENSION = {
+    "length": "[length]",
+    "velocity": "[length] / [time]",
+    "time": "[time]",
+    "angle": "",
+    "force": "[force]",
+}
+
+
+@cache
+def _registry() -> Any:
+    import pint
+
+    return pint.UnitRegistry()
+
+
+def _pint_unit(unit: str) -> str:
+    """Spell a UDUNITS/CF unit (``m s-1``, ``um``, ``degrees``) the way pint parses it."""
+    text = unit.strip().replace("µ", "u").replace("μ", "u")
+    text = re.sub(r"\bmicrons?\b", "um", text)
+    text = re.sub(r"\bdegrees?(_\w+)?\b", "degree", text)
+    # UDUNITS exponents: "s-1" -> "s**-1", "m2" -> "m**2"
+    text = re.sub(r"([A-Za-z])(-?\d+)\b", r"\1**\2", text)
+    return text
+
+
+def to_si(values: Any, unit: str, *, kind: str, option: str) -> np.ndarray:
+    """Convert ``values`` given in ``unit`` to the SI unit of ``kind`` (degrees for angles).
+
+    Parameters
+    ----------
+    values : array_like
+        Numbers in ``unit``.
+    unit : str
+        The unit as the user or the file states it (``"mm/s"``, ``"m s-1"``, ``"um"``, ``"deg"``).
+    kind : {"length", "velocity", "time", "angle", "force"}
+        What the values are; decides the target unit (m, m/s, s, degree, N).
+    option : str
+        The option or attribute that gave the unit, named in errors (``"--velocity-unit"``).
+
+    Returns
+    -------
+    ndarray
+        The values in m, m/s, s, N, or degrees for angles.
+    """
+    import pint
+
+    if not isinstance(unit, str) or not unit.strip():
+        raise ParameterError(f"{option}: no unit given; state the unit of the {kind} values")
+    ureg = _registry()
+    try:
+        quantity = ureg.Quantity(1.0, _pint_unit(unit))
+        factor = quantity.to(_SI[kind]).magnitude
+    except pint.errors.DimensionalityError:
+        raise ParameterError(
+            f"{option} = {unit!r} is not a unit of {kind} (expected something convertible to "
+            f"{_SI[kind]})"
+        ) from None
+    except (pint.errors.UndefinedUnitError, pint.errors.DefinitionSyntaxError, ValueError) as exc:
+        raise ParameterError(
+            f"{option} = {unit!r} is not a unit jointwear knows ({exc}); write e.g. "
+            f"{'mm/s' if kind == 'velocity' else 'mm' if kind == 'length' else _SI[kind]!r}"
+        ) from None
+    except AssertionError:  # pint raises it for some malformed expressions
+        raise ParameterError(f"{option} = {unit!r} is not a unit jointwear can parse") from None
+    return np.asarray(values, dtype=float) * factor
+
+
+def read_table(path: str | Path) -> pd.DataFrame:
+    """Read a CSV/TSV/whitespace table with a header row; ``#`` starts a comment line.
+
+    Raises
+    ------
+    BadInputError
+        The file is missing, empty, not text, or has no header row of names.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise BadInputError(f"'{path}' does not exist or is not a file")
+    try:
+        table = pd.read_csv(
+            path,
+            sep=None,
+            engine="python",
+            comment="#",
+            skipinitialspace=True,
+            encoding="utf-8-sig",
+        )
+    except UnicodeDecodeError:
+        raise BadInputError(
+            f"'{path}' is not UTF-8 text; export it as CSV (UTF-8) from the tool that wrote it"
+        ) from None
+    except (pd.errors.ParserError, pd.errors.EmptyDataError, csv.Error) as exc:
+        raise BadInputError(
+            f"'{path}' could not be read as a table with a header row: {exc}"
+        ) from None
+    if table.empty or table.shape[1] < 2:
+        raise BadInputError(
+            f"'{path}': expected a header row of column names and at least two columns of "
+            f"numbers, found {table.shape[1]} column(s) and {len(table)} row(s)"
+        )
+    table.columns = [str(c).strip() for c in table.columns]
+    return table
+
+
+def _column(table: pd.DataFrame, name: str, path: Path, option: str) -> np.ndarray:
+    """One column as floats; missing names and non-numbers are errors naming the row."""
+    lookup = {c.lower(): c for c in table.columns}
+    if name.lower() not in lookup:
+        raise BadInputError(
+            f"'{path}' has no column {name!r} (columns: {', '.join(map(repr, table.columns))}); "
+            f"name the right one with {option}"
+        )
+    column = table[lookup[name.lower()]]
+    values = pd.to_numeric(column, errors="coerce").to_numpy(dtype=float)
+    bad = np.flatnonzero(~np.isfinite(values))
+    if bad.size:
+        row = int(bad[0])
+        raise BadInputError(
+            f"'{path}', column {name!r}: value {column.iloc[row]!r} in data row {row + 1} is not a "
+            f"finite number ({bad.size} such value(s)); fix or remove those rows"
+        )
+    return values
+
+
+def _check_origin(data_origin: str) -> str:
+    if data_origin not in DATA_ORIGINS:
+        raise ParameterError(
+            f"--origin = {data_origin!r}: say what the numbers are, one of {', '.join(DATA_ORIGINS)}"
+        )
+    return data_origin
+
+
+def _stamp(ds: xr.Dataset, path: Path, data_origin: str, tool: str | None, what: str) -> xr.Dataset:
+    ds.attrs.update(
+        title=f"{what} imported from {path.name}",
+        source=f"external: {tool or 'unnamed tool'} ({path.name})",
+        data_origin=data_origin,
+        external="yes",
+    )
+    return ds
+
+
+def import_motion(
+    path: str | Path,
+    *,
+    velocity_unit: str,
+    data_origin: str,
+    time_unit: str = "s",
+    time_column: str = "time",
+    velocity_columns: Sequence[str] = ("vx", "vy", "vz"),
+    position_columns: Sequence[str] | None = None,
+    position_unit: str | None = None,
+    tool: str | None = None,
+) -> xr.Dataset:
+    """Import a follower motion history (CSV table) from another simulator or instrument.
+
+    Parameters
+    ----------
+    path : path
+        CSV/TSV table with a header row: a time column and one column per velocity component.
+    velocity_unit : str
+        Unit of the velocity columns (``"mm/s"``, ``"m s-1"``, ...). Required: never guessed.
+    data_origin : {"simulated", "measured", "synthetic"}
+        What the numbers are.
+    time_unit : str
+        Unit of the time column [default s].
+    time_column : str
+        Name of the time column.
+    velocity_columns : sequence of str
+        Names of the x, y(, z) velocity columns, in the bearing frame of jointwear's rig
+        (``docs/conventions.md``).
+    position_columns, position_unit : optional
+        Follower position columns and their unit, if the file has them.
+    tool : str, optional
+        The program that wrote the file (e.g. ``"Adams 2024"``), recorded in ``source``.
+
+    Returns
+    -------
+    Dataset
+        ``follower_velocity(time, axis)`` [m s-1] (and ``follower_position`` [m]), ``time`` [s]
+        from 0, ``data_origin`` and ``external = "yes"`` in the attributes.
+    """
+    path = Path(path)
+    _check_origin(data_origin)
+    if not 2 <= len(velocity_columns) <= 3:
+        raise ParameterError(
+            f"--velocity-columns: give 2 or 3 column names (x, y[, z]), got {list(velocity_columns)}"
+        )
+    table = read_table(path)
+    t = to_si(
+        _column(table, time_column, path, "--time-column"),
+        time_unit,
+        kind="time",
+        option="--time-unit",
+    )
+    steps = np.diff(t)
+    if t.size < 2 or np.any(steps <= 0):
+        where = int(np.flatnonzero(steps <= 0)[0]) + 2 if t.size >= 2 else 1
+        raise BadInputError(
+            f"'{path}', column {time_column!r}: time must increase strictly from row to row "
+            f"(it does not at data row {where}); sort the rows or remove duplicates"
+        )
+    axes = ["x", "y", "z"][: len(velocity_columns)]
+    velocity = np.column_stack(
+        [
+            to_si(
+                _column(table, c, path, "--velocity-columns"),
+                velocity_unit,
+                kind="velocity",
+                option="--velocity-unit",
+            )
+            for c in velocity_columns
+        ]
+    )
+    ds = xr.Dataset(coords={"time": t - t[0], "axis": axes})
+    ds["follower_velocity"] = (("time", "axis"), velocity)
+    if position_columns:
+        if position_unit is None:
+            raise ParameterError("--position-unit: give the unit of the position columns")
+        if len(position_columns) != len(axes):
+            raise ParameterError("--position-columns: give as many columns as --velocity-columns")
+        position = np.column_stack(
+            [
+                to_si(
+                    _column(table, c, path, "--position-columns"),
+                    position_unit,
+                    kind="length",
+                    option="--position-unit",
+                )
+                for c in position_columns
+            ]
+        )
+        ds["follower_position"] = (("time", "axis"), position)
+    ds = conventions.annotate(ds)
+    return _stamp(ds, path, data_origin, tool, "follower motion")
+
+
+def import_wear_map(
+    path: str | Path,
+    *,
+    theta_unit: str,
+    z_unit: str,
+    depth_unit: str,
+    angle_zero: str,
+    angle_direction: str,
+    data_origin: str,
+    columns: Sequence[str] = ("theta", "z", "wear_depth"),
+    z_mid_width: float = 0.0,
+    z_reversed: bool = False,
+    cycles: float | None = None,
+    tool: str | None = None,
+) -> xr.Dataset:
+    """Import a wear map given as a long table (one row per bearing point: theta, z, depth).
+
+    Parameters
+    ----------
+    path : path
+        CSV/TSV with a header row. Every (z, theta) pair of a regular grid must appear exactly once.
+    theta_unit, z_unit, depth_unit : str
+        Units of the three columns (``"deg"``/``"rad"``, ``"mm"``, ``"um"``). Required.
+    angle_zero, angle_direction : str
+        The file's angle convention (see :class:`jointwear.conventions.AngleConvention`); the map
+        is converted to the canonical one.
+    data_origin : {"simulated", "measured", "synthetic"}
+        What the numbers are.
+    columns : (str, str, str)
+        Names of the theta, z and depth columns. Depth is positive where material was removed.
+    z_mid_width : float
+        The z value of the bearing's mid-width in the file, in ``z_unit`` (the contract puts
+        ``z = 0`` there) [default 0].
+    z_reversed : bool
+        The file's z grows along the bearing frame's -z axis (the contract's z grows along +z of
+        the bearing frame, ``docs/conventions.md``).
+    cycles : float, optional
+        Crank cycles the map belongs to; adds a ``cycles`` dimension of length 1.
+    tool : str, optional
+        The program that wrote the file.
+
+    Returns
+    -------
+    Dataset
+        ``wear_depth(z, theta)`` [m] on the canonical angle convention.
+    """
+    path = Path(path)
+    _check_origin(data_origin)
+    if len(columns) != 3:
+        raise ParameterError(f"--columns: give three names (theta, z, depth), got {list(columns)}")
+    convention = conventions.AngleConvention(angle_zero, angle_direction)
+    table = read_table(path)
+    theta = to_si(
+        _column(table, columns[0], path, "--columns"),
+        theta_unit,
+        kind="angle",
+        option="--theta-unit",
+    )
+    z_file = _column(table, columns[1], path, "--columns") - float(z_mid_width)
+    z = to_si(-z_file if z_reversed else z_file, z_unit, kind="length", option="--z-unit")
+    depth = to_si(
+        _column(table, columns[2], path, "--columns"),
+        depth_unit,
+        kind="length",
+        option="--depth-unit",
+    )
+    theta = np.mod(theta, 360.0)
+    theta_keys = np.round(theta, 9)
+    z_keys = np.round(z, 12)
+    frame = pd.DataFrame({"z": z_keys, "theta": theta_keys, "depth": depth})
+    duplicated = frame.duplicated(["z", "theta"])
+    if duplicated.any():
+        row = int(np.flatnonzero(duplicated.to_numpy())[0])
+        raise BadInputError(
+            f"'{path}': the point z = {z[row]:g} m, theta = {theta[row]:g} deg appears more than once "
+            f"(data row {row + 1}); a wear map has one depth per bearing point"
+        )
+    grid = frame.pivot(index="z", columns="theta", values="depth")
+    missing = int(grid.isna().to_numpy().sum())
+    if missing:
+        raise BadInputError(
+            f"'{path}': the points do not form a complete (z, theta) grid: {grid.shape[0]} z values "
+            f"x {grid.shape[1]} angles, {missing} point(s) missing; export the map on a regular grid"
+        )
+    if grid.shape[0] < 1 or grid.shape[1] < 3:
+        raise BadInputError(f"'{path}': a wear map needs at least 3 angles, found {grid.shape[1]}")
+    ds = xr.Dataset(
+        {"wear_depth": (("z", "theta"), grid.to_numpy())},
+        coords={
+            "z": conventions.z_coord(grid.index.to_numpy(), note=f"imported from {path.name}"),
+            "theta": conventions.theta_coord(grid.columns.to_numpy(), convention),
+        },
+    )
+    ds = conventions.to_canonical(ds)
+    if cycles is not None:
+        ds = ds.expand_dims(cycles=[float(cycles)])
+    ds = conventions.annotate(ds)
+    return _stamp(ds, path, data_origin, tool, "wear map")
+
+
+def import_cf(
+    path: str | Path,
+    *,
+    data_origin: str | None = None,
+    angle_zero: str | None = None,
+    angle_direction: str | None = None,
+    tool: str | None = None,
+) -> xr.Dataset:
+    """Import a CF-style netCDF file written by another tool.
+
+    The file's variables must use the contract's names (``wear_depth``, ``follower_velocity``,
+    ``theta``, ``z``, ``time``, ...); their ``units`` attributes are converted to the contract's
+    units. A ``theta`` coordinate needs its angle convention, from the file's attributes
+    (``angle_zero``, ``angle_direction``) or given here; ``z`` without ``z_zero`` is taken as
+    measured from the bearing's mid-width only if the caller says nothing else (it is recorded).
+
+    Parameters
+    ----------
+    path : path
+        The netCDF file.
+    data_origin : str, optional
+        What the numbers are; required unless the file states ``data_origin``.
+    angle_zero, angle_direction : str, optional
+        Angle convention of ``theta`` when the file does not state it (or to confirm it).
+    tool : str, optional
+        The program that wrote the file.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise BadInputError(f"'{path}' does not exist or is not a file")
+    try:
+        with xr.open_dataset(path, engine="netcdf4") as raw:
+            ds = raw.load()
+    except (OSError, ValueError) as exc:
+        raise BadInputError(f"'{path}' could not be read as netCDF ({exc})") from None
+    origin = data_origin or ds.attrs.get("data_origin")
+    if origin is None:
+        raise ParameterError(
+            f"'{path}' does not say what its numbers are: give --origin simulated|measured|synthetic"
+        )
+    _check_origin(origin)
+    if data_origin and ds.attrs.get("data_origin") not in (None, data_origin):
+        raise BadInputError(
+            f"'{path}' states data_origin = {ds.attrs['data_origin']!r} but --origin says "
+            f"{data_origin!r}; drop --origin or correct the file"
+        )
+    known = {**conventions.COORDINATES, **conventions.VARIABLES}
+    kinds = {"m": "length", "m s-1": "velocity", "s": "time", "degree": "angle", "N": "force"}
+    for name in list(ds.variables):
+        if name not in known or known[name][0] not in kinds:
+            continue
+        unit = ds[name].attrs.get("units")
+        if unit is None:
+            raise BadInputError(
+                f"'{path}': variable {name!r} has no units attribute; add it (CF requires it)"
+            )
+        values = to_si(
+            ds[name].values, str(unit), kind=kinds[known[name][0]], option=f"{name}:units"
+        )
+        ds[name] = ds[name].copy(data=values)
+        ds[name].attrs["units"] = known[name][0]
+    if "theta" in ds.coords:
+        attrs = ds.coords["theta"].attrs
+        zero = angle_zero or attrs.get("angle_zero")
+        direction = angle_direction or attrs.get("angle_direction")
+        if zero is None or direction is None:
+            raise BadInputError(
+                f"'{path}': theta does not state its angle convention; give --angle-zero and "
+                "--angle-direction (where theta = 0 points and which way it increases, seen from +z)"
+            )
+        for key, given, stated in (
+            ("angle_zero", angle_zero, attrs.get("angle_zero")),
+            ("angle_direction", angle_direction, attrs.get("angle_direction")),
+        ):
+            if given is not None and stated is not None and str(given) != str(stated):
+                raise BadInputError(
+                    f"'{path}': theta states {key} = {stated!r}, the option says {given!r}"
+                )
+        theta = np.mod(ds["theta"].values, 360.0)
+        ds = ds.assign_coords(
+            theta=conventions.theta_coord(theta, conventions.AngleConvention(zero, direction))
+        ).sortby("theta")
+        ds = conventions.to_canonical(ds)
+    if "z" in ds.coords and "z_zero" not in ds.coords["z"].attrs:
+        ds["z"].attrs.update(z_zero="bearing mid-width (assumed on import)", z_direction="+z")
+    ds = conventions.annotate(ds)
+    ds.attrs.pop("provenance", None)
+    return _stamp(ds, path, origin, tool or ds.attrs.get("source"), "dataset")
