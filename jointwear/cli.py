@@ -15,6 +15,7 @@ from typing import Annotated
 
 import typer
 
+from jointwear._compile_notice import announce_compilation
 from jointwear._version import __version__
 from jointwear.errors import EXIT_BAD_INPUT, EXIT_USAGE, JointwearError
 
@@ -103,6 +104,7 @@ def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``jointwear`` script; returns the exit code."""
     args = sys.argv[1:] if argv is None else list(argv)
     debug = "--debug" in args
+    compiled = announce_compilation()
     try:
         app(args=args, prog_name="jointwear", standalone_mode=True)
     except SystemExit as exc:  # click's own exits: 0, usage errors (2), aborts
@@ -121,4 +123,8 @@ def main(argv: list[str] | None = None) -> int:
             raise
         typer.echo(f"jointwear: error: {exc}", err=True)
         return EXIT_BAD_INPUT
+    finally:
+        line = compiled()
+        if line:
+            typer.echo(line, err=True)
     return 0

@@ -1,0 +1,122 @@
+"""A one-line notice on stderr while numba compiles kernels that are not in its cache yet.
+
+The first run after an install compiles the numerical kernels (tens of seconds on a laptop); later
+runs load them from numba's on-disk cache. Without a word the first run looks hung. The command
+line calls :func:`announce_compilation` once at start-up. It does not import numba (the CLI must
+start fast): it waits until something else imports numba and then listens to numba's
+``numba:compile`` event, which fires only on a cache miss, i.e. a real compilation.
+"""
+
+from __future__ import annotations
+
+import importlib.abc
+import importlib.machinery
+import sys
+import time
+from collections.abc import Callable
+from typing import Any, TextIO
+
+__all__ = ["announce_compilation", "NOTICE"]
+
+#: The line printed before the first compilation of a process.
+NOTICE = (
+    "jointwear: compiling numerical kernels for first use "
+    "(once per install; later runs load them from the cache)..."
+)
+
+
+class _Listener:
+    """numba event listener: notice at the first compile, a summary line when the command ends."""
+
+    def __init__(self, stream: TextIO) -> None:
+        self.stream = stream
+        self.count = 0
+        self.seconds = 0.0
+        self._started: list[float] = []
+
+    def on_start(self, event: Any) -> None:
+        if self.count == 0 and not self._started:
+            print(NOTICE, file=self.stream, flush=True)
+        self._started.append(time.perf_counter())
+
+    def on_end(self, event: Any) -> None:
+        if self._started:
+            start = self._started.pop()
+            if not self._started:  # only outermost compiles count towards the time
+                self.seconds += time.perf_counter() - start
+        self.count += 1
+
+    def summary(self) -> str | None:
+        if not self.count:
+            return None
+        return f"jointwear: compiled {self.count} kernel(s) in {self.seconds:.0f} s (cached now)"
+
+
+def _install(stream: TextIO) -> _Listener:
+    from numba.core import event
+
+    listener = _Listener(stream)
+
+    class _NumbaListener(event.Listener):
+        def on_start(self, ev: Any) -> None:
+            listener.on_start(ev)
+
+        def on_end(self, ev: Any) -> None:
+            listener.on_end(ev)
+
+    event.register("numba:compile", _NumbaListener())
+    return listener
+
+
+class _AfterNumbaImport(importlib.abc.MetaPathFinder):
+    """Runs a callback right after ``numba`` itself has been imported, then removes itself."""
+
+    def __init__(self, callback: Callable[[], None]) -> None:
+        self.callback = callback
+
+    def find_spec(self, name: str, path: Any, target: Any = None) -> Any:
+        if name != "numba":
+            return None
+        sys.meta_path.remove(self)
+        spec = importlib.machinery.PathFinder.find_spec(name, path)
+        if spec is None or spec.loader is None:
+            return spec
+        loader = spec.loader
+        exec_module = loader.exec_module
+        callback = self.callback
+
+        def exec_then_notify(module: Any) -> None:
+            exec_module(module)
+            callback()
+
+        loader.exec_module = exec_then_notify  # type: ignore[method-assign]
+        return spec
+
+
+_STATE: dict[str, Any] = {}
+
+
+def announce_compilation(stream: TextIO | None = None) -> Callable[[], str | None]:
+    """Print :data:`NOTICE` on ``stream`` (default stderr) before the first numba compilation.
+
+    Returns a function that gives the summary line (``None`` when nothing was compiled), for
+    the caller to print when the command ends. Calling it again in the same process returns
+    the same summary function.
+    """
+    if "summary" in _STATE:
+        return _STATE["summary"]
+    target = stream if stream is not None else sys.stderr
+
+    def start() -> None:
+        _STATE["listener"] = _install(target)
+
+    def summary() -> str | None:
+        listener = _STATE.get("listener")
+        return listener.summary() if listener else None
+
+    if "numba" in sys.modules:
+        start()
+    else:
+        sys.meta_path.insert(0, _AfterNumbaImport(start))
+    _STATE["summary"] = summary
+    return summary
