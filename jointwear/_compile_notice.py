@@ -28,18 +28,26 @@ NOTICE = (
 class _Listener:
     """numba event listener: notice at the first compile, a summary line when the command ends."""
 
-    def __init__(self, stream: TextIO) -> None:
-        self.stream = stream
+    def __init__(self, stream: TextIO | None) -> None:
+        self.stream = stream  # None: whatever sys.stderr is when a compile starts
+        self.active = True
         self.count = 0
         self.seconds = 0.0
         self._started: list[float] = []
 
     def on_start(self, event: Any) -> None:
+        if not self.active:
+            return
         if self.count == 0 and not self._started:
-            print(NOTICE, file=self.stream, flush=True)
+            try:  # a notice must never break the compilation it announces
+                print(NOTICE, file=self.stream or sys.stderr, flush=True)
+            except (OSError, ValueError):
+                pass
         self._started.append(time.perf_counter())
 
     def on_end(self, event: Any) -> None:
+        if not self.active:
+            return
         if self._started:
             start = self._started.pop()
             if not self._started:  # only outermost compiles count towards the time
@@ -52,7 +60,7 @@ class _Listener:
         return f"jointwear: compiled {self.count} kernel(s) in {self.seconds:.0f} s (cached now)"
 
 
-def _install(stream: TextIO) -> _Listener:
+def _install(stream: TextIO | None) -> _Listener:
     from numba.core import event
 
     listener = _Listener(stream)
@@ -100,19 +108,26 @@ def announce_compilation(stream: TextIO | None = None) -> Callable[[], str | Non
     """Print :data:`NOTICE` on ``stream`` (default stderr) before the first numba compilation.
 
     Returns a function that gives the summary line (``None`` when nothing was compiled), for
-    the caller to print when the command ends. Calling it again in the same process returns
-    the same summary function.
+    the caller to print when the command ends; calling it also ends the announcement, so that a
+    process which goes on (a test runner calling ``main`` in-process) is never written to after
+    its command returned. Calling :func:`announce_compilation` again re-arms the same listener.
     """
     if "summary" in _STATE:
+        listener = _STATE.get("listener")
+        if listener is not None:
+            listener.stream, listener.active = stream, True
+            listener.count, listener.seconds, listener._started = 0, 0.0, []
         return _STATE["summary"]
-    target = stream if stream is not None else sys.stderr
 
     def start() -> None:
-        _STATE["listener"] = _install(target)
+        _STATE["listener"] = _install(stream)
 
     def summary() -> str | None:
         listener = _STATE.get("listener")
-        return listener.summary() if listener else None
+        if listener is None:
+            return None
+        listener.active = False
+        return listener.summary()
 
     if "numba" in sys.modules:
         start()

@@ -73,3 +73,29 @@ def test_help_does_not_import_numba():
         """
     )
     _run(code)
+
+
+_CLOSED_STREAM = textwrap.dedent(
+    """
+    import io, sys
+    from jointwear._compile_notice import announce_compilation
+    stream = io.StringIO()
+    summary = announce_compilation(stream)
+    from numba import njit
+    summary()          # the command has ended ...
+    stream.close()     # ... and its captured stderr is gone (pytest's capsys, a closed pipe)
+
+    @njit
+    def twice(x):
+        return 2 * x
+
+    assert twice(2) == 4   # compiling later must neither print nor raise
+    print("ok")
+    """
+)
+
+
+def test_compiles_after_the_command_ended_do_not_touch_its_stream():
+    done = _run(_CLOSED_STREAM)
+    assert done.stdout.strip() == "ok"
+    assert NOTICE not in done.stderr
