@@ -122,10 +122,8 @@ def _dl(t, P):
 
 @njit(cache=True)
 def _node_delta(n, m, J0, u, P, H, ZL, Nd):
-    d = _node(n, m, J0, u, P, H, ZL, Nd)
-    if abs(d[7]) > 0.5 * P[LJ]:
-        return -1.0  # beyond the journal's end: no contact possible
-    return d[0]
+    """Penetration of bearing point (n, m), -1 beyond the journal's ends."""
+    return _dl(_node(n, m, J0, u, P, H, ZL, Nd), P)
 
 
 @njit(cache=True)
@@ -261,9 +259,64 @@ def _search(n, m0, J0, u, P, H, ZL, Nd):
 
 
 @njit(cache=True)
-def _slices(
-    J0, u, V0, W, P, IP, H, HMIN, ZL, AREA, vimp, srate, son, wrench, acc, hstep, WW, acc_out
-):
+def _layer_axis(n, J0, u, P, HMIN, ZL):
+    """Journal axis point in layer n's plane and a bound of the layer's penetration.
+
+    Returns (reach, ax, ay, dest): reach False when layer n lies beyond the journal's ends;
+    (ax, ay) the axis point in the layer plane; dest an upper bound of the penetration of any
+    point of the layer (from its least worn point), exact for an aligned journal.
+    """
+    s0 = (ZL[n] - J0[2]) / u[2]
+    if abs(s0) > 0.5 * P[LJ]:
+        return False, 0.0, 0.0, -1.0
+    ax = J0[0] + s0 * u[0]
+    ay = J0[1] + s0 * u[1]
+    dest = u[2] * math.sqrt(ax * ax + ay * ay) + P[RJ] - u[2] * (P[RB] + HMIN[n])
+    return True, ax, ay, dest
+
+
+@njit(cache=True)
+def _facing_node(ax, ay, P, Nd):
+    """Index of the bore node facing the journal axis point (ax, ay) (eq. 2 angles)."""
+    phi0 = math.atan2(ay, -ax)
+    if phi0 < 0.0:
+        phi0 += 2.0 * math.pi
+    return int(round(phi0 / P[DPHI])) % Nd
+
+
+@njit(cache=True, inline="always")
+def _add_normal(wrench, px, py, pz, nx, ny, nz, s):
+    """Add the normal force s (nx, ny, nz) at (px, py, pz) to the force, moment and normal slots."""
+    wrench[0] += s * nx
+    wrench[1] += s * ny
+    wrench[2] += s * nz
+    wrench[6] += s * nx
+    wrench[7] += s * ny
+    wrench[8] += s * nz
+    _cross_acc(px, py, pz, nx, ny, nz, wrench, 3, s)
+
+
+@njit(cache=True, inline="always")
+def _damped(fel, rate, vm, vfloor, ce):
+    """Eq. 6: elastic force fel times the L-N factor; vm <= 0 (no impact remembered) uses the
+    current approach rate, at least vfloor, as impact velocity."""
+    if vm <= 0.0:
+        vm = rate if rate > vfloor else vfloor
+    return fel * ln_factor(rate, vm, ce)
+
+
+@njit(cache=True, inline="always")
+def _rel_velocity(V0, W, px, py, pz):
+    """Velocity of the journal relative to the bearing at the point (px, py, pz)."""
+    return (
+        V0[0] + W[1] * pz - W[2] * py,
+        V0[1] + W[2] * px - W[0] * pz,
+        V0[2] + W[0] * py - W[1] * px,
+    )
+
+
+@njit(cache=True)
+def _slices(J0, u, V0, W, ctx, wrench, acc, hstep):
     """Grid-independent radial contact: axial slices with the penetration linear in between.
 
     Each layer gives its deepest penetration (parabola through three nodes); between adjacent
@@ -274,13 +327,11 @@ def _slices(
     Returns (energy, normal force sum, max penetration, K at the deepest layer, contacting
     layers, opposite-sides flag, contact length fraction).
     """
+    P, IP, H, HMIN, ZL, AREA = ctx[0], ctx[1], ctx[2], ctx[3], ctx[4], ctx[6]
+    vimp, srate, son, WW, acc_out = ctx[7], ctx[8], ctx[9], ctx[11], ctx[12]
     Nl = IP[NL]
     Nd = IP[ND]
     nexp = P[NEXP]
-    ce = P[CE]
-    vfloor = P[VFLOOR]
-    muon = P[MUON]
-    uz = u[2]
     lam = 1.0 / (Nl - 1)
     # one scratch block per call: bound, in-plane axis point, reach, results per layer
     scr = np.empty((Nl, 8))
@@ -296,17 +347,8 @@ def _slices(
     sm = np.empty(Nl, dtype=np.int64)
     for n in range(Nl):
         fel[n] = 0.0
-        s0 = (ZL[n] - J0[2]) / uz
-        if abs(s0) > 0.5 * P[LJ]:
-            dest[n] = -1.0
-            reach[n] = 0.0
-            continue
-        reach[n] = 1.0
-        ax = J0[0] + s0 * u[0]
-        ay = J0[1] + s0 * u[1]
-        axs[n] = ax
-        ays[n] = ay
-        dest[n] = uz * math.sqrt(ax * ax + ay * ay) + P[RJ] - uz * (P[RB] + HMIN[n])
+        ok, axs[n], ays[n], dest[n] = _layer_axis(n, J0, u, P, HMIN, ZL)
+        reach[n] = 1.0 if ok else 0.0
     pen = -1.0
     for n in range(Nl):
         act = dest[n] > 0.0 or (n > 0 and dest[n - 1] > 0.0) or (n < Nl - 1 and dest[n + 1] > 0.0)
@@ -315,10 +357,7 @@ def _slices(
             if sd[n] > pen:
                 pen = sd[n]
             continue
-        phi0 = math.atan2(ays[n], -axs[n])
-        if phi0 < 0.0:
-            phi0 += 2.0 * math.pi
-        m0 = int(round(phi0 / P[DPHI])) % Nd
+        m0 = _facing_node(axs[n], ays[n], P, Nd)
         ms, dm, d0, dp, nm, n0, npp = _search(n, m0, J0, u, P, H, ZL, Nd)
         b = 0.5 * (dp - dm)
         dd = 2.0 * d0 - dp - dm
@@ -380,40 +419,22 @@ def _slices(
         nz = lw0 * geo[n, 0, 5] + lw1 * geo[n, 1, 5] + lw2 * geo[n, 2, 5]
         nn = math.sqrt(nx * nx + ny * ny + nz * nz)
         hx, hy, hz = nx / nn, ny / nn, nz / nn
-        vx = V0[0] + W[1] * cz - W[2] * cy
-        vy = V0[1] + W[2] * cx - W[0] * cz
-        vz = V0[2] + W[0] * cy - W[1] * cx
+        vx, vy, vz = _rel_velocity(V0, W, cx, cy, cz)
         rate = vx * hx + vy * hy + vz * hz
-        vm = vimp[n]
-        if vm <= 0.0:
-            vm = rate if rate > vfloor else vfloor
-        fn = fel[n] * ln_factor(rate, vm, ce)
+        fn = _damped(fel[n], rate, vimp[n], P[VFLOOR], P[CE])
         for k in range(3):
             lk = lw0 if k == 0 else (lw1 if k == 1 else lw2)
-            sk = fn * lk
-            for q in range(3):
-                wrench[q] += sk * geo[n, k, 3 + q]
-                wrench[6 + q] += sk * geo[n, k, 3 + q]
-            _cross_acc(
-                geo[n, k, 0],
-                geo[n, k, 1],
-                geo[n, k, 2],
-                geo[n, k, 3],
-                geo[n, k, 4],
-                geo[n, k, 5],
-                wrench,
-                3,
-                sk,
-            )
+            g = geo[n, k]
+            _add_normal(wrench, g[0], g[1], g[2], g[3], g[4], g[5], fn * lk)
         fnsum += fn
         tx = vx - rate * hx
         ty = vy - rate * hy
         tz = vz - rate * hz
-        vt = _apply_friction(wrench, cx, cy, cz, tx, ty, tz, fn, muon, P)
+        vt = _apply_friction(wrench, cx, cy, cz, tx, ty, tz, fn, P[MUON], P)
         srate[n] = rate
         son[n] = 1
         if acc:
-            _spread(n, sm[n], sd[n], fn, vt, hstep, J0, u, P, H, ZL, Nd, AREA, WW)
+            _spread(n, sm[n], fn, vt, hstep, J0, u, P, H, ZL, Nd, AREA, WW)
             acc_out[0] += fn * vt * hstep
             acc_out[2] += fn * hstep
         nslice += 1
@@ -429,11 +450,13 @@ def _slices(
 
 
 @njit(cache=True)
-def _spread(n, ms, dstar, fn, vt, hstep, J0, u, P, H, ZL, Nd, AREA, WW):
-    """Spread a layer's normal force over its contiguous penetrating nodes, weights sqrt(delta),
-    adding p |v_t| dt to WW[0] and |v_t| dt to WW[1]; every node is evaluated once."""
+def _penetrating_run(n, ms, J0, u, P, H, ZL, Nd, buf):
+    """Contiguous run of penetrating nodes of layer n around node ms.
+
+    Returns (lo, hi) and the penetrations in ``buf[m - ms + Nd // 2]`` for m in [lo, hi]
+    (``buf[Nd // 2]`` = that of ms, possibly <= 0); every node is evaluated once.
+    """
     half = Nd // 2
-    buf = np.empty(2 * half + 1)
     d0 = _node_delta(n, ms, J0, u, P, H, ZL, Nd)
     lo = ms
     hi = ms
@@ -451,6 +474,16 @@ def _spread(n, ms, dstar, fn, vt, hstep, J0, u, P, H, ZL, Nd, AREA, WW):
             hi += 1
             buf[hi - ms + half] = dk
     buf[half] = d0
+    return lo, hi
+
+
+@njit(cache=True)
+def _spread(n, ms, fn, vt, hstep, J0, u, P, H, ZL, Nd, AREA, WW):
+    """Spread a layer's normal force over its contiguous penetrating nodes, weights sqrt(delta),
+    adding p |v_t| dt to WW[0] and |v_t| dt to WW[1]; every node is evaluated once."""
+    half = Nd // 2
+    buf = np.empty(2 * half + 1)
+    lo, hi = _penetrating_run(n, ms, J0, u, P, H, ZL, Nd, buf)
     wsum = 0.0
     for mm in range(lo, hi + 1):
         dk = buf[mm - ms + half]
@@ -468,42 +501,16 @@ def _spread(n, ms, dstar, fn, vt, hstep, J0, u, P, H, ZL, Nd, AREA, WW):
 
 
 @njit(cache=True)
-def _contact(
-    J0,
-    u,
-    V0,
-    W,
-    P,
-    IP,
-    H,
-    HMIN,
-    ZL,
-    WL,
-    AREA,
-    vimp,
-    srate,
-    son,
-    wrench,
-    info,
-    acc,
-    hstep,
-    WW,
-    acc_out,
-):
-    """Contact of the journal with the bore and the end faces, in the bearing frame.
+def _per_point(J0, u, V0, W, ctx, wrench, acc, hstep):
+    """The study's literal form: a full L-N force at every penetrating node (grid-dependent).
 
-    With ``acc``, adds to ``WW[0]`` the wear work p |v_t| dt and to ``WW[1]`` the sliding
-    distance |v_t| dt of every contacting bearing point. Adds to ``wrench`` (12: force on the bearing, moment about the bearing centre, normal part of
-    the force, friction part of the force) and returns
-    (elastic energy, normal force magnitude sum, max radial penetration, max axial penetration,
-    mode, stiffness at the deepest slice, number of contacting slices, axial force magnitude).
+    Returns the same tuple as :func:`_slices`.
     """
+    P, IP, H, HMIN, ZL, WL, AREA = ctx[0], ctx[1], ctx[2], ctx[3], ctx[4], ctx[5], ctx[6]
+    vimp, srate, son, WW, acc_out = ctx[7], ctx[8], ctx[9], ctx[11], ctx[12]
     Nl = IP[NL]
     Nd = IP[ND]
     nexp = P[NEXP]
-    ce = P[CE]
-    vfloor = P[VFLOOR]
-    muon = P[MUON]
     energy = 0.0
     fnsum = 0.0
     pen_rad = -1.0
@@ -514,118 +521,77 @@ def _contact(
     two = False
     fn0x, fn0y, fn0z = 0.0, 0.0, 0.0
     have0 = False
-    uz = u[2]
-    K = 0.0
-    hx, hy, hz = 0.0, 0.0, 0.0
-    dstar = 0.0
-    for n in range(Nl if IP[PER_POINT] == 1 else 0):
-        z = ZL[n]
-        s0 = (z - J0[2]) / uz
-        if abs(s0) > 0.5 * P[LJ]:
-            son[n] = 0
+    buf = np.empty(2 * (Nd // 2) + 1)
+    for n in range(Nl):
+        son[n] = 0
+        ok, ax, ay, dest = _layer_axis(n, J0, u, P, HMIN, ZL)
+        if not ok:
             continue
-        ax = J0[0] + s0 * u[0]
-        ay = J0[1] + s0 * u[1]
-        e = math.sqrt(ax * ax + ay * ay)
-        dest = uz * e + P[RJ] - uz * (P[RB] + HMIN[n])
         if dest <= 0.0:
             if dest > pen_rad:
                 pen_rad = dest
-            son[n] = 0
             continue
-        phi0 = math.atan2(ay, -ax)
-        if phi0 < 0.0:
-            phi0 += 2.0 * math.pi
-        m0 = int(round(phi0 / P[DPHI])) % Nd
+        m0 = _facing_node(ax, ay, P, Nd)
         ms, _dm, d0, _dp, _nm, _n0, _np = _search(n, m0, J0, u, P, H, ZL, Nd)
-        # the study's literal form: a full L-N force at every penetrating node
         if d0 > pen_rad:
             pen_rad = d0
         if d0 <= 0.0:
-            son[n] = 0
             continue
-        lo = ms
-        while lo - ms > -Nd // 2 and _node_delta(n, lo - 1, J0, u, P, H, ZL, Nd) > 0.0:
-            lo -= 1
-        hi = ms
-        while hi - ms < Nd // 2 and _node_delta(n, hi + 1, J0, u, P, H, ZL, Nd) > 0.0:
-            hi += 1
+        lo, hi = _penetrating_run(n, ms, J0, u, P, H, ZL, Nd, buf)
         hx, hy, hz = 0.0, 0.0, 0.0
         rate0 = 0.0
         kdk = 0.0
-        dstar = d0
         for mm in range(lo, hi + 1):
             nd = _node(n, mm, J0, u, P, H, ZL, Nd)
             dk = nd[0]
             if dk <= 0.0:
                 continue
             K = _stiffness(P, IP, H[n, mm % Nd])
-            vx = V0[0] + W[1] * nd[3] - W[2] * nd[2]
-            vy = V0[1] + W[2] * nd[1] - W[0] * nd[3]
-            vz = V0[2] + W[0] * nd[2] - W[1] * nd[1]
+            vx, vy, vz = _rel_velocity(V0, W, nd[1], nd[2], nd[3])
             rate = vx * nd[4] + vy * nd[5] + vz * nd[6]
             if mm == ms:
                 rate0 = rate
                 hx, hy, hz = nd[4], nd[5], nd[6]
                 kdk = K
-            vm = vimp[n]
-            if vm <= 0.0:
-                vm = rate if rate > vfloor else vfloor
-            fn = K * dk**nexp * ln_factor(rate, vm, ce)
+            fn = _damped(K * dk**nexp, rate, vimp[n], P[VFLOOR], P[CE])
             energy += K * dk ** (nexp + 1.0) / (nexp + 1.0)
-            wrench[0] += fn * nd[4]
-            wrench[1] += fn * nd[5]
-            wrench[2] += fn * nd[6]
-            wrench[6] += fn * nd[4]
-            wrench[7] += fn * nd[5]
-            wrench[8] += fn * nd[6]
-            _cross_acc(nd[1], nd[2], nd[3], nd[4], nd[5], nd[6], wrench, 3, fn)
+            _add_normal(wrench, nd[1], nd[2], nd[3], nd[4], nd[5], nd[6], fn)
             fnsum += fn
             tx = vx - rate * nd[4]
             ty = vy - rate * nd[5]
             tz = vz - rate * nd[6]
-            vt = _apply_friction(wrench, nd[1], nd[2], nd[3], tx, ty, tz, fn, muon, P)
+            vt = _apply_friction(wrench, nd[1], nd[2], nd[3], tx, ty, tz, fn, P[MUON], P)
             if acc:
                 WW[0, n, mm % Nd] += fn / AREA[n, mm % Nd] * vt * hstep
                 WW[1, n, mm % Nd] += vt * hstep
                 acc_out[0] += fn * vt * hstep
                 acc_out[2] += fn * hstep
-        K = kdk
         srate[n] = rate0
         son[n] = 1
         # contact statistics (modes)
         nslice += 1
         wcontact += WL[n]
-        if dstar > dmaxslice:
-            dmaxslice = dstar
-            kdeep = K
+        if d0 > dmaxslice:
+            dmaxslice = d0
+            kdeep = kdk
         if not have0:
             fn0x, fn0y, fn0z = hx, hy, hz
             have0 = True
         elif fn0x * hx + fn0y * hy + fn0z * hz < 0.0:
             two = True
-    if IP[PER_POINT] == 0:
-        energy, fnsum, pen_rad, kdeep, nslice, two, wcontact = _slices(
-            J0,
-            u,
-            V0,
-            W,
-            P,
-            IP,
-            H,
-            HMIN,
-            ZL,
-            AREA,
-            vimp,
-            srate,
-            son,
-            wrench,
-            acc,
-            hstep,
-            WW,
-            acc_out,
-        )
-    # ---- axial stops: journal shoulders against the bearing end faces ----
+    return energy, fnsum, pen_rad, kdeep, nslice, two, wcontact
+
+
+@njit(cache=True, inline="always")
+def _end_faces(J0, u, V0, W, ctx, wrench, acc, hstep):
+    """Axial stops: the journal's shoulders against the bearing end faces.
+
+    Returns (elastic energy, max axial penetration, axial normal force sum).
+    """
+    P, IP, vimp, srate, son, acc_out = ctx[0], ctx[1], ctx[7], ctx[8], ctx[9], ctx[12]
+    Nl = IP[NL]
+    nexp = P[NEXP]
+    energy = 0.0
     pen_ax = -1.0
     fax = 0.0
     upx, upy = u[0], u[1]
@@ -651,31 +617,46 @@ def _contact(
         if dlt <= 0.0:
             son[k] = 0
             continue
-        vx = V0[0] + W[1] * xz - W[2] * xy
-        vy = V0[1] + W[2] * xx - W[0] * xz
-        vz = V0[2] + W[0] * xy - W[1] * xx
+        vx, vy, vz = _rel_velocity(V0, W, xx, xy, xz)
         vn = vx * u[0] + vy * u[1] + vz * u[2]
         rate = -sg * vn
-        vm = vimp[k]
-        if vm <= 0.0:
-            vm = rate if rate > vfloor else vfloor
-        fn = kax * dlt**nexp * ln_factor(rate, vm, ce)
+        fn = _damped(kax * dlt**nexp, rate, vimp[k], P[VFLOOR], P[CE])
         energy += kax * dlt ** (nexp + 1.0) / (nexp + 1.0)
-        s = -sg * fn
-        wrench[0] += s * u[0]
-        wrench[1] += s * u[1]
-        wrench[2] += s * u[2]
-        wrench[6] += s * u[0]
-        wrench[7] += s * u[1]
-        wrench[8] += s * u[2]
-        _cross_acc(xx, xy, xz, u[0], u[1], u[2], wrench, 3, s)
+        _add_normal(wrench, xx, xy, xz, u[0], u[1], u[2], -sg * fn)
         tx, ty, tz = vx - vn * u[0], vy - vn * u[1], vz - vn * u[2]
-        vt = _apply_friction(wrench, xx, xy, xz, tx, ty, tz, fn, muon, P)
+        vt = _apply_friction(wrench, xx, xy, xz, tx, ty, tz, fn, P[MUON], P)
         srate[k] = rate
         son[k] = 1
         fax += fn
         if acc:
             acc_out[1] += fn * vt * hstep
+    return energy, pen_ax, fax
+
+
+@njit(cache=True, inline="always")
+def _contact(J0, u, V0, W, ctx, wrench, acc, hstep):
+    """Contact of the journal with the bore and the end faces, in the bearing frame.
+
+    ``ctx`` = (P, IP, H, HMIN, ZL, WL, AREA, vimp, srate, son, info, WW, acc_out). With
+    ``acc``, adds to ``WW[0]`` the wear work p |v_t| dt and to ``WW[1]`` the sliding distance
+    |v_t| dt of every contacting bearing point. Adds to ``wrench`` (12: force on the bearing,
+    moment about the bearing centre, normal part of the force, friction part of the force)
+    and returns (elastic energy, normal force magnitude sum, max radial penetration, max axial
+    penetration, mode, stiffness at the deepest slice, number of contacting slices, axial
+    force magnitude).
+    """
+    IP = ctx[1]
+    info = ctx[10]
+    if IP[PER_POINT] == 1:
+        energy, fnsum, pen_rad, kdeep, nslice, two, wcontact = _per_point(
+            J0, u, V0, W, ctx, wrench, acc, hstep
+        )
+    else:
+        energy, fnsum, pen_rad, kdeep, nslice, two, wcontact = _slices(
+            J0, u, V0, W, ctx, wrench, acc, hstep
+        )
+    eax, pen_ax, fax = _end_faces(J0, u, V0, W, ctx, wrench, acc, hstep)
+    energy += eax
     if nslice == 0:
         mode = MODE_FREE
     elif two:
@@ -692,10 +673,9 @@ def _contact(
 
 
 @njit(cache=True)
-def _eval_clearance(
-    t, y, P, IP, H, HMIN, ZL, WL, AREA, vimp, srate, son, info, dy, acc, hstep, WW, acc_out, diag
-):
+def _eval_clearance(t, y, ctx, dy, acc, hstep, diag):
     """Right-hand side of the clearance model; optionally accumulates wear work / fills diag."""
+    P, IP, info = ctx[0], ctx[1], ctx[10]
     th1, th2, w1, w2 = y[0], y[1], y[2], y[3]
     c1, s1 = math.cos(th1), math.sin(th1)
     c2, s2 = math.cos(th2), math.sin(th2)
@@ -762,26 +742,7 @@ def _eval_clearance(
         info[I_BAD] = 1.0
         u[2] = 0.5
     energy, fnsum, pen_rad, pen_ax, mode, kdeep, nslice, fax = _contact(
-        J0,
-        u,
-        V0,
-        W,
-        P,
-        IP,
-        H,
-        HMIN,
-        ZL,
-        WL,
-        AREA,
-        vimp,
-        srate,
-        son,
-        wrench,
-        info,
-        acc,
-        hstep,
-        WW,
-        acc_out,
+        J0, u, V0, W, ctx, wrench, acc, hstep
     )
     # wrench on the bearing, global: force F, moment M about Og
     Fx = Rb[0, 0] * wrench[0] + Rb[0, 1] * wrench[1] + Rb[0, 2] * wrench[2]
@@ -970,60 +931,53 @@ def _eval_ideal(t, y, P, IP, dy, diag):
 
 
 @njit(cache=True)
-def _eval(
-    t, y, P, IP, H, HMIN, ZL, WL, AREA, vimp, srate, son, info, dy, acc, hstep, WW, acc_out, diag
-):
-    if IP[IDEAL] == 1:
-        _eval_ideal(t, y, P, IP, dy, diag)
+def _eval(t, y, ctx, dy, acc, hstep, diag):
+    """Right-hand side dy of either model; ``ctx`` as in :func:`_contact`."""
+    if ctx[1][IDEAL] == 1:
+        _eval_ideal(t, y, ctx[0], ctx[1], dy, diag)
+        info = ctx[10]
         info[I_PEN] = -1.0
         info[I_CONTACT] = 0.0
         info[I_BAD] = 0.0
     else:
-        _eval_clearance(
-            t,
-            y,
-            P,
-            IP,
-            H,
-            HMIN,
-            ZL,
-            WL,
-            AREA,
-            vimp,
-            srate,
-            son,
-            info,
-            dy,
-            acc,
-            hstep,
-            WW,
-            acc_out,
-            diag,
-        )
+        _eval_clearance(t, y, ctx, dy, acc, hstep, diag)
 
 
-# Dormand-Prince 5(4) coefficients
-_C2, _C3, _C4, _C5 = 1.0 / 5.0, 3.0 / 10.0, 4.0 / 5.0, 8.0 / 9.0
-_A21 = 1.0 / 5.0
-_A31, _A32 = 3.0 / 40.0, 9.0 / 40.0
-_A41, _A42, _A43 = 44.0 / 45.0, -56.0 / 15.0, 32.0 / 9.0
-_A51, _A52, _A53, _A54 = 19372.0 / 6561.0, -25360.0 / 2187.0, 64448.0 / 6561.0, -212.0 / 729.0
-_A61, _A62, _A63, _A64, _A65 = (
-    9017.0 / 3168.0,
-    -355.0 / 33.0,
-    46732.0 / 5247.0,
-    49.0 / 176.0,
-    -5103.0 / 18656.0,
+# Dormand-Prince 5(4) tableau: nodes, stage coefficients (row s: stage s + 1), 5th-order
+# weights and error weights (b - b*); the second stage never enters B and E
+_C = np.array([0.0, 1.0 / 5.0, 3.0 / 10.0, 4.0 / 5.0, 8.0 / 9.0, 1.0])
+_A = np.array(
+    [
+        [0.0, 0.0, 0.0, 0.0, 0.0],
+        [1.0 / 5.0, 0.0, 0.0, 0.0, 0.0],
+        [3.0 / 40.0, 9.0 / 40.0, 0.0, 0.0, 0.0],
+        [44.0 / 45.0, -56.0 / 15.0, 32.0 / 9.0, 0.0, 0.0],
+        [19372.0 / 6561.0, -25360.0 / 2187.0, 64448.0 / 6561.0, -212.0 / 729.0, 0.0],
+        [9017.0 / 3168.0, -355.0 / 33.0, 46732.0 / 5247.0, 49.0 / 176.0, -5103.0 / 18656.0],
+    ]
 )
-_B1, _B3, _B4, _B5, _B6 = 35.0 / 384.0, 500.0 / 1113.0, 125.0 / 192.0, -2187.0 / 6784.0, 11.0 / 84.0
-_E1, _E3, _E4, _E5, _E6, _E7 = (
-    71.0 / 57600.0,
-    -71.0 / 16695.0,
-    71.0 / 1920.0,
-    -17253.0 / 339200.0,
-    22.0 / 525.0,
-    -1.0 / 40.0,
+_B = np.array([35.0 / 384.0, 0.0, 500.0 / 1113.0, 125.0 / 192.0, -2187.0 / 6784.0, 11.0 / 84.0])
+_E = np.array(
+    [
+        71.0 / 57600.0,
+        0.0,
+        -71.0 / 16695.0,
+        71.0 / 1920.0,
+        -17253.0 / 339200.0,
+        22.0 / 525.0,
+        -1.0 / 40.0,
+    ]
 )
+
+
+@njit(cache=True, inline="always")
+def _combine(Ks, coef, s, i):
+    """sum_j coef[j] Ks[j, i] over the stages j < s with a non-zero coefficient, in order."""
+    a = 0.0
+    for j in range(s):
+        if coef[j] != 0.0:
+            a += coef[j] * Ks[j, i]
+    return a
 
 
 @njit(cache=True)
@@ -1063,40 +1017,14 @@ def integrate(
     srate = np.zeros(Nl + 2)
     son = np.zeros(Nl + 2, dtype=np.int64)
     info = np.zeros(NINFO)
-    k1 = np.empty(n)
-    k2 = np.empty(n)
-    k3 = np.empty(n)
-    k4 = np.empty(n)
-    k5 = np.empty(n)
-    k6 = np.empty(n)
-    k7 = np.empty(n)
+    ctx = (P, IP, H, HMIN, ZL, WL, AREA, vimp, srate, son, info, WW, acc_out)
+    Ks = np.empty((7, n))  # the seven stage derivatives (the seventh is the next first: FSAL)
     yt = np.empty(n)
     y1 = np.empty(n)
     yi = np.empty(n)
     nodiag = np.empty(0)
-    dummy = np.zeros(3)
     ndg = np.empty(ND_DIAG)
-    _eval(
-        t,
-        y,
-        P,
-        IP,
-        H,
-        HMIN,
-        ZL,
-        WL,
-        AREA,
-        vimp,
-        srate,
-        son,
-        info,
-        k1,
-        False,
-        0.0,
-        WW,
-        dummy,
-        nodiag,
-    )
+    _eval(t, y, ctx, Ks[0], False, 0.0, nodiag)
     pen0 = info[I_PEN]
     contact0 = info[I_CONTACT]
     nacc = 0
@@ -1104,27 +1032,7 @@ def integrate(
     n_out = t_out.shape[0]
     # record an output point sitting exactly at the start
     while i_out < n_out and t_out[i_out] <= t:
-        _eval(
-            t,
-            y,
-            P,
-            IP,
-            H,
-            HMIN,
-            ZL,
-            WL,
-            AREA,
-            vimp,
-            srate,
-            son,
-            info,
-            yi,
-            False,
-            0.0,
-            WW,
-            dummy,
-            ndg,
-        )
+        _eval(t, y, ctx, yi, False, 0.0, ndg)
         for j in range(ND_DIAG):
             diag_out[i_out, j] = ndg[j]
         i_out += 1
@@ -1136,153 +1044,21 @@ def integrate(
         if t + h >= t_end:
             h = t_end - t
             last = True
-        # ---- one DOPRI5 step ----
+        # ---- one DOPRI5 step: stages 2..6, the 5th-order solution and its derivative ----
+        for s in range(1, 6):
+            for i in range(n):
+                if s == 1:
+                    yt[i] = y[i] + h * _A[1, 0] * Ks[0, i]
+                else:
+                    yt[i] = y[i] + h * _combine(Ks, _A[s], s, i)
+            _eval(t + _C[s] * h, yt, ctx, Ks[s], False, 0.0, nodiag)
         for i in range(n):
-            yt[i] = y[i] + h * _A21 * k1[i]
-        _eval(
-            t + _C2 * h,
-            yt,
-            P,
-            IP,
-            H,
-            HMIN,
-            ZL,
-            WL,
-            AREA,
-            vimp,
-            srate,
-            son,
-            info,
-            k2,
-            False,
-            0.0,
-            WW,
-            dummy,
-            nodiag,
-        )
-        for i in range(n):
-            yt[i] = y[i] + h * (_A31 * k1[i] + _A32 * k2[i])
-        _eval(
-            t + _C3 * h,
-            yt,
-            P,
-            IP,
-            H,
-            HMIN,
-            ZL,
-            WL,
-            AREA,
-            vimp,
-            srate,
-            son,
-            info,
-            k3,
-            False,
-            0.0,
-            WW,
-            dummy,
-            nodiag,
-        )
-        for i in range(n):
-            yt[i] = y[i] + h * (_A41 * k1[i] + _A42 * k2[i] + _A43 * k3[i])
-        _eval(
-            t + _C4 * h,
-            yt,
-            P,
-            IP,
-            H,
-            HMIN,
-            ZL,
-            WL,
-            AREA,
-            vimp,
-            srate,
-            son,
-            info,
-            k4,
-            False,
-            0.0,
-            WW,
-            dummy,
-            nodiag,
-        )
-        for i in range(n):
-            yt[i] = y[i] + h * (_A51 * k1[i] + _A52 * k2[i] + _A53 * k3[i] + _A54 * k4[i])
-        _eval(
-            t + _C5 * h,
-            yt,
-            P,
-            IP,
-            H,
-            HMIN,
-            ZL,
-            WL,
-            AREA,
-            vimp,
-            srate,
-            son,
-            info,
-            k5,
-            False,
-            0.0,
-            WW,
-            dummy,
-            nodiag,
-        )
-        for i in range(n):
-            yt[i] = y[i] + h * (
-                _A61 * k1[i] + _A62 * k2[i] + _A63 * k3[i] + _A64 * k4[i] + _A65 * k5[i]
-            )
-        _eval(
-            t + h,
-            yt,
-            P,
-            IP,
-            H,
-            HMIN,
-            ZL,
-            WL,
-            AREA,
-            vimp,
-            srate,
-            son,
-            info,
-            k6,
-            False,
-            0.0,
-            WW,
-            dummy,
-            nodiag,
-        )
-        for i in range(n):
-            y1[i] = y[i] + h * (_B1 * k1[i] + _B3 * k3[i] + _B4 * k4[i] + _B5 * k5[i] + _B6 * k6[i])
-        _eval(
-            t + h,
-            y1,
-            P,
-            IP,
-            H,
-            HMIN,
-            ZL,
-            WL,
-            AREA,
-            vimp,
-            srate,
-            son,
-            info,
-            k7,
-            False,
-            0.0,
-            WW,
-            dummy,
-            nodiag,
-        )
+            y1[i] = y[i] + h * _combine(Ks, _B, 6, i)
+        _eval(t + h, y1, ctx, Ks[6], False, 0.0, nodiag)
         err = 0.0
         finite = True
         for i in range(n):
-            ei = h * (
-                _E1 * k1[i] + _E3 * k3[i] + _E4 * k4[i] + _E5 * k5[i] + _E6 * k6[i] + _E7 * k7[i]
-            )
+            ei = h * _combine(Ks, _E, 7, i)
             if ANG[i] == 1:
                 sc = atol
             else:
@@ -1336,28 +1112,8 @@ def integrate(
             h01 = -2 * th**3 + 3 * th**2
             h11 = th**3 - th**2
             for i in range(n):
-                yi[i] = h00 * y[i] + h10 * h * k1[i] + h01 * y1[i] + h11 * h * k7[i]
-            _eval(
-                t_out[i_out],
-                yi,
-                P,
-                IP,
-                H,
-                HMIN,
-                ZL,
-                WL,
-                AREA,
-                vimp,
-                srate,
-                son,
-                info,
-                yt,
-                False,
-                0.0,
-                WW,
-                dummy,
-                ndg,
-            )
+                yi[i] = h00 * y[i] + h10 * h * Ks[0, i] + h01 * y1[i] + h11 * h * Ks[6, i]
+            _eval(t_out[i_out], yi, ctx, yt, False, 0.0, ndg)
             for j in range(ND_DIAG):
                 diag_out[i_out, j] = ndg[j]
             i_out += 1
@@ -1373,30 +1129,10 @@ def integrate(
         nacc += 1
         # wear work and impact-velocity memory at the new state
         if contact1 != 0.0:
-            _eval(
-                t,
-                y,
-                P,
-                IP,
-                H,
-                HMIN,
-                ZL,
-                WL,
-                AREA,
-                vimp,
-                srate,
-                son,
-                info,
-                k1,
-                True,
-                h,
-                WW,
-                acc_out,
-                nodiag,
-            )
+            _eval(t, y, ctx, Ks[0], True, h, nodiag)
         else:
             for i in range(n):
-                k1[i] = k7[i]
+                Ks[0, i] = Ks[6, i]
             for k in range(Nl + 2):
                 son[k] = 0
         pen0 = pen1
