@@ -592,7 +592,7 @@ def _read_opencv_file(path: Path) -> tuple[dict[str, tuple[np.ndarray, str]], An
     try:
         fs = cv2.FileStorage(str(path), cv2.FILE_STORAGE_READ)
         ok = fs.isOpened()
-    except cv2.error:
+    except (cv2.error, SystemError):  # OpenCV 5 raises SystemError on truncated/empty files
         ok = False
     if not ok:
         raise BadInputError(
@@ -619,6 +619,13 @@ def _read_opencv_file(path: Path) -> tuple[dict[str, tuple[np.ndarray, str]], An
                 arr = _fs_array(node)
                 if arr is not None and arr.size >= 2:
                     size = (int(arr.ravel()[0]), int(arr.ravel()[1]))
+    except BadInputError:
+        raise
+    except (cv2.error, SystemError, ValueError, TypeError, OverflowError) as exc:
+        raise BadInputError(
+            f"'{path}': an entry of the OpenCV FileStorage file cannot be read ({exc}); the "
+            "file is corrupt or truncated - write it again with cv::FileStorage"
+        ) from None
     finally:
         fs.release()
     return found, size
