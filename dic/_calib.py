@@ -204,6 +204,18 @@ class StereoCalibration:
         Number of calibration views accepted and rejected.
     rejected : tuple of str
         Why each rejected view was rejected.
+    view_names : tuple of str
+        Name of each accepted view (its image files), in the order of ``per_view_rms``.
+    length_unit : str
+        Unit of the translations: ``"m"``, or ``"square"`` for a board calibrated without a
+        metric square size (such a calibration cannot measure; see :func:`read_calibration`).
+    length_scale_u_rel : float or None
+        Relative standard uncertainty of lengths measured with this calibration (baseline
+        scatter over the views, and the board's square size when its uncertainty was given)
+        [1]; None: not assessed.
+    status : str
+        ``"accepted"``, ``"accepted with --accept-poor: <problems>"`` or
+        ``"rejected: <problems>"`` (see :mod:`jointwear.dic._calib_gate`).
     source : str
         Where the calibration came from (``"jointwear calibrate"``, ``"opencv:<file>"``,
         ``"vic3d:<file>"``).
@@ -220,6 +232,10 @@ class StereoCalibration:
     source: str = ""
     world_frame: str = "left camera frame (x right, y down, z along the optical axis)"
     rejected: tuple[str, ...] = ()
+    view_names: tuple[str, ...] = ()
+    length_unit: str = "m"
+    length_scale_u_rel: float | None = None
+    status: str = "accepted"
 
     @property
     def cameras(self) -> dict[str, Camera]:
@@ -247,16 +263,13 @@ class StereoCalibration:
 
     def with_world_frame(self, R_wn: np.ndarray, t_wn: np.ndarray, description: str) -> Any:
         """Express both cameras in a new world frame ``X_old = R_wn X_new + t_wn``."""
-        return StereoCalibration(
-            self.left.transformed(R_wn, t_wn),
-            self.right.transformed(R_wn, t_wn),
-            rms=self.rms,
-            per_view_rms=self.per_view_rms,
-            views_used=self.views_used,
-            views_rejected=self.views_rejected,
-            source=self.source,
+        import dataclasses
+
+        return dataclasses.replace(
+            self,
+            left=self.left.transformed(R_wn, t_wn),
+            right=self.right.transformed(R_wn, t_wn),
             world_frame=description,
-            rejected=self.rejected,
         )
 
     # ---- xarray ----------------------------------------------------------------------------
@@ -289,7 +302,10 @@ class StereoCalibration:
                 "translation": (
                     ("camera", "axis"),
                     np.stack([c.translation for c in cams]),
-                    {"units": "m", "long_name": "world-to-camera translation t (Xc = R X + t)"},
+                    {
+                        "units": self.length_unit,
+                        "long_name": "world-to-camera translation t (Xc = R X + t)",
+                    },
                 ),
                 "image_size": (
                     ("camera", "extent"),
@@ -316,6 +332,10 @@ class StereoCalibration:
                 np.asarray(self.per_view_rms, dtype=float),
                 {"units": "pixel", "long_name": "reprojection RMS per accepted calibration view"},
             )
+            if len(self.view_names) == len(self.per_view_rms):
+                ds = ds.assign_coords(
+                    view=("view", list(self.view_names), {"long_name": "calibration view files"})
+                )
         ds.attrs.update(
             {
                 "title": "jointwear stereo calibration",
@@ -326,6 +346,13 @@ class StereoCalibration:
                 "calibration_source": self.source,
                 "world_frame": self.world_frame,
                 "rejected_views": json.dumps(list(self.rejected)),
+                "length_unit": self.length_unit,
+                "calibration_status": self.status,
+                "length_scale_u_rel": (
+                    float(self.length_scale_u_rel)
+                    if self.length_scale_u_rel is not None
+                    else "not assessed"
+                ),
             }
         )
         return ds
@@ -367,6 +394,14 @@ class StereoCalibration:
             source=str(ds.attrs.get("calibration_source", "")),
             world_frame=str(ds.attrs.get("world_frame", "")),
             rejected=tuple(_json_list(ds.attrs.get("rejected_views", "[]"))),
+            view_names=(
+                tuple(str(v) for v in ds["view"].values)
+                if "view_rms" in ds and "view" in ds.coords and ds["view"].dtype.kind in "UO"
+                else ()
+            ),
+            length_unit=str(ds.attrs.get("length_unit", "m")),
+            status=str(ds.attrs.get("calibration_status", "accepted")),
+            length_scale_u_rel=_float_or_none(ds.attrs.get("length_scale_u_rel")),
         )
 
     def save(self, path: str | Path, *, inputs=(), parameters: Any = None) -> Path:
@@ -380,6 +415,14 @@ class StereoCalibration:
             parameters=parameters,
             source="jointwear (dic.calibrate)",
         )
+
+
+def _float_or_none(value: Any) -> float | None:
+    try:
+        out = float(value)
+    except (TypeError, ValueError):
+        return None
+    return out if np.isfinite(out) else None
 
 
 def _json_list(value: Any) -> list[str]:
@@ -549,7 +592,7 @@ def _read_opencv_file(path: Path) -> tuple[dict[str, tuple[np.ndarray, str]], An
     try:
         fs = cv2.FileStorage(str(path), cv2.FILE_STORAGE_READ)
         ok = fs.isOpened()
-    except cv2.error:
+    except (cv2.error, SystemError):  # OpenCV 5 raises SystemError on truncated/empty files
         ok = False
     if not ok:
         raise BadInputError(
@@ -576,6 +619,13 @@ def _read_opencv_file(path: Path) -> tuple[dict[str, tuple[np.ndarray, str]], An
                 arr = _fs_array(node)
                 if arr is not None and arr.size >= 2:
                     size = (int(arr.ravel()[0]), int(arr.ravel()[1]))
+    except BadInputError:
+        raise
+    except (cv2.error, SystemError, ValueError, TypeError, OverflowError) as exc:
+        raise BadInputError(
+            f"'{path}': an entry of the OpenCV FileStorage file cannot be read ({exc}); the "
+            "file is corrupt or truncated - write it again with cv::FileStorage"
+        ) from None
     finally:
         fs.release()
     return found, size
@@ -898,8 +948,15 @@ def read_vic3d_calibration(
     )
 
 
-def read_calibration(path: str | Path) -> StereoCalibration:
-    """Load a jointwear calibration file (``.nc``, written by ``jointwear dic calibrate``)."""
+def read_calibration(
+    path: str | Path, *, allow_rejected: bool = False, allow_unitless: bool = False
+) -> StereoCalibration:
+    """Load a jointwear calibration file (``.nc``, written by ``jointwear dic calibrate``).
+
+    A calibration that failed its sanity checks (``<out>.rejected.nc``) and one whose lengths
+    are in board squares (``--unit square``) cannot measure and are refused unless
+    ``allow_rejected`` / ``allow_unitless``.
+    """
     from jointwear import io
 
     path = Path(path)
@@ -919,7 +976,21 @@ def read_calibration(path: str | Path) -> StereoCalibration:
             "`jointwear dic import-calibration --format vic3d` (or read_vic3d_calibration)"
         )
     ds = io.load(path)
-    return StereoCalibration.from_dataset(ds, what=f"'{path}'")
+    status = str(ds.attrs.get("calibration_status", "accepted"))
+    if status.startswith("rejected") and not allow_rejected:
+        raise BadInputError(
+            f"'{path}' is a calibration that failed its sanity checks ({status}); it was kept "
+            "for inspection only - recalibrate (or, if it is right after all, calibrate again "
+            "with --accept-poor)"
+        )
+    cal = StereoCalibration.from_dataset(ds, what=f"'{path}'")
+    if cal.length_unit != "m" and not allow_unitless:
+        raise BadInputError(
+            f"'{path}' has its lengths in board {cal.length_unit}s (calibrated with --unit "
+            f"{cal.length_unit}); measuring needs a metric scale - calibrate with the board's "
+            "square size, e.g. --square 25 --unit mm"
+        )
+    return cal
 
 
 def _check_enough_views(n_ok: int, n_total: int, minimum: int, reasons: list[str]) -> None:

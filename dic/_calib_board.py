@@ -32,6 +32,12 @@ class CalibrationBoard:
         Side of the ArUco markers of a ChArUco board [m].
     dictionary : str
         ArUco dictionary of a ChArUco board (``"DICT_5X5_100"``, ...).
+    length_unit : {"m", "square"}
+        Unit of ``square_size`` and ``marker_size``: metres, or ``"square"`` for a board of
+        unknown size (``square_size = 1``; the calibration's lengths are then in squares).
+    square_size_u : float, optional
+        Standard uncertainty of ``square_size`` (same unit), e.g. from measuring the printed
+        board; None: not assessed.
     """
 
     kind: Literal["chessboard", "charuco"] = "chessboard"
@@ -40,8 +46,14 @@ class CalibrationBoard:
     square_size: float = 0.01
     marker_size: float = 0.0075
     dictionary: str = "DICT_5X5_100"
+    length_unit: str = "m"
+    square_size_u: float | None = None
 
     def __post_init__(self) -> None:
+        if self.length_unit not in ("m", "square"):
+            raise BadInputError(f"board length_unit {self.length_unit!r}: expected 'm' or 'square'")
+        if self.square_size_u is not None and not self.square_size_u >= 0:
+            raise BadInputError(f"board square_size_u must be >= 0, got {self.square_size_u}")
         if self.kind not in ("chessboard", "charuco"):
             raise BadInputError(f"board kind {self.kind!r}: expected 'chessboard' or 'charuco'")
         if self.squares_x < 3 or self.squares_y < 3:
@@ -86,16 +98,17 @@ class CalibrationBoard:
         return board
 
 
-def detect_board(
-    image: np.ndarray, board: CalibrationBoard
-) -> tuple[np.ndarray, np.ndarray] | None:
+def detect_board(image: np.ndarray, board: CalibrationBoard, *, with_detector: bool = False):
     """Find the board's inner corners in a grey image.
+
+    Chessboards are searched with OpenCV's sector-based detector, then with the classic one.
 
     Returns
     -------
     (ids, corners) or None
         Corner indices into :meth:`CalibrationBoard.object_points` (M,) and their sub-pixel
-        image positions (M, 2) [pixel]; None when the board is not found.
+        image positions (M, 2) [pixel]; None when the board is not found. With
+        ``with_detector``, a third element names the detector that found the board.
     """
     import cv2
 
@@ -106,18 +119,21 @@ def detect_board(
         lo, hi = float(img.min()), float(img.max())
         img = np.clip((img - lo) / max(hi - lo, 1e-12) * 255, 0, 255).astype(np.uint8)
     if board.kind == "chessboard":
-        pattern = board.inner_corners
-        ok, corners = cv2.findChessboardCornersSB(
-            img, pattern, flags=cv2.CALIB_CB_EXHAUSTIVE | cv2.CALIB_CB_ACCURACY
-        )
-        if not ok or corners is None:
+        found = _find_chessboard(img, board.inner_corners)
+        if found is None:
             return None
-        corners = corners.reshape(-1, 2).astype(np.float64)
+        corners, detector = found
         # OpenCV may return the grid in either of two orders; fix it so that the first corner
-        # is the top-left one in the image (the board must not be upside down in either view)
+        # is the top-left one in this image (a convention for a single image, such as the
+        # world-frame view; the two cameras of a calibration pair are made consistent by
+        # geometry, see jointwear.dic._calib_order)
         if (corners[-1] - corners[0]) @ np.array([1.0, 1.0]) < 0:
             corners = corners[::-1].copy()
-        return np.arange(len(corners)), corners
+        return (
+            (np.arange(len(corners)), corners, detector)
+            if with_detector
+            else (np.arange(len(corners)), corners)
+        )
     # boards printed from OpenCV < 4.6 (or tools following it) with an even number of rows
     # place their markers differently; their corners sit at the same board positions
     layouts = (False, True) if board.squares_y % 2 == 0 else (False,)
@@ -125,8 +141,41 @@ def detect_board(
         detector = cv2.aruco.CharucoDetector(board._charuco(legacy))
         ch_corners, ch_ids, _, _ = detector.detectBoard(img)
         if ch_ids is not None and len(ch_ids) >= 6:
-            return ch_ids.ravel().astype(int), ch_corners.reshape(-1, 2).astype(np.float64)
+            ids = ch_ids.ravel().astype(int)
+            pts = ch_corners.reshape(-1, 2).astype(np.float64)
+            return (ids, pts, "charuco") if with_detector else (ids, pts)
     return None
+
+
+def _find_chessboard(img: np.ndarray, pattern: tuple[int, int]):
+    """Inner corners (N, 2) [pixel] and the detector that found them, or None.
+
+    The sector-based detector (``findChessboardCornersSB``) first; where it finds no board, the
+    classic detector (``findChessboardCorners`` with sub-pixel refinement), which finds some
+    boards the former misses (strong perspective, JPEG artefacts, a board touching the edge).
+    """
+    import cv2
+
+    ok, corners = cv2.findChessboardCornersSB(
+        img, pattern, flags=cv2.CALIB_CB_EXHAUSTIVE | cv2.CALIB_CB_ACCURACY
+    )
+    if ok and corners is not None:
+        return corners.reshape(-1, 2).astype(np.float64), "sector-based"
+    flags = cv2.CALIB_CB_ADAPTIVE_THRESH | cv2.CALIB_CB_NORMALIZE_IMAGE
+    ok, corners = cv2.findChessboardCorners(img, pattern, flags=flags)
+    if not ok or corners is None:
+        return None
+    # refinement window: a third of the smallest corner spacing, at most 11 px
+    c = corners.reshape(-1, 2)
+    grid = c.reshape(pattern[1], pattern[0], 2)
+    spacing = min(
+        np.min(np.linalg.norm(np.diff(grid, axis=1), axis=2)),
+        np.min(np.linalg.norm(np.diff(grid, axis=0), axis=2)),
+    )
+    win = int(np.clip(spacing / 3, 2, 11))
+    crit = (cv2.TERM_CRITERIA_EPS + cv2.TERM_CRITERIA_COUNT, 100, 1e-4)
+    corners = cv2.cornerSubPix(img, corners.astype(np.float32), (win, win), (-1, -1), crit)
+    return corners.reshape(-1, 2).astype(np.float64), "classic"
 
 
 def _read_gray(item, what: str) -> np.ndarray:
@@ -196,6 +245,12 @@ def _charuco_obj(board: CalibrationBoard) -> np.ndarray:
     return np.asarray(board._charuco().getChessboardCorners(), dtype=float).reshape(-1, 3)
 
 
+def _view_name(li, ri, i: int) -> str:
+    if isinstance(li, (str, Path)) and isinstance(ri, (str, Path)):
+        return f"{Path(li).name} / {Path(ri).name}"
+    return f"view {i}"
+
+
 def calibrate_stereo(
     left_images: Sequence | Iterable,
     right_images: Sequence | Iterable,
@@ -206,13 +261,22 @@ def calibrate_stereo(
     fix_k3: bool = False,
     rational: bool = False,
     world_view: int | None = None,
+    max_rms: float = 1.0,
+    accept_poor: bool = False,
+    view_names: Sequence[str] | None = None,
 ) -> StereoCalibration:
     """Calibrate a camera pair from simultaneous views of a board.
 
-    Each camera is first calibrated on its own (``cv2.calibrateCameraExtended``); views whose
-    reprojection RMS exceeds ``max_view_rms`` are rejected and the calibration is repeated; then
-    ``cv2.stereoCalibrate`` refines intrinsics and the relative pose on the views both cameras
-    saw (``CALIB_USE_INTRINSIC_GUESS``).
+    Boards are found with both of OpenCV's chessboard detectors (sector-based, then classic).
+    The corner order of the two cameras is made consistent by geometry
+    (:mod:`jointwear.dic._calib_order`): a view whose left and right images do not show the
+    board in the pose the other views agree on is rejected. Each camera is then calibrated on
+    its own (``cv2.calibrateCameraExtended``); views whose reprojection RMS exceeds
+    ``max_view_rms`` are rejected and the calibration is repeated; then ``cv2.stereoCalibrate``
+    refines intrinsics and the relative pose (``CALIB_USE_INTRINSIC_GUESS``). Finally the result
+    passes a sanity gate (:func:`~jointwear.dic._calib_gate.check_calibration`): stereo RMS,
+    field of view, pixel aspect, principal point, baseline against the board distance, and
+    which side the right camera is on.
 
     Parameters
     ----------
@@ -229,13 +293,33 @@ def calibrate_stereo(
     world_view : int, optional
         Index of a view whose board pose becomes the world frame (z normal to the board).
         Default: the left camera frame.
+    max_rms : float
+        Largest acceptable stereo reprojection RMS [pixel] (sanity gate).
+    accept_poor : bool
+        Return a calibration that fails the sanity gate (its ``status`` says so) instead of
+        raising :class:`~jointwear.dic._calib_gate.PoorCalibration`.
+    view_names : sequence of str, optional
+        Names of the views in messages and in the per-view table; default: the image file
+        names, or ``"view <i>"`` for arrays.
 
     Returns
     -------
     StereoCalibration
-        With overall RMS, per-view RMS and the counts of used/rejected views.
+        With overall RMS, per-view RMS (with the view names), the counts of used/rejected
+        views and the relative length uncertainty (baseline scatter over the views, and the
+        square size uncertainty when given).
+
+    Raises
+    ------
+    CalibrationError
+        Too few usable views (exit code 3).
+    PoorCalibration
+        The result failed the sanity gate (exit code 1; the result is attached).
     """
     import cv2
+
+    from jointwear.dic._calib_gate import PoorCalibration, check_calibration
+    from jointwear.dic._calib_order import consistent_order, grid_symmetries, pair_poses
 
     left_images = list(left_images)
     right_images = list(right_images)
@@ -245,6 +329,16 @@ def calibrate_stereo(
             f"{len(right_images)} right images; give the same number, in the same order"
         )
     n_total = len(left_images)
+    names = (
+        list(view_names)
+        if view_names is not None
+        else [
+            _view_name(li, ri, i)
+            for i, (li, ri) in enumerate(zip(left_images, right_images, strict=True))
+        ]
+    )
+    if len(names) != n_total:
+        raise BadInputError(f"view_names: {len(names)} names for {n_total} views")
     obj_all = board.object_points() if board.kind == "chessboard" else _charuco_obj(board)
     views = []  # (index, obj, left_pts, right_pts)
     reasons: list[str] = []
@@ -256,7 +350,7 @@ def calibrate_stereo(
             size = (L.shape[1], L.shape[0])
         if (L.shape[1], L.shape[0]) != size or (Rimg.shape[1], Rimg.shape[0]) != size:
             raise BadInputError(
-                f"calibration view {i}: image size {L.shape[1]}x{L.shape[0]} / "
+                f"calibration view {names[i]}: image size {L.shape[1]}x{L.shape[0]} / "
                 f"{Rimg.shape[1]}x{Rimg.shape[0]} differs from the first view's {size[0]}x{size[1]}"
             )
         fl, fr = detect_board(L, board), detect_board(Rimg, board)
@@ -264,11 +358,11 @@ def calibrate_stereo(
             which = (
                 "both cameras" if fl is None and fr is None else ("left" if fl is None else "right")
             )
-            reasons.append(f"view {i}: board not found ({which})")
+            reasons.append(f"{names[i]}: board not found ({which}) by either detector")
             continue
         common = np.intersect1d(fl[0], fr[0])
         if len(common) < 6:
-            reasons.append(f"view {i}: only {len(common)} corners seen by both cameras")
+            reasons.append(f"{names[i]}: only {len(common)} corners seen by both cameras")
             continue
         li_idx = np.searchsorted(fl[0], common)
         ri_idx = np.searchsorted(fr[0], common)
@@ -288,6 +382,40 @@ def calibrate_stereo(
         )
         return K, D, per_view.ravel()
 
+    # one corner order for both cameras: the relabelling of the right corners whose
+    # left-to-right pose agrees with the other views
+    KL, DL, _ = mono(0, views)
+    KR, DR, _ = mono(1, views)
+    perms_full = grid_symmetries(*board.inner_corners) if board.kind == "chessboard" else None
+    cands = []
+    for v in views:
+        perms = perms_full if perms_full is not None and len(v[1]) == len(obj_all) else None
+        perms = perms or [np.arange(len(v[1]))]
+        cands.append(pair_poses(v[1], v[2], v[3], (KL, DL), (KR, DR), perms, v[0]))
+    relabel, _ = consistent_order(cands)
+    kept, pair_T, board_dist = [], [], []
+    for v, k, cs in zip(views, relabel, cands, strict=True):
+        if k is None:
+            reasons.append(
+                f"{names[v[0]]}: the left and right images do not show the board in the pose "
+                "the other views agree on (mismatched or swapped pair, or the board moved "
+                "between the two exposures)"
+            )
+            continue
+        perm = perms_full[k] if perms_full is not None and len(v[1]) == len(obj_all) else None
+        kept.append(v if perm is None else (v[0], v[1], v[2], v[3][perm]))
+        pair_T.append(np.linalg.norm(next(c.T for c in cs if c.relabel == k)))
+    n_disagree = len(views) - len(kept)
+    if len(kept) < min_views and n_disagree >= len(views) / 2:
+        raise CalibrationError(
+            f"in {n_disagree} of {len(views)} views the left and right images do not show the "
+            "board in one common pose: the two image lists are not simultaneous pairs in the "
+            "same order (check that both folders hold the same views sorted alike, and that "
+            f"--left/--right are not mixed up); e.g. {reasons[-1]}"
+        )
+    views = kept
+    _check_enough_views(len(views), n_total, min_views, reasons)
+
     for _ in range(2):
         KL, DL, pv_l = mono(0, views)
         KR, DR, pv_r = mono(1, views)
@@ -296,8 +424,10 @@ def calibrate_stereo(
             break
         for j in np.flatnonzero(bad):
             reasons.append(
-                f"view {views[j][0]}: reprojection RMS {pv_l[j]:.2f}/{pv_r[j]:.2f} px > {max_view_rms}"
+                f"{names[views[j][0]]}: reprojection RMS {pv_l[j]:.2f}/{pv_r[j]:.2f} px > "
+                f"{max_view_rms} (--max-view-rms)"
             )
+        pair_T = [t for t, b in zip(pair_T, bad, strict=True) if not b]
         views = [v for v, b in zip(views, bad, strict=True) if not b]
         _check_enough_views(len(views), n_total, min_views, reasons)
 
@@ -310,8 +440,13 @@ def calibrate_stereo(
     )
     rms, KL, DL, KR, DR, R, T = out[:7]
     per_view = np.asarray(out[-1]).reshape(len(views), 2)
+    for v in views:  # distance of the board from the left camera (baseline plausibility)
+        ok, _, tvec = cv2.solvePnP(v[1].astype(np.float64), v[2].astype(np.float64), KL, DL)
+        if ok:
+            board_dist.append(float(np.linalg.norm(tvec)))
     left = Camera(KL, DL.ravel(), np.eye(3), np.zeros(3), size)
     right = Camera(KR, DR.ravel(), R, T.ravel(), size)
+    u_rel = _length_u_rel(np.asarray(pair_T), board)
     cal = StereoCalibration(
         left,
         right,
@@ -321,9 +456,42 @@ def calibrate_stereo(
         views_rejected=n_total - len(views),
         source="jointwear calibrate",
         rejected=tuple(reasons),
+        view_names=tuple(names[v[0]] for v in views),
+        length_unit=board.length_unit,
+        length_scale_u_rel=u_rel,
     )
     if world_view is not None:
         if not 0 <= world_view < n_total:
             raise BadInputError(f"world_view {world_view} is outside the {n_total} views")
         cal = board_world_frame(cal, _read_gray(left_images[world_view], "left"), board)
+    problems = check_calibration(
+        cal, max_rms=max_rms, board_distance=float(np.median(board_dist)) if board_dist else None
+    )
+    if problems:
+        import dataclasses
+
+        if not accept_poor:
+            bad = dataclasses.replace(cal, status="rejected: " + "; ".join(problems))
+            raise PoorCalibration(
+                "the stereo calibration is not plausible: "
+                + "; ".join(problems)
+                + ". Check that --left and --right are the right cameras, that the views are "
+                "simultaneous pairs in the same order, and --squares; accept it anyway with "
+                "--accept-poor",
+                bad,
+                tuple(problems),
+            )
+        cal = dataclasses.replace(cal, status="accepted with --accept-poor: " + "; ".join(problems))
     return cal
+
+
+def _length_u_rel(pair_T: np.ndarray, board: CalibrationBoard) -> float | None:
+    """Relative standard uncertainty of lengths: the standard error of the baseline over the
+    views (each view's left-to-right translation from the cameras calibrated on their own),
+    combined with the square size's relative uncertainty when it is known."""
+    if len(pair_T) < 3:
+        return None
+    u_b = float(np.std(pair_T, ddof=1) / np.sqrt(len(pair_T)) / np.mean(pair_T))
+    if board.square_size_u is None:
+        return u_b
+    return float(np.hypot(u_b, board.square_size_u / board.square_size))

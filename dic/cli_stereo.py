@@ -48,8 +48,28 @@ def register(app: typer.Typer) -> None:
         squares: Annotated[
             tuple[int, int], typer.Option(help="Squares along x and y (not inner corners).")
         ] = (10, 7),
-        square_mm: Annotated[float, typer.Option(help="Square side (mm).")] = 10.0,
-        marker_mm: Annotated[float, typer.Option(help="ChArUco marker side (mm).")] = 7.5,
+        square: Annotated[
+            float | None,
+            typer.Option(help="Side of one board square, in --unit (required)."),
+        ] = None,
+        unit: Annotated[
+            str,
+            typer.Option(
+                help="Unit of --square/--marker/--square-u: m, mm, cm, um, in, or 'square' "
+                "(lengths in board squares; such a calibration cannot measure)."
+            ),
+        ] = "mm",
+        square_u: Annotated[
+            float | None,
+            typer.Option(help="Standard uncertainty of the square side, in --unit."),
+        ] = None,
+        square_mm: Annotated[
+            float | None, typer.Option(hidden=True, help="Deprecated: --square N --unit mm.")
+        ] = None,
+        marker: Annotated[
+            float | None, typer.Option(help="ChArUco marker side, in --unit.")
+        ] = None,
+        marker_mm: Annotated[float | None, typer.Option(hidden=True)] = None,
         dictionary: Annotated[str, typer.Option(help="ChArUco ArUco dictionary.")] = "DICT_5X5_100",
         world_view: Annotated[
             int | None,
@@ -57,15 +77,64 @@ def register(app: typer.Typer) -> None:
         ] = None,
         min_views: Annotated[int, typer.Option(help="Fewest usable views.")] = 6,
         every: Annotated[int, typer.Option(help="Videos: use every N-th frame.")] = 10,
+        max_rms: Annotated[
+            float, typer.Option(help="Largest acceptable stereo reprojection RMS (px).")
+        ] = 1.0,
+        max_view_rms: Annotated[
+            float,
+            typer.Option(help="Views above this per-camera reprojection RMS (px) are dropped."),
+        ] = 1.0,
+        accept_poor: Annotated[
+            bool,
+            typer.Option(
+                help="Write a calibration that fails the sanity checks instead of refusing it."
+            ),
+        ] = False,
     ) -> None:
-        """Calibrate a stereo pair from simultaneous views of a chessboard or ChArUco board."""
+        """Calibrate a stereo pair from simultaneous views of a chessboard or ChArUco board.
+
+        The result passes a sanity gate (reprojection RMS, field of view, pixel aspect,
+        principal point, baseline, camera order); a calibration that fails it is written to
+        <out>.rejected.nc for inspection and the command exits with code 1 (--accept-poor
+        writes it to --out instead).
+        """
         from jointwear import io
+        from jointwear.dic._calib import _LENGTH_UNITS
         from jointwear.dic._calib_board import CalibrationBoard, calibrate_stereo
+        from jointwear.dic._calib_gate import PoorCalibration, view_table
         from jointwear.dic._video import is_image_sequence
 
+        if square_mm is not None:
+            if square is not None:
+                raise typer.BadParameter("give --square (with --unit), not also --square-mm")
+            square, unit = square_mm, "mm"
+        if square is None:
+            raise typer.BadParameter(
+                "the board's square size is required: --square 25 --unit mm (or --square 1 "
+                "--unit square for lengths in squares)",
+                param_hint="--square",
+            )
+        if unit == "square":
+            scale, length_unit = 1.0, "square"
+        elif unit in _LENGTH_UNITS:
+            scale, length_unit = _LENGTH_UNITS[unit], "m"
+        else:
+            raise typer.BadParameter(
+                f"{unit!r}: expected one of {', '.join(_LENGTH_UNITS)} or square",
+                param_hint="--unit",
+            )
         io.check_writable(out)
         b = CalibrationBoard(
-            board, squares[0], squares[1], square_mm * 1e-3, marker_mm * 1e-3, dictionary
+            board,
+            squares[0],
+            squares[1],
+            square * scale,
+            marker * scale
+            if marker is not None
+            else (marker_mm * 1e-3 if marker_mm is not None else 0.75 * square * scale),
+            dictionary,
+            length_unit=length_unit,
+            square_size_u=None if square_u is None else square_u * scale,
         )
         if is_image_sequence(left):  # a folder, or a pattern like 'cal/*_0.tif'
             lefts, rights = (
@@ -75,17 +144,57 @@ def register(app: typer.Typer) -> None:
         else:
             lefts = _video_frames(left, every, "left calibration video")
             rights = _video_frames(right, every, "right calibration video")
-        cal = calibrate_stereo(lefts, rights, b, min_views=min_views, world_view=world_view)
-        cal.save(
-            out, inputs=[left, right], parameters={"board": b.__dict__, "world_view": world_view}
+            lefts = [(f"{left.name}#{i * every}", img) for i, img in enumerate(lefts)]
+            rights = [(f"{right.name}#{i * every}", img) for i, img in enumerate(rights)]
+        names = None
+        if lefts and isinstance(lefts[0], tuple):
+            names = [f"{a[0]} / {c[0]}" for a, c in zip(lefts, rights, strict=False)]
+            lefts, rights = [a[1] for a in lefts], [c[1] for c in rights]
+            names = names if len(names) == len(lefts) == len(rights) else None
+        params = {
+            "board": b.__dict__,
+            "world_view": world_view,
+            "square": square,
+            "unit": unit,
+            "max_rms_px": max_rms,
+            "accept_poor": accept_poor,
+        }
+        try:
+            cal = calibrate_stereo(
+                lefts,
+                rights,
+                b,
+                min_views=min_views,
+                world_view=world_view,
+                max_rms=max_rms,
+                max_view_rms=max_view_rms,
+                accept_poor=accept_poor,
+                view_names=names,
+            )
+        except PoorCalibration as exc:
+            rejected = out.with_name(out.stem + ".rejected" + (out.suffix or ".nc"))
+            exc.calibration.save(rejected, inputs=[left, right], parameters=params)
+            for line in view_table(exc.calibration):
+                typer.echo(line, err=True)
+            typer.echo(f"rejected calibration kept for inspection -> {rejected}", err=True)
+            raise
+        cal.save(out, inputs=[left, right], parameters=params)
+        lu = "mm" if cal.length_unit == "m" else cal.length_unit + "s"
+        ls = 1e3 if cal.length_unit == "m" else 1.0
+        u = (
+            f" (relative length uncertainty {cal.length_scale_u_rel:.1e})"
+            if cal.length_scale_u_rel is not None
+            else ""
         )
         typer.echo(
             f"calibrated from {cal.views_used} views ({cal.views_rejected} rejected): RMS "
-            f"{cal.rms:.3f} px, baseline {cal.baseline * 1e3:.2f} mm, focal "
+            f"{cal.rms:.3f} px, baseline {cal.baseline * ls:.2f} {lu}{u}, focal "
             f"{cal.left.focal[0]:.1f}/{cal.right.focal[0]:.1f} px -> {out}"
         )
-        for reason in cal.rejected:
-            typer.echo(f"  rejected {reason}")
+        for line in view_table(cal):
+            typer.echo(line)
+        if cal.status != "accepted":
+            typer.echo(f"WARNING: {cal.status}", err=True)
 
     @app.command("import-calibration")
     def import_calibration(

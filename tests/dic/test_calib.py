@@ -88,7 +88,7 @@ def test_rejected_views_are_counted_with_their_reason(boards, board):
     rights = [b[1] for b in boards[:7]] + [boards[7][1]]
     cal = calibrate_stereo(lefts, rights, board)
     assert cal.views_used == 7 and cal.views_rejected == 1
-    assert cal.rejected == ("view 7: board not found (left)",)
+    assert cal.rejected == ("view 7: board not found (left) by either detector",)
 
 
 def test_save_and_read_round_trip(tmp_path, calibration):
