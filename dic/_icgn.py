@@ -49,7 +49,7 @@ from jointwear.dic._flags import (
     FLAG_OK,
     FLAG_OUTSIDE,
 )
-from jointwear.dic._interp import PAD, interp_value_grad
+from jointwear.dic._interp import PAD, interp_value
 
 # a subset still below this ZNCC after this many iterations is not going to match
 _HOPELESS_AFTER = 10
@@ -313,14 +313,21 @@ def _load_reference(
                 gy[k] = ref_gy[jc + r, ic + c]
                 k += 1
     else:
+        # off the pixel grid: the values and the central differences of the interpolant (the
+        # node gradients are central differences of the pixels, see jointwear.dic._interp)
         for r in range(-half, half + 1):
             for c in range(-half, half + 1):
-                v, vx, vy = interp_value_grad(
-                    ref_coef, order, xc + c, yc + r, w[0], w[1], w[2], w[3]
+                x = xc + c
+                y = yc + r
+                f[k] = interp_value(ref_coef, order, x, y, w[0], w[1])
+                gx[k] = 0.5 * (
+                    interp_value(ref_coef, order, x + 1.0, y, w[0], w[1])
+                    - interp_value(ref_coef, order, x - 1.0, y, w[0], w[1])
                 )
-                f[k] = v
-                gx[k] = vx
-                gy[k] = vy
+                gy[k] = 0.5 * (
+                    interp_value(ref_coef, order, x, y + 1.0, w[0], w[1])
+                    - interp_value(ref_coef, order, x, y - 1.0, w[0], w[1])
+                )
                 k += 1
     fm = 0.0
     for k in range(n):

@@ -19,6 +19,7 @@ frame_rate=None, update_zncc=0.9, update_every=None, progress=False, params=None
 
 from __future__ import annotations
 
+import re
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -90,6 +91,8 @@ def read_frames(
         if is_image_sequence(source):
             # sorted by the frame number in the names (frame_9 before frame_10)
             files, _ = list_image_sequence(source, what="frames source")
+            if path.is_dir():
+                check_frame_names(files, f"folder '{path}'")
             return [read_image(p) for p in files[sel]], None
         if not path.exists():
             raise BadInputError(f"frames source '{path}' does not exist")
@@ -109,6 +112,34 @@ def read_frames(
         return frames, None
     raise BadInputError(
         f"frames: expected an array, a list of images, a folder or a video, got {type(source).__name__}"
+    )
+
+
+def _name_template(p: Path) -> str:
+    """A file name with its digit groups replaced by ``#`` (``frame_0012.png`` -> ``frame_#.png``)."""
+    return re.sub(r"\d+", "#", p.stem) + p.suffix.lower()
+
+
+def check_frame_names(files: Sequence[Path], where: str) -> None:
+    """Refuse a folder whose images are not all named alike (one name with a frame number).
+
+    A mask (``roi.tif``) or a stray image left in a folder of frames would otherwise be
+    correlated as one more frame, every point failing, the command still exiting 0.
+    """
+    groups: dict[str, list[Path]] = {}
+    for f in files:
+        groups.setdefault(_name_template(f), []).append(f)
+    if len(groups) <= 1:
+        return
+    ranked = sorted(groups.items(), key=lambda kv: -len(kv[1]))
+    main_t, main_files = ranked[0]
+    odd = [f.name for _, fs in ranked[1:] for f in fs]
+    shown = ", ".join(f"'{n}'" for n in odd[:5]) + (" ..." if len(odd) > 5 else "")
+    pattern = str(main_files[0].parent / main_t.replace("#", "*"))
+    raise BadInputError(
+        f"{where} holds {len(main_files)} images named like '{main_t}' (# = frame number) and "
+        f"{len(odd)} other image(s): {shown}. Which are the frames is ambiguous: give a pattern "
+        f"that selects them, e.g. '{pattern}', or move the other files out of the folder"
     )
 
 
@@ -165,6 +196,7 @@ def correlate_sequence(
     update_zncc: float = 0.9,
     update_every: int | None = None,
     progress: bool | None = False,
+    seed_points: np.ndarray | None = None,
     params=None,
     **options,
 ) -> xr.Dataset:
@@ -190,6 +222,10 @@ def correlate_sequence(
         frame is correlated with the previous one).
     progress : bool
         Show a progress bar on stderr.
+    seed_points : ndarray (K, 2), optional
+        Where the propagation starts ``(x, y)`` [pixel, frame 0] whenever a frame has to be
+        searched afresh (guesses from the previous frame failed); followed to the moved
+        reference in incremental mode. Seeds outside the image are refused.
     params : CorrelationParams, optional
         Correlation options; keyword arguments override its fields (``subset_size=...``).
 
@@ -237,6 +273,7 @@ def correlate_sequence(
         t = np.arange(n_t) / float(rate)
 
     base = SubsetCorrelator(first, points=points, roi=roi, params=params, **options)
+    seeds0 = base.check_seeds(seed_points) if seed_points is not None else None
     prm = base.params
     n = base.n_points
     P = np.full((n_t, n, 12), np.nan)
@@ -255,6 +292,19 @@ def correlate_sequence(
     P_ref = np.zeros((n, 12))  # total parameters of the current reference frame
     P_prev_inc = np.zeros((n, 12))  # last increment w.r.t. the current reference
 
+    def seeds_for(correlator):
+        """The seeds moved with the tracked point nearest to each (incremental reference)."""
+        if seeds0 is None or correlator is base:
+            return seeds0
+        near = np.argmin(np.hypot(*(base.centres[None, :, :] - seeds0[:, None, :]).T), axis=0)
+        moved = correlator.centres[near] + (seeds0 - base.centres[near])
+        h, w = first.shape
+        inside = np.isfinite(moved).all(axis=1)
+        inside &= (moved[:, 0] >= 0) & (moved[:, 0] <= w - 1)
+        inside &= (moved[:, 1] >= 0) & (moved[:, 1] <= h - 1)
+        moved = moved[inside]
+        return moved if len(moved) else None
+
     def run(correlator, img, guess_inc):
         guess = np.where(np.isfinite(guess_inc).all(axis=1)[:, None], guess_inc, np.nan)
         res = correlator.match(img, initial_guess=guess)
@@ -266,7 +316,7 @@ def correlate_sequence(
                 if known.any()
                 else (0.0, 0.0)
             )
-            res2 = correlator.match(img, search_centre=centre)
+            res2 = correlator.match(img, search_centre=centre, seed_points=seeds_for(correlator))
             if res2.ok.sum() > res.ok.sum():
                 res = res2
         return res

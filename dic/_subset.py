@@ -41,6 +41,9 @@ __all__ = ["CorrelationParams", "SubsetCorrelator", "MatchResult", "FLAG_MEANING
 
 FLAG_MEANINGS = _flags.FLAG_MEANINGS
 
+#: extra margin [pixel] of the default grid beyond the border (see SubsetCorrelator)
+_GRID_SLACK = 2
+
 _SHAPES = {"affine": False, "first": False, "quadratic": True, "second": True}
 
 
@@ -287,8 +290,12 @@ class SubsetCorrelator:
                         f"roi={tuple(roi)!r} must satisfy 0 <= x_min < x_max <= {w - 1} and "
                         f"0 <= y_min < y_max <= {h - 1} (image of {w}x{h} pixels)"
                     )
-            x_min, y_min = max(x_min, b), max(y_min, b)
-            x_max, y_max = min(x_max, w - 1 - b), min(y_max, h - 1 - b)
+            # where the image edge (not the roi) limits the grid, the outer subsets keep
+            # _GRID_SLACK pixels more than the border margin: on the margin itself any motion
+            # towards the edge, even sub-pixel noise, flags them subset_outside_image
+            lo, hix, hiy = b + _GRID_SLACK, w - 1 - b - _GRID_SLACK, h - 1 - b - _GRID_SLACK
+            x_min, y_min = max(x_min, lo), max(y_min, lo)
+            x_max, y_max = min(x_max, hix), min(y_max, hiy)
             xs = np.arange(x_min + half, x_max - half + 1, base.step, dtype=float)
             ys = np.arange(y_min + half, y_max - half + 1, base.step, dtype=float)
             if xs.size == 0 or ys.size == 0:
@@ -575,7 +582,7 @@ class SubsetCorrelator:
             return st
         tex, usable = self._texture_and_usable()
         if seed_points is not None:
-            seeds = np.asarray(seed_points, dtype=float).reshape(-1, 2)
+            seeds = self.check_seeds(seed_points)
             d = np.hypot(
                 self.centres[:, None, 0] - seeds[None, :, 0],
                 self.centres[:, None, 1] - seeds[None, :, 1],
@@ -613,6 +620,32 @@ class SubsetCorrelator:
                 self._propagate(dspl, dinv, st, done, group, 0)
         self._fill_unreached(dspl, dinv, st, done)
         return st
+
+    def check_seeds(self, seed_points) -> np.ndarray:
+        """Seed points as a (K, 2) array of ``(x, y)`` [pixel] inside the reference image, or a
+        BadInputError naming the first one that is not."""
+        seeds = np.asarray(seed_points, dtype=float)
+        if seeds.ndim == 1 and seeds.size == 2:
+            seeds = seeds[None, :]
+        if seeds.ndim != 2 or seeds.shape[1] != 2 or seeds.shape[0] == 0:
+            raise BadInputError(
+                f"seed_points: expected (K, 2) positions (x, y) [pixel], got shape {seeds.shape}"
+            )
+        h, w = self.ref.shape
+        bad = ~(
+            np.isfinite(seeds).all(axis=1)
+            & (seeds[:, 0] >= 0)
+            & (seeds[:, 0] <= w - 1)
+            & (seeds[:, 1] >= 0)
+            & (seeds[:, 1] <= h - 1)
+        )
+        if bad.any():
+            x, y = seeds[np.argmax(bad)]
+            raise BadInputError(
+                f"seed point ({x:g}, {y:g}) [pixel] lies outside the {w}x{h} reference image "
+                f"(x in 0..{w - 1}, y in 0..{h - 1}); give seeds on the specimen"
+            )
+        return seeds
 
     def _match_some(self, deformed, guess: np.ndarray, idx: np.ndarray) -> MatchResult:
         """Refine only the points ``idx`` from ``guess`` (N, 6) affine guesses; no retries.
@@ -669,6 +702,8 @@ class SubsetCorrelator:
         n = self.n_points
         if g.ndim == 1 and g.size in (2, 6, 12):
             g = np.broadcast_to(g, (n, g.size))
+        elif g.ndim == 2 and g.shape[0] == 1 and g.shape[1] in (2, 6, 12):
+            g = np.broadcast_to(g, (n, g.shape[1]))  # one row is broadcast, as documented
         if g.ndim != 2 or g.shape[0] != n or g.shape[1] not in (2, 6, 12):
             raise BadInputError(
                 f"initial_guess: expected shape ({n}, 2) displacements (u, v) [pixel], ({n}, 6) "

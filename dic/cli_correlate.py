@@ -39,6 +39,36 @@ def _parse_points(texts: list[str] | None):
     return np.array(out)
 
 
+def read_points_file(path: Path):
+    """Points of interest from a text file: one ``x, y`` [pixel] per line (comma or blank
+    separated; ``#`` comments and a non-numeric header line are skipped)."""
+    import numpy as np
+
+    if not path.is_file():
+        raise BadInputError(f"--points '{path}' does not exist")
+    rows = []
+    for k, line in enumerate(path.read_text(errors="replace").splitlines(), start=1):
+        text = line.split("#", 1)[0].replace(",", " ").replace(";", " ").split()
+        if not text:
+            continue
+        try:
+            vals = [float(v) for v in text]
+        except ValueError:
+            if not rows and k == 1:
+                continue  # a header line
+            raise BadInputError(
+                f"--points '{path}' line {k}: {line.strip()!r} is not two numbers x, y (pixels)"
+            ) from None
+        if len(vals) != 2:
+            raise BadInputError(
+                f"--points '{path}' line {k}: expected two numbers x, y (pixels), got {len(vals)}"
+            )
+        rows.append(vals)
+    if not rows:
+        raise BadInputError(f"--points '{path}' holds no points (expected lines 'x, y' in pixels)")
+    return np.array(rows)
+
+
 def register(app: typer.Typer) -> None:
     """Add ``correlate`` to the ``jointwear dic`` group."""
 
@@ -46,7 +76,10 @@ def register(app: typer.Typer) -> None:
     def correlate_cmd(
         reference: Annotated[
             Path,
-            typer.Argument(help="Reference image, or a folder of frames / a video (sequence)."),
+            typer.Argument(
+                help="Reference image, or a folder of frames, a quoted pattern ('f/*_0.tif') "
+                "or a video (sequence)."
+            ),
         ],
         deformed: Annotated[
             Path | None, typer.Argument(help="Deformed image (omit for a sequence).")
@@ -73,6 +106,34 @@ def register(app: typer.Typer) -> None:
         zncc_min: Annotated[
             float, typer.Option("--zncc-min", help="Flag matches below this ZNCC.")
         ] = 0.8,
+        points: Annotated[
+            Path | None,
+            typer.Option(
+                "--points",
+                help="Text file of subset centres 'x, y' (pixels, one per line) instead of a grid.",
+            ),
+        ] = None,
+        tolerance: Annotated[
+            float,
+            typer.Option("--tolerance", help="IC-GN convergence: last update norm (pixels)."),
+        ] = 1e-3,
+        max_iterations: Annotated[
+            int, typer.Option("--max-iterations", help="IC-GN iteration limit per point.")
+        ] = 40,
+        update_zncc: Annotated[
+            float,
+            typer.Option(
+                "--update-zncc",
+                help="Incremental: move the reference forward when the median ZNCC drops below.",
+            ),
+        ] = 0.9,
+        update_every: Annotated[
+            int | None,
+            typer.Option(
+                "--update-every",
+                help="Incremental: also move the reference after this many frames (1: always).",
+            ),
+        ] = None,
         reference_mode: Annotated[
             str,
             typer.Option("--reference", help="Sequences: absolute or incremental."),
@@ -105,20 +166,35 @@ def register(app: typer.Typer) -> None:
             interpolation=interpolation,  # type: ignore[arg-type]
             search_radius=search_radius,
             zncc_min=zncc_min,
+            tolerance=tolerance,
+            max_iterations=max_iterations,
             threads=threads,
         )
         roi_vals = _parse_roi(roi)
         seeds = _parse_points(seed)
+        if points is not None and roi_vals is not None:
+            raise typer.BadParameter("give either --points or --roi, not both")
+        pts = read_points_file(points) if points is not None else None
+        if reference_mode != "incremental" and (update_every is not None or update_zncc != 0.9):
+            raise typer.BadParameter(
+                "--update-zncc/--update-every apply to --reference incremental only"
+            )
         t0 = _time.perf_counter()
         if deformed is None:
-            if not reference.exists():
+            from jointwear.dic._video import is_image_sequence
+
+            if not reference.exists() and not is_image_sequence(reference):
                 raise BadInputError(f"'{reference}' does not exist")
             frames, fps = read_frames(reference)
             ds = correlate_sequence(
                 (frames, fps),
                 reference=reference_mode,
                 roi=roi_vals,
+                points=pts,
                 frame_rate=frame_rate,
+                update_zncc=update_zncc,
+                update_every=update_every,
+                seed_points=seeds,
                 progress=None,
                 params=params,
             )
@@ -128,7 +204,7 @@ def register(app: typer.Typer) -> None:
             def_img = read_image(deformed)
             with progress_bar("correlating", total=2, enabled=None) as bar:
                 task = bar.tasks[0].id
-                corr = SubsetCorrelator(ref_img, roi=roi_vals, params=params)
+                corr = SubsetCorrelator(ref_img, roi=roi_vals, points=pts, params=params)
                 bar.update(task, advance=1, description=f"correlating {corr.n_points} points")
                 ds = corr.correlate(def_img, seed_points=seeds)
                 bar.update(task, advance=1)

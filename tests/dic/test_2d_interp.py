@@ -42,9 +42,16 @@ def test_interpolant_passes_through_pixels_and_reproduces_cubics(interpolation, 
 
 
 @pytest.mark.parametrize(("interpolation", "order"), [("cubic", 3), ("quintic", 5)])
-def test_node_gradients_are_the_interpolant_derivatives(interpolation, order):
+def test_node_gradients_are_central_differences_or_the_interpolant_derivatives(
+    interpolation, order
+):
     img = np.random.default_rng(3).random((25, 31)) * 100
-    spl = _interp.prefilter(img, interpolation)
+    central = _interp.prefilter(img, interpolation)
+    gy, gx = np.gradient(img)
+    np.testing.assert_allclose(central.gx[:, 1:-1], gx[:, 1:-1], atol=1e-12)
+    np.testing.assert_allclose(central.gy[1:-1], gy[1:-1], atol=1e-12)
+    assert (central.gx[:, [0, -1]] == 0).all()  # mirror boundary
+    spl = _interp.prefilter(img, interpolation, gradient="spline")
     w = [np.empty(6) for _ in range(4)]
     for py, px in [(0, 0), (12, 17), (24, 30), (3, 29)]:
         _, fx, fy = _interp.interp_value_grad(spl.coef, order, float(px), float(py), *w)
