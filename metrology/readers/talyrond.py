@@ -23,7 +23,7 @@ from pathlib import Path
 import xarray as xr
 
 from jointwear.conventions import AngleConvention
-from jointwear.metrology.readers.text import read_scan
+from jointwear.metrology.readers.scan import read_scan
 
 __all__ = ["TALYROND_DEFAULTS", "read_talyrond"]
 
