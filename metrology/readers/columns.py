@@ -7,13 +7,12 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from jointwear.metrology.readers.meaning import _guess_angle_kind, _value_kind
-
 __all__ = ["COLUMN_KINDS"]
 
 
 #: Column meanings understood by the reader.
 COLUMN_KINDS = (
+    "angle",  # unit from the header, the user (angle_unit) or the values - else refused
     "angle_deg",
     "angle_rad",
     "index",
@@ -22,6 +21,7 @@ COLUMN_KINDS = (
     "z",
     "radius",
     "deviation",
+    "value",  # radius or deviation: from the user (value_kind) or the values - else refused
     "ignore",
 )
 
@@ -29,15 +29,23 @@ COLUMN_KINDS = (
 _UNIT_IN_NAME = re.compile(r"[\[(]\s*([^\])]+?)\s*[\])]")
 
 
+_ANG = r"(theta|angle|phi|φ|θ|winkel|ang|azimuth)"
+# Rules are tried in order; value names are matched as phrases, deviation words first, so that
+# "Radius deviation (um)" is a deviation and only a plain "Radius" is a radius.
 _NAME_RULES: list[tuple[str, str]] = [
     (r"^(x|x[ _-]?coord.*|cart.*x)$", "x"),
     (r"^(y|y[ _-]?coord.*|cart.*y)$", "y"),
-    (r"(rad|radian)s?$|^(theta|angle|phi|φ|θ|winkel)[ _]*\(?rad", "angle_rad"),
-    (r"^(theta|angle|phi|φ|θ|winkel|ang|deg|degrees?)\b", "angle_deg"),
+    (rf"^{_ANG}[ _-]*(rad|radians?)$|^radians?$", "angle_rad"),
+    (rf"^{_ANG}[ _-]*(deg|degrees?|°)$|^(deg|degrees?|°)$", "angle_deg"),
+    (rf"^{_ANG}\b", "angle"),  # an angle of unstated unit
     (r"^(index|point|pt|no\.?|n|#|sample|idx|nr\.?)$", "index"),
     (r"^(z|height|level|layer|position|pos|zpos|h)\b", "z"),
-    (r"^(radius|r|rad\.?)$|radius", "radius"),
-    (r"dev|displac|profile|value|ampl|form|error|runout|signal|data|reading|μ|µ", "deviation"),
+    (
+        r"deviation|abweichung|\bdev\b|displacement|\bdispl?\b|error|runout|departure|\bform\b",
+        "deviation",
+    ),
+    (r"^r$|\bradius\b|\bradii\b", "radius"),
+    (r"profile|value|ampl|signal|data|reading|trace|μ|µ|\bum\b", "value"),
 ]
 
 
@@ -55,6 +63,8 @@ def _kind_from_name(name: str) -> tuple[str | None, str | None]:
         return "angle_deg", None
     if unit and unit.lower() in ("rad", "radian", "radians"):
         return "angle_rad", None
+    if unit and unit.lower() in ("index", "point", "points", "#"):
+        return "index", None
     if re.match(r"^(z|h|height|layer|level|plane)\s*[=:_]?\s*[-+]?\d", low):
         return None, None  # a per-layer value column of a wide file, named by its z
     if low_base.startswith("layer") and unit is None:
@@ -113,20 +123,20 @@ def _guess_columns(
         return tuple(kinds), units  # type: ignore[arg-type]
     # fill the gaps from the values
     if ncol == 1:
-        return (kinds[0] or _value_kind(data[:, 0]),), units
+        return (kinds[0] or "value",), units
     if ncol == 2:
         a, b = data[:, 0], data[:, 1]
         if kinds[0] is None and _runs(a):
             kinds[0] = "z"  # (z, value): a long file without an angle column
         if kinds[0] is None:
             if _looks_monotonic(a):
-                kinds[0] = _guess_angle_kind(a)
+                kinds[0] = "angle"
             elif _xy_like(a, b):
                 kinds[0], kinds[1] = "x", "y"
             else:  # two value columns: a wide file of two layers without an angle column
-                kinds[0] = _value_kind(data)
+                kinds[0] = "value"
         if kinds[1] is None:
-            kinds[1] = "y" if kinds[0] == "x" else _value_kind(b)
+            kinds[1] = "y" if kinds[0] == "x" else "value"
         return tuple(kinds), units  # type: ignore[arg-type]
     # three or more columns
     c0 = data[:, 0]
@@ -138,7 +148,7 @@ def _guess_columns(
             if _xy_like(first[:, 1], first[:, 2]):
                 kinds = ["z", "x", "y"]
             else:
-                kinds = ["z", _guess_angle_kind(first[:, 1]), _value_kind(data[:, 2])]
+                kinds = ["z", "angle", "value"]
         elif np.unique(c2[np.isfinite(c2)]).size <= max(2, data.shape[0] // 8):
             kinds = ["x", "y", "z"]
         elif (
@@ -146,20 +156,18 @@ def _guess_columns(
             and np.all(np.abs(c0 - np.round(c0)) < 1e-9)
             and _looks_monotonic(data[:, 1])
         ):
-            kinds = ["index", _guess_angle_kind(data[:, 1]), _value_kind(data[:, 2])]
+            kinds = ["index", "angle", "value"]
         elif _looks_monotonic(c0):
-            kinds = [_guess_angle_kind(c0), _value_kind(data[:, 1]), _value_kind(data[:, 2])]
+            kinds = ["angle", "value", "value"]
         else:  # three value columns: a wide file without an angle column
-            vk3 = _value_kind(data)
+            vk3 = "value"
             kinds = [vk3, vk3, vk3]
         return tuple(kinds), units  # type: ignore[arg-type]
     # wide: angle + one value column per layer
     if kinds[0] is None and _looks_monotonic(c0):
-        kinds[0] = _guess_angle_kind(c0)
+        kinds[0] = "angle"
     start = 0 if kinds[0] is None else 1  # no angle column: every column is a layer
-    vk = next((k for k in kinds[start:] if k in ("radius", "deviation")), None) or _value_kind(
-        data[:, start:]
-    )
+    vk = next((k for k in kinds[start:] if k in ("radius", "deviation")), None) or "value"
     for i in range(ncol):
         if kinds[i] is None:
             kinds[i] = vk

@@ -7,6 +7,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from jointwear.errors import BadInputError
+from jointwear.metrology.readers.meaning import absurd_length, angle_reading
+from jointwear.metrology.readers.meaning import value_kind as decide_value_kind
 from jointwear.metrology.readers.table import ParsedFile, unit_factor
 
 __all__ = []
@@ -21,15 +23,36 @@ class _Layer:
     source: str
 
 
+_UNIT_OF_KIND = {"angle_deg": "deg", "angle_rad": "rad", "index": "index"}
+
+
 def _angles(
-    pf: ParsedFile, col: int, kind: str, n: int, rows: np.ndarray, where: str
+    pf: ParsedFile,
+    col: int,
+    rows: np.ndarray,
+    where: str,
+    *,
+    angle_unit: str | None,
+    arc: str | None,
+    notes: dict[str, str],
 ) -> np.ndarray:
-    a = pf.data[rows, col]
-    if kind == "angle_rad":
-        return np.degrees(a)
-    if kind == "index":
-        return a * 360.0 / n
-    return a
+    """Angles [degree] of one layer: the column read in its stated or only possible unit."""
+    kind = pf.columns[col]
+    stated = _UNIT_OF_KIND.get(kind) or pf.angle_unit
+    if angle_unit is not None and stated is not None and angle_unit != stated:
+        raise BadInputError(
+            f"{where}: angle_unit={angle_unit!r} (--angle-unit) contradicts the file, which "
+            f"states {stated!r} (column {col + 1} '{pf.column_names[col] if pf.column_names else kind}'"
+            " or the header); drop the option or correct the file"
+        )
+    reading, note = angle_reading(
+        pf.data[rows, col],
+        unit=angle_unit or stated,
+        arc=arc,
+        where=f"{where} column {col + 1} (lines {pf.line_numbers[rows[0]]}-{pf.line_numbers[rows[-1]]})",
+    )
+    notes["angle"] = note + (f", {reading.arc} turn" if reading.arc == "full" else ", partial arc")
+    return reading.theta_deg
 
 
 def _check_angles(theta: np.ndarray, pf: ParsedFile, rows: np.ndarray, where: str) -> np.ndarray:
@@ -71,37 +94,114 @@ def _check_angles(theta: np.ndarray, pf: ParsedFile, rows: np.ndarray, where: st
     return th
 
 
-def _layers_from_file(pf: ParsedFile, expected_points: int | None, layer_kind: str) -> list[_Layer]:
-    """Cut a parsed table into layers according to its column meanings."""
+def _xy_about_origin(x: np.ndarray, y: np.ndarray, where: str) -> None:
+    """Refuse Cartesian points that are not a trace about the origin (the spindle axis)."""
+    from jointwear.metrology.fit import fit_circle
+
+    fit = fit_circle(x, y)
+    th = np.sort(np.arctan2(y, x))
+    gaps = np.diff(np.concatenate([th, th[:1] + 2 * np.pi]))
+    if fit.eccentricity >= 0.5 * fit.radius or np.max(gaps) > np.pi:
+        raise BadInputError(
+            f"{where}: the x, y points do not surround the origin (their least-squares circle "
+            f"has radius {fit.radius:.6g} m and centre ({fit.x0:.6g}, {fit.y0:.6g}) m): they are "
+            "not a trace about the instrument's spindle axis, so angle and radius about the "
+            "origin would be meaningless; assess the point set directly (jointwear metrology "
+            "assess FILE --units ..., an exact least-squares circle) or shift the points"
+        )
+
+
+def _layers_from_file(
+    pf: ParsedFile,
+    expected_points: int | None,
+    *,
+    value_kind: str | None = None,
+    angle_unit: str | None = None,
+    arc: str | None = None,
+    notes: dict[str, str] | None = None,
+) -> list[_Layer]:
+    """Cut a parsed table into layers according to its column meanings.
+
+    Every meaning that the file, the column names or the user do not state is decided by
+    :mod:`~jointwear.metrology.readers.meaning` or refused.
+    """
+    notes = {} if notes is None else notes
     cols = pf.columns
     where = f"'{pf.path}'"
-    if pf.units is None and any(c in ("radius", "deviation", "x", "y") for c in cols):
+    if pf.units is None and any(c in ("radius", "deviation", "value", "x", "y") for c in cols):
         raise BadInputError(
-            f"{where}: the length unit is not stated in the header; pass units='um' (or 'mm', "
-            "'m', 'inch') - jointwear does not guess units"
+            f"{where}: the length unit is not stated in the header; pass units='um' (--units um; "
+            "or mm, m, inch) - jointwear does not guess units"
         )
     f = unit_factor(pf.units, where=where) if pf.units else 1.0
     zf = f
     zc_idx = [i for i, c in enumerate(cols) if c == "z"]
     if zc_idx and str(zc_idx[0]) in pf.column_units:
         zf = unit_factor(pf.column_units[str(zc_idx[0])], where=f"{where} column {zc_idx[0] + 1}")
+    elif zc_idx and pf.z_units is not None:
+        zf = unit_factor(pf.z_units, where=f"{where} z unit")
     elif zc_idx and pf.units is None:
         raise BadInputError(
-            f"{where}: the unit of the z column is not stated; pass units=... (the z column is "
-            "read in the same unit as the values unless its name says otherwise, e.g. 'z [mm]')"
+            f"{where}: the unit of the z column is not stated; pass z_units=... (--z-units mm) "
+            "or name the column with its unit, e.g. 'z [mm]'"
+        )
+    elif zc_idx:
+        raise BadInputError(
+            f"{where}: the unit of the z column is not stated (the header states the unit of "
+            f"the values, {pf.units!r}, which need not be that of z); pass z_units=... "
+            "(--z-units mm) or name the column with its unit, e.g. 'z [mm]'"
         )
     n = pf.data.shape[0]
-    value_cols = [i for i, c in enumerate(cols) if c in ("radius", "deviation")]
-    angle_cols = [i for i, c in enumerate(cols) if c in ("angle_deg", "angle_rad", "index")]
+    value_cols = [i for i, c in enumerate(cols) if c in ("radius", "deviation", "value")]
+    angle_cols = [
+        i for i, c in enumerate(cols) if c in ("angle", "angle_deg", "angle_rad", "index")
+    ]
     has_xy = "x" in cols and "y" in cols
     zcols = [i for i, c in enumerate(cols) if c == "z"]
     out: list[_Layer] = []
+    kind = "radius"
+    if value_cols:
+        named = {cols[i] for i in value_cols} - {"value"}
+        if len(named) > 1:
+            raise BadInputError(
+                f"{where}: the value columns mix radius and deviation ({list(cols)}); pass "
+                "columns=... (--columns) so every value column has the same meaning"
+            )
+        named_kind = named.pop() if named else None
+        if value_kind is not None and named_kind is not None and value_kind != named_kind:
+            raise BadInputError(
+                f"{where}: value_kind={value_kind!r} (--value-kind) contradicts the column name, "
+                f"which says {named_kind}; drop the option, or override the names with "
+                "columns=... (--columns)"
+            )
+        kind, note = decide_value_kind(
+            pf.data[:, value_cols],
+            named=named_kind,
+            stated=value_kind,
+            where=f"{where} value column(s) {', '.join(str(i + 1) for i in value_cols)}",
+            line_of=pf.line_numbers,
+        )
+        notes["value_kind"] = f"{kind} ({note})"
+        absurd_length(pf.data[:, value_cols], kind, f, where, pf.line_numbers)
+    if has_xy:
+        xy = pf.data[:, [cols.index("x"), cols.index("y")]]
+        absurd_length(xy, "radius", f, where, pf.line_numbers)
+    if not angle_cols and not has_xy and value_cols:
+        if arc != "full" and angle_unit != "index":
+            raise BadInputError(
+                f"{where}: no angle column: the points can be read as equally spaced over one "
+                "full turn only if you say so with arc='full' (--arc full); a partial arc needs "
+                "an angle column"
+            )
+        notes["angle"] = "no angle column: points equally spaced over one full turn (stated)"
 
     def make(rows: np.ndarray, vcol: int | None, zval: float | None) -> _Layer:
         m = rows.size
         if has_xy:
             x = pf.data[rows, cols.index("x")] * f
             y = pf.data[rows, cols.index("y")] * f
+            if m >= 3:
+                _xy_about_origin(x, y, where)
             th = np.degrees(np.arctan2(y, x)) % 360.0
             val = np.hypot(x, y)
             order = np.argsort(th, kind="stable")
@@ -117,16 +217,16 @@ def _layers_from_file(pf: ParsedFile, expected_points: int | None, layer_kind: s
         val = pf.data[rows, vcol] * f
         if angle_cols:
             ac = angle_cols[0]
-            th = _angles(pf, ac, cols[ac], m, rows, where)
+            th = _angles(pf, ac, rows, where, angle_unit=angle_unit, arc=arc, notes=notes)
             th = _check_angles(th, pf, rows, where)
         else:
             th = np.arange(m) * 360.0 / m
-        return _Layer(th, val, cols[vcol] if layer_kind == "auto" else layer_kind, zval, pf.path)
+        return _Layer(th, val, kind, zval, pf.path)
 
     if not value_cols and not has_xy:
         raise BadInputError(
-            f"{where}: no radius/deviation column among {list(cols)}; pass columns=(...) naming "
-            "the value column 'radius' or 'deviation'"
+            f"{where}: no radius/deviation column among {list(cols)}; pass columns=(...) "
+            "(--columns) naming the value column 'radius' or 'deviation'"
         )
     if zcols and (value_cols or has_xy):
         zc = pf.data[:, zcols[0]]

@@ -37,6 +37,7 @@ height of the mid-width given as ``z_mid`` [m].
 
 from __future__ import annotations
 
+import glob
 import json
 import re
 from collections.abc import Iterable, Sequence
@@ -60,8 +61,8 @@ from jointwear.metrology.readers.table import _NUM, TextFormat, parse_file, unit
 __all__ = ["read_text", "read_scan"]
 
 
-def _number_from_name(name: str) -> float | None:
-    """z from a file name: 'z=2.5mm', 'z-1.0', 'h2,5mm', 'layer03' -> value in metres or index."""
+def _number_from_name(name: str, z_units: str | None) -> float | None:
+    """z [m] from a file name: 'z=2.5mm', 'z-1.0', 'h2,5mm'; a bare number needs ``z_units``."""
     m = re.search(
         r"(?:^|[_\-\s.])(?:z|h|height|pos)[=_]?([-+]?\d+(?:[.,p]\d+)?)\s*(mm|um|µm|m|in)?",
         name,
@@ -69,8 +70,13 @@ def _number_from_name(name: str) -> float | None:
     )
     if m:
         v = float(m.group(1).replace(",", ".").replace("p", "."))
-        unit = m.group(2)
-        return v * unit_factor(unit) if unit else v * 1e-3  # bare z numbers in file names: mm
+        unit = m.group(2) or z_units
+        if unit is None:
+            raise BadInputError(
+                f"file name '{name}' gives z = {m.group(1)} without a unit; pass z_units=... "
+                "(--z-units mm) or layer_spacing=... (--layer-spacing-mm)"
+            )
+        return v * unit_factor(unit)
     return None
 
 
@@ -92,63 +98,98 @@ _Z_KEYS = re.compile(
 )
 
 
-def _z_from_meta(meta: dict[str, str], units: str | None, where: str) -> float | None:
+def _z_from_meta(meta: dict[str, str], z_units: str | None, where: str) -> float | None:
     for k, v in meta.items():
         if _Z_KEYS.match(k.strip()):
             m = re.match(rf"^\s*({_NUM})\s*([A-Za-zµμ\"]+)?", v)
             if not m:
                 continue
             val = float(m.group(1).replace(",", "."))
-            unit = m.group(2) or (units if units else None)
+            unit = m.group(2) or z_units
             if unit is None:
                 raise BadInputError(
-                    f"{where}: header gives {k} = {v!r} without a unit; pass units=... or "
-                    "layer_spacing=..."
+                    f"{where}: header gives {k} = {v!r} without a unit; pass z_units=... "
+                    "(--z-units mm) or layer_spacing=... (--layer-spacing-mm)"
                 )
             return val * unit_factor(unit, where=where)
     return None
 
 
-def _read_manifest(folder: Path) -> dict[str, float] | None:
-    for name in ("manifest.csv", "manifest.txt", "manifest.json", "layers.csv", "layers.txt"):
+_MANIFESTS = ("manifest.csv", "manifest.txt", "manifest.json", "layers.csv", "layers.txt")
+
+
+def _read_manifest(folder: Path, z_units: str | None) -> tuple[Path, dict[str, float]] | None:
+    """(manifest path, {file: z [m]}) of a folder, or None; every listed file must exist."""
+    for name in _MANIFESTS:
         p = folder / name
         if not p.exists():
             continue
+        lines_of: dict[str, int] = {}
         if p.suffix == ".json":
             try:
                 raw = json.loads(p.read_text())
-                unit = raw.get("units", "m")
-                return {str(k): float(v) * unit_factor(unit) for k, v in raw["layers"].items()}
+                unit = raw.get("units", z_units)
+                vals = {str(k): float(v) for k, v in raw["layers"].items()}
             except (ValueError, KeyError, TypeError, AttributeError) as exc:
                 raise BadInputError(
                     f"'{p}': expected JSON {{'units': 'mm', 'layers': {{file: z}}}} ({exc})"
                 ) from None
-        out: dict[str, float] = {}
-        unit = "m"
-        for i, ln in enumerate(p.read_text().splitlines(), start=1):
-            s = ln.strip()
-            if not s:
-                continue
-            if s.startswith("#"):
-                m = re.search(r"units?\s*[:=]\s*(\S+)", s, re.I)
-                if m:
-                    unit = m.group(1)
-                continue
-            toks = [t.strip() for t in re.split(r"[,;\t]|\s+", s) if t.strip()]
-            if len(toks) < 2:
-                raise BadInputError(f"'{p}' line {i}: expected 'file, z', found {s!r}")
-            try:
-                out[toks[0]] = float(toks[1].replace(",", ".")) * unit_factor(unit, where=str(p))
-            except ValueError:
-                if i == 1 or not out:
-                    m = re.search(r"[\[(]\s*([^\])]+)\s*[\])]", s) or re.search(
-                        r"z[_ ]?(mm|um|µm|m|in|inch)\b", s, re.I
-                    )
+        else:
+            vals = {}
+            unit = None
+            for i, ln in enumerate(p.read_text().splitlines(), start=1):
+                st = ln.strip()
+                if not st:
+                    continue
+                if st.startswith("#"):
+                    m = re.search(r"units?\s*[:=]\s*(\S+)", st, re.I)
                     if m:
                         unit = m.group(1)
-                    continue  # header line
-                raise BadInputError(f"'{p}' line {i}: z {toks[1]!r} is not a number") from None
-        return out
+                    continue
+                toks = [t.strip() for t in re.split(r"[,;\t]|\s+", st) if t.strip()]
+                if len(toks) < 2:
+                    raise BadInputError(f"'{p}' line {i}: expected 'file, z', found {st!r}")
+                try:
+                    vals[toks[0]] = float(toks[1].replace(",", "."))
+                    lines_of[toks[0]] = i
+                except ValueError:
+                    if not vals:
+                        m = re.search(r"[\[(]\s*([^\])]+)\s*[\])]", st) or re.search(
+                            r"z[_ ]?(mm|um|µm|m|in|inch)\b", st, re.I
+                        )
+                        if m:
+                            unit = m.group(1)
+                        continue  # header line
+                    raise BadInputError(f"'{p}' line {i}: z {toks[1]!r} is not a number") from None
+            if (
+                unit is not None
+                and z_units is not None
+                and unit_factor(unit) != unit_factor(z_units)
+            ):
+                raise BadInputError(
+                    f"'{p}': z_units={z_units!r} (--z-units) contradicts the manifest, which says "
+                    f"{unit!r}; drop the option or correct the manifest"
+                )
+            unit = unit or z_units
+        if unit is None:
+            raise BadInputError(
+                f"'{p}': the unit of z is not stated (e.g. a first line 'file,z_mm'); add it or "
+                "pass z_units=... (--z-units mm)"
+            )
+        missing = [
+            k
+            for k in vals
+            if not (folder / k).is_file() and not any(folder.glob(glob.escape(k) + ".*"))
+        ]
+        if missing:
+            where = f" line {lines_of[missing[0]]}" if missing[0] in lines_of else ""
+            raise BadInputError(
+                f"'{p}'{where}: names '{missing[0]}'"
+                + (f" (and {len(missing) - 1} more)" if len(missing) > 1 else "")
+                + f", which is not in '{folder}'; restore the file or delete it from the manifest"
+            )
+        f = unit_factor(unit, where=str(p))
+        return p, {k: v * f for k, v in vals.items()}
     return None
 
 
@@ -339,6 +380,10 @@ def read_scan(
     columns: Sequence[str] | None = None,
     units: str | None = None,
     value: str = "auto",
+    angle_unit: str | None = None,
+    arc: str | None = None,
+    z_units: str | None = None,
+    sheet: str | None = None,
     z: Sequence[float] | None = None,
     layer_spacing: float | None = None,
     z_mid: float | str = "centre",
@@ -364,7 +409,18 @@ def read_scan(
         Format overrides (or give ``delimiter``, ``decimal``, ``header_lines``, ``columns``,
         ``units`` directly).
     value : {"auto", "radius", "deviation"}
-        Meaning of the value column(s) (overrides the guess).
+        Meaning of the value column(s) when the column names do not say it (``auto``: from the
+        numbers if they are unambiguous, else refused).
+    angle_unit : {"deg", "rad", "index"}, optional
+        Unit of the angle column when the file does not state it (``None``: the only unit that
+        gives at most one turn, else refused).
+    arc : {"full", "partial"}, optional
+        Whether each layer covers one full turn or a partial arc; settles an ambiguous angle
+        unit, and is required (``"full"``) for files without an angle column.
+    z_units : str, optional
+        Unit of z (long-file column, header keyword, file names, manifest) when not stated.
+    sheet : str, optional
+        Worksheet of an Excel workbook with several sheets of data.
     z : sequence of float, optional
         Instrument height of each layer [m], in file/column order (overrides everything else).
     layer_spacing : float, optional
@@ -405,6 +461,8 @@ def read_scan(
             header_lines=header_lines,
             columns=tuple(columns) if columns is not None else None,
             units=units,
+            z_units=z_units,
+            sheet=sheet,
         ).items()
         if v is not None
     }
@@ -438,15 +496,23 @@ def read_scan(
         folder = files[0].parent if len(files) > 1 else None
     if layout == "folder" and len(files) < 1:
         raise BadInputError("layout='folder' needs a folder or several files")
-    layer_kind = value if value != "auto" else "auto"
+    value_kind = None if value == "auto" else value
     parsed = [parse_file(f, base) for f in files]
     layers: list[_Layer] = []
     metadata: dict = {}
     notes: dict = {}
     for pf in parsed:
-        if pf.guessed:
-            notes[Path(pf.path).name] = pf.guessed
-        ls = _layers_from_file(pf, None if allow_partial else expected_points, layer_kind)
+        decided: dict[str, str] = {}
+        ls = _layers_from_file(
+            pf,
+            None if allow_partial else expected_points,
+            value_kind=value_kind,
+            angle_unit=angle_unit,
+            arc=arc or pf.arc,
+            notes=decided,
+        )
+        if pf.guessed or decided:
+            notes[Path(pf.path).name] = {**pf.guessed, **decided}
         if len(parsed) > 1 and len(ls) > 1:
             raise BadInputError(
                 f"'{pf.path}' holds {len(ls)} layers; a folder layout expects one layer per file"
@@ -492,30 +558,30 @@ def read_scan(
     elif all(lay.z is not None for lay in layers):
         zsrc = "z column"
     elif layout_used == "folder":
-        manifest = _read_manifest(folder) if folder is not None else None
-        if manifest:
+        found = _read_manifest(folder, z_units) if folder is not None else None
+        manifest = found[1] if found else None
+        if found:
             for lay in layers:
                 name = Path(lay.source).name
                 key = name if name in manifest else Path(name).stem
                 if key not in manifest:
                     raise BadInputError(
-                        f"manifest in '{folder}' has no entry for '{name}'; add a line "
-                        f"'{name}, <z>'"
+                        f"manifest '{found[0]}' has no entry for '{name}'; add a line '{name}, <z>'"
                     )
                 lay.z = manifest[key]
             zsrc = "manifest"
         else:
-            zh = [_z_from_meta(pf.metadata, pf.units, f"'{pf.path}'") for pf in parsed]
+            zh = [_z_from_meta(pf.metadata, pf.z_units, f"'{pf.path}'") for pf in parsed]
             if all(v is not None for v in zh):
                 for lay, v in zip(layers, zh, strict=True):
                     lay.z = v
                 zsrc = "header keyword"
             else:
-                zn = [_number_from_name(Path(lay.source).name) for lay in layers]
+                zn = [_number_from_name(Path(lay.source).name, z_units) for lay in layers]
                 if all(v is not None for v in zn) and len(set(zn)) == len(zn):
                     for lay, v in zip(layers, zn, strict=True):
                         lay.z = v
-                    zsrc = "file names (mm unless a unit is given)"
+                    zsrc = "file names"
                 elif layer_spacing is not None:
                     idx = [_layer_index_from_name(Path(lay.source).name) for lay in layers]
                     if any(i is None for i in idx) or len(set(idx)) != len(idx):
@@ -534,7 +600,7 @@ def read_scan(
                     )
     elif layout_used == "wide":
         names = parsed[0].column_names
-        vidx = [i for i, c in enumerate(parsed[0].columns) if c in ("radius", "deviation")]
+        vidx = [i for i, c in enumerate(parsed[0].columns) if c in ("radius", "deviation", "value")]
         zn = None
         if names and len(names) == len(parsed[0].columns):
             zn = []
@@ -543,8 +609,13 @@ def read_scan(
                 if not m:
                     zn = None
                     break
-                u = m.group(2) or parsed[0].units
-                zn.append(float(m.group(1).replace(",", ".")) * (unit_factor(u) if u else 1e-3))
+                u = m.group(2) or parsed[0].z_units
+                if u is None:
+                    raise BadInputError(
+                        f"'{files[0]}': column name {names[i]!r} gives z without a unit; pass "
+                        "z_units=... (--z-units mm)"
+                    )
+                zn.append(float(m.group(1).replace(",", ".")) * unit_factor(u))
         if zn is not None and len(set(zn)) == len(zn):
             for lay, v in zip(layers, zn, strict=True):
                 lay.z = v

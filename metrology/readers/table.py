@@ -83,9 +83,15 @@ class TextFormat:
         Meaning of each column, from :data:`COLUMN_KINDS`; for a wide file the value columns
         are all ``"radius"`` or ``"deviation"``.
     units : str, optional
-        Unit of the length columns: ``"um"``, ``"mm"``, ``"m"``, ``"inch"`` (overrides the header).
+        Unit of the length columns: ``"um"``, ``"mm"``, ``"m"``, ``"inch"``; for files that do
+        not state it (a file stating another unit is refused).
     encoding : str, optional
-        Text encoding (default: UTF-8, falling back to Latin-1).
+        Text encoding (default: from a byte-order mark (UTF-8, UTF-16), else UTF-8, falling
+        back to Latin-1).
+    z_units : str, optional
+        Unit of the z column / z in file names and headers, when the file does not state it.
+    sheet : str, optional
+        Worksheet of an Excel workbook (needed when it has several with data).
     """
 
     delimiter: str | None = None
@@ -94,6 +100,8 @@ class TextFormat:
     columns: tuple[str, ...] | None = None
     units: str | None = None
     encoding: str | None = None
+    z_units: str | None = None
+    sheet: str | None = None
 
     def __post_init__(self) -> None:
         if self.delimiter is not None and self.delimiter not in _DELIMS:
@@ -117,7 +125,9 @@ class TextFormat:
                 )
             object.__setattr__(self, "columns", cols)
         if self.units is not None:
-            unit_factor(self.units, where="option units")
+            unit_factor(self.units, where="option units (--units)")
+        if self.z_units is not None:
+            unit_factor(self.z_units, where="option z_units (--z-units)")
         if self.header_lines is not None and self.header_lines < 0:
             raise BadInputError(f"header_lines must be >= 0, got {self.header_lines}")
 
@@ -150,9 +160,26 @@ class ParsedFile:
     guessed: dict[str, str] = field(default_factory=dict)
     n_lines: int = 0
     column_units: dict[str, str] = field(default_factory=dict)
+    angle_unit: str | None = None  # stated in the header ("Angle unit: deg")
+    z_units: str | None = None  # stated in the header ("Z unit: mm") or by the user
+    arc: str | None = None  # stated in the header ("Arc: full")
 
 
-def _read_text(path: Path, encoding: str | None) -> str:
+def _utf16(raw: bytes) -> str | None:
+    """The UTF-16 codec of ``raw`` (BOM, or ASCII text with every other byte zero), else None."""
+    if raw[:2] in (b"\xff\xfe", b"\xfe\xff"):
+        return "utf-16"
+    head = raw[:4096]
+    if len(head) >= 4:
+        even, odd = head[0::2], head[1::2]
+        if odd.count(0) > 0.9 * len(odd) and even.count(0) < 0.1 * len(even):
+            return "utf-16-le"
+        if even.count(0) > 0.9 * len(even) and odd.count(0) < 0.1 * len(odd):
+            return "utf-16-be"
+    return None
+
+
+def _read_text(path: Path, encoding: str | None, sheet: str | None = None) -> str:
     try:
         raw = path.read_bytes()
     except FileNotFoundError:
@@ -161,27 +188,56 @@ def _read_text(path: Path, encoding: str | None) -> str:
         raise BadInputError(
             f"'{path}' is a folder; use layout='folder' to read per-layer files"
         ) from None
-    if not raw.strip():
+    except OSError as exc:
+        raise BadInputError(f"'{path}': cannot read ({exc.strerror or exc})") from None
+    if raw[:4] == b"PK\x03\x04":
+        from jointwear.metrology.readers.workbook import workbook_text
+
+        return workbook_text(path, sheet)
+    if raw[:8] == b"\xd0\xcf\x11\xe0\xa1\xb1\x1a\xe1":
+        raise BadInputError(
+            f"'{path}' is an old binary Excel (.xls) or other OLE file; save it as .xlsx or "
+            "export the trace as text (CSV)"
+        )
+    if sheet is not None:
+        raise BadInputError(f"sheet={sheet!r} (--sheet) was given but '{path}' is not a workbook")
+    codec = encoding or _utf16(raw)
+    if codec is None and raw[:3] == b"\xef\xbb\xbf":
+        codec = "utf-8-sig"
+    text = None
+    if codec:
+        try:
+            text = raw.decode(codec)
+        except (UnicodeDecodeError, LookupError) as exc:
+            raise BadInputError(
+                f"'{path}': cannot decode as {codec!r} ({exc}); pass encoding=..."
+            ) from None
+        text = text.lstrip("\ufeff")
+    if not (text if text is not None else raw).strip():
         raise BadInputError(
             f"'{path}' is empty (line 1): expected a text export of a roundness trace; "
             "re-export the measurement"
         )
-    head = raw[:8192]
-    ctrl = sum(1 for b in head if b < 32 and b not in (9, 10, 13, 12))
-    if b"\x00" in head or ctrl > 0.01 * len(head):
-        raise BadInputError(
-            f"'{path}' looks like a binary file (line 1 holds control bytes), not a text "
-            "export; export the trace as text (ASCII/CSV) from the instrument software"
-        )
-    if encoding:
+    if text is None:
+        head = raw[:8192]
+        ctrl = sum(1 for b in head if b < 32 and b not in (9, 10, 13, 12))
+        if b"\x00" in head or ctrl > 0.01 * len(head):
+            raise BadInputError(
+                f"'{path}' looks like a binary file (line 1 holds control bytes), not a text "
+                "export; export the trace as text (ASCII/CSV, UTF-8 or UTF-16) from the "
+                "instrument software"
+            )
         try:
-            return raw.decode(encoding)
-        except (UnicodeDecodeError, LookupError) as exc:
-            raise BadInputError(f"'{path}': cannot decode as {encoding!r} ({exc})") from None
-    try:
-        return raw.decode("utf-8-sig")
-    except UnicodeDecodeError:
-        return raw.decode("latin-1")
+            text = raw.decode("utf-8")
+        except UnicodeDecodeError:
+            text = raw.decode("latin-1")
+    else:
+        ctrl = sum(1 for c in text[:8192] if ord(c) < 32 and c not in "\t\n\r\f")
+        if ctrl > 0.01 * min(len(text), 8192):
+            raise BadInputError(
+                f"'{path}' decoded as {codec} holds control characters; not a text export"
+            )
+    return text
 
 
 def _split(line: str, delim: str) -> list[str]:
@@ -368,6 +424,11 @@ def _bad_line(
                 f"{s.strip()[:60]!r}{more}; fix or delete the line"
             )
         for t in toks:
+            if _is_num(t, fmt.decimal or ".") and not np.isfinite(float(t.replace(",", "."))):
+                raise BadInputError(
+                    f"'{path}' line {ln_no}: {t!r} is beyond the range of numbers (not finite); "
+                    "a corrupt value - fix or delete the line"
+                )
             if not _is_num(t, fmt.decimal or "."):
                 if t.lower() in ("nan", "-nan", "inf", "-inf", "+inf", "na", "n/a"):
                     raise BadInputError(
@@ -392,7 +453,7 @@ def parse_file(path: str | Path, fmt: TextFormat = TextFormat()) -> ParsedFile:
         number), inconsistent field counts, NaN values, unknown units.
     """
     path = Path(path)
-    text = _read_text(path, fmt.encoding)
+    text = _read_text(path, fmt.encoding, fmt.sheet)
     fmt, guessed = sniff(text, fmt, path=str(path))
     lines = text.splitlines()
     hl = fmt.header_lines or 0
@@ -457,18 +518,29 @@ def parse_file(path: str | Path, fmt: TextFormat = TextFormat()) -> ParsedFile:
     else:
         cols, name_units = _guess_columns(data, names)
         guessed["columns"] = ",".join(cols)
-    units = fmt.units
-    if units is None:
-        units = _units_from_meta(meta)
-        if units is None:
-            for i, c in enumerate(cols):
-                if c in ("radius", "deviation", "x", "y", "z") and str(i) in name_units:
-                    units = name_units[str(i)]
-                    break
-        if units is not None:
-            guessed["units"] = f"{units} (from the header)"
-            ln_no = next((i + 1 for i, ln in enumerate(lines[:hl]) if units in ln), max(hl, 1))
-            unit_factor(units, where=f"'{path}' line {ln_no}")
+    units = _file_units(str(path), lines[:hl], meta, cols, name_units, fmt.units, guessed)
+    _check_last_line(str(path), text, lines, body_idx, fmt, guessed)
+    angle_unit = _keyword(meta, _ANGLE_UNIT_KEYS)
+    if angle_unit is not None:
+        angle_unit = _ANGLE_UNIT_WORDS.get(angle_unit.lower().strip())
+        if angle_unit is None:
+            raise BadInputError(
+                f"'{path}': header angle unit {_keyword(meta, _ANGLE_UNIT_KEYS)!r} is not known "
+                "(deg, rad or index)"
+            )
+    z_units = _keyword(meta, _Z_UNIT_KEYS)
+    if z_units is not None:
+        unit_factor(z_units, where=f"'{path}' header z unit")
+        if fmt.z_units is not None and unit_factor(fmt.z_units) != unit_factor(z_units):
+            raise BadInputError(
+                f"'{path}': z_units={fmt.z_units!r} (--z-units) contradicts the header, which "
+                f"says the z unit is {z_units!r}; drop the option or correct the header"
+            )
+    arc = _keyword(meta, _ARC_KEYS)
+    if arc is not None:
+        arc = arc.strip().lower()
+        if arc not in ("full", "partial"):
+            raise BadInputError(f"'{path}': header arc {arc!r} is not known (full or partial)")
     return ParsedFile(
         path=str(path),
         data=data,
@@ -481,4 +553,116 @@ def parse_file(path: str | Path, fmt: TextFormat = TextFormat()) -> ParsedFile:
         guessed=guessed,
         n_lines=len(lines),
         column_units=name_units,
+        angle_unit=angle_unit,
+        z_units=z_units or fmt.z_units,
+        arc=arc,
+    )
+
+
+_ANGLE_UNIT_KEYS = re.compile(r"^(angle|theta)[ _]?units?$", re.I)
+_Z_UNIT_KEYS = re.compile(r"^(z|height|level|axial)[ _]?units?$", re.I)
+_ARC_KEYS = re.compile(r"^(arc|angular[ _]span|span)$", re.I)
+_ANGLE_UNIT_WORDS = {
+    "deg": "deg",
+    "degree": "deg",
+    "degrees": "deg",
+    "°": "deg",
+    "rad": "rad",
+    "radian": "rad",
+    "radians": "rad",
+    "index": "index",
+    "point": "index",
+    "points": "index",
+}
+_LENGTH_KINDS = ("radius", "deviation", "value", "x", "y")
+
+
+def _keyword(meta: dict[str, str], pattern: re.Pattern) -> str | None:
+    return next((v.strip() for k, v in meta.items() if pattern.match(k.strip())), None)
+
+
+def _file_units(
+    path: str,
+    header: Sequence[str],
+    meta: dict[str, str],
+    cols: Sequence[str],
+    name_units: dict[str, str],
+    option: str | None,
+    guessed: dict[str, str],
+) -> str | None:
+    """The length unit of the values: stated by the file (header keyword, column names) or by
+    the user; a user's unit that contradicts the file is an error, never an override."""
+    stated: list[tuple[str, str]] = []
+    head_unit = _units_from_meta(meta)
+    if head_unit is not None:
+        ln_no = next((i + 1 for i, ln in enumerate(header) if head_unit in ln), max(len(header), 1))
+        unit_factor(head_unit, where=f"'{path}' line {ln_no}")
+        stated.append((head_unit, f"line {ln_no} (header)"))
+    for i, c in enumerate(cols):
+        if c in _LENGTH_KINDS and str(i) in name_units:
+            u = name_units[str(i)]
+            unit_factor(u, where=f"'{path}' column {i + 1} name")
+            stated.append((u, f"the name of column {i + 1}"))
+    factors = {unit_factor(u) for u, _ in stated}
+    if len(factors) > 1:
+        raise BadInputError(
+            f"'{path}': the file states different length units: "
+            + ", ".join(f"{u!r} in {w}" for u, w in stated)
+            + "; correct the file"
+        )
+    if option is not None:
+        if stated and unit_factor(option) not in factors:
+            u, w = stated[0]
+            raise BadInputError(
+                f"'{path}': units={option!r} (--units {option}) contradicts the file, which says "
+                f"{u!r} in {w}; a {unit_factor(u) / unit_factor(option):g}x error - drop the "
+                "option (the file states its unit), or correct the file if it is wrong"
+            )
+        return option
+    if stated:
+        guessed["units"] = f"{stated[0][0]} (stated in {stated[0][1]})"
+        return stated[0][0]
+    return None
+
+
+def _decimals(tok: str) -> int:
+    mant = re.split(r"[eE]", tok)[0]
+    for sep in ".,":
+        if sep in mant:
+            return len(mant.split(sep, 1)[1])
+    return 0
+
+
+def _check_last_line(
+    path: str,
+    text: str,
+    lines: Sequence[str],
+    body_idx: Sequence[int],
+    fmt: TextFormat,
+    guessed: dict[str, str],
+) -> None:
+    """A file cut mid-number ends without a newline: compare the last line's number format."""
+    if text.endswith(("\n", "\r")) or len(body_idx) < 3:
+        return
+    ln = body_idx[-1]
+    last = _split(lines[ln], fmt.delimiter or " ")
+    prev = [_split(lines[i], fmt.delimiter or " ") for i in list(body_idx)[-51:-1]]
+    checked = False
+    for j, tok in enumerate(last):
+        decs = {_decimals(p[j]) for p in prev if j < len(p)}
+        if len(decs) == 1:
+            checked = True
+            (d,) = decs
+            if _decimals(tok) != d:
+                raise BadInputError(
+                    f"'{path}' line {ln + 1}: the file ends without a newline and the last "
+                    f"number {tok!r} has {_decimals(tok)} decimal(s) where every line before has "
+                    f"{d}: the file looks cut off - re-export it, or delete the line"
+                )
+    guessed["last_line"] = (
+        "the file does not end with a newline; the last line has the number format of the "
+        "lines before (not cut)"
+        if checked
+        else "the file does not end with a newline and the number format varies, so a cut "
+        "last line could not be ruled out"
     )
