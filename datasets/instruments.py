@@ -352,6 +352,10 @@ def write(
             "Instrument": scan.metadata.get("instrument", "Talyrond"),
             "Operator": scan.metadata.get("operator", ""),
             "Units": units,
+            # the angle unit and the span are stated, never left to the reader's judgement
+            "Angle unit": {"deg": "deg", "rad": "rad", "index": "index"}.get(angle, ""),
+            "Arc": "full" if angle != "xy" else "",
+            "Z unit": "mm" if layout in ("long", "folder-header") else "",
             "Points": str(n),
             "Nominal radius": f"{scan.nominal_radius * 1e3:.6f} mm",
             **extra,

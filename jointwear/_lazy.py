@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import importlib
 import sys
+import types
 from collections.abc import Callable, Sequence
 from typing import Any
 
@@ -61,4 +62,24 @@ def lazy_api(
     def __dir__() -> list[str]:
         return sorted(set(__getattr__("__all__")))
 
+    # The import system binds a freshly imported submodule on its package with ``setattr``
+    # (``import jointwear.metrology.assess`` sets ``jointwear.metrology.assess`` to the module).
+    # When the submodule exports a public name equal to its own name, bind that object
+    # instead, so that ``from jointwear.metrology import assess`` gives the function whatever
+    # was imported first.
+    sys.modules[package].__class__ = _ShadowingModule
     return __getattr__, __dir__
+
+
+class _ShadowingModule(types.ModuleType):
+    """A package whose public names win over same-named submodules bound by the import system."""
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        if (
+            isinstance(value, types.ModuleType)
+            and not name.startswith("_")
+            and value.__name__ == f"{self.__name__}.{name}"
+            and name in getattr(value, "__all__", ())
+        ):
+            value = getattr(value, name)
+        super().__setattr__(name, value)

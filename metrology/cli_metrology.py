@@ -2,10 +2,35 @@
 
 from __future__ import annotations
 
+from enum import StrEnum
 from pathlib import Path
 from typing import Annotated
 
 import typer
+
+
+class AngleUnit(StrEnum):
+    """Unit of the angle column."""
+
+    deg = "deg"
+    rad = "rad"
+    index = "index"
+
+
+class Arc(StrEnum):
+    """Angular span of each layer."""
+
+    full = "full"
+    partial = "partial"
+
+
+class ValueKind(StrEnum):
+    """Meaning of the value column(s)."""
+
+    auto = "auto"
+    radius = "radius"
+    deviation = "deviation"
+
 
 _SOURCE = "jointwear 0.1 (metrology)"
 
@@ -89,7 +114,42 @@ def register(app: typer.Typer) -> None:
                 "radius, deviation, ignore.",
             ),
         ] = None,
-        value: Annotated[str, typer.Option("--value", help="auto, radius or deviation.")] = "auto",
+        value: Annotated[
+            ValueKind,
+            typer.Option(
+                "--value-kind",
+                "--value",
+                help="Values are radius or deviation (auto: from the column name, else from "
+                "unambiguous numbers, else refused).",
+            ),
+        ] = ValueKind.auto,
+        angle_unit: Annotated[
+            AngleUnit | None,
+            typer.Option(
+                "--angle-unit",
+                help="Unit of the angle column when the file does not state it: deg, rad or "
+                "index (point number over one turn).",
+            ),
+        ] = None,
+        arc: Annotated[
+            Arc | None,
+            typer.Option(
+                "--arc",
+                help="Each layer is one full turn or a partial arc (settles an ambiguous angle "
+                "unit; 'full' is needed for files without an angle column).",
+            ),
+        ] = None,
+        z_units: Annotated[
+            str | None,
+            typer.Option(
+                "--z-units",
+                help="Unit of z (column, header, file names) when not stated: mm, um, m.",
+            ),
+        ] = None,
+        sheet: Annotated[
+            str | None,
+            typer.Option("--sheet", help="Worksheet of an Excel workbook with several sheets."),
+        ] = None,
         layer_spacing_mm: Annotated[
             float | None, typer.Option("--layer-spacing-mm", help="Layer spacing [mm].")
         ] = None,
@@ -159,7 +219,11 @@ def register(app: typer.Typer) -> None:
             decimal=decimal,
             header_lines=header_lines,
             columns=tuple(c.strip() for c in columns.split(",")) if columns else None,
-            value=value,
+            value=str(value),
+            angle_unit=str(angle_unit) if angle_unit is not None else None,
+            arc=str(arc) if arc is not None else None,
+            z_units=z_units,
+            sheet=sheet,
             layer_spacing=layer_spacing_mm * 1e-3 if layer_spacing_mm is not None else None,
             z_mid=z_mid_mm * 1e-3 if z_mid_mm is not None else "centre",
             expected_points=expected_points,

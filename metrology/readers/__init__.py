@@ -1,7 +1,7 @@
 """Instrument file readers (one module per instrument family)."""
 
 from jointwear.metrology.readers.talyrond import TALYROND_DEFAULTS, read_talyrond
-from jointwear.metrology.readers.text import (
+from jointwear.metrology.readers.text import (  # the split modules, re-exported
     COLUMN_KINDS,
     TextFormat,
     parse_file,

@@ -6,8 +6,9 @@ or per block, and a published dataset of Talyrond TR31c traces (Zenodo record 70
 University) distributes them as CSV with 3600 points per revolution and the radial displacement in
 micrometres. No published specification of the export layouts was found, so this preset *is* the
 generic text reader (:func:`jointwear.metrology.readers.text.read_scan`) with the defaults such a
-trace needs: values are radial deviations in micrometres unless the header says otherwise, angles
-are equally spaced over one revolution when the file has no angle column, and the instrument name
+trace needs: values in micrometres unless the file states a unit, every trace one full
+revolution (``arc="full"``: a file without an angle column holds equally spaced points over one
+turn, and an angle column must span one turn), and the instrument name
 goes into ``source``. Everything the generic reader sniffs is still sniffed and recorded, and
 every default can be overridden.
 
@@ -23,7 +24,7 @@ from pathlib import Path
 import xarray as xr
 
 from jointwear.conventions import AngleConvention
-from jointwear.metrology.readers.text import read_scan
+from jointwear.metrology.readers.scan import read_scan
 
 __all__ = ["TALYROND_DEFAULTS", "read_talyrond"]
 
@@ -32,6 +33,7 @@ TALYROND_DEFAULTS: dict[str, object] = {
     "units": "um",
     "value": "auto",
     "instrument": "Taylor Hobson Talyrond",
+    "arc": "full",
 }
 
 
@@ -60,6 +62,7 @@ def read_talyrond(
     Dataset
         ``radial_deviation`` (or ``radius``) [m] over (z, theta) in the canonical convention.
     """
+    options = {k: v for k, v in options.items() if v is not None}  # None = not given
     opts = dict(TALYROND_DEFAULTS)
     explicit_units = "units" in options
     opts.update(options)

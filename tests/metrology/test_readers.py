@@ -33,7 +33,7 @@ CASES = [
     dict(layout="folder"),
     dict(layout="folder-names", angle="rad", delimiter=";", decimal=","),
     dict(layout="folder-header", angle="index", delimiter=" "),
-    dict(layout="folder", angle="none"),
+    dict(layout="folder", angle="none", header=False, read=dict(arc="full", units="um")),
     dict(layout="folder", angle="xy", units="mm"),
     dict(layout="folder", value="radius", units="inch", delimiter=","),
     dict(layout="long", units="mm"),
@@ -45,9 +45,11 @@ CASES = [
 
 @pytest.mark.parametrize("case", CASES, ids=lambda c: "-".join(f"{k}={v!r}" for k, v in c.items()))
 def test_round_trip_every_layout(tmp_path, scan, case):
+    case = dict(case)
+    options = case.pop("read", {})
     target = tmp_path / ("scan" if case["layout"].startswith("folder") else "scan.txt")
     write(scan, target, **case)
-    ds = read_scan(target, convention=CONV)
+    ds = read_scan(target, convention=CONV, **options)
     truth = scan.truth
     np.testing.assert_allclose(_values(ds, scan.nominal_radius), truth["radius"].values, atol=2e-10)
     np.testing.assert_allclose(ds["theta"].values, truth["theta"].values, atol=1e-9)
@@ -85,14 +87,14 @@ def test_convention_is_required(tmp_path, scan):
         read_scan(tmp_path / "s")
 
 
-def test_overrides_win(tmp_path, scan):
+def test_overrides_win_where_the_file_is_silent(tmp_path, scan):
     f = tmp_path / "t.txt"
-    write(scan, f, layout="single", angle="deg", units="um")
+    write(scan, f, layout="single", angle="deg", header=False, column_names=False)
     ds = read_scan(
         f,
         convention=AngleConvention("+y", "counterclockwise"),
         columns=("angle_deg", "deviation"),
-        units="mm",  # deliberately wrong: must be obeyed
+        units="mm",  # the file does not say: the option is the truth
     )
     np.testing.assert_allclose(
         ds["radial_deviation"].values[0],
@@ -269,7 +271,7 @@ def test_every_written_combination_reads_back(
     tmp_path_factory, layout, angle, delim, dec, units, value, header, names, n_layers, n_points
 ):
     """Any file the generator can write is read back without options (except what the file
-    cannot say: units without a header, z of an unnamed wide file)."""
+    cannot say without a header: units, angle unit, span, z unit; z of an unnamed wide file)."""
     if delim == dec or (layout == "wide" and angle == "xy"):
         return
     header = header or layout == "folder-header"
@@ -291,6 +293,12 @@ def test_every_written_combination_reads_back(
     kw = {}
     if not header:
         kw["units"] = units
+        if not names and angle in ("rad", "index"):
+            kw["angle_unit"] = angle  # 0..17 is a point index or 17 degrees: the file can't say
+        if angle == "none":
+            kw["arc"] = "full"
+        if layout == "long" and not names:
+            kw["z_units"] = "mm"
     if layout == "wide" and not names:
         kw["layer_spacing"] = 1e-3
     ds = read_scan(path, convention=CONV, **kw)

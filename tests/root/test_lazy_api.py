@@ -48,3 +48,17 @@ def test_function_shadowing_a_submodule():
     import jointwear.metrology as m
 
     assert m.assess is assess
+
+
+def test_function_wins_when_the_submodule_was_imported_first():
+    # a fresh interpreter: importing the module ``assess`` binds it on the package before the
+    # lazy API has loaded; the public function must still be what the name gives
+    code = (
+        "import inspect, jointwear.metrology.assess; "
+        "from jointwear.metrology import assess; "
+        "import sys; "
+        "print(inspect.isfunction(assess), "
+        "inspect.ismodule(sys.modules['jointwear.metrology.assess']))"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.split() == ["True", "True"]

@@ -1,0 +1,668 @@
+"""Text exports to numeric tables: encoding, header, delimiter, decimal separator, units."""
+
+from __future__ import annotations
+
+import io
+import re
+from collections.abc import Sequence
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from jointwear.errors import BadInputError
+from jointwear.metrology.readers.columns import COLUMN_KINDS, _guess_columns, _kind_from_name
+
+__all__ = ["UNITS", "TextFormat", "ParsedFile", "unit_factor", "sniff", "parse_file"]
+
+
+#: Length units -> factor to metres.
+UNITS: dict[str, float] = {
+    "m": 1.0,
+    "mm": 1e-3,
+    "um": 1e-6,
+    "µm": 1e-6,
+    "μm": 1e-6,
+    "micron": 1e-6,
+    "microns": 1e-6,
+    "micrometre": 1e-6,
+    "micrometer": 1e-6,
+    "micrometres": 1e-6,
+    "micrometers": 1e-6,
+    "millimetre": 1e-3,
+    "millimeter": 1e-3,
+    "millimetres": 1e-3,
+    "millimeters": 1e-3,
+    "metre": 1.0,
+    "meter": 1.0,
+    "metres": 1.0,
+    "meters": 1.0,
+    "nm": 1e-9,
+    "in": 0.0254,
+    "inch": 0.0254,
+    "inches": 0.0254,
+    '"': 0.0254,
+}
+
+
+_UNIT_CANON = {
+    1.0: "m",
+    1e-3: "mm",
+    1e-6: "um",
+    1e-9: "nm",
+    0.0254: "inch",
+}
+
+
+_DELIMS = {"\t": "tab", ";": "semicolon", ",": "comma", " ": "whitespace"}
+
+
+_NUM = r"[-+]?(?:\d+(?:[.,]\d*)?|[.,]\d+)(?:[eE][-+]?\d+)?"
+
+
+_NUM_RE = re.compile(rf"^\s*{_NUM}\s*$")
+
+
+_KV_RE = re.compile(r"^\s*([A-Za-zµμ_#][^:=\t]{0,60}?)\s*(?::|=|\t)\s*(.*?)\s*$")
+
+
+@dataclass(frozen=True)
+class TextFormat:
+    """How to read one text export. ``None`` means: sniff it (and record the guess).
+
+    Parameters
+    ----------
+    delimiter : {"\\t", ";", ",", " "}, optional
+        Field separator (``" "`` = any run of whitespace).
+    decimal : {".", ","}, optional
+        Decimal separator.
+    header_lines : int, optional
+        Number of lines before the numeric table (metadata and column names).
+    columns : tuple of str, optional
+        Meaning of each column, from :data:`COLUMN_KINDS`; for a wide file the value columns
+        are all ``"radius"`` or ``"deviation"``.
+    units : str, optional
+        Unit of the length columns: ``"um"``, ``"mm"``, ``"m"``, ``"inch"``; for files that do
+        not state it (a file stating another unit is refused).
+    encoding : str, optional
+        Text encoding (default: from a byte-order mark (UTF-8, UTF-16), else UTF-8, falling
+        back to Latin-1).
+    z_units : str, optional
+        Unit of the z column / z in file names and headers, when the file does not state it.
+    sheet : str, optional
+        Worksheet of an Excel workbook (needed when it has several with data).
+    """
+
+    delimiter: str | None = None
+    decimal: str | None = None
+    header_lines: int | None = None
+    columns: tuple[str, ...] | None = None
+    units: str | None = None
+    encoding: str | None = None
+    z_units: str | None = None
+    sheet: str | None = None
+
+    def __post_init__(self) -> None:
+        if self.delimiter is not None and self.delimiter not in _DELIMS:
+            names = {"tab": "\t", "semicolon": ";", "comma": ",", "whitespace": " ", "space": " "}
+            if self.delimiter in names:
+                object.__setattr__(self, "delimiter", names[self.delimiter])
+            else:
+                raise BadInputError(
+                    f"delimiter {self.delimiter!r} is not supported; use tab, ';', ',' or ' ' "
+                    "(whitespace)"
+                )
+        if self.decimal not in (None, ".", ","):
+            raise BadInputError(f"decimal {self.decimal!r} must be '.' or ','")
+        if self.columns is not None:
+            cols = tuple(str(c).strip().lower() for c in self.columns)
+            bad = [c for c in cols if c not in COLUMN_KINDS]
+            if bad:
+                raise BadInputError(
+                    f"column meaning(s) {', '.join(map(repr, bad))} not understood; use "
+                    + ", ".join(COLUMN_KINDS)
+                )
+            object.__setattr__(self, "columns", cols)
+        if self.units is not None:
+            unit_factor(self.units, where="option units (--units)")
+        if self.z_units is not None:
+            unit_factor(self.z_units, where="option z_units (--z-units)")
+        if self.header_lines is not None and self.header_lines < 0:
+            raise BadInputError(f"header_lines must be >= 0, got {self.header_lines}")
+
+
+def unit_factor(unit: str, *, where: str = "units") -> float:
+    """Factor from a length unit name to metres; a clear error for unknown units."""
+    key = str(unit).strip().strip(".").replace(" ", "")
+    low = key.lower()
+    for k in (key, low):
+        if k in UNITS:
+            return UNITS[k]
+    raise BadInputError(
+        f"{where}: unit {unit!r} is not known; use one of um (micrometre), mm, m, inch "
+        "(pass units=... to override what the file says)"
+    )
+
+
+@dataclass
+class ParsedFile:
+    """A sniffed and parsed text file: the numeric table plus everything that was guessed."""
+
+    path: str
+    data: np.ndarray  # (n_rows, n_cols) float
+    line_numbers: np.ndarray  # 1-based line number of each row
+    columns: tuple[str, ...]
+    column_names: tuple[str, ...]
+    units: str | None
+    metadata: dict[str, str] = field(default_factory=dict)
+    fmt: TextFormat = field(default_factory=TextFormat)
+    guessed: dict[str, str] = field(default_factory=dict)
+    n_lines: int = 0
+    column_units: dict[str, str] = field(default_factory=dict)
+    angle_unit: str | None = None  # stated in the header ("Angle unit: deg")
+    z_units: str | None = None  # stated in the header ("Z unit: mm") or by the user
+    arc: str | None = None  # stated in the header ("Arc: full")
+
+
+def _utf16(raw: bytes) -> str | None:
+    """The UTF-16 codec of ``raw`` (BOM, or ASCII text with every other byte zero), else None."""
+    if raw[:2] in (b"\xff\xfe", b"\xfe\xff"):
+        return "utf-16"
+    head = raw[:4096]
+    if len(head) >= 4:
+        even, odd = head[0::2], head[1::2]
+        if odd.count(0) > 0.9 * len(odd) and even.count(0) < 0.1 * len(even):
+            return "utf-16-le"
+        if even.count(0) > 0.9 * len(even) and odd.count(0) < 0.1 * len(odd):
+            return "utf-16-be"
+    return None
+
+
+def _read_text(path: Path, encoding: str | None, sheet: str | None = None) -> str:
+    try:
+        raw = path.read_bytes()
+    except FileNotFoundError:
+        raise BadInputError(f"'{path}' does not exist") from None
+    except IsADirectoryError:
+        raise BadInputError(
+            f"'{path}' is a folder; use layout='folder' to read per-layer files"
+        ) from None
+    except OSError as exc:
+        raise BadInputError(f"'{path}': cannot read ({exc.strerror or exc})") from None
+    if raw[:4] == b"PK\x03\x04":
+        from jointwear.metrology.readers.workbook import workbook_text
+
+        return workbook_text(path, sheet)
+    if raw[:8] == b"\xd0\xcf\x11\xe0\xa1\xb1\x1a\xe1":
+        raise BadInputError(
+            f"'{path}' is an old binary Excel (.xls) or other OLE file; save it as .xlsx or "
+            "export the trace as text (CSV)"
+        )
+    if sheet is not None:
+        raise BadInputError(f"sheet={sheet!r} (--sheet) was given but '{path}' is not a workbook")
+    codec = encoding or _utf16(raw)
+    if codec is None and raw[:3] == b"\xef\xbb\xbf":
+        codec = "utf-8-sig"
+    text = None
+    if codec:
+        try:
+            text = raw.decode(codec)
+        except (UnicodeDecodeError, LookupError) as exc:
+            raise BadInputError(
+                f"'{path}': cannot decode as {codec!r} ({exc}); pass encoding=..."
+            ) from None
+        text = text.lstrip("\ufeff")
+    if not (text if text is not None else raw).strip():
+        raise BadInputError(
+            f"'{path}' is empty (line 1): expected a text export of a roundness trace; "
+            "re-export the measurement"
+        )
+    if text is None:
+        head = raw[:8192]
+        ctrl = sum(1 for b in head if b < 32 and b not in (9, 10, 13, 12))
+        if b"\x00" in head or ctrl > 0.01 * len(head):
+            raise BadInputError(
+                f"'{path}' looks like a binary file (line 1 holds control bytes), not a text "
+                "export; export the trace as text (ASCII/CSV, UTF-8 or UTF-16) from the "
+                "instrument software"
+            )
+        try:
+            text = raw.decode("utf-8")
+        except UnicodeDecodeError:
+            text = raw.decode("latin-1")
+    else:
+        ctrl = sum(1 for c in text[:8192] if ord(c) < 32 and c not in "\t\n\r\f")
+        if ctrl > 0.01 * min(len(text), 8192):
+            raise BadInputError(
+                f"'{path}' decoded as {codec} holds control characters; not a text export"
+            )
+    return text
+
+
+def _split(line: str, delim: str) -> list[str]:
+    if delim == " ":
+        return line.split()
+    return [t.strip() for t in line.strip().split(delim)]
+
+
+def _is_num(tok: str, dec: str) -> bool:
+    if not tok:
+        return False
+    if dec == ".":
+        if "," in tok:
+            return False
+    elif "." in tok:
+        return False
+    return bool(_NUM_RE.match(tok))
+
+
+def _score(lines: Sequence[str], delim: str, dec: str) -> tuple[int, float] | None:
+    """(modal number of columns, fraction of sample lines that are that many numbers)."""
+    if delim == dec:
+        return None
+    counts: dict[int, int] = {}
+    for ln in lines:
+        toks = _split(ln, delim)
+        if delim != " " and toks and toks[-1] == "":
+            toks = toks[:-1]  # trailing delimiter
+        if toks and all(_is_num(t, dec) for t in toks):
+            counts[len(toks)] = counts.get(len(toks), 0) + 1
+    if not counts:
+        return None
+    n, c = max(counts.items(), key=lambda kv: (kv[1], kv[0]))
+    frac = c / len(lines)
+    return (n, frac) if frac >= 0.75 else None
+
+
+def _numeric_line(line: str) -> bool:
+    s = line.strip()
+    if not s:
+        return False
+    return bool(re.match(r"^[-+]?(?:\d|[.,]\d)", s)) and not re.search(r"[A-DF-Za-df-z]", s)
+
+
+def sniff(
+    text: str, fmt: TextFormat = TextFormat(), *, path: str = "<text>"
+) -> tuple[TextFormat, dict]:
+    """Guess the format of a text export. Returns (completed format, notes on what was guessed)."""
+    lines = text.splitlines()
+    guessed: dict[str, str] = {}
+    # header: the numeric table is the last run of numeric lines; header = everything before
+    if fmt.header_lines is None:
+        start = None
+        # first numeric line of which at least half the next 10 non-blank lines are numeric
+        for i, ln in enumerate(lines):
+            if not _numeric_line(ln):
+                continue
+            nxt = []
+            for j in range(i + 1, min(len(lines), i + 40)):
+                if lines[j].strip():
+                    nxt.append(j)
+                if len(nxt) == 10:
+                    break
+            if not nxt or sum(_numeric_line(lines[j]) for j in nxt) >= 0.5 * len(nxt):
+                start = i
+                break
+        if start is None:
+            raise BadInputError(
+                f"'{path}': no table of numbers found (expected lines like '0.02\\t1.234'); "
+                "is this a roundness export? Pass header_lines=... if the table starts later"
+            )
+        header_lines = start
+        guessed["header_lines"] = str(start)
+    else:
+        header_lines = fmt.header_lines
+    data_sample = [ln for ln in lines[header_lines : header_lines + 400] if ln.strip()][:50]
+    if not data_sample:
+        raise BadInputError(
+            f"'{path}': no data lines after the {header_lines} header line(s) (line "
+            f"{header_lines + 1}); the file looks truncated - re-export it"
+        )
+    delim, dec = fmt.delimiter, fmt.decimal
+    if delim is None or dec is None:
+        best = None
+        for d in [delim] if delim else ["\t", ";", ",", " "]:
+            for c in [dec] if dec else [".", ","]:
+                sc = _score(data_sample, d, c)
+                if sc is None:
+                    continue
+                # lines that all parse first, then more columns, then an explicit delimiter
+                key = (sc[1] >= 0.95, sc[0], sc[1], d != " ")
+                # a comma that only ever separates integers with leading zeros is a decimal comma
+                if d == "," and c == ".":
+                    toks = [_split(ln, ",") for ln in data_sample]
+                    ints = all(all(re.fullmatch(r"[-+]?\d+", t) for t in row) for row in toks)
+                    lead0 = any(
+                        len(row) > 1 and any(t.startswith("0") and len(t) > 1 for t in row[1:])
+                        for row in toks
+                    )
+                    # two integer fields whose second always has the same width (>= 2 digits):
+                    # fixed decimals with a decimal comma, not two integer columns
+                    fixed = all(len(row) == 2 for row in toks) and (
+                        len({len(row[1]) for row in toks}) == 1 and len(toks[0][1]) >= 2
+                    )
+                    if ints and (lead0 or (fixed and len(toks) >= 3)):
+                        continue
+                if best is None or key > best[0]:
+                    best = (key, d, c)
+        if best is None:
+            bad = data_sample[0]
+            line_no = lines.index(bad) + 1 if bad in lines else header_lines + 1
+            raise BadInputError(
+                f"'{path}' line {line_no}: cannot split {bad.strip()[:60]!r} into numbers with "
+                "any delimiter (tab, ';', ',', whitespace) and decimal separator ('.', ','); "
+                "pass delimiter=... and decimal=..., or fix the line"
+            )
+        _, d, c = best
+        if delim is None:
+            guessed["delimiter"] = _DELIMS[d]
+            delim = d
+        if dec is None:
+            guessed["decimal"] = c
+            dec = c
+    return replace(fmt, delimiter=delim, decimal=dec, header_lines=header_lines), guessed
+
+
+def _parse_header(lines: Sequence[str], delim: str, ncols: int) -> tuple[dict[str, str], list[str]]:
+    """Keyword/value metadata, and the column names (the last header line, if it has one field
+    per column)."""
+    meta: dict[str, str] = {}
+    names: list[str] = []
+    cleaned = [ln.strip().lstrip("#;%/!*").strip() for ln in lines]
+    nonblank = [i for i, s in enumerate(cleaned) if s]
+    last = nonblank[-1] if nonblank else -1
+    for i in nonblank:
+        s = cleaned[i]
+        toks = _split(s, delim)
+        if delim != " " and toks and toks[-1] == "":
+            toks = toks[:-1]
+        if i == last:
+            kv = _KV_RE.match(s)
+            kv_like = bool(kv and kv.group(2) and re.search(r"[:=]", s))
+            wide_split = [t for t in re.split(r"\s{2,}|\t", s) if t]
+            if delim == " " and ncols > 1 and len(wide_split) == ncols:
+                cand, ok = wide_split, True  # names separated by 2+ spaces may contain spaces
+            elif delim == " ":
+                cand, ok = toks, not kv_like
+            else:
+                cand, ok = toks, ncols > 1 or not kv
+            if ok and len(cand) == ncols and not all(_NUM_RE.match(t) for t in cand):
+                names = cand
+                continue
+        m = _KV_RE.match(s)
+        if m and m.group(2):
+            meta[m.group(1).strip()] = m.group(2).strip()
+        elif delim != " " and len(toks) >= 2 and toks[0]:
+            meta[toks[0]] = delim.join(toks[1:]).strip()
+    return meta, names
+
+
+_UNIT_KEYS = re.compile(r"^(units?|length[ _]?units?|einheit|unit of measure|scale units?)$", re.I)
+
+
+def _units_from_meta(meta: dict[str, str]) -> str | None:
+    for k, v in meta.items():
+        if _UNIT_KEYS.match(k.strip()):
+            return v.strip()
+    return None
+
+
+def _bad_line(
+    path: str, lines: Sequence[str], line_numbers: np.ndarray, fmt: TextFormat, ncol: int
+):
+    """Find the first line whose fields are not ncol numbers, and raise a clear error."""
+    for ln_no in line_numbers:
+        s = lines[ln_no - 1]
+        toks = _split(s, fmt.delimiter or " ")
+        if fmt.delimiter != " " and toks and toks[-1] == "":
+            toks = toks[:-1]
+        if len(toks) != ncol:
+            more = " (the file looks truncated - re-export it)" if ln_no == line_numbers[-1] else ""
+            raise BadInputError(
+                f"'{path}' line {ln_no}: expected {ncol} fields, found {len(toks)} in "
+                f"{s.strip()[:60]!r}{more}; fix or delete the line"
+            )
+        for t in toks:
+            if _is_num(t, fmt.decimal or ".") and not np.isfinite(float(t.replace(",", "."))):
+                raise BadInputError(
+                    f"'{path}' line {ln_no}: {t!r} is beyond the range of numbers (not finite); "
+                    "a corrupt value - fix or delete the line"
+                )
+            if not _is_num(t, fmt.decimal or "."):
+                if t.lower() in ("nan", "-nan", "inf", "-inf", "+inf", "na", "n/a"):
+                    raise BadInputError(
+                        f"'{path}' line {ln_no}: {t!r} is not a measured value; remove the line "
+                        "or re-export without missing points"
+                    )
+                raise BadInputError(
+                    f"'{path}' line {ln_no}: {t!r} is not a number (expected decimal "
+                    f"separator {fmt.decimal!r}, delimiter {_DELIMS.get(fmt.delimiter or ' ')}); "
+                    "fix the line or pass delimiter=/decimal="
+                )
+    raise BadInputError(f"'{path}': the table could not be parsed; pass delimiter= and decimal=")
+
+
+def parse_file(path: str | Path, fmt: TextFormat = TextFormat()) -> ParsedFile:
+    """Sniff and parse one text export into a numeric table (no interpretation of layers yet).
+
+    Raises
+    ------
+    BadInputError
+        Empty or binary file, no numeric table, a line that is not numbers (named with its line
+        number), inconsistent field counts, NaN values, unknown units.
+    """
+    path = Path(path)
+    text = _read_text(path, fmt.encoding, fmt.sheet)
+    fmt, guessed = sniff(text, fmt, path=str(path))
+    lines = text.splitlines()
+    hl = fmt.header_lines or 0
+    tail = lines[hl:]
+    if any(not ln.strip() for ln in tail):
+        body_idx = [i for i in range(hl, len(lines)) if lines[i].strip()]
+    else:
+        body_idx = range(hl, len(lines))
+    line_numbers = np.asarray(body_idx, dtype=np.int64) + 1
+    first = _split(lines[body_idx[0]], fmt.delimiter or " ")
+    if fmt.delimiter != " " and first and first[-1] == "":
+        first = first[:-1]
+    ncol = len(first)
+    body = "\n".join(tail) if isinstance(body_idx, range) else "\n".join(lines[i] for i in body_idx)
+    sep = r"\s+" if fmt.delimiter == " " else fmt.delimiter
+    try:
+        df = pd.read_csv(
+            io.StringIO(body),
+            sep=sep,
+            decimal=fmt.decimal or ".",
+            header=None,
+            engine="c",
+            dtype=float,
+            skip_blank_lines=False,
+            na_filter=True,
+            keep_default_na=True,
+            usecols=range(ncol),
+            skipinitialspace=True,
+        )
+        data = df.to_numpy(dtype=float)
+    except (ValueError, pd.errors.ParserError):
+        _bad_line(str(path), lines, line_numbers, fmt, ncol)
+        raise  # pragma: no cover - _bad_line always raises
+    if data.shape[0] != len(body_idx) or not np.all(np.isfinite(data)):
+        bad = (
+            np.flatnonzero(~np.all(np.isfinite(data), axis=1))
+            if data.shape[0] == len(body_idx)
+            else []
+        )
+        if len(bad):
+            _bad_line(str(path), lines, line_numbers[bad[0] :], fmt, ncol)
+        _bad_line(str(path), lines, line_numbers, fmt, ncol)
+    # a short last line is read as NaN-padded by pandas; caught above. Extra fields:
+    last = _split(lines[body_idx[-1]], fmt.delimiter or " ")
+    if fmt.delimiter != " " and last and last[-1] == "":
+        last = last[:-1]
+    if len(last) != ncol:
+        _bad_line(str(path), lines, line_numbers[-1:], fmt, ncol)
+    meta, names = _parse_header(lines[:hl], fmt.delimiter or " ", ncol)
+    if fmt.columns is not None:
+        cols = fmt.columns
+        if len(cols) != ncol:
+            raise BadInputError(
+                f"'{path}': columns={list(cols)} names {len(cols)} columns but the table has "
+                f"{ncol}; give one meaning per column"
+            )
+        name_units: dict[str, str] = {}
+        for i, nm in enumerate(names if len(names) == ncol else []):
+            _, u = _kind_from_name(nm)
+            if u:
+                name_units[str(i)] = u
+    else:
+        cols, name_units = _guess_columns(data, names)
+        guessed["columns"] = ",".join(cols)
+    units = _file_units(str(path), lines[:hl], meta, cols, name_units, fmt.units, guessed)
+    _check_last_line(str(path), text, lines, body_idx, fmt, guessed)
+    angle_unit = _keyword(meta, _ANGLE_UNIT_KEYS)
+    if angle_unit is not None:
+        angle_unit = _ANGLE_UNIT_WORDS.get(angle_unit.lower().strip())
+        if angle_unit is None:
+            raise BadInputError(
+                f"'{path}': header angle unit {_keyword(meta, _ANGLE_UNIT_KEYS)!r} is not known "
+                "(deg, rad or index)"
+            )
+    z_units = _keyword(meta, _Z_UNIT_KEYS)
+    if z_units is not None:
+        unit_factor(z_units, where=f"'{path}' header z unit")
+        if fmt.z_units is not None and unit_factor(fmt.z_units) != unit_factor(z_units):
+            raise BadInputError(
+                f"'{path}': z_units={fmt.z_units!r} (--z-units) contradicts the header, which "
+                f"says the z unit is {z_units!r}; drop the option or correct the header"
+            )
+    arc = _keyword(meta, _ARC_KEYS)
+    if arc is not None:
+        arc = arc.strip().lower()
+        if arc not in ("full", "partial"):
+            raise BadInputError(f"'{path}': header arc {arc!r} is not known (full or partial)")
+    return ParsedFile(
+        path=str(path),
+        data=data,
+        line_numbers=line_numbers,
+        columns=tuple(cols),
+        column_names=tuple(names),
+        units=units,
+        metadata=meta,
+        fmt=fmt,
+        guessed=guessed,
+        n_lines=len(lines),
+        column_units=name_units,
+        angle_unit=angle_unit,
+        z_units=z_units or fmt.z_units,
+        arc=arc,
+    )
+
+
+_ANGLE_UNIT_KEYS = re.compile(r"^(angle|theta)[ _]?units?$", re.I)
+_Z_UNIT_KEYS = re.compile(r"^(z|height|level|axial)[ _]?units?$", re.I)
+_ARC_KEYS = re.compile(r"^(arc|angular[ _]span|span)$", re.I)
+_ANGLE_UNIT_WORDS = {
+    "deg": "deg",
+    "degree": "deg",
+    "degrees": "deg",
+    "°": "deg",
+    "rad": "rad",
+    "radian": "rad",
+    "radians": "rad",
+    "index": "index",
+    "point": "index",
+    "points": "index",
+}
+_LENGTH_KINDS = ("radius", "deviation", "value", "x", "y")
+
+
+def _keyword(meta: dict[str, str], pattern: re.Pattern) -> str | None:
+    return next((v.strip() for k, v in meta.items() if pattern.match(k.strip())), None)
+
+
+def _file_units(
+    path: str,
+    header: Sequence[str],
+    meta: dict[str, str],
+    cols: Sequence[str],
+    name_units: dict[str, str],
+    option: str | None,
+    guessed: dict[str, str],
+) -> str | None:
+    """The length unit of the values: stated by the file (header keyword, column names) or by
+    the user; a user's unit that contradicts the file is an error, never an override."""
+    stated: list[tuple[str, str]] = []
+    head_unit = _units_from_meta(meta)
+    if head_unit is not None:
+        ln_no = next((i + 1 for i, ln in enumerate(header) if head_unit in ln), max(len(header), 1))
+        unit_factor(head_unit, where=f"'{path}' line {ln_no}")
+        stated.append((head_unit, f"line {ln_no} (header)"))
+    for i, c in enumerate(cols):
+        if c in _LENGTH_KINDS and str(i) in name_units:
+            u = name_units[str(i)]
+            unit_factor(u, where=f"'{path}' column {i + 1} name")
+            stated.append((u, f"the name of column {i + 1}"))
+    factors = {unit_factor(u) for u, _ in stated}
+    if len(factors) > 1:
+        raise BadInputError(
+            f"'{path}': the file states different length units: "
+            + ", ".join(f"{u!r} in {w}" for u, w in stated)
+            + "; correct the file"
+        )
+    if option is not None:
+        if stated and unit_factor(option) not in factors:
+            u, w = stated[0]
+            raise BadInputError(
+                f"'{path}': units={option!r} (--units {option}) contradicts the file, which says "
+                f"{u!r} in {w}; a {unit_factor(u) / unit_factor(option):g}x error - drop the "
+                "option (the file states its unit), or correct the file if it is wrong"
+            )
+        return option
+    if stated:
+        guessed["units"] = f"{stated[0][0]} (stated in {stated[0][1]})"
+        return stated[0][0]
+    return None
+
+
+def _decimals(tok: str) -> int:
+    mant = re.split(r"[eE]", tok)[0]
+    for sep in ".,":
+        if sep in mant:
+            return len(mant.split(sep, 1)[1])
+    return 0
+
+
+def _check_last_line(
+    path: str,
+    text: str,
+    lines: Sequence[str],
+    body_idx: Sequence[int],
+    fmt: TextFormat,
+    guessed: dict[str, str],
+) -> None:
+    """A file cut mid-number ends without a newline: compare the last line's number format."""
+    if text.endswith(("\n", "\r")) or len(body_idx) < 3:
+        return
+    ln = body_idx[-1]
+    last = _split(lines[ln], fmt.delimiter or " ")
+    prev = [_split(lines[i], fmt.delimiter or " ") for i in list(body_idx)[-51:-1]]
+    checked = False
+    for j, tok in enumerate(last):
+        decs = {_decimals(p[j]) for p in prev if j < len(p)}
+        if len(decs) == 1:
+            checked = True
+            (d,) = decs
+            if _decimals(tok) != d:
+                raise BadInputError(
+                    f"'{path}' line {ln + 1}: the file ends without a newline and the last "
+                    f"number {tok!r} has {_decimals(tok)} decimal(s) where every line before has "
+                    f"{d}: the file looks cut off - re-export it, or delete the line"
+                )
+    guessed["last_line"] = (
+        "the file does not end with a newline; the last line has the number format of the "
+        "lines before (not cut)"
+        if checked
+        else "the file does not end with a newline and the number format varies, so a cut "
+        "last line could not be ruled out"
+    )
