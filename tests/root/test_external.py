@@ -261,3 +261,17 @@ def test_cli_bad_origin_is_a_usage_error(tmp_path):
          "--velocity-unit", "mm/s", "--time-column", "t"]
     )  # fmt: skip
     assert code == 2
+
+
+def test_loading_a_foreign_cf_file_points_to_jointwear_import(tmp_path):
+    theta_c, z, depth = _wear_truth()
+    foreign = xr.Dataset(
+        {"wear_depth": (("z", "theta"), depth, {"units": "m"})},
+        coords={"z": ("z", z, {"units": "m"}), "theta": ("theta", theta_c, {"units": "degree"})},
+        attrs={"Conventions": "CF-1.11", "title": "wear from another tool"},
+    )
+    path = tmp_path / "foreign.nc"
+    foreign.to_netcdf(path)
+    with pytest.raises(BadInputError, match="jointwear import wearmap") as info:
+        io.load(path)
+    assert "not written by jointwear" in str(info.value)
