@@ -91,7 +91,13 @@ def register(app: typer.Typer) -> None:
                 bar.update(task, completed=offsets[stage] + done, description=f"rendering {stage}")
 
             written = generate_rig(
-                out, cfg, video=video, images=images, codec=codec, motion=motion_ds, progress=advance
+                out,
+                cfg,
+                video=video,
+                images=images,
+                codec=codec,
+                motion=motion_ds,
+                progress=advance,
             )
         for key, path in written.items():
             typer.echo(f"{key}: {path}")

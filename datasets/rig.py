@@ -28,9 +28,9 @@ link, y up (gravity along -y), z out of the mechanism plane towards the cameras.
 from __future__ import annotations
 
 import json
+from collections.abc import Callable
 from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
-from collections.abc import Callable
 from typing import Any
 
 import numpy as np
