@@ -16,7 +16,13 @@ def register(app: typer.Typer) -> None:
         out: Annotated[Path, typer.Argument(help="Output folder (or file for long/wide/single).")],
         layers: Annotated[int, typer.Option("--layers", help="Number of layers.")] = 13,
         points: Annotated[int, typer.Option("--points", help="Points per layer.")] = 18000,
-        radius_mm: Annotated[float, typer.Option("--radius-mm", help="Bore radius [mm].")] = 8.0,
+        radius_mm: Annotated[
+            float | None,
+            typer.Option(
+                "--radius-mm",
+                help="Bore radius [mm] (default 8, or the simulated bore's with --wear-from).",
+            ),
+        ] = None,
         spacing_mm: Annotated[
             float, typer.Option("--spacing-mm", help="Layer spacing [mm].")
         ] = 1.0,
@@ -44,6 +50,25 @@ def register(app: typer.Typer) -> None:
         wear_um: Annotated[
             float, typer.Option("--wear-um", help="Peak depth of the imposed wear [µm] (0: none).")
         ] = 20.0,
+        wear_from: Annotated[
+            Path | None,
+            typer.Option(
+                "--wear-from",
+                help="Take the imposed wear from a 'jointwear sim wear' result (last snapshot) "
+                "instead of the built-in pattern; --wear-um is then not used.",
+            ),
+        ] = None,
+        wear_scale: Annotated[
+            float,
+            typer.Option("--wear-scale", help="Factor on the wear taken with --wear-from [1]."),
+        ] = 1.0,
+        wear_rotation_deg: Annotated[
+            float,
+            typer.Option(
+                "--wear-rotation-deg",
+                help="Turn of the wear taken with --wear-from, canonical sense [degree].",
+            ),
+        ] = 0.0,
         noise_um: Annotated[float, typer.Option("--noise-um", help="Probe noise [µm].")] = 0.02,
         quantisation_nm: Annotated[
             float, typer.Option("--quantisation-nm", help="Reading resolution [nm].")
@@ -69,14 +94,23 @@ def register(app: typer.Typer) -> None:
         from jointwear.datasets.instruments import generate, write
 
         delims = {"tab": "\t", "semicolon": ";", "comma": ",", "space": " ", "whitespace": " "}
+        wear: object = "default" if wear_um > 0 else None
+        radius = 8e-3 if radius_mm is None else radius_mm * 1e-3
+        if wear_from is not None:
+            from jointwear.datasets.simulated_wear import wear_from_simulation
+
+            sim = io.load(wear_from)
+            wear = wear_from_simulation(sim, scale=wear_scale, rotation_deg=wear_rotation_deg)
+            if radius_mm is None:
+                radius = float(sim.attrs.get("bearing_radius_m", radius))
         sc = generate(
             n_layers=layers,
             n_points=points,
-            radius=radius_mm * 1e-3,
+            radius=radius,
             layer_spacing=spacing_mm * 1e-3,
             eccentricity=(eccentricity_um[0] * 1e-6, eccentricity_um[1] * 1e-6),
             tilt=tilt,
-            wear="default" if wear_um > 0 else None,
+            wear=wear,
             wear_depth=wear_um * 1e-6,
             noise=noise_um * 1e-6,
             quantisation=quantisation_nm * 1e-9,
@@ -105,6 +139,14 @@ def register(app: typer.Typer) -> None:
                 t,
                 truth,
                 source="jointwear 0.1 (datasets.instruments)",
-                parameters={"layers": layers, "points": points, "seed": seed, "layout": layout},
+                parameters={
+                    "layers": layers,
+                    "points": points,
+                    "seed": seed,
+                    "layout": layout,
+                    "wear_from": None if wear_from is None else str(wear_from),
+                    "wear_scale": wear_scale,
+                    "wear_rotation_deg": wear_rotation_deg,
+                },
             )
             typer.echo(f"wrote {truth}")

@@ -78,6 +78,26 @@ def register(app: typer.Typer) -> None:
             from jointwear import io
 
             motion_ds = io.load(motion)
-        written = generate_rig(out, cfg, video=video, images=images, codec=codec, motion=motion_ds)
+        from jointwear.datasets.rig import VirtualRig
+        from jointwear.progress import progress_bar
+
+        n_views = len(VirtualRig(cfg, motion=motion_ds).board_poses())
+        total = 2 * cfg.n_frames + n_views
+        offsets = {"left": 0, "right": cfg.n_frames, "calibration": 2 * cfg.n_frames}
+        with progress_bar("rendering the rig", total=total) as bar:
+            task = bar.tasks[0].id
+
+            def advance(stage: str, done: int, of: int) -> None:
+                bar.update(task, completed=offsets[stage] + done, description=f"rendering {stage}")
+
+            written = generate_rig(
+                out,
+                cfg,
+                video=video,
+                images=images,
+                codec=codec,
+                motion=motion_ds,
+                progress=advance,
+            )
         for key, path in written.items():
             typer.echo(f"{key}: {path}")

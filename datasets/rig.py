@@ -28,6 +28,7 @@ link, y up (gravity along -y), z out of the mechanism plane towards the cameras.
 from __future__ import annotations
 
 import json
+from collections.abc import Callable
 from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 from typing import Any
@@ -749,6 +750,7 @@ def generate_rig(
     codec: str = "ffv1",
     calibration_images: bool = True,
     motion: PrescribedMotion | xr.Dataset | None = None,
+    progress: Callable[[str, int, int], None] | None = None,
 ) -> dict[str, Path]:
     """Render the virtual rig to ``out``: footage, board images, ground truth and ROI file.
 
@@ -759,6 +761,8 @@ def generate_rig(
 
     ``motion`` (a :class:`PrescribedMotion` or a Dataset such as a simulator output with
     ``crank_angle`` and ``follower_position``/``journal_position``) replaces the analytic motion.
+    ``progress(stage, done, total)`` is called after each rendered frame (stage ``"left"`` or
+    ``"right"``) and each calibration view (``"calibration"``), for a progress display.
 
     Returns
     -------
@@ -794,6 +798,8 @@ def generate_rig(
                 if images:
                     folder.mkdir(exist_ok=True)
                     cv2.imwrite(str(folder / f"frame_{k:06d}.png"), img)
+                if progress is not None:
+                    progress(cam, k + 1, n)
                 yield img
 
         if video:
@@ -806,7 +812,12 @@ def generate_rig(
         if images:
             written[f"{cam}_images"] = folder
     if calibration_images:
-        for i, (L, R) in enumerate(rig.board_images()):
+        poses = rig.board_poses()
+        for i, (rot, origin) in enumerate(poses):
+            L = rig.render_board("left", rot, origin, index=i)
+            R = rig.render_board("right", rot, origin, index=i)
+            if progress is not None:
+                progress("calibration", i + 1, len(poses))
             for cam, img in (("left", L), ("right", R)):
                 folder = out / "calibration" / cam
                 folder.mkdir(parents=True, exist_ok=True)

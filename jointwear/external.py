@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import csv
 import re
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from functools import cache
 from pathlib import Path
 from typing import Any
@@ -39,6 +39,7 @@ __all__ = [
     "import_motion",
     "import_wear_map",
     "import_cf",
+    "load_for_comparison",
 ]
 
 #: What the numbers of a file are (global attribute ``data_origin``).
@@ -472,3 +473,81 @@ def import_cf(
     ds = conventions.annotate(ds)
     ds.attrs.pop("provenance", None)
     return _stamp(ds, path, origin, tool or ds.attrs.get("source"), "dataset")
+
+
+def load_for_comparison(
+    path: str | Path,
+    *,
+    role: str,
+    warn: Callable[[str], None] | None = None,
+) -> xr.Dataset:
+    """Load a file to compare: a jointwear file as it is, a foreign CF file as external data.
+
+    A file written by jointwear (with provenance) is loaded by :func:`jointwear.io.load`. A
+    netCDF file from another tool that uses the contract's variable names, ``units`` attributes
+    and an angle convention on ``theta`` is converted by :func:`import_cf` and accepted with a
+    warning: it is marked ``external = "yes"``, and when it does not state ``data_origin`` the
+    origin is taken from its role in the comparison and recorded as assumed
+    (``data_origin_stated = "no"``), which the report shows. A foreign file whose angle convention
+    or units are missing is refused with the ``jointwear import`` command that settles it.
+
+    Parameters
+    ----------
+    path : path
+        The netCDF file.
+    role : {"simulated", "measured"}
+        The file's place in the comparison (simulation or measurement side).
+    warn : callable, optional
+        Receives the warning text for a foreign file (the CLI prints it on stderr); by default
+        it is issued as a :class:`UserWarning`.
+    """
+    from jointwear import io
+
+    if role not in ("simulated", "measured"):
+        raise ValueError(f"role must be 'simulated' or 'measured', got {role!r}")
+    path = Path(path)
+    try:
+        return io.load(path)
+    except BadInputError:
+        if not path.is_file() or _has_provenance(path):
+            raise
+    command = "wearmap" if role == "measured" else "wearmap|motion"
+    stated = _stated_origin(path)
+    try:
+        ds = import_cf(path, data_origin=None if stated else role)
+    except BadInputError as exc:
+        raise BadInputError(
+            f"{exc}\n'{path}' comes from another tool and cannot be read unambiguously; convert "
+            f"it first: jointwear import {command} {path} --origin ... (docs/tutorial-own-data.md)"
+        ) from None
+    ds.attrs["data_origin_stated"] = "yes" if stated else "no"
+    text = (
+        f"'{path}' was not written by jointwear: taken as external data "
+        f"({ds.attrs['source']}), units and angle convention from its attributes"
+    )
+    if not stated:
+        text += (
+            f"; it does not state what its numbers are, so it is taken as {role!r} from its "
+            f"place in the command - state it with 'jointwear import {command} {path} --origin'"
+        )
+    if warn is None:
+        import warnings
+
+        warnings.warn(text, UserWarning, stacklevel=2)
+    else:
+        warn(text)
+    return ds
+
+
+def _has_provenance(path: Path) -> bool:
+    try:
+        with xr.open_dataset(path, engine="netcdf4") as raw:
+            return "provenance" in raw.attrs
+    except (OSError, ValueError):
+        return True  # not netCDF at all: io.load's message is the right one
+
+
+def _stated_origin(path: Path) -> str | None:
+    with xr.open_dataset(path, engine="netcdf4") as raw:
+        origin = raw.attrs.get("data_origin")
+    return str(origin) if origin is not None else None

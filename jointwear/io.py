@@ -227,6 +227,18 @@ def load(path: str | Path, *, validate: bool = True) -> xr.Dataset:
     for name in list(ds.variables):
         ds[name].attrs = decode_attrs(ds[name].attrs)
     if validate:
-        conventions.validate(ds, require_provenance=True, what=f"'{path}'")
+        try:
+            conventions.validate(ds, require_provenance=True, what=f"'{path}'")
+        except BadInputError as exc:
+            if "provenance" in ds.attrs:
+                raise
+            # a file written by another tool: say how it comes in, rather than only what is wrong
+            raise type(exc)(
+                f"{exc}\n'{path}' was not written by jointwear (no provenance). A file from "
+                "another simulator or instrument comes in with 'jointwear import wearmap' or "
+                "'jointwear import motion' (--origin simulated|measured|synthetic, and the angle "
+                "convention and units when the file does not state them); in Python, "
+                "jointwear.external.import_cf. See docs/tutorial-own-data.md."
+            ) from None
     ds.encoding["source"] = str(path)
     return ds

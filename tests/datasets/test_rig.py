@@ -135,3 +135,17 @@ def test_prescribed_motion_from_a_dataset():
         PrescribedMotion.from_dataset(
             ds[["crank_angle"]].drop_vars("crank_angle").assign(x=("time", t))
         )
+
+
+def test_progress_reports_every_frame_and_calibration_view(tmp_path):
+    from jointwear.datasets.rig import generate_rig
+
+    cfg = RigConfig(width=160, height=128, fps=10.0, duration=0.3)
+    seen: list[tuple[str, int, int]] = []
+    generate_rig(tmp_path, cfg, video=False, progress=lambda *a: seen.append(a))
+    for cam in ("left", "right"):
+        done = [d for s, d, t in seen if s == cam]
+        assert done == list(range(1, cfg.n_frames + 1))
+    views = [(d, t) for s, d, t in seen if s == "calibration"]
+    n_boards = len(list((tmp_path / "calibration" / "left").glob("board_*.png")))
+    assert views == [(k, n_boards) for k in range(1, n_boards + 1)]

@@ -261,3 +261,73 @@ def test_cli_bad_origin_is_a_usage_error(tmp_path):
          "--velocity-unit", "mm/s", "--time-column", "t"]
     )  # fmt: skip
     assert code == 2
+
+
+def test_loading_a_foreign_cf_file_points_to_jointwear_import(tmp_path):
+    theta_c, z, depth = _wear_truth()
+    foreign = xr.Dataset(
+        {"wear_depth": (("z", "theta"), depth, {"units": "m"})},
+        coords={"z": ("z", z, {"units": "m"}), "theta": ("theta", theta_c, {"units": "degree"})},
+        attrs={"Conventions": "CF-1.11", "title": "wear from another tool"},
+    )
+    path = tmp_path / "foreign.nc"
+    foreign.to_netcdf(path)
+    with pytest.raises(BadInputError, match="jointwear import wearmap") as info:
+        io.load(path)
+    assert "not written by jointwear" in str(info.value)
+
+
+def _foreign_wear(path, *, origin=None, convention=True):
+    theta_c, z, depth = _wear_truth()
+    theta_attrs = {"units": "degree"}
+    if convention:
+        theta_attrs.update(angle_zero="-x", angle_direction="clockwise")
+    attrs = {"Conventions": "CF-1.11", "title": "wear from another tool", "source": "MATLAB"}
+    if origin:
+        attrs["data_origin"] = origin
+    xr.Dataset(
+        {"wear_depth": (("z", "theta"), depth * 1e6, {"units": "um"})},
+        coords={"z": ("z", z * 1e3, {"units": "mm"}), "theta": ("theta", theta_c, theta_attrs)},
+        attrs=attrs,
+    ).to_netcdf(path)
+    return depth
+
+
+def test_foreign_cf_is_accepted_for_comparison_with_a_warning(tmp_path):
+    path = tmp_path / "matlab.nc"
+    depth = _foreign_wear(path)
+    said: list[str] = []
+    ds = external.load_for_comparison(path, role="measured", warn=said.append)
+    np.testing.assert_allclose(ds["wear_depth"].transpose("z", "theta"), depth, rtol=1e-12)
+    assert ds.attrs["external"] == "yes" and ds.attrs["data_origin"] == "measured"
+    assert ds.attrs["data_origin_stated"] == "no"
+    assert len(said) == 1 and "does not state what its numbers are" in said[0]
+    assert "--origin" in said[0]
+
+
+def test_foreign_cf_stating_its_origin_keeps_it(tmp_path):
+    path = tmp_path / "synthetic.nc"
+    _foreign_wear(path, origin="synthetic")
+    with pytest.warns(UserWarning, match="not written by jointwear"):
+        ds = external.load_for_comparison(path, role="measured")
+    assert ds.attrs["data_origin"] == "synthetic" and ds.attrs["data_origin_stated"] == "yes"
+
+
+def test_foreign_cf_without_angle_convention_is_refused_for_comparison(tmp_path):
+    path = tmp_path / "noconv.nc"
+    _foreign_wear(path, convention=False)
+    with pytest.raises(BadInputError, match="jointwear import wearmap"):
+        external.load_for_comparison(path, role="measured", warn=lambda s: None)
+
+
+def test_a_broken_jointwear_file_is_not_taken_as_foreign(tmp_path):
+    theta_c, z, depth = _wear_truth()
+    ds = xr.Dataset(
+        {"wear_depth": (("z", "theta"), depth, {"units": "m"})},
+        coords={"z": ("z", z, {"units": "m"}), "theta": ("theta", theta_c, {"units": "degree"})},
+        attrs={"provenance": "{}", "title": "t"},
+    )
+    path = tmp_path / "broken.nc"
+    ds.to_netcdf(path)
+    with pytest.raises(BadInputError, match="data contract"):
+        external.load_for_comparison(path, role="simulated", warn=lambda s: None)
