@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from jointwear import conventions
+from jointwear import conventions, outputs
 from jointwear._version import __version__
 from jointwear.errors import BadInputError
 from jointwear.provenance import build_provenance, dumps, history_line
@@ -83,7 +83,8 @@ def check_writable(path: str | Path, *, what: str = "output") -> Path:
         path.parent.mkdir(parents=True, exist_ok=True)
         fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".check")
         os.close(fd)
-        os.unlink(tmp)
+        with contextlib.suppress(FileNotFoundError):  # removed as stale by a concurrent writer
+            os.unlink(tmp)
     except OSError as exc:
         raise BadInputError(
             f"{what} path '{path}' is not writable ({exc.strerror}); choose another location"
@@ -95,6 +96,12 @@ def check_writable(path: str | Path, *, what: str = "output") -> Path:
 def atomic_path(path: str | Path) -> Iterator[Path]:
     """Yield a temporary path next to ``path``; rename it over ``path`` if the block succeeds.
 
+    While the block runs, the output's lock is held (another process writing ``path`` makes
+    this raise :class:`~jointwear.outputs.OutputBusyError`), stale temporary files of ``path``
+    left by a killed writer are removed first, and a failed write (full disk, permission,
+    netCDF/HDF error) becomes an :class:`~jointwear.outputs.OutputError` naming ``path``; the
+    previous file, if any, is left as it was.
+
     Use for any file type::
 
         with atomic_path("report.html") as tmp:
@@ -102,21 +109,28 @@ def atomic_path(path: str | Path) -> Iterator[Path]:
     """
     path = Path(path)
     check_writable(path)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    os.close(fd)
-    tmp_path = Path(tmp)
-    try:
-        yield tmp_path
-        with open(tmp_path, "rb") as fh:
-            os.fsync(fh.fileno())
-        # mkstemp creates 0600 files; give the result the permissions of a normally created file
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp_path, 0o666 & ~umask)
-        os.replace(tmp_path, path)
-    finally:
-        if tmp_path.exists():
-            tmp_path.unlink()
+    with outputs.output_lock(path):
+        outputs.remove_stale_temporaries(path)
+        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+        os.close(fd)
+        tmp_path = Path(tmp)
+        try:
+            yield tmp_path
+            with open(tmp_path, "rb") as fh:
+                os.fsync(fh.fileno())
+            # mkstemp creates 0600 files; give the result the permissions of a normally created
+            # file
+            umask = os.umask(0)
+            os.umask(umask)
+            os.chmod(tmp_path, 0o666 & ~umask)
+            os.replace(tmp_path, path)
+        except Exception as exc:
+            if outputs.is_write_failure(exc):
+                raise outputs.write_failure(exc, path) from exc
+            raise
+        finally:
+            if tmp_path.exists():
+                tmp_path.unlink()
 
 
 def parse_provenance(ds: xr.Dataset) -> dict[str, Any]:
