@@ -1,5 +1,6 @@
 """Public names of the wear part of jointwear.sim (Archard wear, cycle updates, wear maps)."""
 
+from jointwear.sim._kw_calibration import KwCalibration, calibrate_kw, resimulator
 from jointwear.sim._wear_contact import (
     ConstantContact,
     ContactModel,
@@ -10,13 +11,11 @@ from jointwear.sim._wear_contact import (
 from jointwear.sim.wear import (
     DEFAULT_KW,
     KW_RANGE,
-    KwCalibration,
     WearRun,
     WearSettings,
-    calibrate_kw,
+    apply_overrides,
     default_snapshots,
     halved_schedule,
-    resimulator,
     simulate_wear,
 )
 from jointwear.sim.wearmap import (
@@ -35,6 +34,7 @@ __all__ = [
     "WearSettings",
     "WearRun",
     "simulate_wear",
+    "apply_overrides",
     "default_snapshots",
     "KwCalibration",
     "calibrate_kw",

@@ -127,7 +127,7 @@ def register(app: typer.Typer) -> None:
         """Estimate the wear coefficient kw from a measured wear depth, volume, cylindricity or map."""
         from jointwear import io
         from jointwear.errors import BadInputError
-        from jointwear.sim.wear import calibrate_kw, resimulator
+        from jointwear.sim._kw_calibration import calibrate_kw, resimulator
 
         given = {
             "max_depth": None if max_depth_um is None else max_depth_um * 1e-6,
