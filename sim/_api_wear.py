@@ -1,6 +1,14 @@
 """Public names of the wear part of jointwear.sim (Archard wear, cycle updates, wear maps)."""
 
-from jointwear.sim._kw_calibration import KwCalibration, calibrate_kw, resimulator
+from jointwear.sim._kw_calibration import (
+    KwCalibration,
+    Measurement,
+    MultiCalibration,
+    calibrate_kw,
+    calibrate_kw_and_parameter,
+    calibrate_kw_multi,
+    resimulator,
+)
 from jointwear.sim._wear_contact import (
     ConstantContact,
     ContactModel,
@@ -38,6 +46,10 @@ __all__ = [
     "default_snapshots",
     "KwCalibration",
     "calibrate_kw",
+    "Measurement",
+    "MultiCalibration",
+    "calibrate_kw_multi",
+    "calibrate_kw_and_parameter",
     "halved_schedule",
     "resimulator",
     "BearingGrid",
