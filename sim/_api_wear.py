@@ -1,5 +1,14 @@
 """Public names of the wear part of jointwear.sim (Archard wear, cycle updates, wear maps)."""
 
+from jointwear.sim._kw_calibration import (
+    KwCalibration,
+    Measurement,
+    MultiCalibration,
+    calibrate_kw,
+    calibrate_kw_and_parameter,
+    calibrate_kw_multi,
+    resimulator,
+)
 from jointwear.sim._wear_contact import (
     ConstantContact,
     ContactModel,
@@ -10,13 +19,11 @@ from jointwear.sim._wear_contact import (
 from jointwear.sim.wear import (
     DEFAULT_KW,
     KW_RANGE,
-    KwCalibration,
     WearRun,
     WearSettings,
-    calibrate_kw,
+    apply_overrides,
     default_snapshots,
     halved_schedule,
-    resimulator,
     simulate_wear,
 )
 from jointwear.sim.wearmap import (
@@ -35,9 +42,14 @@ __all__ = [
     "WearSettings",
     "WearRun",
     "simulate_wear",
+    "apply_overrides",
     "default_snapshots",
     "KwCalibration",
     "calibrate_kw",
+    "Measurement",
+    "MultiCalibration",
+    "calibrate_kw_multi",
+    "calibrate_kw_and_parameter",
     "halved_schedule",
     "resimulator",
     "BearingGrid",

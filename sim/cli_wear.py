@@ -23,6 +23,49 @@ def _parse_snapshots(text: str | None) -> list[float] | None:
         ) from None
 
 
+def _measurements(given: dict[str, list[str] | None], default_cycles: float) -> list[Any]:
+    """Measurements from ``value`` or ``value@cycles`` strings (µm, or mm³ for the volume)."""
+    from jointwear.errors import BadInputError
+    from jointwear.sim._kw_calibration import Measurement
+
+    flags = {
+        "max_depth": "--max-depth-um",
+        "volume": "--volume-mm3",
+        "cylindricity": "--cylindricity-um",
+    }
+    out = []
+    for quantity, texts in given.items():
+        scale = 1e-9 if quantity == "volume" else 1e-6
+        for text in texts or []:
+            value, _, at = text.partition("@")
+            try:
+                v = float(value) * scale
+                c = float(at) if at else default_cycles
+            except ValueError:
+                raise BadInputError(
+                    f"{flags[quantity]} {text!r}: expected a number, optionally @cycles, "
+                    "e.g. 28.32@4e5"
+                ) from None
+            out.append(Measurement(quantity, c, v))
+    return out
+
+
+def _parse_vary(text: str) -> tuple[str, tuple[float, float]]:
+    from jointwear.errors import BadInputError
+
+    name, _, rng = text.partition("=")
+    lo, _, hi = rng.partition(":")
+    try:
+        bounds = (float(lo), float(hi))
+    except ValueError:
+        raise BadInputError(
+            f"--vary {text!r}: expected NAME=LO:HI, e.g. mechanism.joint_offset=0:0.02"
+        ) from None
+    if not name.strip() or "." not in name:
+        raise BadInputError(f"--vary {text!r}: NAME must be a dotted parameter name")
+    return name.strip(), bounds
+
+
 def _load_settings(params_file: Path | None, overrides: dict[str, Any]) -> tuple[Any, dict]:
     """WearSettings from the [wear] table of the TOML file plus command-line overrides;
     also returns the rest of the TOML (the simulator's parameters)."""
@@ -94,15 +137,25 @@ def register(app: typer.Typer) -> None:
             Path, typer.Argument(help="Wear map written by 'jointwear sim wear'.")
         ],
         max_depth_um: Annotated[
-            float | None, typer.Option("--max-depth-um", help="Measured maximum wear depth \\[µm].")
+            list[str] | None,
+            typer.Option(
+                "--max-depth-um",
+                help="Measured maximum wear depth \\[µm], optionally @cycles (e.g. 35@1.2e6); "
+                "repeat for several snapshots.",
+            ),
         ] = None,
         volume_mm3: Annotated[
-            float | None, typer.Option("--volume-mm3", help="Measured worn volume \\[mm³].")
+            list[str] | None,
+            typer.Option(
+                "--volume-mm3", help="Measured worn volume \\[mm³], optionally @cycles; repeatable."
+            ),
         ] = None,
         cylindricity_um: Annotated[
-            float | None,
+            list[str] | None,
             typer.Option(
-                "--cylindricity-um", help="Measured growth of the bore's cylindricity \\[µm]."
+                "--cylindricity-um",
+                help="Measured growth of the bore's cylindricity \\[µm], optionally @cycles "
+                "(e.g. 28.32@4e5); repeatable.",
             ),
         ] = None,
         measured_map: Annotated[
@@ -111,7 +164,18 @@ def register(app: typer.Typer) -> None:
         ] = None,
         cycles: Annotated[
             float | None,
-            typer.Option("--cycles", help="Cycle count of the measurement (default: last)."),
+            typer.Option(
+                "--cycles",
+                help="Cycle count of a measurement given without @cycles (default: last).",
+            ),
+        ] = None,
+        vary: Annotated[
+            str | None,
+            typer.Option(
+                "--vary",
+                help="Also fit one simulator parameter within bounds, NAME=LO:HI in SI units "
+                "(e.g. mechanism.joint_offset=0:0.02 \\[m]); needs two or more snapshots.",
+            ),
         ] = None,
         resimulate: Annotated[
             bool,
@@ -124,44 +188,86 @@ def register(app: typer.Typer) -> None:
             float, typer.Option("--rtol", help="Relative tolerance of the re-simulated match.")
         ] = 0.02,
     ) -> None:
-        """Estimate the wear coefficient kw from a measured wear depth, volume, cylindricity or map."""
+        """Estimate the wear coefficient kw from measured wear depth, volume, cylindricity or a map.
+
+        Several snapshots (repeat an option, each value@cycles) are fitted together by least
+        squares of the log misfit; each residual and a leave-one-out check are printed.
+        """
         from jointwear import io
         from jointwear.errors import BadInputError
-        from jointwear.sim.wear import calibrate_kw, resimulator
+        from jointwear.sim._kw_calibration import calibrate_kw, resimulator
 
-        given = {
-            "max_depth": None if max_depth_um is None else max_depth_um * 1e-6,
-            "volume": None if volume_mm3 is None else volume_mm3 * 1e-9,
-            "cylindricity": None if cylindricity_um is None else cylindricity_um * 1e-6,
-            "map": None if measured_map is None else io.load(measured_map),
-        }
-        chosen = {k: v for k, v in given.items() if v is not None}
-        if len(chosen) != 1:
-            raise BadInputError(
-                "give exactly one measurement: --max-depth-um, --volume-mm3, --cylindricity-um "
-                f"or --map (got {len(chosen)})"
-            )
-        ((quantity, measured),) = chosen.items()
         sim = io.load(simulated)
-        cal = calibrate_kw(
-            sim,
-            measured,
-            quantity=quantity,
-            cycles=cycles,
-            resimulate=resimulator(sim) if resimulate else None,
-            rtol=rtol,
+        last = float(sim["cycles"].values[-1])
+        meas = _measurements(
+            {"max_depth": max_depth_um, "volume": volume_mm3, "cylindricity": cylindricity_um},
+            cycles if cycles is not None else last,
         )
-        typer.echo(f"kw (linear estimate): {cal.kw_linear:.4g} m²/N")
-        if cal.linearity_error is not None:
-            typer.echo(
-                f"re-simulated with it: {100 * cal.linearity_error:+.1f} % off the measurement "
-                "(wear is not exactly linear in kw)"
+        n_given = len(meas) + (measured_map is not None)
+        if n_given == 0 or (measured_map is not None and meas):
+            raise BadInputError(
+                "give one measurement, or several scalar snapshots: --max-depth-um, --volume-mm3, "
+                f"--cylindricity-um (repeatable, value@cycles) or --map alone (got {n_given})"
             )
-            state = "converged" if cal.converged else "NOT converged"
-            typer.echo(
-                f"kw (calibrated, {state} after {len(cal.iterations) - 1} re-simulations): "
-                f"{cal.kw:.4g} m²/N"
+        plain = all(
+            "@" not in v
+            for v in (max_depth_um or []) + (volume_mm3 or []) + (cylindricity_um or [])
+        )
+        if vary is None and (measured_map is not None or (len(meas) == 1 and plain)):
+            if measured_map is not None:
+                quantity, measured = "map", io.load(measured_map)
+            else:
+                quantity, measured = meas[0].quantity, meas[0].value
+            cal = calibrate_kw(
+                sim,
+                measured,
+                quantity=quantity,
+                cycles=cycles,
+                resimulate=resimulator(sim) if resimulate else None,
+                rtol=rtol,
             )
+            typer.echo(f"kw (linear estimate): {cal.kw_linear:.4g} m²/N")
+            if cal.linearity_error is not None:
+                typer.echo(
+                    f"re-simulated with it: {100 * cal.linearity_error:+.1f} % off the measurement "
+                    "(wear is not exactly linear in kw)"
+                )
+                state = "converged" if cal.converged else "NOT converged"
+                typer.echo(
+                    f"kw (calibrated, {state} after {len(cal.iterations) - 1} re-simulations): "
+                    f"{cal.kw:.4g} m²/N"
+                )
+            return
+        from jointwear.sim._kw_calibration import calibrate_kw_and_parameter, calibrate_kw_multi
+
+        two_sim = None
+        if vary is not None:
+            name, bounds = _parse_vary(vary)
+            if not resimulate:
+                raise BadInputError("--vary needs re-simulation; drop --linear")
+            if len(meas) < 2:
+                raise BadInputError("--vary needs at least two measured snapshots")
+            two_sim = resimulator(sim, name)
+        one = calibrate_kw_multi(
+            sim, meas, resimulate=resimulator(sim) if resimulate else None, rtol=rtol / 4
+        )
+        typer.echo("kw alone:")
+        for line in one.report():
+            typer.echo(f"  {line}")
+        if two_sim is not None:
+            two = calibrate_kw_and_parameter(
+                two_sim, meas, parameter=name, bounds=bounds, kw0=one.kw
+            )
+            typer.echo(f"kw and {name}:")
+            for line in two.report():
+                typer.echo(f"  {line}")
+            better = two.rms_log_misfit < 0.5 * one.rms_log_misfit
+            typer.echo(
+                f"two parameters {'fit clearly better than' if better else 'do not fit clearly better than'} "
+                f"kw alone (RMS log misfit {100 * two.rms_log_misfit:.1f} % vs "
+                f"{100 * one.rms_log_misfit:.1f} %)"
+            )
+        typer.echo(f"kw (calibrated): {one.kw:.4g} m²/N")
 
     @app.command("wear")
     def wear(
@@ -343,9 +449,13 @@ def register(app: typer.Typer) -> None:
                 fig.savefig(tmp, dpi=110, format="png")
         if "convergence_warning" in ds.attrs:
             typer.echo(f"warning: {ds.attrs['convergence_warning']}", err=True)
+        u_max = float(ds["max_wear_depth_u"][-1])
+        u_vol = float(ds["worn_volume_u"][-1])
+        pm = (lambda u, f: f" ± {u * f:.2g}") if u_max == u_max else (lambda u, f: "")
         typer.echo(
             f"{out}: {run.cycles_done} cycles, max depth "
-            f"{float(ds['max_wear_depth'][-1]) * 1e6:.2f} µm, worn volume "
-            f"{float(ds['worn_volume'][-1]) * 1e9:.4g} mm³, {ds.attrs['n_updates']} updates, "
+            f"{float(ds['max_wear_depth'][-1]) * 1e6:.2f}{pm(u_max, 1e6)} µm, worn volume "
+            f"{float(ds['worn_volume'][-1]) * 1e9:.4g}{pm(u_vol, 1e9)} mm³ "
+            f"(accuracy {ds.attrs['accuracy_status']}, k = 2), {ds.attrs['n_updates']} updates, "
             f"{run.cycles_simulated:g} cycles simulated"
         )

@@ -164,7 +164,7 @@ def test_calibrate_kw_command_recovers_the_kw_of_a_run(tmp_path, capsys):
     assert abs(linear / 3e-13 - 1) > 0.05  # profile feedback: the linear guess is off
     assert calibrated == pytest.approx(3e-13, rel=0.03)
     assert main(["sim", "calibrate-kw", str(sim)]) == 3
-    assert "give exactly one measurement" in capsys.readouterr().err
+    assert "give one measurement" in capsys.readouterr().err
 
 
 def test_a_failing_simulation_leaves_partial_output_and_checkpoint(tmp_path, monkeypatch, capsys):
@@ -204,3 +204,33 @@ def test_help_states_the_default_kw(capsys):
 
     assert main(["sim", "wear", "--help"]) == 0
     assert f"default {DEFAULT_KW:g}" in capsys.readouterr().out
+
+
+def test_calibrate_kw_command_with_several_snapshots_reports_each_residual(tmp_path, capsys):
+    base = ["sim", "wear", "--contact", "winkler", "--layers", "6", "--points", "48"]
+    base += ["--snapshots", "1e4,3e4", "--cycles", "3e4"]
+    sim, truth = tmp_path / "sim.nc", tmp_path / "truth.nc"
+    assert main([*base, "--kw", "1e-13", "--out", str(sim)]) == 0
+    assert main([*base, "--kw", "3e-13", "--out", str(truth)]) == 0
+    t = io.load(truth)
+    d1, d2 = (float(t["max_wear_depth"].sel(cycles=c)) * 1e6 for c in (1e4, 3e4))
+    capsys.readouterr()
+    args = ["sim", "calibrate-kw", str(sim), "--max-depth-um", f"{d1:.6f}@1e4"]
+    assert main([*args, "--max-depth-um", f"{d2:.6f}@3e4"]) == 0
+    out = capsys.readouterr().out
+    assert "data used (2 snapshot(s))" in out
+    assert "max_depth" in out and "at 10000 cycles" in out and "at 30000 cycles" in out
+    assert out.count("residual") == 2 and "left out, predicted" in out
+    kw = float(out.split("kw (calibrated): ")[1].split()[0])
+    assert kw == pytest.approx(3e-13, rel=0.03)
+    assert main([*args, "--max-depth-um", "x@3e4"]) == 3
+    assert "--max-depth-um 'x@3e4'" in capsys.readouterr().err
+    assert main([*args, "--vary", "tilt=0:1", "--max-depth-um", f"{d2:.6f}@3e4"]) == 3
+    assert "NAME must be a dotted parameter name" in capsys.readouterr().err
+    assert main([*args, "--vary", "mechanism.joint_offset=0:0.02"]) == 3
+    assert "at least two measured snapshots" in capsys.readouterr().err
+    assert (
+        main([*args, "--max-depth-um", f"{d2:.6f}@3e4", "--vary", "mechanism.joint_offset=0:0.02"])
+        == 3
+    )
+    assert "prescribed contact model" in capsys.readouterr().err

@@ -1,0 +1,210 @@
+"""Update-interval control of the wear loop: noise-aware rate change, interval, accuracy.
+
+The wear loop (:mod:`jointwear.sim.wear`) advances the profile by ``dN`` cycles with the wear
+rate measured on the current profile (explicit Euler in the cycle count). This module holds the
+pure functions that decide ``dN`` and estimate the error of the result:
+
+* every measurement averages ``m`` single cycles (:func:`sample_rates`); their scatter gives the
+  cycle-to-cycle variability of the wear-rate field *on the current profile* (re-estimated at
+  every update, never once for the whole run);
+* the change of the averaged rate field over an update, ``eta_raw``, contains the noise of both
+  averages; the noise part (:func:`change_noise`) is removed in quadrature and changes below the
+  detection limit ``2 sigma_eta`` are indistinguishable from noise, so the controller aims at
+  ``max(tol, 2 sigma_eta)`` (:func:`effective_tolerance`). dN therefore never falls below the
+  interval at which the wear-driven change becomes detectable: no livelock;
+* ``m`` is chosen so that the detection limit is at most ``tol`` (:func:`cycles_to_average`),
+  bounded by ``max_average_cycles``; if that is not enough the run still finishes, is flagged
+  and says how accurate it is;
+* the accuracy of the depth field is accumulated along the run (:class:`ErrorBudget`): the
+  explicit-Euler truncation ``dN (r_new - r_old) / 2`` per update (signed sum: the systematic
+  part adds up, the noise part telescopes) and the statistical error of each averaged rate,
+  ``dN^2 var(r_mean)``, added in quadrature over the updates.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = [
+    "RateSample",
+    "ErrorBudget",
+    "sample_rates",
+    "rate_change",
+    "change_noise",
+    "effective_tolerance",
+    "cycles_to_average",
+    "next_interval",
+    "COVERAGE",
+    "DETECTION_SIGMAS",
+]
+
+#: Coverage factor of the reported accuracy (expanded uncertainty, about 95 %).
+COVERAGE: float = 2.0
+
+#: A rate change is "detected" when it exceeds this many standard deviations of its noise.
+DETECTION_SIGMAS: float = 2.0
+
+
+@dataclass(frozen=True)
+class RateSample:
+    """The wear rate measured on one profile, averaged over ``n`` single cycles.
+
+    Attributes
+    ----------
+    rate : ndarray (Nl, Nd)
+        Mean wear rate per point [m/cycle].
+    var : ndarray (Nl, Nd)
+        Variance of that mean per point [(m/cycle)²] (sample variance / n); NaN for n = 1.
+    work_rate : float
+        Mean normal work per cycle [N m].
+    volume_rate : float
+        Mean worn-volume rate ``sum(rate * area)`` [m³/cycle].
+    volume_var : float
+        Variance of the mean volume rate [(m³/cycle)²]; NaN for n = 1.
+    rel_noise : float
+        Cycle-to-cycle variability of a single cycle's rate field, relative (area-weighted RMS of
+        the per-point standard deviation over the RMS rate) [1]; NaN for n = 1.
+    n : int
+        Number of single cycles averaged.
+    """
+
+    rate: np.ndarray
+    var: np.ndarray
+    work_rate: float
+    volume_rate: float
+    volume_var: float
+    rel_noise: float
+    n: int
+
+
+def sample_rates(
+    rates: Sequence[np.ndarray], work_rates: Sequence[float], area: np.ndarray
+) -> RateSample:
+    """Average single-cycle wear-rate fields [m/cycle] and measure their scatter.
+
+    Parameters
+    ----------
+    rates : sequence of ndarray (Nl, Nd)
+        The wear rate of each single cycle [m/cycle].
+    work_rates : sequence of float
+        The normal work of each cycle [N m].
+    area : ndarray (Nl, Nd)
+        Bore area of each point [m²] (weights).
+    """
+    stack = np.stack([np.asarray(r, dtype=float) for r in rates])
+    n = stack.shape[0]
+    mean = stack.mean(axis=0)
+    vol = np.array([float(np.sum(r * area)) for r in stack])
+    if n < 2:
+        nan_field = np.full(mean.shape, np.nan)
+        return RateSample(
+            mean, nan_field, float(np.mean(work_rates)), float(vol[0]), math.nan, math.nan, 1
+        )
+    var1 = stack.var(axis=0, ddof=1)  # single-cycle variance per point
+    ref = float(np.sum(area * mean * mean))
+    rel = math.sqrt(float(np.sum(area * var1)) / ref) if ref > 0 else 0.0
+    return RateSample(
+        rate=mean,
+        var=var1 / n,
+        work_rate=float(np.mean(work_rates)),
+        volume_rate=float(vol.mean()),
+        volume_var=float(vol.var(ddof=1)) / n,
+        rel_noise=rel,
+        n=n,
+    )
+
+
+def rate_change(new: np.ndarray, old: np.ndarray, area: np.ndarray) -> float:
+    """``||new - old|| / ||old||`` with the area-weighted L2 norm [1] (inf if old is 0, new not)."""
+    ref = math.sqrt(float(np.sum(area * old * old)))
+    diff = math.sqrt(float(np.sum(area * (new - old) ** 2)))
+    if ref == 0:
+        return 0.0 if diff == 0 else math.inf
+    return diff / ref
+
+
+def change_noise(sigma: float, n_new: int, n_old: int) -> float:
+    """Standard deviation of the relative rate change caused by noise alone [1].
+
+    Two averages of ``n_new`` and ``n_old`` cycles, each cycle with relative variability
+    ``sigma``, differ by noise of relative size ``sigma sqrt(1/n_new + 1/n_old)``. NaN sigma
+    (not measured) counts as 0.
+    """
+    if not np.isfinite(sigma):
+        return 0.0
+    return sigma * math.sqrt(1.0 / n_new + 1.0 / n_old)
+
+
+def systematic_change(eta_raw: float, sigma_eta: float) -> float:
+    """The wear-driven part of a rate change: noise removed in quadrature [1]."""
+    return math.sqrt(max(0.0, eta_raw * eta_raw - sigma_eta * sigma_eta))
+
+
+def effective_tolerance(tol: float, sigma_eta: float) -> float:
+    """What the controller can aim at: ``tol`` or the detection limit, whichever is larger."""
+    return max(tol, DETECTION_SIGMAS * sigma_eta)
+
+
+def cycles_to_average(sigma: float, tol: float, lo: int, hi: int) -> int:
+    """Cycles to average per measurement so that the detection limit is at most ``tol``.
+
+    With ``m`` cycles on both sides of an update the detection limit is
+    ``DETECTION_SIGMAS * sigma * sqrt(2 / m)``; ``m`` is clipped to ``[lo, hi]``.
+    """
+    if not np.isfinite(sigma) or sigma <= 0:
+        return lo
+    m = math.ceil(2.0 * (DETECTION_SIGMAS * sigma / tol) ** 2 - 1e-9)
+    return int(min(hi, max(lo, m)))
+
+
+def next_interval(dn: int, eta: float, tol_eff: float, dn_min: int, dn_max: int) -> int:
+    """The next update interval: ``dN * 0.9 tol_eff / eta``, at most doubled, at least 0.2x."""
+    fac = 2.0 if eta == 0 else min(2.0, max(0.2, 0.9 * tol_eff / eta))
+    return int(min(dn_max, max(dn_min, int(dn * fac))))
+
+
+@dataclass(frozen=True)
+class ErrorBudget:
+    """Accumulated error estimate of the wear-depth field and the worn volume.
+
+    Attributes
+    ----------
+    depth_trunc : ndarray (Nl, Nd)
+        Signed sum of the explicit-Euler local errors ``dN (r_new - r_old) / 2`` [m].
+    depth_var : ndarray (Nl, Nd)
+        Sum of ``dN² var(r_mean)`` over the updates [m²] (NaN once a measurement had n = 1).
+    volume_trunc : float
+        The same for the worn volume [m³].
+    volume_var : float
+        [m⁶].
+    """
+
+    depth_trunc: np.ndarray
+    depth_var: np.ndarray
+    volume_trunc: float
+    volume_var: float
+
+    @classmethod
+    def zero(cls, shape: tuple[int, ...]) -> ErrorBudget:
+        return cls(np.zeros(shape), np.zeros(shape), 0.0, 0.0)
+
+    def add(self, dn: int, old: RateSample, new: RateSample) -> ErrorBudget:
+        """The budget after an accepted update of ``dn`` cycles from ``old`` to ``new``."""
+        return ErrorBudget(
+            self.depth_trunc + dn * (new.rate - old.rate) / 2.0,
+            self.depth_var + float(dn) ** 2 * old.var,
+            self.volume_trunc + dn * (new.volume_rate - old.volume_rate) / 2.0,
+            self.volume_var + float(dn) ** 2 * old.volume_var,
+        )
+
+    def depth_u(self) -> np.ndarray:
+        """Expanded uncertainty (k = :data:`COVERAGE`) of the depth per point [m]."""
+        return COVERAGE * np.sqrt(self.depth_trunc**2 + self.depth_var)
+
+    def volume_u(self) -> float:
+        """Expanded uncertainty (k = :data:`COVERAGE`) of the worn volume [m³]."""
+        return COVERAGE * math.sqrt(self.volume_trunc**2 + self.volume_var)

@@ -1,0 +1,76 @@
+"""Wear runs finish for rigs off the default parameter set (issue 16), at reduced size.
+
+Each rig changes one parameter of the study's mechanism; with the old controller each of them
+stalled with dN collapsing to 1-2 cycles. Reduced size: 6 x 60 grid, kw x 100 and 4000 cycles
+(the study-equivalent 4e5 cycles, since the profile depends on kw N only). Full size (1.2e6
+cycles at 20 x 200) with timings: benchmarks/bench_sim_rigs.py.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from jointwear.errors import ParameterError
+from jointwear.params import replace_nested
+from jointwear.sim import DEFAULT_KW, PARAMETER_SETS, WearSettings, simulate_wear
+
+PARAMS = replace_nested(PARAMETER_SETS["zhang2023"], **{"joint.n_layers": 6, "joint.n_points": 60})
+CYCLES = 4000
+SETTINGS = WearSettings(kw=DEFAULT_KW * 100, tol=0.2, dn=50)
+
+RIGS = {
+    "bearing_radius_8.5mm": {"joint.bearing_radius": 8.5e-3},
+    "60rpm": {"mechanism.crank_speed_rpm": 60.0},
+    "240rpm": {"mechanism.crank_speed_rpm": 240.0},
+    "friction_0": {"friction.static_coefficient": 0.0, "friction.dynamic_coefficient": 0.0},
+    "axial_clearance_2mm": {"joint.axial_clearance": 2e-3},
+    "joint_offset_0": {"mechanism.joint_offset": 0.0},
+}
+
+
+@pytest.mark.parametrize("rig", list(RIGS))
+def test_rig_finishes_with_its_accuracy_stated(rig):
+    ds = simulate_wear(PARAMS, cycles=CYCLES, snapshots=[], settings=SETTINGS, overrides=RIGS[rig])
+    assert ds.attrs["status"] == "complete" and ds.attrs["cycles_done"] == CYCLES
+    # the old controller needed thousands of 1-2 cycle updates here
+    assert ds.attrs["n_updates"] <= 20
+    assert ds.attrs["cycles_simulated"] <= 120
+    assert int(ds["update_dn"].values[ds["update_accepted"].values == 1].max()) >= 500
+    depth, u = float(ds["max_wear_depth"][-1]), float(ds["max_wear_depth_u"][-1])
+    assert depth > 1e-6
+    assert 0 < u < 0.5 * depth
+    assert 0 < float(ds["worn_volume_u"][-1]) < 0.5 * float(ds["worn_volume"][-1])
+    assert ds.attrs["accuracy_status"] in ("reached", "not reached")
+    assert ("accuracy_warning" in ds.attrs) == (ds.attrs["accuracy_status"] == "not reached")
+    for name, units in (("wear_depth_u", "m"), ("max_wear_depth_u", "m"), ("worn_volume_u", "m3")):
+        assert ds[name].attrs["units"] == units
+        assert "expanded uncertainty" in ds[name].attrs["long_name"]
+
+
+def test_overrides_reach_the_simulator():
+    ds = simulate_wear(
+        PARAMS,
+        cycles=100,
+        snapshots=[],
+        settings=WearSettings(kw=DEFAULT_KW, scheme="fixed", dn=100, settle_cycles=0),
+        overrides={"mechanism.joint_offset": 0.004, "wear.kw": 2e-15},
+    )
+    assert ds.attrs["kw_m2_per_N"] == 2e-15
+    with pytest.raises(ParameterError, match="unknown parameter 'joint_ofset'"):
+        simulate_wear(PARAMS, cycles=10, overrides={"mechanism.joint_ofset": 0.0})
+    with pytest.raises(ParameterError, match="unknown wear setting"):
+        simulate_wear(PARAMS, cycles=10, overrides={"wear.kww": 1e-15})
+
+
+def test_halving_tol_moves_the_max_depth_less_than_the_reported_accuracy():
+    out = []
+    for tol in (0.2, 0.1):
+        ds = simulate_wear(
+            PARAMS, cycles=CYCLES, snapshots=[], settings=WearSettings(kw=DEFAULT_KW * 100, tol=tol)
+        )
+        out.append((float(ds["max_wear_depth"][-1]), float(ds["max_wear_depth_u"][-1])))
+    (d1, u1), (d2, u2) = out
+    assert u2 < u1
+    assert abs(d1 - d2) < u1
+    assert abs(d1 - d2) < np.hypot(u1, u2)
