@@ -472,7 +472,7 @@ def test_lost_tracking_is_reinitialised_and_the_speculative_next_frame_redone(sm
     # the pose of frame 1 "fails" once (as when tracking is lost): the body is found again
     # from SIFT features, the next frame (tracked meanwhile from frame 1's matches) is
     # discarded and tracked again, and every pose equals the undisturbed run's
-    import jointwear.dic._footage as footage
+    import jointwear.dic._footage_frames as footage
 
     def run():
         return _track_small(small, max_frames=7)
