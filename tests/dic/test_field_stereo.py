@@ -99,3 +99,34 @@ def test_a_calibration_that_does_not_fit_flags_epipolar_mismatch(scene):
     )
     assert (ds.flag.values[0] == 8).mean() > 0.9
     assert np.nanmedian(ds.reprojection.values) > 3
+
+
+def test_cli_stereo_field_with_patterns_csv_and_figure(scene, tmp_path):
+    import cv2
+
+    from jointwear import io
+    from jointwear.cli import main
+
+    sc, pairs, ds_lib = scene
+    for k, (lft, rgt) in enumerate(pairs[:2]):
+        cv2.imwrite(str(tmp_path / f"spec_{k:04d}_0.png"), lft)
+        cv2.imwrite(str(tmp_path / f"spec_{k:04d}_1.png"), rgt)
+    cal = tmp_path / "cal.nc"
+    sc.calibration.save(cal)
+    x0, y0, x1, y1 = sc.roi_left()
+    out = tmp_path / "f.nc"
+    args = ["dic", "field", "--left", str(tmp_path / "*_0.png"), "--right"]
+    args += [str(tmp_path / "*_1.png"), "--calibration", str(cal)]
+    args += ["--roi", f"{x0},{y0},{x1},{y1}", "--subset", "25", "--step", "12"]
+    args += ["--out", str(out), "--csv", str(tmp_path / "f.csv"), "--plot", str(tmp_path / "f.png")]
+    assert main(args) == 0
+    ds = io.load(out)
+    np.testing.assert_allclose(ds.position.values, ds_lib.position.values, atol=1e-9)
+    assert ds.attrs["data_origin"] == "measured" and "time" not in ds.coords
+    assert list(ds.image_left.values) == ["spec_0000_0.png", "spec_0001_0.png"]
+    assert (tmp_path / "f_0001.csv").is_file() and (tmp_path / "f.png").stat().st_size > 0
+    head = (tmp_path / "f_0001.csv").read_text().splitlines()[0]
+    assert head.startswith("x,y,X [mm],Y [mm],Z [mm],U [mm],V [mm],W [mm]")
+    # usage errors (2) and bad input (3)
+    assert main(["dic", "field", "--left", str(tmp_path / "*_0.png")]) == 2
+    assert main([*args[:6], "--calibration", str(tmp_path / "nope.nc")]) == 3
