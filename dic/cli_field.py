@@ -41,7 +41,8 @@ def _inputs(values: list[str] | None) -> list[Path]:
 
 
 def register(app: typer.Typer) -> None:
-    """Add ``field`` to the ``jointwear dic`` group."""
+    """Add ``field`` and ``import-field`` to the ``jointwear dic`` group."""
+    register_import(app)
 
     @app.command("field")
     def field_cmd(
@@ -183,3 +184,51 @@ def register(app: typer.Typer) -> None:
             save_field_plot(ds, plot)
             msg += f"; figure {plot}"
         typer.echo(msg)
+
+
+def register_import(app: typer.Typer) -> None:
+    """Add ``import-field`` to the ``jointwear dic`` group."""
+
+    @app.command("import-field")
+    def import_field_cmd(
+        files: Annotated[
+            list[str],
+            typer.Argument(help="One file per image (reference first), or a quoted pattern."),
+        ],
+        format: Annotated[
+            str, typer.Option("--format", help="vic3d-csv (VIC-3D CSV export) or dice.")
+        ],
+        origin: Annotated[
+            str, typer.Option("--origin", help="What the images were: measured or synthetic.")
+        ],
+        length_unit: Annotated[
+            str | None,
+            typer.Option("--length-unit", help="Unit of the files' lengths (mm, m, ...; stereo)."),
+        ] = None,
+        fps: Annotated[
+            float | None, typer.Option("--fps", help="Frames per second (omit: still images).")
+        ] = None,
+        out: Annotated[Path, typer.Option("--out", help="Output netCDF file.")] = Path("field.nc"),
+    ) -> None:
+        """Another DIC code's full-field results as a jointwear field dataset."""
+        import numpy as np
+
+        from jointwear._version import __version__
+        from jointwear.dic._field_import import _files, read_field
+        from jointwear.io import check_writable, save
+
+        check_writable(out)
+        paths = _files(files[0] if len(files) == 1 else files)
+        times = np.arange(len(paths)) / fps if fps else None
+        ds = read_field(
+            paths, format=format, length_unit=length_unit, data_origin=origin, times=times
+        )
+        save(
+            ds,
+            out,
+            inputs=paths,
+            parameters={"format": format, "length_unit": length_unit, "fps": fps},
+            source=f"jointwear {__version__} (dic.import-field from {format})",
+        )
+        ok = ds.flag.values[-1] == 0
+        typer.echo(f"{out}: {len(paths)} images, {ok.sum()}/{ok.size} points with data")
