@@ -104,7 +104,7 @@ def speed() -> dict:
                 calibration=sc.calibration,
                 roi=sc.roi_left(),
                 subset_size=41,
-                step=80,
+                step=56,
                 strain_window=3,
             )
             dt = time.perf_counter() - t0
