@@ -1,0 +1,606 @@
+"""Full-field DIC: displacement and shape of a surface over a ROI (2D or stereo).
+
+``measure_field(left, right=None, *, calibration=None, roi=None, ...)`` is what VIC-3D and
+DICe report for a specimen: subsets on a grid over the ROI of the left reference image, each
+matched (affine IC-GN, :mod:`jointwear.dic._subset`) in every image,
+
+* 2D (one camera): in every later left image (absolute reference, guess from the previous
+  image); displacement in pixels;
+* stereo (two cameras and a :class:`~jointwear.dic.StereoCalibration`): the same left reference
+  subsets in the right reference image (initial guess: the affine map that a plane through the
+  cameras' convergence point induces between the two images, then reliability-guided search if
+  that fails), and in every later left and right image; the matched pairs are triangulated into
+  ``position`` (reference shape) and ``displacement`` [m] in the calibration's world frame or in
+  the best-fit-plane frame of the reference surface.
+
+Uncertainty (``displacement_u``): every match carries its standard uncertainty from the IC-GN
+residual (:mod:`jointwear.dic._icgn`; in 2D within 0.75-1.3 of the scatter). The residual mixes
+the noise of the two images it compares in equal parts. In stereo, the left reference image's
+noise shifts the matched positions of one subset in all images alike (the subset tracks a
+slightly different material point) and cancels in ``P_k - P_0``; the other images contribute
+``sigma / sqrt(2)`` each, propagated through the triangulation
+(``cov = (J^T diag(sigma^-2) J)^-1``, J the projection Jacobians) for the right reference
+image (frame 0) and the left and right images of frame k. ``position_u`` propagates the full
+match uncertainty of the reference pair.
+
+Flags (``flag``): the 2D engine's, plus ``epipolar_mismatch`` (the left and right rays miss
+each other by more than ``epipolar_max_px`` RMS reprojection: the right match is on the wrong
+feature, or the calibration does not fit the images) and ``subset_crosses_roi_edge`` (the
+subset is not wholly inside a polygon/mask ROI: it mixes the specimen with what lies beyond).
+A flagged point keeps its row with NaN values.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+from typing import Literal
+
+import numpy as np
+import xarray as xr
+
+from jointwear.dic import _flags
+from jointwear.errors import BadInputError, ParameterError
+
+__all__ = ["FieldParams", "measure_field", "FIELD_FLAG_MEANINGS"]
+
+FLAG_EPIPOLAR = 8
+FLAG_ROI_EDGE = 9
+FIELD_FLAG_MEANINGS = _flags.FLAG_MEANINGS + " epipolar_mismatch subset_crosses_roi_edge"
+
+
+@dataclass(frozen=True)
+class FieldParams:
+    """Options of :func:`measure_field`.
+
+    Parameters
+    ----------
+    subset_size : int
+        Subset side [pixel], odd.
+    step : int
+        Grid spacing of the subset centres [pixel].
+    strain_window : int
+        Side of the strain fit window [grid points], odd >= 3 (0: no strain).
+    frame : {"world", "plane"}
+        Stereo output frame: the calibration's world frame, or the best-fit plane of the
+        reference surface (origin at its centroid, z its normal towards the cameras, x the
+        world x axis projected onto it).
+    zncc_min : float
+        Matches below this ZNCC are flagged.
+    epipolar_max_px : float
+        Largest RMS reprojection residual of a triangulated pair [pixel] before the point is
+        flagged ``epipolar_mismatch``.
+    interpolation, tolerance, max_iterations, search_radius, threads
+        As :class:`jointwear.dic.CorrelationParams`.
+    """
+
+    subset_size: int = 31
+    step: int = 10
+    strain_window: int = 5
+    frame: Literal["world", "plane"] = "world"
+    zncc_min: float = 0.8
+    epipolar_max_px: float = 1.0
+    interpolation: Literal["cubic", "quintic"] = "quintic"
+    tolerance: float = 1e-3
+    max_iterations: int = 40
+    search_radius: int = 48
+    threads: int = 0
+
+    def __post_init__(self) -> None:
+        w = self.strain_window
+        if not isinstance(w, (int, np.integer)) or (w != 0 and (w < 3 or w % 2 == 0)):
+            raise ParameterError(
+                f"strain_window={w!r}: expected an odd number of grid points >= 3 (0: no strain)"
+            )
+        if self.frame not in ("world", "plane"):
+            raise ParameterError(
+                f"frame={self.frame!r}: expected 'world' (calibration) or 'plane' (best fit)"
+            )
+        if not self.epipolar_max_px > 0:
+            raise ParameterError(f"epipolar_max_px={self.epipolar_max_px!r}: expected > 0 pixel")
+
+    def correlation(self):
+        from jointwear.dic._subset import CorrelationParams
+
+        return CorrelationParams(
+            subset_size=self.subset_size,
+            step=self.step,
+            interpolation=self.interpolation,
+            tolerance=self.tolerance,
+            max_iterations=self.max_iterations,
+            zncc_min=self.zncc_min,
+            search_radius=self.search_radius,
+            threads=self.threads,
+        )
+
+
+def _frames(source, what: str) -> tuple[list[np.ndarray], list[str]]:
+    """Images of one camera (first = reference) and their names."""
+    from pathlib import Path
+
+    from jointwear.dic._sequence import read_frames, read_image
+    from jointwear.dic._subset import check_image
+
+    if isinstance(source, np.ndarray) and source.ndim == 2:
+        return [check_image(source, f"{what} image 0")], ["0"]
+    if isinstance(source, (str, Path)):
+        from jointwear.dic._video import is_image_sequence, list_image_sequence
+
+        if is_image_sequence(source):
+            files, _ = list_image_sequence(source, what=f"{what} images")
+            frames, _ = read_frames(source)
+            return frames, [f.name for f in files]
+        return [read_image(source)], [Path(source).name]
+    if isinstance(source, (list, tuple)):
+        out, names = [], []
+        for k, item in enumerate(source):
+            if isinstance(item, (str, Path)):
+                out.append(read_image(item))
+                names.append(Path(item).name)
+            else:
+                out.append(check_image(item, f"{what} image {k}"))
+                names.append(str(k))
+        return out, names
+    frames, _ = read_frames(source)
+    return frames, [str(k) for k in range(len(frames))]
+
+
+def _track(corr, img, guess, search_centre=(0.0, 0.0)):
+    """Match ``img`` from per-point guesses; search afresh from seeds if most fail."""
+    res = corr.match(img, initial_guess=guess)
+    if res.ok.mean() < 0.5:
+        res2 = corr.match(img, search_centre=search_centre)
+        if res2.ok.sum() > res.ok.sum():
+            res = res2
+    return res
+
+
+def plane_guess(calibration, centres: np.ndarray) -> np.ndarray:
+    """Affine guesses (N, 6) of the left-to-right image map that a plane through the cameras'
+    convergence point (normal: the mean viewing direction) induces, at each left centre."""
+    L, R = calibration.left, calibration.right
+    cl, cr = L.centre, R.centre
+    dl, dr = L.rotation[2], R.rotation[2]  # optical axes in the world frame
+    # closest points of the two optical axes
+    w0 = cl - cr
+    a, b, c = dl @ dl, dl @ dr, dr @ dr
+    d, e = dl @ w0, dr @ w0
+    den = a * c - b * b
+    s = (b * e - c * d) / den if abs(den) > 1e-12 else 1.0
+    t = (a * e - b * d) / den if abs(den) > 1e-12 else 1.0
+    p0 = 0.5 * (cl + s * dl + cr + t * dr)
+    nrm = dl + dr
+    nrm /= np.linalg.norm(nrm)
+
+    def to_right(uv):
+        ray = L.rays(uv)
+        lam = ((p0 - cl) @ nrm) / (ray @ nrm)
+        return R.project(cl + lam[:, None] * ray)
+
+    h = 1.0
+    x0 = to_right(centres)
+    gx = (to_right(centres + [h, 0.0]) - to_right(centres - [h, 0.0])) / (2 * h)
+    gy = (to_right(centres + [0.0, h]) - to_right(centres - [0.0, h])) / (2 * h)
+    G = np.empty((len(centres), 6))
+    G[:, 0] = x0[:, 0] - centres[:, 0]
+    G[:, 1] = gx[:, 0] - 1.0
+    G[:, 2] = gy[:, 0]
+    G[:, 3] = x0[:, 1] - centres[:, 1]
+    G[:, 4] = gx[:, 1]
+    G[:, 5] = gy[:, 1] - 1.0
+    return G
+
+
+def _point_cov(calibration, X, sl, sr):
+    """Covariance (N, 3, 3) of triangulated points X (N, 3) from per-image standard
+    uncertainties ``sl``, ``sr`` (N, 2) [pixel] (undistorted-pixel Jacobians)."""
+    from jointwear.dic._stereo import _project_undistorted
+
+    out = np.full((len(X), 3, 3), np.nan)
+    ok = np.isfinite(X).all(axis=1) & np.isfinite(sl).all(axis=1) & np.isfinite(sr).all(axis=1)
+    if not ok.any():
+        return out
+    _, Jl = _project_undistorted(calibration.left, X[ok])
+    _, Jr = _project_undistorted(calibration.right, X[ok])
+    J = np.concatenate([Jl, Jr], axis=1)  # (n, 4, 3)
+    w = 1.0 / np.maximum(np.concatenate([sl[ok], sr[ok]], axis=1), 1e-6) ** 2
+    A = np.einsum("nki,nk,nkj->nij", J, w, J)
+    out[ok] = np.linalg.inv(A)
+    return out
+
+
+def best_fit_plane(P: np.ndarray, towards: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Rotation (3, 3) (rows: plane x, y, z in world coordinates) and origin (3,) [m] of the
+    least-squares plane of the points P (N, 3); z points to the side of ``towards``."""
+    Q = P[np.isfinite(P).all(axis=1)]
+    if len(Q) < 3:
+        raise BadInputError(
+            "best-fit-plane frame: fewer than 3 points were measured in the reference pair"
+        )
+    o = Q.mean(axis=0)
+    _, _, vt = np.linalg.svd(Q - o, full_matrices=False)
+    z = vt[2] * (1.0 if vt[2] @ (towards - o) > 0 else -1.0)
+    ref = np.array([1.0, 0, 0]) if abs(z[0]) < 0.9 else np.array([0, 1.0, 0])
+    x = ref - z * (ref @ z)
+    x /= np.linalg.norm(x)
+    return np.stack([x, np.cross(z, x), z]), o
+
+
+def measure_field(
+    left,
+    right=None,
+    *,
+    calibration=None,
+    roi=None,
+    times=None,
+    frame_rate: float | None = None,
+    data_origin: str = "measured",
+    params: FieldParams | None = None,
+    **options,
+) -> xr.Dataset:
+    """Displacement (and shape) of a surface over a ROI, 2D or stereo (see module docstring).
+
+    Parameters
+    ----------
+    left : image, list of images/paths, folder, pattern or 3D array
+        The (left) camera's images; the first is the reference.
+    right : same as ``left``, optional
+        The right camera's images, one per left image (stereo).
+    calibration : StereoCalibration or path, optional
+        Required with ``right``: the cameras' calibration (a jointwear calibration file or a
+        :class:`~jointwear.dic.StereoCalibration`).
+    roi : optional
+        Rectangle ``(x0, y0, x1, y1)`` [pixel], polygon TOML, mask image or array (see
+        :func:`jointwear.dic._field_roi.read_roi`); default the whole image.
+    times : sequence of float, optional
+        Time of every image [s]; or ``frame_rate`` [1/s]. Without either (still images), the
+        ``time`` dimension has no time coordinate, only the image index.
+    data_origin : {"measured", "synthetic"}
+        What the images are.
+    params : FieldParams, optional
+        Options; keyword arguments override its fields.
+
+    Returns
+    -------
+    Dataset
+        Over ``point`` (and ``time``, ``axis``): ``displacement`` [m, or pixel in 2D] with
+        ``displacement_u``; stereo ``position`` [m] with ``position_u`` and ``reprojection``
+        [pixel]; ``subset_x``/``subset_y`` [pixel] the subset centre in every image
+        (``camera``); ``zncc`` (lowest of the point's matches), ``flag``; ``strain`` and
+        ``strain_engineering`` [1] (``component`` xx, yy, xy) with ``strain_u``; coordinates
+        ``x``, ``y`` [pixel] (left reference image) and the grid ``row``/``col``.
+    """
+    from jointwear.dic._field_roi import grid_points, read_roi
+    from jointwear.dic._subset import SubsetCorrelator, check_pair
+
+    base = params or FieldParams()
+    if options:
+        unknown = sorted(set(options) - set(asdict(base)))
+        if unknown:
+            raise ParameterError(
+                f"unknown field option(s) {', '.join(unknown)}; known: "
+                f"{', '.join(sorted(asdict(base)))}"
+            )
+        base = FieldParams(**{**asdict(base), **options})
+    prm = base
+    if data_origin not in ("measured", "synthetic"):
+        raise ParameterError(f"data_origin={data_origin!r}: expected 'measured' or 'synthetic'")
+    stereo = right is not None
+    if stereo and calibration is None:
+        raise BadInputError(
+            "stereo field: right images given without a calibration; pass calibration= "
+            "(--calibration FILE)"
+        )
+    if calibration is not None and not stereo:
+        raise BadInputError(
+            "a calibration was given but no right images: give the right camera's images "
+            "(--right) for a stereo field, or drop the calibration for a 2D field"
+        )
+    if stereo and not hasattr(calibration, "left"):
+        from jointwear.dic._calib import read_calibration
+
+        calibration = read_calibration(calibration)
+    L, lnames = _frames(left, "left" if stereo else "")
+    Rr, rnames = _frames(right, "right") if stereo else ([], [])
+    n_t = len(L)
+    if stereo and len(Rr) != n_t:
+        raise BadInputError(
+            f"stereo field: {n_t} left images but {len(Rr)} right images; give one right image "
+            "per left image (same order)"
+        )
+    if not stereo and n_t < 2:
+        raise BadInputError("2D field: need a reference and at least one deformed image")
+    for k in range(1, n_t):
+        check_pair(L[0], L[k], what=f"left image {k} ('{lnames[k]}')")
+    for k in range(n_t if stereo else 0):
+        check_pair(L[0], Rr[k], what=f"right image {k} ('{rnames[k]}')")
+    if stereo:
+        w, h = calibration.left.image_size
+        if (w, h) != (L[0].shape[1], L[0].shape[0]):
+            raise BadInputError(
+                f"calibration: the left camera was calibrated for {w}x{h} images, the images "
+                f"are {L[0].shape[1]}x{L[0].shape[0]}; use the calibration of these cameras"
+            )
+    t = None
+    if times is not None:
+        t = np.asarray(times, float)
+        if t.shape != (n_t,) or not np.isfinite(t).all() or np.any(np.diff(t) <= 0):
+            raise BadInputError(f"times: expected {n_t} finite, increasing values [s]")
+    elif frame_rate is not None:
+        if not frame_rate > 0:
+            raise ParameterError(f"frame_rate={frame_rate!r}: expected > 0 frames per second")
+        t = np.arange(n_t) / float(frame_rate)
+
+    mask, roi_text = read_roi(roi, L[0].shape)
+    cp = prm.correlation()
+    grid = grid_points(mask, cp.subset_size, cp.step, cp.border)
+    corr = SubsetCorrelator(L[0], points=grid.centres, params=cp)
+    n = corr.n_points
+    cams = ["left", "right"] if stereo else ["left"]
+    PL = np.full((n_t, n, 12), np.nan)
+    PR = np.full((n_t, n, 12), np.nan)
+    SL = np.full((n_t, n, 2), np.nan)
+    SR = np.full((n_t, n, 2), np.nan)
+    Z = np.full((n_t, len(cams), n), np.nan)
+    F = np.full((n_t, len(cams), n), _flags.FLAG_NOT_REACHED, np.int8)
+    PL[0] = 0.0
+    SL[0] = 0.0
+    Z[0, 0] = 1.0
+    F[0, 0] = np.where(corr._texture_and_usable()[1], _flags.FLAG_OK, _flags.FLAG_NO_TEXTURE)
+    for k in range(1 if not stereo else 0, n_t):
+        if k > 0:
+            g = np.where(np.isfinite(PL[k - 1]).all(axis=1)[:, None], PL[k - 1], np.nan)
+            res = _track(corr, L[k], g)
+            PL[k], SL[k], Z[k, 0], F[k, 0] = res.params, res.sigma, res.zncc, res.flag
+        if stereo:
+            if k == 0:
+                G = plane_guess(calibration, grid.centres)
+                centre = (float(np.median(G[:, 0])), float(np.median(G[:, 3])))
+                res = _track(corr, Rr[0], G, centre)
+            else:
+                g = np.where(np.isfinite(PR[k - 1]).all(axis=1)[:, None], PR[k - 1], np.nan)
+                centre = (
+                    float(np.nanmedian(PR[k - 1, :, 0])),
+                    float(np.nanmedian(PR[k - 1, :, 6])),
+                )
+                res = _track(corr, Rr[k], g, centre)
+            PR[k], SR[k], Z[k, 1], F[k, 1] = res.params, res.sigma, res.zncc, res.flag
+    ok_img = F == _flags.FLAG_OK
+    PL[~ok_img[:, 0]] = np.nan
+    SL[~ok_img[:, 0]] = np.nan
+    if stereo:
+        PR[~ok_img[:, 1]] = np.nan
+        SR[~ok_img[:, 1]] = np.nan
+    c = grid.centres
+    sub_x = np.stack([c[:, 0] + PL[..., 0]] + ([c[:, 0] + PR[..., 0]] if stereo else []), axis=1)
+    sub_y = np.stack([c[:, 1] + PL[..., 6]] + ([c[:, 1] + PR[..., 6]] if stereo else []), axis=1)
+    # one flag per (time, point): the first failing match, else the field's own checks
+    flag = np.full((n_t, n), _flags.FLAG_OK, np.int8)
+    for j in range(len(cams)):
+        bad = (flag == _flags.FLAG_OK) & (F[:, j] != _flags.FLAG_OK)
+        flag[bad] = F[:, j][bad]
+    if stereo:
+        bad0 = F[0, 1] != _flags.FLAG_OK  # no right reference match: no position
+        flag[:, bad0 & (flag[0] == _flags.FLAG_OK)] = F[0, 1][bad0 & (flag[0] == _flags.FLAG_OK)]
+    flag[:, ~grid.complete] = np.where(
+        flag[:, ~grid.complete] == _flags.FLAG_OK, FLAG_ROI_EDGE, flag[:, ~grid.complete]
+    )
+    zncc = np.nanmin(np.where(np.isfinite(Z), Z, np.nan), axis=1) if stereo else Z[:, 0]
+
+    coords = {
+        "point": ("point", np.arange(n), {"long_name": "measurement point (subset)"}),
+        "x": (
+            "point",
+            c[:, 0],
+            {"units": "pixel", "long_name": "subset centre column, left reference image"},
+        ),
+        "y": (
+            "point",
+            c[:, 1],
+            {"units": "pixel", "long_name": "subset centre row, left reference image"},
+        ),
+        "row": ("point", grid.index[:, 0], {"long_name": "grid row of the point"}),
+        "col": ("point", grid.index[:, 1], {"long_name": "grid column of the point"}),
+        "camera": ("camera", cams, {"long_name": "camera"}),
+        "image": ("time", np.arange(n_t), {"long_name": "image index (0 = reference)"}),
+        "image_left": ("time", lnames, {"long_name": "left (or only) camera image"}),
+    }
+    if stereo:
+        coords["image_right"] = ("time", rnames, {"long_name": "right camera image"})
+    if t is not None:
+        coords["time"] = ("time", t, {"units": "s", "long_name": "time of the image"})
+    data: dict[str, xr.DataArray] = {}
+    attrs: dict = {}
+    if not stereo:
+        axes = ["x", "y"]
+        disp = np.stack([PL[..., 0], PL[..., 6]], axis=-1)
+        disp_u = SL.copy()
+        ref_pos = c.copy()
+        unit = "pixel"
+        attrs["field_frame"] = "left image: x to the right (columns), y down (rows), pixel"
+    else:
+        axes = ["x", "y", "z"]
+        from jointwear.dic._stereo import triangulate
+
+        X = np.full((n_t, n, 3), np.nan)
+        rep = np.full((n_t, n), np.nan)
+        for k in range(n_t):
+            uvl = np.stack([sub_x[k, 0], sub_y[k, 0]], axis=1)
+            uvr = np.stack([sub_x[k, 1], sub_y[k, 1]], axis=1)
+            X[k], _, rep[k] = triangulate(calibration, uvl, uvr)
+        far = (rep > prm.epipolar_max_px) & (flag == _flags.FLAG_OK)
+        flag[far] = FLAG_EPIPOLAR
+        flag[:, flag[0] != _flags.FLAG_OK] = np.where(
+            flag[:, flag[0] != _flags.FLAG_OK] == _flags.FLAG_OK,
+            flag[0][flag[0] != _flags.FLAG_OK],
+            flag[:, flag[0] != _flags.FLAG_OK],
+        )
+        ref_pos = X[0]
+        tiny = np.full((n, 2), 1e-6)
+        cov_pos = _point_cov(calibration, X[0], SR[0], SR[0])
+        cov0 = _point_cov(calibration, X[0], tiny, SR[0] / np.sqrt(2))
+        disp = X - X[0][None]
+        cov_d = np.full((n_t, n, 3, 3), np.nan)
+        cov_d[0] = 0.0
+        for k in range(1, n_t):
+            cov_d[k] = _point_cov(calibration, X[k], SL[k] / np.sqrt(2), SR[k] / np.sqrt(2)) + cov0
+        Rf, of = np.eye(3), np.zeros(3)
+        if prm.frame == "plane":
+            Rf, of = best_fit_plane(X[0][flag[0] == _flags.FLAG_OK], calibration.left.centre)
+            attrs["field_frame"] = (
+                "best-fit plane of the reference surface: origin at the centroid of the "
+                "measured points, z its normal towards the cameras, x the world x axis "
+                "projected onto it; world = frame_rotation^T (p) + frame_origin"
+            )
+        else:
+            attrs["field_frame"] = f"calibration world frame: {calibration.world_frame}"
+        ref_pos = (ref_pos - of) @ Rf.T
+        disp = disp @ Rf.T
+        cov_d = Rf @ cov_d @ Rf.T
+        cov_pos = Rf @ cov_pos @ Rf.T
+        disp_u = np.sqrt(np.maximum(np.diagonal(cov_d, axis1=-2, axis2=-1), 0.0))
+        pos_u = np.sqrt(np.maximum(np.diagonal(cov_pos, axis1=-2, axis2=-1), 0.0))
+        unit = "m"
+        okp = flag[0] == _flags.FLAG_OK
+        data["position"] = xr.DataArray(
+            np.where(okp[:, None], ref_pos, np.nan),
+            dims=("point", "axis"),
+            attrs={
+                "units": "m",
+                "long_name": "reference position of the point (surface shape)",
+                "ancillary_variables": "position_u",
+            },
+        )
+        data["position_u"] = xr.DataArray(
+            np.where(okp[:, None], pos_u, np.nan),
+            dims=("point", "axis"),
+            attrs={"units": "m", "long_name": "standard uncertainty of position (image noise)"},
+        )
+        data["reprojection"] = xr.DataArray(
+            rep,
+            dims=("time", "point"),
+            attrs={
+                "units": "pixel",
+                "long_name": "RMS reprojection residual of the triangulated pair",
+            },
+        )
+        data["frame_rotation"] = xr.DataArray(
+            Rf,
+            dims=("axis", "axis_world"),
+            attrs={"units": "1", "long_name": "rows: output frame axes in world coordinates"},
+        )
+        data["frame_origin"] = xr.DataArray(
+            of, dims="axis_world", attrs={"units": "m", "long_name": "output frame origin (world)"}
+        )
+        coords["axis_world"] = ("axis_world", ["x", "y", "z"], {"long_name": "world axis"})
+    ok = flag == _flags.FLAG_OK
+    disp = np.where(ok[..., None], disp, np.nan)
+    disp_u = np.where(ok[..., None], disp_u, np.nan)
+    coords["axis"] = ("axis", axes, {"long_name": "vector component"})
+    data["displacement"] = xr.DataArray(
+        disp,
+        dims=("time", "point", "axis"),
+        attrs={
+            "units": unit,
+            "long_name": "displacement of the point from the reference image",
+            "ancillary_variables": "displacement_u zncc flag",
+        },
+    )
+    data["displacement_u"] = xr.DataArray(
+        disp_u,
+        dims=("time", "point", "axis"),
+        attrs={
+            "units": unit,
+            "long_name": "standard uncertainty of displacement (image noise through the "
+            "matches and the triangulation; excludes calibration and interpolation bias)",
+        },
+    )
+    data["subset_x"] = xr.DataArray(
+        np.where(ok[:, None, :], sub_x, np.nan),
+        dims=("time", "camera", "point"),
+        attrs={"units": "pixel", "long_name": "subset centre column in the image"},
+    )
+    data["subset_y"] = xr.DataArray(
+        np.where(ok[:, None, :], sub_y, np.nan),
+        dims=("time", "camera", "point"),
+        attrs={"units": "pixel", "long_name": "subset centre row in the image"},
+    )
+    data["zncc"] = xr.DataArray(
+        zncc,
+        dims=("time", "point"),
+        attrs={"units": "1", "long_name": "lowest ZNCC of the point's matches"},
+    )
+    data["flag"] = xr.DataArray(
+        flag,
+        dims=("time", "point"),
+        attrs={
+            "units": "1",
+            "long_name": "field quality flag",
+            "flag_values": np.arange(10, dtype=np.int8),
+            "flag_meanings": FIELD_FLAG_MEANINGS,
+        },
+    )
+    if prm.strain_window:
+        from jointwear.dic._strain import engineering_strain, surface_strain
+
+        inplane = np.sqrt(np.mean(disp_u[..., :2] ** 2, axis=-1))
+        E, Eu, _ = surface_strain(
+            np.where(ok[0][:, None], ref_pos, np.nan), ref_pos[None] + disp, inplane,
+            grid.index, prm.strain_window, c, cp.subset_size,
+        )  # fmt: skip
+        comp = {"component": ("component", ["xx", "yy", "xy"], {"long_name": "tensor component"})}
+        coords.update(comp)
+        span = (prm.strain_window - 1) * cp.step
+        note = (
+            f"local linear fit of the deformed positions over {prm.strain_window}x"
+            f"{prm.strain_window} grid points ({span} pixel in the left reference image), in "
+            "the local tangent basis of the reference surface (t1 = frame x projected)"
+        )
+        data["strain"] = xr.DataArray(
+            E,
+            dims=("time", "point", "component"),
+            attrs={
+                "units": "1",
+                "long_name": "Green-Lagrange surface strain (xy: tensor shear)",
+                "strain_window": note,
+                "ancillary_variables": "strain_u",
+            },
+        )
+        data["strain_u"] = xr.DataArray(
+            Eu,
+            dims=("time", "point", "component"),
+            attrs={
+                "units": "1",
+                "long_name": "standard uncertainty of strain (displacement noise through the fit)",
+            },
+        )
+        data["strain_engineering"] = xr.DataArray(
+            engineering_strain(E),
+            dims=("time", "point", "component"),
+            attrs={
+                "units": "1",
+                "long_name": "engineering strain: stretch - 1 (xx, yy), change of the right "
+                "angle in rad (xy)",
+            },
+        )
+    ds = xr.Dataset(data, coords=coords)
+    ds.attrs.update(attrs)
+    ds.attrs.update(
+        {
+            "title": ("stereo" if stereo else "2D") + " DIC displacement field",
+            "data_origin": data_origin,
+            "dic_roi": roi_text,
+            "dic_subset_size_pixel": int(cp.subset_size),
+            "dic_step_pixel": int(cp.step),
+            "dic_shape_function": "affine",
+            "dic_interpolation": f"{cp.interpolation} B-spline (prefiltered)",
+            "dic_criterion": "ZNSSD (IC-GN), image gradients by central differences",
+            "dic_reference": "absolute (image 0), guesses from the previous image",
+            "displacement_convention": "Lagrangian: the point at position moved by displacement",
+        }
+    )
+    if t is None:
+        ds.attrs["time_note"] = "still images: no time base; 'image' indexes the time dimension"
+    if stereo:
+        ds.attrs["calibration_source"] = calibration.source
+        ds.attrs["dic_epipolar_max_pixel"] = float(prm.epipolar_max_px)
+    return ds

@@ -1,0 +1,132 @@
+"""Stereo ``measure_field`` on the virtual rig's cameras looking at a surface of known shape
+(a 4 mm Gaussian bump) that then moves in-plane and bulges out of plane by a known field."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from jointwear.datasets.surface import SurfaceMotion, SurfaceScene
+from jointwear.dic import measure_field
+from jointwear.errors import BadInputError
+
+
+def _bump(a):
+    return lambda x, y: a * np.exp(-((x - 0.29) ** 2 + (y - 0.16) ** 2) / 0.03**2)
+
+
+MOTION = SurfaceMotion(u0=0.5e-3, v0=-0.3e-3, w=_bump(0.2e-3))
+
+
+@pytest.fixture(scope="module")
+def scene():
+    sc = SurfaceScene(_bump(0.004))
+    pairs = [sc.pair(noise_seed=k) for k in range(3)] + [sc.pair(MOTION, noise_seed=3)]
+    ds = measure_field(
+        [p[0] for p in pairs],
+        [p[1] for p in pairs],
+        calibration=sc.calibration,
+        roi=sc.roi_left(),
+        subset_size=25,
+        step=12,
+        data_origin="synthetic",
+    )
+    return sc, pairs, ds
+
+
+def test_zero_motion_scatter_matches_reported_uncertainty_and_the_noise_floor(scene):
+    sc, _, ds = scene
+    ok = (ds.flag.values == 0).all(axis=0)
+    assert ok.mean() > 0.95
+    d = ds.displacement.values[1:3][:, ok].reshape(-1, 3)
+    du = ds.displacement_u.values[1:3][:, ok].reshape(-1, 3)
+    for i in range(3):
+        ratio = np.sqrt(np.mean(du[:, i] ** 2)) / d[:, i].std()
+        assert 0.7 < ratio < 1.3, (i, ratio)
+    assert d[:, 2].std() < 10e-6  # a few micrometres at 1 m with 0.31 mm pixels
+
+
+def test_shape_and_out_of_plane_field_recovered(scene):
+    sc, _, ds = scene
+    ok = ds.flag.values[3] == 0
+    assert ok.mean() > 0.95
+    P = ds.position.values[ok]
+    z_err = P[:, 2] - sc.shape(P[:, 0], P[:, 1])
+    assert np.sqrt(np.mean(z_err**2)) < 30e-6  # 4 mm bump, 7.8 mm subsets: curvature bias
+    truth = MOTION.displacement(P[:, 0], P[:, 1])
+    err = ds.displacement.values[3][ok] - truth
+    assert np.abs(err.mean(axis=0)).max() < 2e-6
+    assert np.sqrt(np.mean(err[:, 2] ** 2)) < 10e-6
+    # the 0.2 mm bulge is seen: centre minus rim
+    w = ds.displacement.values[3][ok, 2]
+    r = np.hypot(P[:, 0] - 0.29, P[:, 1] - 0.16)
+    assert np.median(w[r < 0.01]) - np.median(w[r > 0.045]) > 0.12e-3
+    # subset centres in both images at every image; right differs (disparity)
+    assert np.isfinite(ds.subset_x.values[3, 1][ok]).all()
+    assert np.abs(ds.subset_x.values[0, 1] - ds.subset_x.values[0, 0])[ok].min() > 5
+
+
+def test_best_fit_plane_frame_and_refusals(scene):
+    sc, pairs, _ = scene
+    tilted = SurfaceScene(lambda x, y: 0.15 * (x - 0.29) - 0.1 * (y - 0.16))
+    p0, p1 = tilted.pair(noise_seed=0), tilted.pair(noise_seed=1)
+    ds = measure_field(
+        [p0[0], p1[0]], [p0[1], p1[1]], calibration=tilted.calibration,
+        roi=tilted.roi_left(), subset_size=25, step=16, frame="plane",
+    )  # fmt: skip
+    ok = ds.flag.values[1] == 0
+    assert np.sqrt(np.mean(ds.position.values[ok, 2] ** 2)) < 10e-6  # flat in its own plane
+    R = ds.frame_rotation.values
+    n = np.array([-0.15, 0.1, 1.0]) / np.linalg.norm([-0.15, 0.1, 1.0])
+    assert abs(R[2] @ n) > 0.9999
+    with pytest.raises(BadInputError, match="without a calibration"):
+        measure_field([pairs[0][0]], [pairs[0][1]])
+    with pytest.raises(BadInputError, match="2 left images but 1 right"):
+        measure_field([p0[0], p1[0]], [p0[1]], calibration=tilted.calibration)
+
+
+def test_a_calibration_that_does_not_fit_flags_epipolar_mismatch(scene):
+    from jointwear.dic import Camera, StereoCalibration
+
+    sc, pairs, _ = scene
+    R = sc.calibration.right
+    shifted = Camera(
+        R.matrix, R.distortion, R.rotation, R.translation + [0, 0.006, 0], R.image_size
+    )
+    bad = StereoCalibration(sc.calibration.left, shifted, source="shifted")
+    ds = measure_field(
+        [pairs[0][0]], [pairs[0][1]], calibration=bad, roi=sc.roi_left(), subset_size=25, step=24
+    )
+    assert (ds.flag.values[0] == 8).mean() > 0.9
+    assert np.nanmedian(ds.reprojection.values) > 3
+
+
+def test_cli_stereo_field_with_patterns_csv_and_figure(scene, tmp_path):
+    import cv2
+
+    from jointwear import io
+    from jointwear.cli import main
+
+    sc, pairs, ds_lib = scene
+    for k, (lft, rgt) in enumerate(pairs[:2]):
+        cv2.imwrite(str(tmp_path / f"spec_{k:04d}_0.png"), lft)
+        cv2.imwrite(str(tmp_path / f"spec_{k:04d}_1.png"), rgt)
+    cal = tmp_path / "cal.nc"
+    sc.calibration.save(cal)
+    x0, y0, x1, y1 = sc.roi_left()
+    out = tmp_path / "f.nc"
+    args = ["dic", "field", "--left", str(tmp_path / "*_0.png"), "--right"]
+    args += [str(tmp_path / "*_1.png"), "--calibration", str(cal)]
+    args += ["--roi", f"{x0},{y0},{x1},{y1}", "--subset", "25", "--step", "12"]
+    args += ["--out", str(out), "--csv", str(tmp_path / "f.csv"), "--plot", str(tmp_path / "f.png")]
+    assert main(args) == 0
+    ds = io.load(out)
+    np.testing.assert_allclose(ds.position.values, ds_lib.position.values, atol=1e-9)
+    assert ds.attrs["data_origin"] == "measured" and "time" not in ds.coords
+    assert list(ds.image_left.values) == ["spec_0000_0.png", "spec_0001_0.png"]
+    assert (tmp_path / "f_0001.csv").is_file() and (tmp_path / "f.png").stat().st_size > 0
+    head = (tmp_path / "f_0001.csv").read_text().splitlines()[0]
+    assert head.startswith("x,y,X [mm],Y [mm],Z [mm],U [mm],V [mm],W [mm]")
+    # usage errors (2) and bad input (3)
+    assert main(["dic", "field", "--left", str(tmp_path / "*_0.png")]) == 2
+    assert main([*args[:6], "--calibration", str(tmp_path / "nope.nc")]) == 3
