@@ -27,7 +27,10 @@ BAUM, DPHI = 32, 33
 NP = 34
 # ---- integer parameters (IP) ------------------------------------------------------------------
 DRIVER, ON_COUPLER, IDEAL, PER_POINT, KVARY, KDEN_WORN, NL, ND = 0, 1, 2, 3, 4, 5, 6, 7
-NIP = 8
+WPROJ = 8  # wear projection of the slice formulation: 0 local, 1 lumped, 2 local_conserving
+LATCH = 9  # impact velocity latched 0 once per impact and contact region, 1 per layer
+NIP = 10
+WPROJ_LOCAL, WPROJ_LUMPED, WPROJ_CONSERVING = 0, 1, 2
 # ---- diagnostics row (recorded at output times) ----------------------------------------------
 D_TH1 = 0
 D_CRANK_POS, D_CRANK_VEL = 1, 4
@@ -403,6 +406,8 @@ def _slices(J0, u, V0, W, ctx, wrench, acc, hstep):
     two = False
     have0 = False
     f0x, f0y, f0z = 0.0, 0.0, 0.0
+    proj = IP[WPROJ]
+    wsc = np.empty((Nl if (acc and proj == WPROJ_CONSERVING) else 0, 3))
     for n in range(Nl):
         if fel[n] <= 0.0 or reach[n] != 2.0:
             son[n] = 0
@@ -434,7 +439,13 @@ def _slices(J0, u, V0, W, ctx, wrench, acc, hstep):
         srate[n] = rate
         son[n] = 1
         if acc:
-            _spread(n, sm[n], fn, vt, hstep, J0, u, P, H, ZL, Nd, AREA, WW)
+            fw = _wear_force(n, fn, sd, kk, fel, proj, P)
+            if proj == WPROJ_CONSERVING:  # spread below, once each region's work is known
+                wsc[n, 0] = fn * vt
+                wsc[n, 1] = fw * vt
+                wsc[n, 2] = vt
+            elif fw > 0.0:
+                _spread(n, sm[n], fw, vt, hstep, J0, u, P, H, ZL, Nd, AREA, WW)
             acc_out[0] += fn * vt * hstep
             acc_out[2] += fn * hstep
         nslice += 1
@@ -446,7 +457,62 @@ def _slices(J0, u, V0, W, ctx, wrench, acc, hstep):
             have0 = True
         elif f0x * hx + f0y * hy + f0z * hz < 0.0:
             two = True
+    if acc and proj == WPROJ_CONSERVING:
+        _spread_regions(wsc, sm, son, hstep, J0, u, P, H, ZL, Nd, AREA, WW)
     return energy, fnsum, pen, kdeep, nslice, two, clen
+
+
+@njit(cache=True)
+def _wear_force(n, fn, sd, kk, fel, proj, P):
+    """Force of layer n whose pressure, spread over the layer's slice area, gives its wear work.
+
+    ``fn`` is the layer's (damped) share of the contact force, the derivative of the
+    integrated law: hat-weighted over the two neighbouring intervals. Spreading it over the
+    slice area (``lumped``) averages the pressure over the slice, so a contact shorter than
+    the slice (at the bearing's edges) is diluted by the grid. ``local`` takes the pressure
+    from the penetration at the layer itself, the line load K delta_n^n / wb (same L-N factor),
+    so the wear work is a point value that does not depend on the slice width;
+    ``local_conserving`` scales those per contact region to conserve its work
+    (:func:`_spread_regions`).
+    """
+    if proj == WPROJ_LUMPED:
+        return fn
+    Nl = sd.shape[0]
+    if sd[n] <= 0.0:  # the law at the layer itself
+        return 0.0
+    wl = 0.5 if (n == 0 or n == Nl - 1) else 1.0
+    return fn * kk[n] * sd[n] ** P[NEXP] * wl / ((Nl - 1) * fel[n])
+
+
+@njit(cache=True)
+def _spread_regions(wsc, sm, son, hstep, J0, u, P, H, ZL, Nd, AREA, WW):
+    """Spread the local wear forces, scaled per contact region to its normal work.
+
+    ``wsc[n]`` = (F_n |v_t|, local wear force x |v_t|, |v_t|) of contacting layer n. In each
+    run of adjacent contacting layers the local forces keep their shape and are scaled so that
+    their work equals the region's F_n |v_t| (the worn volume stays kw times the normal work).
+    """
+    Nl = son.shape[0] - 2
+    n = 0
+    while n < Nl:
+        if son[n] != 1:
+            n += 1
+            continue
+        end = n
+        work = 0.0
+        wloc = 0.0
+        while end < Nl and son[end] == 1:
+            work += wsc[end, 0]
+            wloc += wsc[end, 1]
+            end += 1
+        for k in range(n, end):
+            if wloc > 0.0:
+                fw = wsc[k, 1] / wsc[k, 2] * (work / wloc) if wsc[k, 2] > 0.0 else 0.0
+            else:  # no layer of the region penetrates at its node: lumped
+                fw = wsc[k, 0] / wsc[k, 2] if wsc[k, 2] > 0.0 else 0.0
+            if fw > 0.0:
+                _spread(k, sm[k], fw, wsc[k, 2], hstep, J0, u, P, H, ZL, Nd, AREA, WW)
+        n = end
 
 
 @njit(cache=True)
@@ -931,6 +997,41 @@ def _eval_ideal(t, y, P, IP, dy, diag):
 
 
 @njit(cache=True)
+def _latch_impacts(vimp, srate, son, Nl, vfloor, per_layer):
+    """Impact velocity of eq. 6, latched once per impact at its onset, per contact region.
+
+    A contact region is a run of adjacent contacting layers (each end face is one of its own).
+    A region that holds a remembered velocity continues its impact: all its layers take it
+    (the largest, if impacts merged), so a layer that joins a spreading contact does not start
+    an impact of its own. A region without one is a new impact: its largest approach rate,
+    at least ``vfloor``, is latched. Layers out of contact forget. ``per_layer``: the form
+    before issue 16, every layer latches its own rate when it enters contact.
+    """
+    n = 0
+    while n < Nl + 2:
+        if son[n] != 1:
+            vimp[n] = 0.0
+            n += 1
+            continue
+        end = n + 1
+        if n < Nl and per_layer == 0:
+            while end < Nl and son[end] == 1:
+                end += 1
+        v = 0.0
+        r = vfloor
+        for k in range(n, end):
+            if vimp[k] > v:
+                v = vimp[k]
+            if srate[k] > r:
+                r = srate[k]
+        if v <= 0.0:
+            v = r
+        for k in range(n, end):
+            vimp[k] = v
+        n = end
+
+
+@njit(cache=True)
 def _eval(t, y, ctx, dy, acc, hstep, diag):
     """Right-hand side dy of either model; ``ctx`` as in :func:`_contact`."""
     if ctx[1][IDEAL] == 1:
@@ -1137,13 +1238,7 @@ def integrate(
                 son[k] = 0
         pen0 = pen1
         contact0 = contact1
-        for k in range(Nl + 2):
-            if son[k] == 1:
-                if vimp[k] <= 0.0:
-                    r = srate[k]
-                    vimp[k] = r if r > P[VFLOOR] else P[VFLOOR]
-            else:
-                vimp[k] = 0.0
+        _latch_impacts(vimp, srate, son, Nl, P[VFLOOR], IP[LATCH])
         if pen0 > pen_limit:
             return 2, t, h, i_out, nacc, nrej
         # next step size

@@ -166,6 +166,12 @@ def _pack(params: SimParameters) -> tuple[np.ndarray, np.ndarray]:
     IP[kn.KVARY] = 1 if c.stiffness == "time_varying" else 0
     IP[kn.KDEN_WORN] = 1 if c.worn_radius_in_denominator else 0
     IP[kn.NL], IP[kn.ND] = j.n_layers, j.n_points
+    IP[kn.WPROJ] = {
+        "local_conserving": kn.WPROJ_CONSERVING,
+        "local": kn.WPROJ_LOCAL,
+        "lumped": kn.WPROJ_LUMPED,
+    }[c.wear_projection]
+    IP[kn.LATCH] = 1 if c.impact_latch == "layer" else 0
     return P, IP
 
 
@@ -649,6 +655,12 @@ def _dataset(params: SimParameters, t_rel: np.ndarray, diag: np.ndarray, t0: flo
     ds.attrs["parameter_set"] = params.name
     ds.attrs["joint_model"] = params.joint.model
     ds.attrs["contact_formulation"] = params.contact.formulation
+    if params.contact.formulation == "per_point":
+        ds.attrs["contact_formulation_note"] = (
+            "the study's literal per-point sum: forces and wear work depend on the grid"
+        )
+    ds.attrs["wear_projection"] = params.contact.wear_projection
+    ds.attrs["impact_latch"] = params.contact.impact_latch
     ds.attrs["contact_stiffness_model"] = params.contact.stiffness
     ds.attrs["bearing_on"] = params.mechanism.bearing_on
     ds.attrs["parameters_json"] = json.dumps(to_jsonable(params))

@@ -189,7 +189,21 @@ class ContactParameters:
 
     ``formulation``: ``"slice"`` (default, grid-independent: each axial slice carries its width
     share of the joint-level law at its deepest point) or ``"per_point"`` (the study's literal
-    sum of a full law at every penetrating point; grid-dependent, for comparison only).
+    sum of a full law at every penetrating point; *grid-dependent*, for comparison only).
+    ``wear_projection`` (slice formulation): how a layer's contact becomes wear work at its
+    points. ``"local_conserving"`` (default): the pressure follows the local law at each layer
+    (line load K delta^n / wb at the layer's own penetration), scaled per contact region so
+    that the worn volume is exactly kw times the normal work. ``"local"``: the local law
+    unscaled - the wear work of one cycle at a point does not depend on the grid, but where a
+    contact is shorter than a layer spacing (bearing edges) the worn volume exceeds kw times
+    the normal work. ``"lumped"``: the layer's force spread over its whole slice area (before
+    issue 16; dilutes edge contacts shorter than the slice, so edge wear grows as the grid is
+    refined). ``impact_latch``: ``"region"`` (default) latches the impact velocity of eq. 6
+    once per impact, at the onset, for each run of adjacent contacting layers; ``"layer"``:
+    each layer latches its own approach rate when it enters contact (before issue 16).
+    ``impact_velocity_floor`` [m/s]: lower bound of a latched impact velocity (an impact that
+    starts slower, e.g. grazing, is damped as if it started at the floor); results do not
+    depend on it (0.01 vs 0.001 m/s, docs/sim-wear.md).
     ``stiffness``: ``"time_varying"`` (eq. 9, local worn radius) or ``"constant"`` (eq. 7).
     ``worn_radius_in_denominator``: the eq. 9 variant with Rb + h also in Rb - Rj.
     ``axial_stiffness``: L-N stiffness of the end-face (thrust) contact [N/m^n]; 0 means "same
@@ -197,6 +211,8 @@ class ContactParameters:
     """
 
     formulation: Literal["slice", "per_point"] = "slice"
+    wear_projection: Literal["local_conserving", "local", "lumped"] = "local_conserving"
+    impact_latch: Literal["region", "layer"] = "region"
     stiffness: Literal["time_varying", "constant"] = "time_varying"
     worn_radius_in_denominator: bool = False
     exponent: float = 1.5
