@@ -31,6 +31,7 @@ Pipeline (``track_footage``)
 
 from __future__ import annotations
 
+import contextlib
 import os
 import time as _time
 from concurrent.futures import ThreadPoolExecutor
@@ -92,6 +93,7 @@ def track_footage(
     progress: bool = False,
     inputs: tuple = (),
     resume: bool = False,
+    scheduler: str | None = None,
 ) -> xr.Dataset:
     """Track rigid bodies through rig footage; body poses, follower velocity, journal motion.
 
@@ -124,6 +126,11 @@ def track_footage(
         must be those of the partial run (``workers``/``chunk_size`` may differ); otherwise a
         :class:`~jointwear.errors.BadInputError` says what differs. A complete ``out`` is
         returned as it is.
+    scheduler : str, optional
+        Address of a ``dask.distributed`` scheduler (``tcp://host:8786``): the chunks run as
+        tasks on its workers (which must see the footage at the same paths), as with
+        ``workers > 1``. Inside a daemonic process (a dask worker, which may not start
+        processes), ``workers > 1`` runs the chunks in threads instead.
 
     Returns
     -------
@@ -193,13 +200,13 @@ def track_footage(
 
     # one process: the cameras' and bodies' trackers of a frame run in threads (their
     # kernels release the GIL); several processes: one thread each
-    n_threads = min(2, os.cpu_count() or 1) if cfg.workers <= 1 else 1
+    n_threads = min(2, os.cpu_count() or 1) if cfg.workers <= 1 and scheduler is None else 1
     pool = ThreadPoolExecutor(max_workers=n_threads) if n_threads > 1 else None
     try:
         with progress_bar("tracking frames", n_total, enabled=progress) as bar:
             task = bar.tasks[0].id
             bar.update(task, advance=start)
-            if cfg.workers <= 1:
+            if cfg.workers <= 1 and scheduler is None:
                 # decoding overlaps; a resumed run starts one frame early for the duplicate check
                 frames = prefetch(_paired_frames(L, R, max(start - 1, 0), n_total))
                 for i, t, flag, dup in _run_frames(
@@ -213,18 +220,13 @@ def track_footage(
                     if len(times) % cfg.chunk_size == 0:
                         save("partial")
             else:
-                import multiprocessing
-                from concurrent.futures import ProcessPoolExecutor
-
                 ranges = [
                     (a, min(a + cfg.chunk_size, n_total))
                     for a in range(start, n_total, cfg.chunk_size)
                 ]
-                # spawn: forking a process that already runs OpenMP/numba threads is unsafe
-                ctx = multiprocessing.get_context("spawn")
-                with ProcessPoolExecutor(max_workers=cfg.workers, mp_context=ctx) as pool:
+                with _chunk_executor(cfg.workers, scheduler) as chunks:
                     futures = [
-                        pool.submit(_run_chunk, L, R, bodies, calibration, cfg, a, b)
+                        chunks.submit(_run_chunk, L, R, bodies, calibration, cfg, a, b)
                         for a, b in ranges
                     ]
                     for fut in futures:
@@ -242,7 +244,7 @@ def track_footage(
                             raise BadInputError(part["error"])
                         save("partial")
     except (BadInputError, KeyboardInterrupt) as exc:
-        if pool is not None:
+        if isinstance(pool, ThreadPoolExecutor):
             pool.shutdown(cancel_futures=True)
             pool = None
         status = f"stopped after {len(times)} frames: {exc}"
@@ -253,7 +255,7 @@ def track_footage(
             ) from None
         raise
     finally:
-        if pool is not None:
+        if isinstance(pool, ThreadPoolExecutor):
             pool.shutdown()
     return _finish_result(
         states, times, flags, duplicates, L, R, cfg, calibration, out, inputs, bodies, t_start
@@ -317,3 +319,52 @@ def _run_chunk(L, R, bodies, calibration, cfg, start: int, stop: int) -> dict:
         "rows": {st.spec.name: st.rows for st in states},
         "error": error,
     }
+
+
+@contextlib.contextmanager
+def _chunk_executor(workers: int, scheduler: str | None):
+    """Where independent chunks run: a dask.distributed cluster (``scheduler`` address),
+    threads inside a daemonic process (a dask or multiprocessing worker may not start
+    processes: "daemonic processes are not allowed to have children"), otherwise ``workers``
+    spawned processes. Yields an object with ``submit(fn, *args)`` returning futures."""
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor
+
+    if scheduler is not None:
+        try:
+            from distributed import Client
+        except ImportError:  # pragma: no cover - distributed is a dependency
+            raise BadInputError(
+                "--scheduler needs the 'distributed' package (pip install distributed)"
+            ) from None
+        try:
+            client = Client(scheduler, timeout="20s", set_as_default=False)
+        except (OSError, TimeoutError) as exc:
+            raise BadInputError(
+                f"cannot reach the dask scheduler at {scheduler!r} ({exc}); start one with "
+                "`dask scheduler` and workers with `dask worker ADDRESS`, or drop --scheduler"
+            ) from None
+        try:
+            yield _DaskSubmitter(client)
+        finally:
+            client.close()
+        return
+    if multiprocessing.current_process().daemon:
+        with ThreadPoolExecutor(max_workers=workers) as pool:
+            yield pool
+        return
+    # spawn: forking a process that already runs OpenMP/numba threads is unsafe
+    ctx = multiprocessing.get_context("spawn")
+    with ProcessPoolExecutor(max_workers=workers, mp_context=ctx) as pool:
+        yield pool
+
+
+class _DaskSubmitter:
+    """``submit`` on a dask client, each chunk a pure task (the same chunk gives the same
+    result whichever worker runs it)."""
+
+    def __init__(self, client) -> None:
+        self.client = client
+
+    def submit(self, fn, *args):
+        return self.client.submit(fn, *args, pure=False)

@@ -68,7 +68,10 @@ class TrackConfig:
     zncc_min : float
         Matches below this ZNCC are discarded.
     max_epipolar_px : float
-        Stereo matches farther from the epipolar line are discarded [pixel].
+        Stereo matches farther from the epipolar line are discarded [pixel]. The SIFT matches
+        that start stereo tracking use the same gate, but at least 3 px. Raise it (CLI
+        ``--max-epipolar-px``) only for a calibration known to be off its images by that much
+        (the error message measures the offset).
     min_points : int
         Fewest valid points for a body's pose in a frame (fewer: the frame is flagged).
     velocity_window, velocity_order : int
@@ -86,6 +89,10 @@ class TrackConfig:
     world_origin : [x, y, z]
         Mechanism-frame position of the world origin (the calibration board's first inner
         corner), used to place ``centroid_mechanism`` [m].
+    max_reinit : int
+        Most SIFT re-initialisations per body after tracking was lost (chunk starts do not
+        count); beyond, lost frames are flagged ``tracking_failed`` without another attempt.
+        0: never re-initialise. Each one is recorded (``<body>_reinitialised``).
     workers : int
         Processes working on chunks in parallel (1: sequential, tracking carried across
         chunks; >1: each chunk starts from SIFT features of the reference images).
@@ -104,6 +111,7 @@ class TrackConfig:
     interpolation: Literal["cubic", "quintic"] = "cubic"
     world_origin: list[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
     workers: int = 1
+    max_reinit: int = 50
 
     def __post_init__(self) -> None:
         if self.subset_size < 7 or self.subset_size % 2 == 0:
@@ -113,6 +121,12 @@ class TrackConfig:
         if self.interpolation not in ("cubic", "quintic"):
             raise ParameterError(
                 f"track.interpolation={self.interpolation!r}: expected 'cubic' or 'quintic'"
+            )
+        if self.max_reinit < 0:
+            raise ParameterError(f"track.max_reinit={self.max_reinit}: expected >= 0")
+        if not self.max_epipolar_px > 0:
+            raise ParameterError(
+                f"track.max_epipolar_px={self.max_epipolar_px}: expected a positive distance [px]"
             )
         if self.workers < 1:
             raise ParameterError(f"track.workers={self.workers}: expected >= 1")

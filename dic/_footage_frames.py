@@ -9,7 +9,13 @@ from typing import Any
 import numpy as np
 
 from jointwear.dic._footage_config import FRAME_FLAGS, BodySpec, TrackConfig
-from jointwear.dic._footage_features import _homography_guess, _sift_features, _sift_homography
+from jointwear.dic._footage_features import (
+    MatchReport,
+    _homography_guess,
+    _sift_features,
+    _sift_homography,
+    epipolar_band,
+)
 from jointwear.dic._footage_tracker import (
     _CameraBodyTracker,
     _grid_in_polygon,
@@ -55,7 +61,12 @@ def _setup_states(L, R, bodies, calibration, cfg, ref_l, ref_r) -> list[_BodySta
 def _setup_bodies(L, R, bodies, calibration, cfg, ref_l, ref_r, pool) -> list[_BodyState]:
     half = cfg.subset_size // 2
     w, h = L.size
-    right_features = pool.submit(_sift_features, ref_r) if pool is not None else None
+    gate = sift_epipolar_px(cfg)
+    right_features = None
+    if R is not None:
+        polys = [np.asarray(b.polygon, dtype=float) for b in bodies]
+        band = epipolar_band(calibration, polys, ref_r.shape, gate)
+        right_features = pool.submit(_sift_features, ref_r, mask=band)
     noise = _noise_sigma(ref_l)
     states: list[_BodyState] = []
     for spec in bodies:
@@ -81,25 +92,35 @@ def _setup_bodies(L, R, bodies, calibration, cfg, ref_l, ref_r, pool) -> list[_B
             else _match_sigma(ref_l, pts, half, noise)
         )
         if R is not None:
+            report = MatchReport()
             H = _sift_homography(
-                _sift_features(ref_l, poly), right_features.result(), calibration=calibration
+                _sift_features(ref_l, poly),
+                right_features.result(),
+                calibration=calibration,
+                max_epipolar_px=gate,
+                report=report,
             )
             if H is None:
-                raise BadInputError(
-                    f"body '{spec.name}': its region could not be found in the right reference "
-                    "image (too few SIFT matches consistent with the calibration's epipolar "
-                    "geometry); check that both cameras see the speckle pattern and that the "
-                    "calibration belongs to this rig"
-                )
+                raise BadInputError(_no_stereo_match_message(spec.name, report, gate))
             guess = _homography_guess(H, pts)
             pos_r, zn, good = lt.track(ref_r, point_guess=guess)
             epi = epipolar_distance(calibration, pts, np.where(np.isfinite(pos_r), pos_r, 0.0))
+            correlated = good.copy()
             good &= epi < cfg.max_epipolar_px
             if good.sum() < cfg.min_points:
+                off = float(np.median(epi[correlated])) if correlated.any() else float("nan")
+                hint = (
+                    f"; the {correlated.sum()} subsets that correlated lie a median {off:.1f} px "
+                    "from the calibration's epipolar lines: recalibrate, or accept the "
+                    f"calibration with max_epipolar_px = {np.ceil(1.5 * off):g} ([track] in the "
+                    "bodies TOML, CLI --max-epipolar-px)"
+                    if correlated.sum() >= cfg.min_points and off > cfg.max_epipolar_px
+                    else "; check the calibration and the ROI"
+                )
                 raise BadInputError(
                     f"body '{spec.name}': only {good.sum()} of {len(pts)} subsets matched between "
                     f"the left and right reference images (ZNCC >= {cfg.zncc_min}, epipolar "
-                    f"distance < {cfg.max_epipolar_px} px); check the calibration and the ROI"
+                    f"distance < {cfg.max_epipolar_px} px){hint}"
                 )
             pts, pos_r, sig = pts[good], pos_r[good], sig[good]
             lt = _CameraBodyTracker(ref_l, pts, cfg, f"left/{spec.name}")
@@ -112,6 +133,34 @@ def _setup_bodies(L, R, bodies, calibration, cfg, ref_l, ref_r, pool) -> list[_B
         lt.polygon = poly
         states.append(_BodyState(spec, lt, rt, ref, sig, _body_point(spec, ref, cfg)))
     return states
+
+
+def sift_epipolar_px(cfg: TrackConfig) -> float:
+    """Epipolar gate of the SIFT matches that start stereo tracking [pixel]: the subsets'
+    ``max_epipolar_px``, but at least 3 px (feature positions are coarser than subsets')."""
+    return max(3.0, float(cfg.max_epipolar_px))
+
+
+def _no_stereo_match_message(name: str, report: MatchReport, gate: float) -> str:
+    what = (
+        f"body '{name}': its region could not be found in the right reference image "
+        f"({report.features_ref} features in the region, {report.features_target} in the right "
+        f"image's epipolar band, {report.matches} descriptor matches, {report.epipolar_inliers} "
+        f"within {gate:g} px of their epipolar lines)"
+    )
+    off = report.measured_epipolar_px
+    if off is not None and off > gate:
+        return (
+            f"{what}; the matches one homography explains lie a median {off:.1f} px from the "
+            "calibration's epipolar lines: the calibration does not fit these images "
+            "(recalibrate, or check that it belongs to this rig and resolution), or accept it "
+            f"with max_epipolar_px = {np.ceil(1.5 * off):g} ([track] in the bodies TOML, CLI "
+            "--max-epipolar-px)"
+        )
+    return (
+        f"{what}; check that both cameras see the speckle pattern and that the calibration "
+        "belongs to this rig"
+    )
 
 
 def _is_duplicate(img: np.ndarray, prev: np.ndarray, cfg: TrackConfig) -> bool:
@@ -273,7 +322,10 @@ def _finish_frame(states, fr, cfg, calibration, speculative) -> tuple[int, bool]
         res = None
         if not reinit:
             res = _body_pose(st, *tracked[k], cfg, calibration)
-        if res is None or not res[0]:
+        lost = not reinit and (res is None or not res[0])
+        n_reinit = int(sum(st.rows.get("reinit", ())))
+        retry = reinit or (lost and n_reinit < cfg.max_reinit)
+        if retry:
             # chunk start or lost: initialise from SIFT features of the reference images
             if speculative is not None and speculative["left"] is not None and not rolled_back:
                 _wait(speculative)  # the next frame's left tracking started from this one
@@ -324,6 +376,7 @@ def _finish_frame(states, fr, cfg, calibration, speculative) -> tuple[int, bool]
             cur.astype(np.float32),
             pu.astype(np.float32),
             zn.astype(np.float32),
+            int(lost and retry),
         )
     return flag, rolled_back
 
@@ -335,9 +388,10 @@ def _failed_pose(d: int, n: int) -> tuple:
             np.full((n, d), np.nan), None, None, None, np.full(n, np.nan))  # fmt: skip
 
 
-def _append_row(st, Rm, poi, u, n_in, rms, cur, cur_u, zncc) -> None:
+def _append_row(st, Rm, poi, u, n_in, rms, cur, cur_u, zncc, reinit=0) -> None:
     row = st.rows
     for key, val in (
+        ("reinit", reinit),
         ("R", Rm),
         ("poi", poi),
         ("poi_u", u),

@@ -84,6 +84,11 @@ def _restore_rows(prev: xr.Dataset, states, times, flags, duplicates, stereo: bo
             "points": pts,
             "points_u": prev[f"{name}_points_u"].values,
             "zncc": prev[f"{name}_zncc"].values,
+            "reinit": (
+                prev[f"{name}_reinitialised"].values
+                if f"{name}_reinitialised" in prev
+                else np.zeros(len(pts), dtype=np.int8)
+            ),
         }
         st.rows = {key: list(val) for key, val in columns.items()}
     times.extend(float(t) for t in prev["time"].values)
@@ -131,6 +136,7 @@ def _assemble(states, times, flags, duplicates, L, R, cfg, calibration, status) 
     }
     valid_time = ~(flag_arr & FRAME_FLAGS["duplicated"]).astype(bool)
     attrs_extra: dict[str, float] = {}
+    reinit_counts: dict[str, int] = {}
     for st in states:
         rows = st.rows
         name = st.spec.name
@@ -203,6 +209,17 @@ def _assemble(states, times, flags, duplicates, L, R, cfg, calibration, status) 
                 "long_name": f"displacement of the {name}'s subsets since the reference frame",
             },
         )
+        reinit = np.asarray(rows.get("reinit", np.zeros(len(t))), dtype=np.int8)
+        data[f"{name}_reinitialised"] = (
+            "time",
+            reinit,
+            {
+                "units": "1",
+                "long_name": f"1 where the {name}'s tracking was lost and found again from SIFT "
+                "features of the reference images",
+            },
+        )
+        reinit_counts[name] = int(reinit.sum())
         coords[f"{name}_row"] = (f"{name}_row", np.arange(d))
         coords[f"{name}_col"] = (f"{name}_col", np.arange(d))
         coords[f"{name}_point_axis"] = (f"{name}_point_axis", axes)
@@ -323,6 +340,7 @@ def _assemble(states, times, flags, duplicates, L, R, cfg, calibration, status) 
             "frames_processed": len(t),
             "duplicated_frames": json.dumps([int(i) for i in duplicates]),
             "dropped_frames_estimated": dropped,
+            "sift_reinitialisations": json.dumps(reinit_counts),
             "gaps_after_frames": json.dumps([int(i) for i in gaps]),
             "left_footage": str(L.path),
             "right_footage": str(R.path) if R is not None else "",

@@ -295,6 +295,24 @@ def register(app: typer.Typer) -> None:
                 "bodies and options)."
             ),
         ] = False,
+        max_epipolar_px: Annotated[
+            float | None,
+            typer.Option(
+                help="Epipolar gate of the stereo matches (px; overrides the TOML's "
+                "max_epipolar_px). Raise only for a calibration known to be that far off."
+            ),
+        ] = None,
+        max_reinit: Annotated[
+            int | None,
+            typer.Option(
+                help="Most SIFT re-initialisations per body after lost tracking (0: none; "
+                "overrides the TOML)."
+            ),
+        ] = None,
+        scheduler: Annotated[
+            str | None,
+            typer.Option(help="Run the chunks on this dask.distributed cluster (tcp://host:8786)."),
+        ] = None,
     ) -> None:
         """Track the bodies of rig footage: poses, follower velocity, journal out-of-plane motion.
 
@@ -307,14 +325,23 @@ def register(app: typer.Typer) -> None:
 
         io.check_writable(out)
         cfg, specs = read_bodies(bodies)
-        if workers is not None or chunk_size is not None:
+        overrides = {
+            "workers": workers,
+            "chunk_size": chunk_size,
+            "max_epipolar_px": max_epipolar_px,
+            "max_reinit": max_reinit,
+        }
+        overrides = {k: v for k, v in overrides.items() if v is not None}
+        if overrides:
             import dataclasses
 
-            cfg = dataclasses.replace(
-                cfg,
-                workers=cfg.workers if workers is None else workers,
-                chunk_size=cfg.chunk_size if chunk_size is None else chunk_size,
-            )
+            from jointwear.errors import ParameterError
+
+            try:
+                cfg = dataclasses.replace(cfg, **overrides)
+            except ParameterError as exc:
+                flag = "--" + str(exc).split("=")[0].removeprefix("track.").replace("_", "-")
+                raise typer.BadParameter(str(exc), param_hint=flag) from None
         cal = read_calibration(calibration) if calibration is not None else None
         inputs = [p for p in (left, right, bodies, calibration) if p is not None]
         ds = track_footage(
@@ -329,6 +356,7 @@ def register(app: typer.Typer) -> None:
             progress=True,
             inputs=tuple(inputs),
             resume=resume,
+            scheduler=scheduler,
         )
         dup = ds.attrs.get("duplicated_frames", "[]")
         typer.echo(
@@ -336,6 +364,23 @@ def register(app: typer.Typer) -> None:
             f"duplicated frames: {dup}; dropped frames (time gaps): "
             f"{ds.attrs.get('dropped_frames_estimated', 0)} -> {out}"
         )
+        import json
+
+        counts = json.loads(ds.attrs.get("sift_reinitialisations", "{}"))
+        if any(counts.values()):
+            typer.echo(
+                "tracking lost and found again from SIFT features (re-initialisations): "
+                + ", ".join(f"{k} {v}" for k, v in counts.items())
+                + f" (limit {cfg.max_reinit} per body, --max-reinit; frames in "
+                "<body>_reinitialised)"
+            )
+            full = [k for k, v in counts.items() if v >= cfg.max_reinit]
+            if full:
+                typer.echo(
+                    f"WARNING: {', '.join(full)} reached the re-initialisation limit; later "
+                    "lost frames are flagged tracking_failed",
+                    err=True,
+                )
         if plot is not None:
             from jointwear.dic._footage_plot import plot_body_motion
 

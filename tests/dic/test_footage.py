@@ -8,13 +8,14 @@ one crank revolution (0.5 s), joint C moving 2.5 mm out of plane, 1 grey level s
 from __future__ import annotations
 
 import dataclasses
+import json
 
 import numpy as np
 import pytest
 
 from jointwear import io
 from jointwear.datasets.rig import RigConfig, VirtualRig, generate_rig
-from jointwear.dic._footage import BodySpec, TrackConfig, read_bodies, track_footage
+from jointwear.dic._footage import FRAME_FLAGS, BodySpec, TrackConfig, read_bodies, track_footage
 from jointwear.dic._video import check_stereo_pair, open_frames
 from jointwear.errors import BadInputError, ParameterError
 
@@ -108,6 +109,7 @@ def _track_small(small, *, config=None, max_frames=None, folders=None, **options
     cfg, written, _ = small
     tc, bodies = read_bodies(written["bodies"])
     f = folders or {"left": written["left_images"], "right": written["right_images"]}
+    scheduler = options.pop("scheduler", None)
     return track_footage(
         f["left"],
         f["right"],
@@ -116,6 +118,7 @@ def _track_small(small, *, config=None, max_frames=None, folders=None, **options
         calibration=VirtualRig(cfg).calibration,
         config=dataclasses.replace(tc, **options) if config is None else config,
         max_frames=max_frames,
+        scheduler=scheduler,
     )
 
 
@@ -641,3 +644,91 @@ def test_cli_shared_folders_patterns_and_resume(small, tmp_path, capsys):
     assert ok.sum() == ds.sizes["time"] - 1  # all but the duplicated frame
     perr = ds["follower_position"].values[ok] - (t["follower_position"].values[ok] - origin)
     assert np.max(np.abs(perr)) < 3e-5
+
+
+def test_chunks_inside_a_daemon_process_and_on_a_dask_cluster(small, monkeypatch):
+    # a dask worker is a daemonic process, which may not start processes ("daemonic
+    # processes are not allowed to have children"): the chunks run in threads there; and
+    # --scheduler runs them as tasks on a cluster; both give the sequential poses
+    import multiprocessing
+
+    seq = _track_small(small, max_frames=4, workers=1, chunk_size=2)
+    proc = multiprocessing.current_process()
+    monkeypatch.setattr(proc, "_config", {**proc._config, "daemon": True})
+    assert multiprocessing.current_process().daemon
+    in_daemon = _track_small(small, max_frames=4, workers=2, chunk_size=2)
+    monkeypatch.undo()
+    from distributed import LocalCluster
+
+    with LocalCluster(
+        n_workers=1, threads_per_worker=2, processes=False, dashboard_address=":0"
+    ) as cluster:
+        on_cluster = _track_small(
+            small, max_frames=4, workers=1, chunk_size=2, scheduler=cluster.scheduler_address
+        )
+    a = seq["follower_position"].values
+    for other in (in_daemon, on_cluster):
+        assert np.allclose(other["follower_position"].values, a, atol=3e-6, equal_nan=True)
+
+
+def _shifted_calibration(cfg, dy_px):
+    from jointwear.dic._calib import Camera
+
+    cal = VirtualRig(cfg).calibration
+    r = cal.right
+    K = r.matrix.copy()
+    K[1, 2] += dy_px  # the right camera's images sit dy_px lower than the calibration says
+    right = Camera(K, r.distortion, r.rotation, r.translation, r.image_size)
+    return dataclasses.replace(cal, right=right)
+
+
+def test_a_calibration_off_its_images_is_measured_and_the_gate_configurable(small, capsys):
+    from jointwear.cli import main
+
+    cfg, written, out = small
+    tc, bodies = read_bodies(written["bodies"])
+    bad = _shifted_calibration(cfg, 20.0)
+    opts = {"fps": 50, "bodies": bodies, "max_frames": 3}
+    imgs = (written["left_images"], written["right_images"])
+    with pytest.raises(BadInputError, match=r"a median (19\.\d|20\.\d) px from the calibration"):
+        track_footage(*imgs, calibration=bad, config=tc, **opts)
+    # the message's figure, used as the gate, lets the (biased) calibration through
+    loose = dataclasses.replace(tc, max_epipolar_px=30.0)
+    ds = track_footage(*imgs, calibration=bad, config=loose, **opts)
+    assert np.all(ds["follower_n_points"].values >= tc.min_points)
+    # the CLI flag reaches the gate; a bad value is a usage error naming the flag
+    bad.save(out / "shifted.nc")
+    args = ["dic", "track", "--left", str(imgs[0]), "--right", str(imgs[1]), "--bodies",
+            str(written["bodies"]), "--calibration", str(out / "shifted.nc"), "--fps", "50",
+            "--max-frames", "2", "--out", str(out / "shifted_motion.nc")]  # fmt: skip
+    assert main(args) == 3
+    assert "max_epipolar_px" in capsys.readouterr().err
+    assert main([*args, "--max-epipolar-px", "30"]) == 0
+    assert main([*args, "--max-epipolar-px", "-1"]) == 2
+    assert "--max-epipolar-px" in capsys.readouterr().err
+
+
+def test_reinitialisations_are_counted_and_limited(small, monkeypatch):
+    import jointwear.dic._footage_frames as frames
+
+    real_pose = frames._body_pose
+    calls = []
+
+    def flaky_pose(st, left, right, cfg, calibration):
+        res = real_pose(st, left, right, cfg, calibration)
+        frame = len(st.rows.get("poi", ()))
+        if st.spec.name == "follower" and frame in (1, 3) and frame not in calls:
+            calls.append(frame)  # frames 1 and 3 lose the follower (first attempt)
+            return frames._failed_pose(3, len(st.ref3d))
+        return res
+
+    monkeypatch.setattr(frames, "_body_pose", flaky_pose)
+    ds = _track_small(small, max_frames=5)
+    assert ds["follower_reinitialised"].values.tolist() == [0, 1, 0, 1, 0]
+    assert json.loads(ds.attrs["sift_reinitialisations"])["follower"] == 2
+    assert not np.any(ds["frame_flag"].values & FRAME_FLAGS["tracking_failed"])
+    calls.clear()
+    limited = _track_small(small, max_frames=5, max_reinit=1)
+    assert limited["follower_reinitialised"].values.tolist() == [0, 1, 0, 0, 0]
+    failed = (limited["frame_flag"].values & FRAME_FLAGS["tracking_failed"]) > 0
+    assert failed.tolist() == [False, False, False, True, False]
