@@ -225,3 +225,31 @@ def test_cli_sweep_writes_the_file_and_reports_failures(tmp_path, capsys):
     code = main(["sim", "sweep", str(spec), "--out", str(out), "--workers", "0"])
     err = capsys.readouterr().err
     assert code == 3 and "method = 'lhz'" in err and "Traceback" not in err
+
+
+def test_runs_lost_by_the_cluster_are_not_run_and_resumable(tmp_path, monkeypatch, capsys):
+    spec = tmp_path / "spec.toml"
+    spec.write_text(
+        '[sweep]\nrun = "function"\nfunction = "linear"\nmethod = "lhs"\nsamples = 6\n'
+        '[parameters.x1]\ndistribution = "uniform"\nbounds = [0, 1]\n'
+    )
+    out = tmp_path / "s.nc"
+    real = sweep_mod.execute_runs
+
+    def losing(tasks, **kw):  # dask gives up on run 2 (it killed several workers)
+        kw["on_lost"](2, "KilledWorker: attempted to run task 3 times")
+        real([t for t in tasks if t.index != 2], **kw)
+
+    monkeypatch.setattr(sweep_mod, "execute_runs", losing)
+    code = main(["sim", "sweep", str(spec), "--out", str(out), "--workers", "0"])
+    err = capsys.readouterr().err
+    assert code == 3 and "--resume" in err
+    ds = io.load(out)  # what was computed is written ...
+    assert ds["status"].values.tolist() == [0, 0, 2, 0, 0, 0]
+    assert "KilledWorker" in str(ds["error"].values[2]) and np.isnan(ds["y"].values[2])
+    assert len(list(parts_dir(out).glob("run-*.npz"))) == 5  # ... and the parts are kept
+    monkeypatch.setattr(sweep_mod, "execute_runs", real)
+    assert main(["sim", "sweep", str(spec), "--out", str(out), "--workers", "0", "--resume"]) == 0
+    ds = io.load(out)
+    assert ds.attrs["runs_computed_now"] == 1 and (ds["status"].values == 0).all()
+    assert not parts_dir(out).exists()
