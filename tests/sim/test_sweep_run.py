@@ -253,3 +253,28 @@ def test_runs_lost_by_the_cluster_are_not_run_and_resumable(tmp_path, monkeypatc
     ds = io.load(out)
     assert ds.attrs["runs_computed_now"] == 1 and (ds["status"].values == 0).all()
     assert not parts_dir(out).exists()
+
+
+def test_second_order_sobol_index_of_the_ishigami_interaction():
+    u = {"distribution": "uniform", "bounds": [-PI, PI]}
+    ds = run_sweep(
+        function_spec(
+            "sobol",
+            samples=512,
+            function="ishigami",
+            params={"x1": u, "x2": u, "x3": u},
+            second_order=True,
+            seed=3,
+        ),
+        workers=0,
+    )
+    assert ds.sizes["run"] == 512 * 8  # N (2D + 2)
+    truth = analytic_sobol("ishigami")
+    s13_true = truth["ST"]["x3"]  # x3 acts only through its interaction with x1
+    s2 = ds["sobol_S2"].sel(output="y")
+    conf = ds["sobol_S2_conf"].sel(output="y")
+    est = float(s2.sel(parameter="x1", parameter_2="x3"))
+    assert abs(est - s13_true) <= float(conf.sel(parameter="x1", parameter_2="x3"))
+    assert abs(float(s2.sel(parameter="x1", parameter_2="x2"))) <= float(
+        conf.sel(parameter="x1", parameter_2="x2")
+    )
