@@ -451,8 +451,8 @@ def run_sweep(
 
     if resume and out is None:
         raise BadInputError("resume needs the sweep's result file (out=/--out)")
-    spec = spec if isinstance(spec, SweepSpec) else read_spec(spec)
     spec_file = [Path(spec)] if isinstance(spec, (str, Path)) else []
+    spec = spec if isinstance(spec, SweepSpec) else read_spec(spec)
     sim, wear, base_record, inputs = _base(spec, params, wear)
     if spec.run != "function":
         _check_feasible(spec, sim, wear)

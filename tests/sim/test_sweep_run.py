@@ -219,6 +219,8 @@ def test_cli_sweep_writes_the_file_and_reports_failures(tmp_path, capsys):
     assert 0 < n_failed < 6
     assert f"{6 - n_failed} ok, {n_failed} failed, 0 not run" in cap.out
     assert "exceeds fail_above" in cap.err
+    prov = io.parse_provenance(ds)
+    assert any(str(spec) in i["path"] and "sha256" in i for i in prov["inputs"])
     code = main(["sim", "sweep", str(spec), "--out", str(out), "--params", "x.toml"])
     assert code == 3 and "--params does not apply" in capsys.readouterr().err
     spec.write_text(spec.read_text().replace('"lhs"', '"lhz"'))
