@@ -280,3 +280,21 @@ def test_second_order_sobol_index_of_the_ishigami_interaction():
     assert abs(float(s2.sel(parameter="x1", parameter_2="x2"))) <= float(
         conf.sel(parameter="x1", parameter_2="x2")
     )
+
+
+def test_a_wear_run_over_its_cycle_budget_fails_with_the_reason(tmp_path):
+    spec = {
+        "sweep": {
+            "run": "wear",
+            "method": "grid",
+            "cycles": 300,
+            "max_cycles_simulated": 3,
+            "outputs": ["max_wear_depth"],
+        },
+        "parameters": {"wear.kw": {"values": [9e-16]}},
+    }
+    ds = run_sweep(spec, params=tiny_base(tmp_path), workers=0)
+    assert ds["status"].values.tolist() == [1]
+    err = str(ds["error"].values[0])
+    assert "max_cycles_simulated = 3" in err and "of 300 cycles done" in err
+    assert np.isnan(ds["max_wear_depth"].values[0])
