@@ -217,6 +217,7 @@ def assemble(
                 "design): their spread is NOT an input uncertainty"
             ),
             "n_runs": n,
+            "ensemble_complete": bool(np.all(status == STATUS["ok"])),
             "n_ok": int(np.sum(status == STATUS["ok"])),
             "n_failed": n_failed,
             "n_not_run": n_missing,

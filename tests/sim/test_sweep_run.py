@@ -52,7 +52,7 @@ def test_ishigami_sobol_indices_match_the_analytic_values_within_salib_intervals
     assert float(ds.sobol_S1_conf.max()) < 0.1
     assert float(ds.sobol_ST.sel(output="y", parameter="x3")) > 0.15  # interaction x1 x3
     assert float(ds.sobol_S1.sel(output="y", parameter="x3")) < 0.05
-    assert ds.attrs["probabilistic_sample"] is True
+    assert ds.attrs["probabilistic_sample"] is True and ds.attrs["ensemble_complete"] is True
 
 
 def test_morris_ranks_a_linear_model_by_its_coefficients():
@@ -78,6 +78,7 @@ def test_failed_runs_are_recorded_and_do_not_stop_the_sweep(tmp_path):
     assert np.allclose(ds["y"].values[~failed], x1[~failed] + 2 * ds["x2"].values[~failed])
     back = io.load(out)
     assert back.attrs["n_failed"] == int(failed.sum())
+    assert back.attrs["ensemble_complete"] is False and back.attrs["probabilistic_sample"] is True
     assert back["status"].attrs["flag_meanings"] == "ok failed not_run"
     assert back["x1"].attrs["units"] == "1"
     assert json.loads(back.attrs["provenance"])["parameters"]["spec"]["method"] == "lhs"
