@@ -53,7 +53,10 @@ def _client(workers: int | None, scheduler: str | None) -> tuple[Any, Any, str]:
         n_workers=n,
         threads_per_worker=1,
         processes=True,
-        dashboard_address=None,
+        # no dashboard; the scheduler's HTTP endpoints (health, metrics) take a free port
+        # instead of 8787, which another cluster on the machine may hold (a warning)
+        dashboard_address=":0",
+        scheduler_kwargs={"dashboard": False},
         env=dict(WORKER_ENV),
         silence_logs=logging.ERROR,
     )

@@ -22,9 +22,13 @@ WEAR_OUTPUTS: dict[str, tuple[str, str]] = {
     "cylindricity": ("m", "cylindricity (minimum zone) of the worn bore at the target cycles"),
     "max_wear_theta": (
         "degree",
-        "angle of the largest wear depth (canonical convention: 0 along -x, clockwise from +z)",
+        "angle of the largest wear depth (canonical convention: 0 along -x, clockwise from +z; "
+        "NaN if nothing wore)",
     ),
-    "max_wear_z": ("m", "axial position of the largest wear depth (0 at bearing mid-width, +z)"),
+    "max_wear_z": (
+        "m",
+        "axial position of the largest wear depth (0 at bearing mid-width, +z; NaN if nothing wore)",
+    ),
     "normal_work": ("N m", "accumulated normal work integral F_n |v_t| dt (Archard's F_n s)"),
     "cycles_simulated": ("1", "crank cycles actually simulated by the wear run"),
     "n_updates": ("1", "accepted wear-profile updates"),
@@ -66,12 +70,13 @@ def wear_outputs(ds: xr.Dataset) -> dict[str, float]:
     depth = last["wear_depth"]
     k = int(np.argmax(depth.values))
     iz, it = np.unravel_index(k, depth.shape)
+    worn = float(depth.values.flat[k]) > 0  # an unworn bore has no location of maximum wear
     return {
         "max_wear_depth": float(last["max_wear_depth"]),
         "worn_volume": float(last["worn_volume"]),
         "cylindricity": float(last["cylindricity"]),
-        "max_wear_theta": float(depth["theta"].values[it]),
-        "max_wear_z": float(depth["z"].values[iz]),
+        "max_wear_theta": float(depth["theta"].values[it]) if worn else float("nan"),
+        "max_wear_z": float(depth["z"].values[iz]) if worn else float("nan"),
         "normal_work": float(last["normal_work"]) if "normal_work" in ds else float("nan"),
         "cycles_simulated": float(ds.attrs.get("cycles_simulated", np.nan)),
         "n_updates": float(ds.attrs.get("n_updates", np.nan)),

@@ -54,6 +54,7 @@ def _record_cycles(params: Any, h: np.ndarray | None, settle: float, cycles: flo
 
 
 def _wear(task: RunTask) -> tuple[dict[str, float], dict[str, np.ndarray]]:
+    from jointwear.errors import SimulationError
     from jointwear.sim._sweep_outputs import (
         MOTION_OUTPUTS,
         force_history,
@@ -66,7 +67,27 @@ def _wear(task: RunTask) -> tuple[dict[str, float], dict[str, np.ndarray]]:
 
     spec = task.spec
     params, settings = apply_values(task.sim_params, task.wear_settings, task.values)
-    run = WearRun(DynamicContact(params), settings, cycles=spec.cycles, snapshots=[spec.cycles])
+    budget = spec.max_cycles_simulated
+
+    def within_budget(info: dict[str, Any]) -> None:
+        # a deterministic cap (cycles, not seconds): the same runs stop on any executor
+        if info["cycles_simulated"] > budget:
+            raise SimulationError(
+                f"wear run stopped after simulating {info['cycles_simulated']:g} crank cycles "
+                f"([sweep] max_cycles_simulated = {budget:g}) with only {info['cycles_done']} "
+                f"of {info['target']} cycles done: the update interval has shrunk to "
+                f"dN = {info['dn']} (the wear-rate field changes by {info['rate_change']:.2f} "
+                "per update); raise max_cycles_simulated, or set wear.dn_min / wear.noise_floor "
+                "in --params"
+            )
+
+    run = WearRun(
+        DynamicContact(params),
+        settings,
+        cycles=spec.cycles,
+        snapshots=[spec.cycles],
+        on_update=within_budget,
+    )
     ds = run.run()
     out = wear_outputs(ds)
     fields: dict[str, np.ndarray] = {}

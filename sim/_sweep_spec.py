@@ -54,6 +54,8 @@ _SWEEP_KEYS = {
     "outputs": "scalar outputs to keep",
     "keep": "fields to keep per run (wear_depth, contact_force)",
     "settle_cycles": "cycle: crank cycles simulated and discarded before recording (default 1)",
+    "max_cycles_simulated": "wear: a run that simulates more crank cycles than this fails "
+    "(default 1000; a full 1e6-cycle run simulates about 60-120)",
     "function": "run = function: name of the analytic model",
     "function_args": "run = function: options of the analytic model",
     "levels": "morris: number of grid levels (default 4)",
@@ -81,6 +83,7 @@ class SweepSpec:
     outputs: tuple[str, ...] = ()
     keep: tuple[str, ...] = ()
     settle_cycles: float = 1.0
+    max_cycles_simulated: float = 1000.0
     function: str | None = None
     function_args: dict[str, Any] = field(default_factory=dict)
     levels: int = 4
@@ -270,6 +273,12 @@ def read_spec(spec: str | Path | Mapping[str, Any]) -> SweepSpec:
     if isinstance(settle, bool) or not isinstance(settle, (int, float)) or not settle >= 0:
         raise ParameterError(f"[sweep] settle_cycles must be >= 0, got {settle!r}")
 
+    budget = sw.get("max_cycles_simulated", 1000.0)
+    if isinstance(budget, bool) or not isinstance(budget, (int, float)) or not budget > 0:
+        raise ParameterError(f"[sweep] max_cycles_simulated must be > 0, got {budget!r}")
+    if "max_cycles_simulated" in sw and run != "wear":
+        raise ParameterError('[sweep] max_cycles_simulated applies to run = "wear" only')
+
     avail = available_outputs(run, model)
     outputs = (
         _names(sw["outputs"], "[sweep] outputs")
@@ -368,6 +377,7 @@ def read_spec(spec: str | Path | Mapping[str, Any]) -> SweepSpec:
         outputs=tuple(outputs),
         keep=tuple(keep),
         settle_cycles=float(settle),
+        max_cycles_simulated=float(budget),
         function=model.name if model else None,
         function_args=function_args,
         levels=levels,

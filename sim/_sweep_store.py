@@ -172,7 +172,8 @@ class PartStore:
         return done
 
     def close(self, *, remove: bool) -> None:
-        """Release the lock; with ``remove``, delete the folder (the result file has it all)."""
+        """Release the lock; with ``remove`` (the result file has it all) or when no run finished,
+        delete the folder."""
         self._lock.release()
-        if remove:
+        if remove or not self.finished_files():
             shutil.rmtree(self.dir, ignore_errors=True)

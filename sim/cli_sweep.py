@@ -75,15 +75,26 @@ def register(app: typer.Typer) -> None:
                     description=f"sweep: {s['done'] - s['failed']} ok, {s['failed']} failed",
                 )
 
-            ds = run_sweep(
-                spec,
-                out=out,
-                params=params,
-                workers=workers,
-                scheduler=scheduler,
-                resume=resume,
-                on_progress=on_progress,
-            )
+            try:
+                ds = run_sweep(
+                    spec,
+                    out=out,
+                    params=params,
+                    workers=workers,
+                    scheduler=scheduler,
+                    resume=resume,
+                    on_progress=on_progress,
+                )
+            except KeyboardInterrupt:
+                from jointwear.sim._sweep_store import parts_dir
+
+                n = len(list(parts_dir(out).glob("run-*.npz")))
+                typer.echo(
+                    f"interrupted: {n} finished run(s) are kept in {parts_dir(out)}; "
+                    "run the same command with --resume to compute the rest",
+                    err=True,
+                )
+                raise
         status = np.asarray(ds["status"].values)
         typer.echo(
             f"{out}: {ds.attrs['n_runs']} runs ({ds.attrs['sweep_method']}, "

@@ -217,6 +217,7 @@ def assemble(
                 "design): their spread is NOT an input uncertainty"
             ),
             "n_runs": n,
+            "ensemble_complete": bool(np.all(status == STATUS["ok"])),
             "n_ok": int(np.sum(status == STATUS["ok"])),
             "n_failed": n_failed,
             "n_not_run": n_missing,
@@ -260,6 +261,10 @@ def sensitivity(ds: xr.Dataset, spec: SweepSpec, design: Design) -> xr.Dataset:
 
         keys = ("S1", "S1_conf", "ST", "ST_conf")
         table = {k: np.full((len(spec.outputs), len(names)), np.nan) for k in keys}
+        keys2 = ("S2", "S2_conf") if spec.second_order else ()
+        table.update(
+            {k: np.full((len(spec.outputs), len(names), len(names)), np.nan) for k in keys2}
+        )
         for i, out in enumerate(spec.outputs):
             y = np.asarray(ds[out].values, dtype=float)
             if not np.all(np.isfinite(y)):
@@ -276,12 +281,21 @@ def sensitivity(ds: xr.Dataset, spec: SweepSpec, design: Design) -> xr.Dataset:
                 )
             )
             notes += [f"{out}: {c}" for c in caught]
-            for k in keys:
+            for k in keys + keys2:
                 table[k][i] = np.asarray(res[k], dtype=float)
         long = {
             "S1": "first-order Sobol index",
             "ST": "total-effect Sobol index",
+            "S2": "second-order Sobol index of the pair (parameter, parameter_2)",
         }
+        for k in keys2:
+            attrs = {"units": "1", "long_name": long["S2"]}
+            if k.endswith("_conf"):
+                attrs["long_name"] = (
+                    f"half-width of the {100 * spec.confidence:g} % bootstrap confidence interval "
+                    "of the second-order Sobol index"
+                )
+            ds[f"sobol_{k}"] = xr.Variable(("output", "parameter", "parameter_2"), table[k], attrs)
         for k in keys:
             base = k.split("_")[0]
             attrs = {"units": "1", "long_name": long[base]}
@@ -352,6 +366,12 @@ def sensitivity(ds: xr.Dataset, spec: SweepSpec, design: Design) -> xr.Dataset:
         ds = ds.assign_coords(
             output=xr.Variable("output", np.array(spec.outputs), {"long_name": "sweep output"})
         )
+        if spec.second_order:
+            ds = ds.assign_coords(
+                parameter_2=xr.Variable(
+                    "parameter_2", np.array(names), {"long_name": "swept parameter (second)"}
+                )
+            )
     if not_assessed:
         ds.attrs["sensitivity_not_assessed"] = json.dumps(not_assessed, sort_keys=True)
     if notes:
@@ -432,8 +452,8 @@ def run_sweep(
 
     if resume and out is None:
         raise BadInputError("resume needs the sweep's result file (out=/--out)")
-    spec = spec if isinstance(spec, SweepSpec) else read_spec(spec)
     spec_file = [Path(spec)] if isinstance(spec, (str, Path)) else []
+    spec = spec if isinstance(spec, SweepSpec) else read_spec(spec)
     sim, wear, base_record, inputs = _base(spec, params, wear)
     if spec.run != "function":
         _check_feasible(spec, sim, wear)

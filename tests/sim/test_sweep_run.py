@@ -52,7 +52,7 @@ def test_ishigami_sobol_indices_match_the_analytic_values_within_salib_intervals
     assert float(ds.sobol_S1_conf.max()) < 0.1
     assert float(ds.sobol_ST.sel(output="y", parameter="x3")) > 0.15  # interaction x1 x3
     assert float(ds.sobol_S1.sel(output="y", parameter="x3")) < 0.05
-    assert ds.attrs["probabilistic_sample"] is True
+    assert ds.attrs["probabilistic_sample"] is True and ds.attrs["ensemble_complete"] is True
 
 
 def test_morris_ranks_a_linear_model_by_its_coefficients():
@@ -78,6 +78,7 @@ def test_failed_runs_are_recorded_and_do_not_stop_the_sweep(tmp_path):
     assert np.allclose(ds["y"].values[~failed], x1[~failed] + 2 * ds["x2"].values[~failed])
     back = io.load(out)
     assert back.attrs["n_failed"] == int(failed.sum())
+    assert back.attrs["ensemble_complete"] is False and back.attrs["probabilistic_sample"] is True
     assert back["status"].attrs["flag_meanings"] == "ok failed not_run"
     assert back["x1"].attrs["units"] == "1"
     assert json.loads(back.attrs["provenance"])["parameters"]["spec"]["method"] == "lhs"
@@ -219,9 +220,82 @@ def test_cli_sweep_writes_the_file_and_reports_failures(tmp_path, capsys):
     assert 0 < n_failed < 6
     assert f"{6 - n_failed} ok, {n_failed} failed, 0 not run" in cap.out
     assert "exceeds fail_above" in cap.err
+    prov = io.parse_provenance(ds)
+    assert any(str(spec) in i["path"] and "sha256" in i for i in prov["inputs"])
     code = main(["sim", "sweep", str(spec), "--out", str(out), "--params", "x.toml"])
     assert code == 3 and "--params does not apply" in capsys.readouterr().err
     spec.write_text(spec.read_text().replace('"lhs"', '"lhz"'))
     code = main(["sim", "sweep", str(spec), "--out", str(out), "--workers", "0"])
     err = capsys.readouterr().err
     assert code == 3 and "method = 'lhz'" in err and "Traceback" not in err
+
+
+def test_runs_lost_by_the_cluster_are_not_run_and_resumable(tmp_path, monkeypatch, capsys):
+    spec = tmp_path / "spec.toml"
+    spec.write_text(
+        '[sweep]\nrun = "function"\nfunction = "linear"\nmethod = "lhs"\nsamples = 6\n'
+        '[parameters.x1]\ndistribution = "uniform"\nbounds = [0, 1]\n'
+    )
+    out = tmp_path / "s.nc"
+    real = sweep_mod.execute_runs
+
+    def losing(tasks, **kw):  # dask gives up on run 2 (it killed several workers)
+        kw["on_lost"](2, "KilledWorker: attempted to run task 3 times")
+        real([t for t in tasks if t.index != 2], **kw)
+
+    monkeypatch.setattr(sweep_mod, "execute_runs", losing)
+    code = main(["sim", "sweep", str(spec), "--out", str(out), "--workers", "0"])
+    err = capsys.readouterr().err
+    assert code == 3 and "--resume" in err
+    ds = io.load(out)  # what was computed is written ...
+    assert ds["status"].values.tolist() == [0, 0, 2, 0, 0, 0]
+    assert "KilledWorker" in str(ds["error"].values[2]) and np.isnan(ds["y"].values[2])
+    assert len(list(parts_dir(out).glob("run-*.npz"))) == 5  # ... and the parts are kept
+    monkeypatch.setattr(sweep_mod, "execute_runs", real)
+    assert main(["sim", "sweep", str(spec), "--out", str(out), "--workers", "0", "--resume"]) == 0
+    ds = io.load(out)
+    assert ds.attrs["runs_computed_now"] == 1 and (ds["status"].values == 0).all()
+    assert not parts_dir(out).exists()
+
+
+def test_second_order_sobol_index_of_the_ishigami_interaction():
+    u = {"distribution": "uniform", "bounds": [-PI, PI]}
+    ds = run_sweep(
+        function_spec(
+            "sobol",
+            samples=512,
+            function="ishigami",
+            params={"x1": u, "x2": u, "x3": u},
+            second_order=True,
+            seed=3,
+        ),
+        workers=0,
+    )
+    assert ds.sizes["run"] == 512 * 8  # N (2D + 2)
+    truth = analytic_sobol("ishigami")
+    s13_true = truth["ST"]["x3"]  # x3 acts only through its interaction with x1
+    s2 = ds["sobol_S2"].sel(output="y")
+    conf = ds["sobol_S2_conf"].sel(output="y")
+    est = float(s2.sel(parameter="x1", parameter_2="x3"))
+    assert abs(est - s13_true) <= float(conf.sel(parameter="x1", parameter_2="x3"))
+    assert abs(float(s2.sel(parameter="x1", parameter_2="x2"))) <= float(
+        conf.sel(parameter="x1", parameter_2="x2")
+    )
+
+
+def test_a_wear_run_over_its_cycle_budget_fails_with_the_reason(tmp_path):
+    spec = {
+        "sweep": {
+            "run": "wear",
+            "method": "grid",
+            "cycles": 300,
+            "max_cycles_simulated": 3,
+            "outputs": ["max_wear_depth"],
+        },
+        "parameters": {"wear.kw": {"values": [9e-16]}},
+    }
+    ds = run_sweep(spec, params=tiny_base(tmp_path), workers=0)
+    assert ds["status"].values.tolist() == [1]
+    err = str(ds["error"].values[0])
+    assert "max_cycles_simulated = 3" in err and "of 300 cycles done" in err
+    assert np.isnan(ds["max_wear_depth"].values[0])

@@ -245,3 +245,19 @@ def test_function_runs_check_their_inputs():
                 "parameters": {"x1": {"distribution": "uniform", "bounds": [0, 1]}},
             }
         )
+
+
+def test_an_unworn_bore_has_no_location_of_maximum_wear():
+    from jointwear.sim._sweep_outputs import wear_outputs
+    from jointwear.sim.wearmap import BearingGrid, wear_map_dataset
+
+    grid = BearingGrid(4, 24)
+    maps = np.zeros((2, *grid.shape))
+    maps[1, 2, 5] = 1e-6  # layer 2 (from +z), point 5
+    ds = wear_map_dataset(maps, np.array([10.0, 20.0]), grid)
+    out = wear_outputs(ds)
+    assert out["max_wear_theta"] == pytest.approx(5 * 360 / 24)
+    assert out["max_wear_z"] == pytest.approx(grid.z[2])
+    out = wear_outputs(ds.isel(cycles=[0]))
+    assert out["max_wear_depth"] == 0 and math.isnan(out["max_wear_theta"])
+    assert math.isnan(out["max_wear_z"])
