@@ -60,6 +60,45 @@ def _expand_batch(paths: list[Path], batch: bool) -> list[Path]:
     return items
 
 
+def _assess_point_file(path: Path, target: Path | None, units: str | None) -> None:
+    """``assess`` of a file of Cartesian points: exact LS circle per layer, printed in mm/µm."""
+    from jointwear import io
+    from jointwear.errors import BadInputError
+    from jointwear.metrology.assess import assess_points
+    from jointwear.metrology.readers.table import TextFormat, parse_file, unit_factor
+
+    pf = parse_file(path, TextFormat(units=units))
+    cols = list(pf.columns)
+    if "x" not in cols or "y" not in cols:
+        raise BadInputError(
+            f"'{path}': not a netCDF scan, and its columns ({', '.join(cols)}) are not x, y "
+            "points; import instrument traces with 'jointwear metrology import' first, or name "
+            "the columns X, Y (and Z)"
+        )
+    if pf.units is None:
+        raise BadInputError(
+            f"'{path}': the length unit of the points is not stated; pass --units (um, mm, m)"
+        )
+    f = unit_factor(pf.units)
+    x, y = pf.data[:, cols.index("x")] * f, pf.data[:, cols.index("y")] * f
+    z = None
+    if "z" in cols:
+        zu = pf.column_units.get(str(cols.index("z"))) or pf.z_units or pf.units
+        z = pf.data[:, cols.index("z")] * unit_factor(zu)
+    ds = assess_points(x, y, z, source=str(path))
+    typer.echo(f"{path}  (exact least-squares circle per layer; lengths in mm, form in µm)")
+    for i in range(ds.sizes["z"]):
+        typer.echo(
+            f"  z {float(ds['z'][i]) * 1e3:9.4f}  n {int(ds['n_points'][i]):6d}  arc "
+            f"{float(ds['arc'][i]):6.1f} deg  centre ({float(ds['x0'][i]) * 1e3:.9g}, "
+            f"{float(ds['y0'][i]) * 1e3:.9g})  radius {float(ds['radius'][i]) * 1e3:.12g}  "
+            f"RONt {float(ds['RONt_LS'][i]) * 1e6:.4f}  RONq {float(ds['RONq_LS'][i]) * 1e6:.4f}"
+        )
+    if target is not None:
+        io.save(ds, target, inputs=[path], source=_SOURCE, parameters={"units": pf.units})
+        typer.echo(f"wrote {target}")
+
+
 def register(app: typer.Typer) -> None:
     """Add the metrology commands."""
 
@@ -254,7 +293,13 @@ def register(app: typer.Typer) -> None:
 
     @app.command("assess")
     def assess_cmd(
-        scans: Annotated[list[Path], typer.Argument(help="Imported scan(s) (.nc).")],
+        scans: Annotated[
+            list[Path],
+            typer.Argument(
+                help="Imported scan(s) (.nc), or text/Excel files of x, y (and z) points, which "
+                "get an exact least-squares circle per layer (need not surround the origin)."
+            ),
+        ],
         filter_upr: Annotated[
             float | None,
             typer.Option("--filter", help="Filter cut-off [UPR], e.g. 15, 50, 150, 500."),
@@ -271,8 +316,25 @@ def register(app: typer.Typer) -> None:
             typer.Option("--outliers", help="Remove spikes beyond this many robust std devs."),
         ] = None,
         exact: Annotated[
-            bool, typer.Option("--exact", help="Also the exact geometric LS cylinder.")
+            bool,
+            typer.Option(
+                "--exact",
+                help="Also the exact geometric LS circle per layer (and cylinder for several "
+                "layers).",
+            ),
         ] = False,
+        nominal_radius_mm: Annotated[
+            float | None,
+            typer.Option(
+                "--nominal-radius-mm",
+                help="Bore radius [mm] for the centring check and --exact on deviation data "
+                "(default: the mean radius, or the file's nominal radius).",
+            ),
+        ] = None,
+        units: Annotated[
+            str | None,
+            typer.Option("--units", help="Length unit of a point file that does not state it."),
+        ] = None,
         csv: Annotated[Path | None, typer.Option("--csv", help="Write the table as CSV.")] = None,
         out: Annotated[
             Path | None,
@@ -292,7 +354,15 @@ def register(app: typer.Typer) -> None:
             io.check_writable(csv)
         targets = _outputs(scans, out, "_form.nc") if out is not None else [None] * len(scans)
         tables = []
+        if nominal_radius_mm is not None and not nominal_radius_mm > 0:
+            raise typer.BadParameter(
+                f"must be a positive radius in mm, got {nominal_radius_mm:g}",
+                param_hint="--nominal-radius-mm",
+            )
         for scan_path, target in zip(scans, targets, strict=True):
+            if scan_path.suffix.lower() not in (".nc", ".nc4", ".netcdf"):
+                _assess_point_file(scan_path, target, units)
+                continue
             scan = io.load(scan_path)
             with warnings.catch_warnings(record=True) as caught:
                 warnings.simplefilter("always", CentringWarning)
@@ -303,6 +373,7 @@ def register(app: typer.Typer) -> None:
                     filter_kind=filter_kind,
                     outliers=outliers,
                     exact=exact,
+                    radius=nominal_radius_mm * 1e-3 if nominal_radius_mm is not None else None,
                 )
             for w in caught:
                 typer.echo(f"warning: {scan_path}: {w.message}", err=True)
@@ -327,7 +398,7 @@ def register(app: typer.Typer) -> None:
                 typer.echo(f"wrote {target}")
             table.insert(0, "scan", str(scan_path))
             tables.append(table)
-        if csv is not None:
+        if csv is not None and tables:
             with io.atomic_path(csv) as tmp:
                 pd.concat(tables, ignore_index=True).to_csv(tmp, index=False)
             typer.echo(f"wrote {csv}")
