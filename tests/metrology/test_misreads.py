@@ -296,3 +296,14 @@ def test_cli_refuses_with_exit_3_and_accepts_with_the_flag(tmp_path, capsys):
     assert not (tmp_path / "o.nc").exists()
     assert main(base + ["--angle-unit", "deg"]) == 0
     assert (tmp_path / "o.nc").exists()
+
+
+def test_corrupt_first_row_is_not_taken_for_column_names(tmp_path):
+    # found by the fuzz test: '0.0<TAB>n.a.' above the table was read as the names line and the
+    # point silently dropped (an 18-point partial arc instead of a 19-point full turn)
+    rows = [f"{a:.1f}\t{v:.4f}" for a, v in zip(np.arange(19) * 360 / 19, _dev(19), strict=True)]
+    rows[0] = "0.0\tn.a."
+    f = tmp_path / "first.txt"
+    f.write_text("Units: um\n" + "\n".join(rows) + "\n")
+    with pytest.raises(BadInputError, match=r"first.txt' line 2: .*looks like a row of the table"):
+        read_scan(f, convention=CONV)
