@@ -24,6 +24,53 @@ class Arc(StrEnum):
     partial = "partial"
 
 
+class Preset(StrEnum):
+    """Reader preset."""
+
+    generic = "generic"
+    talyrond = "talyrond"
+
+
+class Layout(StrEnum):
+    """Multi-layer layout."""
+
+    auto = "auto"
+    single = "single"
+    folder = "folder"
+    long = "long"
+    wide = "wide"
+
+
+class Decimal(StrEnum):
+    """Decimal separator."""
+
+    point = "."
+    comma = ","
+
+
+class FilterKind(StrEnum):
+    """Profile filter."""
+
+    gaussian = "gaussian"
+    rc2 = "2rc"
+
+
+class Shape(StrEnum):
+    """Unworn reference shape."""
+
+    cylinder = "cylinder"
+    circle = "circle"
+
+
+class Reference(StrEnum):
+    """ISO reference."""
+
+    LS = "LS"
+    MZ = "MZ"
+    MI = "MI"
+    MC = "MC"
+
+
 class ValueKind(StrEnum):
     """Meaning of the value column(s)."""
 
@@ -33,6 +80,20 @@ class ValueKind(StrEnum):
 
 
 _SOURCE = "jointwear 0.1 (metrology)"
+
+
+def _length_unit(value: str | None) -> str | None:
+    """Validate a length-unit option at parse time (a bad value is a usage error, exit 2)."""
+    if value is None:
+        return None
+    from jointwear.errors import BadInputError
+    from jointwear.metrology.readers.table import unit_factor
+
+    try:
+        unit_factor(value)
+    except BadInputError:
+        raise typer.BadParameter(f"unit {value!r} is not known; use um, mm, m or inch") from None
+    return value
 
 
 def _outputs(inputs: list[Path], out: Path, suffix: str) -> list[Path]:
@@ -130,18 +191,27 @@ def register(app: typer.Typer) -> None:
             ),
         ] = None,
         preset: Annotated[
-            str, typer.Option("--preset", help="generic or talyrond (defaults: values in µm).")
-        ] = "generic",
+            Preset,
+            typer.Option("--preset", help="generic or talyrond (values in µm, whole revolutions)."),
+        ] = Preset.generic,
         layout: Annotated[
-            str, typer.Option("--layout", help="auto, single, folder, long or wide.")
-        ] = "auto",
+            Layout, typer.Option("--layout", help="auto, single, folder, long or wide.")
+        ] = Layout.auto,
         units: Annotated[
-            str | None, typer.Option("--units", help="Length unit: um, mm, m or inch.")
+            str | None,
+            typer.Option(
+                "--units",
+                help="Length unit of files that do not state it: um, mm, m or inch (a unit the "
+                "file contradicts is an error).",
+                callback=_length_unit,
+            ),
         ] = None,
         delimiter: Annotated[
             str | None, typer.Option("--delimiter", help="tab, semicolon, comma or whitespace.")
         ] = None,
-        decimal: Annotated[str | None, typer.Option("--decimal", help="'.' or ','.")] = None,
+        decimal: Annotated[
+            Decimal | None, typer.Option("--decimal", help="Decimal separator: '.' or ','.")
+        ] = None,
         header_lines: Annotated[
             int | None, typer.Option("--header-lines", help="Lines before the numeric table.")
         ] = None,
@@ -237,8 +307,6 @@ def register(app: typer.Typer) -> None:
                 "(clockwise or counterclockwise seen from +z); text exports rarely state it and "
                 "jointwear never guesses it"
             )
-        if preset not in ("generic", "talyrond"):
-            raise BadInputError(f"--preset {preset!r}: use generic or talyrond")
         reader = read_talyrond if preset == "talyrond" else read_scan
         if batch:
             items: list = _expand_batch(paths, batch)
@@ -253,9 +321,9 @@ def register(app: typer.Typer) -> None:
             )
         targets = _outputs(names, out, ".nc")
         opts = dict(
-            layout=layout,
+            layout=str(layout),
             delimiter=delimiter,
-            decimal=decimal,
+            decimal=str(decimal) if decimal is not None else None,
             header_lines=header_lines,
             columns=tuple(c.strip() for c in columns.split(",")) if columns else None,
             value=str(value),
@@ -305,10 +373,10 @@ def register(app: typer.Typer) -> None:
             typer.Option("--filter", help="Filter cut-off [UPR], e.g. 15, 50, 150, 500."),
         ] = None,
         filter_kind: Annotated[
-            str, typer.Option("--filter-kind", help="gaussian or 2rc.")
-        ] = "gaussian",
+            FilterKind, typer.Option("--filter-kind", help="gaussian or 2rc.")
+        ] = FilterKind.gaussian,
         reference: Annotated[
-            list[str] | None,
+            list[Reference] | None,
             typer.Option("--reference", "-r", help="LS, MZ, MI, MC (repeat; default: all four)."),
         ] = None,
         outliers: Annotated[
@@ -333,7 +401,11 @@ def register(app: typer.Typer) -> None:
         ] = None,
         units: Annotated[
             str | None,
-            typer.Option("--units", help="Length unit of a point file that does not state it."),
+            typer.Option(
+                "--units",
+                help="Length unit of a point file that does not state it: um, mm, m or inch.",
+                callback=_length_unit,
+            ),
         ] = None,
         csv: Annotated[Path | None, typer.Option("--csv", help="Write the table as CSV.")] = None,
         out: Annotated[
@@ -349,7 +421,8 @@ def register(app: typer.Typer) -> None:
         from jointwear import io
         from jointwear.metrology.assess import CentringWarning, assess, form_table
 
-        refs = tuple(reference) if reference else ("LS", "MZ", "MI", "MC")
+        refs = tuple(str(r) for r in reference) if reference else ("LS", "MZ", "MI", "MC")
+        filter_kind = str(filter_kind)
         if csv is not None:
             io.check_writable(csv)
         targets = _outputs(scans, out, "_form.nc") if out is not None else [None] * len(scans)
@@ -420,8 +493,9 @@ def register(app: typer.Typer) -> None:
             bool, typer.Option("--register", help="Estimate the rotation from the unworn regions.")
         ] = False,
         shape: Annotated[
-            str, typer.Option("--shape", help="Unworn reference: cylinder or circle (per layer).")
-        ] = "cylinder",
+            Shape,
+            typer.Option("--shape", help="Unworn reference: cylinder or circle (per layer)."),
+        ] = Shape.cylinder,
         threshold: Annotated[
             float, typer.Option("--threshold", help="Unworn = within this many robust std devs.")
         ] = 3.0,
@@ -446,7 +520,7 @@ def register(app: typer.Typer) -> None:
                 ref,
                 angle_offset_deg=angle_offset_deg,
                 register=register,
-                shape=shape,
+                shape=str(shape),
                 threshold=threshold,
                 radius=radius_mm * 1e-3 if radius_mm else None,
             )
@@ -460,7 +534,7 @@ def register(app: typer.Typer) -> None:
                 parameters={
                     "angle_offset_deg": angle_offset_deg,
                     "register": register,
-                    "shape": shape,
+                    "shape": str(shape),
                     "threshold": threshold,
                 },
             )

@@ -293,6 +293,9 @@ def test_cli_refuses_with_exit_3_and_accepts_with_the_flag(tmp_path, capsys):
     assert main(base) == 3
     assert "--angle-unit" in capsys.readouterr().err
     assert main(base + ["--angle-unit", "degrees"]) == 2  # not a choice: usage error
+    assert main(base + ["--layout", "diagonal"]) == 2
+    assert main(base[:-4] + ["--units", "furlong", "--out", str(tmp_path / "o.nc")]) == 2
+    assert main(base + ["--decimal", ";"]) == 2
     assert not (tmp_path / "o.nc").exists()
     assert main(base + ["--angle-unit", "deg"]) == 0
     assert (tmp_path / "o.nc").exists()
