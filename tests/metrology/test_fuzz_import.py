@@ -112,3 +112,47 @@ def _num(c):
         return float(c)
     except ValueError:
         return c
+
+
+@settings(
+    max_examples=int(os.environ.get("JOINTWEAR_FUZZ_EXAMPLES", "15")),
+    deadline=None,
+    suppress_health_check=[HealthCheck.function_scoped_fixture],
+)
+@given(
+    n=st.integers(12, 200),
+    layers=st.integers(1, 4),
+    radius=st.floats(1e-3, 0.2),
+    offset=st.floats(0.0, 3.0),
+    seed=st.integers(0, 2**32 - 1),
+)
+def test_x3p_point_clouds_read_exactly_or_refuse(tmp_path_factory, n, layers, radius, offset, seed):
+    """Any X3P point cloud about the spindle axis reads back point for point; one whose centre
+    is half a radius or more off the axis is refused, never re-interpreted."""
+    x3pio = pytest.importorskip("x3pio")
+    rng = np.random.default_rng(seed)
+    t = np.sort(rng.uniform(0, 2 * np.pi, n))
+    t = t[np.concatenate([[True], np.diff(t) > 1e-6])]
+    e = offset * radius * np.array([np.cos(seed), np.sin(seed)])
+    pts = np.concatenate(
+        [
+            np.column_stack(
+                [e[0] + radius * np.cos(t), e[1] + radius * np.sin(t), np.full(t.size, k * 1e-3)]
+            )
+            for k in range(layers)
+        ]
+    )
+    f = tmp_path_factory.mktemp("x3") / "cloud.x3p"
+    x3pio.write_points(f, pts)
+    try:
+        ds = read_scan(f, convention=CANON)
+    except JointwearError as exc:
+        assert "cloud.x3p" in str(exc)
+        assert offset >= 0.5, str(exc)
+        assert "do not surround the origin" in str(exc)
+        return
+    assert offset < 0.5  # an off-axis cloud must never be read as a trace about the axis
+    assert ds.sizes["z"] == layers
+    got = ds["radius"].values[-1]
+    last = pts[-t.size :]
+    np.testing.assert_allclose(np.sort(got), np.sort(np.hypot(last[:, 0], last[:, 1])), rtol=1e-15)
