@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from jointwear.metrology.assess import CentringWarning, assess, form_table
+from jointwear.metrology.assess import CentringWarning, assess, assess_points, form_table
 from jointwear.metrology.filters import (
     STANDARD_CUTOFFS,
     filter_profile,
@@ -40,6 +40,7 @@ __all__ = [
     "TextFormat",
     "ZoneResult",
     "assess",
+    "assess_points",
     "circle_zone",
     "cylinder_zone",
     "cylindricity",

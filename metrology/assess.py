@@ -15,6 +15,7 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
+from jointwear.conventions import z_coord
 from jointwear.errors import BadInputError
 from jointwear.metrology.filters import (
     filter_profile,
@@ -22,7 +23,7 @@ from jointwear.metrology.filters import (
     is_uniform,
     remove_outliers,
 )
-from jointwear.metrology.fit import fit_cylinder_polar
+from jointwear.metrology.fit import fit_circle, fit_circle_polar, fit_cylinder_polar
 from jointwear.metrology.form import (
     REFERENCES,
     circle_zone,
@@ -32,7 +33,7 @@ from jointwear.metrology.form import (
     normalise_reference,
 )
 
-__all__ = ["CentringWarning", "assess", "form_table"]
+__all__ = ["CentringWarning", "assess", "assess_points", "form_table"]
 
 _PARAMS = {"t": "peak-to-valley", "p": "peak", "v": "valley", "q": "RMS"}
 
@@ -88,7 +89,9 @@ def assess(
         Bore radius for the centring check [m] (default: the mean radius, or the
         ``nominal_radius`` attribute of deviation data).
     exact : bool
-        Also compute the exact geometric least-squares cylinder (needs the radius).
+        Also compute the exact geometric least-squares circle of each layer and, for several
+        layers, the exact cylinder. Deviation data need the bore radius (``radius`` or the
+        ``nominal_radius`` attribute); without it the request is refused, never ignored.
 
     Returns
     -------
@@ -233,18 +236,8 @@ def assess(
                     res.tilt[1],
                     {"units": "1", "long_name": "LS axis slope dy/dz (scan frame)"},
                 )
-        if exact and name == "radius":
-            fit = fit_cylinder_polar(zz, tt, v)
-            out["CYLt_LS_exact"] = (
-                (),
-                float(np.nanmax(fit.residual) - np.nanmin(fit.residual)),
-                {"units": "m", "long_name": "CYLt from the exact geometric least-squares cylinder"},
-            )
-            out["radius_LS_exact"] = (
-                (),
-                fit.radius,
-                {"units": "m", "long_name": "radius of the exact geometric least-squares cylinder"},
-            )
+    if exact:
+        out.update(_exact_fits(z, th, v, name, radius))
     # spectrum
     if uniform and np.all(np.isfinite(v)):
         spec = harmonic_spectrum(v, max_order=max_harmonic)
@@ -264,6 +257,128 @@ def assess(
             "units": "1",
             "long_name": "harmonic order (undulations per revolution)",
         }
+    return ds
+
+
+def _exact_fits(
+    z: np.ndarray, th: np.ndarray, v: np.ndarray, name: str, radius: float | None
+) -> dict[str, tuple]:
+    """Exact geometric LS circle per layer (and cylinder for several layers) of r(z, theta)."""
+    if name != "radius":
+        if radius is None or not radius > 0:
+            raise BadInputError(
+                "assess: exact=True (--exact) on radial deviations needs the bore radius to "
+                "rebuild the radii: pass radius= (--nominal-radius-mm), or import radii"
+            )
+        v = v + radius
+    out: dict[str, tuple] = {}
+    fits = [fit_circle_polar(th, v[i]) for i in range(z.size)]
+    out["RONt_LS_exact"] = (
+        ("z",),
+        np.array([np.nanmax(f.residual) - np.nanmin(f.residual) for f in fits]),
+        {"units": "m", "long_name": "RONt from the exact geometric least-squares circle"},
+    )
+    out["radius_LS_exact_layer"] = (
+        ("z",),
+        np.array([f.radius for f in fits]),
+        {"units": "m", "long_name": "radius of the exact geometric least-squares circle"},
+    )
+    if z.size > 1:
+        zz = np.broadcast_to(z[:, None], v.shape)
+        tt = np.broadcast_to(th[None, :], v.shape)
+        fit = fit_cylinder_polar(zz, tt, v)
+        out["CYLt_LS_exact"] = (
+            (),
+            float(np.nanmax(fit.residual) - np.nanmin(fit.residual)),
+            {"units": "m", "long_name": "CYLt from the exact geometric least-squares cylinder"},
+        )
+        out["radius_LS_exact"] = (
+            (),
+            fit.radius,
+            {"units": "m", "long_name": "radius of the exact geometric least-squares cylinder"},
+        )
+    return out
+
+
+def assess_points(
+    x: np.ndarray, y: np.ndarray, z: np.ndarray | None = None, *, source: str = "points"
+) -> xr.Dataset:
+    """Exact least-squares circle of each layer of a Cartesian point set (any arc, any centre).
+
+    Parameters
+    ----------
+    x, y : ndarray
+        Point coordinates [m]; the points need not surround the origin.
+    z : ndarray, optional
+        Layer height of each point [m]; points of equal z form a layer (default: one layer).
+    source : str
+        Name of the input for messages.
+
+    Returns
+    -------
+    Dataset
+        Per layer (``z``): ``x0``, ``y0``, ``radius`` [m] of the geometric LS circle (Gauss-Newton
+        to machine precision), ``RON{t,p,v,q}_LS`` [m] from the orthogonal residuals,
+        ``n_points``, ``arc`` [degree] covered about the fitted centre.
+    """
+    x = np.asarray(x, dtype=float).ravel()
+    y = np.asarray(y, dtype=float).ravel()
+    zz = np.zeros_like(x) if z is None else np.asarray(z, dtype=float).ravel()
+    levels = np.unique(zz)
+    cols: dict[str, list] = {k: [] for k in ("x0", "y0", "radius", "t", "p", "v", "q", "n", "arc")}
+    for level in levels:
+        sel = zz == level
+        fit = fit_circle(x[sel], y[sel])
+        res = fit.residual
+        ang = np.sort(np.arctan2(y[sel] - fit.y0, x[sel] - fit.x0))
+        gaps = np.diff(np.concatenate([ang, ang[:1] + 2 * np.pi]))
+        for k, val in (
+            ("x0", fit.x0),
+            ("y0", fit.y0),
+            ("radius", fit.radius),
+            ("t", np.nanmax(res) - np.nanmin(res)),
+            ("p", np.nanmax(res)),
+            ("v", -np.nanmin(res)),
+            ("q", fit.rms),
+            ("n", int(sel.sum())),
+            ("arc", float(np.degrees(2 * np.pi - np.max(gaps)))),
+        ):
+            cols[k].append(val)
+    m = {"units": "m"}
+    ds = xr.Dataset(
+        {
+            "x0": (("z",), cols["x0"], {**m, "long_name": "x of the LS circle centre"}),
+            "y0": (("z",), cols["y0"], {**m, "long_name": "y of the LS circle centre"}),
+            "radius": (("z",), cols["radius"], {**m, "long_name": "radius of the LS circle"}),
+            **{
+                f"RON{k}_LS": (
+                    ("z",),
+                    cols[k],
+                    {**m, "long_name": f"roundness RON{k} ({_PARAMS[k]}) from the exact LS circle"},
+                )
+                for k in _PARAMS
+            },
+            "n_points": (("z",), cols["n"], {"units": "1", "long_name": "points in the layer"}),
+            "arc": (
+                ("z",),
+                cols["arc"],
+                {"units": "degree", "long_name": "angle covered about the fitted centre"},
+            ),
+        },
+        coords={
+            "z": z_coord(
+                levels,
+                note="layer height as given in the point file (not re-centred on the "
+                "bearing mid-width)",
+            )
+        },
+        attrs={
+            "title": "form assessment of a point set",
+            "model": "exact geometric least-squares circle per layer (orthogonal distances; "
+            "Levenberg-Marquardt then Gauss-Newton with double-double residuals)",
+            "input": source,
+        },
+    )
     return ds
 
 

@@ -24,6 +24,53 @@ class Arc(StrEnum):
     partial = "partial"
 
 
+class Preset(StrEnum):
+    """Reader preset."""
+
+    generic = "generic"
+    talyrond = "talyrond"
+
+
+class Layout(StrEnum):
+    """Multi-layer layout."""
+
+    auto = "auto"
+    single = "single"
+    folder = "folder"
+    long = "long"
+    wide = "wide"
+
+
+class Decimal(StrEnum):
+    """Decimal separator."""
+
+    point = "."
+    comma = ","
+
+
+class FilterKind(StrEnum):
+    """Profile filter."""
+
+    gaussian = "gaussian"
+    rc2 = "2rc"
+
+
+class Shape(StrEnum):
+    """Unworn reference shape."""
+
+    cylinder = "cylinder"
+    circle = "circle"
+
+
+class Reference(StrEnum):
+    """ISO reference."""
+
+    LS = "LS"
+    MZ = "MZ"
+    MI = "MI"
+    MC = "MC"
+
+
 class ValueKind(StrEnum):
     """Meaning of the value column(s)."""
 
@@ -33,6 +80,20 @@ class ValueKind(StrEnum):
 
 
 _SOURCE = "jointwear 0.1 (metrology)"
+
+
+def _length_unit(value: str | None) -> str | None:
+    """Validate a length-unit option at parse time (a bad value is a usage error, exit 2)."""
+    if value is None:
+        return None
+    from jointwear.errors import BadInputError
+    from jointwear.metrology.readers.table import unit_factor
+
+    try:
+        unit_factor(value)
+    except BadInputError:
+        raise typer.BadParameter(f"unit {value!r} is not known; use um, mm, m or inch") from None
+    return value
 
 
 def _outputs(inputs: list[Path], out: Path, suffix: str) -> list[Path]:
@@ -58,6 +119,45 @@ def _expand_batch(paths: list[Path], batch: bool) -> list[Path]:
             raise BadInputError(f"--batch: folder '{p}' is empty")
         items.extend(children)
     return items
+
+
+def _assess_point_file(path: Path, target: Path | None, units: str | None) -> None:
+    """``assess`` of a file of Cartesian points: exact LS circle per layer, printed in mm/µm."""
+    from jointwear import io
+    from jointwear.errors import BadInputError
+    from jointwear.metrology.assess import assess_points
+    from jointwear.metrology.readers.table import TextFormat, parse_file, unit_factor
+
+    pf = parse_file(path, TextFormat(units=units))
+    cols = list(pf.columns)
+    if "x" not in cols or "y" not in cols:
+        raise BadInputError(
+            f"'{path}': not a netCDF scan, and its columns ({', '.join(cols)}) are not x, y "
+            "points; import instrument traces with 'jointwear metrology import' first, or name "
+            "the columns X, Y (and Z)"
+        )
+    if pf.units is None:
+        raise BadInputError(
+            f"'{path}': the length unit of the points is not stated; pass --units (um, mm, m)"
+        )
+    f = unit_factor(pf.units)
+    x, y = pf.data[:, cols.index("x")] * f, pf.data[:, cols.index("y")] * f
+    z = None
+    if "z" in cols:
+        zu = pf.column_units.get(str(cols.index("z"))) or pf.z_units or pf.units
+        z = pf.data[:, cols.index("z")] * unit_factor(zu)
+    ds = assess_points(x, y, z, source=str(path))
+    typer.echo(f"{path}  (exact least-squares circle per layer; lengths in mm, form in µm)")
+    for i in range(ds.sizes["z"]):
+        typer.echo(
+            f"  z {float(ds['z'][i]) * 1e3:9.4f}  n {int(ds['n_points'][i]):6d}  arc "
+            f"{float(ds['arc'][i]):6.1f} deg  centre ({float(ds['x0'][i]) * 1e3:.9g}, "
+            f"{float(ds['y0'][i]) * 1e3:.9g})  radius {float(ds['radius'][i]) * 1e3:.12g}  "
+            f"RONt {float(ds['RONt_LS'][i]) * 1e6:.4f}  RONq {float(ds['RONq_LS'][i]) * 1e6:.4f}"
+        )
+    if target is not None:
+        io.save(ds, target, inputs=[path], source=_SOURCE, parameters={"units": pf.units})
+        typer.echo(f"wrote {target}")
 
 
 def register(app: typer.Typer) -> None:
@@ -91,18 +191,27 @@ def register(app: typer.Typer) -> None:
             ),
         ] = None,
         preset: Annotated[
-            str, typer.Option("--preset", help="generic or talyrond (defaults: values in µm).")
-        ] = "generic",
+            Preset,
+            typer.Option("--preset", help="generic or talyrond (values in µm, whole revolutions)."),
+        ] = Preset.generic,
         layout: Annotated[
-            str, typer.Option("--layout", help="auto, single, folder, long or wide.")
-        ] = "auto",
+            Layout, typer.Option("--layout", help="auto, single, folder, long or wide.")
+        ] = Layout.auto,
         units: Annotated[
-            str | None, typer.Option("--units", help="Length unit: um, mm, m or inch.")
+            str | None,
+            typer.Option(
+                "--units",
+                help="Length unit of files that do not state it: um, mm, m or inch (a unit the "
+                "file contradicts is an error).",
+                callback=_length_unit,
+            ),
         ] = None,
         delimiter: Annotated[
             str | None, typer.Option("--delimiter", help="tab, semicolon, comma or whitespace.")
         ] = None,
-        decimal: Annotated[str | None, typer.Option("--decimal", help="'.' or ','.")] = None,
+        decimal: Annotated[
+            Decimal | None, typer.Option("--decimal", help="Decimal separator: '.' or ','.")
+        ] = None,
         header_lines: Annotated[
             int | None, typer.Option("--header-lines", help="Lines before the numeric table.")
         ] = None,
@@ -198,8 +307,6 @@ def register(app: typer.Typer) -> None:
                 "(clockwise or counterclockwise seen from +z); text exports rarely state it and "
                 "jointwear never guesses it"
             )
-        if preset not in ("generic", "talyrond"):
-            raise BadInputError(f"--preset {preset!r}: use generic or talyrond")
         reader = read_talyrond if preset == "talyrond" else read_scan
         if batch:
             items: list = _expand_batch(paths, batch)
@@ -214,9 +321,9 @@ def register(app: typer.Typer) -> None:
             )
         targets = _outputs(names, out, ".nc")
         opts = dict(
-            layout=layout,
+            layout=str(layout),
             delimiter=delimiter,
-            decimal=decimal,
+            decimal=str(decimal) if decimal is not None else None,
             header_lines=header_lines,
             columns=tuple(c.strip() for c in columns.split(",")) if columns else None,
             value=str(value),
@@ -254,16 +361,22 @@ def register(app: typer.Typer) -> None:
 
     @app.command("assess")
     def assess_cmd(
-        scans: Annotated[list[Path], typer.Argument(help="Imported scan(s) (.nc).")],
+        scans: Annotated[
+            list[Path],
+            typer.Argument(
+                help="Imported scan(s) (.nc), or text/Excel files of x, y (and z) points, which "
+                "get an exact least-squares circle per layer (need not surround the origin)."
+            ),
+        ],
         filter_upr: Annotated[
             float | None,
             typer.Option("--filter", help="Filter cut-off [UPR], e.g. 15, 50, 150, 500."),
         ] = None,
         filter_kind: Annotated[
-            str, typer.Option("--filter-kind", help="gaussian or 2rc.")
-        ] = "gaussian",
+            FilterKind, typer.Option("--filter-kind", help="gaussian or 2rc.")
+        ] = FilterKind.gaussian,
         reference: Annotated[
-            list[str] | None,
+            list[Reference] | None,
             typer.Option("--reference", "-r", help="LS, MZ, MI, MC (repeat; default: all four)."),
         ] = None,
         outliers: Annotated[
@@ -271,8 +384,29 @@ def register(app: typer.Typer) -> None:
             typer.Option("--outliers", help="Remove spikes beyond this many robust std devs."),
         ] = None,
         exact: Annotated[
-            bool, typer.Option("--exact", help="Also the exact geometric LS cylinder.")
+            bool,
+            typer.Option(
+                "--exact",
+                help="Also the exact geometric LS circle per layer (and cylinder for several "
+                "layers).",
+            ),
         ] = False,
+        nominal_radius_mm: Annotated[
+            float | None,
+            typer.Option(
+                "--nominal-radius-mm",
+                help="Bore radius [mm] for the centring check and --exact on deviation data "
+                "(default: the mean radius, or the file's nominal radius).",
+            ),
+        ] = None,
+        units: Annotated[
+            str | None,
+            typer.Option(
+                "--units",
+                help="Length unit of a point file that does not state it: um, mm, m or inch.",
+                callback=_length_unit,
+            ),
+        ] = None,
         csv: Annotated[Path | None, typer.Option("--csv", help="Write the table as CSV.")] = None,
         out: Annotated[
             Path | None,
@@ -287,12 +421,21 @@ def register(app: typer.Typer) -> None:
         from jointwear import io
         from jointwear.metrology.assess import CentringWarning, assess, form_table
 
-        refs = tuple(reference) if reference else ("LS", "MZ", "MI", "MC")
+        refs = tuple(str(r) for r in reference) if reference else ("LS", "MZ", "MI", "MC")
+        filter_kind = str(filter_kind)
         if csv is not None:
             io.check_writable(csv)
         targets = _outputs(scans, out, "_form.nc") if out is not None else [None] * len(scans)
         tables = []
+        if nominal_radius_mm is not None and not nominal_radius_mm > 0:
+            raise typer.BadParameter(
+                f"must be a positive radius in mm, got {nominal_radius_mm:g}",
+                param_hint="--nominal-radius-mm",
+            )
         for scan_path, target in zip(scans, targets, strict=True):
+            if scan_path.suffix.lower() not in (".nc", ".nc4", ".netcdf"):
+                _assess_point_file(scan_path, target, units)
+                continue
             scan = io.load(scan_path)
             with warnings.catch_warnings(record=True) as caught:
                 warnings.simplefilter("always", CentringWarning)
@@ -303,6 +446,7 @@ def register(app: typer.Typer) -> None:
                     filter_kind=filter_kind,
                     outliers=outliers,
                     exact=exact,
+                    radius=nominal_radius_mm * 1e-3 if nominal_radius_mm is not None else None,
                 )
             for w in caught:
                 typer.echo(f"warning: {scan_path}: {w.message}", err=True)
@@ -327,7 +471,7 @@ def register(app: typer.Typer) -> None:
                 typer.echo(f"wrote {target}")
             table.insert(0, "scan", str(scan_path))
             tables.append(table)
-        if csv is not None:
+        if csv is not None and tables:
             with io.atomic_path(csv) as tmp:
                 pd.concat(tables, ignore_index=True).to_csv(tmp, index=False)
             typer.echo(f"wrote {csv}")
@@ -349,8 +493,9 @@ def register(app: typer.Typer) -> None:
             bool, typer.Option("--register", help="Estimate the rotation from the unworn regions.")
         ] = False,
         shape: Annotated[
-            str, typer.Option("--shape", help="Unworn reference: cylinder or circle (per layer).")
-        ] = "cylinder",
+            Shape,
+            typer.Option("--shape", help="Unworn reference: cylinder or circle (per layer)."),
+        ] = Shape.cylinder,
         threshold: Annotated[
             float, typer.Option("--threshold", help="Unworn = within this many robust std devs.")
         ] = 3.0,
@@ -375,7 +520,7 @@ def register(app: typer.Typer) -> None:
                 ref,
                 angle_offset_deg=angle_offset_deg,
                 register=register,
-                shape=shape,
+                shape=str(shape),
                 threshold=threshold,
                 radius=radius_mm * 1e-3 if radius_mm else None,
             )
@@ -389,7 +534,7 @@ def register(app: typer.Typer) -> None:
                 parameters={
                     "angle_offset_deg": angle_offset_deg,
                     "register": register,
-                    "shape": shape,
+                    "shape": str(shape),
                     "threshold": threshold,
                 },
             )

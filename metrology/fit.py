@@ -78,11 +78,14 @@ def fit_circle(x: np.ndarray, y: np.ndarray) -> CircleFit:
     if ok.sum() < 3:
         raise BadInputError(f"circle fit needs at least 3 points, got {int(ok.sum())}")
     xs, ys = x[ok], y[ok]
-    # centre the data for conditioning
+    # centre and scale the data for conditioning, exactly: the offsets are kept as double-double
+    # (hi, lo) pairs and the scale is a power of two
     cx, cy = xs.mean(), ys.mean()
-    u, v = xs - cx, ys - cy
-    scale = np.sqrt(np.mean(u**2 + v**2)) or 1.0
-    u, v = u / scale, v / scale
+    u, ul = _two_sum(xs, -cx)
+    v, vl = _two_sum(ys, -cy)
+    rms = np.sqrt(np.mean(u**2 + v**2))
+    scale = float(2.0 ** np.round(np.log2(rms))) if rms > 0 else 1.0
+    u, ul, v, vl = u / scale, ul / scale, v / scale, vl / scale
     # Kåsa algebraic fit: u^2 + v^2 + D u + E v + F = 0
     A = np.column_stack([u, v, np.ones_like(u)])
     sol, *_ = np.linalg.lstsq(A, -(u**2 + v**2), rcond=None)
@@ -97,14 +100,84 @@ def fit_circle(x: np.ndarray, y: np.ndarray) -> CircleFit:
         d = np.where(d == 0, 1e-300, d)
         return np.column_stack([-(u - p[0]) / d, -(v - p[1]) / d, -np.ones_like(u)])
 
+    def fun_exact(p):
+        return _circle_residual(u, ul, v, vl, p)
+
     res = least_squares(fun, [a0, b0, r0], jac=jac, method="lm", xtol=1e-15, ftol=1e-15, gtol=1e-15)
-    a, b, r = res.x
+    a, b, r = _gauss_newton(res.x, fun_exact, jac)
     x0, y0, radius = cx + a * scale, cy + b * scale, r * scale
     resid = np.full(x.shape, np.nan)
     resid[ok] = np.hypot(xs - x0, ys - y0) - radius
     return CircleFit(
         float(x0), float(y0), float(radius), float(np.sqrt(np.nanmean(resid**2))), resid
     )
+
+
+def _two_sum(a, b):
+    """Error-free sum: a + b = s + e exactly (Knuth)."""
+    s = a + b
+    bb = s - a
+    return s, (a - (s - bb)) + (b - bb)
+
+
+def _two_prod(a, b):
+    """Error-free product: a * b = p + e exactly (Dekker, no FMA needed)."""
+    p = a * b
+
+    def split(c):
+        t = 134217729.0 * c
+        hi = t - (t - c)
+        return hi, c - hi
+
+    ah, al = split(a)
+    bh, bl = split(b)
+    return p, ((ah * bh - p) + ah * bl + al * bh) + al * bl
+
+
+def _circle_residual(u, ul, v, vl, p):
+    """hypot(u - a, v - b) - r accurate to its own size, not to r.
+
+    The plain difference loses all digits below eps * r, which is what stalls the fit on short
+    arcs; here (u - a)^2 + (v - b)^2 - r^2 is formed in double-double arithmetic from the exact
+    offsets (u + ul, v + vl) and divided by d + r.
+    """
+    a, b, r = p
+    s1, e1 = _two_sum(u, -a)
+    s2, e2 = _two_sum(v, -b)
+    e1 = e1 + ul
+    e2 = e2 + vl
+    p1, q1 = _two_prod(s1, s1)
+    p2, q2 = _two_prod(s2, s2)
+    p3, q3 = _two_prod(np.full_like(u, r), np.full_like(u, r))
+    hi, lo1 = _two_sum(p1, p2)
+    hi, lo2 = _two_sum(hi, -p3)
+    lo = lo1 + lo2 + q1 + q2 - q3 + (2 * s1 * e1 + e1 * e1) + (2 * s2 * e2 + e2 * e2)
+    q = hi + lo
+    d = np.hypot(s1 + e1, s2 + e2)
+    return q / (d + r)
+
+
+def _gauss_newton(p, fun, jac, max_steps: int = 30) -> np.ndarray:
+    """Polish a least-squares solution with full Gauss-Newton steps to machine precision.
+
+    Levenberg-Marquardt stops on its tolerances about 1e-10 relative on short arcs, where the
+    problem is ill-conditioned; plain Gauss-Newton steps (solved by SVD-based least squares)
+    converge quadratically from there. Stops when a step no longer shrinks the residual norm or
+    is below a few ulps of the parameters.
+    """
+    p = np.asarray(p, dtype=float).copy()
+    best = float(np.sum(fun(p) ** 2))
+    for _ in range(max_steps):
+        step, *_ = np.linalg.lstsq(jac(p), -fun(p), rcond=None)
+        trial = p + step
+        cost = float(np.sum(fun(trial) ** 2))
+        if not np.isfinite(cost) or cost > best * (1 + 1e-12):
+            break
+        small = np.all(np.abs(step) <= 4 * np.finfo(float).eps * np.maximum(np.abs(p), 1.0))
+        p, best = trial, min(best, cost)
+        if small:
+            break
+    return p
 
 
 def fit_circle_polar(theta_deg: np.ndarray, r: np.ndarray) -> CircleFit:

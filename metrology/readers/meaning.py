@@ -206,7 +206,8 @@ def angle_reading(
                 f"{where}: arc={arc!r} was given, but the angles {r.describe()}; check "
                 f"{_ANGLE_FLAG} and {_ARC_FLAG}"
             )
-        return r, f"angle unit {unit} (stated)"
+        first = "; point 1 is taken at 0 degree" if unit == "index" and a[0] == 1.0 else ""
+        return r, f"angle unit {unit} (stated){first}"
     if arc is not None:
         readings = [r for r in readings if r.arc == arc]
     if not readings:
@@ -249,6 +250,8 @@ def angle_reading(
         if len(readings) == 1
         else f"{' and '.join(x.unit for x in readings)} give the same angles"
     )
+    if r.unit == "index" and a[0] == 1.0:
+        why += "; numbering starts at 1: point 1 is taken at 0 degree"
     return r, f"angle unit {r.unit}: {why}"
 
 
@@ -306,7 +309,9 @@ def value_kind(
     ptp = float(np.ptp(finite))
     # what the numbers say on their own: radius-like (positive, spread tiny against the mean),
     # deviation-like (about zero, or an offset comparable to the spread)
-    robust_radius = med > 0 and med > 100 * max(spread, 1e-300)
+    # (a bore of 8 mm with 50 um of set-up eccentricity and form is ~80; a deviation trace
+    # offset by a wrong nominal radius ~1..5)
+    robust_radius = med > 0 and med > 25 * max(spread, 1e-300)
     robust_dev = abs(med) <= 5 * max(spread, 1e-300)
     rows_bad = np.flatnonzero(np.any(flat <= 0, axis=1)) if robust_radius else np.array([])
     kind = stated or named
@@ -336,10 +341,8 @@ def value_kind(
                 f"{spread:g}) look like radii; say which with {_VALUE_FLAG}"
             )
         return "deviation", ("stated" if stated else "from the column name")
-    if robust_radius and rows_bad.size == 0 and ptp < med / 100:
-        return "radius", (
-            f"radius: values positive, median {med:g} over 100 x their spread {ptp:g}"
-        )
+    if robust_radius and rows_bad.size == 0 and ptp < med / 25:
+        return "radius", (f"radius: values positive, median {med:g} over 25 x their spread {ptp:g}")
     if robust_dev and not robust_radius:
         return "deviation", (
             f"deviation: median {med:g} within 5 x the spread {spread:g} of the values"

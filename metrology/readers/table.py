@@ -502,6 +502,8 @@ def parse_file(path: str | Path, fmt: TextFormat = TextFormat()) -> ParsedFile:
         last = last[:-1]
     if len(last) != ncol:
         _bad_line(str(path), lines, line_numbers[-1:], fmt, ncol)
+    if "header_lines" in guessed:
+        _no_data_in_header(str(path), lines[:hl], fmt, ncol)
     meta, names = _parse_header(lines[:hl], fmt.delimiter or " ", ncol)
     if fmt.columns is not None:
         cols = fmt.columns
@@ -575,6 +577,26 @@ _ANGLE_UNIT_WORDS = {
     "points": "index",
 }
 _LENGTH_KINDS = ("radius", "deviation", "value", "x", "y")
+
+
+def _no_data_in_header(path: str, header: Sequence[str], fmt: TextFormat, ncol: int) -> None:
+    """A data row with one bad field ('0.0<TAB>n.a.') just above the table would be taken for
+    the line of column names and silently dropped: refuse it, naming the line."""
+    idx = [i for i, ln in enumerate(header) if ln.strip()]
+    if not idx:
+        return
+    i = idx[-1]
+    toks = _split(header[i], fmt.delimiter or " ")
+    if fmt.delimiter != " " and toks and toks[-1] == "":
+        toks = toks[:-1]
+    nums = [t for t in toks if _is_num(t, fmt.decimal or ".")]
+    if len(toks) == ncol and nums and len(nums) < len(toks) and not re.search(r"[:=]", header[i]):
+        bad = next(t for t in toks if not _is_num(t, fmt.decimal or "."))
+        raise BadInputError(
+            f"'{path}' line {i + 1}: {header[i].strip()[:60]!r} looks like a row of the table "
+            f"with {bad!r} where a number belongs; fix or delete the line (or pass "
+            "header_lines=... / --header-lines if it really is a header)"
+        )
 
 
 def _keyword(meta: dict[str, str], pattern: re.Pattern) -> str | None:

@@ -293,6 +293,36 @@ def test_cli_refuses_with_exit_3_and_accepts_with_the_flag(tmp_path, capsys):
     assert main(base) == 3
     assert "--angle-unit" in capsys.readouterr().err
     assert main(base + ["--angle-unit", "degrees"]) == 2  # not a choice: usage error
+    assert main(base + ["--layout", "diagonal"]) == 2
+    assert main(base[:-4] + ["--units", "furlong", "--out", str(tmp_path / "o.nc")]) == 2
+    assert main(base + ["--decimal", ";"]) == 2
     assert not (tmp_path / "o.nc").exists()
     assert main(base + ["--angle-unit", "deg"]) == 0
     assert (tmp_path / "o.nc").exists()
+
+
+def test_corrupt_first_row_is_not_taken_for_column_names(tmp_path):
+    # found by the fuzz test: '0.0<TAB>n.a.' above the table was read as the names line and the
+    # point silently dropped (an 18-point partial arc instead of a 19-point full turn)
+    rows = [f"{a:.1f}\t{v:.4f}" for a, v in zip(np.arange(19) * 360 / 19, _dev(19), strict=True)]
+    rows[0] = "0.0\tn.a."
+    f = tmp_path / "first.txt"
+    f.write_text("Units: um\n" + "\n".join(rows) + "\n")
+    with pytest.raises(BadInputError, match=r"first.txt' line 2: .*looks like a row of the table"):
+        read_scan(f, convention=CONV)
+
+
+def test_off_centre_radius_trace_is_still_a_radius(tmp_path):
+    # 8 mm bore, 50 um set-up eccentricity and 20 um of wear: spread ~100 um, no column names
+    t = np.radians(np.arange(360) * 1.0)
+    r = 8000.0 + 50.0 * np.cos(t) - 20.0 * np.exp(-((t - 2.0) ** 2) / 0.1)
+    ds = read_scan(_table(tmp_path / "r.txt", np.arange(360) * 1.0, r), convention=CONV, units="um")
+    assert "radius" in ds
+    np.testing.assert_allclose(np.sort(ds["radius"].values[0]), np.sort(np.round(r, 6)) * 1e-6)
+
+
+def test_point_numbers_from_one_start_at_zero_degree_and_say_so(tmp_path):
+    f = _table(tmp_path / "one.txt", np.arange(1, 721), _dev(720), head="Point\tDeviation [um]\n")
+    ds = read_scan(f, convention=("-x", "clockwise"))
+    assert float(ds["theta"].min()) == 0.0 and float(ds["theta"].max()) == pytest.approx(359.5)
+    assert "point 1 is taken at 0 degree" in ds.attrs["reader_guesses"]["one.txt"]["angle"]
