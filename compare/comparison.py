@@ -337,10 +337,10 @@ def compare(
     ens = as_ensemble(ensemble)
     if verification is None:
         gci: Mapping[str, GCI] = {}
-    elif isinstance(verification, Mapping):
-        gci = verification
+    elif isinstance(verification, xr.Dataset) or not isinstance(verification, Mapping):
+        gci = numerical_uncertainty(verification)  # a Dataset is a Mapping too: test it first
     else:
-        gci = numerical_uncertainty(verification)
+        gci = verification
     sims = [sim] if isinstance(sim, (xr.Dataset, xr.DataArray)) else list(sim)
     meass = [meas] if isinstance(meas, (xr.Dataset, xr.DataArray)) else list(meas)
     s_wear, s_motion = _split(sims)
