@@ -354,6 +354,8 @@ def write(
             "Units": units,
             "Points": str(n),
             "Nominal radius": f"{scan.nominal_radius * 1e3:.6f} mm",
+            # generated with a known truth: the importer keeps this (data contract: data_origin)
+            "Data origin": "synthetic",
             **extra,
         }
         return "".join(f"{k}: {v}\n" for k, v in meta.items() if v != "")

@@ -288,7 +288,6 @@ def _measure_wear(folder: Path, sim_wear_path: Path, size: DemoSize) -> tuple[Pa
             "title": "measured wear map of the bearing bore (virtual Talyrond scan)",
             "cycles": float(size.cycles),
             "source": "synthetic: virtual Talyrond 565H scans (jointwear.datasets.instruments)",
-            "data_origin": "synthetic",
         }
     )
     out = io.save(

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from html.parser import HTMLParser
 
+import _jw_synth as syn
 import pytest
 
 from jointwear.cli import main
@@ -192,3 +193,40 @@ def test_verification_figures_and_pdf_determinism(built, tmp_path):
     a = write_pdf(result, tmp_path / "a.pdf", verification=[conv])
     b = write_pdf(result, tmp_path / "b.pdf", verification=[conv])
     assert a.read_bytes() == b.read_bytes() and a.read_bytes().startswith(b"%PDF")
+
+
+def test_generated_scan_stays_synthetic_into_the_decision_card(tmp_path):
+    """Instrument files from the generator -> importer -> wear map -> compare -> card."""
+    import re
+
+    from jointwear.compare import compare
+    from jointwear.datasets import instruments
+    from jointwear.metrology import wear_map
+    from jointwear.metrology.readers import read_talyrond
+    from jointwear.reports import render_html
+
+    conv = ("+y", "counterclockwise")
+    kw = {"n_layers": 13, "n_points": 720, "convention": conv, "seed": 5}
+    instruments.write(instruments.generate(**kw), tmp_path / "worn", layout="folder")
+    instruments.write(
+        instruments.generate(wear=None, noise_seed=9, **kw), tmp_path / "before", layout="folder"
+    )
+    first = next((tmp_path / "worn").glob("*.txt")).read_text(encoding="utf-8")
+    assert "Data origin: synthetic" in first
+    worn = read_talyrond(tmp_path / "worn", convention=conv)
+    assert worn.attrs["data_origin"] == "synthetic"
+    assert not worn.attrs["source"].startswith("measurement")
+    wm = wear_map(worn, read_talyrond(tmp_path / "before", convention=conv))
+    assert wm.attrs["data_origin"] == "synthetic"
+    wm.attrs["cycles"] = 4e5
+    sim = syn.sim_wear()
+    sim.attrs["data_origin"] = "simulated"
+    c = compare(sim, wm)
+    html = render_html(c, command="t")
+    card = html[html.index('id="decision"') : html.index('id="metrics"')]
+    assert re.search(r"measurement: <strong[^>]*>synthetic</strong>", card)
+    assert "Synthetic data:" in card and "SYNTHETIC measurement data" in card
+    # and an export without the line is a measurement
+    plain = tmp_path / "plain"
+    instruments.write(instruments.generate(**kw), plain, layout="folder", header=False)
+    assert read_talyrond(plain, convention=conv).attrs["data_origin"] == "measured"
