@@ -43,7 +43,14 @@ WEAR_QUANTITIES = ("max_wear_depth", "worn_volume", "cylindricity")
 
 
 def _parameters(ds: xr.Dataset) -> tuple[str, ...]:
-    return tuple(sorted(str(c) for c in ds.coords if c != "run" and ds[c].dims == ("run",)))
+    """The varied inputs: ``sweep_parameters`` (jointwear sim sweep) or the run coordinates."""
+    stated = ds.attrs.get("sweep_parameters")
+    if isinstance(stated, str):
+        stated = [stated]
+    if stated is not None and len(stated):
+        return tuple(sorted(str(p) for p in stated))
+    skip = {"run", "run_seed"}
+    return tuple(sorted(str(c) for c in ds.coords if c not in skip and ds[c].dims == ("run",)))
 
 
 def _cycles(ds: xr.Dataset) -> float | None:
@@ -104,7 +111,7 @@ class Ensemble:
         rows: list[dict[str, object]] = []
         for ds in self.datasets:
             for kind in ("S1", "ST"):
-                for name in (f"{quantity}_{kind}", f"{kind}"):
+                for name in (f"sobol_{kind}", f"{quantity}_{kind}", f"{kind}"):
                     if name not in ds.data_vars:
                         continue
                     var = ds[name]
@@ -113,7 +120,7 @@ class Ensemble:
                         if quantity not in outs:
                             continue
                         var = var.sel(output=quantity)
-                    elif name == kind:
+                    elif name in (kind, f"sobol_{kind}"):
                         continue
                     if var.dims != ("parameter",):
                         continue

@@ -188,3 +188,28 @@ def test_uncovered_maximum_is_not_comparable_not_pass():
     inside = norm.cdf(13.5 / 2) - norm.cdf(1.5 / 2)
     total = norm.cdf(15 / 2) - norm.cdf(0)
     assert frac == pytest.approx(inside / total, abs=0.02)
+
+
+def test_sweep_style_ensemble_sobol_indices_reach_the_comparison():
+    """The layout of ``jointwear sim sweep``: run_seed coordinate, sobol_S1/ST(output, parameter)."""
+    from jointwear.reports import render_html
+
+    sim = syn.sim_wear()
+    meas = syn.meas_wear(u=1e-6, n_layers=16)
+    ens = _ensemble({"max_wear_depth": [30e-6, 33e-6, 31e-6, 34e-6]}, run_seed=np.arange(4))
+    ens = ens.assign_coords(**{"wear.kw": ("run", [1.0, 1.1, 0.9, 1.2])})
+    ens.attrs["sweep_parameters"] = ["wear.kw", "friction.dynamic_coefficient"]
+    ens["sobol_S1"] = (("output", "parameter"), [[0.8, 0.1]])
+    ens["sobol_ST"] = (("output", "parameter"), [[0.85, 0.12]])
+    ens = ens.assign_coords(
+        output=["max_wear_depth"], parameter=["wear.kw", "friction.dynamic_coefficient"]
+    )
+    c = compare(sim, meas, ensemble=ens)
+    rows = c.sensitivity.set_index("parameter")
+    assert rows.loc["wear.kw", "S1"] == pytest.approx(0.8)
+    assert rows.loc["friction.dynamic_coefficient", "ST"] == pytest.approx(0.12)
+    html = render_html(c, command="t")
+    assert "first-order Sobol index S1" in html and "friction.dynamic_coefficient" in html
+    # run_seed is not a varied input: a second ensemble with its own seeds is not refused
+    other = _ensemble({"worn_volume": [1e-9, 1.1e-9]}, run_seed=np.arange(2), mu=[0.1, 0.2])
+    compare(sim, meas, ensemble=[ens, other])
