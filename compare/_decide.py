@@ -12,7 +12,7 @@ import jointwear.compare.metrics as mt
 import jointwear.compare.verdicts as vd
 
 METRIC_COLUMNS = ["quantity", "metric", "value", "units", "long_name", "definition", "basis"]
-DECISION_COLUMNS = ["quantity", "criterion", "value", "state", "basis", "reason", "passed"]
+DECISION_COLUMNS = ["quantity", "criterion", "value", "state", "basis", "reason", "passed", "key"]
 
 
 @dataclass(frozen=True)
@@ -87,8 +87,9 @@ def decision(
     state: str,
     basis: str,
     reason: str = "",
+    key: str = "",
 ) -> dict[str, Any]:
-    """One row of the decision card."""
+    """One row of the decision card (``key``: the metrics-table quantity it judges)."""
     vd.state_code(state)  # refuse unknown states
     return {
         "quantity": quantity,
@@ -98,6 +99,7 @@ def decision(
         "basis": basis,
         "reason": reason,
         "passed": state == vd.PASS,
+        "key": key or quantity,
     }
 
 
@@ -151,6 +153,7 @@ def scalar_decision(
                 vd.NOT_COMPARABLE,
                 "V&V 20",
                 reason,
+                key=quantity,
             )
         )
         return
@@ -165,6 +168,7 @@ def scalar_decision(
                 vd.NOT_ASSESSED,
                 "V&V 20",
                 reason,
+                key=quantity,
             )
         )
         ok = bool(np.isfinite(rel) and abs(rel) <= relative_error_max)
@@ -175,6 +179,7 @@ def scalar_decision(
                 f"{rel:+.3g} (S = {fmt(s, units)}, D = {fmt(d, units)})",
                 threshold_state(ok, bool(np.isfinite(rel))),
                 "threshold",
+                key=quantity,
             )
         )
         return
@@ -190,5 +195,6 @@ def scalar_decision(
             f"|E| = {fmt(abs(res.E), units)}, U_val = {fmt(res.U_val, units)}",
             vd.PASS if res.passed else vd.FAIL,
             "V&V 20",
+            key=quantity,
         )
     )

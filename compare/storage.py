@@ -70,6 +70,7 @@ def to_dataset(c: Comparison) -> xr.Dataset:
                 "value": row.value,
                 "basis": row.basis,
                 "reason": row.reason,
+                "key": row.key,
                 "flag_values": vd.FLAG_VALUES,
                 "flag_meanings": vd.FLAG_MEANINGS,
             },
@@ -140,6 +141,7 @@ def load_comparison(source: str | Path | xr.Dataset) -> Comparison:
                     "basis": var.attrs.get("basis", ""),
                     "reason": var.attrs.get("reason", ""),
                     "passed": state == vd.PASS,
+                    "key": var.attrs.get("key", var.attrs.get("quantity", str(name))),
                 }
             )
     wear_dims = ({"z", "theta"}, {"z_sim", "theta_sim"}, {"run", "z", "theta"})

@@ -156,16 +156,13 @@ def _budget(c: Comparison) -> tuple[list[dict[str, Any]], list[str]]:
 
     m = c.metrics
     budget, sources = [], []
-    states = {}
-    for r in c.decisions.itertuples():
-        if r.basis == "V&V 20":
-            states[str(r.quantity)] = str(r.state)
-    labels = [str(r.quantity) for r in c.decisions.itertuples() if r.basis == "V&V 20"]
-    for q, label in zip(
-        [q for q in dict.fromkeys(m.quantity) if "u_D" in set(m[m.quantity == q].metric)],
-        labels,
-        strict=False,
-    ):
+    vv = {
+        str(r.key): (str(r.quantity), str(r.state))
+        for r in c.decisions.itertuples()
+        if r.basis == "V&V 20"
+    }
+    for q in [q for q in dict.fromkeys(m.quantity) if str(q) in vv]:
+        label, state = vv[str(q)]
         sub = m[m.quantity == q].set_index("metric")
         units = str(sub.loc["value_sim", "units"])
         cells = []
@@ -175,7 +172,6 @@ def _budget(c: Comparison) -> tuple[list[dict[str, Any]], list[str]]:
                 continue
             v, u = format_value(float(sub.loc[key, "value"]), units, digits=3)
             cells.append(f"{v} {u}".strip())
-        state = states.get(label, vd.NOT_ASSESSED)
         budget.append(
             {"quantity": label, "cells": cells, "state": state, "label": vd.LABELS[state]}
         )
