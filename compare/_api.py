@@ -1,15 +1,9 @@
 """Public names of :mod:`jointwear.compare` (alignment in xarray and validation metrics)."""
 
 from jointwear.compare.align import MOTION_VARIABLES, align_time_series, align_wear_maps
-from jointwear.compare.comparison import (
-    Comparison,
-    Criteria,
-    compare,
-    load_comparison,
-    load_criteria,
-    metrics_table,
-    save_comparison,
-)
+from jointwear.compare.comparison import DEFAULT_AXES, Comparison, compare
+from jointwear.compare.criteria import Criteria, load_criteria
+from jointwear.compare.ensemble import Ensemble, as_ensemble
 from jointwear.compare.metrics import (
     DEFINITIONS,
     VV20,
@@ -25,6 +19,10 @@ from jointwear.compare.metrics import (
     worn_volume,
     wrap_angle_deg,
 )
+from jointwear.compare.origin import origin_of, side_origin
+from jointwear.compare.storage import load_comparison, metrics_table, save_comparison
+from jointwear.compare.verdicts import FLAG_MEANINGS, FLAG_VALUES, STATES, summary_line
+from jointwear.compare.verification import GCI, gci, numerical_uncertainty
 
 __all__ = [
     "MOTION_VARIABLES",
@@ -32,6 +30,18 @@ __all__ = [
     "align_wear_maps",
     "Comparison",
     "Criteria",
+    "DEFAULT_AXES",
+    "Ensemble",
+    "as_ensemble",
+    "origin_of",
+    "side_origin",
+    "FLAG_MEANINGS",
+    "FLAG_VALUES",
+    "STATES",
+    "summary_line",
+    "GCI",
+    "gci",
+    "numerical_uncertainty",
     "compare",
     "load_comparison",
     "load_criteria",

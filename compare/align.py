@@ -337,6 +337,7 @@ def align_wear_maps(
         out[f"{variable}_{side}"].attrs["ancillary_variables"] = uname
         anc.append(uname)
     radius = _bearing_radius(s_ds, m_ds)
+    out = _with_coverage(out, s_da, lo, hi, variable)
     out.attrs.update(
         {
             "title": "simulated and measured wear maps on a common grid",
@@ -370,6 +371,70 @@ def align_wear_maps(
             value = _stated_scalar(ds, "cylindricity", s_cycles if side == "sim" else m_cycles)
             if value is not None and np.isfinite(value):
                 out.attrs[f"cylindricity_stated_{side}_m"] = value
+    return out
+
+
+def _volume_between(z: np.ndarray, per_layer: np.ndarray, lo: float, hi: float) -> float:
+    """Trapezoid integral of a piecewise-linear per-layer profile over [lo, hi]."""
+    lo, hi = max(lo, float(z.min())), min(hi, float(z.max()))
+    if hi <= lo:
+        return 0.0
+    grid = np.unique(np.concatenate([[lo, hi], z[(z > lo) & (z < hi)]]))
+    return float(np.trapezoid(np.interp(grid, z, per_layer), grid))
+
+
+def _with_coverage(
+    out: xr.Dataset, s_da: xr.DataArray, lo: float, hi: float, variable: str
+) -> xr.Dataset:
+    """Add the whole simulated map and how much of it the common grid covers.
+
+    ``<variable>_sim_full`` over ``(z_sim, theta_sim)`` (canonical); attributes
+    ``sim_max_value_m``, ``sim_max_z_m``, ``sim_max_theta_deg`` (maximum of the whole simulated
+    map), ``sim_max_inside`` (1 if it lies in the compared axial range) and
+    ``volume_fraction_compared`` (share of the simulated worn volume inside that range).
+    """
+    z = np.asarray(s_da["z"].values, dtype=float)
+    th = np.asarray(s_da["theta"].values, dtype=float)
+    h = np.asarray(s_da.values, dtype=float)
+    out = out.assign_coords(
+        z_sim=xr.DataArray(
+            z,
+            dims="z_sim",
+            attrs={**s_da["z"].attrs, "long_name": "axial position of the simulated map's layers"},
+        ),
+        theta_sim=xr.DataArray(th, dims="theta_sim", attrs={**s_da["theta"].attrs}),
+    )
+    out[f"{variable}_sim_full"] = (
+        ("z_sim", "theta_sim"),
+        h,
+        {"units": "m", "long_name": "simulated wear depth over the whole simulated width"},
+    )
+    tol = 1e-9
+    if np.any(np.isfinite(h)):
+        i, j = np.unravel_index(np.nanargmax(h), h.shape)
+        zmax, tmax, vmax = float(z[i]), float(th[j]), float(h[i, j])
+    else:
+        zmax = tmax = vmax = float("nan")
+    inside = bool(lo - tol <= zmax <= hi + tol)
+    per_layer = np.nansum(np.clip(np.nan_to_num(h), 0.0, None), axis=1)
+    total = float(np.trapezoid(per_layer, z)) if z.size > 1 else float(per_layer.sum())
+    if z.size > 1 and total > 0:
+        fraction = _volume_between(z, per_layer, lo, hi) / total
+    elif z.size == 1:
+        fraction = 1.0 if inside else 0.0
+    else:
+        fraction = float("nan")
+    out.attrs.update(
+        {
+            "sim_max_value_m": vmax,
+            "sim_max_z_m": zmax,
+            "sim_max_theta_deg": tmax,
+            "sim_max_inside": int(inside),
+            "volume_fraction_compared": float(min(1.0, fraction))
+            if np.isfinite(fraction)
+            else fraction,
+        }
+    )
     return out
 
 

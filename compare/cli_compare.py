@@ -65,21 +65,56 @@ def register(app: typer.Typer) -> None:
                 "journal_offset, journal_displacement, contact_force when both sides have them).",
             ),
         ] = None,
+        axes: Annotated[
+            list[str] | None,
+            typer.Option(
+                "--axis",
+                help="Motion component to compare (repeatable; default x and y, the plane of "
+                "the mechanism).",
+            ),
+        ] = None,
+        ensemble: Annotated[
+            list[Path] | None,
+            typer.Option(
+                "--ensemble",
+                help="Ensemble of simulations (.nc with a 'run' dimension, from jointwear sim "
+                "sweep); its spread is the V&V 20 input uncertainty. Repeatable.",
+            ),
+        ] = None,
+        verification: Annotated[
+            list[Path] | None,
+            typer.Option(
+                "--verification",
+                help="Verification study (.nc: quantities over a refinement parameter); its "
+                "GCI is the numerical uncertainty when it converges monotonically.",
+            ),
+        ] = None,
         strict: Annotated[
-            bool, typer.Option("--strict", help="Exit with code 1 if a criterion fails.")
+            bool,
+            typer.Option(
+                "--strict",
+                help="Also exit 1 when a criterion is not assessed or not comparable, or a "
+                "part was not compared (a failed criterion always exits 1).",
+            ),
         ] = False,
     ) -> None:
         """Compare simulation and measurement (wear maps and/or motion, detected from variables).
 
         Writes the aligned fields, their differences and every metric (units and definition in
-        the attributes) to OUT, prints the decision card, and exits 1 with --strict when a
-        validation criterion fails.
+        the attributes) to OUT and prints the decision card. Each criterion is PASS, FAIL, NOT
+        ASSESSED (an uncertainty it needs is unknown) or NOT COMPARABLE (the data do not cover
+        it). Exit code 1 when a criterion fails; with --strict also when one is undecided.
         """
         if ctx.invoked_subcommand is not None:
             return
         from jointwear import io
-        from jointwear.compare.comparison import compare, load_criteria, save_comparison
-        from jointwear.errors import ValidationFailed
+        from jointwear.compare import compare, load_criteria, save_comparison
+        from jointwear.compare.outcome import (
+            card_lines,
+            origin_line,
+            outcome_lines,
+            raise_for_outcome,
+        )
 
         io.check_writable(out)
         crit = load_criteria(criteria)
@@ -87,6 +122,10 @@ def register(app: typer.Typer) -> None:
         meas_paths = [meas, *(meas_extra or [])]
         sims = [io.load(p) for p in sim_paths]
         meass = [io.load(p) for p in meas_paths]
+        ens = [io.load(p) for p in ensemble or []]
+        vers = [io.load(p, validate=False) for p in verification or []]
+        from jointwear.compare.ensemble import as_ensemble
+
         result = compare(
             sims,
             meass,
@@ -95,14 +134,22 @@ def register(app: typer.Typer) -> None:
             period_s=period,
             motion_method=method,
             variables=variables or None,
+            axes=axes or ("x", "y"),
+            ensemble=as_ensemble(ens, [p.name for p in ensemble or []]) if ens else None,
+            verification=vers or None,
         )
-        save_comparison(result, out, inputs=[*sim_paths, *meas_paths], parents=[*sims, *meass])
+        save_comparison(
+            result,
+            out,
+            inputs=[*sim_paths, *meas_paths, *(ensemble or []), *(verification or [])],
+            parents=[*sims, *meass],
+        )
         if table is not None:
             with io.atomic_path(table) as tmp:
                 result.metrics.to_csv(tmp, index=False, float_format="%.6g")
-        for row in result.decisions.itertuples():
-            mark = "PASS" if row.passed else "FAIL"
-            typer.echo(f"{mark}  {row.quantity}: {row.value}  [{row.criterion}]")
+        typer.echo(origin_line(result))
+        for line in card_lines(result):
+            typer.echo(line)
         if result.wear is not None:
             typer.echo(f"wear maps: {result.wear.attrs['interpolation']}")
         if result.motion is not None:
@@ -115,7 +162,6 @@ def register(app: typer.Typer) -> None:
         for note in result.notes:
             typer.echo(f"note: {note}")
         typer.echo(f"metrics: {out}")
-        if strict and not result.passed:
-            raise ValidationFailed(
-                f"validation failed for: {', '.join(result.failed())} (details in {out})"
-            )
+        for line in outcome_lines(result):
+            typer.echo(line)
+        raise_for_outcome(result, strict=strict, where=str(out))

@@ -1,104 +1,48 @@
-"""Simulation versus measurement: alignment, metrics, validation decisions, tidy table, netCDF.
+"""Simulation versus measurement: alignment, metrics, validation decisions.
 
 :func:`compare` takes simulated and measured datasets (wear maps and/or motion records, told
 apart by their variables), aligns them (:mod:`jointwear.compare.align`), computes the metrics of
-:mod:`jointwear.compare.metrics` and decides, per quantity, whether the simulation passes its
-validation criterion (:class:`Criteria`): the ASME V&V 20 test ``|E| <= U_val`` where
-uncertainties are available, otherwise a stated threshold.
+:mod:`jointwear.compare.metrics` and decides every criterion (:class:`Criteria`) in one of four
+states (:mod:`jointwear.compare.verdicts`): pass, fail, not assessed (an uncertainty it needs is
+unknown) or not comparable (the data do not cover what it judges). Scalar quantities are judged by
+ASME V&V 20 (``|E| <= U_val``) with uncertainties from :mod:`jointwear.compare.sources`: the
+ensemble of simulations (``ensemble=``) for u_input, a verification study (``verification=``)
+for u_num; what is unknown stays unknown.
 """
 
 from __future__ import annotations
 
-import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pandas as pd
 import xarray as xr
 
-import jointwear.compare.metrics as mt
-from jointwear import io
+import jointwear.compare.verdicts as vd
+from jointwear.compare._decide import DECISION_COLUMNS, Rows
+from jointwear.compare._motion import motion_metrics, rms_quantities
+from jointwear.compare._wear import sim_quantities, wear_metrics
 from jointwear.compare.align import MOTION_VARIABLES, align_time_series, align_wear_maps
-from jointwear.errors import BadInputError, ParameterError
-from jointwear.params import from_mapping, read_toml
+from jointwear.compare.criteria import Criteria, load_criteria
+from jointwear.compare.ensemble import Ensemble, as_ensemble
+from jointwear.compare.origin import side_origin
+from jointwear.compare.sources import Sources
+from jointwear.compare.verification import GCI, numerical_uncertainty
+from jointwear.errors import BadInputError
 
 __all__ = [
     "Criteria",
     "Comparison",
     "compare",
     "load_criteria",
-    "metrics_table",
-    "save_comparison",
-    "load_comparison",
+    "DEFAULT_AXES",
 ]
 
-METRIC_COLUMNS = ["quantity", "metric", "value", "units", "long_name", "definition"]
-DECISION_COLUMNS = ["quantity", "criterion", "value", "passed", "basis"]
-
-
-@dataclass(frozen=True)
-class Criteria:
-    """Validation criteria and uncertainty assumptions (all editable from a TOML file).
-
-    Parameters
-    ----------
-    k : float
-        Coverage factor of the expanded validation uncertainty ``U_val = k u_val`` [1].
-    wear_nrmse_max : float
-        Largest acceptable normalised RMSE of the wear map [1].
-    wear_r_min : float
-        Smallest acceptable Pearson correlation between the simulated and measured wear maps
-        [1]. Together with ``wear_nrmse_max`` it makes the shape criterion: a low NRMSE alone
-        is also reached by a simulation that predicts almost no wear against a peaky
-        measurement.
-    max_angle_error_deg : float
-        Largest acceptable error of the angle of maximum wear [degree].
-    max_z_error_m : float
-        Largest acceptable error of the axial position of maximum wear [m].
-    relative_error_max : float
-        Largest acceptable ``|S - D| / |D|`` of a scalar quantity when no uncertainty is known
-        (max wear depth, worn volume, cylindricity, RMS motion) [1].
-    motion_sg_c_max : float
-        Largest acceptable Sprague-Geers comprehensive error of a motion component [1].
-    wear_u_input_rel, motion_u_input_rel : float
-        Relative standard uncertainty of the simulated quantities from their inputs (e.g. the
-        wear coefficient), ``u_input = rel * |S|`` [1]. 0 = not assessed.
-    wear_u_num_rel, motion_u_num_rel : float
-        Relative numerical standard uncertainty used where the simulation states none
-        (``<name>_u``) [1]. 0 = not assessed.
-    """
-
-    k: float = 2.0
-    wear_nrmse_max: float = 0.25
-    wear_r_min: float = 0.5
-    max_angle_error_deg: float = 30.0
-    max_z_error_m: float = 3.0e-3
-    relative_error_max: float = 0.30
-    motion_sg_c_max: float = 0.30
-    wear_u_input_rel: float = 0.0
-    motion_u_input_rel: float = 0.0
-    wear_u_num_rel: float = 0.0
-    motion_u_num_rel: float = 0.0
-
-    def __post_init__(self) -> None:
-        for f in self.__dataclass_fields__:
-            value = getattr(self, f)
-            if not (np.isfinite(value) and value >= 0):
-                raise ParameterError(f"criteria.{f} must be a finite number >= 0, got {value!r}")
-        if self.k == 0:
-            raise ParameterError("criteria.k (coverage factor) must be > 0")
-
-
-def load_criteria(path: str | Path | None) -> Criteria:
-    """Criteria from a TOML file (keys of :class:`Criteria`, optionally in a ``[criteria]`` table)."""
-    if path is None:
-        return Criteria()
-    data = read_toml(path)
-    data = data.get("criteria", data)
-    return from_mapping(Criteria, data, where="criteria")
+#: vector components compared by default: the mechanism is planar; the out-of-plane (z) motion of
+#: a rig record is set by the rig, not by the mechanism, unless the user asks for it (axes=)
+DEFAULT_AXES = ("x", "y")
 
 
 @dataclass(frozen=True)
@@ -108,17 +52,26 @@ class Comparison:
     Attributes
     ----------
     wear : Dataset or None
-        Aligned wear maps over ``(z, theta)`` (see :func:`align_wear_maps`).
+        Aligned wear maps over ``(z, theta)`` (see :func:`align_wear_maps`), the whole simulated
+        map over ``(z_sim, theta_sim)`` and, with an ensemble that keeps its maps,
+        ``wear_depth_sim_ensemble`` over ``(run, z, theta)``.
     motion : Dataset or None
-        Aligned motion over ``time`` (see :func:`align_time_series`).
+        Aligned motion over ``time`` (see :func:`align_time_series`), with ensemble members
+        ``<var>_sim_ensemble`` over ``(run, time, ...)`` when available.
     metrics : DataFrame
-        Tidy table: quantity, metric, value, units, long_name, definition.
+        Tidy table: quantity, metric, value, units, long_name, definition, basis.
     decisions : DataFrame
-        Decision card: quantity, criterion, value, passed, basis.
+        Decision card: quantity, criterion, value, state, basis, reason, passed.
     notes : tuple of str
         What was not compared and why.
     criteria : Criteria
         The criteria used.
+    data_origin : dict
+        ``{"simulation": ..., "measurement": ...}``: what each side's numbers are.
+    partial : tuple of str
+        Parts that were not compared (a side without wear maps or motion).
+    sensitivity : DataFrame
+        Sobol indices from the ensemble (quantity, parameter, S1, ST); empty without.
     """
 
     wear: xr.Dataset | None
@@ -127,15 +80,44 @@ class Comparison:
     decisions: pd.DataFrame
     notes: tuple[str, ...] = ()
     criteria: Criteria = field(default_factory=Criteria)
+    data_origin: Mapping[str, str] = field(default_factory=dict)
+    partial: tuple[str, ...] = ()
+    sensitivity: pd.DataFrame = field(
+        default_factory=lambda: pd.DataFrame(columns=["quantity", "parameter", "S1", "ST"])
+    )
+
+    @property
+    def states(self) -> pd.Series:
+        """State of every decision."""
+        return self.decisions["state"]
 
     @property
     def passed(self) -> bool:
         """True when every decision passed (and there is at least one)."""
-        return bool(len(self.decisions)) and bool(self.decisions["passed"].all())
+        return bool(len(self.decisions)) and bool((self.states == vd.PASS).all())
+
+    @property
+    def any_failed(self) -> bool:
+        """True when a criterion failed (exit code 1)."""
+        return bool((self.states == vd.FAIL).any())
+
+    @property
+    def complete(self) -> bool:
+        """True when nothing is not assessed, not comparable or left out (``--strict``)."""
+        undecided = self.states.isin([vd.NOT_ASSESSED, vd.NOT_COMPARABLE]).any()
+        return not undecided and not self.partial and bool(len(self.decisions))
+
+    def quantities(self, state: str) -> list[str]:
+        """Quantities with a decision in ``state``."""
+        return [str(q) for q in self.decisions.loc[self.states == state, "quantity"]]
 
     def failed(self) -> list[str]:
         """Quantities whose criterion failed."""
-        return [str(q) for q in self.decisions.loc[~self.decisions["passed"], "quantity"]]
+        return self.quantities(vd.FAIL)
+
+    def summary(self) -> str:
+        """``"12 criteria: 3 pass, 1 fail, ..."``."""
+        return vd.summary_line(self.states)
 
     def value(self, quantity: str, metric: str) -> float:
         """One number of the metrics table."""
@@ -144,102 +126,20 @@ class Comparison:
             raise KeyError(f"no metric {metric!r} for quantity {quantity!r}")
         return float(rows["value"].iloc[0])
 
+    def state(self, quantity: str, basis: str | None = None) -> str:
+        """State of the (first) decision on ``quantity`` (optionally of one ``basis``)."""
+        d = self.decisions[self.decisions.quantity == quantity]
+        if basis is not None:
+            d = d[d.basis == basis]
+        if d.empty:
+            raise KeyError(f"no decision on {quantity!r}")
+        return str(d["state"].iloc[0])
+
     def to_dataset(self) -> xr.Dataset:
         """Aligned fields, differences, metrics (scalar variables) and decisions in one Dataset."""
-        return _to_dataset(self)
+        from jointwear.compare.storage import to_dataset
 
-
-# --------------------------------------------------------------------------- helpers
-
-
-class _Rows:
-    """Collects metric rows with units and definitions."""
-
-    def __init__(self) -> None:
-        self.rows: list[dict[str, Any]] = []
-
-    def add(self, quantity: str, metric: str, value: float, units: str) -> None:
-        long, definition, rule = mt.DEFINITIONS[metric]
-        unit = units if rule == "same" else rule
-        self.rows.append(
-            {
-                "quantity": quantity,
-                "metric": metric,
-                "value": float(value),
-                "units": unit,
-                "long_name": long,
-                "definition": definition,
-            }
-        )
-
-    def frame(self) -> pd.DataFrame:
-        return pd.DataFrame(self.rows, columns=METRIC_COLUMNS)
-
-
-def _fmt(value: float, units: str) -> str:
-    if not np.isfinite(value):
-        return "n/a"
-    if units == "m" and abs(value) < 1e-2:
-        return f"{value * 1e6:.3g} µm"
-    if units == "m3":
-        return f"{value * 1e9:.3g} mm³"
-    if units == "1":
-        return f"{value:.3g}"
-    return f"{value:.4g} {units}"
-
-
-def _scalar_decision(
-    rows: _Rows,
-    decisions: list[dict[str, Any]],
-    quantity: str,
-    label: str,
-    s: float,
-    d: float,
-    units: str,
-    *,
-    u_num: float,
-    u_input: float,
-    u_d: float,
-    criteria: Criteria,
-) -> None:
-    rows.add(quantity, "value_sim", s, units)
-    rows.add(quantity, "value_meas", d, units)
-    rel = (s - d) / abs(d) if d != 0 else float("nan")
-    rows.add(quantity, "relative_error", rel, units)
-    if not (np.isfinite(s) and np.isfinite(d)):
-        return
-    res = mt.vv20(s, d, u_num=u_num, u_input=u_input, u_d=u_d, k=criteria.k)
-    if res.u_val > 0:
-        for name, value in (
-            ("E", res.E),
-            ("u_num", res.u_num),
-            ("u_input", res.u_input),
-            ("u_D", res.u_D),
-            ("u_val", res.u_val),
-            ("U_val", res.U_val),
-        ):
-            rows.add(quantity, name, value, units)
-        decisions.append(
-            {
-                "quantity": label,
-                "criterion": f"|E| <= U_val = {criteria.k:g} u_val (ASME V&V 20)",
-                "value": f"|E| = {_fmt(abs(res.E), units)}, U_val = {_fmt(res.U_val, units)}",
-                "passed": res.passed,
-                "basis": "V&V 20",
-            }
-        )
-    else:
-        rows.add(quantity, "E", res.E, units)
-        ok = bool(np.isfinite(rel) and abs(rel) <= criteria.relative_error_max)
-        decisions.append(
-            {
-                "quantity": label,
-                "criterion": f"|S - D| / |D| <= {criteria.relative_error_max:g} (no uncertainty given)",
-                "value": f"{rel:+.3g} (S = {_fmt(s, units)}, D = {_fmt(d, units)})",
-                "passed": ok,
-                "basis": "threshold",
-            }
-        )
+        return to_dataset(self)
 
 
 def _split(objs: xr.Dataset | Sequence[xr.Dataset]) -> tuple[xr.Dataset | None, xr.Dataset | None]:
@@ -259,214 +159,122 @@ def _split(objs: xr.Dataset | Sequence[xr.Dataset]) -> tuple[xr.Dataset | None, 
     return wear, motion
 
 
-# --------------------------------------------------------------------------- wear
-
-
-def _wear_metrics(
-    al: xr.Dataset, rows: _Rows, decisions: list[dict[str, Any]], criteria: Criteria
-) -> None:
-    s = np.asarray(al["wear_depth_sim"].values)
-    d = np.asarray(al["wear_depth_meas"].values)
-    z = np.asarray(al["z"].values)
-    th = np.asarray(al["theta"].values)
-    q = "wear_depth"
-    rows.add(q, "rmse", mt.rmse(s, d), "m")
-    nr = mt.nrmse(s, d)
-    rows.add(q, "nrmse", nr, "m")
-    rows.add(q, "pearson_r", mt.pearson_r(s, d), "m")
-    rows.add(q, "mean_error", float(np.nanmean(s - d)), "m")
-    rows.add(q, "max_abs_error", float(np.nanmax(np.abs(s - d))), "m")
-    rows.add(q, "area_validation_metric", mt.area_validation_metric(s, d), "m")
-    vs, zs, ts = mt.max_location(s, z, th)
-    vd, zd, td = mt.max_location(d, z, th)
-    ang = float(mt.wrap_angle_deg(ts - td))
-    rows.add(q, "max_angle_error", ang, "m")
-    rows.add(q, "max_z_error", zs - zd, "m")
-    r = mt.pearson_r(s, d)
-    decisions.append(
-        {
-            "quantity": "wear map shape",
-            "criterion": f"NRMSE <= {criteria.wear_nrmse_max:g} and r >= {criteria.wear_r_min:g}",
-            "value": f"NRMSE = {nr:.3g}, r = {r:.3g}",
-            "passed": bool(
-                np.isfinite(nr)
-                and nr <= criteria.wear_nrmse_max
-                and np.isfinite(r)
-                and r >= criteria.wear_r_min
-            ),
-            "basis": "threshold",
-        }
-    )
-    decisions.append(
-        {
-            "quantity": "angle of maximum wear",
-            "criterion": f"|error| <= {criteria.max_angle_error_deg:g} degree",
-            "value": f"{ang:+.1f} degree (sim {ts:.1f}, meas {td:.1f})",
-            "passed": abs(ang) <= criteria.max_angle_error_deg,
-            "basis": "threshold",
-        }
-    )
-    decisions.append(
-        {
-            "quantity": "axial position of maximum wear",
-            "criterion": f"|error| <= {criteria.max_z_error_m * 1e3:g} mm",
-            "value": f"{(zs - zd) * 1e3:+.2f} mm (sim {zs * 1e3:+.2f}, meas {zd * 1e3:+.2f})",
-            "passed": abs(zs - zd) <= criteria.max_z_error_m + 1e-12,
-            "basis": "threshold",
-        }
-    )
-    us = np.asarray(al["wear_depth_sim_u"].values) if "wear_depth_sim_u" in al else None
-    ud = np.asarray(al["wear_depth_meas_u"].values) if "wear_depth_meas_u" in al else None
-
-    def at_max(u: np.ndarray | None, field: np.ndarray) -> float:
-        if u is None:
-            return 0.0
-        i, j = np.unravel_index(np.nanargmax(field), field.shape)
-        return float(u[i, j])
-
-    def u_num_of(value: float, u_field: float) -> float:
-        return u_field if u_field > 0 else criteria.wear_u_num_rel * abs(value)
-
-    _scalar_decision(
-        rows,
-        decisions,
-        "max_wear_depth",
-        "maximum wear depth",
-        vs,
-        vd,
-        "m",
-        u_num=u_num_of(vs, at_max(us, s)),
-        u_input=criteria.wear_u_input_rel * abs(vs),
-        u_d=at_max(ud, d),
-        criteria=criteria,
-    )
-    radius = al.attrs.get("bearing_radius_m")
-    if radius is not None and len(z) > 1:
-        v_s = mt.worn_volume(s, z, th, float(radius))
-        v_d = mt.worn_volume(d, z, th, float(radius))
-        u_vs = mt.worn_volume(us, z, th, float(radius)) if us is not None else 0.0
-        u_vd = mt.worn_volume(ud, z, th, float(radius)) if ud is not None else 0.0
-        _scalar_decision(
-            rows,
-            decisions,
-            "worn_volume",
-            "worn volume (overlapping width)",
-            v_s,
-            v_d,
-            "m3",
-            u_num=u_num_of(v_s, u_vs),
-            u_input=criteria.wear_u_input_rel * abs(v_s),
-            u_d=u_vd,
-            criteria=criteria,
+def _select_axes(ds: xr.Dataset, axes: Sequence[str] | None) -> tuple[xr.Dataset, list[str]]:
+    """Keep the requested vector components; return the dataset and the components left out."""
+    if axes is None or "axis" not in ds.dims:
+        return ds, []
+    have = [str(a) for a in ds["axis"].values]
+    bad = [a for a in axes if a not in ("x", "y", "z")]
+    if bad:
+        raise BadInputError(f"axes: {', '.join(bad)} - components are 'x', 'y' and 'z'")
+    keep = [a for a in have if a in axes]
+    if not keep:
+        raise BadInputError(
+            f"none of the requested components ({', '.join(axes)}) is in the motion record "
+            f"(it has {', '.join(have)})"
         )
-    if len(z) > 1:
-        c_s = mt.lsq_cylindricity(s, z, th)
-        c_d = mt.lsq_cylindricity(d, z, th)
-        rms_u = lambda u: float(np.sqrt(np.nanmean(u**2))) if u is not None else 0.0  # noqa: E731
-        _scalar_decision(
-            rows,
-            decisions,
-            "cylindricity",
-            "cylindricity of the wear (LSCY, common grid)",
-            c_s,
-            c_d,
-            "m",
-            u_num=u_num_of(c_s, math.sqrt(2) * rms_u(us)),
-            u_input=criteria.wear_u_input_rel * abs(c_s),
-            u_d=math.sqrt(2) * rms_u(ud),
-            criteria=criteria,
-        )
-    cs, cd = al.attrs.get("cylindricity_stated_sim_m"), al.attrs.get("cylindricity_stated_meas_m")
-    if cs is not None and cd is not None:
-        rows.add("cylindricity_stated", "value_sim", float(cs), "m")
-        rows.add("cylindricity_stated", "value_meas", float(cd), "m")
-        rows.add("cylindricity_stated", "E", float(cs) - float(cd), "m")
-    u_model = np.hypot(
-        criteria.wear_u_input_rel * s, us if us is not None else criteria.wear_u_num_rel * s
-    )
-    if us is not None or ud is not None or np.any(u_model > 0):
-        u_tot = np.sqrt(u_model**2 + (0 if ud is None else ud**2))
-        ok = np.isfinite(s - d) & np.isfinite(u_tot)
-        frac = float(np.mean(np.abs(s - d)[ok] <= criteria.k * u_tot[ok])) if ok.any() else np.nan
-        rows.add(q, "fraction_within_U_val", frac, "m")
+    return ds.sel(axis=keep), [a for a in have if a not in axes]
 
 
-# --------------------------------------------------------------------------- motion
-
-
-def _motion_metrics(
-    al: xr.Dataset, rows: _Rows, decisions: list[dict[str, Any]], criteria: Criteria
-) -> None:
-    names = [str(v)[: -len("_sim")] for v in al.data_vars if str(v).endswith("_sim")]
-    for name in names:
-        sim = al[f"{name}_sim"]
-        meas = al[f"{name}_meas"]
-        units = str(sim.attrs.get("units", "1"))
-        comps = [str(c) for c in al["axis"].values] if "axis" in sim.dims else [None]
-        for c in comps:
-            s = np.asarray(sim.sel(axis=c).values if c else sim.values, dtype=float)
-            d = np.asarray(meas.sel(axis=c).values if c else meas.values, dtype=float)
-            ok = np.isfinite(s) & np.isfinite(d)
-            if ok.sum() < 4:
+def _ensemble_wear(
+    ens: Ensemble, m_wear: xr.Dataset, al: xr.Dataset, cycles: float | None
+) -> tuple[dict[str, list[tuple[int, np.ndarray]]], xr.DataArray | None]:
+    """Per-run compared wear quantities and aligned maps from ensembles that keep ``wear_depth``."""
+    values: dict[str, list[tuple[int, np.ndarray]]] = {}
+    band = None
+    for i, da in ens.field("wear_depth"):
+        ds = ens.datasets[i]
+        per_run: dict[str, list[float]] = {}
+        maps = []
+        snap = cycles
+        if "cycles" in da.dims:
+            avail = np.asarray(da["cycles"].values, dtype=float)
+            if snap is None or not np.any(np.isclose(avail, snap, rtol=1e-9)):
+                snap = float(avail[-1])
+        for r in range(da.sizes["run"]):
+            member = da.isel(run=r, drop=True)
+            if not np.any(np.isfinite(member.values)):
+                for key in per_run:
+                    per_run[key].append(np.nan)
+                maps.append(np.full(al["wear_depth_sim"].shape, np.nan))
                 continue
-            s, d = s[ok], d[ok]
-            q = f"{name}_{c}" if c else name
-            label = q.replace("_", " ")
-            rows.add(q, "rmse", mt.rmse(s, d), units)
-            rows.add(q, "nrmse", mt.nrmse(s, d), units)
-            rows.add(q, "pearson_r", mt.pearson_r(s, d), units)
-            sg = mt.sprague_geers(s, d)
-            rows.add(q, "sg_magnitude", sg.M, units)
-            rows.add(q, "sg_phase", sg.P, units)
-            rows.add(q, "sg_comprehensive", sg.C, units)
-            rows.add(q, "area_validation_metric", mt.area_validation_metric(s, d), units)
-            decisions.append(
-                {
-                    "quantity": f"{label} history",
-                    "criterion": f"Sprague-Geers C <= {criteria.motion_sg_c_max:g}",
-                    "value": f"C = {sg.C:.3g} (M = {sg.M:+.3g}, P = {sg.P:.3g})",
-                    "passed": bool(np.isfinite(sg.C) and sg.C <= criteria.motion_sg_c_max),
-                    "basis": "threshold",
-                }
+            mds = member.to_dataset(name="wear_depth")
+            radius = {k: v for k, v in al.attrs.items() if k == "bearing_radius_m"}
+            mds.attrs = {**ds.attrs, **radius}
+            a = align_wear_maps(mds, m_wear, cycles=snap)
+            q = sim_quantities(a)
+            for key, v in q.items():
+                per_run.setdefault(key, [np.nan] * r).append(v)
+            same = a.sizes == al.sizes and np.allclose(a["z"], al["z"])
+            maps.append(np.asarray(a["wear_depth_sim"].values) if same else np.nan)
+        for key, vals in per_run.items():
+            values.setdefault(key, []).append((i, np.asarray(vals, dtype=float)))
+        if band is None:
+            band = xr.DataArray(
+                np.stack([np.broadcast_to(m, al["wear_depth_sim"].shape) for m in maps]),
+                dims=("run", "z", "theta"),
+                attrs={
+                    "units": "m",
+                    "long_name": f"simulated wear depth of each run of {ens.names[i]}",
+                },
             )
-            u = {}
-            for side in ("sim", "meas"):
-                uname = f"{name}_{side}_u"
-                if uname in al:
-                    uv = al[uname].sel(axis=c).values if c else al[uname].values
-                    u[side] = np.asarray(uv, dtype=float)[ok]
-            u_model = np.hypot(
-                criteria.motion_u_input_rel * s,
-                u["sim"] if "sim" in u else criteria.motion_u_num_rel * s,
-            )
-            if "meas" in u or np.any(u_model > 0):
-                u_tot = np.sqrt(u_model**2 + u.get("meas", 0.0) ** 2)
-                good = np.isfinite(u_tot)
-                rows.add(
-                    q,
-                    "fraction_within_U_val",
-                    float(np.mean(np.abs(s - d)[good] <= criteria.k * u_tot[good])),
-                    units,
+    return values, band
+
+
+def _ensemble_motion(
+    ens: Ensemble, m_motion: xr.Dataset, al: xr.Dataset, kwargs: dict[str, Any]
+) -> tuple[dict[str, list[tuple[int, np.ndarray]]], dict[str, xr.DataArray]]:
+    """Per-run RMS of the compared motion components from ensembles that keep motion histories."""
+    values: dict[str, list[tuple[int, np.ndarray]]] = {}
+    bands: dict[str, xr.DataArray] = {}
+    names = [str(v)[: -len("_sim")] for v in al.data_vars if str(v).endswith("_sim")]
+    for i, ds in enumerate(ens.datasets):
+        have = [n for n in names if n in ds.data_vars and {"run", "time"} <= set(ds[n].dims)]
+        if not have:
+            continue
+        per_run: dict[str, list[float]] = {}
+        members: dict[str, list[np.ndarray]] = {n: [] for n in have}
+        for r in range(ds.sizes["run"]):
+            keep = [*have, *(["crank_angle"] if "crank_angle" in ds else [])]
+            member = ds[keep].isel(run=r, drop=True)
+            t = np.asarray(member["time"].values, dtype=float)
+            finite = np.isfinite(t) & np.isfinite(
+                np.asarray(member[have[0]].values, dtype=float).reshape(t.size, -1)
+            ).all(axis=1)
+            try:
+                a = align_time_series(member.isel(time=np.flatnonzero(finite)), m_motion, **kwargs)
+            except BadInputError:
+                a = None
+            q = rms_quantities(a) if a is not None else {}
+            for key in set(per_run) | set(q):
+                per_run.setdefault(key, [np.nan] * r).append(q.get(key, np.nan))
+            for n in have:
+                shape = al[f"{n}_sim"].shape
+                ok = a is not None and f"{n}_sim" in a and a[f"{n}_sim"].shape == shape
+                members[n].append(
+                    np.asarray(a[f"{n}_sim"].values) if ok else np.full(shape, np.nan)
                 )
-            rms_s = float(np.sqrt(np.mean(s**2)))
-            rms_d = float(np.sqrt(np.mean(d**2)))
-            rms_u = {k: float(np.sqrt(np.nanmean(v**2))) for k, v in u.items()}
-            _scalar_decision(
-                rows,
-                decisions,
-                f"{q}_rms",
-                f"{label} RMS",
-                rms_s,
-                rms_d,
-                units,
-                u_num=rms_u.get("sim", criteria.motion_u_num_rel * rms_s),
-                u_input=criteria.motion_u_input_rel * rms_s,
-                u_d=rms_u.get("meas", 0.0),
-                criteria=criteria,
-            )
+        for key, vals in per_run.items():
+            values.setdefault(key, []).append((i, np.asarray(vals, dtype=float)))
+        for n in have:
+            if n not in bands:
+                bands[n] = xr.DataArray(
+                    np.stack(members[n]),
+                    dims=("run", *al[f"{n}_sim"].dims),
+                    attrs={
+                        "units": al[f"{n}_sim"].attrs.get("units", ""),
+                        "long_name": f"simulated {n} of each run of {ens.names[i]}",
+                    },
+                )
+    return values, bands
 
 
-# --------------------------------------------------------------------------- main entry
+def _sensitivity(ens: Ensemble | None, quantities: Sequence[str]) -> pd.DataFrame:
+    rows = []
+    if ens is not None:
+        for q in quantities:
+            rows += [{"quantity": q, **r} for r in ens.sensitivity(q)]
+    return pd.DataFrame(rows, columns=["quantity", "parameter", "S1", "ST"])
 
 
 def compare(
@@ -479,6 +287,9 @@ def compare(
     motion_method: str = "auto",
     period_s: float | None = None,
     variables: Sequence[str] | None = None,
+    axes: Sequence[str] | None = DEFAULT_AXES,
+    ensemble: xr.Dataset | Sequence[xr.Dataset] | Ensemble | None = None,
+    verification: xr.Dataset | Sequence[xr.Dataset] | Mapping[str, GCI] | None = None,
 ) -> Comparison:
     """Compare simulation and measurement: wear maps and/or motion, detected from the variables.
 
@@ -500,30 +311,55 @@ def compare(
         Crank period [s] (default from the crank angle).
     variables : sequence of str, optional
         Motion variables to compare (default: all in common).
+    axes : sequence of str or None
+        Vector components of the motion to compare (default in-plane ``("x", "y")``; None =
+        every component both sides have).
+    ensemble : Dataset, sequence of Datasets or Ensemble, optional
+        Ensembles of simulations over uncertain inputs (``run`` dimension); their spread is
+        the u_input of each compared quantity (:mod:`jointwear.compare.ensemble`).
+    verification : Dataset(s) or mapping of GCI, optional
+        Verification studies (quantities over a refinement parameter) for u_num
+        (:mod:`jointwear.compare.verification`).
 
     Returns
     -------
     Comparison
-        Aligned data, metrics table, decision card, notes.
+        Aligned data, metrics table, decision card (four states), notes, data origin.
 
     Raises
     ------
     BadInputError
-        Nothing to compare (no wear map or motion record on both sides), or the inputs cannot
-        be aligned.
+        Nothing to compare, inputs that cannot be aligned, or a malformed ensemble.
     ConventionError
         A wear map does not state its angle convention.
     """
     criteria = criteria or Criteria()
-    s_wear, s_motion = _split(sim)
-    m_wear, m_motion = _split(meas)
-    rows = _Rows()
+    ens = as_ensemble(ensemble)
+    if verification is None:
+        gci: Mapping[str, GCI] = {}
+    elif isinstance(verification, xr.Dataset) or not isinstance(verification, Mapping):
+        gci = numerical_uncertainty(verification)  # a Dataset is a Mapping too: test it first
+    else:
+        gci = verification
+    sims = [sim] if isinstance(sim, (xr.Dataset, xr.DataArray)) else list(sim)
+    meass = [meas] if isinstance(meas, (xr.Dataset, xr.DataArray)) else list(meas)
+    s_wear, s_motion = _split(sims)
+    m_wear, m_motion = _split(meass)
+    rows = Rows()
     decisions: list[dict[str, Any]] = []
     notes: list[str] = []
+    partial: list[str] = []
     wear = motion = None
+    field_values: dict[str, list[tuple[int, np.ndarray]]] = {}
     if s_wear is not None and m_wear is not None:
         wear = align_wear_maps(s_wear, m_wear, cycles=cycles, theta_step_deg=theta_step_deg)
-        _wear_metrics(wear, rows, decisions, criteria)
+        if ens is not None:
+            values, band = _ensemble_wear(ens, m_wear, wear, float(wear.attrs["cycles_sim"]))
+            field_values.update(values)
+            if band is not None:
+                wear["wear_depth_sim_ensemble"] = band
+        src = Sources(criteria, ens, gci, float(wear.attrs["cycles_sim"]), field_values)
+        wear_metrics(wear, rows, decisions, src)
         if cycles is None and not np.isfinite(float(wear.attrs.get("cycles_meas", np.nan))):
             notes.append(
                 "wear cycles: the measured map does not state after how many crank cycles it was "
@@ -532,15 +368,33 @@ def compare(
             )
     elif s_wear is not None or m_wear is not None:
         side = "measurement" if s_wear is not None else "simulation"
-        notes.append(f"wear maps not compared: the {side} has no wear map (wear_depth)")
+        partial.append(f"wear maps not compared: the {side} has no wear map (wear_depth)")
     if s_motion is not None and m_motion is not None:
-        motion = align_time_series(
-            s_motion, m_motion, variables=variables, method=motion_method, period_s=period_s
-        )
-        _motion_metrics(motion, rows, decisions, criteria)
+        s_sel, s_out = _select_axes(s_motion, axes)
+        m_sel, m_out = _select_axes(m_motion, axes)
+        left_out = sorted(set(s_out) | set(m_out))
+        kwargs = {"variables": variables, "method": motion_method, "period_s": period_s}
+        motion = align_time_series(s_sel, m_sel, **kwargs)
+        if left_out:
+            notes.append(
+                f"motion component(s) {', '.join(left_out)} not compared: only "
+                f"{', '.join(axes or ())} by default (the mechanism is planar; out-of-plane rig "
+                "motion is not a prediction of it) - ask for them with axes= / --axis"
+            )
+        if ens is not None:
+            ens_sel = Ensemble(
+                tuple(_select_axes(d, axes)[0] if "axis" in d.dims else d for d in ens.datasets),
+                ens.names,
+            )
+            values, bands = _ensemble_motion(ens_sel, m_sel, motion, kwargs)
+            field_values.update(values)
+            for n, band in bands.items():
+                motion[f"{n}_sim_ensemble"] = band
+        src = Sources(criteria, ens, gci, None, field_values)
+        motion_metrics(motion, rows, decisions, src)
     elif s_motion is not None or m_motion is not None:
         side = "measurement" if s_motion is not None else "simulation"
-        notes.append(f"motion not compared: the {side} has no motion record over time")
+        partial.append(f"motion not compared: the {side} has no motion record over time")
     if wear is None and motion is None:
         raise BadInputError(
             "nothing to compare: give a wear map (wear_depth over z, theta) and/or a motion "
@@ -548,151 +402,16 @@ def compare(
         )
     card = pd.DataFrame(decisions, columns=DECISION_COLUMNS)
     card["passed"] = card["passed"].astype(bool)
+    metrics = rows.frame()
+    compared = list(dict.fromkeys(metrics.loc[metrics.metric == "value_sim", "quantity"]))
     return Comparison(
         wear=wear,
         motion=motion,
-        metrics=rows.frame(),
+        metrics=metrics,
         decisions=card,
-        notes=tuple(notes),
+        notes=tuple([*partial, *notes]),
         criteria=criteria,
-    )
-
-
-def metrics_table(comparison: Comparison | xr.Dataset) -> pd.DataFrame:
-    """The tidy metrics table (quantity, metric, value, units, long_name, definition)."""
-    if isinstance(comparison, Comparison):
-        return comparison.metrics.copy()
-    return load_comparison(comparison).metrics
-
-
-# --------------------------------------------------------------------------- netCDF
-
-
-def _to_dataset(c: Comparison) -> xr.Dataset:
-    parts = []
-    attrs: dict[str, Any] = {}
-    for prefix, part in (("wear", c.wear), ("motion", c.motion)):
-        if part is None:
-            continue
-        parts.append(part)
-        attrs.update({f"{prefix}_{k}": v for k, v in part.attrs.items() if k != "title"})
-    ds = xr.merge(parts, combine_attrs="override", join="outer") if parts else xr.Dataset()
-    for row in c.metrics.itertuples():
-        name = f"{row.quantity}__{row.metric}"
-        ds[name] = xr.DataArray(
-            float(row.value),
-            attrs={
-                "units": row.units,
-                "long_name": f"{row.long_name} of {row.quantity}",
-                "definition": row.definition,
-                "quantity": row.quantity,
-                "metric": row.metric,
-            },
-        )
-    for i, row in enumerate(c.decisions.itertuples()):
-        ds[f"decision_{i:02d}"] = xr.DataArray(
-            np.int8(bool(row.passed)),
-            attrs={
-                "units": "1",
-                "long_name": f"validation decision: {row.quantity}",
-                "quantity": row.quantity,
-                "criterion": row.criterion,
-                "value": row.value,
-                "basis": row.basis,
-                "flag_values": np.array([0, 1], dtype=np.int8),
-                "flag_meanings": "fail pass",
-            },
-        )
-    attrs.update(
-        {
-            "title": "jointwear comparison of simulation and measurement",
-            "validation_passed": int(c.passed),
-            "n_criteria": len(c.decisions),
-            "n_failed": len(c.failed()),
-            "notes": "\n".join(c.notes),
-            "criteria": json_dumps(c.criteria),
-        }
-    )
-    ds.attrs = attrs
-    return ds
-
-
-def json_dumps(criteria: Criteria) -> str:
-    """Criteria as JSON text (sorted keys)."""
-    import json
-
-    from jointwear.params import to_jsonable
-
-    return json.dumps(to_jsonable(criteria), sort_keys=True)
-
-
-def load_comparison(source: str | Path | xr.Dataset) -> Comparison:
-    """Rebuild a :class:`Comparison` from the netCDF written by :func:`save_comparison`."""
-    import json
-
-    ds = io.load(source) if not isinstance(source, xr.Dataset) else source
-    metric_rows = []
-    decision_rows = []
-    for name, var in ds.data_vars.items():
-        if "__" in str(name) and "metric" in var.attrs:
-            metric_rows.append(
-                {
-                    "quantity": var.attrs["quantity"],
-                    "metric": var.attrs["metric"],
-                    "value": float(var.values),
-                    "units": var.attrs.get("units", ""),
-                    "long_name": mt.DEFINITIONS.get(var.attrs["metric"], ("",))[0],
-                    "definition": var.attrs.get("definition", ""),
-                }
-            )
-        elif str(name).startswith("decision_"):
-            decision_rows.append(
-                {
-                    "quantity": var.attrs.get("quantity", str(name)),
-                    "criterion": var.attrs.get("criterion", ""),
-                    "value": var.attrs.get("value", ""),
-                    "passed": bool(int(var.values)),
-                    "basis": var.attrs.get("basis", ""),
-                }
-            )
-    wear_vars = [v for v in ds.data_vars if set(ds[v].dims) == {"z", "theta"}]
-    motion_vars = [v for v in ds.data_vars if "time" in ds[v].dims]
-    wear = ds[wear_vars] if wear_vars else None
-    motion = ds[motion_vars] if motion_vars else None
-    for prefix, part in (("wear_", wear), ("motion_", motion)):
-        if part is not None:
-            part.attrs = {k[len(prefix) :]: v for k, v in ds.attrs.items() if k.startswith(prefix)}
-    try:
-        crit = from_mapping(Criteria, json.loads(ds.attrs.get("criteria", "{}")), where="criteria")
-    except (ValueError, ParameterError):
-        crit = Criteria()
-    notes = tuple(n for n in str(ds.attrs.get("notes", "")).splitlines() if n)
-    return Comparison(
-        wear=wear,
-        motion=motion,
-        metrics=pd.DataFrame(metric_rows, columns=METRIC_COLUMNS),
-        decisions=pd.DataFrame(decision_rows, columns=DECISION_COLUMNS).astype({"passed": bool}),
-        notes=notes,
-        criteria=crit,
-    )
-
-
-def save_comparison(
-    comparison: Comparison,
-    path: str | Path,
-    *,
-    inputs: Sequence[str | Path] = (),
-    parents: Sequence[xr.Dataset] = (),
-    command: str | None = None,
-) -> Path:
-    """Write the aligned fields, differences, metrics and decisions to netCDF (atomic, provenance)."""
-    ds = comparison.to_dataset()
-    return io.save(
-        ds,
-        path,
-        inputs=inputs,
-        parameters=comparison.criteria,
-        parents=parents,
-        command=command,
-        source="jointwear compare",
+        data_origin={"simulation": side_origin(sims), "measurement": side_origin(meass)},
+        partial=tuple(partial),
+        sensitivity=_sensitivity(ens, compared),
     )

@@ -92,6 +92,12 @@ DEFINITIONS: dict[str, tuple[str, str, str]] = {
         "z(max S) - z(max D)",
         "m",
     ),
+    "volume_fraction_compared": (
+        "fraction of the simulated worn volume compared",
+        "integral of the simulated wear depth over the axial range the measurement covers / its "
+        "integral over the whole simulated width",
+        "1",
+    ),
     "value_sim": ("simulated value", "value of the quantity from the simulation", "same"),
     "value_meas": ("measured value", "value of the quantity from the measurement", "same"),
     "relative_error": ("relative error", "(S - D) / |D|", "1"),

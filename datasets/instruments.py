@@ -358,6 +358,8 @@ def write(
             "Z unit": "mm" if layout in ("long", "folder-header") else "",
             "Points": str(n),
             "Nominal radius": f"{scan.nominal_radius * 1e3:.6f} mm",
+            # generated with a known truth: the importer keeps this (data contract: data_origin)
+            "Data origin": "synthetic",
             **extra,
         }
         return "".join(f"{k}: {v}\n" for k, v in meta.items() if v != "")

@@ -648,6 +648,10 @@ def wear_map(
             "centring": centring,
         },
     )
+    origins = {str(getattr(o, "attrs", {}).get("data_origin", "")) for o in (worn, before)}
+    origins.discard("")
+    if origins:  # keep the inputs' origin: one synthetic scan makes the map synthetic
+        out.attrs["data_origin"] = "synthetic" if "synthetic" in origins else sorted(origins)[0]
     return out
 
 

@@ -147,44 +147,68 @@ def _metrics_rows(c: Comparison) -> list[dict[str, str]]:
     return rows
 
 
+_BUDGET_KEYS = ("value_sim", "value_meas", "E", "u_num", "u_input", "u_D", "u_val", "U_val")
+
+
 def _budget(c: Comparison) -> tuple[list[dict[str, Any]], list[str]]:
+    """Rows of the V&V 20 budget (every compared scalar) and the sources of each uncertainty."""
+    import jointwear.compare.verdicts as vd
+
     m = c.metrics
-    budget, none = [], []
-    for q in dict.fromkeys(m.quantity):
+    budget, sources = [], []
+    vv = {
+        str(r.key): (str(r.quantity), str(r.state))
+        for r in c.decisions.itertuples()
+        if r.basis == "V&V 20"
+    }
+    for q in [q for q in dict.fromkeys(m.quantity) if str(q) in vv]:
+        label, state = vv[str(q)]
         sub = m[m.quantity == q].set_index("metric")
-        if "value_sim" not in sub.index:
-            continue
-        if "u_val" not in sub.index:
-            none.append(str(q))
-            continue
         units = str(sub.loc["value_sim", "units"])
         cells = []
-        for key in ("value_sim", "value_meas", "E", "u_num", "u_input", "u_D", "u_val", "U_val"):
+        for key in _BUDGET_KEYS:
+            if key not in sub.index or not np.isfinite(float(sub.loc[key, "value"])):
+                cells.append("not assessed" if key.startswith("u_") else "–")
+                continue
             v, u = format_value(float(sub.loc[key, "value"]), units, digits=3)
             cells.append(f"{v} {u}".strip())
-        passed = abs(float(sub.loc["E", "value"])) <= float(sub.loc["U_val", "value"])
-        budget.append({"quantity": str(q), "cells": cells, "passed": passed})
-    return budget, none
+        budget.append(
+            {"quantity": label, "cells": cells, "state": state, "label": vd.LABELS[state]}
+        )
+        for key in ("u_num", "u_input", "u_D"):
+            if key in sub.index:
+                sources.append(
+                    {"quantity": label, "component": key, "basis": str(sub.loc[key, "basis"])}
+                )
+    return budget, sources
 
 
 def _uncertainty_sources(crit: Criteria) -> list[tuple[str, str]]:
+    def stated(name: str) -> str:
+        v = getattr(crit, name)
+        return "not stated" if v is None else f"user-stated {v:.3g}·|S|"
+
     return [
         (
             "u_D (measurement)",
             "the measurement's stated standard uncertainty (<name>_u): at the location of the "
             "maximum for the maximum wear depth; its surface integral for the worn volume (fully "
             "correlated, conservative); √2·RMS for the cylindricity (peak-to-valley of two "
-            "points); its RMS for the RMS motion",
+            "points); its RMS for the RMS motion. None stated: not assessed.",
         ),
         (
             "u_num (numerical)",
-            "the simulation's stated standard uncertainty (<name>_u) if any, else "
-            f"{crit.wear_u_num_rel:.3g}·|S| (wear) and {crit.motion_u_num_rel:.3g}·|S| (motion)",
+            "the simulation's stated standard uncertainty (<name>_u), else a verification study "
+            "(GCI, Roache; only for monotone convergence), else a fraction stated in the criteria "
+            f"(wear: {stated('wear_u_num_rel')}; motion: {stated('motion_u_num_rel')}); "
+            "otherwise not assessed.",
         ),
         (
             "u_input (model inputs)",
-            f"{crit.wear_u_input_rel:.3g}·|S| (wear) and {crit.motion_u_input_rel:.3g}·|S| (motion), "
-            "from the criteria file; 0 means not assessed",
+            "the standard deviation of the quantity over an ensemble of simulations (--ensemble), "
+            "else a fraction stated in the criteria (wear: "
+            f"{stated('wear_u_input_rel')}; motion: {stated('motion_u_input_rel')}); otherwise "
+            "not assessed - never zero.",
         ),
     ]
 
@@ -218,6 +242,71 @@ def _input_records(inputs: Sequence[ReportInput]) -> tuple[list[dict[str, str]],
     return records, (max(created) if created else None)
 
 
+def _verdict(c: Comparison, counts: dict[str, int]) -> tuple[str, str]:
+    """Headline of the decision card and its CSS class."""
+    import jointwear.compare.verdicts as vd
+
+    n = sum(counts.values())
+    synthetic = (
+        " (against SYNTHETIC measurement data)"
+        if c.data_origin.get("measurement") == "synthetic"
+        else ""
+    )
+    if n == 0:
+        return "NO DECISION: nothing was compared", "undecided"
+    if counts[vd.FAIL]:
+        return f"NOT VALIDATED: {counts[vd.FAIL]} of {n} criteria failed{synthetic}", "fail"
+    undecided = counts[vd.NOT_ASSESSED] + counts[vd.NOT_COMPARABLE]
+    if undecided or c.partial:
+        what = []
+        if counts[vd.NOT_ASSESSED]:
+            what.append(f"{counts[vd.NOT_ASSESSED]} not assessed")
+        if counts[vd.NOT_COMPARABLE]:
+            what.append(f"{counts[vd.NOT_COMPARABLE]} not comparable")
+        if c.partial:
+            what.append("parts not compared")
+        return (
+            f"INCOMPLETE: no criterion failed, but {', '.join(what)}{synthetic}",
+            "undecided",
+        )
+    return f"VALIDATED: every criterion is met{synthetic}", "pass"
+
+
+def _coverage(c: Comparison) -> list[str]:
+    """What the wear comparison covers (the compared fraction of the simulated volume)."""
+    if c.wear is None or "volume_fraction_compared" not in c.wear.attrs:
+        return []
+    a = c.wear.attrs
+    lo, hi = (float(v) for v in np.ravel(a["z_overlap_m"]))
+    zs = [float(v) for v in np.ravel(a.get("z_range_sim_m", [np.nan, np.nan]))]
+    frac = float(a["volume_fraction_compared"])
+    out = [
+        f"Compared axial range z = {lo * 1e3:+.2f} to {hi * 1e3:+.2f} mm of the simulated "
+        f"{zs[0] * 1e3:+.2f} to {zs[1] * 1e3:+.2f} mm: {frac:.0%} of the simulated worn volume "
+        "is compared (uncompared region hatched on the wear maps)."
+    ]
+    if not int(a.get("sim_max_inside", 1)):
+        out.append(
+            f"The simulated maximum ({float(a['sim_max_value_m']) * 1e6:.3g} µm at z = "
+            f"{float(a['sim_max_z_m']) * 1e3:+.2f} mm) lies outside the measured range."
+        )
+    return out
+
+
+def _sensitivity_rows(c: Comparison) -> list[dict[str, str]]:
+    rows = []
+    for r in c.sensitivity.itertuples():
+        rows.append(
+            {
+                "quantity": str(r.quantity),
+                "parameter": str(r.parameter),
+                "S1": f"{float(r.S1):.2f}" if np.isfinite(float(r.S1)) else "–",
+                "ST": f"{float(r.ST):.2f}" if np.isfinite(float(r.ST)) else "–",
+            }
+        )
+    return rows
+
+
 def _context(
     c: Comparison,
     *,
@@ -229,41 +318,56 @@ def _context(
     command: str | None,
     parameters: dict[str, Any] | None,
 ) -> dict[str, Any]:
+    import jointwear.compare.verdicts as vd
     from jointwear.reports import figures
 
     n = len(c.decisions)
-    n_pass = int(c.decisions["passed"].sum()) if n else 0
+    counts = vd.counts(c.states)
+    n_pass = counts[vd.PASS]
     # the comparison's own notes ("motion not compared: ...") unless the caller already said why
     covered = {m.split(":", 1)[0].split()[0].lower() for m in missing if m.strip()}
-    gaps = [n for n in c.notes if "not compared" in n]
+    gaps = [n for n in c.notes if "not compared" in n and n.split()[0] in ("wear", "motion")]
     missing = [*missing, *(n for n in gaps if n.split()[0].lower() not in covered)]
     notes = [*notes, *(n for n in c.notes if n not in gaps)]
+    verdict, verdict_class = _verdict(c, counts)
+    origin = dict(c.data_origin)
     ctx: dict[str, Any] = {
         "version": __version__,
         "title": title,
         "css": _template("report.css"),
         "passed": c.passed,
-        "verdict": (
-            "VALIDATED: every criterion is met"
-            if c.passed
-            else ("NOT VALIDATED: criteria failed" if n else "NO DECISION: nothing was compared")
-        ),
+        "card_class": verdict_class,
+        "verdict": verdict,
+        "summary": c.summary(),
         "n_passed": n_pass,
         "n_decisions": n,
-        "failed": c.failed(),
-        "decisions": [r._asdict() for r in c.decisions.itertuples(index=False)],
+        "failed": list(dict.fromkeys(c.failed())),
+        "undecided": [
+            (vd.LABELS[st].lower(), list(dict.fromkeys(c.quantities(st))))
+            for st in (vd.NOT_ASSESSED, vd.NOT_COMPARABLE)
+            if c.quantities(st)
+        ],
+        "decisions": [
+            {**r._asdict(), "label": vd.LABELS[r.state], "cls": r.state.replace("_", "-")}
+            for r in c.decisions.itertuples(index=False)
+        ],
+        "origin_sim": origin.get("simulation", "not stated"),
+        "origin_meas": origin.get("measurement", "not stated"),
+        "synthetic": "synthetic" in origin.values(),
+        "coverage": _coverage(c),
         "missing": missing,
         "notes": list(notes),
         "metrics": _metrics_rows(c),
         "alignment": _alignment(c),
         "k": f"{c.criteria.k:g}",
         "uncertainty_sources": _uncertainty_sources(c.criteria),
+        "sensitivity": _sensitivity_rows(c),
     }
     parts = [p for p, d in (("wear maps", c.wear), ("motion", c.motion)) if d is not None]
     ctx["subtitle"] = (
-        "Simulation against measurement: "
+        f"Simulation ({ctx['origin_sim']}) against measurement ({ctx['origin_meas']}): "
         + (" and ".join(parts) if parts else "nothing compared")
-        + f". {n_pass} of {n} validation criteria met."
+        + f". {c.summary()}."
     )
     ctx["toc"] = [
         ("decision", "Decision"),
@@ -311,9 +415,9 @@ def _context(
             (m for m in missing if "motion" in m.lower() or "dic" in m.lower()),
             "Motion was not compared: no simulated and measured motion record were given.",
         )
-    budget, none = _budget(c)
+    budget, sources = _budget(c)
     ctx["budget"] = budget
-    ctx["no_budget"] = none
+    ctx["budget_sources"] = sources
     vfig = figures.verification_figure(verification) if verification else None
     ctx["verification_svg"] = figures.svg_markup(vfig, "verification") if vfig is not None else None
     ctx["verification_missing"] = next(
@@ -464,13 +568,32 @@ def write_pdf(
 
     c = comparison
     path = Path(path)
+    from textwrap import wrap
+
+    import jointwear.compare.verdicts as vd
+
+    verdict, _ = _verdict(c, vd.counts(c.states))
     lines = [
-        ("VALIDATED: every criterion is met" if c.passed else "NOT VALIDATED: criteria failed"),
+        verdict,
+        f"data origin: simulation {c.data_origin.get('simulation', 'not stated')}, "
+        f"measurement {c.data_origin.get('measurement', 'not stated')}",
+        c.summary(),
+        *_coverage(c),
         "",
     ]
     for r in c.decisions.itertuples():
-        lines.append(f"{'PASS' if r.passed else 'FAIL'}  {r.quantity}")
-        lines.append(f"      {r.value}   [{r.criterion}; {r.basis}]")
+        lines.append(f"{vd.LABELS[r.state]:<14s}  {r.quantity}")
+        lines += wrap(
+            f"{r.value}   [{r.criterion}; {r.basis}]",
+            100,
+            initial_indent=" " * 6,
+            subsequent_indent=" " * 6,
+        )
+        if r.reason:
+            lines += wrap(
+                f"why: {r.reason}", 100, initial_indent=" " * 6, subsequent_indent=" " * 6
+            )
+    lines = [piece for line in lines for piece in (wrap(line, 110) or [""])]
     for m in [*missing, *c.notes]:
         lines += ["", f"Not covered: {m}"]
     for m in notes:
@@ -521,6 +644,8 @@ def report_from_files(
     cycles: float | None = None,
     period_s: float | None = None,
     variables: Sequence[str] | None = None,
+    ensemble: Sequence[str | Path] = (),
+    axes: Sequence[str] | None = ("x", "y"),
 ) -> tuple[Path, Comparison]:
     """Build a report from files: simulation, metrology and DIC netCDF, or a saved comparison.
 
@@ -534,7 +659,12 @@ def report_from_files(
     comparison : path, optional
         A file written by ``jointwear compare`` (instead of sim/metrology/dic).
     verification : sequence of path
-        Verification (convergence) data files to plot.
+        Verification (convergence) data files: plotted, and their GCI is the numerical
+        uncertainty of the compared quantities (:mod:`jointwear.compare.verification`).
+    ensemble : sequence of path
+        Ensembles of simulations (``run`` dimension) whose spread is the input uncertainty.
+    axes : sequence of str or None
+        Motion components to compare (default in-plane x, y).
     criteria : Criteria, optional
         Validation criteria.
     title, pdf, command
@@ -548,13 +678,17 @@ def report_from_files(
     -------
     (Path, Comparison)
     """
-    from jointwear.compare import load_comparison
+    from jointwear.compare import as_ensemble, load_comparison
 
     inputs: list[ReportInput] = []
     missing: list[str] = []
+    vers = [io.load(p, validate=False) for p in verification]
+    ens_ds = [io.load(p) for p in ensemble]
     if comparison is not None:
-        if sim or metrology or dic:
-            raise BadInputError("give either --comparison or --sim/--metrology/--dic, not both")
+        if sim or metrology or dic or ensemble:
+            raise BadInputError(
+                "give either --comparison or --sim/--metrology/--dic/--ensemble, not both"
+            )
         ds = io.load(comparison)
         result = load_comparison(ds)
         inputs.append(ReportInput("comparison", Path(comparison), ds))
@@ -584,8 +718,13 @@ def report_from_files(
             cycles=cycles,
             period_s=period_s,
             variables=variables,
+            axes=axes,
+            ensemble=as_ensemble(ens_ds, [Path(p).name for p in ensemble]) if ens_ds else None,
+            verification=vers or None,
         )
-    vers = [io.load(p, validate=False) for p in verification]
+        inputs += [
+            ReportInput("ensemble", Path(p), d) for p, d in zip(ensemble, ens_ds, strict=True)
+        ]
     inputs += [
         ReportInput("verification", Path(p), d) for p, d in zip(verification, vers, strict=True)
     ]

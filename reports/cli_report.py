@@ -56,16 +56,38 @@ def register(app: typer.Typer) -> None:
             list[str] | None,
             typer.Option("--variable", help="Motion variable to compare (repeatable)."),
         ] = None,
+        ensemble: Annotated[
+            list[Path] | None,
+            typer.Option(
+                "--ensemble",
+                help="Ensemble of simulations (.nc with a 'run' dimension, from jointwear sim "
+                "sweep): its spread is the V&V 20 input uncertainty. Repeatable.",
+            ),
+        ] = None,
+        axes: Annotated[
+            list[str] | None,
+            typer.Option("--axis", help="Motion component to compare (default x and y)."),
+        ] = None,
         strict: Annotated[
-            bool, typer.Option("--strict", help="Exit with code 1 if a criterion fails.")
+            bool,
+            typer.Option(
+                "--strict",
+                help="Also exit 1 when a criterion is not assessed or not comparable, or a "
+                "part was not compared (a failed criterion always exits 1).",
+            ),
         ] = False,
     ) -> None:
-        """Build a self-contained HTML validation report from simulation and measurement files."""
+        """Build a self-contained HTML validation report from simulation and measurement files.
+
+        Exit code 1 when a criterion fails (the report is written first); with --strict also
+        when one is not assessed or not comparable.
+        """
         if ctx.invoked_subcommand is not None:
             return
         from jointwear import io
         from jointwear.compare import load_criteria
-        from jointwear.errors import ValidationFailed
+        from jointwear.compare.outcome import origin_line, outcome_lines, raise_for_outcome
+        from jointwear.compare.verdicts import LABELS
         from jointwear.reports.builder import DEFAULT_TITLE, report_from_files
 
         io.check_writable(out, what="report")
@@ -82,11 +104,15 @@ def register(app: typer.Typer) -> None:
             cycles=cycles,
             period_s=period,
             variables=variables or None,
+            ensemble=ensemble or [],
+            axes=axes or ("x", "y"),
         )
+        typer.echo(origin_line(result))
         for row in result.decisions.itertuples():
-            typer.echo(f"{'PASS' if row.passed else 'FAIL'}  {row.quantity}: {row.value}")
+            typer.echo(f"{LABELS[row.state]:<14}  {row.quantity}: {row.value}")
         typer.echo(f"report: {path}")
         if pdf is not None:
             typer.echo(f"pdf: {pdf}")
-        if strict and not result.passed:
-            raise ValidationFailed(f"validation failed for: {', '.join(result.failed())}")
+        for line in outcome_lines(result):
+            typer.echo(line)
+        raise_for_outcome(result, strict=strict, where=str(path))

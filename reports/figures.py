@@ -106,11 +106,27 @@ def wear_maps_figure(wear: xr.Dataset) -> Any:
             (d, "measurement", "magma_r", vmin, vmax),
             (diff, "simulation − measurement", "RdBu_r", -dmax, dmax),
         )
-        for ax, (field, title, cmap, lo, hi) in zip(axes, panels, strict=True):
+        full = "wear_depth_sim_full" in wear
+        if full:
+            th_f = np.asarray(wear["theta_sim"].values, dtype=float)
+            z_f = np.asarray(wear["z_sim"].values, dtype=float) * 1e3
+            s_f = np.asarray(wear["wear_depth_sim_full"].values) * 1e6
+            vmax = float(np.nanmax([vmax, np.nanmax(s_f)]))
+            panels = ((s_f, "simulation (whole width)", "magma_r", vmin, vmax), *panels[1:])
+        for k, (ax, (field, title, cmap, lo, hi)) in enumerate(zip(axes, panels, strict=True)):
+            x, y = (th_f, z_f) if (full and k == 0) else (theta, z_mm)
             mesh = ax.pcolormesh(
-                theta, z_mm, field, shading="nearest", cmap=cmap, vmin=lo, vmax=hi, rasterized=True
+                x, y, field, shading="nearest", cmap=cmap, vmin=lo, vmax=hi, rasterized=True
             )
             ax.set_title(title)
+            if full:
+                zlo, zhi = z_mm.min(), z_mm.max()
+                for a, b in ((z_f.min(), zlo), (zhi, z_f.max())):
+                    if b - a > 1e-9:
+                        ax.axhspan(a, b, facecolor="none", edgecolor="0.35", hatch="///", lw=0)
+                ax.axhline(zlo, color="0.2", lw=0.8, ls="--")
+                ax.axhline(zhi, color="0.2", lw=0.8, ls="--")
+                ax.set_ylim(z_f.min() - 0.5, z_f.max() + 0.5)
             ax.set_xlabel("θ [degree] (0 along −x, clockwise)")
             ax.set_xticks(np.arange(0, 361, 90))
             fig.colorbar(mesh, ax=ax, label="wear depth [µm]" if cmap != "RdBu_r" else "Δ [µm]")
@@ -132,7 +148,10 @@ def polar_layers_figure(wear: xr.Dataset, *, max_layers: int = 6) -> Any:
     idx = np.unique(np.round(np.linspace(z.size - 1, 0, n)).astype(int))[::-1]
     s = np.asarray(wear["wear_depth_sim"].values) * 1e6
     d = np.asarray(wear["wear_depth_meas"].values) * 1e6
+    ens = _band(wear, "wear_depth_sim_ensemble", 1e6)
     rmax = float(np.nanmax([np.nanmax(s), np.nanmax(d)])) * 1.05 or 1.0
+    if ens is not None:
+        rmax = max(rmax, float(np.nanmax(ens[1])) * 1.05)
     ncol = min(3, idx.size)
     nrow = int(np.ceil(idx.size / ncol))
     th = np.deg2rad(np.append(theta, theta[0] + 360.0))
@@ -142,6 +161,17 @@ def polar_layers_figure(wear: xr.Dataset, *, max_layers: int = 6) -> Any:
             ax = fig.add_subplot(nrow, ncol, k + 1, projection="polar")
             ax.set_theta_zero_location("W")
             ax.set_theta_direction(-1)
+            if ens is not None:
+                lo_b, hi_b = ens[0][i], ens[1][i]
+                ax.fill_between(
+                    th,
+                    np.append(lo_b, lo_b[0]),
+                    np.append(hi_b, hi_b[0]),
+                    color=SIM_COLOUR,
+                    alpha=0.2,
+                    lw=0,
+                    label="ensemble 5-95 %",
+                )
             ax.plot(th, np.append(s[i], s[i][0]), color=SIM_COLOUR, lw=1.2, label="simulation")
             ax.plot(th, np.append(d[i], d[i][0]), color=MEAS_COLOUR, lw=1.0, label="measurement")
             ax.set_ylim(min(0.0, float(np.nanmin([s[i].min(), d[i].min()]))), rmax)
@@ -151,6 +181,17 @@ def polar_layers_figure(wear: xr.Dataset, *, max_layers: int = 6) -> Any:
                 ax.legend(loc="upper left", bbox_to_anchor=(-0.25, 1.18), frameon=False)
         fig.suptitle("wear depth [µm] per layer", fontsize=9)
     return fig
+
+
+def _band(ds: xr.Dataset, name: str, factor: float) -> tuple[np.ndarray, np.ndarray] | None:
+    """5th and 95th percentile over ``run`` of an ensemble field (None when absent/empty)."""
+    if name not in ds or "run" not in ds[name].dims:
+        return None
+    v = np.asarray(ds[name].transpose("run", ...).values, dtype=float) * factor
+    ok = np.isfinite(v).reshape(v.shape[0], -1).any(axis=1)
+    if ok.sum() < 2:
+        return None
+    return np.nanpercentile(v[ok], 5, axis=0), np.nanpercentile(v[ok], 95, axis=0)
 
 
 def _components(motion: xr.Dataset) -> list[tuple[str, str | None]]:
@@ -196,6 +237,15 @@ def motion_figure(motion: xr.Dataset, *, k: float = 2.0) -> Any:
                     alpha=0.22,
                     lw=0,
                     label=f"measurement ± {k:g}u",
+                )
+            band = _band(motion, f"{base}_sim_ensemble", 1.0)
+            if band is not None:
+                lo_b, hi_b = band
+                if c is not None and "axis" in motion[f"{base}_sim_ensemble"].dims:
+                    j = [str(a) for a in motion["axis"].values].index(c)
+                    lo_b, hi_b = lo_b[:, j], hi_b[:, j]
+                ax.fill_between(
+                    t, lo_b, hi_b, color=SIM_COLOUR, alpha=0.2, lw=0, label="ensemble 5-95 %"
                 )
             ax.plot(t, m, color=MEAS_COLOUR, lw=0.9, marker=".", ms=2.5, label="measurement")
             ax.plot(

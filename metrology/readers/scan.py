@@ -315,9 +315,11 @@ def _assemble(
     ds = xr.Dataset({name: da})
     ds = convert_theta(ds, CANONICAL)
     ds["z"].attrs["instrument_height_of_z0"] = float(mid)
+    origin = _data_origin(metadata)
     attrs = {
         "title": "roundness/cylindricity scan",
-        "source": f"measurement: {instrument}",
+        "source": f"{'measurement' if origin == 'measured' else origin}: {instrument}",
+        "data_origin": origin,
         "instrument": instrument,
         "instrument_angle_zero": convention.zero,
         "instrument_angle_direction": convention.direction,
@@ -339,6 +341,24 @@ def _assemble(
         attrs["nominal_radius"] = nominal
     ds.attrs.update(attrs)
     return ds
+
+
+def _data_origin(meta: dict) -> str:
+    """``data_origin`` from a ``Data origin:`` header line (generated files say "synthetic").
+
+    An instrument export without that line is taken as measured (it came from the instrument);
+    a stated origin is kept whatever it is, so an imported generated scan stays synthetic.
+    """
+    for k, v in meta.items():
+        if str(k).strip().lower().replace("_", " ") == "data origin":
+            value = str(v).strip().lower()
+            if value in ("measured", "synthetic", "simulated"):
+                return value
+            raise BadInputError(
+                f"header 'Data origin: {v}' is not one of measured, synthetic, simulated; "
+                "correct the header line"
+            )
+    return "measured"
 
 
 def _nominal_radius(meta: dict) -> float | None:

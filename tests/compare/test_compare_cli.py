@@ -17,6 +17,8 @@ def files(tmp_path):
         "sim_wear": syn.sim_wear(),
         "sim_motion": syn.sim_motion(),
         "meas_wear": syn.meas_wear(u=1e-6),
+        "meas_wear_full": syn.meas_wear(u=1e-6, n_layers=16),  # covers the simulated width
+        "meas_wear_turned": syn.meas_wear(u=1e-6, n_layers=16, rotate_deg=180.0),
         "meas_wear_bad": syn.meas_wear(scale=2.0),
         "meas_motion": syn.meas_motion(u=0.002),
         "meas_unstated": syn.meas_wear(state_convention=False),
@@ -26,33 +28,78 @@ def files(tmp_path):
     return paths
 
 
+def _stated_zero(tmp_path):
+    crit = tmp_path / "criteria.toml"
+    crit.write_text(
+        "[criteria]\nwear_u_num_rel = 0.0\nwear_u_input_rel = 0.0\n"
+        "motion_u_num_rel = 0.0\nmotion_u_input_rel = 0.0\n"
+    )
+    return crit
+
+
 def test_compare_cli_writes_metrics_and_table(files, tmp_path, capsys):
     out = tmp_path / "m.nc"
     table = tmp_path / "m.csv"
-    argv = ["compare", str(files["sim_wear"]), str(files["meas_wear"]), "--out", str(out)]
+    argv = ["compare", str(files["sim_wear"]), str(files["meas_wear_full"]), "--out", str(out)]
     argv += ["--sim", str(files["sim_motion"]), "--meas", str(files["meas_motion"])]
+    argv += ["--criteria", str(_stated_zero(tmp_path))]
     assert main([*argv, "--table", str(table), "--strict"]) == 0
     text = capsys.readouterr().out
-    assert "PASS  wear map shape" in text and "follower velocity x history" in text
+    assert "PASS            wear map shape" in text and "follower velocity x history" in text
+    assert (
+        "13 criteria" not in text
+        and "criteria: " in text
+        and "fail" not in text.split("metrics:")[1]
+    )
     ds = io.load(out)
     assert {"wear_depth_sim", "wear_depth_diff", "follower_velocity_diff"} <= set(ds.data_vars)
     prov = io.parse_provenance(ds)
     assert len(prov["inputs"]) == 4 and all("sha256" in r for r in prov["inputs"])
     df = pd.read_csv(table)
-    assert list(df.columns) == ["quantity", "metric", "value", "units", "long_name", "definition"]
+    assert list(df.columns) == [
+        "quantity",
+        "metric",
+        "value",
+        "units",
+        "long_name",
+        "definition",
+        "basis",
+    ]
     assert (df.query("metric == 'rmse' and quantity == 'wear_depth'")["units"] == "m").all()
+    # the user-stated uncertainties are labelled as such
+    basis = df.query("metric == 'u_input' and quantity == 'max_wear_depth'")["basis"].iloc[0]
+    assert basis.startswith("user-stated")
 
 
 def test_compare_cli_exit_codes(files, tmp_path, capsys):
     out = tmp_path / "m.nc"
     bad = ["compare", str(files["sim_wear"]), str(files["meas_wear_bad"]), "--out", str(out)]
-    assert main(bad) == 0  # without --strict a failed criterion is only reported
-    assert "FAIL  maximum wear depth" in capsys.readouterr().out
-    assert main([*bad, "--strict"]) == 1
-    assert "validation failed for: maximum wear depth" in capsys.readouterr().err
+    assert main(bad) == 1  # a failed criterion exits 1 (no --strict needed)
+    captured = capsys.readouterr()
+    assert "FAIL            maximum wear depth" in captured.out
+    assert "validation failed for: maximum wear depth" in captured.err
+    # nothing fails, but V&V 20 is not assessed and the narrow scan leaves criteria not
+    # comparable: exit 0 with a summary saying so; --strict makes it exit 1
+    undecided = ["compare", str(files["sim_wear"]), str(files["meas_wear"]), "-o", str(out)]
+    assert main(undecided) == 0
+    text = capsys.readouterr().out
+    assert "not assessed (an uncertainty is unknown" in text
+    assert "not comparable (the data do not cover it): wear map shape" in text
+    assert main([*undecided, "--strict"]) == 1
+    assert "--strict: not every criterion was decided" in capsys.readouterr().err
     unstated = ["compare", str(files["sim_wear"]), str(files["meas_unstated"]), "-o", str(out)]
     assert main(unstated) == 3
     assert "angle_zero" in capsys.readouterr().err
+
+
+def test_compare_cli_map_turned_180_degree_fails(files, tmp_path, capsys):
+    """A measurement turned half a turn (a wrong angle zero) must fail, not pass."""
+    out = tmp_path / "m.nc"
+    argv = ["compare", str(files["sim_wear"]), str(files["meas_wear_turned"]), "-o", str(out)]
+    assert main(argv) == 1
+    text = capsys.readouterr().out
+    assert "FAIL            angle of maximum wear: +180.0 degree" in text
+    assert "FAIL            wear map shape" in text
 
 
 def test_compare_cli_motion_variables(files, tmp_path, capsys):
@@ -60,7 +107,11 @@ def test_compare_cli_motion_variables(files, tmp_path, capsys):
     argv = ["compare", str(files["sim_motion"]), str(files["meas_motion"]), "-o", str(out)]
     assert main([*argv, "--variable", "follower_velocity"]) == 0
     text = capsys.readouterr().out
-    assert "follower velocity z history" in text and "wear map" not in text
+    # z is out of the mechanism's plane: not compared unless asked for
+    assert "follower velocity z history" not in text and "wear map" not in text
+    assert "component(s) z not compared" in text
+    assert main([*argv, "--axis", "x", "--axis", "y", "--axis", "z"]) == 0
+    assert "follower velocity z history" in capsys.readouterr().out
     assert "motion aligned by crank angle: shift -111.41 ms (-80.2 degree" in text
     assert main([*argv, "--variable", "journal_offset"]) == 3
     assert "journal_offset are not in both" in capsys.readouterr().err

@@ -21,7 +21,7 @@ def report_files(tmp_path_factory):
     data = {
         "sim_wear": syn.sim_wear(),
         "sim_motion": syn.sim_motion(),
-        "metrology": syn.meas_wear(u=1e-6, rotate_deg=10.0),
+        "metrology": syn.meas_wear(u=1e-6, rotate_deg=10.0, scale=1.5),
         "dic": syn.meas_motion(u=0.01, scale=1.05),
     }
     paths = {}

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from html.parser import HTMLParser
 
+import _jw_synth as syn
 import pytest
 
 from jointwear.cli import main
@@ -84,10 +85,17 @@ def test_report_structure(built):
     page = parse(path)
     assert page.h2 == EXPECTED_SECTIONS
     # decision card: one PASS/FAIL cell per decision, matching the comparison
+    from jointwear.compare.verdicts import LABELS
+
     verdicts = [
-        text for cls, text in page.cells if cls in ("pass", "fail") and text in ("PASS", "FAIL")
+        text
+        for cls, text in page.cells
+        if cls in ("pass", "fail", "not-assessed", "not-comparable") and text in LABELS.values()
     ]
-    assert verdicts == ["PASS" if p else "FAIL" for p in result.decisions.passed]
+    assert verdicts[: len(result.decisions)] == [LABELS[s] for s in result.decisions.state]
+    # all four states occur in this comparison (no uncertainty stated for the model, a scan
+    # narrower than the simulated worn zone, a rotated and a scaled measurement)
+    assert set(result.decisions.state) == {"pass", "fail", "not_assessed", "not_comparable"}
     # the rotated measurement: angle error of the maximum is -10 degree, shown in the card
     assert any("-10.0 degree" in text for _, text in page.cells)
     # figures inline: the wear maps as PNG, polar plots and motion as SVG
@@ -139,18 +147,19 @@ def test_report_cli_html_pdf_and_comparison(report_files, tmp_path, capsys):
     pdf = tmp_path / "r.pdf"
     argv = ["report", "--sim", str(f["sim_wear"]), "--sim", str(f["sim_motion"])]
     argv += ["--metrology", str(f["metrology"]), "--dic", str(f["dic"])]
-    assert main([*argv, "--out", str(out), "--pdf", str(pdf), "--strict"]) == 0
+    # a failed criterion exits 1 - after writing the report and the PDF
+    assert main([*argv, "--out", str(out), "--pdf", str(pdf)]) == 1
     assert f"report: {out}" in capsys.readouterr().out
     assert pdf.read_bytes().startswith(b"%PDF") and pdf.stat().st_size > 10_000
     # from a saved comparison
     metrics = tmp_path / "m.nc"
-    assert main(["compare", str(f["sim_wear"]), str(f["metrology"]), "-o", str(metrics)]) == 0
+    assert main(["compare", str(f["sim_wear"]), str(f["metrology"]), "-o", str(metrics)]) == 1
     out2 = tmp_path / "r2.html"
-    assert main(["report", "--comparison", str(metrics), "--out", str(out2)]) == 0
+    assert main(["report", "--comparison", str(metrics), "--out", str(out2)]) == 1
     assert parse(out2).h2 == EXPECTED_SECTIONS
     # a .pdf name writes the PDF version only
     out3 = tmp_path / "only.pdf"
-    assert main(["report", "--comparison", str(metrics), "--out", str(out3)]) == 0
+    assert main(["report", "--comparison", str(metrics), "--out", str(out3)]) == 1
     assert out3.read_bytes().startswith(b"%PDF")
     # usage errors
     assert main(["report", "--out", str(out2)]) == 3
@@ -184,3 +193,40 @@ def test_verification_figures_and_pdf_determinism(built, tmp_path):
     a = write_pdf(result, tmp_path / "a.pdf", verification=[conv])
     b = write_pdf(result, tmp_path / "b.pdf", verification=[conv])
     assert a.read_bytes() == b.read_bytes() and a.read_bytes().startswith(b"%PDF")
+
+
+def test_generated_scan_stays_synthetic_into_the_decision_card(tmp_path):
+    """Instrument files from the generator -> importer -> wear map -> compare -> card."""
+    import re
+
+    from jointwear.compare import compare
+    from jointwear.datasets import instruments
+    from jointwear.metrology import wear_map
+    from jointwear.metrology.readers import read_talyrond
+    from jointwear.reports import render_html
+
+    conv = ("+y", "counterclockwise")
+    kw = {"n_layers": 13, "n_points": 720, "convention": conv, "seed": 5}
+    instruments.write(instruments.generate(**kw), tmp_path / "worn", layout="folder")
+    instruments.write(
+        instruments.generate(wear=None, noise_seed=9, **kw), tmp_path / "before", layout="folder"
+    )
+    first = next((tmp_path / "worn").glob("*.txt")).read_text(encoding="utf-8")
+    assert "Data origin: synthetic" in first
+    worn = read_talyrond(tmp_path / "worn", convention=conv)
+    assert worn.attrs["data_origin"] == "synthetic"
+    assert not worn.attrs["source"].startswith("measurement")
+    wm = wear_map(worn, read_talyrond(tmp_path / "before", convention=conv))
+    assert wm.attrs["data_origin"] == "synthetic"
+    wm.attrs["cycles"] = 4e5
+    sim = syn.sim_wear()
+    sim.attrs["data_origin"] = "simulated"
+    c = compare(sim, wm)
+    html = render_html(c, command="t")
+    card = html[html.index('id="decision"') : html.index('id="metrics"')]
+    assert re.search(r"measurement: <strong[^>]*>synthetic</strong>", card)
+    assert "Synthetic data:" in card and "SYNTHETIC measurement data" in card
+    # and an export without the line is a measurement
+    plain = tmp_path / "plain"
+    instruments.write(instruments.generate(**kw), plain, layout="folder", header=False)
+    assert read_talyrond(plain, convention=conv).attrs["data_origin"] == "measured"

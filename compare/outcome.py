@@ -1,0 +1,72 @@
+"""What a comparison means for the command line: card lines, summary and exit code.
+
+Exit code 1 (:class:`~jointwear.errors.ValidationFailed`) when any criterion fails; with
+``strict`` also when a criterion is not assessed or not comparable or a part was not compared.
+Otherwise 0 - with a distinct summary line saying what was left undecided.
+"""
+
+from __future__ import annotations
+
+import jointwear.compare.verdicts as vd
+from jointwear.compare.comparison import Comparison
+from jointwear.errors import ValidationFailed
+
+__all__ = ["card_lines", "origin_line", "outcome_lines", "raise_for_outcome"]
+
+
+def origin_line(c: Comparison) -> str:
+    """``data origin: simulation simulated, measurement SYNTHETIC (...)``."""
+    sim = c.data_origin.get("simulation", "not stated")
+    meas = c.data_origin.get("measurement", "not stated")
+    line = f"data origin: simulation {sim}, measurement {meas}"
+    if meas == "synthetic":
+        line += " - SYNTHETIC measurement: generated data with a known truth, not a real test"
+    elif meas == "not stated":
+        line += " - the measured files do not state data_origin"
+    return line
+
+
+def card_lines(c: Comparison) -> list[str]:
+    """One line per decision: ``STATE  quantity: value  [criterion]`` plus the reason."""
+    out = []
+    width = max(len(v) for v in vd.LABELS.values())
+    for row in c.decisions.itertuples():
+        out.append(
+            f"{vd.LABELS[row.state]:<{width}}  {row.quantity}: {row.value}  [{row.criterion}]"
+        )
+        if row.reason:
+            out.append(f"{'':<{width}}    why: {row.reason}")
+    return out
+
+
+def outcome_lines(c: Comparison) -> list[str]:
+    """The summary line and, when something is undecided, what and why in one line each."""
+    lines = [c.summary()]
+    na, nc = c.quantities(vd.NOT_ASSESSED), c.quantities(vd.NOT_COMPARABLE)
+    if na:
+        lines.append(
+            "not assessed (an uncertainty is unknown - give --ensemble / --verification or "
+            f"state it in --criteria): {', '.join(dict.fromkeys(na))}"
+        )
+    if nc:
+        lines.append(f"not comparable (the data do not cover it): {', '.join(dict.fromkeys(nc))}")
+    for p in c.partial:
+        lines.append(f"partial: {p}")
+    return lines
+
+
+def raise_for_outcome(c: Comparison, *, strict: bool = False, where: str = "") -> None:
+    """Raise :class:`ValidationFailed` (exit 1) when a criterion failed, or with ``strict`` when
+    anything is undecided."""
+    tail = f" (details in {where})" if where else ""
+    if c.any_failed:
+        raise ValidationFailed(
+            f"validation failed for: {', '.join(dict.fromkeys(c.failed()))}{tail}"
+        )
+    if strict and not c.complete:
+        raise ValidationFailed(
+            "--strict: not every criterion was decided: "
+            + c.summary()
+            + ("; partial" if c.partial else "")
+            + tail
+        )

@@ -1,0 +1,111 @@
+"""Where each standard uncertainty of the V&V 20 budget comes from, in order of precedence.
+
+``u_num`` (numerical): the simulation's own ``<name>_u`` > a verification study
+(``--verification``, GCI when it converges monotonically) > a fraction the user states in the
+criteria (labelled *user-stated*) > not assessed.
+
+``u_input`` (model inputs): the spread of an ensemble (``--ensemble``) > a fraction the user
+states > not assessed.
+
+``u_D`` (measurement): the measurement's own ``<name>_u`` > not assessed.
+
+Nothing unknown is ever replaced by zero.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from jointwear.compare._decide import Uncertainty, unknown
+from jointwear.compare.criteria import Criteria
+from jointwear.compare.ensemble import Ensemble, spread
+from jointwear.compare.verification import GCI
+
+__all__ = ["Sources"]
+
+
+@dataclass(frozen=True)
+class Sources:
+    """The uncertainty information available to one comparison.
+
+    Attributes
+    ----------
+    criteria : Criteria
+        User statements (``*_u_num_rel``, ``*_u_input_rel``).
+    ensemble : Ensemble or None
+        Ensembles of simulations for u_input.
+    gci : mapping
+        Quantity name -> :class:`~jointwear.compare.verification.GCI` from verification data.
+    compared_cycles : float or None
+        Wear cycles of the compared simulation.
+    field_values : mapping
+        Quantity -> per-ensemble per-run values computed from ensemble fields (preferred over
+        the ensemble's scalar outputs).
+    """
+
+    criteria: Criteria
+    ensemble: Ensemble | None = None
+    gci: Mapping[str, GCI] = field(default_factory=dict)
+    compared_cycles: float | None = None
+    field_values: Mapping[str, Sequence[tuple[int, np.ndarray]]] = field(default_factory=dict)
+
+    def u_num(self, quantity: str, s: float, stated: float | None, family: str) -> Uncertainty:
+        """Numerical standard uncertainty of a simulated value ``s`` (``family``: wear/motion)."""
+        if stated is not None and np.isfinite(stated):
+            return Uncertainty(float(stated), "stated by the simulation file (<name>_u)")
+        g = self.gci.get(quantity)
+        if g is not None and g.assessed:
+            return Uncertainty(g.u_num_rel * abs(s), "verification: " + g.describe())
+        rel = getattr(self.criteria, f"{family}_u_num_rel")
+        if rel is not None:
+            return Uncertainty(
+                rel * abs(s), f"user-stated {rel:.3g}·|S| (criteria {family}_u_num_rel)"
+            )
+        if g is not None:
+            return unknown(f"verification study: {g.reason}")
+        return unknown(
+            "the simulation states none (<name>_u), no verification study was given "
+            f"(--verification) and the criteria state no {family}_u_num_rel"
+        )
+
+    def u_input(self, quantity: str, s: float, family: str) -> Uncertainty:
+        """Input standard uncertainty of a simulated value ``s``."""
+        if self.ensemble is not None:
+            found = list(self.field_values.get(quantity, ()))
+            have = {i for i, _ in found}
+            found += [(i, v) for i, v in self.ensemble.scalar(quantity) if i not in have]
+            if found:
+                cyc = self.compared_cycles if family == "wear" else None
+                parts = [
+                    (
+                        self.ensemble.names[i],
+                        values,
+                        self.ensemble.cycles(i) if family == "wear" else None,
+                    )
+                    for i, values in sorted(found, key=lambda t: t[0])
+                ]
+                return spread(parts, s, compared_cycles=cyc)
+        rel = getattr(self.criteria, f"{family}_u_input_rel")
+        if rel is not None:
+            return Uncertainty(
+                rel * abs(s), f"user-stated {rel:.3g}·|S| (criteria {family}_u_input_rel)"
+            )
+        if self.ensemble is not None:
+            return unknown(
+                f"no ensemble given has '{quantity}' (nor a field it can be computed from), and "
+                f"the criteria state no {family}_u_input_rel"
+            )
+        return unknown(
+            f"no ensemble of simulations was given (--ensemble) and the criteria state no "
+            f"{family}_u_input_rel"
+        )
+
+    @staticmethod
+    def u_d(stated: float | None) -> Uncertainty:
+        """Measurement standard uncertainty, from the measurement file only."""
+        if stated is not None and np.isfinite(stated):
+            return Uncertainty(float(stated), "stated by the measurement file (<name>_u)")
+        return unknown("the measurement states no uncertainty (<name>_u)")

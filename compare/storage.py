@@ -1,0 +1,196 @@
+"""A comparison in netCDF: aligned fields, metrics as scalar variables, decisions as CF flags."""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+import xarray as xr
+
+import jointwear.compare.metrics as mt
+import jointwear.compare.verdicts as vd
+from jointwear import io
+from jointwear.compare._decide import DECISION_COLUMNS, METRIC_COLUMNS
+from jointwear.compare.comparison import Comparison
+from jointwear.compare.criteria import Criteria
+from jointwear.errors import ParameterError
+from jointwear.params import from_mapping, to_jsonable
+
+__all__ = ["to_dataset", "load_comparison", "save_comparison", "metrics_table"]
+
+
+def metrics_table(comparison: Comparison | xr.Dataset) -> pd.DataFrame:
+    """The tidy metrics table (quantity, metric, value, units, long_name, definition, basis)."""
+    if isinstance(comparison, Comparison):
+        return comparison.metrics.copy()
+    return load_comparison(comparison).metrics
+
+
+def json_dumps(criteria: Criteria) -> str:
+    """Criteria as JSON text (sorted keys)."""
+    return json.dumps(to_jsonable(criteria), sort_keys=True)
+
+
+def to_dataset(c: Comparison) -> xr.Dataset:
+    """Aligned fields, differences, metrics (scalar variables) and decisions in one Dataset."""
+    parts = []
+    attrs: dict[str, Any] = {}
+    for prefix, part in (("wear", c.wear), ("motion", c.motion)):
+        if part is None:
+            continue
+        parts.append(part)
+        attrs.update({f"{prefix}_{k}": v for k, v in part.attrs.items() if k != "title"})
+    ds = xr.merge(parts, combine_attrs="override", join="outer") if parts else xr.Dataset()
+    for row in c.metrics.itertuples():
+        name = f"{row.quantity}__{row.metric}"
+        extra = {"basis": row.basis} if row.basis else {}
+        ds[name] = xr.DataArray(
+            float(row.value),
+            attrs={
+                "units": row.units,
+                "long_name": f"{row.long_name} of {row.quantity}",
+                "definition": row.definition,
+                "quantity": row.quantity,
+                "metric": row.metric,
+                **extra,
+            },
+        )
+    for i, row in enumerate(c.decisions.itertuples()):
+        ds[f"decision_{i:02d}"] = xr.DataArray(
+            vd.state_code(row.state),
+            attrs={
+                "units": "1",
+                "long_name": f"validation decision: {row.quantity}",
+                "quantity": row.quantity,
+                "criterion": row.criterion,
+                "value": row.value,
+                "basis": row.basis,
+                "reason": row.reason,
+                "key": row.key,
+                "flag_values": vd.FLAG_VALUES,
+                "flag_meanings": vd.FLAG_MEANINGS,
+            },
+        )
+    for i, row in enumerate(c.sensitivity.itertuples()):
+        attrs[f"sensitivity_{i:02d}"] = json.dumps(
+            {"quantity": row.quantity, "parameter": row.parameter, "S1": row.S1, "ST": row.ST}
+        )
+    n = vd.counts(c.states)
+    attrs.update(
+        {
+            "title": "jointwear comparison of simulation and measurement",
+            "validation_passed": int(c.passed),
+            "n_criteria": len(c.decisions),
+            "n_pass": n[vd.PASS],
+            "n_failed": n[vd.FAIL],
+            "n_not_assessed": n[vd.NOT_ASSESSED],
+            "n_not_comparable": n[vd.NOT_COMPARABLE],
+            "verdict_summary": c.summary(),
+            "notes": "\n".join(c.notes),
+            "partial": "\n".join(c.partial),
+            "criteria": json_dumps(c.criteria),
+            "data_origin_simulation": c.data_origin.get("simulation", "not stated"),
+            "data_origin_measurement": c.data_origin.get("measurement", "not stated"),
+        }
+    )
+    if "synthetic" in c.data_origin.values():
+        attrs["data_origin"] = "synthetic"
+    ds.attrs = attrs
+    return ds
+
+
+def _state(var: xr.DataArray) -> str:
+    meanings = str(var.attrs.get("flag_meanings", vd.FLAG_MEANINGS)).split()
+    values = [int(v) for v in np.ravel(var.attrs.get("flag_values", vd.FLAG_VALUES))]
+    code = int(var.values)
+    if meanings == ["fail", "pass"]:  # files written before the four states
+        return vd.PASS if code else vd.FAIL
+    return meanings[values.index(code)]
+
+
+def load_comparison(source: str | Path | xr.Dataset) -> Comparison:
+    """Rebuild a :class:`Comparison` from the netCDF written by :func:`save_comparison`."""
+    ds = io.load(source) if not isinstance(source, xr.Dataset) else source
+    metric_rows = []
+    decision_rows = []
+    for name, var in ds.data_vars.items():
+        if "__" in str(name) and "metric" in var.attrs:
+            metric_rows.append(
+                {
+                    "quantity": var.attrs["quantity"],
+                    "metric": var.attrs["metric"],
+                    "value": float(var.values),
+                    "units": var.attrs.get("units", ""),
+                    "long_name": mt.DEFINITIONS.get(var.attrs["metric"], ("",))[0],
+                    "definition": var.attrs.get("definition", ""),
+                    "basis": var.attrs.get("basis", ""),
+                }
+            )
+        elif str(name).startswith("decision_"):
+            state = _state(var)
+            decision_rows.append(
+                {
+                    "quantity": var.attrs.get("quantity", str(name)),
+                    "criterion": var.attrs.get("criterion", ""),
+                    "value": var.attrs.get("value", ""),
+                    "state": state,
+                    "basis": var.attrs.get("basis", ""),
+                    "reason": var.attrs.get("reason", ""),
+                    "passed": state == vd.PASS,
+                    "key": var.attrs.get("key", var.attrs.get("quantity", str(name))),
+                }
+            )
+    wear_dims = ({"z", "theta"}, {"z_sim", "theta_sim"}, {"run", "z", "theta"})
+    wear_vars = [v for v in ds.data_vars if set(ds[v].dims) in wear_dims]
+    motion_vars = [v for v in ds.data_vars if "time" in ds[v].dims]
+    wear = ds[wear_vars] if wear_vars else None
+    motion = ds[motion_vars] if motion_vars else None
+    for prefix, part in (("wear_", wear), ("motion_", motion)):
+        if part is not None:
+            part.attrs = {k[len(prefix) :]: v for k, v in ds.attrs.items() if k.startswith(prefix)}
+    try:
+        crit = from_mapping(Criteria, json.loads(ds.attrs.get("criteria", "{}")), where="criteria")
+    except (ValueError, ParameterError):
+        crit = Criteria()
+    notes = tuple(n for n in str(ds.attrs.get("notes", "")).splitlines() if n)
+    partial = tuple(n for n in str(ds.attrs.get("partial", "")).splitlines() if n)
+    sens = [json.loads(v) for k, v in sorted(ds.attrs.items()) if k.startswith("sensitivity_")]
+    return Comparison(
+        wear=wear,
+        motion=motion,
+        metrics=pd.DataFrame(metric_rows, columns=METRIC_COLUMNS),
+        decisions=pd.DataFrame(decision_rows, columns=DECISION_COLUMNS).astype({"passed": bool}),
+        notes=notes,
+        criteria=crit,
+        data_origin={
+            "simulation": str(ds.attrs.get("data_origin_simulation", "not stated")),
+            "measurement": str(ds.attrs.get("data_origin_measurement", "not stated")),
+        },
+        partial=partial,
+        sensitivity=pd.DataFrame(sens, columns=["quantity", "parameter", "S1", "ST"]),
+    )
+
+
+def save_comparison(
+    comparison: Comparison,
+    path: str | Path,
+    *,
+    inputs: Sequence[str | Path] = (),
+    parents: Sequence[xr.Dataset] = (),
+    command: str | None = None,
+) -> Path:
+    """Write the aligned fields, differences, metrics and decisions to netCDF (atomic, provenance)."""
+    ds = comparison.to_dataset()
+    return io.save(
+        ds,
+        path,
+        inputs=inputs,
+        parameters=comparison.criteria,
+        parents=parents,
+        command=command,
+        source="jointwear compare",
+    )

@@ -1,0 +1,278 @@
+"""Numerical uncertainty from a refinement study: the Grid Convergence Index (Roache; Celik et al.).
+
+A verification study repeats the simulation with a refinement parameter ``h`` made finer (grid
+step, time step, tolerance of the adaptive wear update, ...) and records the quantities of
+interest. From the three finest solutions ``f1`` (finest), ``f2``, ``f3`` with refinement ratios
+``r21 = h2 / h1`` and ``r32 = h3 / h2`` (Celik et al. 2008, the ASME J. Fluids Eng. procedure):
+
+* ``e21 = f2 - f1``, ``e32 = f3 - f2``; the convergence ratio ``R = e21 / e32`` decides the
+  case: ``0 < R < 1`` monotone convergence (the only case a GCI is computed for),
+  ``R < 0`` oscillatory, ``R >= 1`` divergence, ``e21 = 0`` or ``e32 = 0`` undecidable;
+* the observed order ``p`` solves ``p = |ln|e32 / e21| + q(p)| / ln r21`` with
+  ``q(p) = ln((r21^p - s) / (r32^p - s))``, ``s = sign(e32 / e21)`` (fixed-point iteration;
+  ``q = 0`` for a constant ratio);
+* the extrapolated value ``f_ext = (r21^p f1 - f2) / (r21^p - 1)``, the relative error
+  ``e_a = |(f1 - f2) / f1|`` and ``GCI_fine = Fs e_a / (r21^p - 1)`` with the factor of safety
+  ``Fs = 1.25`` (Roache, three or more solutions).
+
+The GCI is an expanded (about 95 %) uncertainty; ASME V&V 20 (section 2-4) takes the standard
+numerical uncertainty as ``u_num = GCI / 1.15``. Two solutions cannot show that the sequence
+converges and an oscillating or diverging one has no order: those are *not assessed*, with the
+reason, never a number.
+
+References
+----------
+- Roache, P. J. (1998). *Verification and Validation in Computational Science and
+  Engineering*. Hermosa, Albuquerque.
+- Celik, I. B., Ghia, U., Roache, P. J., Freitas, C. J., Coleman, H., Raad, P. E. (2008).
+  Procedure for estimation and reporting of uncertainty due to discretization in CFD
+  applications. *J. Fluids Eng.* 130, 078001.
+- ASME V&V 20-2009 (R2021), section 2-4.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import xarray as xr
+
+from jointwear.errors import BadInputError
+
+__all__ = ["GCI", "gci", "numerical_uncertainty", "GCI_TO_STANDARD"]
+
+#: V&V 20: standard numerical uncertainty = GCI / 1.15 (GCI with Fs = 1.25 taken as a 95 % bound)
+GCI_TO_STANDARD = 1.15
+
+
+@dataclass(frozen=True)
+class GCI:
+    """Result of a grid-convergence study of one quantity.
+
+    Attributes
+    ----------
+    quantity : str
+        Name of the studied quantity.
+    assessed : bool
+        True when the three finest solutions converge monotonically and a GCI was computed.
+    reason : str
+        Why the numerical uncertainty is not assessed ('' when it is).
+    h : tuple of float
+        Refinement parameter of the solutions used, finest first [units of the study].
+    values : tuple of float
+        The solutions used, finest first [units of the quantity].
+    convergence_ratio : float
+        ``R = (f2 - f1) / (f3 - f2)`` (NaN when undefined).
+    order : float
+        Observed order of convergence ``p`` [1] (NaN when not assessed).
+    extrapolated : float
+        Richardson-extrapolated value ``f_ext`` (NaN when not assessed).
+    relative_error : float
+        ``e_a = |(f1 - f2) / f1|`` [1].
+    gci_fine : float
+        Relative GCI of the finest solution [1] (NaN when not assessed).
+    u_num_rel : float
+        Relative standard numerical uncertainty ``GCI / 1.15`` [1] (NaN when not assessed).
+    safety_factor : float
+        ``Fs`` used.
+    """
+
+    quantity: str
+    assessed: bool
+    reason: str
+    h: tuple[float, ...]
+    values: tuple[float, ...]
+    convergence_ratio: float
+    order: float
+    extrapolated: float
+    relative_error: float
+    gci_fine: float
+    u_num_rel: float
+    safety_factor: float
+
+    def describe(self) -> str:
+        """One line for the report: the method and its figures, or why it was not assessed."""
+        seq = " → ".join(f"{v:.4g}" for v in self.values[::-1])
+        if not self.assessed:
+            return f"{self.quantity}: not assessed - {self.reason} (coarse to fine: {seq})"
+        return (
+            f"{self.quantity}: GCI (Roache; Celik et al. 2008), Fs = {self.safety_factor:g}, "
+            f"observed order p = {self.order:.2f}, R = {self.convergence_ratio:.3g}, "
+            f"GCI_fine = {self.gci_fine:.3g} -> u_num = GCI/{GCI_TO_STANDARD:g} = "
+            f"{self.u_num_rel:.3g}·|S| (coarse to fine: {seq})"
+        )
+
+
+def _not_assessed(quantity, reason, h, f, ratio=float("nan"), e_a=float("nan"), fs=1.25) -> GCI:
+    nan = float("nan")
+    return GCI(quantity, False, reason, tuple(h), tuple(f), ratio, nan, nan, e_a, nan, nan, fs)
+
+
+def _order(r21: float, r32: float, e21: float, e32: float) -> float:
+    s = math.copysign(1.0, e32 / e21)
+    ln_ratio = math.log(abs(e32 / e21))
+    p = abs(ln_ratio) / math.log(r21)
+    for _ in range(200):
+        q = math.log((r21**p - s) / (r32**p - s))
+        p_new = abs(ln_ratio + q) / math.log(r21)
+        if abs(p_new - p) < 1e-12 * max(1.0, p):
+            return p_new
+        p = p_new
+    return float("nan")
+
+
+def gci(
+    h: Sequence[float],
+    values: Sequence[float],
+    *,
+    quantity: str = "quantity",
+    safety_factor: float = 1.25,
+) -> GCI:
+    """Grid Convergence Index of a quantity from a refinement sequence (three finest solutions).
+
+    Parameters
+    ----------
+    h : sequence of float
+        Refinement parameter of each solution (grid step, time step, tolerance), > 0; smaller
+        is finer. Any order.
+    values : sequence of float
+        The quantity computed with each ``h`` [any unit].
+    quantity : str
+        Name used in messages.
+    safety_factor : float
+        ``Fs`` (1.25 for three or more solutions, Roache).
+
+    Returns
+    -------
+    GCI
+        ``assessed`` False (with the reason) unless the three finest solutions converge
+        monotonically with refinement ratios > 1.
+    """
+    h_arr = np.asarray(h, dtype=float)
+    f_arr = np.asarray(values, dtype=float)
+    if h_arr.shape != f_arr.shape or h_arr.ndim != 1:
+        raise BadInputError(
+            f"verification of {quantity}: {h_arr.size} refinement values for {f_arr.size} solutions"
+        )
+    ok = np.isfinite(h_arr) & np.isfinite(f_arr)
+    h_arr, f_arr = h_arr[ok], f_arr[ok]
+    order = np.argsort(h_arr)
+    h_arr, f_arr = h_arr[order], f_arr[order]
+    if np.any(h_arr <= 0):
+        raise BadInputError(f"verification of {quantity}: the refinement parameter must be > 0")
+    if np.any(np.diff(h_arr) <= 0):
+        raise BadInputError(
+            f"verification of {quantity}: two solutions share the refinement value "
+            f"{h_arr[np.argmin(np.diff(h_arr))]:g}; each solution needs its own"
+        )
+    if h_arr.size < 3:
+        return _not_assessed(
+            quantity,
+            f"{h_arr.size} solution(s): three are needed to show monotone convergence and an "
+            "observed order",
+            h_arr,
+            f_arr,
+            fs=safety_factor,
+        )
+    (h1, h2, h3), (f1, f2, f3) = h_arr[:3], f_arr[:3]
+    r21, r32 = h2 / h1, h3 / h2
+    e21, e32 = f2 - f1, f3 - f2
+    e_a = abs(e21 / f1) if f1 != 0 else float("nan")
+    if e21 == 0 or e32 == 0:
+        return _not_assessed(
+            quantity,
+            "two successive solutions are identical, the order of convergence is undefined",
+            h_arr[:3],
+            f_arr[:3],
+            e_a=e_a,
+            fs=safety_factor,
+        )
+    ratio = e21 / e32
+    if ratio < 0:
+        return _not_assessed(
+            quantity,
+            f"the solutions oscillate with refinement (convergence ratio R = {ratio:.3g} < 0)",
+            h_arr[:3],
+            f_arr[:3],
+            ratio,
+            e_a,
+            safety_factor,
+        )
+    if ratio >= 1:
+        return _not_assessed(
+            quantity,
+            f"the solutions do not converge with refinement (convergence ratio R = {ratio:.3g} "
+            ">= 1: the finest step changes the result as much as or more than the previous one)",
+            h_arr[:3],
+            f_arr[:3],
+            ratio,
+            e_a,
+            safety_factor,
+        )
+    p = _order(r21, r32, e21, e32)
+    if not np.isfinite(p) or p <= 0:
+        return _not_assessed(
+            quantity,
+            "the observed order of convergence could not be determined",
+            h_arr[:3],
+            f_arr[:3],
+            ratio,
+            e_a,
+            safety_factor,
+        )
+    rp = r21**p
+    f_ext = (rp * f1 - f2) / (rp - 1)
+    g = safety_factor * e_a / (rp - 1)
+    return GCI(
+        quantity,
+        True,
+        "",
+        tuple(h_arr[:3]),
+        tuple(f_arr[:3]),
+        ratio,
+        p,
+        f_ext,
+        e_a,
+        g,
+        g / GCI_TO_STANDARD,
+        safety_factor,
+    )
+
+
+def numerical_uncertainty(
+    studies: xr.Dataset | Sequence[xr.Dataset],
+) -> Mapping[str, GCI]:
+    """GCI of every 1-D quantity of one or more verification datasets.
+
+    Parameters
+    ----------
+    studies : Dataset or sequence of Datasets
+        Verification data: each quantity (``max_wear_depth``, ``worn_volume``,
+        ``cylindricity``, ...) over one refinement dimension whose coordinate holds ``h`` (> 0,
+        smaller = finer), e.g. ``update_tolerance`` or ``dN``.
+
+    Returns
+    -------
+    dict
+        Quantity name -> :class:`GCI`.
+    """
+    items = [studies] if isinstance(studies, xr.Dataset) else list(studies)
+    out: dict[str, GCI] = {}
+    for ds in items:
+        for name, var in ds.data_vars.items():
+            if var.ndim != 1 or var.dtype.kind not in "fiu":
+                continue
+            dim = var.dims[0]
+            if dim not in ds.coords:
+                raise BadInputError(
+                    f"verification data: '{name}' varies over '{dim}', which has no coordinate "
+                    "values (the refinement parameter h of each solution)"
+                )
+            out[str(name)] = gci(
+                np.asarray(ds[dim].values, dtype=float),
+                np.asarray(var.values, dtype=float),
+                quantity=str(name),
+            )
+    return out

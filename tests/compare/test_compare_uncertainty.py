@@ -1,0 +1,215 @@
+"""Verdict states, GCI (verification), ensemble u_input and data origin against constructed truths."""
+
+from __future__ import annotations
+
+import _jw_synth as syn
+import numpy as np
+import pytest
+import xarray as xr
+
+from jointwear.compare import (
+    Criteria,
+    compare,
+    gci,
+    load_comparison,
+    numerical_uncertainty,
+    save_comparison,
+)
+from jointwear.errors import BadInputError
+
+# ----------------------------------------------------------------------------- GCI
+
+
+def test_gci_recovers_order_and_extrapolated_value():
+    # f(h) = 10 + 0.3 h^2 on h = 1, 2, 4: p = 2, f_ext = 10, e_a = 0.9/10.3
+    h = np.array([4.0, 2.0, 1.0])
+    g = gci(h, 10 + 0.3 * h**2, quantity="f")
+    assert g.assessed and g.order == pytest.approx(2.0, rel=1e-9)
+    assert g.extrapolated == pytest.approx(10.0, rel=1e-12)
+    e_a = 0.9 / 10.3
+    assert g.gci_fine == pytest.approx(1.25 * e_a / 3.0, rel=1e-12)
+    assert g.u_num_rel == pytest.approx(g.gci_fine / 1.15)
+
+
+def test_gci_non_constant_ratio():
+    # unequal refinement ratios (Celik's iteration): f = 2 - 0.5 h^1.5, h = 0.1, 0.25, 0.4
+    h = np.array([0.1, 0.25, 0.4])
+    g = gci(h, 2 - 0.5 * h**1.5)
+    assert g.assessed and g.order == pytest.approx(1.5, rel=1e-6)
+    assert g.extrapolated == pytest.approx(2.0, rel=1e-9)
+
+
+def test_gci_refuses_oscillating_and_diverging_sequences():
+    # the demo's earlier study: 10.65 -> 10.46 -> 11.15 um as tol is refined (oscillating)
+    osc = gci([0.4, 0.2, 0.1], [10.65, 10.46, 11.15], quantity="max_wear_depth")
+    assert not osc.assessed and "oscillate" in osc.reason and np.isnan(osc.u_num_rel)
+    div = gci([0.4, 0.2, 0.1], [1.0, 1.1, 1.3])  # changes grow with refinement
+    assert not div.assessed and "do not converge" in div.reason
+    two = gci([0.2, 0.1], [1.0, 1.01])
+    assert not two.assessed and "three are needed" in two.reason
+    with pytest.raises(BadInputError, match="share the refinement value"):
+        gci([0.1, 0.1, 0.2], [1, 2, 3])
+
+
+def test_verification_study_sets_u_num_only_when_monotone():
+    sim = syn.sim_wear()
+    meas = syn.meas_wear(u=1e-6, n_layers=16)
+    tol = np.array([0.4, 0.2, 0.1])
+    s = compare(sim, meas).value("max_wear_depth", "value_sim")
+
+    def study(values):
+        return xr.Dataset(
+            {"max_wear_depth": ("tol", values, {"units": "m"})},
+            coords={"tol": ("tol", tol, {"units": "1"})},
+        )
+
+    conv = study(s * (1 + 0.08 * tol))  # first order, converging to S
+    c = compare(sim, meas, verification=study(s * (1 + 0.08 * tol)))
+    g = numerical_uncertainty(conv)["max_wear_depth"]
+    assert c.value("max_wear_depth", "u_num") == pytest.approx(g.u_num_rel * s)
+    basis = c.metrics.set_index(["quantity", "metric"]).loc[("max_wear_depth", "u_num"), "basis"]
+    assert "GCI" in basis
+    osc = compare(sim, meas, verification=study(s * np.array([1.02, 0.99, 1.05])))
+    assert np.isnan(osc.value("max_wear_depth", "u_num"))
+    row = osc.decisions[(osc.decisions.quantity == "maximum wear depth")]
+    assert row.state.iloc[0] == "not_assessed" and "oscillate" in row.reason.iloc[0]
+
+
+# ----------------------------------------------------------------------------- ensemble
+
+
+def _ensemble(values: dict[str, np.ndarray], **coords) -> xr.Dataset:
+    n = len(next(iter(values.values())))
+    ds = xr.Dataset(coords={"run": np.arange(n), **{k: ("run", v) for k, v in coords.items()}})
+    for k, v in values.items():
+        ds[k] = ("run", np.asarray(v, dtype=float), {"units": "m"})
+    return ds
+
+
+def test_ensemble_spread_is_u_input():
+    sim = syn.sim_wear()
+    meas = syn.meas_wear(u=1e-6, n_layers=16)
+    rng = np.random.default_rng(3)
+    depth = 32e-6 + 2e-6 * rng.standard_normal(12)
+    depth[4] = np.nan  # a failed run is left out, not counted as zero
+    ens = _ensemble({"max_wear_depth": depth}, kw=rng.uniform(1, 2, 12))
+    c = compare(sim, meas, ensemble=ens, criteria=Criteria(wear_u_num_rel=0.0))
+    assert c.value("max_wear_depth", "u_input") == pytest.approx(np.nanstd(depth, ddof=1))
+    basis = c.metrics.set_index(["quantity", "metric"]).loc[("max_wear_depth", "u_input"), "basis"]
+    assert "11 runs (1 failed, left out)" in basis
+    assert c.state("maximum wear depth", "V&V 20") in ("pass", "fail")
+    # a quantity the ensemble does not have stays not assessed
+    assert np.isnan(c.value("worn_volume", "u_input"))
+    # two ensembles over independent inputs: variances add; over the same input: refused
+    other = _ensemble({"max_wear_depth": 32e-6 + np.array([-1e-6, 1e-6])}, mu=[0.1, 0.2])
+    both = compare(sim, meas, ensemble=[ens, other], criteria=Criteria(wear_u_num_rel=0.0))
+    expected = np.hypot(np.nanstd(depth, ddof=1), np.std([-1e-6, 1e-6], ddof=1))
+    assert both.value("max_wear_depth", "u_input") == pytest.approx(expected)
+    with pytest.raises(BadInputError, match="both vary 'kw'"):
+        compare(sim, meas, ensemble=[ens, ens])
+    with pytest.raises(BadInputError, match="'run' dimension"):
+        compare(sim, meas, ensemble=xr.Dataset({"max_wear_depth": 1.0}))
+
+
+def test_ensemble_of_maps_gives_the_compared_quantity_per_run():
+    """With maps, u_input is the spread of the quantity on the compared window itself."""
+    meas = syn.meas_wear(u=1e-6, n_layers=16)
+    sim = syn.sim_wear()
+    scales = np.array([0.8, 0.9, 1.0, 1.1, 1.25])
+    base = sim["wear_depth"].isel(cycles=-1)
+    ens = xr.Dataset(
+        {"wear_depth": (("run", "z", "theta"), np.stack([f * base.values for f in scales]))},
+        coords={"run": np.arange(5), "kw": ("run", scales), "z": sim["z"], "theta": sim["theta"]},
+        attrs={"cycles": 4e5},
+    )
+    ens["wear_depth"].attrs.update(sim["wear_depth"].attrs)
+    c = compare(sim, meas, ensemble=ens)
+    s = c.value("max_wear_depth", "value_sim")
+    assert c.value("max_wear_depth", "u_input") == pytest.approx(
+        s * np.std(scales, ddof=1), rel=1e-6
+    )
+    v = c.value("worn_volume", "value_sim")
+    assert c.value("worn_volume", "u_input") == pytest.approx(v * np.std(scales, ddof=1), rel=1e-6)
+    assert c.wear["wear_depth_sim_ensemble"].sizes["run"] == 5
+    # run for fewer cycles: the relative spread is applied to the compared value
+    short = ens.assign_attrs(cycles=1e5)
+    short["wear_depth"] = short["wear_depth"] * 0.25
+    c2 = compare(sim, meas, ensemble=short)
+    assert c2.value("max_wear_depth", "u_input") == pytest.approx(
+        s * np.std(scales, ddof=1) / np.mean(scales), rel=1e-6
+    )
+
+
+# ----------------------------------------------------------------------------- states, origin
+
+
+def test_states_are_cf_flags_in_the_file(tmp_path):
+    sim = syn.sim_wear()
+    sim.attrs["data_origin"] = "simulated"
+    meas = syn.meas_wear(u=1e-6)  # +-6 mm: narrower than the simulated worn zone
+    meas.attrs["data_origin"] = "synthetic"
+    c = compare(sim, meas)
+    assert c.data_origin == {"simulation": "simulated", "measurement": "synthetic"}
+    path = save_comparison(c, tmp_path / "m.nc")
+    ds = xr.open_dataset(path)
+    flags = [ds[v] for v in ds.data_vars if str(v).startswith("decision_")]
+    assert all(f.attrs["flag_meanings"] == "fail pass not_assessed not_comparable" for f in flags)
+    assert list(flags[0].attrs["flag_values"]) == [0, 1, 2, 3]
+    assert (
+        ds.attrs["data_origin_measurement"] == "synthetic"
+        and ds.attrs["data_origin"] == "synthetic"
+    )
+    assert ds.attrs["n_not_comparable"] >= 1 and ds.attrs["n_not_assessed"] >= 1
+    ds.close()
+    back = load_comparison(path)
+    assert list(back.decisions.state) == list(c.decisions.state)
+    assert back.data_origin == c.data_origin
+    # a measurement without data_origin is "not stated", never assumed measured
+    assert compare(sim, syn.meas_wear()).data_origin["measurement"] == "not stated"
+
+
+def test_uncovered_maximum_is_not_comparable_not_pass():
+    """Both maxima clipped to the scan edge agree - a believable wrong PASS without the check."""
+    sim = syn.sim_wear(width=15e-3)
+    # move the simulated wear to the bearing edge: its maximum lies at z = -7.5 mm
+    z = sim["z"].values
+    edge = np.exp(-0.5 * ((z + 7.5e-3) / 2e-3) ** 2)[None, :, None]
+    sim["wear_depth"] = sim["wear_depth"] * 0 + edge * 20e-6
+    meas = syn.meas_wear(n_layers=13)  # +-6 mm
+    c = compare(sim, meas, criteria=Criteria(max_z_error_m=10.0))
+    assert c.wear.attrs["sim_max_inside"] == 0
+    assert c.state("axial position of maximum wear") == "not_comparable"
+    assert c.state("maximum wear depth") == "not_comparable"
+    assert "lies outside the compared range" in c.decisions.reason.iloc[2]
+    frac = c.value("wear_depth", "volume_fraction_compared")
+    # analytic share of a Gaussian (sigma 2 mm, centre -7.5 mm) inside [-6, 6] of [-7.5, 7.5]
+    from scipy.stats import norm
+
+    inside = norm.cdf(13.5 / 2) - norm.cdf(1.5 / 2)
+    total = norm.cdf(15 / 2) - norm.cdf(0)
+    assert frac == pytest.approx(inside / total, abs=0.02)
+
+
+def test_sweep_style_ensemble_sobol_indices_reach_the_comparison():
+    """The layout of ``jointwear sim sweep``: run_seed coordinate, sobol_S1/ST(output, parameter)."""
+    from jointwear.reports import render_html
+
+    sim = syn.sim_wear()
+    meas = syn.meas_wear(u=1e-6, n_layers=16)
+    ens = _ensemble({"max_wear_depth": [30e-6, 33e-6, 31e-6, 34e-6]}, run_seed=np.arange(4))
+    ens = ens.assign_coords(**{"wear.kw": ("run", [1.0, 1.1, 0.9, 1.2])})
+    ens.attrs["sweep_parameters"] = ["wear.kw", "friction.dynamic_coefficient"]
+    ens["sobol_S1"] = (("output", "parameter"), [[0.8, 0.1]])
+    ens["sobol_ST"] = (("output", "parameter"), [[0.85, 0.12]])
+    ens = ens.assign_coords(
+        output=["max_wear_depth"], parameter=["wear.kw", "friction.dynamic_coefficient"]
+    )
+    c = compare(sim, meas, ensemble=ens)
+    rows = c.sensitivity.set_index("parameter")
+    assert rows.loc["wear.kw", "S1"] == pytest.approx(0.8)
+    assert rows.loc["friction.dynamic_coefficient", "ST"] == pytest.approx(0.12)
+    html = render_html(c, command="t")
+    assert "first-order Sobol index S1" in html and "friction.dynamic_coefficient" in html
+    # run_seed is not a varied input: a second ensemble with its own seeds is not refused
+    other = _ensemble({"worn_volume": [1e-9, 1.1e-9]}, run_seed=np.arange(2), mu=[0.1, 0.2])
+    compare(sim, meas, ensemble=[ens, other])
