@@ -207,4 +207,7 @@ def test_cli_pattern_skips_other_files(tmp_path, scan, capsys):
     assert main(args) == 3
     assert "README.md': no table of numbers" in capsys.readouterr().err
     assert main([*args, "--pattern", "layer*.txt", "--instrument", "Talyrond 565H"]) == 0
-    assert io.load(tmp_path / "x.nc").attrs["source"] == "measurement: Talyrond 565H"
+    scan = io.load(tmp_path / "x.nc")
+    # generated files say "Data origin: synthetic" in their header, and the import keeps it
+    assert scan.attrs["source"] == "synthetic: Talyrond 565H"
+    assert scan.attrs["data_origin"] == "synthetic"
