@@ -368,7 +368,13 @@ def read_scan(
     ds.attrs["reader_format"] = {
         k: v for k, v in asdict(parsed[0].fmt).items() if v is not None and k != "columns"
     }
-    ds.attrs["reader_columns"] = list(parsed[0].columns)
+    # the meaning every column was finally read with (placeholders resolved)
+    first = notes.get(Path(parsed[0].path).name, {})
+    resolve = {
+        "angle": first.get("angle_column", "angle"),
+        "value": first.get("value_column", "value"),
+    }
+    ds.attrs["reader_columns"] = [resolve.get(c, c) for c in parsed[0].columns]
     if parsed[0].units:
         ds.attrs["instrument_units"] = parsed[0].units
     return ds
