@@ -52,6 +52,7 @@ def _angles(
         where=f"{where} column {col + 1} (lines {pf.line_numbers[rows[0]]}-{pf.line_numbers[rows[-1]]})",
     )
     notes["angle"] = note + (f", {reading.arc} turn" if reading.arc == "full" else ", partial arc")
+    notes["angle_column"] = {"deg": "angle_deg", "rad": "angle_rad", "index": "index"}[reading.unit]
     return reading.theta_deg
 
 
@@ -182,6 +183,7 @@ def _layers_from_file(
             line_of=pf.line_numbers,
         )
         notes["value_kind"] = f"{kind} ({note})"
+        notes["value_column"] = kind
         absurd_length(pf.data[:, value_cols], kind, f, where, pf.line_numbers)
     if has_xy:
         xy = pf.data[:, [cols.index("x"), cols.index("y")]]

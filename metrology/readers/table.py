@@ -13,46 +13,10 @@ import pandas as pd
 
 from jointwear.errors import BadInputError
 from jointwear.metrology.readers.columns import COLUMN_KINDS, _guess_columns, _kind_from_name
+from jointwear.metrology.readers.source import _read_text
+from jointwear.metrology.readers.units import UNITS, _file_units, unit_factor
 
 __all__ = ["UNITS", "TextFormat", "ParsedFile", "unit_factor", "sniff", "parse_file"]
-
-
-#: Length units -> factor to metres.
-UNITS: dict[str, float] = {
-    "m": 1.0,
-    "mm": 1e-3,
-    "um": 1e-6,
-    "µm": 1e-6,
-    "μm": 1e-6,
-    "micron": 1e-6,
-    "microns": 1e-6,
-    "micrometre": 1e-6,
-    "micrometer": 1e-6,
-    "micrometres": 1e-6,
-    "micrometers": 1e-6,
-    "millimetre": 1e-3,
-    "millimeter": 1e-3,
-    "millimetres": 1e-3,
-    "millimeters": 1e-3,
-    "metre": 1.0,
-    "meter": 1.0,
-    "metres": 1.0,
-    "meters": 1.0,
-    "nm": 1e-9,
-    "in": 0.0254,
-    "inch": 0.0254,
-    "inches": 0.0254,
-    '"': 0.0254,
-}
-
-
-_UNIT_CANON = {
-    1.0: "m",
-    1e-3: "mm",
-    1e-6: "um",
-    1e-9: "nm",
-    0.0254: "inch",
-}
 
 
 _DELIMS = {"\t": "tab", ";": "semicolon", ",": "comma", " ": "whitespace"}
@@ -132,19 +96,6 @@ class TextFormat:
             raise BadInputError(f"header_lines must be >= 0, got {self.header_lines}")
 
 
-def unit_factor(unit: str, *, where: str = "units") -> float:
-    """Factor from a length unit name to metres; a clear error for unknown units."""
-    key = str(unit).strip().strip(".").replace(" ", "")
-    low = key.lower()
-    for k in (key, low):
-        if k in UNITS:
-            return UNITS[k]
-    raise BadInputError(
-        f"{where}: unit {unit!r} is not known; use one of um (micrometre), mm, m, inch "
-        "(pass units=... to override what the file says)"
-    )
-
-
 @dataclass
 class ParsedFile:
     """A sniffed and parsed text file: the numeric table plus everything that was guessed."""
@@ -163,81 +114,6 @@ class ParsedFile:
     angle_unit: str | None = None  # stated in the header ("Angle unit: deg")
     z_units: str | None = None  # stated in the header ("Z unit: mm") or by the user
     arc: str | None = None  # stated in the header ("Arc: full")
-
-
-def _utf16(raw: bytes) -> str | None:
-    """The UTF-16 codec of ``raw`` (BOM, or ASCII text with every other byte zero), else None."""
-    if raw[:2] in (b"\xff\xfe", b"\xfe\xff"):
-        return "utf-16"
-    head = raw[:4096]
-    if len(head) >= 4:
-        even, odd = head[0::2], head[1::2]
-        if odd.count(0) > 0.9 * len(odd) and even.count(0) < 0.1 * len(even):
-            return "utf-16-le"
-        if even.count(0) > 0.9 * len(even) and odd.count(0) < 0.1 * len(odd):
-            return "utf-16-be"
-    return None
-
-
-def _read_text(path: Path, encoding: str | None, sheet: str | None = None) -> str:
-    try:
-        raw = path.read_bytes()
-    except FileNotFoundError:
-        raise BadInputError(f"'{path}' does not exist") from None
-    except IsADirectoryError:
-        raise BadInputError(
-            f"'{path}' is a folder; use layout='folder' to read per-layer files"
-        ) from None
-    except OSError as exc:
-        raise BadInputError(f"'{path}': cannot read ({exc.strerror or exc})") from None
-    if raw[:4] == b"PK\x03\x04":
-        from jointwear.metrology.readers.workbook import workbook_text
-
-        return workbook_text(path, sheet)
-    if raw[:8] == b"\xd0\xcf\x11\xe0\xa1\xb1\x1a\xe1":
-        raise BadInputError(
-            f"'{path}' is an old binary Excel (.xls) or other OLE file; save it as .xlsx or "
-            "export the trace as text (CSV)"
-        )
-    if sheet is not None:
-        raise BadInputError(f"sheet={sheet!r} (--sheet) was given but '{path}' is not a workbook")
-    codec = encoding or _utf16(raw)
-    if codec is None and raw[:3] == b"\xef\xbb\xbf":
-        codec = "utf-8-sig"
-    text = None
-    if codec:
-        try:
-            text = raw.decode(codec)
-        except (UnicodeDecodeError, LookupError) as exc:
-            raise BadInputError(
-                f"'{path}': cannot decode as {codec!r} ({exc}); pass encoding=..."
-            ) from None
-        text = text.lstrip("\ufeff")
-    if not (text if text is not None else raw).strip():
-        raise BadInputError(
-            f"'{path}' is empty (line 1): expected a text export of a roundness trace; "
-            "re-export the measurement"
-        )
-    if text is None:
-        head = raw[:8192]
-        ctrl = sum(1 for b in head if b < 32 and b not in (9, 10, 13, 12))
-        if b"\x00" in head or ctrl > 0.01 * len(head):
-            raise BadInputError(
-                f"'{path}' looks like a binary file (line 1 holds control bytes), not a text "
-                "export; export the trace as text (ASCII/CSV, UTF-8 or UTF-16) from the "
-                "instrument software"
-            )
-        try:
-            text = raw.decode("utf-8")
-        except UnicodeDecodeError:
-            text = raw.decode("latin-1")
-    else:
-        ctrl = sum(1 for c in text[:8192] if ord(c) < 32 and c not in "\t\n\r\f")
-        if ctrl > 0.01 * min(len(text), 8192):
-            raise BadInputError(
-                f"'{path}' decoded as {codec} holds control characters; not a text export"
-            )
-    return text
 
 
 def _split(line: str, delim: str) -> list[str]:
@@ -396,16 +272,6 @@ def _parse_header(lines: Sequence[str], delim: str, ncols: int) -> tuple[dict[st
         elif delim != " " and len(toks) >= 2 and toks[0]:
             meta[toks[0]] = delim.join(toks[1:]).strip()
     return meta, names
-
-
-_UNIT_KEYS = re.compile(r"^(units?|length[ _]?units?|einheit|unit of measure|scale units?)$", re.I)
-
-
-def _units_from_meta(meta: dict[str, str]) -> str | None:
-    for k, v in meta.items():
-        if _UNIT_KEYS.match(k.strip()):
-            return v.strip()
-    return None
 
 
 def _bad_line(
@@ -576,7 +442,6 @@ _ANGLE_UNIT_WORDS = {
     "point": "index",
     "points": "index",
 }
-_LENGTH_KINDS = ("radius", "deviation", "value", "x", "y")
 
 
 def _no_data_in_header(path: str, header: Sequence[str], fmt: TextFormat, ncol: int) -> None:
@@ -601,50 +466,6 @@ def _no_data_in_header(path: str, header: Sequence[str], fmt: TextFormat, ncol: 
 
 def _keyword(meta: dict[str, str], pattern: re.Pattern) -> str | None:
     return next((v.strip() for k, v in meta.items() if pattern.match(k.strip())), None)
-
-
-def _file_units(
-    path: str,
-    header: Sequence[str],
-    meta: dict[str, str],
-    cols: Sequence[str],
-    name_units: dict[str, str],
-    option: str | None,
-    guessed: dict[str, str],
-) -> str | None:
-    """The length unit of the values: stated by the file (header keyword, column names) or by
-    the user; a user's unit that contradicts the file is an error, never an override."""
-    stated: list[tuple[str, str]] = []
-    head_unit = _units_from_meta(meta)
-    if head_unit is not None:
-        ln_no = next((i + 1 for i, ln in enumerate(header) if head_unit in ln), max(len(header), 1))
-        unit_factor(head_unit, where=f"'{path}' line {ln_no}")
-        stated.append((head_unit, f"line {ln_no} (header)"))
-    for i, c in enumerate(cols):
-        if c in _LENGTH_KINDS and str(i) in name_units:
-            u = name_units[str(i)]
-            unit_factor(u, where=f"'{path}' column {i + 1} name")
-            stated.append((u, f"the name of column {i + 1}"))
-    factors = {unit_factor(u) for u, _ in stated}
-    if len(factors) > 1:
-        raise BadInputError(
-            f"'{path}': the file states different length units: "
-            + ", ".join(f"{u!r} in {w}" for u, w in stated)
-            + "; correct the file"
-        )
-    if option is not None:
-        if stated and unit_factor(option) not in factors:
-            u, w = stated[0]
-            raise BadInputError(
-                f"'{path}': units={option!r} (--units {option}) contradicts the file, which says "
-                f"{u!r} in {w}; a {unit_factor(u) / unit_factor(option):g}x error - drop the "
-                "option (the file states its unit), or correct the file if it is wrong"
-            )
-        return option
-    if stated:
-        guessed["units"] = f"{stated[0][0]} (stated in {stated[0][1]})"
-        return stated[0][0]
-    return None
 
 
 def _decimals(tok: str) -> int:

@@ -326,3 +326,11 @@ def test_point_numbers_from_one_start_at_zero_degree_and_say_so(tmp_path):
     ds = read_scan(f, convention=("-x", "clockwise"))
     assert float(ds["theta"].min()) == 0.0 and float(ds["theta"].max()) == pytest.approx(359.5)
     assert "point 1 is taken at 0 degree" in ds.attrs["reader_guesses"]["one.txt"]["angle"]
+
+
+def test_reader_columns_record_the_resolved_meaning(tmp_path):
+    f = _table(tmp_path / "res.txt", np.arange(180), _dev(180))
+    ds = read_scan(f, convention=CONV, units="um", arc="partial")
+    assert ds.attrs["reader_columns"] == ["angle_deg", "deviation"]
+    ds = read_scan(f, convention=CONV, units="um", arc="full")
+    assert ds.attrs["reader_columns"] == ["index", "deviation"]
