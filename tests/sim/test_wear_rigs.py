@@ -74,3 +74,19 @@ def test_halving_tol_moves_the_max_depth_less_than_the_reported_accuracy():
     assert u2 < u1
     assert abs(d1 - d2) < u1
     assert abs(d1 - d2) < np.hypot(u1, u2)
+
+
+def test_offset_zero_is_planar_with_friction_only():
+    """docs/sim.md: offset 0 admits a planar motion; without friction it is unstable."""
+    from jointwear.sim import run_cycles
+
+    flat = replace_nested(PARAMS, **{"mechanism.joint_offset": 0.0})
+    tilt = {}
+    for friction in (True, False):
+        res = run_cycles(replace_nested(flat, **{"friction.enabled": friction}), cycles=3)
+        tilt[friction] = float(np.degrees(res.dataset["journal_tilt"].max()))
+        axial = res.dataset["journal_offset"].sel(axis="z")
+        if not friction:
+            assert float(np.abs(axial).max()) > 0.3e-3  # travels in its axial play
+    assert tilt[True] < 1e-6
+    assert tilt[False] > 1.0
