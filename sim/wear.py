@@ -625,7 +625,12 @@ def simulate_wear(
             initial_wear=initial_wear,
             on_update=on_update,
         )
-    return run.run()
+    ds = run.run()
+    if overrides:
+        ds.attrs["parameter_overrides"] = json.dumps(
+            {k: float(v) for k, v in overrides.items()}, sort_keys=True
+        )
+    return ds
 
 
 def apply_overrides(

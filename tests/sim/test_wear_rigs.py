@@ -8,6 +8,8 @@ cycles at 20 x 200) with timings: benchmarks/bench_sim_rigs.py.
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pytest
 
@@ -49,14 +51,26 @@ def test_rig_finishes_with_its_accuracy_stated(rig):
 
 
 def test_overrides_reach_the_simulator():
-    ds = simulate_wear(
-        PARAMS,
-        cycles=100,
-        snapshots=[],
-        settings=WearSettings(kw=DEFAULT_KW, scheme="fixed", dn=100, settle_cycles=0),
-        overrides={"mechanism.joint_offset": 0.004, "wear.kw": 2e-15},
-    )
-    assert ds.attrs["kw_m2_per_N"] == 2e-15
+    fixed = WearSettings(kw=DEFAULT_KW, scheme="fixed", dn=100, settle_cycles=0)
+    base = simulate_wear(PARAMS, cycles=100, snapshots=[], settings=fixed)
+    for name, value in (
+        ("mechanism.joint_offset", 0.004),
+        ("joint.thrust_radius", 9.0e-3),
+        ("mechanism.initial_crank_angle_deg", 90.0),
+        ("friction.dynamic_coefficient", 0.15),
+    ):
+        ds = simulate_wear(
+            PARAMS,
+            cycles=100,
+            snapshots=[],
+            settings=fixed,
+            overrides={name: value, "wear.kw": 2 * DEFAULT_KW},
+        )
+        assert ds.attrs["kw_m2_per_N"] == 2 * DEFAULT_KW
+        assert json.loads(ds.attrs["parameter_overrides"])[name] == value
+        # the parameter changed the simulation (not only kw, which scales the depth by 2)
+        h0, h1 = base["wear_depth"].values[-1], ds["wear_depth"].values[-1]
+        assert np.max(np.abs(h1 - 2.0 * h0)) > 0.01 * np.max(2.0 * h0), name
     with pytest.raises(ParameterError, match="unknown parameter 'joint_ofset'"):
         simulate_wear(PARAMS, cycles=10, overrides={"mechanism.joint_ofset": 0.0})
     with pytest.raises(ParameterError, match="unknown wear setting"):
@@ -74,3 +88,19 @@ def test_halving_tol_moves_the_max_depth_less_than_the_reported_accuracy():
     assert u2 < u1
     assert abs(d1 - d2) < u1
     assert abs(d1 - d2) < np.hypot(u1, u2)
+
+
+def test_offset_zero_is_planar_with_friction_only():
+    """docs/sim.md: offset 0 admits a planar motion; without friction it is unstable."""
+    from jointwear.sim import run_cycles
+
+    flat = replace_nested(PARAMS, **{"mechanism.joint_offset": 0.0})
+    tilt = {}
+    for friction in (True, False):
+        res = run_cycles(replace_nested(flat, **{"friction.enabled": friction}), cycles=3)
+        tilt[friction] = float(np.degrees(res.dataset["journal_tilt"].max()))
+        axial = res.dataset["journal_offset"].sel(axis="z")
+        if not friction:
+            assert float(np.abs(axial).max()) > 0.3e-3  # travels in its axial play
+    assert tilt[True] < 1e-6
+    assert tilt[False] > 1.0
