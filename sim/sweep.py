@@ -449,6 +449,7 @@ def run_sweep(
         Unreachable scheduler, resume of another sweep, unwritable ``out``.
     """
     from jointwear import io
+    from jointwear._version import __version__
 
     if resume and out is None:
         raise BadInputError("resume needs the sweep's result file (out=/--out)")
@@ -527,7 +528,7 @@ def run_sweep(
                 out,
                 inputs=[*spec_file, *inputs],
                 parameters=record,
-                source="jointwear (sim.sweep)",
+                source=f"jointwear {__version__} (sim.sweep)",
             )
             finished = not lost
     finally:
