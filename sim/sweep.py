@@ -449,6 +449,7 @@ def run_sweep(
         Unreachable scheduler, resume of another sweep, unwritable ``out``.
     """
     from jointwear import io
+    from jointwear._version import __version__
 
     if resume and out is None:
         raise BadInputError("resume needs the sweep's result file (out=/--out)")
@@ -467,6 +468,11 @@ def run_sweep(
         RunTask(i, design.run_values(names, i), int(design.seeds[i]), spec, sim, wear)
         for i in range(design.n_runs)
     ]
+    if resume and _already_complete(out, digest):
+        ds = io.load(out)
+        ds.attrs.update(runs_computed_now=0, runs_resumed=design.n_runs)
+        ds.attrs["executor"] = "none (all runs resumed)"
+        return ds
     store = None
     results: dict[int, RunResult] = {}
     if out is not None:
@@ -518,6 +524,7 @@ def run_sweep(
         )
         ds = assemble(spec, design, results, lost, sim=sim)
         ds = sensitivity(ds, spec, design)
+        ds.attrs["sweep_digest"] = digest
         ds.attrs["runs_computed_now"] = state["computed"]
         ds.attrs["runs_resumed"] = state["resumed"]
         ds.attrs["executor"] = state["executor"] or "none (all runs resumed)"
@@ -527,13 +534,27 @@ def run_sweep(
                 out,
                 inputs=[*spec_file, *inputs],
                 parameters=record,
-                source="jointwear (sim.sweep)",
+                source=f"jointwear {__version__} (sim.sweep)",
             )
             finished = not lost
     finally:
         if store is not None:
             store.close(remove=finished)
     return ds
+
+
+def _already_complete(out: str | Path | None, digest: str) -> bool:
+    """True if ``out`` is the finished result of this very sweep (nothing left to resume)."""
+    from jointwear import io
+    from jointwear.sim._sweep_store import parts_dir
+
+    if out is None or not Path(out).exists() or parts_dir(out).exists():
+        return False
+    try:
+        attrs = io.load(out, validate=False).attrs
+    except BadInputError:
+        return False
+    return attrs.get("sweep_digest") == digest and attrs.get("n_not_run") == 0
 
 
 def execute_runs(tasks: list[RunTask], **kwargs: Any) -> None:

@@ -141,6 +141,10 @@ def test_resume_computes_only_the_missing_runs(tmp_path, monkeypatch):
     # same numbers as the uninterrupted sweep (each run's noise comes from its own seed)
     assert np.array_equal(ds["y"].values, full["y"].values)
     assert np.array_equal(io.load(out)["y"].values, full["y"].values)
+    given.clear()  # resuming a finished sweep computes nothing and returns it
+    again = run_sweep(spec, out=out, workers=0, resume=True)
+    assert given == [] and again.attrs["runs_computed_now"] == 0
+    assert np.array_equal(again["y"].values, full["y"].values)
 
 
 def test_grid_sweep_reshapes_to_parameter_axes():

@@ -261,3 +261,17 @@ def test_an_unworn_bore_has_no_location_of_maximum_wear():
     out = wear_outputs(ds.isel(cycles=[0]))
     assert out["max_wear_depth"] == 0 and math.isnan(out["max_wear_theta"])
     assert math.isnan(out["max_wear_z"])
+
+
+def test_the_specs_in_the_guide_are_valid():
+    import re
+    import tomllib
+    from pathlib import Path
+
+    guide = Path(__file__).resolve().parents[2] / "docs" / "sweeps.md"
+    blocks = re.findall(r"```toml\n(.*?)```", guide.read_text(encoding="utf-8"), re.S)
+    assert len(blocks) >= 2
+    for block in blocks:
+        s = read_spec(tomllib.loads(block))
+        _check_feasible(s, BASE, WEAR)
+        assert make_design(s).n_runs >= 32
