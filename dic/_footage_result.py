@@ -11,7 +11,12 @@ import numpy as np
 import xarray as xr
 
 from jointwear.dic._footage_config import FRAME_FLAGS, TrackConfig
-from jointwear.dic._rigid import rotation_angle_z, time_derivative
+from jointwear.dic._rigid import (
+    derivative_truncation,
+    position_noise,
+    rotation_angle_z,
+    time_derivative,
+)
 from jointwear.dic._video import FrameSource
 from jointwear.errors import BadInputError
 
@@ -115,6 +120,40 @@ def _write(ds: xr.Dataset, out, inputs, cfg, bodies) -> None:
     )
 
 
+def velocity_budget(t, pos, pos_u, vel, gain, cfg: TrackConfig, calibration) -> dict:
+    """Standard uncertainty of a tracked point's velocity (time, axis) and its parts.
+
+    * noise: the positions' noise times the differentiator's noise gain; the noise is the
+      larger of the propagated uncertainty (median over frames) and the empirical scatter
+      about a local polynomial (:func:`~jointwear.dic._rigid.position_noise`);
+    * truncation: the differentiator's model error,
+      :func:`~jointwear.dic._rigid.derivative_truncation` (dominant for fast mechanisms at a
+      few tens of frames per second);
+    * calibration: the calibration's relative length uncertainty ``length_scale_u_rel`` times
+      the speed, on every axis (a scale error of the world frame changes every component in
+      proportion, an orientation error of the same relative size moves speed between axes);
+      None when the calibration does not state it (imported or exact cameras).
+    """
+    sigma = np.nanmedian(pos_u, axis=0)
+    emp = position_noise(t, pos, window=cfg.velocity_window, order=cfg.velocity_order)
+    sigma = np.where(np.isfinite(emp), np.fmax(sigma, emp), sigma)
+    noise = gain[:, None] * sigma[None, :]
+    trunc = derivative_truncation(t, pos, window=cfg.velocity_window, order=cfg.velocity_order)
+    trunc = np.where(np.isfinite(trunc), trunc, 0.0)
+    cal = None
+    u_rel = getattr(calibration, "length_scale_u_rel", None) if calibration is not None else None
+    if u_rel is not None:
+        speed = np.linalg.norm(vel, axis=1, keepdims=True)
+        cal = np.broadcast_to(u_rel * speed, vel.shape)
+    total = np.sqrt(noise**2 + trunc**2 + (cal**2 if cal is not None else 0.0))
+    total = np.where(np.isfinite(vel), total, np.nan)
+    return {"noise": noise, "truncation": trunc, "calibration": cal, "total": total}
+
+
+def _med(a) -> list[float]:
+    return [float(v) for v in np.nanmedian(np.asarray(a, dtype=float), axis=0)]
+
+
 def _assemble(states, times, flags, duplicates, L, R, cfg, calibration, status) -> xr.Dataset:
     from jointwear import conventions as C
 
@@ -145,7 +184,8 @@ def _assemble(states, times, flags, duplicates, L, R, cfg, calibration, status) 
         poi_u = np.asarray(rows["poi_u"], dtype=float)
         poi_v = np.where(valid_time[:, None], poi, np.nan)
         vel, gain = time_derivative(t, poi_v, window=cfg.velocity_window, order=cfg.velocity_order)
-        vel_u = gain[:, None] * np.nanmedian(poi_u, axis=0)[None, :]
+        budget = velocity_budget(t, poi_v, poi_u, vel, gain, cfg, calibration if stereo else None)
+        vel_u = budget["total"]
         data[f"{name}{img}_position"] = (
             ("time", "axis"),
             poi,
@@ -258,8 +298,16 @@ def _assemble(states, times, flags, duplicates, L, R, cfg, calibration, status) 
                 vel_u,
                 {
                     "units": f"{unit} s-1",
-                    "long_name": "standard uncertainty of follower_velocity (noise propagated "
-                    "through the differentiator)",
+                    "long_name": "standard uncertainty of follower_velocity: position noise "
+                    "through the differentiator, its truncation error and the calibration's "
+                    "length and orientation uncertainty, combined in quadrature",
+                    "noise_median": _med(budget["noise"]),
+                    "truncation_median": _med(budget["truncation"]),
+                    "calibration_median": (
+                        _med(budget["calibration"])
+                        if budget["calibration"] is not None
+                        else "not assessed (the calibration carries no length_scale_u_rel)"
+                    ),
                 },
             )
         elif role == "journal":

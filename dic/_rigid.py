@@ -6,7 +6,13 @@ import numpy as np
 
 from jointwear.errors import BadInputError
 
-__all__ = ["fit_rigid", "fit_rigid_robust", "time_derivative", "rotation_angle_z"]
+__all__ = [
+    "fit_rigid",
+    "fit_rigid_robust",
+    "time_derivative",
+    "derivative_truncation",
+    "rotation_angle_z",
+]
 
 
 def fit_rigid(
@@ -168,7 +174,7 @@ def rotation_angle_z(R: np.ndarray) -> np.ndarray:
 
 
 def time_derivative(
-    t: np.ndarray, x: np.ndarray, *, window: int = 9, order: int = 5
+    t: np.ndarray, x: np.ndarray, *, window: int = 9, order: int = 5, centred: bool = True
 ) -> tuple[np.ndarray, np.ndarray]:
     """First derivative by local polynomial least squares (Savitzky–Golay on actual times).
 
@@ -194,7 +200,9 @@ def time_derivative(
     dxdt : (N, ...) array
         Derivative [unit of x per s]; NaN at the first and last sample and where too few
         valid samples remain. Within ``window // 2`` samples of an end the window shrinks
-        symmetrically (centred differences; degree at most ``2 * distance to the end``).
+        symmetrically (centred differences; degree at most ``2 * distance to the end``);
+        with ``centred=False`` the full window and degree are kept there instead (an
+        off-centre fit: less truncation, more noise; used to estimate the truncation error).
     gain : (N,) array
         Noise gain ``sqrt(sum c_j^2)`` [1/s]: the derivative's standard uncertainty is
         ``gain * sigma_x`` for independent sample noise ``sigma_x``.
@@ -225,8 +233,11 @@ def time_derivative(
     # biased; the first and last samples get NaN
     pos = np.arange(n)[:, None]
     reach = np.minimum(np.arange(n), n - 1 - np.arange(n))[:, None]
-    valid &= np.abs(idx - pos) <= reach
-    deg = np.minimum(order, 2 * reach[:, 0])
+    if centred:
+        valid &= np.abs(idx - pos) <= reach
+        deg = np.minimum(order, 2 * reach[:, 0])
+    else:
+        deg = np.full(n, order)
     A = np.where(np.arange(order + 1)[None, None, :] <= deg[:, None, None], A, 0.0)
     Aw = A * valid[..., None]
     pinv = np.linalg.pinv(Aw)  # (n, p+1, w)
@@ -237,3 +248,67 @@ def time_derivative(
     gain = np.sqrt(np.sum(c**2, axis=1))
     gain[~enough] = np.nan
     return out.reshape(x.shape), gain
+
+
+def derivative_truncation(
+    t: np.ndarray, x: np.ndarray, *, window: int = 9, order: int = 5
+) -> np.ndarray:
+    """Estimated truncation (model) error of :func:`time_derivative` per sample [unit of x/s].
+
+    Inside the record: the difference between the derivative of degree ``order`` on
+    ``window`` samples and that of degree ``order + 2`` on ``window + 2`` samples (whose own
+    truncation error is far smaller), the larger over three neighbouring samples. Within
+    ``window // 2`` samples of an end, where :func:`time_derivative` shrinks its window and
+    degree: the difference from the full-degree off-centre fit. Both differences also hold
+    some noise, so the estimate errs on the large side.
+    """
+    t = np.asarray(t, dtype=float)
+    x = np.asarray(x, dtype=float)
+    n = len(t)
+    v, _ = time_derivative(t, x, window=window, order=order)
+    if n < window + 2:
+        return np.full_like(x, np.nan)
+    hi, _ = time_derivative(t, x, window=window + 2, order=order + 2)
+    off, _ = time_derivative(t, x, window=window, order=order, centred=False)
+    reach = np.minimum(np.arange(n), n - 1 - np.arange(n))
+    shape = (n,) + (1,) * (x.ndim - 1)
+    e = np.where((reach < window // 2).reshape(shape), np.abs(v - off), np.abs(v - hi))
+    padded = np.concatenate([e[:1], e, e[-1:]], axis=0)
+    stacked = np.stack([padded[:-2], padded[1:-1], padded[2:]])
+    with np.errstate(invalid="ignore"):
+        out = np.nanmax(np.where(np.isfinite(stacked), stacked, -np.inf), axis=0)
+    out[~np.isfinite(v)] = np.nan
+    out[np.isinf(out)] = np.nan
+    return out
+
+
+def position_noise(t: np.ndarray, x: np.ndarray, *, window: int = 9, order: int = 5) -> np.ndarray:
+    """Empirical upper estimate of the sample noise of ``x`` (N, k) per column [unit of x].
+
+    Every interior sample is compared with the local polynomial (degree ``order`` on its
+    ``window - 1`` neighbours, actual times); the residuals, corrected for the fit's variance,
+    hold the noise actually present (image noise, rigid-fit scatter, lever arms) plus the
+    polynomial's model error, so this bounds the noise from above (closely for slow motion).
+    """
+    t = np.asarray(t, dtype=float)
+    x = np.asarray(x, dtype=float).reshape(len(t), -1)
+    n, h = len(t), window // 2
+    if n < window + 2:
+        return np.full(x.shape[1], np.nan)
+    centres = np.arange(h, n - h)
+    idx = centres[:, None] + np.arange(-h, h + 1)[None, :]
+    dt = t[idx] - t[centres][:, None]
+    scale = np.max(np.abs(dt)) or 1.0
+    A = (dt / scale)[..., None] ** np.arange(order + 1)
+    vals = x[idx]
+    valid = np.all(np.isfinite(vals), axis=2)
+    valid[:, h] = False  # leave the sample out of its own fit
+    pinv = np.linalg.pinv(A * valid[..., None])
+    c0 = pinv[:, 0, :]  # value of the fitted polynomial at the centre
+    pred = np.einsum("nw,nwk->nk", c0, np.where(valid[..., None], vals, 0.0))
+    ok = (valid.sum(axis=1) > order + 1) & np.all(np.isfinite(x[centres]), axis=1)
+    if ok.sum() < 3:
+        return np.full(x.shape[1], np.nan)
+    res = (x[centres] - pred)[ok]
+    infl = 1.0 + np.sum(c0[ok] ** 2, axis=1)  # var(residual) = sigma^2 (1 + sum c0^2)
+    return np.sqrt(np.mean(res**2 / infl[:, None], axis=0))
