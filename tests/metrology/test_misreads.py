@@ -107,6 +107,11 @@ def test_header_states_the_angle_unit_and_contradiction_is_refused(tmp_path):
     assert ds.sizes["theta"] == 180 and np.ptp(ds["theta"].values) == pytest.approx(179.0)
     with pytest.raises(BadInputError, match=r"--angle-unit\) contradicts the file.*'deg'"):
         read_scan(f, convention=CONV, units="um", angle_unit="index")
+    g = _table(
+        tmp_path / "hn.txt", np.arange(180), _dev(180), head="Angle unit: rad\nAngle (deg)\tDev\n"
+    )
+    with pytest.raises(BadInputError, match=r"contradicts itself.*'deg'.*header.*'rad'"):
+        read_scan(g, convention=CONV, units="um")
 
 
 def test_values_without_angle_column_need_the_span(tmp_path):
