@@ -339,3 +339,12 @@ def test_reader_columns_record_the_resolved_meaning(tmp_path):
     assert ds.attrs["reader_columns"] == ["angle_deg", "deviation"]
     ds = read_scan(f, convention=CONV, units="um", arc="full")
     assert ds.attrs["reader_columns"] == ["index", "deviation"]
+
+
+def test_help_texts_keep_their_units(capsys):
+    assert main(["metrology", "import", "--help"]) == 0
+    out = " ".join(capsys.readouterr().out.replace("│", " ").split())
+    assert "Layer spacing, in mm" in out and "mid-width, in mm" in out
+    assert main(["metrology", "assess", "--help"]) == 0
+    out = " ".join(capsys.readouterr().out.replace("│", " ").split())
+    assert "Bore radius in mm" in out and "cut-off in UPR" in out
