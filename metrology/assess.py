@@ -383,7 +383,11 @@ def assess_points(
 
 
 def form_table(result: xr.Dataset) -> pd.DataFrame:
-    """Per-layer table of an :func:`assess` result in micrometres (one row per layer + bore)."""
+    """Per-layer table of an :func:`assess` result in micrometres (one row per layer + bore).
+
+    With exact fits, ``RONt_LS_exact_um`` and ``radius_LS_exact_mm`` per layer (the bore row:
+    CYLt and radius of the exact cylinder).
+    """
 
     rows = []
     refs = result.attrs.get("references", "LS,MZ,MI,MC").split(",")
@@ -391,6 +395,9 @@ def form_table(result: xr.Dataset) -> pd.DataFrame:
         row = {"layer": i + 1, "z_mm": float(zv) * 1e3}
         for ref in refs:
             row[f"RONt_{ref}_um"] = float(result[f"RONt_{ref}"].values[i]) * 1e6
+        if "RONt_LS_exact" in result:
+            row["RONt_LS_exact_um"] = float(result["RONt_LS_exact"].values[i]) * 1e6
+            row["radius_LS_exact_mm"] = float(result["radius_LS_exact_layer"].values[i]) * 1e3
         row["ecc_um"] = float(result["eccentricity"].values[i]) * 1e6
         row["outliers"] = int(result["outliers_removed"].values[i])
         rows.append(row)
@@ -399,5 +406,8 @@ def form_table(result: xr.Dataset) -> pd.DataFrame:
         cyl = {"layer": "bore", "z_mm": np.nan}
         for ref in refs:
             cyl[f"RONt_{ref}_um"] = float(result[f"CYLt_{ref}"]) * 1e6
+        if "CYLt_LS_exact" in result:
+            cyl["RONt_LS_exact_um"] = float(result["CYLt_LS_exact"]) * 1e6
+            cyl["radius_LS_exact_mm"] = float(result["radius_LS_exact"]) * 1e3
         df = pd.concat([df, pd.DataFrame([cyl])], ignore_index=True)
     return df

@@ -260,13 +260,13 @@ def register(app: typer.Typer) -> None:
             typer.Option("--sheet", help="Worksheet of an Excel workbook with several sheets."),
         ] = None,
         layer_spacing_mm: Annotated[
-            float | None, typer.Option("--layer-spacing-mm", help="Layer spacing [mm].")
+            float | None, typer.Option("--layer-spacing-mm", help="Layer spacing, in mm.")
         ] = None,
         z_mid_mm: Annotated[
             float | None,
             typer.Option(
                 "--z-mid-mm",
-                help="Instrument height of the bearing mid-width [mm] (default: middle of the "
+                help="Instrument height of the bearing mid-width, in mm (default: middle of the "
                 "layers).",
             ),
         ] = None,
@@ -370,7 +370,10 @@ def register(app: typer.Typer) -> None:
         ],
         filter_upr: Annotated[
             float | None,
-            typer.Option("--filter", help="Filter cut-off [UPR], e.g. 15, 50, 150, 500."),
+            typer.Option(
+                "--filter",
+                help="Filter cut-off in UPR (undulations per revolution), e.g. 15, 50, 150, 500.",
+            ),
         ] = None,
         filter_kind: Annotated[
             FilterKind, typer.Option("--filter-kind", help="gaussian or 2rc.")
@@ -395,7 +398,7 @@ def register(app: typer.Typer) -> None:
             float | None,
             typer.Option(
                 "--nominal-radius-mm",
-                help="Bore radius [mm] for the centring check and --exact on deviation data "
+                help="Bore radius in mm for the centring check and --exact on deviation data "
                 "(default: the mean radius, or the file's nominal radius).",
             ),
         ] = None,
@@ -487,7 +490,9 @@ def register(app: typer.Typer) -> None:
         ] = Path("wear.nc"),
         angle_offset_deg: Annotated[
             float,
-            typer.Option("--angle-offset-deg", help="Set-up rotation of the before scan [deg]."),
+            typer.Option(
+                "--angle-offset-deg", help="Set-up rotation of the before scan, in degrees."
+            ),
         ] = 0.0,
         register: Annotated[
             bool, typer.Option("--register", help="Estimate the rotation from the unworn regions.")
@@ -500,7 +505,7 @@ def register(app: typer.Typer) -> None:
             float, typer.Option("--threshold", help="Unworn = within this many robust std devs.")
         ] = 3.0,
         radius_mm: Annotated[
-            float | None, typer.Option("--radius-mm", help="Bore radius for the volume [mm].")
+            float | None, typer.Option("--radius-mm", help="Bore radius for the volume, in mm.")
         ] = None,
         plot: Annotated[
             Path | None, typer.Option("--plot", help="Also save a wear-map figure (PNG).")

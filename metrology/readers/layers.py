@@ -38,7 +38,14 @@ def _angles(
 ) -> np.ndarray:
     """Angles [degree] of one layer: the column read in its stated or only possible unit."""
     kind = pf.columns[col]
-    stated = _UNIT_OF_KIND.get(kind) or pf.angle_unit
+    named = _UNIT_OF_KIND.get(kind)
+    if named is not None and pf.angle_unit is not None and named != pf.angle_unit:
+        raise BadInputError(
+            f"{where}: the file contradicts itself: column {col + 1} is read as {named!r} (its "
+            f"name or columns=...) but the header says the angle unit is {pf.angle_unit!r}; "
+            "correct the file or pass columns=... (--columns)"
+        )
+    stated = named or pf.angle_unit
     if angle_unit is not None and stated is not None and angle_unit != stated:
         raise BadInputError(
             f"{where}: angle_unit={angle_unit!r} (--angle-unit) contradicts the file, which "

@@ -170,3 +170,9 @@ def test_cli_nominal_radius_drives_the_centring_check(tmp_path, capsys):
     assert main(["metrology", "assess", str(p), "--nominal-radius-mm", "-1"]) == 2
     assert main(["metrology", "assess", str(p), "-r", "LS", "--exact"]) == 3
     assert "--nominal-radius-mm" in capsys.readouterr().err
+    # one layer, --exact with the radius: the exact circle is in the printed table
+    args = ["metrology", "assess", str(p), "-r", "LS", "--exact", "--nominal-radius-mm", "10"]
+    assert main(args) == 0
+    out = capsys.readouterr().out
+    assert "RONt_LS_exact_um" in out and "radius_LS_exact_mm" in out
+    assert "2.000" in out.splitlines()[-1]  # the 4-lobe form, 2 um peak to valley

@@ -107,6 +107,11 @@ def test_header_states_the_angle_unit_and_contradiction_is_refused(tmp_path):
     assert ds.sizes["theta"] == 180 and np.ptp(ds["theta"].values) == pytest.approx(179.0)
     with pytest.raises(BadInputError, match=r"--angle-unit\) contradicts the file.*'deg'"):
         read_scan(f, convention=CONV, units="um", angle_unit="index")
+    g = _table(
+        tmp_path / "hn.txt", np.arange(180), _dev(180), head="Angle unit: rad\nAngle (deg)\tDev\n"
+    )
+    with pytest.raises(BadInputError, match=r"contradicts itself.*'deg'.*header.*'rad'"):
+        read_scan(g, convention=CONV, units="um")
 
 
 def test_values_without_angle_column_need_the_span(tmp_path):
@@ -334,3 +339,12 @@ def test_reader_columns_record_the_resolved_meaning(tmp_path):
     assert ds.attrs["reader_columns"] == ["angle_deg", "deviation"]
     ds = read_scan(f, convention=CONV, units="um", arc="full")
     assert ds.attrs["reader_columns"] == ["index", "deviation"]
+
+
+def test_help_texts_keep_their_units(capsys):
+    assert main(["metrology", "import", "--help"]) == 0
+    out = " ".join(capsys.readouterr().out.replace("│", " ").split())
+    assert "Layer spacing, in mm" in out and "mid-width, in mm" in out
+    assert main(["metrology", "assess", "--help"]) == 0
+    out = " ".join(capsys.readouterr().out.replace("│", " ").split())
+    assert "Bore radius in mm" in out and "cut-off in UPR" in out
