@@ -66,6 +66,11 @@ class Sources:
             )
         if g is not None:
             return unknown(f"verification study: {g.reason}")
+        if self.gci:
+            return unknown(
+                f"the verification study has no '{quantity}', the simulation states none "
+                f"(<name>_u) and the criteria state no {family}_u_num_rel"
+            )
         return unknown(
             "the simulation states none (<name>_u), no verification study was given "
             f"(--verification) and the criteria state no {family}_u_num_rel"

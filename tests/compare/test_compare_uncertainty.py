@@ -213,3 +213,19 @@ def test_sweep_style_ensemble_sobol_indices_reach_the_comparison():
     # run_seed is not a varied input: a second ensemble with its own seeds is not refused
     other = _ensemble({"worn_volume": [1e-9, 1.1e-9]}, run_seed=np.arange(2), mu=[0.1, 0.2])
     compare(sim, meas, ensemble=[ens, other])
+
+
+def test_regression_importance_without_sobol_finds_the_dominant_input():
+    """An LHS-style ensemble: y = 3 a + 0.3 b -> SRC² of a near 0.99, of b near 0.01."""
+    rng = np.random.default_rng(7)
+    a, b = rng.standard_normal(40), rng.standard_normal(40)
+    y = 32e-6 * (1 + 0.05 * (3 * a + 0.3 * b) / 3)
+    ens = _ensemble({"max_wear_depth": y}, a=a, b=b)
+    c = compare(syn.sim_wear(), syn.meas_wear(u=1e-6, n_layers=16), ensemble=ens)
+    rows = c.sensitivity.set_index("parameter")
+    # exact for a linear model: SRC_a = 3 sd(a) / sd(y) (the sample's own correlations included)
+    lin = 3 * a + 0.3 * b
+    assert rows.loc["a", "S1"] == pytest.approx((3 * np.std(a) / np.std(lin)) ** 2, rel=1e-9)
+    assert rows.loc["b", "S1"] == pytest.approx((0.3 * np.std(b) / np.std(lin)) ** 2, rel=1e-6)
+    assert rows.loc["b", "S1"] < 0.03
+    assert rows.loc["a", "method"].startswith("SRC²") and "R² = 1.00" in rows.loc["a", "method"]
