@@ -1,0 +1,15 @@
+"""Public names of the sweep part of jointwear.sim (ensembles, sensitivity, dask execution)."""
+
+from jointwear.sim._sweep_models import analytic_sobol
+from jointwear.sim._sweep_spec import SweepSpec, make_design, read_spec
+from jointwear.sim.sweep import STATUS, run_sweep, to_grid
+
+__all__ = [
+    "run_sweep",
+    "read_spec",
+    "SweepSpec",
+    "make_design",
+    "to_grid",
+    "analytic_sobol",
+    "STATUS",
+]

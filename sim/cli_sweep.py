@@ -1,0 +1,115 @@
+"""``jointwear sim sweep``: parameter sweeps, ensembles and sensitivity analysis on dask."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated, Any
+
+import typer
+
+__all__ = ["register"]
+
+
+def register(app: typer.Typer) -> None:
+    """Add ``jointwear sim sweep`` to the ``sim`` group."""
+
+    @app.command("sweep")
+    def sweep(
+        spec: Annotated[Path, typer.Argument(help="Sweep spec (TOML; see docs/sweeps.md).")],
+        out: Annotated[Path, typer.Option("--out", help="Result file (netCDF).")],
+        workers: Annotated[
+            int | None,
+            typer.Option(
+                "--workers",
+                help="Local dask worker processes, one thread each (default: one per core; "
+                "0 = in this process, no dask).",
+            ),
+        ] = None,
+        scheduler: Annotated[
+            str | None,
+            typer.Option(
+                "--scheduler", help="Address of a running dask scheduler, e.g. tcp://host:8786."
+            ),
+        ] = None,
+        resume: Annotated[
+            bool,
+            typer.Option(
+                "--resume", help="Continue an interrupted sweep: compute only the missing runs."
+            ),
+        ] = False,
+        params: Annotated[
+            Path | None,
+            typer.Option(
+                "--params",
+                help="Base parameters of every run (TOML, as for 'sim wear', with an optional "
+                "\\[wear] table).",
+            ),
+        ] = None,
+        progress: Annotated[
+            bool | None,
+            typer.Option("--progress/--no-progress", help="Progress bar (default: on a terminal)."),
+        ] = None,
+    ) -> None:
+        """Run a parameter sweep or ensemble of simulations; each run is one dask task.
+
+        Each finished run is written at once to <out>.parts/, so an interrupted sweep continues
+        with --resume; a failing run is recorded with its error and the sweep goes on. For
+        method = "sobol" or "morris" the result holds SALib's sensitivity indices.
+        """
+        import numpy as np
+
+        from jointwear.errors import BadInputError, SimulationError
+        from jointwear.progress import progress_bar
+        from jointwear.sim.sweep import run_sweep
+
+        if scheduler is not None and workers is not None:
+            raise BadInputError("give --workers or --scheduler, not both")
+        with progress_bar("sweep", total=None, enabled=progress) as bar:
+            task = bar.tasks[0].id
+
+            def on_progress(s: dict[str, Any]) -> None:
+                bar.update(
+                    task,
+                    total=s["total"],
+                    completed=s["done"],
+                    description=f"sweep: {s['done'] - s['failed']} ok, {s['failed']} failed",
+                )
+
+            try:
+                ds = run_sweep(
+                    spec,
+                    out=out,
+                    params=params,
+                    workers=workers,
+                    scheduler=scheduler,
+                    resume=resume,
+                    on_progress=on_progress,
+                )
+            except KeyboardInterrupt:
+                from jointwear.sim._sweep_store import parts_dir
+
+                n = len(list(parts_dir(out).glob("run-*.npz")))
+                typer.echo(
+                    f"interrupted: {n} finished run(s) are kept in {parts_dir(out)}; "
+                    "run the same command with --resume to compute the rest",
+                    err=True,
+                )
+                raise
+        status = np.asarray(ds["status"].values)
+        typer.echo(
+            f"{out}: {ds.attrs['n_runs']} runs ({ds.attrs['sweep_method']}, "
+            f"{ds.attrs['sweep_run']}) on {ds.attrs['executor']}: {ds.attrs['n_ok']} ok, "
+            f"{ds.attrs['n_failed']} failed, {ds.attrs['n_not_run']} not run; "
+            f"{ds.attrs['runs_computed_now']} computed now, {ds.attrs['runs_resumed']} resumed"
+        )
+        for i in np.flatnonzero(status == 1)[:5]:
+            typer.echo(f"  run {int(i)} failed: {ds['error'].values[i]}", err=True)
+        if "sensitivity_not_assessed" in ds.attrs:
+            typer.echo(
+                f"sensitivity not assessed for: {ds.attrs['sensitivity_not_assessed']}", err=True
+            )
+        if ds.attrs["n_not_run"]:
+            raise SimulationError(
+                f"{ds.attrs['n_not_run']} run(s) were lost by the cluster (see 'error' in {out}); "
+                "their parts are kept: run the same command with --resume to compute them"
+            )
