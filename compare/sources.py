@@ -83,6 +83,12 @@ class Sources:
             have = {i for i, _ in found}
             found += [(i, v) for i, v in self.ensemble.scalar(quantity) if i not in have]
             if found:
+                from jointwear.compare.ensemble import not_a_distribution
+
+                for i, _ in found:
+                    why = not_a_distribution(self.ensemble.datasets[i], self.ensemble.names[i])
+                    if why:
+                        return unknown(why)
                 cyc = self.compared_cycles if family == "wear" else None
                 parts = [
                     (

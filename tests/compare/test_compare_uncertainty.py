@@ -91,19 +91,30 @@ def test_ensemble_spread_is_u_input():
     meas = syn.meas_wear(u=1e-6, n_layers=16)
     rng = np.random.default_rng(3)
     depth = 32e-6 + 2e-6 * rng.standard_normal(12)
-    depth[4] = np.nan  # a failed run is left out, not counted as zero
     ens = _ensemble({"max_wear_depth": depth}, kw=rng.uniform(1, 2, 12))
     c = compare(sim, meas, ensemble=ens, criteria=Criteria(wear_u_num_rel=0.0))
-    assert c.value("max_wear_depth", "u_input") == pytest.approx(np.nanstd(depth, ddof=1))
+    assert c.value("max_wear_depth", "u_input") == pytest.approx(np.std(depth, ddof=1))
     basis = c.metrics.set_index(["quantity", "metric"]).loc[("max_wear_depth", "u_input"), "basis"]
-    assert "11 runs (1 failed, left out)" in basis
+    assert "standard deviation over 12 runs" in basis
+    # a failed run (NaN) biases the spread of the others: not assessed, never left out silently
+    broken = ens.copy(deep=True)
+    broken["max_wear_depth"][4] = np.nan
+    c_broken = compare(sim, meas, ensemble=broken, criteria=Criteria(wear_u_num_rel=0.0))
+    assert np.isnan(c_broken.value("max_wear_depth", "u_input"))
+    assert c_broken.state("maximum wear depth", "V&V 20") == "not_assessed"
+    # a grid sweep's spread is not an input distribution
+    grid = ens.assign_attrs(probabilistic_sample="false", sweep_method="grid")
+    c_grid = compare(sim, meas, ensemble=grid, criteria=Criteria(wear_u_num_rel=0.0))
+    assert np.isnan(c_grid.value("max_wear_depth", "u_input"))
+    reason = c_grid.decisions.set_index("key").loc["max_wear_depth", "reason"].iloc[0]
+    assert "not a sample of the input distribution" in reason
     assert c.state("maximum wear depth", "V&V 20") in ("pass", "fail")
     # a quantity the ensemble does not have stays not assessed
     assert np.isnan(c.value("worn_volume", "u_input"))
     # two ensembles over independent inputs: variances add; over the same input: refused
     other = _ensemble({"max_wear_depth": 32e-6 + np.array([-1e-6, 1e-6])}, mu=[0.1, 0.2])
     both = compare(sim, meas, ensemble=[ens, other], criteria=Criteria(wear_u_num_rel=0.0))
-    expected = np.hypot(np.nanstd(depth, ddof=1), np.std([-1e-6, 1e-6], ddof=1))
+    expected = np.hypot(np.std(depth, ddof=1), np.std([-1e-6, 1e-6], ddof=1))
     assert both.value("max_wear_depth", "u_input") == pytest.approx(expected)
     with pytest.raises(BadInputError, match="both vary 'kw'"):
         compare(sim, meas, ensemble=[ens, ens])
