@@ -71,7 +71,8 @@ class Comparison:
     partial : tuple of str
         Parts that were not compared (a side without wear maps or motion).
     sensitivity : DataFrame
-        Sobol indices from the ensemble (quantity, parameter, S1, ST); empty without.
+        Which inputs dominate each quantity: the ensemble's Sobol indices (S1, ST), else
+        squared standardised regression coefficients (S1 column; method says which).
     """
 
     wear: xr.Dataset | None
@@ -83,7 +84,9 @@ class Comparison:
     data_origin: Mapping[str, str] = field(default_factory=dict)
     partial: tuple[str, ...] = ()
     sensitivity: pd.DataFrame = field(
-        default_factory=lambda: pd.DataFrame(columns=["quantity", "parameter", "S1", "ST"])
+        default_factory=lambda: pd.DataFrame(
+            columns=["quantity", "parameter", "S1", "ST", "method"]
+        )
     )
 
     @property
@@ -269,12 +272,65 @@ def _ensemble_motion(
     return values, bands
 
 
-def _sensitivity(ens: Ensemble | None, quantities: Sequence[str]) -> pd.DataFrame:
-    rows = []
+SENSITIVITY_COLUMNS = ["quantity", "parameter", "S1", "ST", "method"]
+
+
+def _regression(
+    ens: Ensemble, q: str, field_values: Mapping[str, Sequence[tuple[int, np.ndarray]]]
+) -> list[dict[str, object]]:
+    """Squared standardised regression coefficients of ``q`` on the inputs of a random ensemble.
+
+    For a model close to linear in its inputs, SRC² is the share of the output variance each
+    input explains (their sum is the R² of the fit, stated in the method). Used only when the
+    ensemble has no Sobol indices; needs more runs than inputs + 1.
+    """
+    found = list(field_values.get(q, ())) or ens.scalar(q)
+    rows: list[dict[str, object]] = []
+    for i, y in found[:1]:
+        ds = ens.datasets[i]
+        names = [p for p in ens.parameters(i) if p in ds.coords and ds[p].dims == ("run",)]
+        x = (
+            np.column_stack([np.asarray(ds[p].values, dtype=float) for p in names])
+            if names
+            else None
+        )
+        if x is None:
+            continue
+        ok = np.isfinite(y) & np.all(np.isfinite(x), axis=1)
+        sd = x[ok].std(axis=0, ddof=1) if ok.sum() > 1 else np.zeros(len(names))
+        if ok.sum() <= len(names) + 1 or np.any(sd == 0) or np.std(y[ok]) == 0:
+            continue
+        xs = (x[ok] - x[ok].mean(axis=0)) / sd
+        ys = (y[ok] - y[ok].mean()) / y[ok].std(ddof=1)
+        beta, *_ = np.linalg.lstsq(np.column_stack([np.ones(ok.sum()), xs]), ys, rcond=None)
+        r2 = 1.0 - float(
+            np.sum((ys - np.column_stack([np.ones(ok.sum()), xs]) @ beta) ** 2)
+        ) / float(np.sum(ys**2))
+        method = f"SRC² (linear fit over {int(ok.sum())} runs, R² = {r2:.2f})"
+        for p, b in zip(names, beta[1:], strict=True):
+            rows.append(
+                {
+                    "quantity": q,
+                    "parameter": p,
+                    "S1": float(b**2),
+                    "ST": float("nan"),
+                    "method": method,
+                }
+            )
+    return rows
+
+
+def _sensitivity(
+    ens: Ensemble | None,
+    quantities: Sequence[str],
+    field_values: Mapping[str, Sequence[tuple[int, np.ndarray]]],
+) -> pd.DataFrame:
+    rows: list[dict[str, object]] = []
     if ens is not None:
         for q in quantities:
-            rows += [{"quantity": q, **r} for r in ens.sensitivity(q)]
-    return pd.DataFrame(rows, columns=["quantity", "parameter", "S1", "ST"])
+            sobol = [{"quantity": q, **r, "method": "Sobol (SALib)"} for r in ens.sensitivity(q)]
+            rows += sobol or _regression(ens, q, field_values)
+    return pd.DataFrame(rows, columns=SENSITIVITY_COLUMNS)
 
 
 def compare(
@@ -413,5 +469,5 @@ def compare(
         criteria=criteria,
         data_origin={"simulation": side_origin(sims), "measurement": side_origin(meass)},
         partial=tuple(partial),
-        sensitivity=_sensitivity(ens, compared),
+        sensitivity=_sensitivity(ens, compared, field_values),
     )

@@ -193,6 +193,33 @@ def as_ensemble(
     return Ensemble(tuple(items), tuple(labels))
 
 
+def not_a_distribution(ds: xr.Dataset, label: str) -> str:
+    """Why an ensemble's spread is not a propagated input uncertainty ('' when it is).
+
+    A grid or a Morris design (``probabilistic_sample`` false, as ``jointwear sim sweep``
+    records it) samples the inputs evenly, not from their distribution; its spread means
+    nothing for V&V 20. Runs that failed or were not run make the spread of the others biased
+    (failures may cluster in one region of the inputs).
+    """
+    prob = ds.attrs.get("probabilistic_sample")
+    if prob is not None and str(prob).lower() in ("false", "0", "no"):
+        method = ds.attrs.get("sweep_method", "a grid or Morris design")
+        return (
+            f"{label} is a {method} sweep, not a sample of the input distribution: its spread is "
+            "not an input uncertainty (use method = 'lhs' or 'sobol')"
+        )
+    n_bad = 0
+    if "status" in ds.data_vars:
+        n_bad = int(np.sum(np.asarray(ds["status"].values) != 0))
+    if n_bad:
+        return (
+            f"{label}: {n_bad} of {ds.sizes['run']} runs failed or were not run; the spread of "
+            "the others is not the propagated uncertainty (failures may cluster in one region "
+            "of the inputs) - rerun them (jointwear sim sweep --resume) or fix their cause"
+        )
+    return ""
+
+
 def spread(
     per_ensemble: Sequence[tuple[str, np.ndarray, float | None]],
     s: float,
@@ -224,11 +251,14 @@ def spread(
         ok = v[np.isfinite(v)]
         if ok.size < 2:
             return unknown(f"{label}: {ok.size} finished run(s) with this quantity, 2 are needed")
+        if ok.size < v.size:
+            return unknown(
+                f"{label}: {v.size - ok.size} of {v.size} runs have no value (failed); the spread "
+                "of the others is not the propagated uncertainty (failures may cluster in one "
+                "region of the inputs)"
+            )
         sd = float(np.std(ok, ddof=1))
-        failed = v.size - ok.size
-        note = f"{label}: standard deviation over {ok.size} runs" + (
-            f" ({failed} failed, left out)" if failed else ""
-        )
+        note = f"{label}: standard deviation over {ok.size} runs"
         if (
             compared_cycles is not None
             and cycles is not None

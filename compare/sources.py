@@ -66,6 +66,11 @@ class Sources:
             )
         if g is not None:
             return unknown(f"verification study: {g.reason}")
+        if self.gci:
+            return unknown(
+                f"the verification study has no '{quantity}', the simulation states none "
+                f"(<name>_u) and the criteria state no {family}_u_num_rel"
+            )
         return unknown(
             "the simulation states none (<name>_u), no verification study was given "
             f"(--verification) and the criteria state no {family}_u_num_rel"
@@ -78,6 +83,12 @@ class Sources:
             have = {i for i, _ in found}
             found += [(i, v) for i, v in self.ensemble.scalar(quantity) if i not in have]
             if found:
+                from jointwear.compare.ensemble import not_a_distribution
+
+                for i, _ in found:
+                    why = not_a_distribution(self.ensemble.datasets[i], self.ensemble.names[i])
+                    if why:
+                        return unknown(why)
                 cyc = self.compared_cycles if family == "wear" else None
                 parts = [
                     (

@@ -77,7 +77,13 @@ def to_dataset(c: Comparison) -> xr.Dataset:
         )
     for i, row in enumerate(c.sensitivity.itertuples()):
         attrs[f"sensitivity_{i:02d}"] = json.dumps(
-            {"quantity": row.quantity, "parameter": row.parameter, "S1": row.S1, "ST": row.ST}
+            {
+                "quantity": row.quantity,
+                "parameter": row.parameter,
+                "S1": row.S1,
+                "ST": row.ST,
+                "method": row.method,
+            }
         )
     n = vd.counts(c.states)
     attrs.update(
@@ -171,7 +177,7 @@ def load_comparison(source: str | Path | xr.Dataset) -> Comparison:
             "measurement": str(ds.attrs.get("data_origin_measurement", "not stated")),
         },
         partial=partial,
-        sensitivity=pd.DataFrame(sens, columns=["quantity", "parameter", "S1", "ST"]),
+        sensitivity=pd.DataFrame(sens, columns=["quantity", "parameter", "S1", "ST", "method"]),
     )
 
 

@@ -302,6 +302,7 @@ def _sensitivity_rows(c: Comparison) -> list[dict[str, str]]:
                 "parameter": str(r.parameter),
                 "S1": f"{float(r.S1):.2f}" if np.isfinite(float(r.S1)) else "–",
                 "ST": f"{float(r.ST):.2f}" if np.isfinite(float(r.ST)) else "–",
+                "method": str(r.method),
             }
         )
     return rows
@@ -326,7 +327,7 @@ def _context(
     n_pass = counts[vd.PASS]
     # the comparison's own notes ("motion not compared: ...") unless the caller already said why
     covered = {m.split(":", 1)[0].split()[0].lower() for m in missing if m.strip()}
-    gaps = [n for n in c.notes if "not compared" in n and n.split()[0] in ("wear", "motion")]
+    gaps = list(c.partial)
     missing = [*missing, *(n for n in gaps if n.split()[0].lower() not in covered)]
     notes = [*notes, *(n for n in c.notes if n not in gaps)]
     verdict, verdict_class = _verdict(c, counts)

@@ -115,3 +115,39 @@ def test_compare_cli_motion_variables(files, tmp_path, capsys):
     assert "motion aligned by crank angle: shift -111.41 ms (-80.2 degree" in text
     assert main([*argv, "--variable", "journal_offset"]) == 3
     assert "journal_offset are not in both" in capsys.readouterr().err
+
+
+def test_compare_cli_ensemble_and_verification(files, tmp_path, capsys):
+    """--ensemble: u_input is the ensemble's standard deviation; --verification: GCI u_num."""
+    import numpy as np
+    import xarray as xr
+
+    depth = np.array([31e-6, 33e-6, 32.5e-6, 30e-6, 34e-6])
+    ens = xr.Dataset(
+        {"max_wear_depth": ("run", depth, {"units": "m", "long_name": "max depth"})},
+        coords={
+            "run": np.arange(5),
+            "kw": ("run", np.linspace(1, 2, 5), {"units": "1", "long_name": "kw"}),
+        },
+    )
+    tol = np.array([0.4, 0.2, 0.1])
+    study = xr.Dataset(
+        {"max_wear_depth": ("tol", 32e-6 * (1 + 0.04 * tol), {"units": "m", "long_name": "d"})},
+        coords={"tol": ("tol", tol, {"units": "1", "long_name": "tolerance"})},
+    )
+    io.save(ens, tmp_path / "ens.nc")
+    io.save(study, tmp_path / "ver.nc")
+    out = tmp_path / "m.nc"
+    argv = ["compare", str(files["sim_wear"]), str(files["meas_wear_full"]), "-o", str(out)]
+    argv += ["--ensemble", str(tmp_path / "ens.nc"), "--verification", str(tmp_path / "ver.nc")]
+    assert main(argv) in (0, 1)
+    from jointwear.compare import load_comparison
+
+    c = load_comparison(out)
+    assert c.value("max_wear_depth", "u_input") == pytest.approx(np.std(depth, ddof=1))
+    assert c.value("max_wear_depth", "u_num") > 0
+    assert c.state("maximum wear depth", "V&V 20") in ("pass", "fail")
+    assert (
+        "ens.nc"
+        in c.metrics.set_index(["quantity", "metric"]).loc[("max_wear_depth", "u_input"), "basis"]
+    )

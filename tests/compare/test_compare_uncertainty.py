@@ -91,19 +91,30 @@ def test_ensemble_spread_is_u_input():
     meas = syn.meas_wear(u=1e-6, n_layers=16)
     rng = np.random.default_rng(3)
     depth = 32e-6 + 2e-6 * rng.standard_normal(12)
-    depth[4] = np.nan  # a failed run is left out, not counted as zero
     ens = _ensemble({"max_wear_depth": depth}, kw=rng.uniform(1, 2, 12))
     c = compare(sim, meas, ensemble=ens, criteria=Criteria(wear_u_num_rel=0.0))
-    assert c.value("max_wear_depth", "u_input") == pytest.approx(np.nanstd(depth, ddof=1))
+    assert c.value("max_wear_depth", "u_input") == pytest.approx(np.std(depth, ddof=1))
     basis = c.metrics.set_index(["quantity", "metric"]).loc[("max_wear_depth", "u_input"), "basis"]
-    assert "11 runs (1 failed, left out)" in basis
+    assert "standard deviation over 12 runs" in basis
+    # a failed run (NaN) biases the spread of the others: not assessed, never left out silently
+    broken = ens.copy(deep=True)
+    broken["max_wear_depth"][4] = np.nan
+    c_broken = compare(sim, meas, ensemble=broken, criteria=Criteria(wear_u_num_rel=0.0))
+    assert np.isnan(c_broken.value("max_wear_depth", "u_input"))
+    assert c_broken.state("maximum wear depth", "V&V 20") == "not_assessed"
+    # a grid sweep's spread is not an input distribution
+    grid = ens.assign_attrs(probabilistic_sample="false", sweep_method="grid")
+    c_grid = compare(sim, meas, ensemble=grid, criteria=Criteria(wear_u_num_rel=0.0))
+    assert np.isnan(c_grid.value("max_wear_depth", "u_input"))
+    reason = c_grid.decisions.set_index("key").loc["max_wear_depth", "reason"].iloc[0]
+    assert "not a sample of the input distribution" in reason
     assert c.state("maximum wear depth", "V&V 20") in ("pass", "fail")
     # a quantity the ensemble does not have stays not assessed
     assert np.isnan(c.value("worn_volume", "u_input"))
     # two ensembles over independent inputs: variances add; over the same input: refused
     other = _ensemble({"max_wear_depth": 32e-6 + np.array([-1e-6, 1e-6])}, mu=[0.1, 0.2])
     both = compare(sim, meas, ensemble=[ens, other], criteria=Criteria(wear_u_num_rel=0.0))
-    expected = np.hypot(np.nanstd(depth, ddof=1), np.std([-1e-6, 1e-6], ddof=1))
+    expected = np.hypot(np.std(depth, ddof=1), np.std([-1e-6, 1e-6], ddof=1))
     assert both.value("max_wear_depth", "u_input") == pytest.approx(expected)
     with pytest.raises(BadInputError, match="both vary 'kw'"):
         compare(sim, meas, ensemble=[ens, ens])
@@ -213,3 +224,19 @@ def test_sweep_style_ensemble_sobol_indices_reach_the_comparison():
     # run_seed is not a varied input: a second ensemble with its own seeds is not refused
     other = _ensemble({"worn_volume": [1e-9, 1.1e-9]}, run_seed=np.arange(2), mu=[0.1, 0.2])
     compare(sim, meas, ensemble=[ens, other])
+
+
+def test_regression_importance_without_sobol_finds_the_dominant_input():
+    """An LHS-style ensemble: y = 3 a + 0.3 b -> SRC² of a near 0.99, of b near 0.01."""
+    rng = np.random.default_rng(7)
+    a, b = rng.standard_normal(40), rng.standard_normal(40)
+    y = 32e-6 * (1 + 0.05 * (3 * a + 0.3 * b) / 3)
+    ens = _ensemble({"max_wear_depth": y}, a=a, b=b)
+    c = compare(syn.sim_wear(), syn.meas_wear(u=1e-6, n_layers=16), ensemble=ens)
+    rows = c.sensitivity.set_index("parameter")
+    # exact for a linear model: SRC_a = 3 sd(a) / sd(y) (the sample's own correlations included)
+    lin = 3 * a + 0.3 * b
+    assert rows.loc["a", "S1"] == pytest.approx((3 * np.std(a) / np.std(lin)) ** 2, rel=1e-9)
+    assert rows.loc["b", "S1"] == pytest.approx((0.3 * np.std(b) / np.std(lin)) ** 2, rel=1e-6)
+    assert rows.loc["b", "S1"] < 0.03
+    assert rows.loc["a", "method"].startswith("SRC²") and "R² = 1.00" in rows.loc["a", "method"]

@@ -82,3 +82,11 @@ def test_report_renders_in_chromium(report_files, tmp_path):
     page.feed(dom.stdout.decode("utf-8"))
     assert page.h2 == EXPECTED_SECTIONS
     assert page.tags.get("svg", 0) >= 2
+    # the four verdict states as Chromium renders them, with their own classes (colours)
+    states = {text: cls for cls, text in page.cells}
+    assert states.get("FAIL") == "fail" and states.get("PASS") == "pass"
+    assert states.get("NOT ASSESSED") == "not-assessed"
+    assert states.get("NOT COMPARABLE") == "not-comparable"
+    dom_text = dom.stdout.decode("utf-8")
+    assert "NOT VALIDATED: 1 of" in dom_text
+    assert "uncompared region hatched" in dom_text
