@@ -77,8 +77,8 @@ def _wear(task: RunTask) -> tuple[dict[str, float], dict[str, np.ndarray]]:
                 f"([sweep] max_cycles_simulated = {budget:g}) with only {info['cycles_done']} "
                 f"of {info['target']} cycles done: the update interval has shrunk to "
                 f"dN = {info['dn']} (the wear-rate field changes by {info['rate_change']:.2f} "
-                "per update); raise max_cycles_simulated, or set wear.dn_min / wear.noise_floor "
-                "in --params"
+                "per update); raise max_cycles_simulated, or set wear.dn_min (or the wear "
+                "scheme's other settings) in the [wear] table of --params"
             )
 
     run = WearRun(

@@ -168,7 +168,6 @@ def tiny_base(tmp_path):
     base.write_text(
         "[joint]\nn_layers = 4\nn_points = 24\n"
         '[wear]\nscheme = "fixed"\ndn = 100\nsettle_cycles = 0.25\ninitial_settle_cycles = 0.5\n'
-        "estimate_noise = false\n"
     )
     return base
 
