@@ -95,7 +95,7 @@ def check_calibration(
         ratio = cal.baseline / board_distance
         if not BASELINE_TO_DISTANCE[0] <= ratio <= BASELINE_TO_DISTANCE[1]:
             problems.append(
-                f"baseline {cal.baseline:.4g} is {ratio:.2f} times the board distance "
+                f"baseline {cal.baseline:.4g} is {ratio:.3g} times the board distance "
                 f"{board_distance:.4g} (plausible {BASELINE_TO_DISTANCE[0]:g}-"
                 f"{BASELINE_TO_DISTANCE[1]:g})"
             )

@@ -22,10 +22,13 @@ import numpy as np
 
 __all__ = ["grid_symmetries", "PairPose", "consistent_order"]
 
-#: Largest rotation between a view's left-to-right rotation and the consensus [degree].
-MAX_ROTATION_DEG = 5.0
+#: Largest rotation between a view's left-to-right rotation and the consensus [degree]: far
+#: above the scatter of per-view poses of a usable calibration (< 1-2 degrees), far below the
+#: 90/180 degrees of a wrong relabelling and the 20-45 degrees between the board poses of
+#: different views (a mismatched pair).
+MAX_ROTATION_DEG = 10.0
 #: Largest distance between a view's left-to-right translation and the consensus, relative.
-MAX_TRANSLATION_REL = 0.15
+MAX_TRANSLATION_REL = 0.25
 
 
 def grid_symmetries(nx: int, ny: int) -> list[np.ndarray]:

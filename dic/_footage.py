@@ -4,9 +4,10 @@ Pipeline (``track_footage``)
 ---------------------------
 1. The first frame of each camera is the reference. Each body's region of interest (a polygon
    in the left reference image, from a small TOML file) is filled with a grid of subsets.
-2. Stereo correspondence at the reference: SIFT features of the region are matched into the
-   right image, kept only if they satisfy the calibrated epipolar constraint (< 2 px), and a
-   RANSAC homography gives every subset an initial guess (position and affine gradients); the
+2. Stereo correspondence at the reference: SIFT features of the region are matched (FLANN,
+   guided by the epipolar lines, :mod:`jointwear.dic._footage_features`) with the right image's
+   features in the regions' epipolar band, kept within the epipolar gate
+   (``max(3, max_epipolar_px)`` px), and a RANSAC homography gives every subset an initial guess (position and affine gradients); the
    2D engine (:class:`jointwear.dic.SubsetCorrelator`, affine IC-GN) refines it. Matches with an
    epipolar distance above ``max_epipolar_px`` or low ZNCC are discarded. The matched pairs are
    triangulated (undistorted) into the body's reference 3D points.
@@ -21,12 +22,21 @@ Pipeline (``track_footage``)
 4. Per frame and body: triangulation, robust rigid fit (3D; planar 2D without stereo) of the
    current points to the reference points -> pose; the body-fixed point of interest (follower
    centre of mass, journal cap centre) is moved with the pose. Velocities come from a
-   Savitzky–Golay differentiator on the actual frame times (window 9, order 5 by default).
+   Savitzky–Golay differentiator on the actual frame times (window 9, order 5 by default);
+   their uncertainty includes the differentiator's truncation error and the calibration's.
 5. Frames are decoded ahead in a background thread and processed in order (bounded memory:
    the reference images, a few frames per camera and the per-frame results are held); the
    trackers run in two threads, the left ones of frame k + 1 beside the right ones and the
    poses of frame k. The result is written after each chunk when an output path is given, so an
-   interrupted run keeps what was computed; ``workers > 1`` runs chunks in processes instead.
+   interrupted run keeps what was computed; ``workers > 1`` runs chunks in processes instead
+   (threads inside a daemonic process such as a dask worker; tasks on a dask cluster with
+   ``scheduler``).
+
+Modules: :mod:`~jointwear.dic._footage_config` (options, bodies, flags),
+:mod:`~jointwear.dic._footage_features` (SIFT, matching, homography),
+:mod:`~jointwear.dic._footage_tracker` (one body in one camera),
+:mod:`~jointwear.dic._footage_frames` (set-up and per-frame pipeline),
+:mod:`~jointwear.dic._footage_result` (the dataset, its file, resuming), and this one.
 """
 
 from __future__ import annotations

@@ -134,7 +134,7 @@ def velocity_budget(t, pos, pos_u, vel, gain, cfg: TrackConfig, calibration) -> 
       proportion, an orientation error of the same relative size moves speed between axes);
       None when the calibration does not state it (imported or exact cameras).
     """
-    sigma = np.nanmedian(pos_u, axis=0)
+    sigma = _nanmedian(pos_u)
     emp = position_noise(t, pos, window=cfg.velocity_window, order=cfg.velocity_order)
     sigma = np.where(np.isfinite(emp), np.fmax(sigma, emp), sigma)
     noise = gain[:, None] * sigma[None, :]
@@ -150,8 +150,17 @@ def velocity_budget(t, pos, pos_u, vel, gain, cfg: TrackConfig, calibration) -> 
     return {"noise": noise, "truncation": trunc, "calibration": cal, "total": total}
 
 
+def _nanmedian(a) -> np.ndarray:
+    """Median over time ignoring NaN; NaN (without a warning) where nothing is valid."""
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        return np.nanmedian(np.asarray(a, dtype=float), axis=0)
+
+
 def _med(a) -> list[float]:
-    return [float(v) for v in np.nanmedian(np.asarray(a, dtype=float), axis=0)]
+    return [float(v) for v in _nanmedian(a)]
 
 
 def _assemble(states, times, flags, duplicates, L, R, cfg, calibration, status) -> xr.Dataset:

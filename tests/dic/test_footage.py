@@ -210,6 +210,9 @@ def test_cli_chain_calibrate_track_plot(small):
     good = np.all(np.isfinite(ds["follower_position"].values), axis=1)
     perr = ds["follower_position"].values[good] - (t["follower_position"].values[good] - origin)
     assert np.max(np.abs(perr)) < 3e-5
+    # the board calibration states its length uncertainty: a part of the velocity's budget
+    cal_u = ds["follower_velocity_u"].attrs["calibration_median"]
+    assert isinstance(cal_u, (list, np.ndarray)) and 0 < np.max(cal_u) < 1e-3
     assert (out / "motion.png").stat().st_size > 10_000
     # videos (FFV1, lossless): same result for the first frames, frame rate from the container
     motion_v = out / "motion_video.nc"
