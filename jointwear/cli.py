@@ -97,9 +97,7 @@ def demo(
 ) -> None:
     """Run the whole chain on the embedded default data and write a validation report.
 
-    Phases [1/5]..[5/5]: simulation and verification, an ensemble over the uncertain inputs,
-    virtual roundness scans, stereo footage, comparison and report. The report is always
-    written; exit code 1 when a validation criterion fails.
+    Phases [1/5]..[5/5]: simulation and verification, an ensemble over the uncertain inputs, virtual roundness scans, stereo footage, comparison and report. The report is always written; exit code 1 when a validation criterion fails.
     """
     from jointwear.reports.demo import run_demo
 
