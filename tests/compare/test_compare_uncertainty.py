@@ -81,6 +81,7 @@ def test_verification_study_sets_u_num_only_when_monotone():
 def _ensemble(values: dict[str, np.ndarray], **coords) -> xr.Dataset:
     n = len(next(iter(values.values())))
     ds = xr.Dataset(coords={"run": np.arange(n), **{k: ("run", v) for k, v in coords.items()}})
+    ds.attrs["cycles"] = 4e5  # the synthetic maps' cycles (syn.meas_wear)
     for k, v in values.items():
         ds[k] = ("run", np.asarray(v, dtype=float), {"units": "m"})
     return ds
@@ -96,6 +97,11 @@ def test_ensemble_spread_is_u_input():
     assert c.value("max_wear_depth", "u_input") == pytest.approx(np.std(depth, ddof=1))
     basis = c.metrics.set_index(["quantity", "metric"]).loc[("max_wear_depth", "u_input"), "basis"]
     assert "standard deviation over 12 runs" in basis
+    # an ensemble that does not say after how many cycles: its spread could be of any wear time
+    undated = ens.copy()
+    del undated.attrs["cycles"]
+    c_undated = compare(sim, meas, ensemble=undated, criteria=Criteria(wear_u_num_rel=0.0))
+    assert np.isnan(c_undated.value("max_wear_depth", "u_input"))
     # a failed run (NaN) biases the spread of the others: not assessed, never left out silently
     broken = ens.copy(deep=True)
     broken["max_wear_depth"][4] = np.nan
