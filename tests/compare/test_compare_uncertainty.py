@@ -246,3 +246,45 @@ def test_regression_importance_without_sobol_finds_the_dominant_input():
     assert rows.loc["b", "S1"] == pytest.approx((0.3 * np.std(b) / np.std(lin)) ** 2, rel=1e-6)
     assert rows.loc["b", "S1"] < 0.03
     assert rows.loc["a", "method"].startswith("SRC²") and "R² = 1.00" in rows.loc["a", "method"]
+
+
+def test_real_sweep_output_as_ensemble(tmp_path):
+    """jointwear.sim.run_sweep's own file: u_input = spread of the quantity each member gives
+    when compared on its own (computed here through the public API, member by member)."""
+    from jointwear import io
+    from jointwear.params import replace_nested
+    from jointwear.sim import DEFAULT_KW, PARAMETER_SETS, WearSettings, run_sweep, simulate_wear
+
+    p = replace_nested(PARAMETER_SETS["zhang2023"], **{"joint.n_layers": 6, "joint.n_points": 36})
+    wear = WearSettings(scheme="fixed", dn=2000)
+    spec = {
+        "sweep": {
+            "run": "wear",
+            "cycles": 4000.0,
+            "method": "lhs",
+            "samples": 4,
+            "seed": 2,
+            "outputs": ["max_wear_depth", "worn_volume"],
+            "keep": ["wear_depth"],
+        },
+        "parameters": {
+            "wear.kw": {"distribution": "uniform", "bounds": [0.8 * DEFAULT_KW, 1.2 * DEFAULT_KW]}
+        },
+    }
+    io.save(run_sweep(spec, params=p, wear=wear, workers=0), tmp_path / "sweep.nc")
+    ens = io.load(tmp_path / "sweep.nc")
+    sim = simulate_wear(p, cycles=4000.0, snapshots=[4000.0], settings=wear)
+    meas = syn.meas_wear(cycles=4000.0, u=1e-9)
+    c = compare(sim, meas, ensemble=ens)
+    per_member = []
+    for r in range(ens.sizes["run"]):
+        member = ens[["wear_depth"]].isel(run=r, drop=True)
+        member.attrs["bearing_radius_m"] = sim.attrs.get("bearing_radius_m", 8e-3)
+        member_c = compare(member, meas)
+        per_member.append(
+            [member_c.value(q, "value_sim") for q in ("max_wear_depth", "worn_volume")]
+        )
+    sd = np.std(np.asarray(per_member), axis=0, ddof=1)
+    assert c.value("max_wear_depth", "u_input") == pytest.approx(sd[0], rel=1e-9)
+    assert c.value("worn_volume", "u_input") == pytest.approx(sd[1], rel=1e-9)
+    assert c.value("max_wear_depth", "u_input") > 0
