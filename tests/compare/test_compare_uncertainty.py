@@ -288,3 +288,25 @@ def test_real_sweep_output_as_ensemble(tmp_path):
     assert c.value("max_wear_depth", "u_input") == pytest.approx(sd[0], rel=1e-9)
     assert c.value("worn_volume", "u_input") == pytest.approx(sd[1], rel=1e-9)
     assert c.value("max_wear_depth", "u_input") > 0
+
+
+def test_partial_arc_is_not_interpolated_across_its_gap():
+    """A scan of half the circumference: the missing half is not compared (no interpolation
+    across the gap), and a simulated maximum inside the gap makes the maximum not comparable."""
+    from jointwear.conventions import CANONICAL, AngleConvention
+
+    own = AngleConvention("+y", "counterclockwise")
+    full = syn.meas_wear(n_layers=16, u=1e-6)
+    peak_own = float(own.from_physical(CANONICAL.to_physical(90.0)))  # the largest wear bump
+    d = (full["theta"].values - (peak_own + 180.0) + 180.0) % 360.0 - 180.0
+    arc = full.isel(theta=np.flatnonzero(np.abs(d) < 90.0))  # the half opposite the bump
+    c = compare(syn.sim_wear(), arc)
+    assert c.wear.attrs["theta_fraction_measured"] == pytest.approx(0.5, abs=0.02)
+    meas = c.wear["wear_depth_meas"].values
+    assert np.isnan(meas).any() and np.isfinite(meas).any()
+    # the simulated map is blanked where the measurement is missing: nothing is compared there
+    np.testing.assert_array_equal(np.isnan(c.wear["wear_depth_sim"].values), np.isnan(meas))
+    assert c.state("maximum wear depth") == "not_comparable"
+    assert "of the circumference" in c.decisions[c.decisions.key == "max_wear_depth"].reason.iloc[0]
+    assert c.state("wear map shape") == "not_comparable"
+    assert c.value("wear_depth", "volume_fraction_compared") < 0.5
