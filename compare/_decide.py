@@ -77,7 +77,8 @@ def fmt(value: float, units: str) -> str:
         return f"{value * 1e9:.3g} mm³"
     if units == "1":
         return f"{value:.3g}"
-    return f"{value:.4g} {units}"
+    shown = {"m s-1": "m/s", "m s-2": "m/s²"}.get(units, units)  # as in the report's tables
+    return f"{value:.4g} {shown}"
 
 
 def decision(

@@ -33,11 +33,15 @@ def coverage(al: xr.Dataset, max_outside: float) -> tuple[str, str]:
     a = al.attrs
     lo, hi = (float(v) for v in np.ravel(a["z_overlap_m"]))
     window = f"the measurement covers z = {lo * 1e3:+.2f} to {hi * 1e3:+.2f} mm"
+    arc = float(a.get("theta_fraction_measured", 1.0))
+    if arc < 1.0:
+        window += f" and {arc:.0%} of the circumference"
     peak = ""
     if not int(a.get("sim_max_inside", 1)):
         peak = (
             f"the simulated maximum ({float(a['sim_max_value_m']) * 1e6:.3g} µm at z = "
-            f"{float(a['sim_max_z_m']) * 1e3:+.2f} mm) lies outside the compared range: {window}"
+            f"{float(a['sim_max_z_m']) * 1e3:+.2f} mm, theta {float(a['sim_max_theta_deg']):.0f} "
+            f"degree) lies outside the compared range: {window}"
         )
     whole = ""
     frac = float(a.get("volume_fraction_compared", 1.0))

@@ -311,6 +311,13 @@ def align_wear_maps(
     theta_tgt = np.arange(n) * step
     s_vals, s_interp = _resample(s_da, z_tgt, theta_tgt, step)
     m_vals, m_interp = _resample(m_da, z_tgt, theta_tgt, step)
+    # a measurement with an angular gap (a partial arc) is not interpolated across it: both
+    # sides are compared only where the measurement has samples
+    covered = _theta_covered(np.asarray(m_da["theta"].values, dtype=float), theta_tgt)
+    if not covered.all():
+        s_vals = np.where(covered[None, :], s_vals, np.nan)
+        m_vals = np.where(covered[None, :], m_vals, np.nan)
+        m_interp += f"; {int((~covered).sum())} of {covered.size} grid angles lie in an angular gap of the measurement and are not compared"
 
     z = conventions.z_coord(z_tgt, note=f"layers of the {z_src} inside the overlapping range")
     theta = conventions.theta_coord(theta_tgt)
@@ -337,7 +344,7 @@ def align_wear_maps(
         out[f"{variable}_{side}"].attrs["ancillary_variables"] = uname
         anc.append(uname)
     radius = _bearing_radius(s_ds, m_ds)
-    out = _with_coverage(out, s_da, lo, hi, variable)
+    out = _with_coverage(out, s_da, lo, hi, variable, theta_tgt, covered)
     out.attrs.update(
         {
             "title": "simulated and measured wear maps on a common grid",
@@ -383,8 +390,28 @@ def _volume_between(z: np.ndarray, per_layer: np.ndarray, lo: float, hi: float) 
     return float(np.trapezoid(np.interp(grid, z, per_layer), grid))
 
 
+def _theta_covered(theta_src: np.ndarray, theta_tgt: np.ndarray) -> np.ndarray:
+    """Target angles [degree] within reach of the source samples (no angular gap), periodic.
+
+    A target angle is covered when a source sample lies within 1.5 source steps (the median
+    spacing) of it: a full circle covers everything, a partial arc only itself.
+    """
+    th = np.sort(np.mod(theta_src, 360.0))
+    own = _theta_step(th)
+    ext = np.concatenate([th - 360.0, th, th + 360.0])
+    idx = np.clip(np.searchsorted(ext, theta_tgt), 1, ext.size - 1)
+    dist = np.minimum(np.abs(ext[idx] - theta_tgt), np.abs(ext[idx - 1] - theta_tgt))
+    return dist <= 1.5 * own + 1e-9
+
+
 def _with_coverage(
-    out: xr.Dataset, s_da: xr.DataArray, lo: float, hi: float, variable: str
+    out: xr.Dataset,
+    s_da: xr.DataArray,
+    lo: float,
+    hi: float,
+    variable: str,
+    theta_tgt: np.ndarray,
+    covered: np.ndarray,
 ) -> xr.Dataset:
     """Add the whole simulated map and how much of it the common grid covers.
 
@@ -415,11 +442,18 @@ def _with_coverage(
         zmax, tmax, vmax = float(z[i]), float(th[j]), float(h[i, j])
     else:
         zmax = tmax = vmax = float("nan")
-    inside = bool(lo - tol <= zmax <= hi + tol)
-    per_layer = np.nansum(np.clip(np.nan_to_num(h), 0.0, None), axis=1)
+    # simulated angles in the measured arc (nearest common-grid angle, periodic)
+    step = 360.0 / theta_tgt.size
+    in_arc = covered[np.mod(np.rint(np.mod(th, 360.0) / step).astype(int), theta_tgt.size)]
+    inside = bool(lo - tol <= zmax <= hi + tol) and (
+        not np.isfinite(tmax) or bool(in_arc[int(np.argmin(np.abs(th - tmax)))])
+    )
+    pos = np.clip(np.nan_to_num(h), 0.0, None)
+    per_layer = np.nansum(pos, axis=1)
+    per_layer_arc = np.nansum(np.where(in_arc[None, :], pos, 0.0), axis=1)
     total = float(np.trapezoid(per_layer, z)) if z.size > 1 else float(per_layer.sum())
     if z.size > 1 and total > 0:
-        fraction = _volume_between(z, per_layer, lo, hi) / total
+        fraction = _volume_between(z, per_layer_arc, lo, hi) / total
     elif z.size == 1:
         fraction = 1.0 if inside else 0.0
     else:
@@ -430,6 +464,7 @@ def _with_coverage(
             "sim_max_z_m": zmax,
             "sim_max_theta_deg": tmax,
             "sim_max_inside": int(inside),
+            "theta_fraction_measured": float(np.mean(covered)),
             "volume_fraction_compared": float(min(1.0, fraction))
             if np.isfinite(fraction)
             else fraction,

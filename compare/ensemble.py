@@ -20,7 +20,9 @@ Which variable of the ensemble is which compared quantity:
 
 If the ensemble was run for a different number of wear cycles than the comparison (a reduced
 ensemble), the spread of a wear quantity is used relative to the ensemble mean and scaled to the
-compared value (``u_input = s / |mean| * |S|``); the basis says so.
+compared value (``u_input = s / |mean| * |S|``); the basis says so. An ensemble that does not
+state its cycles (attribute ``cycles``, or a ``cycles`` axis of its maps) gives no u_input for
+wear quantities: its spread could belong to any wear time.
 
 Several ensembles (``--ensemble`` repeated) must vary disjoint sets of parameters; their
 variances then add (independent inputs). Two that vary the same parameter are refused.
@@ -259,6 +261,12 @@ def spread(
             )
         sd = float(np.std(ok, ddof=1))
         note = f"{label}: standard deviation over {ok.size} runs"
+        if compared_cycles is not None and cycles is None:
+            return unknown(
+                f"{label} does not state after how many crank cycles its wear quantities are "
+                "(attribute 'cycles', written by jointwear sim sweep); its spread cannot be "
+                "matched to the compared simulation"
+            )
         if (
             compared_cycles is not None
             and cycles is not None

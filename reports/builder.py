@@ -280,7 +280,14 @@ def _coverage(c: Comparison) -> list[str]:
     lo, hi = (float(v) for v in np.ravel(a["z_overlap_m"]))
     zs = [float(v) for v in np.ravel(a.get("z_range_sim_m", [np.nan, np.nan]))]
     frac = float(a["volume_fraction_compared"])
-    out = [
+    arc = float(a.get("theta_fraction_measured", 1.0))
+    out = []
+    if arc < 1.0:
+        out.append(
+            f"The measurement covers {arc:.0%} of the circumference; the rest is not compared "
+            "(blank on the maps), never interpolated across."
+        )
+    out += [
         f"Compared axial range z = {lo * 1e3:+.2f} to {hi * 1e3:+.2f} mm of the simulated "
         f"{zs[0] * 1e3:+.2f} to {zs[1] * 1e3:+.2f} mm: {frac:.0%} of the simulated worn volume "
         "is compared (uncompared region hatched on the wear maps)."

@@ -488,99 +488,80 @@ def _phase(k: int, text: str) -> None:
     _say(f"[{k}/{PHASES}] {text}")
 
 
-def _ensemble_samples(n: int, seed: int = 11) -> dict[str, np.ndarray]:
-    """Latin-hypercube normal samples of :data:`ENSEMBLE_INPUTS` (relative factors, mean 1)."""
-    from scipy.stats import norm, qmc
+def ensemble_spec(params: Any, size: DemoSize) -> dict[str, Any]:
+    """The demo's sweep spec (``jointwear sim sweep`` format): LHS over :data:`ENSEMBLE_INPUTS`."""
+    from jointwear.sim import DEFAULT_KW
 
-    u = qmc.LatinHypercube(d=len(ENSEMBLE_INPUTS), seed=seed).random(n)
+    parameters: dict[str, Any] = {}
+    for name, (rel, _) in ENSEMBLE_INPUTS.items():
+        section, field = name.split(".")
+        mean = DEFAULT_KW if name == "wear.kw" else float(getattr(getattr(params, section), field))
+        spec = {"distribution": "truncnormal", "mean": mean, "std": rel * mean}
+        spec["bounds"] = [mean * (1 - 4 * rel), mean * (1 + 4 * rel)]
+        parameters[name] = spec
     return {
-        name: 1.0 + rel * norm.ppf(u[:, j])
-        for j, (name, (rel, _)) in enumerate(ENSEMBLE_INPUTS.items())
+        "sweep": {
+            "run": "wear",
+            "cycles": float(size.ensemble_cycles),
+            "method": "lhs",
+            "samples": int(size.ensemble_runs),
+            "seed": 11,
+            "outputs": ["max_wear_depth", "worn_volume", "cylindricity"],
+            "keep": ["wear_depth"],
+        },
+        "parameters": parameters,
     }
 
 
 def run_ensemble(
     params: Any, size: DemoSize, motion_time: np.ndarray, *, progress: bool = True
 ) -> xr.Dataset:
-    """A small ensemble over the uncertain inputs: wear (fixed ΔN, reduced cycles) and motion.
+    """A small real ensemble over the uncertain inputs, through :func:`jointwear.sim.run_sweep`.
 
-    Returns a Dataset with a ``run`` dimension (the inputs as coordinates along it): scalar wear
-    outputs, the final wear map ``wear_depth(run, z, theta)`` and the follower velocity
-    ``(run, time, axis)`` on ``motion_time``. A run that fails is kept as NaN and counted.
+    The wear runs are a Latin-hypercube sweep (:func:`ensemble_spec`; fixed update interval,
+    reduced cycles, in this process) keeping each run's final wear map; each member's motion is
+    then simulated with the same sampled inputs and its follower velocity
+    ``(run, time, axis)`` added on ``motion_time``, so that the compared in-plane velocity RMS
+    has an ensemble spread too (the sweep's own motion output is the speed RMS).
     """
     from jointwear import conventions
     from jointwear.params import replace_nested
-    from jointwear.sim import DEFAULT_KW, WearSettings, run_cycles, simulate_wear
+    from jointwear.sim import WearSettings, run_cycles, run_sweep
 
-    samples = _ensemble_samples(size.ensemble_runs)
-    n = size.ensemble_runs
-    cyc = size.ensemble_cycles
-    kw0 = DEFAULT_KW
-    maps, scalars, vel, crank, errors = [], [], [], [], []
-    z = theta = None
-    for r in range(n):
-        t0 = time.perf_counter()
-        changes = {
-            k: getattr(getattr(params, k.split(".")[0]), k.split(".")[1]) * samples[k][r]
-            for k in ENSEMBLE_INPUTS
-            if not k.startswith("wear.")
-        }
-        p = replace_nested(params, **changes)
-        kw = kw0 * samples["wear.kw"][r]
+    dn = int(size.ensemble_cycles // size.ensemble_updates)
+
+    def report(state: dict[str, Any]) -> None:
+        if progress and state["done"]:
+            _say(
+                f"      wear runs done {state['done']}/{state['total']}"
+                + (f", failed {state['failed']}" if state.get("failed") else "")
+            )
+
+    ds = run_sweep(
+        ensemble_spec(params, size),
+        params=params,
+        wear=WearSettings(scheme="fixed", dn=dn),
+        workers=0,
+        on_progress=report,
+    )
+    vel, crank = [], []
+    for r in range(ds.sizes["run"]):
+        changes = {k: float(ds[k].values[r]) for k in ENSEMBLE_INPUTS if not k.startswith("wear.")}
         try:
-            w = simulate_wear(
-                p,
-                cycles=cyc,
-                snapshots=[cyc],
-                settings=WearSettings(kw=kw, scheme="fixed", dn=int(cyc // size.ensemble_updates)),
-            )
-            da = w["wear_depth"].isel(cycles=-1).transpose("z", "theta")
-            z, theta = da["z"], da["theta"]
-            maps.append(np.asarray(da.values, dtype=float))
-            scalars.append(
-                [float(w[v][-1]) for v in ("max_wear_depth", "worn_volume", "cylindricity")]
-            )
-            m = run_cycles(p, cycles=size.motion_cycles).dataset
-            t = np.asarray(m["time"].values, dtype=float)
-            v = np.asarray(m["follower_velocity"].transpose("time", "axis").values, dtype=float)
-            vel.append(np.stack([np.interp(motion_time, t, v[:, j]) for j in range(3)], axis=1))
-            crank.append(np.interp(motion_time, t, np.unwrap(np.asarray(m["crank_angle"].values))))
-            errors.append("")
+            m = run_cycles(replace_nested(params, **changes), cycles=size.motion_cycles).dataset
         except JointwearError as exc:
-            errors.append(str(exc))
-            maps.append(None)
-            scalars.append([np.nan] * 3)
+            _say(f"      motion of run {r + 1} failed: {exc}")
             vel.append(np.full((motion_time.size, 3), np.nan))
             crank.append(np.full(motion_time.size, np.nan))
-        if progress:
-            _say(
-                f"      run {r + 1}/{n}: kw x {samples['wear.kw'][r]:.2f}, bore radius x "
-                f"{samples['joint.bearing_radius'][r]:.4f}, friction x "
-                f"{samples['friction.dynamic_coefficient'][r]:.2f}"
-                + (f" - FAILED: {errors[-1][:80]}" if errors[-1] else "")
-                + f" ({time.perf_counter() - t0:.0f} s)"
-            )
-    if z is None:
-        raise ValidationFailed("the demo ensemble failed in every run: " + errors[0])
-    shape = (z.size, theta.size)
-    field = np.stack([m if m is not None else np.full(shape, np.nan) for m in maps])
-    sc = np.asarray(scalars, dtype=float)
-    coords: dict[str, Any] = {
-        "run": ("run", np.arange(n), {"long_name": "ensemble member"}),
-        "z": z,
-        "theta": theta,
-        "time": ("time", motion_time, {"units": "s", "long_name": "time"}),
-        "axis": ("axis", np.array(["x", "y", "z"]), {"long_name": "vector component"}),
-    }
-    for k, (rel, what) in ENSEMBLE_INPUTS.items():
-        base = kw0 if k == "wear.kw" else getattr(getattr(params, k.split(".")[0]), k.split(".")[1])
-        coords[k] = ("run", base * samples[k], {"long_name": what, "relative_std": rel})
-    ds = xr.Dataset(coords=coords)
-    ds["wear_depth"] = (("run", "z", "theta"), field, conventions.variable_attrs("wear_depth"))
-    for j, (v, units) in enumerate(
-        (("max_wear_depth", "m"), ("worn_volume", "m3"), ("cylindricity", "m"))
-    ):
-        ds[v] = ("run", sc[:, j], {"units": units, "long_name": f"simulated {v.replace('_', ' ')}"})
+            continue
+        t = np.asarray(m["time"].values, dtype=float)
+        v = np.asarray(m["follower_velocity"].transpose("time", "axis").values, dtype=float)
+        vel.append(np.stack([np.interp(motion_time, t, v[:, j]) for j in range(3)], axis=1))
+        crank.append(np.interp(motion_time, t, np.unwrap(np.asarray(m["crank_angle"].values))))
+    ds = ds.assign_coords(
+        time=("time", motion_time, {"units": "s", "long_name": "time"}),
+        axis=("axis", np.array(["x", "y", "z"]), {"long_name": "vector component"}),
+    )
     ds["follower_velocity"] = (
         ("run", "time", "axis"),
         np.stack(vel),
@@ -595,11 +576,7 @@ def run_ensemble(
         {
             "title": "demo ensemble over the uncertain model inputs",
             "data_origin": "simulated",
-            "cycles": float(cyc),
             "bearing_radius_m": float(params.joint.bearing_radius),
-            "n_failed": int(sum(1 for e in errors if e)),
-            "errors": [e for e in errors if e] or "none",
-            "sampling": f"Latin hypercube, {n} runs, normal inputs (seed 11)",
         }
     )
     return ds
@@ -661,8 +638,8 @@ def run_demo(out: Path, *, quick: bool = False) -> Path:
     if size.ensemble_runs and params is not None:
         _phase(
             2,
-            f"ensemble over the uncertain inputs ({size.ensemble_runs} runs of "
-            f"{size.ensemble_cycles:g} cycles, fixed update interval)",
+            f"ensemble over the uncertain inputs (jointwear.sim.run_sweep: {size.ensemble_runs} "
+            f"LHS runs of {size.ensemble_cycles:g} cycles, fixed update interval)",
         )
         t0 = time.perf_counter()
         motion_time = np.asarray(io.load(sim_motion_path)["time"].values, dtype=float)
@@ -673,7 +650,10 @@ def run_demo(out: Path, *, quick: bool = False) -> Path:
             parameters={"inputs": {k: v[0] for k, v in ENSEMBLE_INPUTS.items()}},
             source="jointwear (sim.wear, sim.dynamics) ensemble via jointwear demo",
         )
-        _say(f"      ensemble: {ens.sizes['run']} runs ({time.perf_counter() - t0:.0f} s)")
+        _say(
+            f"      ensemble: {ens.sizes['run']} runs, {int(ens.attrs.get('n_failed', 0))} failed "
+            f"({time.perf_counter() - t0:.0f} s)"
+        )
         notes.append(
             f"Input uncertainty u_input: spread of a {ens.sizes['run']}-run ensemble over "
             + ", ".join(f"{k} (±{v[0]:.1%})" for k, v in ENSEMBLE_INPUTS.items())

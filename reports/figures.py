@@ -174,8 +174,13 @@ def polar_layers_figure(wear: xr.Dataset, *, max_layers: int = 6) -> Any:
                 )
             ax.plot(th, np.append(s[i], s[i][0]), color=SIM_COLOUR, lw=1.2, label="simulation")
             ax.plot(th, np.append(d[i], d[i][0]), color=MEAS_COLOUR, lw=1.0, label="measurement")
-            ax.set_ylim(min(0.0, float(np.nanmin([s[i].min(), d[i].min()]))), rmax)
-            ax.set_title(f"z = {z[i] * 1e3:+.2f} mm", pad=10)
+            # each layer on its own radial scale (a shared one leaves shallow layers empty)
+            top = float(np.nanmax([np.nanmax(s[i]), np.nanmax(d[i])]))
+            if ens is not None:
+                top = max(top, float(np.nanmax(ens[1][i])))
+            top = top * 1.05 if np.isfinite(top) and top > 0 else rmax
+            ax.set_ylim(min(0.0, float(np.nanmin([s[i].min(), d[i].min()]))), top)
+            ax.set_title(f"z = {z[i] * 1e3:+.2f} mm (max {top / 1.05:.3g} µm)", pad=10)
             ax.tick_params(labelsize=7)
             if k == 0:
                 ax.legend(loc="upper left", bbox_to_anchor=(-0.25, 1.18), frameon=False)

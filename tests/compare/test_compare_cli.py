@@ -129,6 +129,7 @@ def test_compare_cli_ensemble_and_verification(files, tmp_path, capsys):
             "run": np.arange(5),
             "kw": ("run", np.linspace(1, 2, 5), {"units": "1", "long_name": "kw"}),
         },
+        attrs={"cycles": 4e5},  # the cycles of the measured map: spreads are absolute
     )
     tol = np.array([0.4, 0.2, 0.1])
     study = xr.Dataset(

@@ -81,6 +81,7 @@ def test_verification_study_sets_u_num_only_when_monotone():
 def _ensemble(values: dict[str, np.ndarray], **coords) -> xr.Dataset:
     n = len(next(iter(values.values())))
     ds = xr.Dataset(coords={"run": np.arange(n), **{k: ("run", v) for k, v in coords.items()}})
+    ds.attrs["cycles"] = 4e5  # the synthetic maps' cycles (syn.meas_wear)
     for k, v in values.items():
         ds[k] = ("run", np.asarray(v, dtype=float), {"units": "m"})
     return ds
@@ -96,6 +97,11 @@ def test_ensemble_spread_is_u_input():
     assert c.value("max_wear_depth", "u_input") == pytest.approx(np.std(depth, ddof=1))
     basis = c.metrics.set_index(["quantity", "metric"]).loc[("max_wear_depth", "u_input"), "basis"]
     assert "standard deviation over 12 runs" in basis
+    # an ensemble that does not say after how many cycles: its spread could be of any wear time
+    undated = ens.copy()
+    del undated.attrs["cycles"]
+    c_undated = compare(sim, meas, ensemble=undated, criteria=Criteria(wear_u_num_rel=0.0))
+    assert np.isnan(c_undated.value("max_wear_depth", "u_input"))
     # a failed run (NaN) biases the spread of the others: not assessed, never left out silently
     broken = ens.copy(deep=True)
     broken["max_wear_depth"][4] = np.nan
@@ -240,3 +246,67 @@ def test_regression_importance_without_sobol_finds_the_dominant_input():
     assert rows.loc["b", "S1"] == pytest.approx((0.3 * np.std(b) / np.std(lin)) ** 2, rel=1e-6)
     assert rows.loc["b", "S1"] < 0.03
     assert rows.loc["a", "method"].startswith("SRC²") and "R² = 1.00" in rows.loc["a", "method"]
+
+
+def test_real_sweep_output_as_ensemble(tmp_path):
+    """jointwear.sim.run_sweep's own file: u_input = spread of the quantity each member gives
+    when compared on its own (computed here through the public API, member by member)."""
+    from jointwear import io
+    from jointwear.params import replace_nested
+    from jointwear.sim import DEFAULT_KW, PARAMETER_SETS, WearSettings, run_sweep, simulate_wear
+
+    p = replace_nested(PARAMETER_SETS["zhang2023"], **{"joint.n_layers": 6, "joint.n_points": 36})
+    wear = WearSettings(scheme="fixed", dn=2000)
+    spec = {
+        "sweep": {
+            "run": "wear",
+            "cycles": 4000.0,
+            "method": "lhs",
+            "samples": 4,
+            "seed": 2,
+            "outputs": ["max_wear_depth", "worn_volume"],
+            "keep": ["wear_depth"],
+        },
+        "parameters": {
+            "wear.kw": {"distribution": "uniform", "bounds": [0.8 * DEFAULT_KW, 1.2 * DEFAULT_KW]}
+        },
+    }
+    io.save(run_sweep(spec, params=p, wear=wear, workers=0), tmp_path / "sweep.nc")
+    ens = io.load(tmp_path / "sweep.nc")
+    sim = simulate_wear(p, cycles=4000.0, snapshots=[4000.0], settings=wear)
+    meas = syn.meas_wear(cycles=4000.0, u=1e-9)
+    c = compare(sim, meas, ensemble=ens)
+    per_member = []
+    for r in range(ens.sizes["run"]):
+        member = ens[["wear_depth"]].isel(run=r, drop=True)
+        member.attrs["bearing_radius_m"] = sim.attrs.get("bearing_radius_m", 8e-3)
+        member_c = compare(member, meas)
+        per_member.append(
+            [member_c.value(q, "value_sim") for q in ("max_wear_depth", "worn_volume")]
+        )
+    sd = np.std(np.asarray(per_member), axis=0, ddof=1)
+    assert c.value("max_wear_depth", "u_input") == pytest.approx(sd[0], rel=1e-9)
+    assert c.value("worn_volume", "u_input") == pytest.approx(sd[1], rel=1e-9)
+    assert c.value("max_wear_depth", "u_input") > 0
+
+
+def test_partial_arc_is_not_interpolated_across_its_gap():
+    """A scan of half the circumference: the missing half is not compared (no interpolation
+    across the gap), and a simulated maximum inside the gap makes the maximum not comparable."""
+    from jointwear.conventions import CANONICAL, AngleConvention
+
+    own = AngleConvention("+y", "counterclockwise")
+    full = syn.meas_wear(n_layers=16, u=1e-6)
+    peak_own = float(own.from_physical(CANONICAL.to_physical(90.0)))  # the largest wear bump
+    d = (full["theta"].values - (peak_own + 180.0) + 180.0) % 360.0 - 180.0
+    arc = full.isel(theta=np.flatnonzero(np.abs(d) < 90.0))  # the half opposite the bump
+    c = compare(syn.sim_wear(), arc)
+    assert c.wear.attrs["theta_fraction_measured"] == pytest.approx(0.5, abs=0.02)
+    meas = c.wear["wear_depth_meas"].values
+    assert np.isnan(meas).any() and np.isfinite(meas).any()
+    # the simulated map is blanked where the measurement is missing: nothing is compared there
+    np.testing.assert_array_equal(np.isnan(c.wear["wear_depth_sim"].values), np.isnan(meas))
+    assert c.state("maximum wear depth") == "not_comparable"
+    assert "of the circumference" in c.decisions[c.decisions.key == "max_wear_depth"].reason.iloc[0]
+    assert c.state("wear map shape") == "not_comparable"
+    assert c.value("wear_depth", "volume_fraction_compared") < 0.5
