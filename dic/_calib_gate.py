@@ -105,8 +105,9 @@ def check_calibration(
     if c_right[0] < 0 and abs(c_right[0]) > abs(c_right[1]):
         problems.append(
             f"the right camera sits to the LEFT of the left camera (x = {c_right[0]:.4g} in the "
-            "left camera frame): the --left and --right images look swapped (swap them; accept "
-            "with --accept-poor only if a camera is mounted upside down)"
+            "left camera frame): the --left and --right images look swapped (swap them; if the "
+            "camera given as --left really sits on the right, or is mounted upside down, accept "
+            "with --accept-poor)"
         )
     return problems
 

@@ -101,6 +101,13 @@ def _setup_bodies(L, R, bodies, calibration, cfg, ref_l, ref_r, pool) -> list[_B
                 report=report,
             )
             if H is None:
+                if report.measured_epipolar_px is None:
+                    # the band may miss the region when the calibration is far off: measure
+                    # the offset on the whole right image
+                    _sift_homography(
+                        _sift_features(ref_l, poly), _sift_features(ref_r),
+                        calibration=calibration, max_epipolar_px=gate, report=report,
+                    )  # fmt: skip
                 raise BadInputError(_no_stereo_match_message(spec.name, report, gate))
             guess = _homography_guess(H, pts)
             pos_r, zn, good = lt.track(ref_r, point_guess=guess)

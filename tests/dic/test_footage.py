@@ -720,6 +720,10 @@ def test_a_calibration_off_its_images_is_measured_and_the_gate_configurable(smal
     imgs = (written["left_images"], written["right_images"])
     with pytest.raises(BadInputError, match=r"a median (19\.\d|20\.\d) px from the calibration"):
         track_footage(*imgs, calibration=bad, config=tc, **opts)
+    # far off (the epipolar band misses the region): measured on the whole image
+    far = _shifted_calibration(cfg, 60.0)
+    with pytest.raises(BadInputError, match=r"a median (59\.\d|60\.\d) px from the calibration"):
+        track_footage(*imgs, calibration=far, config=tc, **opts)
     # the message's figure, used as the gate, lets the (biased) calibration through
     loose = dataclasses.replace(tc, max_epipolar_px=30.0)
     ds = track_footage(*imgs, calibration=bad, config=loose, **opts)
