@@ -115,12 +115,6 @@ DEFINITIONS: dict[str, tuple[str, str, str]] = {
         "same",
     ),
     "U_val": ("expanded validation uncertainty", "U_val = k u_val (ASME V&V 20)", "same"),
-    "fraction_within_U_val": (
-        "fraction of points within U_val",
-        "share of grid points where |S - D| <= k sqrt(u_num^2 + u_input^2 + u_D^2), point by "
-        "point (V&V 20 applied to every sample)",
-        "1",
-    ),
 }
 
 

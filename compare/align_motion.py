@@ -1,0 +1,328 @@
+"""Putting a simulated and a measured motion record on one time base, in phase.
+
+See :mod:`jointwear.compare.align` (module docstring, "Time series").
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+import numpy as np
+import xarray as xr
+
+from jointwear import conventions
+from jointwear.errors import BadInputError, ConventionError
+
+__all__ = ["align_time_series", "MOTION_VARIABLES"]
+
+#: time-series variables compared by default when both sides have them (contract names).
+#: Positions (``follower_position``) are left out: they depend on where each record puts its
+#: origin (a DIC calibration's world frame is the board's); ask for them explicitly.
+MOTION_VARIABLES = (
+    "follower_velocity",
+    "journal_offset",
+    "journal_displacement",
+    "contact_force",
+)
+
+
+def _time(ds: xr.Dataset, what: str) -> np.ndarray:
+    if "time" not in ds.coords:
+        raise BadInputError(f"{what} has no 'time' coordinate")
+    t = np.asarray(ds["time"].values, dtype=float)
+    if t.size < 4:
+        raise BadInputError(f"{what} has only {t.size} time samples; at least 4 are needed")
+    if np.any(np.diff(t) <= 0):
+        raise BadInputError(f"{what}: time is not strictly increasing")
+    units = ds["time"].attrs.get("units", "s")
+    if units != "s":
+        raise ConventionError(f"{what}: time has units {units!r}, the contract says 's'")
+    return t
+
+
+def _period_from_crank(ds: xr.Dataset) -> float | None:
+    if "crank_angle" not in ds:
+        return None
+    t = np.asarray(ds["time"].values, dtype=float)
+    phi = np.unwrap(np.asarray(ds["crank_angle"].values, dtype=float))
+    if t.size < 2 or not np.all(np.isfinite(phi)):
+        return None
+    slope = np.polyfit(t - t[0], phi, 1)[0]
+    if abs(slope) < 1e-12:
+        return None
+    return float(2 * math.pi / abs(slope))
+
+
+def _common_variables(
+    sim: xr.Dataset, meas: xr.Dataset, variables: Sequence[str] | None
+) -> list[str]:
+    if variables is not None:
+        missing = [v for v in variables if v not in sim or v not in meas]
+        if missing:
+            raise BadInputError(
+                f"variable(s) {', '.join(missing)} are not in both the simulation and the "
+                f"measurement (simulation has {', '.join(map(str, sim.data_vars))}; measurement "
+                f"has {', '.join(map(str, meas.data_vars))})"
+            )
+        return list(variables)
+    found = [
+        v
+        for v in MOTION_VARIABLES
+        if v in sim and v in meas and "time" in sim[v].dims and "time" in meas[v].dims
+    ]
+    if not found:
+        raise BadInputError(
+            "the simulation and the measurement have no motion variable in common (looked for "
+            f"{', '.join(MOTION_VARIABLES)}); simulation has {', '.join(map(str, sim.data_vars))}, "
+            f"measurement has {', '.join(map(str, meas.data_vars))}"
+        )
+    return found
+
+
+def _components(sim_da: xr.DataArray, meas_da: xr.DataArray, name: str) -> list[str] | None:
+    if "axis" not in sim_da.dims and "axis" not in meas_da.dims:
+        return None
+    if "axis" not in sim_da.dims or "axis" not in meas_da.dims:
+        raise BadInputError(f"'{name}' has an 'axis' dimension on one side only")
+    common = [
+        str(a) for a in meas_da["axis"].values if str(a) in set(map(str, sim_da["axis"].values))
+    ]
+    if not common:
+        raise BadInputError(f"'{name}': the two sides have no vector component in common")
+    return common
+
+
+def _unit_check(sim_da: xr.DataArray, meas_da: xr.DataArray, name: str) -> str:
+    us, um = sim_da.attrs.get("units"), meas_da.attrs.get("units")
+    if us != um:
+        raise ConventionError(
+            f"'{name}' has units {us!r} in the simulation and {um!r} in the measurement; convert "
+            "one of them to the contract units before comparing"
+        )
+    return str(us)
+
+
+def align_time_series(
+    sim: xr.Dataset,
+    meas: xr.Dataset,
+    *,
+    variables: Sequence[str] | None = None,
+    method: str = "auto",
+    period_s: float | None = None,
+    whole_cycles: bool = True,
+) -> xr.Dataset:
+    """Put a simulated and a measured motion record on one time base, in phase.
+
+    Parameters
+    ----------
+    sim : Dataset
+        Simulated motion over ``time`` [s] (any, e.g. variable, step), with ``crank_angle``
+        [rad] when available; must cover at least one whole crank cycle.
+    meas : Dataset
+        Measured motion over ``time`` [s] (e.g. DIC at 50 frames/s).
+    variables : sequence of str, optional
+        Variables to compare (default: those of :data:`MOTION_VARIABLES` present in both).
+    method : {"auto", "crank_angle", "cross_correlation"}
+        Phase alignment. ``"auto"``: by crank angle when both sides have ``crank_angle``,
+        else by cross-correlation.
+    period_s : float, optional
+        Crank period [s]; default from the simulation's crank angle rate.
+    whole_cycles : bool
+        Keep only an integer number of crank cycles of the measurement (default True).
+
+    Returns
+    -------
+    Dataset
+        Over the measurement's ``time`` (and ``axis``): ``<var>_sim``, ``<var>_meas``,
+        ``<var>_diff`` (sim - meas), ``<var>_meas_u`` / ``<var>_sim_u`` when given, and
+        ``sim_time`` (the simulated instant each sample was taken from). Attributes:
+        ``alignment_method``, ``time_shift_s``, ``time_shift_deg`` (crank degrees),
+        ``period_s``, ``n_cycles``, ``interpolation``.
+    """
+    ts = _time(sim, "simulated motion")
+    tm = _time(meas, "measured motion")
+    names = _common_variables(sim, meas, variables)
+    period = period_s if period_s is not None else _period_from_crank(sim)
+    if period is None:
+        period = _period_from_crank(meas)
+    if period is None or not (np.isfinite(period) and period > 0):
+        raise BadInputError(
+            "cannot tell the crank period: neither record has a usable 'crank_angle'; pass "
+            "period_s= (or --period) [s]"
+        )
+    if ts[-1] - ts[0] < period * (1 - 1e-9):
+        raise BadInputError(
+            f"the simulated motion covers {ts[-1] - ts[0]:.4g} s, less than one crank cycle "
+            f"({period:.4g} s); simulate at least one whole cycle"
+        )
+    if method not in ("auto", "crank_angle", "cross_correlation"):
+        raise BadInputError(
+            f"method must be 'auto', 'crank_angle' or 'cross_correlation', got {method!r}"
+        )
+    has_crank = "crank_angle" in sim and "crank_angle" in meas
+    if method == "auto":
+        method = "crank_angle" if has_crank else "cross_correlation"
+    if method == "crank_angle" and not has_crank:
+        raise BadInputError("method='crank_angle' needs 'crank_angle' in both records")
+
+    # measurement window: whole cycles from its start
+    n_cycles = (tm[-1] - tm[0] + np.median(np.diff(tm))) / period
+    if whole_cycles and n_cycles >= 1:
+        n_keep = int(math.floor(n_cycles + 1e-9))
+        keep = tm < tm[0] + n_keep * period - 1e-12
+        cycles_note = f"{n_keep} whole crank cycle(s) of the measurement"
+    else:
+        keep = np.ones_like(tm, dtype=bool)
+        n_keep = float(n_cycles)
+        cycles_note = f"the whole measurement ({n_cycles:.3g} cycles; less than one whole cycle)"
+    tm_k = tm[keep]
+    t0 = ts[-1] - period  # start of the simulation's last whole cycle
+
+    def sim_at(t_sim: np.ndarray, values: np.ndarray) -> np.ndarray:
+        phase = t0 + np.mod(t_sim - t0, period)
+        return np.interp(phase, ts, values)
+
+    if method == "crank_angle":
+        phi_s = np.unwrap(np.asarray(sim["crank_angle"].values, dtype=float))
+        phi_m = np.asarray(meas["crank_angle"].values, dtype=float)[keep]
+        sign = 1.0 if phi_s[-1] >= phi_s[0] else -1.0
+        ps = sign * phi_s
+        if np.any(np.diff(ps) <= 0):
+            raise BadInputError(
+                "the simulated crank angle is not monotonic in time; cannot align by crank angle "
+                "(use method='cross_correlation')"
+            )
+        start = ps[-1] - 2 * math.pi
+        target = start + np.mod(sign * phi_m - start, 2 * math.pi)
+        t_sim = np.interp(target, ps, ts)
+        # shift = measurement time - simulation time, modulo the period (circular mean)
+        ang = 2 * math.pi * (tm_k - t_sim) / period
+        shift = math.atan2(np.mean(np.sin(ang)), np.mean(np.cos(ang))) * period / (2 * math.pi)
+        how = "by crank angle (each frame matched to the simulated instant at the same crank angle)"
+    else:
+        # normalised signals of every common component, simulation on a fine periodic grid
+        pairs = []
+        for name in names:
+            comps = _components(sim[name], meas[name], name)
+            for c in comps or [None]:
+                s = sim[name] if c is None else sim[name].sel(axis=c)
+                m = meas[name] if c is None else meas[name].sel(axis=c)
+                sv = np.asarray(s.transpose("time").values, dtype=float)
+                mv = np.asarray(m.transpose("time").values, dtype=float)[keep]
+                ok = np.isfinite(mv)
+                if ok.sum() < 4 or np.nanstd(mv) == 0:
+                    continue
+                pairs.append((sv, (mv - np.nanmean(mv)) / np.nanstd(mv), ok))
+        if not pairs:
+            raise BadInputError("no usable signal for the cross-correlation (all constant or NaN)")
+
+        def score(tau: float) -> float:
+            total = 0.0
+            for sv, mz, ok in pairs:
+                x = sim_at(tm_k[ok] - tau, sv)
+                sd = x.std()
+                if sd == 0:
+                    continue
+                total += float(np.mean((x - x.mean()) / sd * mz[ok]))
+            return total
+
+        from scipy.optimize import minimize_scalar
+
+        grid = np.linspace(0.0, period, 720, endpoint=False)
+        scores = np.array([score(t) for t in grid])
+        best = grid[int(np.argmax(scores))]
+        step = period / 720
+        res = minimize_scalar(
+            lambda t: -score(t),
+            bounds=(best - step, best + step),
+            method="bounded",
+            options={"xatol": period * 1e-7},
+        )
+        tau = float(res.x) if -res.fun >= scores.max() else float(best)
+        shift = (tau + period / 2) % period - period / 2
+        t_sim = t0 + np.mod(tm_k - shift - t0, period)
+        how = (
+            "by cross-correlation of the normalised signals over whole cycles (the simulation's "
+            "last whole cycle repeated periodically)"
+        )
+
+    time = xr.DataArray(tm_k, dims="time", attrs=dict(meas["time"].attrs))
+    time.attrs.setdefault("units", "s")
+    time.attrs.setdefault("long_name", conventions.COORDINATES["time"][1])
+    out = xr.Dataset(coords={"time": time})
+    comps_of = {name: _components(sim[name], meas[name], name) for name in names}
+    union = [c for c in ("x", "y", "z") if any(c in (v or []) for v in comps_of.values())]
+    union += sorted({c for v in comps_of.values() for c in (v or []) if c not in union})
+    if union:
+        out = out.assign_coords(
+            axis=xr.DataArray(
+                np.array(union, dtype=str), dims="axis", attrs={"long_name": "vector component"}
+            )
+        )
+
+    def columns(da: xr.DataArray, comps: list[str] | None, times: np.ndarray | None) -> np.ndarray:
+        """Values on the output grid: sampled at ``times`` in the simulation (None: kept rows)."""
+        if comps is None or "axis" not in da.dims:
+            v = np.asarray(da.transpose("time", ...).values, dtype=float).reshape(da.sizes["time"])
+            v = v[keep] if times is None else np.interp(times, ts, v)
+            return v if comps is None else np.repeat(v[:, None], len(union), axis=1)
+        result = np.full((tm_k.size, len(union)), np.nan)
+        for c in comps:
+            v = np.asarray(da.sel(axis=c).transpose("time").values, dtype=float)
+            result[:, union.index(c)] = v[keep] if times is None else np.interp(times, ts, v)
+        return result
+
+    for name in names:
+        comps = comps_of[name]
+        units = _unit_check(sim[name], meas[name], name)
+        long = meas[name].attrs.get("long_name", sim[name].attrs.get("long_name", name))
+        dims = ("time", "axis") if comps is not None else ("time",)
+        svals = columns(sim[name], comps, t_sim)
+        mv = columns(meas[name], comps, None)
+        out[f"{name}_sim"] = (dims, svals, {"units": units, "long_name": f"simulated {long}"})
+        out[f"{name}_meas"] = (dims, mv, {"units": units, "long_name": f"measured {long}"})
+        out[f"{name}_diff"] = (
+            dims,
+            svals - mv,
+            {"units": units, "long_name": f"{long}: simulation minus measurement"},
+        )
+        for side, src in (("meas", meas), ("sim", sim)):
+            uname = f"{name}_u"
+            if uname not in src:
+                continue
+            uv = columns(src[uname], comps, None if side == "meas" else t_sim)
+            out[f"{name}_{side}_u"] = (
+                dims,
+                uv,
+                {"units": units, "long_name": f"standard uncertainty of {name}_{side}"},
+            )
+            out[f"{name}_{side}"].attrs["ancillary_variables"] = f"{name}_{side}_u"
+    out["sim_time"] = (
+        "time",
+        t_sim,
+        {"units": "s", "long_name": "time in the simulated record each sample is taken from"},
+    )
+    if "crank_angle" in meas:
+        out["crank_angle_meas"] = (
+            "time",
+            np.asarray(meas["crank_angle"].values, dtype=float)[keep],
+            {"units": "rad", "long_name": "measured crank angle"},
+        )
+    fps = 1.0 / float(np.median(np.diff(tm)))
+    out.attrs.update(
+        {
+            "title": "simulated and measured motion on a common time base",
+            "alignment_method": method,
+            "alignment": how,
+            "time_shift_s": float(shift),
+            "time_shift_deg": float(shift / period * 360.0),
+            "period_s": float(period),
+            "n_cycles": float(n_keep),
+            "interpolation": (
+                f"common time base: the measurement's samples ({fps:.4g} per s), {cycles_note}; "
+                "simulation interpolated linearly onto them after the phase alignment"
+            ),
+        }
+    )
+    return out

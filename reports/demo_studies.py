@@ -1,0 +1,259 @@
+"""The demo's verification studies and its input-uncertainty ensemble (used by :mod:`.demo`)."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import xarray as xr
+
+from jointwear.errors import JointwearError
+
+if TYPE_CHECKING:
+    from jointwear.reports.demo import DemoSize
+
+__all__ = [
+    "ENSEMBLE_INPUTS",
+    "MOTION_RTOLS",
+    "ensemble_spec",
+    "motion_verification",
+    "run_ensemble",
+    "wear_verification",
+]
+
+
+def _say(msg: str) -> None:
+    import typer
+
+    typer.echo(msg, err=True)
+
+
+def wear_verification(
+    params: Any, size: DemoSize, main: xr.Dataset, main_tol: float
+) -> tuple[xr.Dataset, float]:
+    """Convergence of the simulated wear with the cycle-update tolerance (verification).
+
+    The wear run is repeated with coarser tolerances of the adaptive update interval
+    (``WearSettings.tol``). :func:`jointwear.compare.compare` turns the study into ``u_num`` by
+    the GCI (:mod:`jointwear.compare.verification`) only where the three solutions converge
+    monotonically; otherwise u_num is reported as not assessed, with the reason. The returned
+    relative change between the two finest runs is for the console only.
+
+    Returns
+    -------
+    (Dataset, float)
+        ``max_wear_depth`` [m] and ``worn_volume`` [m³] over ``update_tolerance`` [1], and the
+        relative numerical uncertainty [1].
+    """
+    from jointwear.sim import WearSettings, simulate_wear
+
+    tols = [*size.verification_tols, main_tol]
+    depth, volume, cyl = [], [], []
+    for tol in size.verification_tols:
+        run = simulate_wear(
+            params,
+            cycles=size.cycles,
+            snapshots=list(size.snapshots),
+            settings=WearSettings(tol=tol),
+        )
+        depth.append(float(run["max_wear_depth"][-1]))
+        volume.append(float(run["worn_volume"][-1]))
+        cyl.append(float(run["cylindricity"][-1]))
+    depth.append(float(main["max_wear_depth"][-1]))
+    volume.append(float(main["worn_volume"][-1]))
+    cyl.append(float(main["cylindricity"][-1]))
+    rel = max(abs(depth[-1] - depth[-2]) / depth[-1], abs(volume[-1] - volume[-2]) / volume[-1])
+    ds = xr.Dataset(
+        {
+            "max_wear_depth": (
+                "update_tolerance",
+                depth,
+                {"units": "m", "long_name": "largest simulated wear depth"},
+            ),
+            "worn_volume": (
+                "update_tolerance",
+                volume,
+                {"units": "m3", "long_name": "simulated worn volume"},
+            ),
+            "cylindricity": (
+                "update_tolerance",
+                cyl,
+                {"units": "m", "long_name": "cylindricity of the simulated worn bore"},
+            ),
+        },
+        coords={
+            "update_tolerance": (
+                "update_tolerance",
+                tols,
+                {
+                    "units": "1",
+                    "long_name": "tolerance of the adaptive wear-update interval (WearSettings.tol)",
+                },
+            )
+        },
+        attrs={
+            "title": "verification: simulated wear versus the cycle-update tolerance",
+            "data_origin": "simulated",
+            "u_num_rel": rel,
+            "cycles": size.cycles,
+        },
+    )
+    return ds, rel
+
+
+#: solver tolerances of the motion verification study (the default 1e-6 is the finest)
+MOTION_RTOLS = (1e-4, 1e-5)
+
+
+def _rms_last_cycle(motion: xr.Dataset) -> dict[str, float]:
+    phi = np.unwrap(np.asarray(motion["crank_angle"].values, dtype=float))
+    last = phi >= phi[-1] - 2 * np.pi
+    v = motion["follower_velocity"]
+    return {
+        f"follower_velocity_{c}_rms": float(
+            np.sqrt(np.mean(np.asarray(v.sel(axis=c).values, dtype=float)[last] ** 2))
+        )
+        for c in ("x", "y")
+    }
+
+
+def motion_verification(params: Any, size: DemoSize, main: xr.Dataset) -> xr.Dataset:
+    """Convergence of the simulated in-plane follower velocity RMS with the solver tolerance.
+
+    The motion is repeated with ``solver.rtol`` = :data:`MOTION_RTOLS` (the main run uses the
+    default); the RMS of each in-plane component over the last whole crank cycle is the studied
+    quantity. :func:`jointwear.compare.compare` turns it into u_num by the GCI when it converges
+    monotonically, and reports it not assessed otherwise.
+    """
+    from jointwear.params import replace_nested
+    from jointwear.sim import run_cycles
+
+    rtols = [*MOTION_RTOLS, float(params.solver.rtol)]
+    rows = []
+    for rtol in MOTION_RTOLS:
+        p = replace_nested(params, **{"solver.rtol": rtol})
+        rows.append(_rms_last_cycle(run_cycles(p, cycles=size.motion_cycles).dataset))
+    rows.append(_rms_last_cycle(main))
+    data = {
+        name: (
+            "solver_rtol",
+            [r[name] for r in rows],
+            {"units": "m s-1", "long_name": f"RMS of {name[: -len('_rms')]} over the last cycle"},
+        )
+        for name in rows[0]
+    }
+    return xr.Dataset(
+        data,
+        coords={
+            "solver_rtol": (
+                "solver_rtol",
+                rtols,
+                {"units": "1", "long_name": "relative tolerance of the ODE solver (solver.rtol)"},
+            )
+        },
+    )
+
+
+#: The demo's uncertain model inputs: dotted parameter name -> (relative standard deviation,
+#: what it stands for). The wear coefficient has to be calibrated (the reference study's value
+#: cannot be used as printed), the radial clearance and the friction coefficient are not
+#: measured on the rig.
+ENSEMBLE_INPUTS: dict[str, tuple[float, str]] = {
+    "wear.kw": (0.15, "Archard wear coefficient, calibrated to about 15 %"),
+    "joint.bearing_radius": (0.004, "bore radius (radial clearance 0.5 mm +- 32 µm)"),
+    "friction.dynamic_coefficient": (0.2, "dynamic friction coefficient, +- 20 %"),
+}
+
+
+def ensemble_spec(params: Any, size: DemoSize) -> dict[str, Any]:
+    """The demo's sweep spec (``jointwear sim sweep`` format): LHS over :data:`ENSEMBLE_INPUTS`."""
+    from jointwear.sim import DEFAULT_KW
+
+    parameters: dict[str, Any] = {}
+    for name, (rel, _) in ENSEMBLE_INPUTS.items():
+        section, field = name.split(".")
+        mean = DEFAULT_KW if name == "wear.kw" else float(getattr(getattr(params, section), field))
+        spec = {"distribution": "truncnormal", "mean": mean, "std": rel * mean}
+        spec["bounds"] = [mean * (1 - 4 * rel), mean * (1 + 4 * rel)]
+        parameters[name] = spec
+    return {
+        "sweep": {
+            "run": "wear",
+            "cycles": float(size.ensemble_cycles),
+            "method": "lhs",
+            "samples": int(size.ensemble_runs),
+            "seed": 11,
+            "outputs": ["max_wear_depth", "worn_volume", "cylindricity"],
+            "keep": ["wear_depth"],
+        },
+        "parameters": parameters,
+    }
+
+
+def run_ensemble(
+    params: Any, size: DemoSize, motion_time: np.ndarray, *, progress: bool = True
+) -> xr.Dataset:
+    """A small real ensemble over the uncertain inputs, through :func:`jointwear.sim.run_sweep`.
+
+    The wear runs are a Latin-hypercube sweep (:func:`ensemble_spec`; fixed update interval,
+    reduced cycles, in this process) keeping each run's final wear map; each member's motion is
+    then simulated with the same sampled inputs and its follower velocity
+    ``(run, time, axis)`` added on ``motion_time``, so that the compared in-plane velocity RMS
+    has an ensemble spread too (the sweep's own motion output is the speed RMS).
+    """
+    from jointwear import conventions
+    from jointwear.params import replace_nested
+    from jointwear.sim import WearSettings, run_cycles, run_sweep
+
+    dn = int(size.ensemble_cycles // size.ensemble_updates)
+
+    def report(state: dict[str, Any]) -> None:
+        if progress and state["done"]:
+            _say(
+                f"      wear runs done {state['done']}/{state['total']}"
+                + (f", failed {state['failed']}" if state.get("failed") else "")
+            )
+
+    ds = run_sweep(
+        ensemble_spec(params, size),
+        params=params,
+        wear=WearSettings(scheme="fixed", dn=dn),
+        workers=0,
+        on_progress=report,
+    )
+    vel, crank = [], []
+    for r in range(ds.sizes["run"]):
+        changes = {k: float(ds[k].values[r]) for k in ENSEMBLE_INPUTS if not k.startswith("wear.")}
+        try:
+            m = run_cycles(replace_nested(params, **changes), cycles=size.motion_cycles).dataset
+        except JointwearError as exc:
+            _say(f"      motion of run {r + 1} failed: {exc}")
+            vel.append(np.full((motion_time.size, 3), np.nan))
+            crank.append(np.full(motion_time.size, np.nan))
+            continue
+        t = np.asarray(m["time"].values, dtype=float)
+        v = np.asarray(m["follower_velocity"].transpose("time", "axis").values, dtype=float)
+        vel.append(np.stack([np.interp(motion_time, t, v[:, j]) for j in range(3)], axis=1))
+        crank.append(np.interp(motion_time, t, np.unwrap(np.asarray(m["crank_angle"].values))))
+    ds = ds.assign_coords(
+        time=("time", motion_time, {"units": "s", "long_name": "time"}),
+        axis=("axis", np.array(["x", "y", "z"]), {"long_name": "vector component"}),
+    )
+    ds["follower_velocity"] = (
+        ("run", "time", "axis"),
+        np.stack(vel),
+        conventions.variable_attrs("follower_velocity"),
+    )
+    ds["crank_angle"] = (
+        ("run", "time"),
+        np.stack(crank),
+        conventions.variable_attrs("crank_angle"),
+    )
+    ds.attrs.update(
+        {
+            "title": "demo ensemble over the uncertain model inputs",
+            "data_origin": "simulated",
+            "bearing_radius_m": float(params.joint.bearing_radius),
+        }
+    )
+    return ds
