@@ -385,9 +385,10 @@ class SubsetCorrelator:
         inv = _integral_invalid(spl.valid) if not spl.valid.all() else np.zeros((1, 1), np.int64)
         return spl, inv, raw
 
-    def _kernel_args(self, dspl, dinv):
+    def _kernel_args(self, dspl, dinv) -> tuple[tuple, tuple]:
+        """The kernels' packed ``ref`` and ``dfm`` arguments (see :mod:`jointwear.dic._icgn`)."""
         r = self.ref
-        return (r.image, r.gx, r.gy, r.coef, self._ref_invalid, dspl.coef, dinv, r.order)
+        return (r.image, r.gx, r.gy, r.coef, self._ref_invalid), (dspl.coef, dinv)
 
     @property
     def _min_subset_std(self) -> float:
@@ -396,17 +397,18 @@ class SubsetCorrelator:
 
     def _solver_options(self) -> tuple:
         """IC-GN options in the kernels' order: half, quadratic, max_iter, tol, min_std,
-        max_shift, border, zncc_min."""
+        max_shift, border, zncc_min, order."""
         p = self.params
         return (
-            p.half,
-            p.quadratic,
-            p.max_iterations,
-            p.tolerance,
-            self._min_subset_std,
+            int(p.half),
+            bool(p.quadratic),
+            int(p.max_iterations),
+            float(p.tolerance),
+            float(self._min_subset_std),
             float(max(p.half, 5)),
             float(p.border),
-            p.zncc_min,
+            float(p.zncc_min),
+            int(self.ref.order),
         )
 
     def preload_references(self) -> None:
@@ -428,53 +430,39 @@ class SubsetCorrelator:
         HINV, JF, JS = np.empty((n, 6, 6)), np.empty((n, 6)), np.empty((n, 6))
         FN, FLAG0 = np.empty(n), np.empty(n, dtype=np.int8)
         r = self.ref
+        ref = (r.image, r.gx, r.gy, r.coef, self._ref_invalid)
         _icgn.affine_references(
-            r.image, r.gx, r.gy, r.coef, self._ref_invalid, r.order, self.centres,
-            self.params.half, self._min_subset_std, float(self.params.border),
-            F, GX, GY, HINV, JF, JS, FN, FLAG0,
-        )  # fmt: skip
+            ref, self._solver_options(), self.centres, F, GX, GY, HINV, JF, JS, FN, FLAG0
+        )
         self._loaded = (F, GX, GY, HINV, JF, JS, FN, FLAG0)
 
     def _run_many(self, dspl, dinv, P, active, st, serial=False):
         from jointwear.dic import _icgn
 
+        ref, dfm = self._kernel_args(dspl, dinv)
+        out = (st.zncc, st.iterations, st.flag, st.sigma)
+        opts = self._solver_options()
         if self._loaded is not None:
-            opts = self._solver_options()
-            _icgn.icgn_affine_loaded(
-                *self._loaded, dspl.coef, dinv, self.ref.order, self.centres, P, active,
-                opts[0], opts[2], opts[3], opts[5], opts[6], opts[7],
-                st.zncc, st.iterations, st.flag, st.sigma,
-            )  # fmt: skip
+            _icgn.icgn_affine_loaded(self._loaded, dfm, opts, self.centres, P, active, out)
             return
         kernel = _icgn.icgn_serial if serial else _icgn.icgn_many
-        kernel(
-            *self._kernel_args(dspl, dinv),
-            self.centres,
-            P,
-            active,
-            *self._solver_options(),
-            st.zncc,
-            st.iterations,
-            st.flag,
-            st.sigma,
-        )
+        kernel(ref, dfm, opts, self.centres, P, active, out)
 
     def _propagate(self, dspl, dinv, st, done, group, n_groups):
         from jointwear.dic import _icgn
 
+        ref, dfm = self._kernel_args(dspl, dinv)
         _icgn.rg_propagate(
             n_groups,
             group,
-            *self._kernel_args(dspl, dinv),
+            ref,
+            dfm,
+            self._solver_options(),
             self.centres,
             self._nb_ptr,
             self._nb_idx,
             st.params,
-            *self._solver_options(),
-            st.zncc,
-            st.iterations,
-            st.flag,
-            st.sigma,
+            (st.zncc, st.iterations, st.flag, st.sigma),
             done,
         )
 
