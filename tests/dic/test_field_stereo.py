@@ -56,7 +56,11 @@ def test_shape_and_out_of_plane_field_recovered(scene):
     truth = MOTION.displacement(P[:, 0], P[:, 1])
     err = ds.displacement.values[3][ok] - truth
     assert np.abs(err.mean(axis=0)).max() < 2e-6
-    assert np.sqrt(np.mean(err[:, 2] ** 2)) < 10e-6
+    # measured: 3.9 um RMS against 2.7 um reported (static scatter 2.5 um); the rest is the
+    # interpolation bias of a 1.6-pixel move, which the reported noise does not include
+    rms = np.sqrt(np.mean(err**2, axis=0))
+    rep = np.sqrt(np.mean(ds.displacement_u.values[3][ok] ** 2, axis=0))
+    assert rms[2] < 6e-6 and (rms < 1.8 * rep).all()
     # the 0.2 mm bulge is seen: centre minus rim
     w = ds.displacement.values[3][ok, 2]
     r = np.hypot(P[:, 0] - 0.29, P[:, 1] - 0.16)
