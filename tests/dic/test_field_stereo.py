@@ -134,3 +134,20 @@ def test_cli_stereo_field_with_patterns_csv_and_figure(scene, tmp_path):
     # usage errors (2) and bad input (3)
     assert main(["dic", "field", "--left", str(tmp_path / "*_0.png")]) == 2
     assert main([*args[:6], "--calibration", str(tmp_path / "nope.nc")]) == 3
+
+
+def test_uniform_stretch_gives_its_green_lagrange_strain():
+    # a flat specimen in the world plane stretched by 0.3 % along x: E_xx = e + e^2 / 2
+    sc = SurfaceScene()
+    pairs = [sc.pair(noise_seed=0), sc.pair(SurfaceMotion(stretch=0.003), noise_seed=1)]
+    ds = measure_field(
+        [p[0] for p in pairs], [p[1] for p in pairs], calibration=sc.calibration,
+        roi=sc.roi_left(), subset_size=25, step=12, strain_window=5,
+    )  # fmt: skip
+    E = ds.strain.values[1]
+    good = np.isfinite(E).all(axis=1)
+    assert good.mean() > 0.8
+    np.testing.assert_allclose(np.median(E[good], axis=0), [0.003 + 0.003**2 / 2, 0, 0], atol=5e-5)
+    robust = (np.percentile(E[good], 75, axis=0) - np.percentile(E[good], 25, axis=0)) / 1.349
+    ratio = np.median(ds.strain_u.values[1][good], axis=0) / robust
+    assert ((ratio > 0.5) & (ratio < 1.6)).all(), ratio
