@@ -154,75 +154,53 @@ def _track(corr, img, guess, search_centre=(0.0, 0.0)):
     return res
 
 
-def plane_guess(calibration, centres: np.ndarray) -> np.ndarray:
-    """Affine guesses (N, 6) of the left-to-right image map that a plane through the cameras'
-    convergence point (normal: the mean viewing direction) induces, at each left centre."""
-    L, R = calibration.left, calibration.right
-    cl, cr = L.centre, R.centre
-    dl, dr = L.rotation[2], R.rotation[2]  # optical axes in the world frame
-    # closest points of the two optical axes
-    w0 = cl - cr
-    a, b, c = dl @ dl, dl @ dr, dr @ dr
-    d, e = dl @ w0, dr @ w0
-    den = a * c - b * b
-    s = (b * e - c * d) / den if abs(den) > 1e-12 else 1.0
-    t = (a * e - b * d) / den if abs(den) > 1e-12 else 1.0
-    p0 = 0.5 * (cl + s * dl + cr + t * dr)
-    nrm = dl + dr
-    nrm /= np.linalg.norm(nrm)
+def _match_images(corr, L, Rr, calibration, centres):
+    """Match the left reference subsets in every left image and (stereo) every right image.
 
-    def to_right(uv):
-        ray = L.rays(uv)
-        lam = ((p0 - cl) @ nrm) / (ray @ nrm)
-        return R.project(cl + lam[:, None] * ray)
+    Returns shape parameters ``PL``, ``PR`` (T, N, 12), their (u, v) uncertainties ``SL``,
+    ``SR`` (T, N, 2) [pixel] (NaN where the match failed), ZNCC ``Z`` and flags ``F``
+    (T, cameras, N).
+    """
+    from jointwear.dic._field_stereo import plane_guess
 
-    h = 1.0
-    x0 = to_right(centres)
-    gx = (to_right(centres + [h, 0.0]) - to_right(centres - [h, 0.0])) / (2 * h)
-    gy = (to_right(centres + [0.0, h]) - to_right(centres - [0.0, h])) / (2 * h)
-    G = np.empty((len(centres), 6))
-    G[:, 0] = x0[:, 0] - centres[:, 0]
-    G[:, 1] = gx[:, 0] - 1.0
-    G[:, 2] = gy[:, 0]
-    G[:, 3] = x0[:, 1] - centres[:, 1]
-    G[:, 4] = gx[:, 1]
-    G[:, 5] = gy[:, 1] - 1.0
-    return G
-
-
-def _point_cov(calibration, X, sl, sr):
-    """Covariance (N, 3, 3) of triangulated points X (N, 3) from per-image standard
-    uncertainties ``sl``, ``sr`` (N, 2) [pixel] (undistorted-pixel Jacobians)."""
-    from jointwear.dic._stereo import _project_undistorted
-
-    out = np.full((len(X), 3, 3), np.nan)
-    ok = np.isfinite(X).all(axis=1) & np.isfinite(sl).all(axis=1) & np.isfinite(sr).all(axis=1)
-    if not ok.any():
-        return out
-    _, Jl = _project_undistorted(calibration.left, X[ok])
-    _, Jr = _project_undistorted(calibration.right, X[ok])
-    J = np.concatenate([Jl, Jr], axis=1)  # (n, 4, 3)
-    w = 1.0 / np.maximum(np.concatenate([sl[ok], sr[ok]], axis=1), 1e-6) ** 2
-    A = np.einsum("nki,nk,nkj->nij", J, w, J)
-    out[ok] = np.linalg.inv(A)
-    return out
-
-
-def best_fit_plane(P: np.ndarray, towards: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Rotation (3, 3) (rows: plane x, y, z in world coordinates) and origin (3,) [m] of the
-    least-squares plane of the points P (N, 3); z points to the side of ``towards``."""
-    Q = P[np.isfinite(P).all(axis=1)]
-    if len(Q) < 3:
-        raise BadInputError(
-            "best-fit-plane frame: fewer than 3 points were measured in the reference pair"
-        )
-    o = Q.mean(axis=0)
-    _, _, vt = np.linalg.svd(Q - o, full_matrices=False)
-    z = vt[2] * (1.0 if vt[2] @ (towards - o) > 0 else -1.0)
-    ref = np.array([1.0, 0, 0]) if abs(z[0]) < 0.9 else np.array([0, 1.0, 0])
-    x = ref - z * (ref @ z)
-    x /= np.linalg.norm(x)
-    return np.stack([x, np.cross(z, x), z]), o
+    stereo = len(Rr) > 0
+    n_t, n = len(L), corr.n_points
+    cams = 2 if stereo else 1
+    PL = np.full((n_t, n, 12), np.nan)
+    PR = np.full((n_t, n, 12), np.nan)
+    SL = np.full((n_t, n, 2), np.nan)
+    SR = np.full((n_t, n, 2), np.nan)
+    Z = np.full((n_t, cams, n), np.nan)
+    F = np.full((n_t, cams, n), _flags.FLAG_NOT_REACHED, np.int8)
+    PL[0] = 0.0
+    SL[0] = 0.0
+    Z[0, 0] = 1.0
+    F[0, 0] = np.where(corr._texture_and_usable()[1], _flags.FLAG_OK, _flags.FLAG_NO_TEXTURE)
+    for k in range(1 if not stereo else 0, n_t):
+        if k > 0:
+            g = np.where(np.isfinite(PL[k - 1]).all(axis=1)[:, None], PL[k - 1], np.nan)
+            res = _track(corr, L[k], g)
+            PL[k], SL[k], Z[k, 0], F[k, 0] = res.params, res.sigma, res.zncc, res.flag
+        if stereo:
+            if k == 0:
+                G = plane_guess(calibration, centres)
+                centre = (float(np.median(G[:, 0])), float(np.median(G[:, 3])))
+                res = _track(corr, Rr[0], G, centre)
+            else:
+                g = np.where(np.isfinite(PR[k - 1]).all(axis=1)[:, None], PR[k - 1], np.nan)
+                centre = (
+                    float(np.nanmedian(PR[k - 1, :, 0])),
+                    float(np.nanmedian(PR[k - 1, :, 6])),
+                )
+                res = _track(corr, Rr[k], g, centre)
+            PR[k], SR[k], Z[k, 1], F[k, 1] = res.params, res.sigma, res.zncc, res.flag
+    ok_img = F == _flags.FLAG_OK
+    PL[~ok_img[:, 0]] = np.nan
+    SL[~ok_img[:, 0]] = np.nan
+    if stereo:
+        PR[~ok_img[:, 1]] = np.nan
+        SR[~ok_img[:, 1]] = np.nan
+    return PL, PR, SL, SR, Z, F
 
 
 def measure_field(
@@ -270,6 +248,7 @@ def measure_field(
         ``x``, ``y`` [pixel] (left reference image) and the grid ``row``/``col``.
     """
     from jointwear.dic._field_roi import grid_points, read_roi
+    from jointwear.dic._field_stereo import stereo_geometry
     from jointwear.dic._subset import SubsetCorrelator, check_pair
 
     base = params or FieldParams()
@@ -336,40 +315,7 @@ def measure_field(
     corr = SubsetCorrelator(L[0], points=grid.centres, params=cp)
     n = corr.n_points
     cams = ["left", "right"] if stereo else ["left"]
-    PL = np.full((n_t, n, 12), np.nan)
-    PR = np.full((n_t, n, 12), np.nan)
-    SL = np.full((n_t, n, 2), np.nan)
-    SR = np.full((n_t, n, 2), np.nan)
-    Z = np.full((n_t, len(cams), n), np.nan)
-    F = np.full((n_t, len(cams), n), _flags.FLAG_NOT_REACHED, np.int8)
-    PL[0] = 0.0
-    SL[0] = 0.0
-    Z[0, 0] = 1.0
-    F[0, 0] = np.where(corr._texture_and_usable()[1], _flags.FLAG_OK, _flags.FLAG_NO_TEXTURE)
-    for k in range(1 if not stereo else 0, n_t):
-        if k > 0:
-            g = np.where(np.isfinite(PL[k - 1]).all(axis=1)[:, None], PL[k - 1], np.nan)
-            res = _track(corr, L[k], g)
-            PL[k], SL[k], Z[k, 0], F[k, 0] = res.params, res.sigma, res.zncc, res.flag
-        if stereo:
-            if k == 0:
-                G = plane_guess(calibration, grid.centres)
-                centre = (float(np.median(G[:, 0])), float(np.median(G[:, 3])))
-                res = _track(corr, Rr[0], G, centre)
-            else:
-                g = np.where(np.isfinite(PR[k - 1]).all(axis=1)[:, None], PR[k - 1], np.nan)
-                centre = (
-                    float(np.nanmedian(PR[k - 1, :, 0])),
-                    float(np.nanmedian(PR[k - 1, :, 6])),
-                )
-                res = _track(corr, Rr[k], g, centre)
-            PR[k], SR[k], Z[k, 1], F[k, 1] = res.params, res.sigma, res.zncc, res.flag
-    ok_img = F == _flags.FLAG_OK
-    PL[~ok_img[:, 0]] = np.nan
-    SL[~ok_img[:, 0]] = np.nan
-    if stereo:
-        PR[~ok_img[:, 1]] = np.nan
-        SR[~ok_img[:, 1]] = np.nan
+    PL, PR, SL, SR, Z, F = _match_images(corr, L, Rr, calibration, grid.centres)
     c = grid.centres
     sub_x = np.stack([c[:, 0] + PL[..., 0]] + ([c[:, 0] + PR[..., 0]] if stereo else []), axis=1)
     sub_y = np.stack([c[:, 1] + PL[..., 6]] + ([c[:, 1] + PR[..., 6]] if stereo else []), axis=1)
@@ -419,79 +365,13 @@ def measure_field(
         attrs["field_frame"] = "left image: x to the right (columns), y down (rows), pixel"
     else:
         axes = ["x", "y", "z"]
-        from jointwear.dic._stereo import triangulate
-
-        X = np.full((n_t, n, 3), np.nan)
-        rep = np.full((n_t, n), np.nan)
-        for k in range(n_t):
-            uvl = np.stack([sub_x[k, 0], sub_y[k, 0]], axis=1)
-            uvr = np.stack([sub_x[k, 1], sub_y[k, 1]], axis=1)
-            X[k], _, rep[k] = triangulate(calibration, uvl, uvr)
-        far = (rep > prm.epipolar_max_px) & (flag == _flags.FLAG_OK)
-        flag[far] = FLAG_EPIPOLAR
-        flag[:, flag[0] != _flags.FLAG_OK] = np.where(
-            flag[:, flag[0] != _flags.FLAG_OK] == _flags.FLAG_OK,
-            flag[0][flag[0] != _flags.FLAG_OK],
-            flag[:, flag[0] != _flags.FLAG_OK],
+        ref_pos, disp, disp_u, extra, extra_coords, extra_attrs = stereo_geometry(
+            calibration, sub_x, sub_y, SL, SR, flag, prm
         )
-        ref_pos = X[0]
-        tiny = np.full((n, 2), 1e-6)
-        cov_pos = _point_cov(calibration, X[0], SR[0], SR[0])
-        cov0 = _point_cov(calibration, X[0], tiny, SR[0] / np.sqrt(2))
-        disp = X - X[0][None]
-        cov_d = np.full((n_t, n, 3, 3), np.nan)
-        cov_d[0] = 0.0
-        for k in range(1, n_t):
-            cov_d[k] = _point_cov(calibration, X[k], SL[k] / np.sqrt(2), SR[k] / np.sqrt(2)) + cov0
-        Rf, of = np.eye(3), np.zeros(3)
-        if prm.frame == "plane":
-            Rf, of = best_fit_plane(X[0][flag[0] == _flags.FLAG_OK], calibration.left.centre)
-            attrs["field_frame"] = (
-                "best-fit plane of the reference surface: origin at the centroid of the "
-                "measured points, z its normal towards the cameras, x the world x axis "
-                "projected onto it; world = frame_rotation^T (p) + frame_origin"
-            )
-        else:
-            attrs["field_frame"] = f"calibration world frame: {calibration.world_frame}"
-        ref_pos = (ref_pos - of) @ Rf.T
-        disp = disp @ Rf.T
-        cov_d = Rf @ cov_d @ Rf.T
-        cov_pos = Rf @ cov_pos @ Rf.T
-        disp_u = np.sqrt(np.maximum(np.diagonal(cov_d, axis1=-2, axis2=-1), 0.0))
-        pos_u = np.sqrt(np.maximum(np.diagonal(cov_pos, axis1=-2, axis2=-1), 0.0))
         unit = "m"
-        okp = flag[0] == _flags.FLAG_OK
-        data["position"] = xr.DataArray(
-            np.where(okp[:, None], ref_pos, np.nan),
-            dims=("point", "axis"),
-            attrs={
-                "units": "m",
-                "long_name": "reference position of the point (surface shape)",
-                "ancillary_variables": "position_u",
-            },
-        )
-        data["position_u"] = xr.DataArray(
-            np.where(okp[:, None], pos_u, np.nan),
-            dims=("point", "axis"),
-            attrs={"units": "m", "long_name": "standard uncertainty of position (image noise)"},
-        )
-        data["reprojection"] = xr.DataArray(
-            rep,
-            dims=("time", "point"),
-            attrs={
-                "units": "pixel",
-                "long_name": "RMS reprojection residual of the triangulated pair",
-            },
-        )
-        data["frame_rotation"] = xr.DataArray(
-            Rf,
-            dims=("axis", "axis_world"),
-            attrs={"units": "1", "long_name": "rows: output frame axes in world coordinates"},
-        )
-        data["frame_origin"] = xr.DataArray(
-            of, dims="axis_world", attrs={"units": "m", "long_name": "output frame origin (world)"}
-        )
-        coords["axis_world"] = ("axis_world", ["x", "y", "z"], {"long_name": "world axis"})
+        data.update(extra)
+        coords.update(extra_coords)
+        attrs.update(extra_attrs)
     ok = flag == _flags.FLAG_OK
     disp = np.where(ok[..., None], disp, np.nan)
     disp_u = np.where(ok[..., None], disp_u, np.nan)
@@ -540,48 +420,14 @@ def measure_field(
         },
     )
     if prm.strain_window:
-        from jointwear.dic._strain import engineering_strain, surface_strain
+        from jointwear.dic._strain import strain_variables
 
-        inplane = np.sqrt(np.mean(disp_u[..., :2] ** 2, axis=-1))
-        E, Eu, _ = surface_strain(
-            np.where(ok[0][:, None], ref_pos, np.nan), ref_pos[None] + disp, inplane,
-            grid.index, prm.strain_window, c, cp.subset_size,
+        strain, comp = strain_variables(
+            np.where(ok[0][:, None], ref_pos, np.nan), ref_pos[None] + disp, disp_u,
+            grid.index, c, prm.strain_window, cp.step, cp.subset_size,
         )  # fmt: skip
-        comp = {"component": ("component", ["xx", "yy", "xy"], {"long_name": "tensor component"})}
+        data.update(strain)
         coords.update(comp)
-        span = (prm.strain_window - 1) * cp.step
-        note = (
-            f"local linear fit of the deformed positions over {prm.strain_window}x"
-            f"{prm.strain_window} grid points ({span} pixel in the left reference image), in "
-            "the local tangent basis of the reference surface (t1 = frame x projected)"
-        )
-        data["strain"] = xr.DataArray(
-            E,
-            dims=("time", "point", "component"),
-            attrs={
-                "units": "1",
-                "long_name": "Green-Lagrange surface strain (xy: tensor shear)",
-                "strain_window": note,
-                "ancillary_variables": "strain_u",
-            },
-        )
-        data["strain_u"] = xr.DataArray(
-            Eu,
-            dims=("time", "point", "component"),
-            attrs={
-                "units": "1",
-                "long_name": "standard uncertainty of strain (displacement noise through the fit)",
-            },
-        )
-        data["strain_engineering"] = xr.DataArray(
-            engineering_strain(E),
-            dims=("time", "point", "component"),
-            attrs={
-                "units": "1",
-                "long_name": "engineering strain: stretch - 1 (xx, yy), change of the right "
-                "angle in rad (xy)",
-            },
-        )
     ds = xr.Dataset(data, coords=coords)
     ds.attrs.update(attrs)
     ds.attrs.update(
