@@ -151,3 +151,27 @@ def test_uniform_stretch_gives_its_green_lagrange_strain():
     robust = (np.percentile(E[good], 75, axis=0) - np.percentile(E[good], 25, axis=0)) / 1.349
     ratio = np.median(ds.strain_u.values[1][good], axis=0) / robust
     assert ((ratio > 0.5) & (ratio < 1.6)).all(), ratio
+
+
+def test_subsets_straddling_a_depth_step_are_flagged_left_right_inconsistent():
+    # two levels 20 mm apart (19 pixel of disparity): the far half is found by a fresh search,
+    # and subsets across the step - ZNCC up to 0.9, Z up to 0.5 mm off - are flagged
+    def step(x, y):
+        return np.where(x < 0.29, 0.0, -0.02)
+
+    sc = SurfaceScene(step)
+    lft, rgt = sc.pair(noise_seed=0)
+    kw = dict(calibration=sc.calibration, roi=sc.roi_left(), subset_size=25, step=12)
+    ds = measure_field([lft], [rgt], strain_window=0, **kw)
+    flag = ds.flag.values[0]
+    assert (flag == 0).mean() > 0.9
+    flagged = flag == 10
+    assert flagged.sum() >= 5
+    # where the flagged subsets are: across the step (left image, the step's column)
+    col = sc.calibration.left.project(np.array([[0.29, 0.16, 0.0]]))[0, 0]
+    assert (np.abs(ds.x.values[flagged] - col) < 40).all()
+    P = ds.position.values[flag == 0]
+    assert np.abs(P[:, 2] - step(P[:, 0], P[:, 1])).max() < 25e-6
+    loose = measure_field([lft], [rgt], strain_window=0, consistency_max_px=1e9, **kw)
+    Q = loose.position.values[loose.flag.values[0] == 0]
+    assert np.abs(Q[:, 2] - step(Q[:, 0], Q[:, 1])).max() > 100e-6  # what the flag prevents
