@@ -9,7 +9,7 @@ import numpy as np
 from numba import njit
 
 from jointwear.dic._flags import FLAG_INVALID_PIXELS, FLAG_NO_TEXTURE, FLAG_OK, FLAG_OUTSIDE
-from jointwear.dic._interp import interp_value
+from jointwear.dic._interp import PAD, interp_value
 
 
 @njit(cache=True)
@@ -149,3 +149,46 @@ def subset_std(img, invalid, centres, half, border):
         m = s / (size * size)
         out[i] = math.sqrt(max(s2 / (size * size) - m * m, 0.0))
     return out
+
+
+@njit(cache=True)
+def subset_kappa(coef, order, gx, gy, centres, half, out):
+    """Per subset, ``kappa = sum |g_c|^2 / sum g_c . g_s``: central-difference node gradients
+    ``gx``, ``gy`` against the interpolant's exact node derivative ``g_s`` (from the padded
+    coefficients), over the subset square around each centre (1 where undefined)."""
+    if order == 3:
+        val = np.array([1.0, 4.0, 1.0]) / 6.0
+        der = np.array([-0.5, 0.0, 0.5])
+    else:
+        val = np.array([1.0, 26.0, 66.0, 26.0, 1.0]) / 120.0
+        der = np.array([-1.0, -10.0, 0.0, 10.0, 1.0]) / 24.0
+    r = val.shape[0] // 2
+    h, w = gx.shape
+    for i in range(centres.shape[0]):
+        out[i] = 1.0
+        xc = centres[i, 0]
+        yc = centres[i, 1]
+        if not (math.isfinite(xc) and math.isfinite(yc)):
+            continue
+        ic = int(round(xc))
+        jc = int(round(yc))
+        a = 0.0
+        b = 0.0
+        for y in range(max(jc - half, 0), min(jc + half + 1, h)):
+            for x in range(max(ic - half, 0), min(ic + half + 1, w)):
+                sx = 0.0
+                sy = 0.0
+                for p in range(2 * r + 1):
+                    row = coef[y + PAD - r + p]
+                    vd = 0.0
+                    vv = 0.0
+                    for q in range(2 * r + 1):
+                        c = row[x + PAD - r + q]
+                        vd += der[q] * c
+                        vv += val[q] * c
+                    sx += val[p] * vd
+                    sy += der[p] * vv
+                a += gx[y, x] * gx[y, x] + gy[y, x] * gy[y, x]
+                b += gx[y, x] * sx + gy[y, x] * sy
+        if b > 0.0 and math.isfinite(a / b):
+            out[i] = a / b

@@ -129,7 +129,7 @@ class SubsetCorrelator:
         self.ref = prefilter(self.reference_raw, base.interpolation)
         self._ref_invalid = _integral_invalid(self.ref.valid)
         h, w = self.ref.shape
-        valid_vals = self.ref.image[self.ref.valid]
+        valid_vals = self.ref.image if self.ref.valid.all() else self.ref.image[self.ref.valid]
         if valid_vals.size == 0:
             raise BadInputError("reference image: every pixel is NaN")
         self.image_std = float(np.std(valid_vals))
@@ -496,26 +496,12 @@ class SubsetCorrelator:
         uncertainty exceeds the scatter by 1.2-1.3 on 3-4 px speckle).
         """
         if getattr(self, "_kappa", None) is None:
-            from scipy import ndimage
-
-            from jointwear.dic._interp import _node_gradients
+            from jointwear.dic._icgn_reference import subset_kappa
 
             r = self.ref
-            gxs, gys = np.empty(r.shape), np.empty(r.shape)
-            _node_gradients(r.coef, r.order, gxs, gys)
-            size = self.params.subset_size
-            a = ndimage.uniform_filter(r.gx * r.gx + r.gy * r.gy, size, mode="mirror")
-            b = ndimage.uniform_filter(r.gx * gxs + r.gy * gys, size, mode="mirror")
-            with np.errstate(invalid="ignore", divide="ignore"):
-                kmap = np.where(b > 0, a / b, 1.0)
-            h, w = r.shape
-            c = self.centres
-            fin = np.isfinite(c).all(axis=1)
             k = np.ones(self.n_points)
-            ix = np.clip(np.rint(c[fin, 0]).astype(int), 0, w - 1)
-            iy = np.clip(np.rint(c[fin, 1]).astype(int), 0, h - 1)
-            k[fin] = np.clip(np.nan_to_num(kmap[iy, ix], nan=1.0), 0.5, 1.5)
-            self._kappa = k
+            subset_kappa(r.coef, r.order, r.gx, r.gy, self.centres, self.params.half, k)
+            self._kappa = np.clip(np.nan_to_num(k, nan=1.0), 0.5, 1.5)
         return self._kappa
 
     def check_seeds(self, seed_points) -> np.ndarray:
