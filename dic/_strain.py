@@ -26,7 +26,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-__all__ = ["window_neighbours", "tangent_frames", "surface_strain"]
+__all__ = ["window_neighbours", "tangent_frames", "surface_strain", "strain_variables"]
 
 
 def window_neighbours(index: np.ndarray, window: int) -> tuple[np.ndarray, np.ndarray]:
@@ -230,3 +230,50 @@ def engineering_strain(E: np.ndarray) -> np.ndarray:
     with np.errstate(invalid="ignore"):
         gamma = np.arcsin(np.clip(2.0 * E[..., 2] / (l1 * l2), -1.0, 1.0))
     return np.stack([l1 - 1.0, l2 - 1.0, gamma], axis=-1)
+
+
+def strain_variables(ref, cur, disp_u, index, pixels, window, step, subset_size):
+    """The field dataset's ``strain``, ``strain_u`` and ``strain_engineering`` variables and
+    the ``component`` coordinate, from reference positions ``ref`` (N, d) (NaN where unknown),
+    deformed positions ``cur`` (T, N, d) and the displacement uncertainty ``disp_u``
+    (T, N, d); ``step`` and ``subset_size`` [pixel] describe the grid."""
+    import xarray as xr
+
+    data = {}
+    inplane = np.sqrt(np.mean(disp_u[..., :2] ** 2, axis=-1))
+    E, Eu, _ = surface_strain(ref, cur, inplane, index, window, pixels, subset_size)
+    coords = {"component": ("component", ["xx", "yy", "xy"], {"long_name": "tensor component"})}
+    span = (window - 1) * step
+    note = (
+        f"local linear fit of the deformed positions over {window}x"
+        f"{window} grid points ({span} pixel in the left reference image), in "
+        "the local tangent basis of the reference surface (t1 = frame x projected)"
+    )
+    data["strain"] = xr.DataArray(
+        E,
+        dims=("time", "point", "component"),
+        attrs={
+            "units": "1",
+            "long_name": "Green-Lagrange surface strain (xy: tensor shear)",
+            "strain_window": note,
+            "ancillary_variables": "strain_u",
+        },
+    )
+    data["strain_u"] = xr.DataArray(
+        Eu,
+        dims=("time", "point", "component"),
+        attrs={
+            "units": "1",
+            "long_name": "standard uncertainty of strain (displacement noise through the fit)",
+        },
+    )
+    data["strain_engineering"] = xr.DataArray(
+        engineering_strain(E),
+        dims=("time", "point", "component"),
+        attrs={
+            "units": "1",
+            "long_name": "engineering strain: stretch - 1 (xx, yy), change of the right "
+            "angle in rad (xy)",
+        },
+    )
+    return data, coords

@@ -26,166 +26,40 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import asdict, dataclass
-from typing import TYPE_CHECKING, Literal
+from typing import TYPE_CHECKING
 
 import numpy as np
 import xarray as xr
 
 import jointwear.dic._flags as _flags
+from jointwear.dic._subset_output import result_dataset
+from jointwear.dic._subset_params import (
+    CorrelationParams,
+    _integral_invalid,
+    check_image,
+    check_pair,
+    set_threads,
+)
 from jointwear.errors import BadInputError, ParameterError
 
 if TYPE_CHECKING:
     from jointwear.dic._interp import SplineImage
 
-__all__ = ["CorrelationParams", "SubsetCorrelator", "MatchResult", "FLAG_MEANINGS"]
+__all__ = [
+    "CorrelationParams",
+    "SubsetCorrelator",
+    "MatchResult",
+    "FLAG_MEANINGS",
+    "check_image",
+    "check_pair",
+    "result_dataset",
+    "set_threads",
+]
 
 FLAG_MEANINGS = _flags.FLAG_MEANINGS
 
 #: extra margin [pixel] of the default grid beyond the border (see SubsetCorrelator)
 _GRID_SLACK = 2
-
-_SHAPES = {"affine": False, "first": False, "quadratic": True, "second": True}
-
-
-@dataclass(frozen=True)
-class CorrelationParams:
-    """Options of the subset correlation.
-
-    Parameters
-    ----------
-    subset_size : int
-        Side of the square subset [pixel], odd, >= 7.
-    step : int
-        Grid spacing of the points of interest [pixel] (grids only).
-    shape : str
-        Subset shape function: ``"affine"`` (first order) or ``"quadratic"`` (second order).
-    interpolation : str
-        ``"cubic"`` or ``"quintic"`` B-spline on prefiltered coefficients.
-    max_iterations : int
-        IC-GN iteration limit per point.
-    tolerance : float
-        Convergence: norm of the last parameter update, gradients scaled by the subset
-        half-width [pixel] (Pan et al. 2013 use 0.001). Gauss-Newton converges fast near the
-        optimum, so the remaining error is far below this value.
-    zncc_min : float
-        Points below this ZNCC are flagged ``low_correlation`` and do not propagate.
-    search_radius : int
-        Half-width of the integer-pixel search window for seeds [pixel].
-    min_texture : float
-        Subsets whose intensity standard deviation is below this fraction of the image's are
-        flagged ``no_texture``.
-    border : int
-        Margin [pixel] subsets must keep from the image edges (reference and deformed): the
-        B-spline interpolant is less accurate within a few pixels of an edge (errors up to
-        ~0.003 px at 2-3 px from it). Subsets closer are flagged ``subset_outside_image``.
-    threads : int
-        numba threads (at most 2 on the shared machine; 0 = min(2, available)).
-    """
-
-    subset_size: int = 31
-    step: int = 10
-    shape: Literal["affine", "quadratic"] = "affine"
-    interpolation: Literal["cubic", "quintic"] = "quintic"
-    max_iterations: int = 40
-    tolerance: float = 1e-3
-    zncc_min: float = 0.8
-    search_radius: int = 48
-    min_texture: float = 0.05
-    border: int = 4
-    threads: int = 0
-
-    def __post_init__(self) -> None:
-        s = self.subset_size
-        if isinstance(s, bool) or not isinstance(s, (int, np.integer)) or s < 7 or s % 2 == 0:
-            raise ParameterError(
-                f"subset_size={s!r}: expected an odd integer >= 7 (the subset is centred on "
-                f"its point); use {s + 1 if isinstance(s, (int, np.integer)) and s >= 6 else 31}"
-            )
-        if not isinstance(self.step, (int, np.integer)) or self.step < 1:
-            raise ParameterError(f"step={self.step!r}: expected an integer >= 1 pixel")
-        if self.shape not in _SHAPES:
-            raise ParameterError(
-                f"shape={self.shape!r}: expected 'affine' (first order) or 'quadratic' (second order)"
-            )
-        if self.interpolation not in ("cubic", "quintic"):
-            raise ParameterError(
-                f"interpolation={self.interpolation!r}: expected 'cubic' or 'quintic' (B-spline)"
-            )
-        if not (0.0 < self.tolerance < 1.0):
-            raise ParameterError(f"tolerance={self.tolerance!r}: expected 0 < tolerance < 1 pixel")
-        if not (-1.0 <= self.zncc_min < 1.0):
-            raise ParameterError(f"zncc_min={self.zncc_min!r}: expected a value in [-1, 1)")
-        if self.max_iterations < 1:
-            raise ParameterError(f"max_iterations={self.max_iterations!r}: expected >= 1")
-        if not isinstance(self.border, (int, np.integer)) or self.border < 0:
-            raise ParameterError(f"border={self.border!r}: expected an integer >= 0 pixel")
-        if self.search_radius < 0:
-            raise ParameterError(f"search_radius={self.search_radius!r}: expected >= 0 pixel")
-
-    @property
-    def half(self) -> int:
-        return self.subset_size // 2
-
-    @property
-    def quadratic(self) -> bool:
-        return _SHAPES[self.shape]
-
-
-def set_threads(threads: int = 0) -> int:
-    """Set numba's thread count to ``threads`` (0: min(2, available)); returns it."""
-    import numba
-
-    avail = numba.config.NUMBA_NUM_THREADS
-    n = min(avail, 2) if not threads else max(1, min(int(threads), avail))
-    numba.set_num_threads(n)
-    return n
-
-
-def check_image(image, name: str) -> np.ndarray:
-    """A 2D numeric image as an array, or a BadInputError naming ``name``."""
-    arr = np.asarray(image)
-    if arr.ndim == 3 and arr.shape[2] in (3, 4):
-        raise BadInputError(
-            f"{name}: expected a single-channel (grey) image, got shape {arr.shape} (colour); "
-            "convert it to grey first, e.g. cv2.cvtColor(img, cv2.COLOR_BGR2GRAY)"
-        )
-    if arr.ndim != 2:
-        raise BadInputError(f"{name}: expected a 2D image (rows, columns), got shape {arr.shape}")
-    if arr.dtype.kind not in "uif" or arr.dtype == np.bool_:
-        raise BadInputError(f"{name}: expected numeric pixels, got dtype {arr.dtype}")
-    if min(arr.shape) < 8:
-        raise BadInputError(f"{name}: image {arr.shape} is too small (need at least 8x8 pixels)")
-    if arr.dtype.kind == "f" and np.isinf(arr).any():
-        raise BadInputError(
-            f"{name}: contains infinite pixel values; replace them by NaN (flagged) or finite values"
-        )
-    return arr
-
-
-def check_pair(reference: np.ndarray, deformed: np.ndarray, what: str = "deformed image") -> None:
-    """Sizes and dtypes must agree."""
-    if reference.shape != deformed.shape:
-        raise BadInputError(
-            f"{what}: size {deformed.shape[1]}x{deformed.shape[0]} (width x height) differs from "
-            f"the reference {reference.shape[1]}x{reference.shape[0]}; crop or resize so that both "
-            "images have the same size"
-        )
-    if reference.dtype != deformed.dtype:
-        raise BadInputError(
-            f"{what}: pixel type {deformed.dtype} differs from the reference's {reference.dtype}; "
-            "images of one sequence must come from the same camera setting - convert both to the "
-            "same type (e.g. .astype(np.float64)) if that is intended"
-        )
-
-
-def _integral_invalid(valid: np.ndarray) -> np.ndarray:
-    """Summed-area table of invalid pixels; a (1, 1) array when every pixel is valid."""
-    if valid.all():
-        return np.zeros((1, 1), dtype=np.int64)
-    inv = (~valid).astype(np.int64)
-    out = np.zeros((inv.shape[0] + 1, inv.shape[1] + 1), dtype=np.int64)
-    out[1:, 1:] = inv.cumsum(0).cumsum(1)
-    return out
 
 
 @dataclass
@@ -255,7 +129,7 @@ class SubsetCorrelator:
         self.ref = prefilter(self.reference_raw, base.interpolation)
         self._ref_invalid = _integral_invalid(self.ref.valid)
         h, w = self.ref.shape
-        valid_vals = self.ref.image[self.ref.valid]
+        valid_vals = self.ref.image if self.ref.valid.all() else self.ref.image[self.ref.valid]
         if valid_vals.size == 0:
             raise BadInputError("reference image: every pixel is NaN")
         self.image_std = float(np.std(valid_vals))
@@ -385,9 +259,10 @@ class SubsetCorrelator:
         inv = _integral_invalid(spl.valid) if not spl.valid.all() else np.zeros((1, 1), np.int64)
         return spl, inv, raw
 
-    def _kernel_args(self, dspl, dinv):
+    def _kernel_args(self, dspl, dinv) -> tuple[tuple, tuple]:
+        """The kernels' packed ``ref`` and ``dfm`` arguments (see :mod:`jointwear.dic._icgn`)."""
         r = self.ref
-        return (r.image, r.gx, r.gy, r.coef, self._ref_invalid, dspl.coef, dinv, r.order)
+        return (r.image, r.gx, r.gy, r.coef, self._ref_invalid), (dspl.coef, dinv)
 
     @property
     def _min_subset_std(self) -> float:
@@ -396,17 +271,18 @@ class SubsetCorrelator:
 
     def _solver_options(self) -> tuple:
         """IC-GN options in the kernels' order: half, quadratic, max_iter, tol, min_std,
-        max_shift, border, zncc_min."""
+        max_shift, border, zncc_min, order."""
         p = self.params
         return (
-            p.half,
-            p.quadratic,
-            p.max_iterations,
-            p.tolerance,
-            self._min_subset_std,
+            int(p.half),
+            bool(p.quadratic),
+            int(p.max_iterations),
+            float(p.tolerance),
+            float(self._min_subset_std),
             float(max(p.half, 5)),
             float(p.border),
-            p.zncc_min,
+            float(p.zncc_min),
+            int(self.ref.order),
         )
 
     def preload_references(self) -> None:
@@ -428,53 +304,39 @@ class SubsetCorrelator:
         HINV, JF, JS = np.empty((n, 6, 6)), np.empty((n, 6)), np.empty((n, 6))
         FN, FLAG0 = np.empty(n), np.empty(n, dtype=np.int8)
         r = self.ref
+        ref = (r.image, r.gx, r.gy, r.coef, self._ref_invalid)
         _icgn.affine_references(
-            r.image, r.gx, r.gy, r.coef, self._ref_invalid, r.order, self.centres,
-            self.params.half, self._min_subset_std, float(self.params.border),
-            F, GX, GY, HINV, JF, JS, FN, FLAG0,
-        )  # fmt: skip
+            ref, self._solver_options(), self.centres, F, GX, GY, HINV, JF, JS, FN, FLAG0
+        )
         self._loaded = (F, GX, GY, HINV, JF, JS, FN, FLAG0)
 
     def _run_many(self, dspl, dinv, P, active, st, serial=False):
         from jointwear.dic import _icgn
 
+        ref, dfm = self._kernel_args(dspl, dinv)
+        out = (st.zncc, st.iterations, st.flag, st.sigma)
+        opts = self._solver_options()
         if self._loaded is not None:
-            opts = self._solver_options()
-            _icgn.icgn_affine_loaded(
-                *self._loaded, dspl.coef, dinv, self.ref.order, self.centres, P, active,
-                opts[0], opts[2], opts[3], opts[5], opts[6], opts[7],
-                st.zncc, st.iterations, st.flag, st.sigma,
-            )  # fmt: skip
+            _icgn.icgn_affine_loaded(self._loaded, dfm, opts, self.centres, P, active, out)
             return
         kernel = _icgn.icgn_serial if serial else _icgn.icgn_many
-        kernel(
-            *self._kernel_args(dspl, dinv),
-            self.centres,
-            P,
-            active,
-            *self._solver_options(),
-            st.zncc,
-            st.iterations,
-            st.flag,
-            st.sigma,
-        )
+        kernel(ref, dfm, opts, self.centres, P, active, out)
 
     def _propagate(self, dspl, dinv, st, done, group, n_groups):
         from jointwear.dic import _icgn
 
+        ref, dfm = self._kernel_args(dspl, dinv)
         _icgn.rg_propagate(
             n_groups,
             group,
-            *self._kernel_args(dspl, dinv),
+            ref,
+            dfm,
+            self._solver_options(),
             self.centres,
             self._nb_ptr,
             self._nb_idx,
             st.params,
-            *self._solver_options(),
-            st.zncc,
-            st.iterations,
-            st.flag,
-            st.sigma,
+            (st.zncc, st.iterations, st.flag, st.sigma),
             done,
         )
 
@@ -634,26 +496,12 @@ class SubsetCorrelator:
         uncertainty exceeds the scatter by 1.2-1.3 on 3-4 px speckle).
         """
         if getattr(self, "_kappa", None) is None:
-            from scipy import ndimage
-
-            from jointwear.dic._interp import _node_gradients
+            from jointwear.dic._icgn_reference import subset_kappa
 
             r = self.ref
-            gxs, gys = np.empty(r.shape), np.empty(r.shape)
-            _node_gradients(r.coef, r.order, gxs, gys)
-            size = self.params.subset_size
-            a = ndimage.uniform_filter(r.gx * r.gx + r.gy * r.gy, size, mode="mirror")
-            b = ndimage.uniform_filter(r.gx * gxs + r.gy * gys, size, mode="mirror")
-            with np.errstate(invalid="ignore", divide="ignore"):
-                kmap = np.where(b > 0, a / b, 1.0)
-            h, w = r.shape
-            c = self.centres
-            fin = np.isfinite(c).all(axis=1)
             k = np.ones(self.n_points)
-            ix = np.clip(np.rint(c[fin, 0]).astype(int), 0, w - 1)
-            iy = np.clip(np.rint(c[fin, 1]).astype(int), 0, h - 1)
-            k[fin] = np.clip(np.nan_to_num(kmap[iy, ix], nan=1.0), 0.5, 1.5)
-            self._kappa = k
+            subset_kappa(r.coef, r.order, r.gx, r.gy, self.centres, self.params.half, k)
+            self._kappa = np.clip(np.nan_to_num(k, nan=1.0), 0.5, 1.5)
         return self._kappa
 
     def check_seeds(self, seed_points) -> np.ndarray:
@@ -796,118 +644,3 @@ class SubsetCorrelator:
             self.grid,
             sigma=res.sigma,
         )
-
-
-_GRAD_NAMES = [
-    ("u", 0, "pixel", "displacement along x (image columns, right)"),
-    ("du_dx", 1, "1", "displacement gradient du/dx"),
-    ("du_dy", 2, "1", "displacement gradient du/dy"),
-    ("v", 6, "pixel", "displacement along y (image rows, down)"),
-    ("dv_dx", 7, "1", "displacement gradient dv/dx"),
-    ("dv_dy", 8, "1", "displacement gradient dv/dy"),
-]
-_SECOND = [
-    ("d2u_dx2", 3, "pixel-1", "second derivative d2u/dx2"),
-    ("d2u_dxdy", 4, "pixel-1", "second derivative d2u/dxdy"),
-    ("d2u_dy2", 5, "pixel-1", "second derivative d2u/dy2"),
-    ("d2v_dx2", 9, "pixel-1", "second derivative d2v/dx2"),
-    ("d2v_dxdy", 10, "pixel-1", "second derivative d2v/dxdy"),
-    ("d2v_dy2", 11, "pixel-1", "second derivative d2v/dy2"),
-]
-
-
-def result_dataset(
-    centres, P, zncc, iterations, flag, params: CorrelationParams, grid=None, sigma=None
-):
-    """Per-point arrays -> Dataset following the data contract (leading dims allowed).
-
-    ``sigma`` (..., N, 2): standard uncertainty of (u, v) [pixel] -> ``u_u``, ``v_u``.
-    """
-    P = np.asarray(P, float)
-    ok = np.asarray(flag) == _flags.FLAG_OK
-    lead = P.shape[:-2]
-    lead_dims = ("time",) if len(lead) == 1 else ()
-    if grid is not None:
-        xs, ys = grid
-        dims = (*lead_dims, "y", "x")
-        shape = (*lead, ys.size, xs.size)
-        coords = {
-            "x": ("x", xs, {"units": "pixel", "long_name": "subset centre column (reference)"}),
-            "y": ("y", ys, {"units": "pixel", "long_name": "subset centre row (reference)"}),
-        }
-    else:
-        dims = (*lead_dims, "point")
-        shape = (*lead, centres.shape[0])
-        coords = {
-            "point": ("point", np.arange(centres.shape[0]), {"long_name": "point of interest"}),
-            "x": ("point", centres[:, 0], {"units": "pixel", "long_name": "subset centre column"}),
-            "y": ("point", centres[:, 1], {"units": "pixel", "long_name": "subset centre row"}),
-        }
-    data = {}
-    names = _GRAD_NAMES + (_SECOND if params.quadratic else [])
-    for name, k, units, long in names:
-        vals = np.where(ok, P[..., k], np.nan).reshape(shape)
-        data[name] = xr.DataArray(vals, dims=dims, attrs={"units": units, "long_name": long})
-    data["zncc"] = xr.DataArray(
-        np.asarray(zncc, float).reshape(shape),
-        dims=dims,
-        attrs={"units": "1", "long_name": "zero-normalised cross-correlation coefficient (final)"},
-    )
-    data["iterations"] = xr.DataArray(
-        np.asarray(iterations, np.int32).reshape(shape),
-        dims=dims,
-        attrs={"units": "1", "long_name": "IC-GN iterations"},
-    )
-    data["converged"] = xr.DataArray(
-        ok.astype(np.int8).reshape(shape),
-        dims=dims,
-        attrs={
-            "units": "1",
-            "long_name": "IC-GN converged to an accepted match",
-            "flag_values": np.array([0, 1], np.int8),
-            "flag_meanings": "no yes",
-        },
-    )
-    data["flag"] = xr.DataArray(
-        np.asarray(flag, np.int8).reshape(shape),
-        dims=dims,
-        attrs={
-            "units": "1",
-            "long_name": "correlation quality flag",
-            "flag_values": _flags.FLAG_VALUES,
-            "flag_meanings": _flags.FLAG_MEANINGS,
-        },
-    )
-    if sigma is not None:
-        sig = np.asarray(sigma, float)
-        for k, name in enumerate(("u", "v")):
-            data[f"{name}_u"] = xr.DataArray(
-                np.where(ok, sig[..., k], np.nan).reshape(shape),
-                dims=dims,
-                attrs={
-                    "units": "pixel",
-                    "long_name": f"standard uncertainty of {name} from the match residual "
-                    "(image noise; excludes interpolation bias)",
-                },
-            )
-    ds = xr.Dataset(data, coords=coords)
-    for name in ("u", "v"):
-        extra = f" {name}_u" if sigma is not None else ""
-        ds[name].attrs["ancillary_variables"] = f"zncc flag{extra}"
-    ds.attrs.update(
-        {
-            "title": "2D subset DIC displacement field",
-            "dic_criterion": "ZNSSD (IC-GN)",
-            "dic_subset_size_pixel": int(params.subset_size),
-            "dic_step_pixel": int(params.step),
-            "dic_shape_function": params.shape,
-            "dic_interpolation": f"{params.interpolation} B-spline (prefiltered)",
-            "dic_tolerance_pixel": float(params.tolerance),
-            "dic_zncc_min": float(params.zncc_min),
-            "displacement_convention": (
-                "Lagrangian: the subset centred at (x, y) of the reference moved by (u, v); x to "
-                "the right, y down, pixel centres at integers"
-            ),
-        }
-    )
-    return ds

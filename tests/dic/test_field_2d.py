@@ -99,3 +99,32 @@ def test_csv_export_and_figure(affine, tmp_path):
     assert float(rows[k]["exx"]) == pytest.approx(ds.strain.values[2, k, 0], rel=1e-8)
     fig = plot_field(ds)
     assert len(fig.axes) >= 4
+
+
+def test_cli_2d_field_with_a_frame_rate_and_a_mask(affine, tmp_path):
+    import cv2
+
+    from jointwear import io
+    from jointwear.cli import main
+
+    _, frames = affine
+    names = []
+    for k, f in enumerate(frames):
+        names.append(str(tmp_path / f"img_{k}.png"))
+        cv2.imwrite(names[-1], f)
+    mask = np.zeros(frames[0].shape, np.uint8)
+    mask[20:120, 30:130] = 255
+    cv2.imwrite(str(tmp_path / "mask.png"), mask)
+    out = tmp_path / "f.nc"
+    args = ["dic", "field", *names, "--roi", str(tmp_path / "mask.png"), "--subset", "21"]
+    assert main([*args, "--step", "10", "--fps", "50", "--out", str(out)]) == 0
+    ds = io.load(out)
+    np.testing.assert_allclose(ds.time.values, [0, 0.02, 0.04])
+    assert ds.time.attrs["units"] == "s" and ds.displacement.attrs["units"] == "pixel"
+    x, y = ds.x.values, ds.y.values
+    assert (x - 10 >= 30).all() and (x + 10 <= 129).all() and (y - 10 >= 20).all()
+    assert (ds.flag.values[2] == 0).mean() > 0.95
+    # a mask of another size is refused, naming both sizes
+    cv2.imwrite(str(tmp_path / "small.png"), mask[:50])
+    bad = ["dic", "field", *names, "--roi", str(tmp_path / "small.png"), "--out", str(out)]
+    assert main(bad) == 3

@@ -56,7 +56,11 @@ def test_shape_and_out_of_plane_field_recovered(scene):
     truth = MOTION.displacement(P[:, 0], P[:, 1])
     err = ds.displacement.values[3][ok] - truth
     assert np.abs(err.mean(axis=0)).max() < 2e-6
-    assert np.sqrt(np.mean(err[:, 2] ** 2)) < 10e-6
+    # measured: 3.9 um RMS against 2.7 um reported (static scatter 2.5 um); the rest is the
+    # interpolation bias of a 1.6-pixel move, which the reported noise does not include
+    rms = np.sqrt(np.mean(err**2, axis=0))
+    rep = np.sqrt(np.mean(ds.displacement_u.values[3][ok] ** 2, axis=0))
+    assert rms[2] < 6e-6 and (rms < 1.8 * rep).all()
     # the 0.2 mm bulge is seen: centre minus rim
     w = ds.displacement.values[3][ok, 2]
     r = np.hypot(P[:, 0] - 0.29, P[:, 1] - 0.16)
@@ -130,3 +134,44 @@ def test_cli_stereo_field_with_patterns_csv_and_figure(scene, tmp_path):
     # usage errors (2) and bad input (3)
     assert main(["dic", "field", "--left", str(tmp_path / "*_0.png")]) == 2
     assert main([*args[:6], "--calibration", str(tmp_path / "nope.nc")]) == 3
+
+
+def test_uniform_stretch_gives_its_green_lagrange_strain():
+    # a flat specimen in the world plane stretched by 0.3 % along x: E_xx = e + e^2 / 2
+    sc = SurfaceScene()
+    pairs = [sc.pair(noise_seed=0), sc.pair(SurfaceMotion(stretch=0.003), noise_seed=1)]
+    ds = measure_field(
+        [p[0] for p in pairs], [p[1] for p in pairs], calibration=sc.calibration,
+        roi=sc.roi_left(), subset_size=25, step=12, strain_window=5,
+    )  # fmt: skip
+    E = ds.strain.values[1]
+    good = np.isfinite(E).all(axis=1)
+    assert good.mean() > 0.8
+    np.testing.assert_allclose(np.median(E[good], axis=0), [0.003 + 0.003**2 / 2, 0, 0], atol=5e-5)
+    robust = (np.percentile(E[good], 75, axis=0) - np.percentile(E[good], 25, axis=0)) / 1.349
+    ratio = np.median(ds.strain_u.values[1][good], axis=0) / robust
+    assert ((ratio > 0.5) & (ratio < 1.6)).all(), ratio
+
+
+def test_subsets_straddling_a_depth_step_are_flagged_left_right_inconsistent():
+    # two levels 20 mm apart (19 pixel of disparity): the far half is found by a fresh search,
+    # and subsets across the step - ZNCC up to 0.9, Z up to 0.5 mm off - are flagged
+    def step(x, y):
+        return np.where(x < 0.29, 0.0, -0.02)
+
+    sc = SurfaceScene(step)
+    lft, rgt = sc.pair(noise_seed=0)
+    kw = dict(calibration=sc.calibration, roi=sc.roi_left(), subset_size=25, step=12)
+    ds = measure_field([lft], [rgt], strain_window=0, **kw)
+    flag = ds.flag.values[0]
+    assert (flag == 0).mean() > 0.9
+    flagged = flag == 10
+    assert flagged.sum() >= 5
+    # where the flagged subsets are: across the step (left image, the step's column)
+    col = sc.calibration.left.project(np.array([[0.29, 0.16, 0.0]]))[0, 0]
+    assert (np.abs(ds.x.values[flagged] - col) < 40).all()
+    P = ds.position.values[flag == 0]
+    assert np.abs(P[:, 2] - step(P[:, 0], P[:, 1])).max() < 25e-6
+    loose = measure_field([lft], [rgt], strain_window=0, consistency_max_px=1e9, **kw)
+    Q = loose.position.values[loose.flag.values[0] == 0]
+    assert np.abs(Q[:, 2] - step(Q[:, 0], Q[:, 1])).max() > 100e-6  # what the flag prevents

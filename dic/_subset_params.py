@@ -1,0 +1,156 @@
+"""Options and input checks of the 2D subset-DIC engine: :class:`CorrelationParams`, image
+checks, numba thread count, and the summed-area table of invalid pixels."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+
+from jointwear.errors import BadInputError, ParameterError
+
+__all__ = ["CorrelationParams", "set_threads", "check_image", "check_pair"]
+
+_SHAPES = {"affine": False, "first": False, "quadratic": True, "second": True}
+
+
+@dataclass(frozen=True)
+class CorrelationParams:
+    """Options of the subset correlation.
+
+    Parameters
+    ----------
+    subset_size : int
+        Side of the square subset [pixel], odd, >= 7.
+    step : int
+        Grid spacing of the points of interest [pixel] (grids only).
+    shape : str
+        Subset shape function: ``"affine"`` (first order) or ``"quadratic"`` (second order).
+    interpolation : str
+        ``"cubic"`` or ``"quintic"`` B-spline on prefiltered coefficients.
+    max_iterations : int
+        IC-GN iteration limit per point.
+    tolerance : float
+        Convergence: norm of the last parameter update, gradients scaled by the subset
+        half-width [pixel] (Pan et al. 2013 use 0.001). Gauss-Newton converges fast near the
+        optimum, so the remaining error is far below this value.
+    zncc_min : float
+        Points below this ZNCC are flagged ``low_correlation`` and do not propagate.
+    search_radius : int
+        Half-width of the integer-pixel search window for seeds [pixel].
+    min_texture : float
+        Subsets whose intensity standard deviation is below this fraction of the image's are
+        flagged ``no_texture``.
+    border : int
+        Margin [pixel] subsets must keep from the image edges (reference and deformed): the
+        B-spline interpolant is less accurate within a few pixels of an edge (errors up to
+        ~0.003 px at 2-3 px from it). Subsets closer are flagged ``subset_outside_image``.
+    threads : int
+        numba threads (at most 2 on the shared machine; 0 = min(2, available)).
+    """
+
+    subset_size: int = 31
+    step: int = 10
+    shape: Literal["affine", "quadratic"] = "affine"
+    interpolation: Literal["cubic", "quintic"] = "quintic"
+    max_iterations: int = 40
+    tolerance: float = 1e-3
+    zncc_min: float = 0.8
+    search_radius: int = 48
+    min_texture: float = 0.05
+    border: int = 4
+    threads: int = 0
+
+    def __post_init__(self) -> None:
+        s = self.subset_size
+        if isinstance(s, bool) or not isinstance(s, (int, np.integer)) or s < 7 or s % 2 == 0:
+            raise ParameterError(
+                f"subset_size={s!r}: expected an odd integer >= 7 (the subset is centred on "
+                f"its point); use {s + 1 if isinstance(s, (int, np.integer)) and s >= 6 else 31}"
+            )
+        if not isinstance(self.step, (int, np.integer)) or self.step < 1:
+            raise ParameterError(f"step={self.step!r}: expected an integer >= 1 pixel")
+        if self.shape not in _SHAPES:
+            raise ParameterError(
+                f"shape={self.shape!r}: expected 'affine' (first order) or 'quadratic' (second order)"
+            )
+        if self.interpolation not in ("cubic", "quintic"):
+            raise ParameterError(
+                f"interpolation={self.interpolation!r}: expected 'cubic' or 'quintic' (B-spline)"
+            )
+        if not (0.0 < self.tolerance < 1.0):
+            raise ParameterError(f"tolerance={self.tolerance!r}: expected 0 < tolerance < 1 pixel")
+        if not (-1.0 <= self.zncc_min < 1.0):
+            raise ParameterError(f"zncc_min={self.zncc_min!r}: expected a value in [-1, 1)")
+        if self.max_iterations < 1:
+            raise ParameterError(f"max_iterations={self.max_iterations!r}: expected >= 1")
+        if not isinstance(self.border, (int, np.integer)) or self.border < 0:
+            raise ParameterError(f"border={self.border!r}: expected an integer >= 0 pixel")
+        if self.search_radius < 0:
+            raise ParameterError(f"search_radius={self.search_radius!r}: expected >= 0 pixel")
+
+    @property
+    def half(self) -> int:
+        return self.subset_size // 2
+
+    @property
+    def quadratic(self) -> bool:
+        return _SHAPES[self.shape]
+
+
+def set_threads(threads: int = 0) -> int:
+    """Set numba's thread count to ``threads`` (0: min(2, available)); returns it."""
+    import numba
+
+    avail = numba.config.NUMBA_NUM_THREADS
+    n = min(avail, 2) if not threads else max(1, min(int(threads), avail))
+    numba.set_num_threads(n)
+    return n
+
+
+def check_image(image, name: str) -> np.ndarray:
+    """A 2D numeric image as an array, or a BadInputError naming ``name``."""
+    arr = np.asarray(image)
+    if arr.ndim == 3 and arr.shape[2] in (3, 4):
+        raise BadInputError(
+            f"{name}: expected a single-channel (grey) image, got shape {arr.shape} (colour); "
+            "convert it to grey first, e.g. cv2.cvtColor(img, cv2.COLOR_BGR2GRAY)"
+        )
+    if arr.ndim != 2:
+        raise BadInputError(f"{name}: expected a 2D image (rows, columns), got shape {arr.shape}")
+    if arr.dtype.kind not in "uif" or arr.dtype == np.bool_:
+        raise BadInputError(f"{name}: expected numeric pixels, got dtype {arr.dtype}")
+    if min(arr.shape) < 8:
+        raise BadInputError(f"{name}: image {arr.shape} is too small (need at least 8x8 pixels)")
+    if arr.dtype.kind == "f" and np.isinf(arr).any():
+        raise BadInputError(
+            f"{name}: contains infinite pixel values; replace them by NaN (flagged) or finite values"
+        )
+    return arr
+
+
+def check_pair(reference: np.ndarray, deformed: np.ndarray, what: str = "deformed image") -> None:
+    """Sizes and dtypes must agree."""
+    if reference.shape != deformed.shape:
+        raise BadInputError(
+            f"{what}: size {deformed.shape[1]}x{deformed.shape[0]} (width x height) differs from "
+            f"the reference {reference.shape[1]}x{reference.shape[0]}; crop or resize so that both "
+            "images have the same size"
+        )
+    if reference.dtype != deformed.dtype:
+        raise BadInputError(
+            f"{what}: pixel type {deformed.dtype} differs from the reference's {reference.dtype}; "
+            "images of one sequence must come from the same camera setting - convert both to the "
+            "same type (e.g. .astype(np.float64)) if that is intended"
+        )
+
+
+def _integral_invalid(valid: np.ndarray) -> np.ndarray:
+    """Summed-area table of invalid pixels; a (1, 1) array when every pixel is valid."""
+    if valid.all():
+        return np.zeros((1, 1), dtype=np.int64)
+    inv = (~valid).astype(np.int64)
+    out = np.zeros((inv.shape[0] + 1, inv.shape[1] + 1), dtype=np.int64)
+    out[1:, 1:] = inv.cumsum(0).cumsum(1)
+    return out
