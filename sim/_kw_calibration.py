@@ -388,8 +388,9 @@ class MultiCalibration:
         for k, m in enumerate(self.measurements):
             loo = self.loo_errors[k]
             loo_txt = "not assessed" if not np.isfinite(loo) else f"{100 * loo:+.1f} %"
+            scale, unit = (1e9, "mm³") if m.quantity == "volume" else (1e6, "µm")
             lines.append(
-                f"  {m.describe()}: simulated {self.simulated[k] * (1e9 if m.quantity == 'volume' else 1e6):.4g}"
+                f"  {m.describe()}: simulated {self.simulated[k] * scale:.4g} {unit}"
                 f" -> residual {100 * self.residuals[k]:+.1f} %; left out, predicted {loo_txt}"
             )
         fitted = f"kw = {self.kw:.4g} m²/N"

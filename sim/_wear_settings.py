@@ -93,7 +93,9 @@ class WearSettings:
     average_cycles, max_average_cycles : int
         Adaptive: single cycles averaged per measurement of the wear rate, at least
         ``average_cycles``, more (up to ``max_average_cycles``) when the cycle-to-cycle
-        variability hides changes of ``tol``. The fixed and schedule schemes measure one cycle.
+        variability hides changes of ``tol``; the first measurement averages
+        ``max(average_cycles, 4)`` (at most ``max_average_cycles``) to start the noise estimate.
+        The fixed and schedule schemes measure one cycle (their accuracy is not assessed).
     """
 
     kw: float = DEFAULT_KW

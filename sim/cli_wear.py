@@ -343,6 +343,8 @@ def register(app: typer.Typer) -> None:
         ] = None,
     ) -> None:
         """Simulate Archard wear of joint C over many cycles; checkpoint after every update."""
+        import logging
+
         from jointwear import io
         from jointwear.errors import BadInputError, SimulationError
         from jointwear.params import to_jsonable
@@ -350,6 +352,9 @@ def register(app: typer.Typer) -> None:
         from jointwear.sim.wear import WearRun
         from jointwear.sim.wearmap import BearingGrid
 
+        # the accuracy warning is printed below with the result; without this handler Python's
+        # last-resort handler would print it a second time
+        logging.getLogger("jointwear.sim.wear").addHandler(logging.NullHandler())
         io.check_writable(out, what="--out")
         if figure is not None:
             io.check_writable(figure, what="--figure")
@@ -447,8 +452,9 @@ def register(app: typer.Typer) -> None:
             fig = plot_wear_map(ds, kind="both")
             with io.atomic_path(figure) as tmp:
                 fig.savefig(tmp, dpi=110, format="png")
-        if "convergence_warning" in ds.attrs:
-            typer.echo(f"warning: {ds.attrs['convergence_warning']}", err=True)
+        for key in ("convergence_warning", "accuracy_warning"):
+            if key in ds.attrs:
+                typer.echo(f"warning: {ds.attrs[key]}", err=True)
         u_max = float(ds["max_wear_depth_u"][-1])
         u_vol = float(ds["worn_volume_u"][-1])
         pm = (lambda u, f: f" ± {u * f:.2g}") if u_max == u_max else (lambda u, f: "")

@@ -234,3 +234,20 @@ def test_calibrate_kw_command_with_several_snapshots_reports_each_residual(tmp_p
         == 3
     )
     assert "prescribed contact model" in capsys.readouterr().err
+
+
+def test_noise_limited_rig_finishes_and_says_how_accurate_it_is(tmp_path, capsys):
+    toml = tmp_path / "rig.toml"
+    toml.write_text(
+        "[mechanism]\ncrank_speed_rpm = 60.0\n\n[joint]\nn_layers = 6\nn_points = 60\n\n"
+        "[wear]\nkw = 9.0e-14\ntol = 0.05\ndn = 50\n"
+    )
+    out = tmp_path / "w.nc"
+    assert main(["sim", "wear", "--cycles", "4000", "--out", str(out), "--params", str(toml)]) == 0
+    cap = capsys.readouterr()
+    assert cap.err.count("cycle-to-cycle variability of the wear rate") == 1
+    assert "warning: " in cap.err and "tol = 0.05" in cap.err
+    assert "accuracy not reached, k = 2" in cap.out and " ± " in cap.out
+    ds = io.load(out)
+    assert ds.attrs["accuracy_status"] == "not reached"
+    assert float(ds["max_wear_depth_u"][-1]) > 0

@@ -2,7 +2,8 @@
 
 Cost reduction: the worn profile after N cycles depends on kw N only (each simulated cycle sees
 just the profile), so the study's 10^6 cycles at the default kw are reproduced with 50x fewer
-cycles at 50x the kw; the number of updates, not of cycles, sets the cost.
+cycles at 50x the kw; the number of updates, not of cycles, sets the cost. At most 3 cycles are
+averaged per rate measurement.
 """
 
 from __future__ import annotations
@@ -30,6 +31,9 @@ N_EQ = 1e6  # study-equivalent cycles
 
 
 def _run(params=PARAMS, *, tol=0.1, cycles=N_EQ / SCALE, kw=DEFAULT_KW * SCALE, **kw_args):
+    # CI cost: at most 3 cycles averaged per rate measurement (default 8); the accuracy the
+    # controller reports is then looser, the physics checked here is the same
+    kw_args.setdefault("max_average_cycles", 3)
     return simulate_wear(
         params,
         cycles=cycles,
