@@ -3,9 +3,11 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Literal
 
 import typer
+
+from jointwear._cli import Overwrite
 
 FIELDS = ("rigid", "affine", "rotation", "sinusoidal")
 
@@ -16,9 +18,11 @@ def register(app: typer.Typer) -> None:
     @app.command("speckle")
     def speckle_cmd(
         out: Annotated[Path, typer.Argument(help="Output folder.")],
+        overwrite: Overwrite = False,
         size: Annotated[str, typer.Option("--size", help="WIDTHxHEIGHT (pixels).")] = "512x512",
         field: Annotated[
-            str, typer.Option("--field", help="rigid, affine, rotation or sinusoidal.")
+            Literal["rigid", "affine", "rotation", "sinusoidal"],
+            typer.Option("--field", help="rigid, affine, rotation or sinusoidal."),
         ] = "rigid",
         u: Annotated[float, typer.Option("--u", help="Translation along x (pixels).")] = 1.5,
         v: Annotated[float, typer.Option("--v", help="Translation along y (pixels).")] = -0.7,

@@ -3,10 +3,11 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Literal
 
 import typer
 
+from jointwear._cli import Overwrite
 from jointwear.errors import BadInputError
 
 
@@ -52,16 +53,19 @@ def register(app: typer.Typer) -> None:
             Path | None, typer.Argument(help="Deformed image (omit for a sequence).")
         ] = None,
         out: Annotated[Path, typer.Option("--out", help="Output netCDF file.")] = Path("field.nc"),
+        overwrite: Overwrite = False,
         roi: Annotated[
             str | None, typer.Option("--roi", help="Region x_min,y_min,x_max,y_max (pixels).")
         ] = None,
         subset: Annotated[int, typer.Option("--subset", help="Subset size (pixels), odd.")] = 31,
         step: Annotated[int, typer.Option("--step", help="Grid step (pixels).")] = 10,
         shape: Annotated[
-            str, typer.Option("--shape", help="Shape function: affine or quadratic.")
+            Literal["affine", "quadratic"],
+            typer.Option("--shape", help="Shape function: affine or quadratic."),
         ] = "affine",
         interpolation: Annotated[
-            str, typer.Option("--interpolation", help="B-spline: quintic or cubic.")
+            Literal["quintic", "cubic"],
+            typer.Option("--interpolation", help="B-spline: quintic or cubic."),
         ] = "quintic",
         search_radius: Annotated[
             int, typer.Option("--search-radius", help="Seed search half-width (pixels).")
@@ -74,7 +78,7 @@ def register(app: typer.Typer) -> None:
             float, typer.Option("--zncc-min", help="Flag matches below this ZNCC.")
         ] = 0.8,
         reference_mode: Annotated[
-            str,
+            Literal["absolute", "incremental"],
             typer.Option("--reference", help="Sequences: absolute or incremental."),
         ] = "absolute",
         frame_rate: Annotated[

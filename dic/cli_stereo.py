@@ -3,9 +3,11 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Literal
 
 import typer
+
+from jointwear._cli import Overwrite
 
 
 def _image_list(path: Path, what: str) -> list[Path]:
@@ -44,7 +46,10 @@ def register(app: typer.Typer) -> None:
         out: Annotated[Path, typer.Option("--out", "-o", help="Calibration file (.nc).")] = Path(
             "calibration.nc"
         ),
-        board: Annotated[str, typer.Option(help="chessboard or charuco.")] = "chessboard",
+        overwrite: Overwrite = False,
+        board: Annotated[
+            Literal["chessboard", "charuco"], typer.Option(help="chessboard or charuco.")
+        ] = "chessboard",
         squares: Annotated[
             tuple[int, int], typer.Option(help="Squares along x and y (not inner corners).")
         ] = (10, 7),
@@ -97,10 +102,13 @@ def register(app: typer.Typer) -> None:
                 show_default=False,
             ),
         ],
-        fmt: Annotated[str, typer.Option("--format", help="opencv or vic3d.")],
+        fmt: Annotated[
+            Literal["opencv", "vic3d"], typer.Option("--format", help="opencv or vic3d.")
+        ],
         out: Annotated[Path, typer.Option("--out", "-o", help="Calibration file (.nc).")] = Path(
             "calibration.nc"
         ),
+        overwrite: Overwrite = False,
         length_unit: Annotated[
             str | None,
             typer.Option(help="OpenCV: unit of T (m, mm, cm, um, in, or metres per unit)."),
@@ -164,6 +172,7 @@ def register(app: typer.Typer) -> None:
         out: Annotated[Path, typer.Option("--out", "-o", help="Body motion (.nc).")] = Path(
             "motion.nc"
         ),
+        overwrite: Overwrite = False,
         fps: Annotated[
             float | None, typer.Option(help="Frame rate (1/s) (image sequences).")
         ] = None,
@@ -239,6 +248,7 @@ def register(app: typer.Typer) -> None:
         out: Annotated[Path, typer.Option("--out", "-o", help="Figure (.png/.svg/.pdf).")] = Path(
             "motion.png"
         ),
+        overwrite: Overwrite = False,
         reference: Annotated[
             Path | None, typer.Option(help="Reference to overlay (ground truth, simulation).")
         ] = None,

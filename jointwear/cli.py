@@ -9,12 +9,15 @@ stderr; the traceback only with ``--debug``).
 
 from __future__ import annotations
 
+import os
+import signal
 import sys
 from pathlib import Path
 from typing import Annotated
 
 import typer
 
+from jointwear._cli import CommandGroup, Overwrite, apply_classes
 from jointwear._compile_notice import announce_compilation
 from jointwear._version import __version__
 from jointwear.errors import EXIT_BAD_INPUT, EXIT_USAGE, JointwearError
@@ -25,9 +28,10 @@ app = typer.Typer(
     no_args_is_help=True,
     pretty_exceptions_enable=False,
     add_completion=False,
+    cls=CommandGroup,
 )
 
-_STATE = {"debug": False}
+_STATE = {"debug": False, "terminated": False}
 
 
 def _version_callback(value: bool) -> None:
@@ -89,6 +93,7 @@ def demo(
     quick: Annotated[
         bool, typer.Option("--quick", help="Reduced size (seconds instead of about a minute).")
     ] = False,
+    overwrite: Overwrite = False,
 ) -> None:
     """Run the whole chain on the embedded default data and write a validation report."""
     from jointwear.reports.demo import run_demo
@@ -98,6 +103,22 @@ def demo(
 
 
 _register_groups()
+apply_classes(app)
+
+
+def _on_sigterm(signum: int, frame: object) -> None:
+    """SIGTERM is handled like Ctrl-C (commands keep their partial results), exit 143."""
+    _STATE["terminated"] = True
+    raise KeyboardInterrupt()
+
+
+def _quiet_broken_pipe() -> None:
+    """The reader of stdout went away (``jointwear info x.nc | head``): stop quietly."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+    except (OSError, ValueError):  # stdout without a file descriptor (tests)
+        pass
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -105,26 +126,42 @@ def main(argv: list[str] | None = None) -> int:
     args = sys.argv[1:] if argv is None else list(argv)
     debug = "--debug" in args
     compiled = announce_compilation()
+    _STATE["terminated"] = False
+    try:
+        previous = signal.signal(signal.SIGTERM, _on_sigterm)
+    except ValueError:  # not the main thread
+        previous = None
     try:
         app(args=args, prog_name="jointwear", standalone_mode=True)
     except SystemExit as exc:  # click's own exits: 0, usage errors (2), aborts
         code = exc.code
+        if _STATE["terminated"]:  # click turned the KeyboardInterrupt into an exit
+            return 128 + signal.SIGTERM
         return code if isinstance(code, int) else (0 if code is None else EXIT_USAGE)
+    except BrokenPipeError:
+        _quiet_broken_pipe()
+        return 0
     except JointwearError as exc:
         if debug:
             raise
         typer.echo(f"jointwear: error: {exc}", err=True)
         return exc.exit_code
     except KeyboardInterrupt:
-        typer.echo("interrupted", err=True)
-        return 130
+        terminated = bool(_STATE["terminated"])
+        typer.echo("terminated" if terminated else "interrupted", err=True)
+        return 128 + (signal.SIGTERM if terminated else signal.SIGINT)
     except (OSError, MemoryError) as exc:
         if debug:
             raise
         typer.echo(f"jointwear: error: {exc}", err=True)
         return EXIT_BAD_INPUT
     finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
         line = compiled()
         if line:
-            typer.echo(line, err=True)
+            try:
+                typer.echo(line, err=True)
+            except OSError:
+                pass
     return 0

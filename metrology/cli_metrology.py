@@ -3,9 +3,11 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Literal
 
 import typer
+
+from jointwear._cli import Overwrite
 
 _SOURCE = "jointwear 0.1 (metrology)"
 
@@ -51,6 +53,7 @@ def register(app: typer.Typer) -> None:
             Path,
             typer.Option("--out", "-o", help="Output .nc (one scan) or folder (several scans)."),
         ] = Path("scan.nc"),
+        overwrite: Overwrite = False,
         angle_zero: Annotated[
             str | None,
             typer.Option(
@@ -66,10 +69,12 @@ def register(app: typer.Typer) -> None:
             ),
         ] = None,
         preset: Annotated[
-            str, typer.Option("--preset", help="generic or talyrond (defaults: values in µm).")
+            Literal["generic", "talyrond"],
+            typer.Option("--preset", help="generic or talyrond (defaults: values in µm)."),
         ] = "generic",
         layout: Annotated[
-            str, typer.Option("--layout", help="auto, single, folder, long or wide.")
+            Literal["auto", "single", "folder", "long", "wide"],
+            typer.Option("--layout", help="auto, single, folder, long or wide."),
         ] = "auto",
         units: Annotated[
             str | None, typer.Option("--units", help="Length unit: um, mm, m or inch.")
@@ -89,7 +94,10 @@ def register(app: typer.Typer) -> None:
                 "radius, deviation, ignore.",
             ),
         ] = None,
-        value: Annotated[str, typer.Option("--value", help="auto, radius or deviation.")] = "auto",
+        value: Annotated[
+            Literal["auto", "radius", "deviation"],
+            typer.Option("--value", help="auto, radius or deviation."),
+        ] = "auto",
         layer_spacing_mm: Annotated[
             float | None, typer.Option("--layer-spacing-mm", help="Layer spacing [mm].")
         ] = None,
@@ -196,7 +204,7 @@ def register(app: typer.Typer) -> None:
             typer.Option("--filter", help="Filter cut-off [UPR], e.g. 15, 50, 150, 500."),
         ] = None,
         filter_kind: Annotated[
-            str, typer.Option("--filter-kind", help="gaussian or 2rc.")
+            Literal["gaussian", "2rc"], typer.Option("--filter-kind", help="gaussian or 2rc.")
         ] = "gaussian",
         reference: Annotated[
             list[str] | None,
@@ -214,6 +222,7 @@ def register(app: typer.Typer) -> None:
             Path | None,
             typer.Option("--out", "-o", help="Write the full result as netCDF (file or folder)."),
         ] = None,
+        overwrite: Overwrite = False,
     ) -> None:
         """Roundness per layer and cylindricity (LS/MZ/MI/MC), printed as a table."""
         import warnings
@@ -277,6 +286,7 @@ def register(app: typer.Typer) -> None:
         out: Annotated[
             Path, typer.Option("--out", "-o", help="Output .nc (or folder for several).")
         ] = Path("wear.nc"),
+        overwrite: Overwrite = False,
         angle_offset_deg: Annotated[
             float,
             typer.Option("--angle-offset-deg", help="Set-up rotation of the before scan [deg]."),
@@ -285,7 +295,8 @@ def register(app: typer.Typer) -> None:
             bool, typer.Option("--register", help="Estimate the rotation from the unworn regions.")
         ] = False,
         shape: Annotated[
-            str, typer.Option("--shape", help="Unworn reference: cylinder or circle (per layer).")
+            Literal["cylinder", "circle"],
+            typer.Option("--shape", help="Unworn reference: cylinder or circle (per layer)."),
         ] = "cylinder",
         threshold: Annotated[
             float, typer.Option("--threshold", help="Unworn = within this many robust std devs.")
@@ -354,6 +365,7 @@ def register(app: typer.Typer) -> None:
         out: Annotated[
             Path, typer.Option("--out", "-o", help="Figure file (PNG, PDF, SVG).")
         ] = Path("wear_map.png"),
+        overwrite: Overwrite = False,
         layers: Annotated[
             str | None,
             typer.Option("--layers", help="Comma-separated layer indices for the polar plot."),

@@ -45,12 +45,14 @@ def test_compare_cli_writes_metrics_and_table(files, tmp_path, capsys):
 
 def test_compare_cli_exit_codes(files, tmp_path, capsys):
     out = tmp_path / "m.nc"
-    bad = ["compare", str(files["sim_wear"]), str(files["meas_wear_bad"]), "--out", str(out)]
+    bad = ["compare", str(files["sim_wear"]), str(files["meas_wear_bad"]), "-o", str(out)]
+    bad.append("--overwrite")  # the same --out for every run
     assert main(bad) == 0  # without --strict a failed criterion is only reported
     assert "FAIL  maximum wear depth" in capsys.readouterr().out
     assert main([*bad, "--strict"]) == 1
     assert "validation failed for: maximum wear depth" in capsys.readouterr().err
     unstated = ["compare", str(files["sim_wear"]), str(files["meas_unstated"]), "-o", str(out)]
+    unstated.append("--overwrite")
     assert main(unstated) == 3
     assert "angle_zero" in capsys.readouterr().err
 
@@ -58,6 +60,7 @@ def test_compare_cli_exit_codes(files, tmp_path, capsys):
 def test_compare_cli_motion_variables(files, tmp_path, capsys):
     out = tmp_path / "m.nc"
     argv = ["compare", str(files["sim_motion"]), str(files["meas_motion"]), "-o", str(out)]
+    argv.append("--overwrite")  # the same --out for every run
     assert main([*argv, "--variable", "follower_velocity"]) == 0
     text = capsys.readouterr().out
     assert "follower velocity z history" in text and "wear map" not in text

@@ -217,3 +217,13 @@ def test_lock_file_is_gone_after_a_refused_claim(tmp_path):
         with outputs.claim({"--out": out}, overwrite=False):
             pass
     assert sorted(p.name for p in tmp_path.iterdir()) == ["a.nc"]
+
+
+def test_image_write_failure_names_the_file(tmp_path, tiny_disk):
+    img = (np.random.default_rng(0).random((400, 400)) * 255).astype(np.uint8)
+    path = tiny_disk / "frame_000001.png"
+    with pytest.raises(outputs.OutputError) as info:
+        outputs.write_image(path, img)
+    assert f"'{path}'" in str(info.value) and "disk is full" in str(info.value)
+    assert not path.exists()
+    assert outputs.write_image(tmp_path / "ok.png", img).stat().st_size > 1000

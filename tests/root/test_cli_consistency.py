@@ -1,0 +1,248 @@
+"""CLI consistency: --overwrite on every writing command, help without <bool>/<list[...]> and
+with its units, bad option values exit 2, errors speak in flags, SIGTERM like Ctrl-C (143),
+a closed pipe exits 0 quietly, partial results are flagged."""
+
+from __future__ import annotations
+
+import os
+import re
+import signal
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+import typer
+import xarray as xr
+
+from jointwear import io
+from jointwear._cli import OUTPUT_PARAMS, speak_flags
+from jointwear.cli import app, main
+
+
+def _commands():
+    """(path, click command) of every command and group callback of the jointwear CLI."""
+    root = typer.main.get_command(app)
+    out = []
+
+    def walk(cmd, path):
+        out.append((path, cmd))
+        for name, sub in (getattr(cmd, "commands", None) or {}).items():
+            walk(sub, [*path, name])
+
+    walk(root, [])
+    return out
+
+
+COMMANDS = _commands()
+
+
+def _command(*path):
+    return next(c for p, c in COMMANDS if p == list(path))
+
+
+def test_every_command_that_writes_files_has_overwrite():
+    writers = [p for p, c in COMMANDS if any(prm.name in OUTPUT_PARAMS for prm in c.params) and p]
+    assert len(writers) >= 18  # sim, dic, metrology, datasets, compare, report, import, demo
+    missing = [
+        " ".join(p) for p in writers if "overwrite" not in {prm.name for prm in _command(*p).params}
+    ]
+    assert not missing, f"commands writing files without --overwrite: {missing}"
+
+
+@pytest.mark.parametrize("path", [p for p, _ in COMMANDS], ids=lambda p: " ".join(p) or "root")
+def test_help_has_no_python_type_names_and_keeps_units(path, capsys, monkeypatch):
+    monkeypatch.setenv("COLUMNS", "200")
+    assert main([*path, "--help"]) == 0
+    text = capsys.readouterr().out
+    assert "<bool>" not in text and "<list[" not in text, text
+    # every unit in brackets written in the help source is shown
+    for prm in _command(*path).params:
+        for unit in re.findall(r"\\\[([^\]]+)\]", prm.help or ""):
+            assert f"[{unit}]" in text, (prm.name, unit)
+
+
+def test_units_in_help_survive_rich_markup(capsys, monkeypatch):
+    monkeypatch.setenv("COLUMNS", "200")
+    assert main(["metrology", "import", "--help"]) == 0
+    text = capsys.readouterr().out
+    assert "Layer spacing [mm]." in text
+    assert "mid-width [mm]" in text
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["sim", "wear", "--out", "x.nc", "--contact", "rigid"],
+        ["sim", "wear", "--out", "x.nc", "--scheme", "fast"],
+        ["datasets", "speckle", "sp", "--field", "wavy"],
+        ["datasets", "rig", "--out", "r", "--codec", "h264"],
+        ["metrology", "import", "a.txt", "--layout", "diagonal"],
+        ["dic", "correlate", "a.png", "b.png", "--shape", "cubic"],
+        ["metrology", "assess", "a.nc", "--filter-kind", "spline"],
+        ["sim", "cycle", "--cycles", "many"],
+    ],
+    ids=lambda a: " ".join(a[:2] + a[-2:-1]),
+)
+def test_bad_option_values_are_usage_errors_naming_the_flag(argv, tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert argv[-2] in err and "Traceback" not in err
+    assert not list(tmp_path.iterdir())  # nothing written
+
+
+def _speckle(tmp_path, *extra):
+    return main(["datasets", "speckle", str(tmp_path / "sp"), "--size", "32x32", *extra])
+
+
+def test_existing_output_is_refused_unless_overwrite(tmp_path, capsys):
+    assert _speckle(tmp_path) == 0
+    truth = tmp_path / "sp" / "truth.nc"
+    first = truth.stat().st_mtime_ns
+    capsys.readouterr()
+    assert _speckle(tmp_path, "--u", "0.5") == 3
+    err = capsys.readouterr().err
+    assert "--overwrite" in err and str(tmp_path / "sp") in err
+    assert truth.stat().st_mtime_ns == first
+    assert _speckle(tmp_path, "--u", "0.5", "--overwrite") == 0
+    assert float(io.load(truth)["u"].isel(x=16, y=16)) == pytest.approx(0.5)
+
+
+def test_stale_temporary_of_a_killed_run_is_removed_and_reported(tmp_path, capsys):
+    stale = tmp_path / ".sp.abcd1234.tmp"
+    stale.write_text("left by a SIGKILL")
+    assert _speckle(tmp_path) == 0
+    assert not stale.exists()
+    assert f"removed {stale}" in capsys.readouterr().err
+
+
+class _Param:
+    """Enough of a click option for speak_flags."""
+
+    def __init__(self, opts, name, is_flag=False, secondary=()):
+        self.opts, self.name, self.is_flag, self.secondary_opts = opts, name, is_flag, secondary
+
+
+def test_library_keywords_become_the_commands_flags():
+    params = _command("metrology", "import").params
+    cases = {
+        "the length unit is not stated in the header; pass units='um' (or 'mm')": (
+            "pass --units um (or 'mm')"
+        ),
+        "no z in the file names; pass layer_spacing=<m> or z=[...]": (
+            "pass --layer-spacing-mm <mm> or"
+        ),
+        "re-export it or pass expected_points=None / allow_partial=True": (
+            "pass without --expected-points / --allow-partial"
+        ),
+        "check the column meaning (columns=...)": "(--columns ...)",
+        "fix the line or pass delimiter=/decimal=": "pass --delimiter .../--decimal ...",
+        "import with resample=True": "import with --resample",
+    }
+    for message, expected in cases.items():
+        spoken = speak_flags(message, params)
+        assert expected in spoken, spoken
+    # words that merely contain a keyword, and values in quotes, are left alone
+    assert speak_flags("subunits='x' and 'units=mm'", params) == "subunits='x' and 'units=mm'"
+    prm = [_Param(["--progress"], "progress", True, ["--no-progress"])]
+    assert speak_flags("progress=False", prm) == "--no-progress"
+
+
+def test_error_from_the_library_names_the_flag_end_to_end(tmp_path, capsys):
+    scan = tmp_path / "layer.txt"
+    theta = np.arange(0, 360, 2.0)
+    scan.write_text("angle;value\n" + "".join(f"{t:.1f};{np.sin(t):.4f}\n" for t in theta))
+    code = main(
+        [
+            "metrology",
+            "import",
+            str(scan),
+            "--angle-zero",
+            "+x",
+            "--angle-direction",
+            "counterclockwise",
+            "--out",
+            str(tmp_path / "s.nc"),
+        ]
+    )
+    err = capsys.readouterr().err
+    assert code == 3, err
+    assert "--units" in err and "units=" not in err and "Traceback" not in err
+
+
+def _big_file(path):
+    n = 1500
+    ds = xr.Dataset(
+        {
+            f"v{i:04d}": ("x", [1.0], {"units": "m", "long_name": "a long name " * 6})
+            for i in range(n)
+        },
+        coords={"x": ("x", [0.0], {"units": "m", "long_name": "x"})},
+    )
+    io.save(ds, path)
+
+
+def test_closed_pipe_exits_0_quietly(tmp_path):
+    path = tmp_path / "big.nc"
+    _big_file(path)
+    res = subprocess.run(
+        ["bash", "-c", f"set -o pipefail; '{sys.executable}' -m jointwear info '{path}' | head -2"],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+    assert res.stdout.startswith("file: ")
+    assert res.returncode == 0, res.stderr
+    assert res.stderr == "", res.stderr
+
+
+SMALL = ["--contact", "winkler", "--layers", "6", "--points", "48", "--kw", "1e-13"]
+
+
+def test_sigterm_is_handled_like_ctrl_c_and_the_partial_map_is_flagged(tmp_path, capsys):
+    out = tmp_path / "w.nc"
+    ckpt = tmp_path / "w.nc.ckpt"
+    run = ["sim", "wear", *SMALL, "--scheme", "fixed", "--dn", "200", "--cycles", "3e5"]
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "jointwear", *run, "--out", str(out)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        env=dict(os.environ, PYTHONUNBUFFERED="1"),
+    )
+    t0 = time.monotonic()
+    while not ckpt.exists() and proc.poll() is None and time.monotonic() - t0 < 120:
+        time.sleep(0.02)
+    time.sleep(0.3)
+    assert proc.poll() is None, "the run finished before it could be terminated"
+    proc.send_signal(signal.SIGTERM)
+    _, err = proc.communicate(timeout=120)
+    assert proc.returncode == 143, err
+    assert b"interrupted after" in err and b"Traceback" not in err
+    partial = io.load(out)
+    assert partial.attrs["status"] == "partial"
+    done = int(partial.attrs["cycles_done"])
+    assert 0 < done < 300_000
+
+    assert main(["info", str(out)]) == 0
+    text = capsys.readouterr().out
+    assert f"status: PARTIAL result: the run stopped after {done:g} of 300000 cycles" in text
+    # any command reading it says so too
+    main(["sim", "calibrate-kw", str(out), "--max-depth-um", "1", "--linear"])
+    assert f"warning: {out}: PARTIAL result" in capsys.readouterr().err
+    # and a rerun without --resume does not silently replace it
+    assert main([*run, "--out", str(out)]) == 3
+    assert "--resume" in capsys.readouterr().err
+
+
+def test_describe_status_of_partial_results():
+    from jointwear.conventions import describe_status, is_partial
+
+    assert not is_partial({}) and describe_status({"status": "complete"}) is None
+    wear = {"status": "partial", "cycles_done": 30000, "cycles_target": 1e6}
+    assert describe_status(wear).startswith(
+        "PARTIAL result: the run stopped after 30000 of 1e+06 cycles"
+    )
+    track = {"status": "stopped after 7 frames: unreadable frame", "frames_processed": 7}
+    assert is_partial(track) and "after 7 frames" in describe_status(track)
