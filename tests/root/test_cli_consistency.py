@@ -246,3 +246,41 @@ def test_describe_status_of_partial_results():
     )
     track = {"status": "stopped after 7 frames: unreadable frame", "frames_processed": 7}
     assert is_partial(track) and "after 7 frames" in describe_status(track)
+
+
+@pytest.fixture
+def small_disk(tmp_path):
+    """A 64 kB tmpfs that can be enlarged ("free space"); needs root, skipped elsewhere."""
+    mnt = tmp_path / "disk"
+    mnt.mkdir()
+    cmd = ["mount", "-t", "tmpfs", "-o", "size=64k", "tmpfs", str(mnt)]
+    if subprocess.run(cmd, capture_output=True, check=False).returncode != 0:
+        pytest.skip("cannot mount a small tmpfs here (needs root)")
+    try:
+        yield mnt
+    finally:
+        subprocess.run(["umount", str(mnt)], check=False)
+
+
+def test_wear_run_on_a_full_disk_names_the_file_and_resumes_identically(
+    small_disk, tmp_path, capsys
+):
+    run = ["sim", "wear", *SMALL, "--scheme", "fixed", "--dn", "200", "--cycles", "3e4"]
+    ref = tmp_path / "ref.nc"
+    assert main([*run, "--out", str(ref)]) == 0
+    out = small_disk / "w.nc"
+    capsys.readouterr()
+    assert main([*run, "--out", str(out)]) == 3
+    err = capsys.readouterr().err
+    ckpt = small_disk / "w.nc.ckpt"
+    assert f"'{ckpt}'" in err and "disk is full" in err and "--resume" in err
+    assert "Traceback" not in err
+    assert sorted(p.name for p in small_disk.iterdir()) == ["w.nc.ckpt"]  # no temporaries
+    # free space, then continue: the result is the one of the uninterrupted run
+    remount = ["mount", "-o", "remount,size=1m", str(small_disk)]
+    subprocess.run(remount, check=True)
+    assert main([*run, "--out", str(out), "--resume"]) == 0
+    full, resumed = io.load(ref), io.load(out)
+    assert resumed.attrs["status"] == "complete"
+    for name in ("wear_depth", "worn_volume", "normal_work", "update_dn"):
+        np.testing.assert_array_equal(resumed[name].values, full[name].values)
