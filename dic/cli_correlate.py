@@ -57,8 +57,10 @@ def register(app: typer.Typer) -> None:
         roi: Annotated[
             str | None, typer.Option("--roi", help="Region x_min,y_min,x_max,y_max (pixels).")
         ] = None,
-        subset: Annotated[int, typer.Option("--subset", help="Subset size (pixels), odd.")] = 31,
-        step: Annotated[int, typer.Option("--step", help="Grid step (pixels).")] = 10,
+        subset: Annotated[
+            int, typer.Option("--subset", min=3, help="Subset size (pixels), odd.")
+        ] = 31,
+        step: Annotated[int, typer.Option("--step", min=1, help="Grid step (pixels).")] = 10,
         shape: Annotated[
             Literal["affine", "quadratic"],
             typer.Option("--shape", help="Shape function: affine or quadratic."),
@@ -79,15 +81,22 @@ def register(app: typer.Typer) -> None:
         ] = 0.8,
         reference_mode: Annotated[
             Literal["absolute", "incremental"],
-            typer.Option("--reference", help="Sequences: absolute or incremental."),
+            typer.Option(
+                "--sequence-mode",
+                help="Sequences: absolute (every frame against the first) or incremental "
+                "(against the previous one).",
+            ),
         ] = "absolute",
         frame_rate: Annotated[
-            float | None, typer.Option("--frame-rate", help="Sequences: frames per second.")
+            float | None,
+            typer.Option("--fps", "--frame-rate", help="Sequences: frame rate (1/s)."),
         ] = None,
         plot: Annotated[
             Path | None, typer.Option("--plot", help="Write a quick-look figure (png).")
         ] = None,
-        threads: Annotated[int, typer.Option("--threads", help="numba threads (0: auto).")] = 0,
+        threads: Annotated[
+            int, typer.Option("--threads", min=0, help="numba threads (0: auto).")
+        ] = 0,
     ) -> None:
         """Subset DIC (ZNSSD, IC-GN): displacement u, v (pixels) on a grid, written to netCDF."""
         import time as _time

@@ -60,8 +60,8 @@ def register(app: typer.Typer) -> None:
             int | None,
             typer.Option(help="Index of the view whose board pose becomes the world frame."),
         ] = None,
-        min_views: Annotated[int, typer.Option(help="Fewest usable views.")] = 6,
-        every: Annotated[int, typer.Option(help="Videos: use every N-th frame.")] = 10,
+        min_views: Annotated[int, typer.Option(min=1, help="Fewest usable views.")] = 6,
+        every: Annotated[int, typer.Option(min=1, help="Videos: use every N-th frame.")] = 10,
     ) -> None:
         """Calibrate a stereo pair from simultaneous views of a chessboard or ChArUco board."""
         from jointwear import io
@@ -250,7 +250,8 @@ def register(app: typer.Typer) -> None:
         ),
         overwrite: Overwrite = False,
         reference: Annotated[
-            Path | None, typer.Option(help="Reference to overlay (ground truth, simulation).")
+            Path | None,
+            typer.Option("--overlay", help="File to overlay (ground truth, simulation) (.nc)."),
         ] = None,
     ) -> None:
         """Plot the follower velocity and the journal's out-of-plane displacement."""

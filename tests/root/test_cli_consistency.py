@@ -82,6 +82,9 @@ def test_units_in_help_survive_rich_markup(capsys, monkeypatch):
         ["dic", "correlate", "a.png", "b.png", "--shape", "cubic"],
         ["metrology", "assess", "a.nc", "--filter-kind", "spline"],
         ["sim", "cycle", "--cycles", "many"],
+        ["sim", "wear", "--out", "x.nc", "--layers", "0"],
+        ["datasets", "speckle", "sp", "--bit-depth", "17"],
+        ["dic", "correlate", "a.png", "b.png", "--step", "0"],
     ],
     ids=lambda a: " ".join(a[:2] + a[-2:-1]),
 )
@@ -91,6 +94,20 @@ def test_bad_option_values_are_usage_errors_naming_the_flag(argv, tmp_path, caps
     err = capsys.readouterr().err
     assert argv[-2] in err and "Traceback" not in err
     assert not list(tmp_path.iterdir())  # nothing written
+
+
+def test_one_name_per_concept():
+    # a frame rate is --fps everywhere (--frame-rate only as the old second name of it)
+    rates = [
+        (p, prm.opts)
+        for p, c in COMMANDS
+        for prm in c.params
+        if {"--fps", "--frame-rate"} & set(prm.opts)
+    ]
+    assert len(rates) >= 3 and all(opts[0] == "--fps" for _, opts in rates), rates
+    # --reference is the ISO reference circle/cylinder of metrology assess, nothing else
+    users = [" ".join(p) for p, c in COMMANDS for prm in c.params if "--reference" in prm.opts]
+    assert users == ["metrology assess"], users
 
 
 def _speckle(tmp_path, *extra):
