@@ -112,6 +112,15 @@ def _on_sigterm(signum: int, frame: object) -> None:
     raise KeyboardInterrupt()
 
 
+def _stdout_is_null() -> bool:
+    """True if stdout is /dev/null (rich points it there when the reader of a pipe is gone)."""
+    try:
+        out, null = os.fstat(sys.stdout.fileno()), os.stat(os.devnull)
+    except (OSError, ValueError, AttributeError):  # no file descriptor (tests)
+        return False
+    return (out.st_dev, out.st_ino) == (null.st_dev, null.st_ino)
+
+
 def _quiet_broken_pipe() -> None:
     """The reader of stdout went away (``jointwear info x.nc | head``): stop quietly."""
     try:
@@ -127,6 +136,7 @@ def main(argv: list[str] | None = None) -> int:
     debug = "--debug" in args
     compiled = announce_compilation()
     _STATE["terminated"] = False
+    stdout_was_null = _stdout_is_null()
     try:
         previous = signal.signal(signal.SIGTERM, _on_sigterm)
     except ValueError:  # not the main thread
@@ -137,6 +147,12 @@ def main(argv: list[str] | None = None) -> int:
         code = exc.code
         if _STATE["terminated"]:  # click turned the KeyboardInterrupt into an exit
             return 128 + signal.SIGTERM
+        if code == 1 and (
+            type(sys.stdout).__name__ == "PacifyFlushWrapper"  # click, on a closed pipe
+            or (not stdout_was_null and _stdout_is_null())  # rich, on a closed pipe
+        ):
+            _quiet_broken_pipe()
+            return 0
         return code if isinstance(code, int) else (0 if code is None else EXIT_USAGE)
     except BrokenPipeError:
         _quiet_broken_pipe()

@@ -201,18 +201,26 @@ def _big_file(path):
     io.save(ds, path)
 
 
+def _closed_pipe(*argv):
+    """Run jointwear with a stdout pipe whose reader is gone before the first write."""
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "jointwear", *argv],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+    )
+    proc.stdout.close()  # long before the command has imported what it needs
+    _, err = proc.communicate(timeout=120)
+    return proc.returncode, err.decode()
+
+
 def test_closed_pipe_exits_0_quietly(tmp_path):
     path = tmp_path / "big.nc"
     _big_file(path)
-    res = subprocess.run(
-        ["bash", "-c", f"set -o pipefail; '{sys.executable}' -m jointwear info '{path}' | head -2"],
-        capture_output=True,
-        text=True,
-        check=False,
-    )
-    assert res.stdout.startswith("file: ")
-    assert res.returncode == 0, res.stderr
-    assert res.stderr == "", res.stderr
+    assert _closed_pipe("info", str(path)) == (0, "")
+    # help is written by rich, which has its own way of meeting a closed pipe
+    assert _closed_pipe("sim", "wear", "--help") == (0, "")
+    # an error is still an error
+    assert _closed_pipe("info", str(tmp_path / "missing.nc"))[0] == 3
 
 
 SMALL = ["--contact", "winkler", "--layers", "6", "--points", "48", "--kw", "1e-13"]
