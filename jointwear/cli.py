@@ -171,6 +171,18 @@ def main(argv: list[str] | None = None) -> int:
             raise
         typer.echo(f"jointwear: error: {exc}", err=True)
         return EXIT_BAD_INPUT
+    except Exception as exc:  # a bug: say so, without a traceback unless --debug
+        if debug:
+            raise
+        text = str(exc)
+        text = text if len(text) < 300 else text[:300] + " ..."
+        typer.echo(
+            f"jointwear: error: unexpected {type(exc).__name__}: {text}\n"
+            "This is a bug in jointwear: please report it with the output of the same command "
+            "run with --debug.",
+            err=True,
+        )
+        return EXIT_BAD_INPUT
     finally:
         if previous is not None:
             signal.signal(signal.SIGTERM, previous)

@@ -309,3 +309,18 @@ def test_wear_run_on_a_full_disk_names_the_file_and_resumes_identically(
     assert resumed.attrs["status"] == "complete"
     for name in ("wear_depth", "worn_volume", "normal_work", "update_dn"):
         np.testing.assert_array_equal(resumed[name].values, full[name].values)
+
+
+def test_an_unexpected_exception_is_reported_without_traceback(tmp_path, capsys, monkeypatch):
+    import jointwear.summary
+
+    def broken(path, validate=True):
+        raise ZeroDivisionError("deep inside a library")
+
+    monkeypatch.setattr(jointwear.summary, "summarise", broken)
+    assert main(["info", str(tmp_path / "x.nc")]) == 3
+    err = capsys.readouterr().err
+    assert "unexpected ZeroDivisionError: deep inside a library" in err
+    assert "--debug" in err and "Traceback" not in err
+    with pytest.raises(ZeroDivisionError):
+        main(["--debug", "info", str(tmp_path / "x.nc")])
