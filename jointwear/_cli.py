@@ -13,7 +13,7 @@ Every command and group of ``jointwear`` is built with :class:`Command` / :class
 - warn on stderr when a netCDF input is the partial result of an interrupted run
   (:func:`jointwear.conventions.describe_status`);
 - show no ``<bool>`` after flags and ``<path>`` rather than ``<list[Path]>`` for repeatable
-  options in the help, and keep units in brackets (``[mm]``), which rich markup would eat.
+  options in the help, ``FILE`` rather than ``{file}`` in usage lines, and keep units in brackets (``[mm]``), which rich markup would eat.
 """
 
 from __future__ import annotations
@@ -71,6 +71,12 @@ class _TidyOption(TyperOption):
 
 
 class _TidyArgument(TyperArgument):
+    def _usage_display_name(self) -> str:
+        # FILE, [DEFORMED], PATHS... (click's convention) rather than {file}
+        name = (self.metavar or self.name or "arg").upper()
+        name = name if self.required else f"[{name}]"
+        return name + ("..." if self.nargs != 1 else "")
+
     def display_type(self, ctx: Any) -> str:
         if self.type_descriptor.is_list and not self.type_descriptor.is_choice:
             return f"<{_element_label(self)}>"

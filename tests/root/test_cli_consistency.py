@@ -57,6 +57,8 @@ def test_help_has_no_python_type_names_and_keeps_units(path, capsys, monkeypatch
     assert main([*path, "--help"]) == 0
     text = capsys.readouterr().out
     assert "<bool>" not in text and "<list[" not in text, text
+    usage = next(line for line in text.splitlines() if "Usage:" in line)
+    assert "{" not in usage, usage  # FILE, not {file}
     # every unit in brackets written in the help source is shown
     for prm in _command(*path).params:
         for unit in re.findall(r"\\\[([^\]]+)\]", prm.help or ""):
