@@ -31,7 +31,7 @@ app = typer.Typer(
     cls=CommandGroup,
 )
 
-_STATE = {"debug": False, "terminated": False}
+_STATE: dict[str, object] = {"debug": False, "signal": None}
 
 
 def _version_callback(value: bool) -> None:
@@ -106,10 +106,16 @@ _register_groups()
 apply_classes(app)
 
 
-def _on_sigterm(signum: int, frame: object) -> None:
-    """SIGTERM is handled like Ctrl-C (commands keep their partial results), exit 143."""
-    _STATE["terminated"] = True
+def _on_signal(signum: int, frame: object) -> None:
+    """Ctrl-C and SIGTERM: commands keep their partial results; exit 130 or 143."""
+    _STATE["signal"] = signum
     raise KeyboardInterrupt()
+
+
+def _interrupted() -> int | None:
+    """128 + the signal that stopped the command (also when it turned it into an error)."""
+    signum = _STATE["signal"]
+    return 128 + int(signum) if signum is not None else None
 
 
 def _stdout_is_null() -> bool:
@@ -135,18 +141,20 @@ def main(argv: list[str] | None = None) -> int:
     args = sys.argv[1:] if argv is None else list(argv)
     debug = "--debug" in args
     compiled = announce_compilation()
-    _STATE["terminated"] = False
+    _STATE["signal"] = None
     stdout_was_null = _stdout_is_null()
-    try:
-        previous = signal.signal(signal.SIGTERM, _on_sigterm)
-    except ValueError:  # not the main thread
-        previous = None
+    previous = {}
+    for signum in (signal.SIGINT, signal.SIGTERM):
+        try:
+            previous[signum] = signal.signal(signum, _on_signal)
+        except ValueError:  # not the main thread
+            pass
     try:
         app(args=args, prog_name="jointwear", standalone_mode=True)
     except SystemExit as exc:  # click's own exits: 0, usage errors (2), aborts
         code = exc.code
-        if _STATE["terminated"]:  # click turned the KeyboardInterrupt into an exit
-            return 128 + signal.SIGTERM
+        if _interrupted():  # click turned the KeyboardInterrupt into an exit
+            return _interrupted()
         if code == 1 and (
             type(sys.stdout).__name__ == "PacifyFlushWrapper"  # click, on a closed pipe
             or (not stdout_was_null and _stdout_is_null())  # rich, on a closed pipe
@@ -161,11 +169,11 @@ def main(argv: list[str] | None = None) -> int:
         if debug:
             raise
         typer.echo(f"jointwear: error: {exc}", err=True)
-        return exc.exit_code
+        return _interrupted() or exc.exit_code  # a command may report an interrupt as error
     except KeyboardInterrupt:
-        terminated = bool(_STATE["terminated"])
+        terminated = _STATE["signal"] == signal.SIGTERM
         typer.echo("terminated" if terminated else "interrupted", err=True)
-        return 128 + (signal.SIGTERM if terminated else signal.SIGINT)
+        return _interrupted() or 128 + signal.SIGINT
     except (OSError, MemoryError) as exc:
         if debug:
             raise
@@ -184,8 +192,8 @@ def main(argv: list[str] | None = None) -> int:
         )
         return EXIT_BAD_INPUT
     finally:
-        if previous is not None:
-            signal.signal(signal.SIGTERM, previous)
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)
         line = compiled()
         if line:
             try:
