@@ -196,12 +196,12 @@ def _flag_partial_inputs(cmd: Any, ctx: Any) -> None:
     if cmd.name == "info":
         return
     for p in cmd.params:
-        if p.name in OUTPUT_PARAMS or p.name == "checkpoint":
+        if p.name in OUTPUT_PARAMS:
             continue
         values = ctx.params.get(p.name)
         values = values if isinstance(values, (list, tuple)) else [values]
         for v in values:
-            if isinstance(v, Path) and v.suffix == ".nc" and v.is_file():
+            if isinstance(v, Path) and v.suffix == ".nc" and _is_file(str(v)):
                 status = _input_status(v)
                 if status:
                     typer.echo(f"warning: {v}: {status}", err=True)
