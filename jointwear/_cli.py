@@ -65,6 +65,10 @@ class _TidyOption(TyperOption):
     def display_type(self, ctx: Any) -> str:
         if self.is_flag and not self.count:
             return ""
+        if self.type_descriptor.is_choice:  # the help text lists them; keep the column narrow
+            return "<choice>"
+        if self.type_descriptor.is_ranged:  # "<int range>": the range follows as [x>=1]
+            return f"<{self.bare_type()}>"
         if self.type_descriptor.is_list and not self.type_descriptor.is_choice:
             return f"<{_element_label(self)}>"
         return super().display_type(ctx)

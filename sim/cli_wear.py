@@ -230,10 +230,10 @@ def register(app: typer.Typer) -> None:
             ),
         ] = None,
         layers: Annotated[
-            int | None, typer.Option("--layers", min=1, help="Layers over the bearing width (Nl).")
+            int | None, typer.Option("--layers", help="Layers over the bearing width (Nl).")
         ] = None,
         points: Annotated[
-            int | None, typer.Option("--points", min=1, help="Points per layer (Nd).")
+            int | None, typer.Option("--points", help="Points per layer (Nd).")
         ] = None,
         contact: Annotated[
             Literal["dynamics", "winkler"],

@@ -84,7 +84,7 @@ def test_units_in_help_survive_rich_markup(capsys, monkeypatch):
         ["dic", "correlate", "a.png", "b.png", "--shape", "cubic"],
         ["metrology", "assess", "a.nc", "--filter-kind", "spline"],
         ["sim", "cycle", "--cycles", "many"],
-        ["sim", "wear", "--out", "x.nc", "--layers", "0"],
+        ["dic", "correlate", "a.png", "b.png", "--subset", "1"],
         ["datasets", "speckle", "sp", "--bit-depth", "17"],
         ["dic", "correlate", "a.png", "b.png", "--step", "0"],
     ],
