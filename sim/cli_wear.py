@@ -253,7 +253,7 @@ def register(app: typer.Typer) -> None:
         """Simulate Archard wear of joint C over many cycles; checkpoint after every update."""
         from jointwear import io
         from jointwear.errors import BadInputError, SimulationError
-        from jointwear.outputs import OutputError
+        from jointwear.outputs import OutputError, OutputExistsError
         from jointwear.params import to_jsonable
         from jointwear.progress import progress_bar
         from jointwear.sim.wear import WearRun
@@ -282,6 +282,11 @@ def register(app: typer.Typer) -> None:
         else:
             raise BadInputError(f"--contact must be 'dynamics' or 'winkler', got {contact!r}")
         if not resume and ckpt.exists():
+            if not overwrite:  # the state of an earlier run: never thrown away unasked
+                raise OutputExistsError(
+                    f"checkpoint '{ckpt}' of an earlier run exists; continue that run with "
+                    "--resume, or give --overwrite to start over"
+                )
             typer.echo(
                 f"note: replacing the old checkpoint {ckpt} (use --resume to continue it)", err=True
             )

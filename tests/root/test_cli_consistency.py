@@ -326,3 +326,16 @@ def test_an_unexpected_exception_is_reported_without_traceback(tmp_path, capsys,
     assert "--debug" in err and "Traceback" not in err
     with pytest.raises(ZeroDivisionError):
         main(["--debug", "info", str(tmp_path / "x.nc")])
+
+
+def test_checkpoint_of_a_killed_wear_run_is_not_thrown_away_unasked(tmp_path, capsys):
+    out = tmp_path / "w.nc"
+    ckpt = tmp_path / "w.nc.ckpt"
+    ckpt.write_bytes(b"state of a run killed before it wrote --out")
+    run = ["sim", "wear", *SMALL, "--cycles", "1e3", "--out", str(out)]
+    assert main(run) == 3
+    err = capsys.readouterr().err
+    assert f"'{ckpt}'" in err and "--resume" in err and "--overwrite" in err
+    assert ckpt.read_bytes().startswith(b"state of a run killed")
+    assert main([*run, "--overwrite"]) == 0
+    assert io.load(out).attrs["status"] == "complete"
