@@ -7,6 +7,8 @@ from typing import Annotated
 
 import typer
 
+from jointwear._cli import Overwrite
+
 
 def register(app: typer.Typer) -> None:
     """Make the ``jointwear compare`` group itself the command (no sub-command needed)."""
@@ -27,6 +29,7 @@ def register(app: typer.Typer) -> None:
             Path,
             typer.Option("--out", "-o", help="netCDF of aligned fields, differences, metrics."),
         ] = Path("metrics.nc"),
+        overwrite: Overwrite = False,
         sim_extra: Annotated[
             list[Path] | None,
             typer.Option("--sim", help="Further simulated file (e.g. the motion record)."),

@@ -3,9 +3,11 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Literal
 
 import typer
+
+from jointwear._cli import Overwrite
 
 
 def register(app: typer.Typer) -> None:
@@ -14,6 +16,7 @@ def register(app: typer.Typer) -> None:
     @app.command("instruments")
     def instruments_cmd(
         out: Annotated[Path, typer.Argument(help="Output folder (or file for long/wide/single).")],
+        overwrite: Overwrite = False,
         layers: Annotated[int, typer.Option("--layers", help="Number of layers.")] = 13,
         points: Annotated[int, typer.Option("--points", help="Points per layer.")] = 18000,
         radius_mm: Annotated[
@@ -27,15 +30,18 @@ def register(app: typer.Typer) -> None:
             float, typer.Option("--spacing-mm", help="Layer spacing [mm].")
         ] = 1.0,
         layout: Annotated[
-            str,
+            Literal["folder", "folder-names", "folder-header", "long", "wide", "single"],
             typer.Option(
                 "--layout", help="folder, folder-names, folder-header, long, wide or single."
             ),
         ] = "folder",
-        value: Annotated[str, typer.Option("--value", help="deviation or radius.")] = "deviation",
+        value: Annotated[
+            Literal["deviation", "radius"], typer.Option("--value", help="deviation or radius.")
+        ] = "deviation",
         units: Annotated[str, typer.Option("--units", help="um, mm, m or inch.")] = "um",
         angle: Annotated[
-            str, typer.Option("--angle", help="Angle column: deg, rad, index, none or xy.")
+            Literal["deg", "rad", "index", "none", "xy"],
+            typer.Option("--angle", help="Angle column: deg, rad, index, none or xy."),
         ] = "deg",
         delimiter: Annotated[
             str, typer.Option("--delimiter", help="tab, semicolon, comma or space.")

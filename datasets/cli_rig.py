@@ -3,9 +3,11 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Literal
 
 import typer
+
+from jointwear._cli import Overwrite
 
 
 def register(app: typer.Typer) -> None:
@@ -14,6 +16,7 @@ def register(app: typer.Typer) -> None:
     @app.command("rig")
     def rig(
         out: Annotated[Path, typer.Option("--out", "-o", help="Output folder.")],
+        overwrite: Overwrite = False,
         duration: Annotated[float, typer.Option(help="Recorded time (s).")] = 1.0,
         fps: Annotated[float, typer.Option(help="Frame rate (1/s).")] = 50.0,
         width: Annotated[int, typer.Option(help="Image width (px).")] = 1280,
@@ -25,7 +28,8 @@ def register(app: typer.Typer) -> None:
         blur: Annotated[float, typer.Option(help="Optical blur sigma (px).")] = 0.6,
         exposure: Annotated[float, typer.Option(help="Brightness gain.")] = 1.0,
         codec: Annotated[
-            str, typer.Option(help="ffv1, png or grey (lossless), mjpg or mp4v (lossy).")
+            Literal["ffv1", "png", "grey", "mjpg", "mp4v"],
+            typer.Option(help="ffv1, png or grey (lossless), mjpg or mp4v (lossy)."),
         ] = "ffv1",
         video: Annotated[bool, typer.Option(help="Write videos.")] = True,
         images: Annotated[bool, typer.Option(help="Write image folders.")] = True,
@@ -37,7 +41,7 @@ def register(app: typer.Typer) -> None:
         ] = None,
         seed: Annotated[int, typer.Option(help="Random seed.")] = 0,
         board: Annotated[
-            str,
+            Literal["chessboard", "charuco"],
             typer.Option(
                 help="Calibration board: chessboard, or charuco (10 x 8 squares of 25 mm, "
                 "18.75 mm DICT_5X5_100 markers)."

@@ -3,9 +3,11 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Literal
 
 import typer
+
+from jointwear._cli import Overwrite
 
 FIELDS = ("rigid", "affine", "rotation", "sinusoidal")
 
@@ -16,9 +18,11 @@ def register(app: typer.Typer) -> None:
     @app.command("speckle")
     def speckle_cmd(
         out: Annotated[Path, typer.Argument(help="Output folder.")],
+        overwrite: Overwrite = False,
         size: Annotated[str, typer.Option("--size", help="WIDTHxHEIGHT (pixels).")] = "512x512",
         field: Annotated[
-            str, typer.Option("--field", help="rigid, affine, rotation or sinusoidal.")
+            Literal["rigid", "affine", "rotation", "sinusoidal"],
+            typer.Option("--field", help="rigid, affine, rotation or sinusoidal."),
         ] = "rigid",
         u: Annotated[float, typer.Option("--u", help="Translation along x (pixels).")] = 1.5,
         v: Annotated[float, typer.Option("--v", help="Translation along y (pixels).")] = -0.7,
@@ -35,7 +39,7 @@ def register(app: typer.Typer) -> None:
             float, typer.Option("--wavelength", help="Sinusoidal: wavelength (pixels).")
         ] = 128.0,
         frames: Annotated[
-            int, typer.Option("--frames", help="Number of deformed frames (field ramps up).")
+            int, typer.Option("--frames", min=1, help="Number of deformed frames (field ramps up).")
         ] = 1,
         speckle_size: Annotated[
             float, typer.Option("--speckle-size", help="Speckle diameter (pixels).")
@@ -44,7 +48,9 @@ def register(app: typer.Typer) -> None:
         contrast: Annotated[float, typer.Option("--contrast", help="0..1 of full scale.")] = 0.8,
         noise: Annotated[float, typer.Option("--noise", help="Noise std (grey levels).")] = 0.0,
         blur: Annotated[float, typer.Option("--blur", help="Gaussian PSF std (pixels).")] = 0.0,
-        bit_depth: Annotated[int, typer.Option("--bit-depth", help="8 or up to 16.")] = 8,
+        bit_depth: Annotated[
+            int, typer.Option("--bit-depth", min=1, max=16, help="8 or up to 16.")
+        ] = 8,
         seed: Annotated[int, typer.Option("--seed", help="Random seed.")] = 0,
     ) -> None:
         """Write reference/deformed speckle PNGs and the exact displacement (truth.nc)."""

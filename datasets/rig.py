@@ -38,6 +38,7 @@ import xarray as xr
 
 from jointwear.dic._calib import Camera, StereoCalibration
 from jointwear.errors import BadInputError
+from jointwear.outputs import write_image
 
 __all__ = [
     "RigConfig",
@@ -769,7 +770,6 @@ def generate_rig(
     dict
         Paths of what was written.
     """
-    import cv2
 
     from jointwear import io
 
@@ -797,7 +797,7 @@ def generate_rig(
                 img = last[1]
                 if images:
                     folder.mkdir(exist_ok=True)
-                    cv2.imwrite(str(folder / f"frame_{k:06d}.png"), img)
+                    write_image(folder / f"frame_{k:06d}.png", img)
                 if progress is not None:
                     progress(cam, k + 1, n)
                 yield img
@@ -821,7 +821,7 @@ def generate_rig(
             for cam, img in (("left", L), ("right", R)):
                 folder = out / "calibration" / cam
                 folder.mkdir(parents=True, exist_ok=True)
-                cv2.imwrite(str(folder / f"board_{i:02d}.png"), img)
+                write_image(folder / f"board_{i:02d}.png", img)
         written["calibration"] = out / "calibration"
     truth = rig.ground_truth()
     truth["frame_recorded"] = (

@@ -3,10 +3,11 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Literal
 
 import typer
 
+from jointwear._cli import Overwrite
 from jointwear.errors import BadInputError
 
 
@@ -85,16 +86,21 @@ def register(app: typer.Typer) -> None:
             Path | None, typer.Argument(help="Deformed image (omit for a sequence).")
         ] = None,
         out: Annotated[Path, typer.Option("--out", help="Output netCDF file.")] = Path("field.nc"),
+        overwrite: Overwrite = False,
         roi: Annotated[
             str | None, typer.Option("--roi", help="Region x_min,y_min,x_max,y_max (pixels).")
         ] = None,
-        subset: Annotated[int, typer.Option("--subset", help="Subset size (pixels), odd.")] = 31,
-        step: Annotated[int, typer.Option("--step", help="Grid step (pixels).")] = 10,
+        subset: Annotated[
+            int, typer.Option("--subset", min=3, help="Subset size (pixels), odd.")
+        ] = 31,
+        step: Annotated[int, typer.Option("--step", min=1, help="Grid step (pixels).")] = 10,
         shape: Annotated[
-            str, typer.Option("--shape", help="Shape function: affine or quadratic.")
+            Literal["affine", "quadratic"],
+            typer.Option("--shape", help="Shape function: affine or quadratic."),
         ] = "affine",
         interpolation: Annotated[
-            str, typer.Option("--interpolation", help="B-spline: quintic or cubic.")
+            Literal["quintic", "cubic"],
+            typer.Option("--interpolation", help="B-spline: quintic or cubic."),
         ] = "quintic",
         search_radius: Annotated[
             int, typer.Option("--search-radius", help="Seed search half-width (pixels).")
@@ -135,16 +141,23 @@ def register(app: typer.Typer) -> None:
             ),
         ] = None,
         reference_mode: Annotated[
-            str,
-            typer.Option("--reference", help="Sequences: absolute or incremental."),
+            Literal["absolute", "incremental"],
+            typer.Option(
+                "--sequence-mode",
+                help="Sequences: absolute (every frame against the first) or incremental "
+                "(against the previous one).",
+            ),
         ] = "absolute",
         frame_rate: Annotated[
-            float | None, typer.Option("--frame-rate", help="Sequences: frames per second.")
+            float | None,
+            typer.Option("--fps", "--frame-rate", help="Sequences: frame rate (1/s)."),
         ] = None,
         plot: Annotated[
             Path | None, typer.Option("--plot", help="Write a quick-look figure (png).")
         ] = None,
-        threads: Annotated[int, typer.Option("--threads", help="numba threads (0: auto).")] = 0,
+        threads: Annotated[
+            int, typer.Option("--threads", min=0, help="numba threads (0: auto).")
+        ] = 0,
     ) -> None:
         """Subset DIC (ZNSSD, IC-GN): displacement u, v (pixels) on a grid, written to netCDF."""
         import time as _time

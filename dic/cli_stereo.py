@@ -3,9 +3,11 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Literal
 
 import typer
+
+from jointwear._cli import Overwrite
 
 
 def _image_list(path: Path, what: str) -> list[Path]:
@@ -44,7 +46,10 @@ def register(app: typer.Typer) -> None:
         out: Annotated[Path, typer.Option("--out", "-o", help="Calibration file (.nc).")] = Path(
             "calibration.nc"
         ),
-        board: Annotated[str, typer.Option(help="chessboard or charuco.")] = "chessboard",
+        overwrite: Overwrite = False,
+        board: Annotated[
+            Literal["chessboard", "charuco"], typer.Option(help="chessboard or charuco.")
+        ] = "chessboard",
         squares: Annotated[
             tuple[int, int], typer.Option(help="Squares along x and y (not inner corners).")
         ] = (10, 7),
@@ -75,8 +80,8 @@ def register(app: typer.Typer) -> None:
             int | None,
             typer.Option(help="Index of the view whose board pose becomes the world frame."),
         ] = None,
-        min_views: Annotated[int, typer.Option(help="Fewest usable views.")] = 6,
-        every: Annotated[int, typer.Option(help="Videos: use every N-th frame.")] = 10,
+        min_views: Annotated[int, typer.Option(min=1, help="Fewest usable views.")] = 6,
+        every: Annotated[int, typer.Option(min=1, help="Videos: use every N-th frame.")] = 10,
         max_rms: Annotated[
             float, typer.Option(help="Largest acceptable stereo reprojection RMS (px).")
         ] = 1.0,
@@ -206,10 +211,13 @@ def register(app: typer.Typer) -> None:
                 show_default=False,
             ),
         ],
-        fmt: Annotated[str, typer.Option("--format", help="opencv or vic3d.")],
+        fmt: Annotated[
+            Literal["opencv", "vic3d"], typer.Option("--format", help="opencv or vic3d.")
+        ],
         out: Annotated[Path, typer.Option("--out", "-o", help="Calibration file (.nc).")] = Path(
             "calibration.nc"
         ),
+        overwrite: Overwrite = False,
         length_unit: Annotated[
             str | None,
             typer.Option(help="OpenCV: unit of T (m, mm, cm, um, in, or metres per unit)."),
@@ -273,6 +281,7 @@ def register(app: typer.Typer) -> None:
         out: Annotated[Path, typer.Option("--out", "-o", help="Body motion (.nc).")] = Path(
             "motion.nc"
         ),
+        overwrite: Overwrite = False,
         fps: Annotated[
             float | None, typer.Option(help="Frame rate (1/s) (image sequences).")
         ] = None,
@@ -393,8 +402,10 @@ def register(app: typer.Typer) -> None:
         out: Annotated[Path, typer.Option("--out", "-o", help="Figure (.png/.svg/.pdf).")] = Path(
             "motion.png"
         ),
+        overwrite: Overwrite = False,
         reference: Annotated[
-            Path | None, typer.Option(help="Reference to overlay (ground truth, simulation).")
+            Path | None,
+            typer.Option("--overlay", help="File to overlay (ground truth, simulation) (.nc)."),
         ] = None,
     ) -> None:
         """Plot the follower velocity and the journal's out-of-plane displacement."""

@@ -1,20 +1,297 @@
-"""Helpers shared by the CLI groups."""
+"""Helpers shared by the CLI groups: command classes that make every command behave alike.
+
+Every command and group of ``jointwear`` is built with :class:`Command` / :class:`CommandGroup`
+(:func:`apply_classes` sets them on the whole tree), which
+
+- claim the outputs of a command that declares ``overwrite: Overwrite = False`` for its whole
+  run (:func:`jointwear.outputs.claim`): the options named in :data:`OUTPUT_PARAMS` are locked
+  against a second writer, and an existing output is refused unless ``--overwrite`` (or
+  ``--resume`` for the commands that continue a partial result) is given;
+- speak in flags: a message raised by the library that quotes a Python keyword
+  (``units='um'``, ``layer_spacing=<m>``) is rewritten with the command's flag
+  (``--units um``, ``--layer-spacing-mm <mm>``);
+- warn on stderr when a netCDF input is the partial result of an interrupted run
+  (:func:`jointwear.conventions.describe_status`);
+- show no ``<bool>`` after flags and ``<path>`` rather than ``<list[Path]>`` for repeatable
+  options in the help, ``FILE`` rather than ``{file}`` in usage lines, and keep units in brackets (``[mm]``), which rich markup would eat.
+"""
 
 from __future__ import annotations
 
 import importlib
 import pkgutil
-from typing import Any
+import re
+from pathlib import Path
+from typing import Annotated, Any
 
 import typer
-from typer.core import TyperGroup
+from typer.core import TyperArgument, TyperCommand, TyperGroup, TyperOption
 
-__all__ = ["discover_commands", "CommandGroup"]
+__all__ = [
+    "discover_commands",
+    "apply_classes",
+    "Command",
+    "CommandGroup",
+    "Overwrite",
+    "OUTPUT_PARAMS",
+    "speak_flags",
+]
+
+Overwrite = Annotated[
+    bool,
+    typer.Option(
+        "--overwrite",
+        help="Replace existing output files (otherwise an existing output is refused).",
+    ),
+]
+"""The ``--overwrite`` option of every command that writes files."""
+
+OUTPUT_PARAMS = ("out", "checkpoint", "figure", "plot", "csv", "table", "pdf", "truth")
+"""Names of the parameters that are output paths (claimed by :class:`Command`)."""
+
+_UNIT_SUFFIXES = ("mm", "um", "m", "deg", "rad", "s", "ms", "px", "nm", "mm3")
+
+
+# --- help: no <bool>, no <list[...]> ------------------------------------------------------
+def _element_label(param: Any) -> str:
+    from typing import get_args
+
+    args = get_args(param.type_descriptor.annotation)
+    label = param._bare_type(args[0]) if args else "value"
+    return label.lower()
+
+
+class _TidyOption(TyperOption):
+    def display_type(self, ctx: Any) -> str:
+        if self.is_flag and not self.count:
+            return ""
+        if self.type_descriptor.is_choice:  # the help text lists them; keep the column narrow
+            return "<choice>"
+        if self.type_descriptor.is_ranged:  # "<int range>": the range follows as [x>=1]
+            return f"<{self.bare_type()}>"
+        if self.type_descriptor.is_list and not self.type_descriptor.is_choice:
+            return f"<{_element_label(self)}>"
+        return super().display_type(ctx)
+
+
+class _TidyArgument(TyperArgument):
+    def _usage_display_name(self) -> str:
+        # FILE, [DEFORMED], PATHS... (click's convention) rather than {file}
+        name = (self.metavar or self.name or "arg").upper()
+        name = name if self.required else f"[{name}]"
+        return name + ("..." if self.nargs != 1 else "")
+
+    def display_type(self, ctx: Any) -> str:
+        if self.type_descriptor.is_list and not self.type_descriptor.is_choice:
+            return f"<{_element_label(self)}>"
+        return super().display_type(ctx)
+
+
+def escape_brackets(text: str | None) -> str | None:
+    """Escape ``[`` so rich markup keeps units such as ``[mm]`` in help texts (idempotent)."""
+    return re.sub(r"(?<!\\)\[", r"\\[", text) if text else text
+
+
+def _tidy(params: list[Any]) -> list[Any]:
+    for p in params:
+        if getattr(p, "help", None):
+            p.help = escape_brackets(p.help)
+        if type(p) is TyperOption:
+            p.__class__ = _TidyOption
+        elif type(p) is TyperArgument:
+            p.__class__ = _TidyArgument
+    return params
+
+
+# --- errors: flags, not keywords ----------------------------------------------------------
+def _flag_of(param: Any) -> str | None:
+    longs = [o for o in getattr(param, "opts", []) if o.startswith("--")]
+    return longs[0] if longs else None
+
+
+def _keywords(params: list[Any]) -> dict[str, tuple[str, str | None, Any]]:
+    """Library keyword -> (flag, unit of the flag, parameter) for the options of a command."""
+    out: dict[str, tuple[str, str | None, Any]] = {}
+    for p in params:
+        flag = _flag_of(p)
+        if flag is None or flag == "--help":
+            continue
+        name = flag[2:].replace("-", "_")
+        unit = None
+        for suffix in _UNIT_SUFFIXES:
+            if name.endswith("_" + suffix):
+                name, unit = name[: -len(suffix) - 1], suffix
+                break
+        out.setdefault(name, (flag, unit, p))
+        if p.name and p.name != name:
+            out.setdefault(p.name, (flag, unit, p))
+    return out
+
+
+_VALUE = r"""('[^']*'|"[^"]*"|<[^>]*>|\([^)]*\)|\[[^\]]*\]|\.\.\.|[\w.+-]+)?"""
+
+
+def speak_flags(message: str, params: list[Any]) -> str:
+    """Rewrite ``keyword=value`` in a library message as the command's ``--flag value``."""
+    table = _keywords(params)
+    if not table:
+        return message
+    names = "|".join(sorted(map(re.escape, table), key=len, reverse=True))
+    pattern = re.compile(rf"(?<![\w\-.'\"])({names})={_VALUE}")
+
+    def repl(m: re.Match) -> str:
+        flag, unit, param = table[m.group(1)]
+        value = m.group(2)
+        is_flag = bool(getattr(param, "is_flag", False))
+        secondary = getattr(param, "secondary_opts", None) or []
+        if value in (None, "", "..."):
+            return flag if is_flag else f"{flag} ..."
+        if value == "True" and is_flag:
+            return flag
+        if value in ("False", "None"):
+            if is_flag and secondary:
+                return secondary[0]
+            return f"without {flag}"
+        if value[0] in "'\"" and value[-1] == value[0]:
+            value = value[1:-1]
+        elif value[0] == "<" and unit is not None:
+            value = f"<{unit}>"
+        elif value[0] in "([" and value[-1] in ")]":
+            inner = value[1:-1].strip()
+            value = "..." if inner in ("", "...") else inner.replace(", ", " ").replace(",", " ")
+        return f"{flag} {value}"
+
+    return pattern.sub(repl, message)
+
+
+# --- outputs: lock, refuse existing ---------------------------------------------------------
+def _output_paths(cmd: Any, ctx: Any) -> dict[str, Path]:
+    paths: dict[str, Path] = {}
+    for p in cmd.params:
+        if p.name in OUTPUT_PARAMS and ctx.params.get(p.name) is not None:
+            value = ctx.params[p.name]
+            if isinstance(value, (str, Path)):
+                label = _flag_of(p) or p.name.upper()
+                paths[label] = Path(value)
+    return paths
+
+
+def _input_status(path: Path) -> str | None:
+    """describe_status of a netCDF input, from its global attributes only (cheap)."""
+    try:
+        import netCDF4
+
+        with netCDF4.Dataset(path) as nc:
+            attrs = {
+                k: nc.getncattr(k)
+                for k in ("status", "cycles_done", "cycles_target", "frames_processed")
+                if k in nc.ncattrs()
+            }
+    except Exception:  # unreadable inputs are the command's to report
+        return None
+    from jointwear.conventions import describe_status
+
+    return describe_status(attrs)
+
+
+def _flag_partial_inputs(cmd: Any, ctx: Any) -> None:
+    """A warning on stderr for every netCDF input that is a partial result of a stopped run
+    (``jointwear info`` says it in its summary instead)."""
+    if cmd.name == "info":
+        return
+    for p in cmd.params:
+        if p.name in OUTPUT_PARAMS:
+            continue
+        values = ctx.params.get(p.name)
+        values = values if isinstance(values, (list, tuple)) else [values]
+        for v in values:
+            if isinstance(v, Path) and v.suffix == ".nc" and _is_file(str(v)):
+                status = _input_status(v)
+                if status:
+                    typer.echo(f"warning: {v}: {status}", err=True)
+
+
+def _invoke(cmd: Any, ctx: Any, invoke: Any) -> Any:
+    from jointwear.errors import JointwearError
+
+    try:
+        _flag_partial_inputs(cmd, ctx)
+        if "overwrite" not in ctx.params:
+            return invoke(ctx)
+        from jointwear import outputs
+
+        with outputs.claim(
+            _output_paths(cmd, ctx),
+            overwrite=bool(ctx.params["overwrite"]),
+            resume=bool(ctx.params.get("resume")),
+            resumable="resume" in ctx.params,
+        ) as removed:
+            for tmp in removed:
+                typer.echo(f"note: removed {tmp}, left by an interrupted write", err=True)
+            return invoke(ctx)
+    except JointwearError as exc:
+        if exc.args and isinstance(exc.args[0], str):
+            message = _name_the_input(speak_flags(exc.args[0], cmd.params), cmd, ctx)
+            exc.args = (message, *exc.args[1:])
+        raise
+
+
+def _is_file(text: str) -> bool:
+    try:
+        return Path(text).is_file()
+    except (OSError, ValueError):
+        return False
+
+
+def _name_the_input(message: str, cmd: Any, ctx: Any) -> str:
+    """Prefix ``'<file>': `` to a message that names nothing given on the command line, when
+    the command was given exactly one existing input file (so it can only be about that)."""
+    given = []
+    for p in cmd.params:
+        values = ctx.params.get(p.name)
+        for v in values if isinstance(values, (list, tuple)) else [values]:
+            if isinstance(v, (str, Path)) and str(v):
+                given.append((p, str(v)))
+            flag = _flag_of(p)
+            if flag and v not in (None, False, (), []) and v != p.default:
+                given.append((p, flag))
+    if any(text in message for _, text in given if len(text) > 1):
+        return message
+    inputs = {
+        text
+        for p, text in given
+        if p.name not in OUTPUT_PARAMS and not text.startswith("-") and _is_file(text)
+    }
+    return f"'{inputs.pop()}': {message}" if len(inputs) == 1 else message
+
+
+class Command(TyperCommand):
+    """A jointwear command (see the module docstring)."""
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        self.help = escape_brackets(self.help)
+        _tidy(self.params)
+
+    def get_params(self, ctx: Any) -> list[Any]:
+        return _tidy(super().get_params(ctx))
+
+    def invoke(self, ctx: Any) -> Any:
+        return _invoke(self, ctx, super().invoke)
 
 
 class CommandGroup(TyperGroup):
-    """A group whose callback is the command itself (``jointwear compare A B``): while it has
-    no sub-commands its usage line shows no ``COMMAND [ARGS]...``."""
+    """A group; when its callback is the command itself (``jointwear compare A B``), it claims
+    outputs like :class:`Command` and, while it has no sub-commands, its usage line shows no
+    ``COMMAND [ARGS]...``."""
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        self.help = escape_brackets(self.help)
+        _tidy(self.params)
+
+    def get_params(self, ctx: Any) -> list[Any]:
+        return _tidy(super().get_params(ctx))
 
     def collect_usage_pieces(self, ctx: Any) -> list[str]:
         # (Click itself is not imported: Typer >= 0.26 vendors it and no longer installs it)
@@ -22,6 +299,21 @@ class CommandGroup(TyperGroup):
         if not self.commands and pieces and pieces[-1] == self.subcommand_metavar:
             pieces = pieces[:-1]
         return pieces
+
+    def invoke(self, ctx: Any) -> Any:
+        return _invoke(self, ctx, super().invoke)
+
+
+def apply_classes(app: typer.Typer) -> None:
+    """Build every command of ``app`` (recursively) with :class:`Command`/:class:`CommandGroup`."""
+    for info in app.registered_commands:
+        if info.cls is None or info.cls is TyperCommand:
+            info.cls = Command
+    for group in app.registered_groups:
+        group.cls = CommandGroup
+        if group.typer_instance is not None:
+            group.typer_instance.info.cls = CommandGroup
+            apply_classes(group.typer_instance)
 
 
 def discover_commands(app: typer.Typer, package: str) -> None:

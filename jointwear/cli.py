@@ -9,12 +9,15 @@ stderr; the traceback only with ``--debug``).
 
 from __future__ import annotations
 
+import os
+import signal
 import sys
 from pathlib import Path
 from typing import Annotated
 
 import typer
 
+from jointwear._cli import CommandGroup, Overwrite, apply_classes
 from jointwear._compile_notice import announce_compilation
 from jointwear._version import __version__
 from jointwear.errors import EXIT_BAD_INPUT, EXIT_USAGE, JointwearError
@@ -25,9 +28,10 @@ app = typer.Typer(
     no_args_is_help=True,
     pretty_exceptions_enable=False,
     add_completion=False,
+    cls=CommandGroup,
 )
 
-_STATE = {"debug": False}
+_STATE: dict[str, object] = {"debug": False, "signal": None}
 
 
 def _version_callback(value: bool) -> None:
@@ -94,6 +98,7 @@ def demo(
             "instead of about 2 minutes.",
         ),
     ] = False,
+    overwrite: Overwrite = False,
 ) -> None:
     """Run the whole chain on the embedded default data and write a validation report.
 
@@ -106,6 +111,37 @@ def demo(
 
 
 _register_groups()
+apply_classes(app)
+
+
+def _on_signal(signum: int, frame: object) -> None:
+    """Ctrl-C and SIGTERM: commands keep their partial results; exit 130 or 143."""
+    _STATE["signal"] = signum
+    raise KeyboardInterrupt()
+
+
+def _interrupted() -> int | None:
+    """128 + the signal that stopped the command (also when it turned it into an error)."""
+    signum = _STATE["signal"]
+    return 128 + int(signum) if signum is not None else None
+
+
+def _stdout_is_null() -> bool:
+    """True if stdout is /dev/null (rich points it there when the reader of a pipe is gone)."""
+    try:
+        out, null = os.fstat(sys.stdout.fileno()), os.stat(os.devnull)
+    except (OSError, ValueError, AttributeError):  # no file descriptor (tests)
+        return False
+    return (out.st_dev, out.st_ino) == (null.st_dev, null.st_ino)
+
+
+def _quiet_broken_pipe() -> None:
+    """The reader of stdout went away (``jointwear info x.nc | head``): stop quietly."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+    except (OSError, ValueError):  # stdout without a file descriptor (tests)
+        pass
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -113,26 +149,63 @@ def main(argv: list[str] | None = None) -> int:
     args = sys.argv[1:] if argv is None else list(argv)
     debug = "--debug" in args
     compiled = announce_compilation()
+    _STATE["signal"] = None
+    stdout_was_null = _stdout_is_null()
+    previous = {}
+    for signum in (signal.SIGINT, signal.SIGTERM):
+        try:
+            previous[signum] = signal.signal(signum, _on_signal)
+        except ValueError:  # not the main thread
+            pass
     try:
         app(args=args, prog_name="jointwear", standalone_mode=True)
     except SystemExit as exc:  # click's own exits: 0, usage errors (2), aborts
         code = exc.code
+        if _interrupted():  # click turned the KeyboardInterrupt into an exit
+            return _interrupted()
+        if code == 1 and (
+            type(sys.stdout).__name__ == "PacifyFlushWrapper"  # click, on a closed pipe
+            or (not stdout_was_null and _stdout_is_null())  # rich, on a closed pipe
+        ):
+            _quiet_broken_pipe()
+            return 0
         return code if isinstance(code, int) else (0 if code is None else EXIT_USAGE)
+    except BrokenPipeError:
+        _quiet_broken_pipe()
+        return 0
     except JointwearError as exc:
         if debug:
             raise
         typer.echo(f"jointwear: error: {exc}", err=True)
-        return exc.exit_code
+        return _interrupted() or exc.exit_code  # a command may report an interrupt as error
     except KeyboardInterrupt:
-        typer.echo("interrupted", err=True)
-        return 130
+        terminated = _STATE["signal"] == signal.SIGTERM
+        typer.echo("terminated" if terminated else "interrupted", err=True)
+        return _interrupted() or 128 + signal.SIGINT
     except (OSError, MemoryError) as exc:
         if debug:
             raise
         typer.echo(f"jointwear: error: {exc}", err=True)
         return EXIT_BAD_INPUT
+    except Exception as exc:  # a bug: say so, without a traceback unless --debug
+        if debug:
+            raise
+        text = str(exc)
+        text = text if len(text) < 300 else text[:300] + " ..."
+        typer.echo(
+            f"jointwear: error: unexpected {type(exc).__name__}: {text}\n"
+            "This is a bug in jointwear: please report it with the output of the same command "
+            "run with --debug.",
+            err=True,
+        )
+        return EXIT_BAD_INPUT
     finally:
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)
         line = compiled()
         if line:
-            typer.echo(line, err=True)
+            try:
+                typer.echo(line, err=True)
+            except OSError:
+                pass
     return 0

@@ -8,6 +8,8 @@ from typing import Annotated
 
 import typer
 
+from jointwear._cli import Overwrite
+
 app = typer.Typer(
     help="Import your own data (CSV or CF netCDF from other simulators and instruments).",
     no_args_is_help=True,
@@ -59,6 +61,7 @@ def _save(ds, out: Path, source: Path) -> None:
 def motion(
     file: Annotated[Path, typer.Argument(help="CSV table (header row) or CF netCDF file.")],
     out: Annotated[Path, _OUT],
+    overwrite: Overwrite = False,
     origin: Annotated[Origin | None, _ORIGIN] = None,
     velocity_unit: Annotated[
         str | None, typer.Option("--velocity-unit", help="Unit of the velocity columns, e.g. mm/s.")
@@ -108,6 +111,7 @@ def motion(
 def wearmap(
     file: Annotated[Path, typer.Argument(help="CSV table (theta, z, depth per row) or CF netCDF.")],
     out: Annotated[Path, _OUT],
+    overwrite: Overwrite = False,
     origin: Annotated[Origin | None, _ORIGIN] = None,
     angle_zero: Annotated[
         str | None,

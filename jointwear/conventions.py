@@ -17,7 +17,7 @@ zero along -x, increasing clockwise (:data:`CANONICAL`).
 from __future__ import annotations
 
 import json
-from collections.abc import Iterable
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 
 import numpy as np
@@ -40,6 +40,8 @@ __all__ = [
     "annotate",
     "validate",
     "check_convention",
+    "is_partial",
+    "describe_status",
 ]
 
 #: Coordinates of the contract: name -> (units, long_name).
@@ -366,3 +368,39 @@ def validate(
 def check_convention(obj: xr.DataArray | xr.Dataset, what: str) -> AngleConvention:
     """Alias of :func:`angle_convention_of` for use at module boundaries."""
     return angle_convention_of(obj, what=what)
+
+
+def _attrs(obj: xr.Dataset | Mapping[str, object]) -> Mapping[str, object]:
+    return obj.attrs if isinstance(obj, (xr.Dataset, xr.DataArray)) else obj
+
+
+def is_partial(obj: xr.Dataset | Mapping[str, object]) -> bool:
+    """True if a dataset (or its global attributes) is the partial result of a run that stopped.
+
+    Long runs write what they computed when interrupted (Ctrl-C, SIGTERM, a failure) with the
+    global attribute ``status``: ``"complete"``, ``"partial"`` (``jointwear sim wear``) or
+    ``"stopped after N frames: ..."`` (``jointwear dic track``). A dataset without ``status``
+    is complete.
+    """
+    status = str(_attrs(obj).get("status", "complete")).strip().lower()
+    return status != "complete"
+
+
+def describe_status(obj: xr.Dataset | Mapping[str, object]) -> str | None:
+    """One line saying that, and how far, a partial result got (None if complete).
+
+    For example ``"PARTIAL result: the run stopped after 30000 of 1e+06 cycles (status
+    'partial'); continue it with --resume"``.
+    """
+    attrs = _attrs(obj)
+    if not is_partial(attrs):
+        return None
+    status = str(attrs.get("status"))
+    done, target = attrs.get("cycles_done"), attrs.get("cycles_target")
+    if done is not None and target is not None:
+        progress = f"the run stopped after {float(done):g} of {float(target):g} cycles"
+    elif attrs.get("frames_processed") is not None:
+        progress = f"the run stopped after {int(attrs['frames_processed'])} frames"
+    else:
+        progress = "the run that wrote it did not finish"
+    return f"PARTIAL result: {progress} (status {status!r}); continue it with --resume"

@@ -26,9 +26,11 @@ import re
 import shutil
 import socket
 import sys
+import tempfile
 import time
 from collections.abc import Iterator
 from pathlib import Path
+from typing import Any
 
 from jointwear.errors import JointwearError
 
@@ -43,9 +45,11 @@ __all__ = [
     "remove_stale_temporaries",
     "refuse_existing",
     "claim",
+    "check_location",
     "write_failure",
     "is_write_failure",
     "describe_free_space",
+    "write_image",
 ]
 
 
@@ -218,6 +222,8 @@ def claim(
         The command could resume (mentioned in the refusal).
     """
     removed: list[Path] = []
+    for flag, path in paths.items():
+        check_location(path, what=flag)
     with contextlib.ExitStack() as stack:
         for flag, path in paths.items():
             stack.enter_context(output_lock(path, what=flag))
@@ -228,14 +234,40 @@ def claim(
         yield removed
 
 
-def describe_free_space(path: str | Path) -> str:
-    """``"12.3 MB free"`` on the file system holding ``path`` (empty if unknown)."""
+def check_location(path: str | Path, *, what: str = "output") -> Path:
+    """Fail early if output ``path`` (a file, or a folder to write into) cannot be written.
+
+    Creates the missing parent folders and tries a temporary file where the output goes.
+    """
+    path = Path(path)
+    folder = path if path.is_dir() else path.parent
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(dir=folder, prefix=f".{path.name}.", suffix=".check")
+        os.close(fd)
+        with contextlib.suppress(FileNotFoundError):  # removed as stale by a concurrent writer
+            os.unlink(tmp)
+    except OSError as exc:
+        raise OutputError(
+            f"{what} path '{path}' is not writable ({exc.strerror or exc}); choose another location"
+        ) from None
+    return path
+
+
+def _free_bytes(path: str | Path) -> int | None:
     folder = Path(path).parent
     while not folder.exists() and folder != folder.parent:
         folder = folder.parent
     try:
-        free = shutil.disk_usage(folder).free
+        return shutil.disk_usage(folder).free
     except OSError:
+        return None
+
+
+def describe_free_space(path: str | Path) -> str:
+    """``"12.3 MB free"`` on the file system holding ``path`` (empty if unknown)."""
+    free = _free_bytes(path)
+    if free is None:
         return ""
     for unit in ("bytes", "kB", "MB", "GB", "TB"):
         if free < 1000 or unit == "TB":
@@ -263,7 +295,9 @@ def is_write_failure(exc: BaseException) -> bool:
     return isinstance(exc, RuntimeError) and ("NetCDF" in str(exc) or "HDF" in str(exc))
 
 
-def write_failure(exc: BaseException, path: str | Path, *, what: str = "output") -> OutputError:
+def write_failure(
+    exc: BaseException, path: str | Path, *, what: str = "output", needed: int | None = None
+) -> OutputError:
     """An :class:`OutputError` naming ``path``, the cause and the fix, for a failed write."""
     path = Path(path)
     code = getattr(exc, "errno", None)
@@ -271,10 +305,36 @@ def write_failure(exc: BaseException, path: str | Path, *, what: str = "output")
     free = describe_free_space(path)
     advice = _ADVICE.get(code) if code is not None else None
     if advice is None:
+        full = free.startswith("0 bytes") or (
+            needed is not None and _free_bytes(path) is not None and _free_bytes(path) < needed
+        )
         advice = (
-            "check the free space and permissions there"
-            if not free.startswith("0 bytes")
-            else "the disk is full: free space or choose another location"
+            "the disk is full: free space or choose another location"
+            if full
+            else "check the free space and permissions there"
         )
     where = f"; {free} there" if free else ""
     return OutputError(f"could not write {what} '{path}' ({cause}{where}); {advice}")
+
+
+def write_image(path: str | Path, image: Any) -> Path:
+    """``cv2.imwrite`` that raises :class:`OutputError` naming the file when it fails.
+
+    OpenCV reports a failed write (full disk, missing folder, permission) only by returning
+    False; the half-written file is removed.
+    """
+    import cv2
+
+    path = Path(path)
+    try:
+        ok = bool(cv2.imwrite(str(path), image))
+    except (cv2.error, SystemError) as exc:  # OpenCV 5 raises SystemError for some failures
+        ok, cause = False, exc
+    else:
+        cause = RuntimeError("OpenCV could not write the image")
+    if not ok:
+        error = write_failure(cause, path, what="image", needed=getattr(image, "nbytes", None))
+        with contextlib.suppress(OSError):
+            path.unlink()
+        raise error
+    return path

@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from jointwear import io
+from jointwear.conventions import describe_status
 
 __all__ = ["summarise"]
 
@@ -25,6 +26,9 @@ def summarise(path: str | Path, *, validate: bool = True) -> str:
     """Return a text summary of the file at ``path`` (validated against the contract)."""
     ds = io.load(path, validate=validate)
     lines = [f"file: {path}"]
+    status = describe_status(ds)
+    if status:
+        lines.append(f"status: {status}")
     for key in ("title", "source", "Conventions"):
         if key in ds.attrs:
             lines.append(f"{key}: {ds.attrs[key]}")

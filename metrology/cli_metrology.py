@@ -8,6 +8,8 @@ from typing import Annotated
 
 import typer
 
+from jointwear._cli import Overwrite
+
 
 class AngleUnit(StrEnum):
     """Unit of the angle column."""
@@ -176,6 +178,7 @@ def register(app: typer.Typer) -> None:
             Path,
             typer.Option("--out", "-o", help="Output .nc (one scan) or folder (several scans)."),
         ] = Path("scan.nc"),
+        overwrite: Overwrite = False,
         angle_zero: Annotated[
             str | None,
             typer.Option(
@@ -415,6 +418,7 @@ def register(app: typer.Typer) -> None:
             Path | None,
             typer.Option("--out", "-o", help="Write the full result as netCDF (file or folder)."),
         ] = None,
+        overwrite: Overwrite = False,
     ) -> None:
         """Roundness per layer and cylindricity (LS/MZ/MI/MC), printed as a table."""
         import warnings
@@ -488,6 +492,7 @@ def register(app: typer.Typer) -> None:
         out: Annotated[
             Path, typer.Option("--out", "-o", help="Output .nc (or folder for several).")
         ] = Path("wear.nc"),
+        overwrite: Overwrite = False,
         angle_offset_deg: Annotated[
             float,
             typer.Option(
@@ -568,6 +573,7 @@ def register(app: typer.Typer) -> None:
         out: Annotated[
             Path, typer.Option("--out", "-o", help="Figure file (PNG, PDF, SVG).")
         ] = Path("wear_map.png"),
+        overwrite: Overwrite = False,
         layers: Annotated[
             str | None,
             typer.Option("--layers", help="Comma-separated layer indices for the polar plot."),

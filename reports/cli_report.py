@@ -7,6 +7,8 @@ from typing import Annotated
 
 import typer
 
+from jointwear._cli import Overwrite
+
 
 def register(app: typer.Typer) -> None:
     """Make the ``jointwear report`` group itself build the report (options only)."""
@@ -18,6 +20,7 @@ def register(app: typer.Typer) -> None:
             Path,
             typer.Option("--out", "-o", help="HTML report to write (.pdf: the PDF version only)."),
         ] = Path("report.html"),
+        overwrite: Overwrite = False,
         sim: Annotated[
             list[Path] | None,
             typer.Option("--sim", help="Simulated wear map and/or motion (.nc); repeatable."),

@@ -7,6 +7,8 @@ from typing import Annotated
 
 import typer
 
+from jointwear._cli import Overwrite
+
 __all__ = ["register"]
 
 
@@ -16,6 +18,7 @@ def register(app: typer.Typer) -> None:
     @app.command("cycle")
     def cycle(
         out: Annotated[Path, typer.Option("--out", help="Output netCDF file.")] = Path("cycle.nc"),
+        overwrite: Overwrite = False,
         cycles: Annotated[
             float, typer.Option("--cycles", help="Crank cycles to simulate (fractions allowed).")
         ] = 1.0,

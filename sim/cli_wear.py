@@ -3,9 +3,11 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated, Any
+from typing import Annotated, Any, Literal
 
 import typer
+
+from jointwear._cli import Overwrite
 
 __all__ = ["register"]
 
@@ -106,6 +108,17 @@ def _sim_parameters(params_file: Path | None, rest: dict[str, Any], grid: tuple)
 
         params = replace_nested(params, **changes)
     return params
+
+
+def _resumable(exc: Exception, cycles_done: float, ckpt: Path) -> Exception:
+    """A failed write of a wear run (full disk) that says how to continue it."""
+    from jointwear.outputs import OutputError
+
+    return OutputError(
+        f"{exc}. The wear run stopped after {cycles_done:g} cycles; nothing computed is lost "
+        f"beyond the last update: its checkpoint '{ckpt}' holds the last good state. Free space "
+        "and run the same command again with --resume to continue it."
+    )
 
 
 def demo_winkler_contact(grid: Any) -> Any:
@@ -272,6 +285,7 @@ def register(app: typer.Typer) -> None:
     @app.command("wear")
     def wear(
         out: Annotated[Path, typer.Option("--out", help="Output wear map (netCDF).")],
+        overwrite: Overwrite = False,
         cycles: Annotated[float, typer.Option("--cycles", help="Target number of cycles.")] = 1e6,
         kw: Annotated[
             float | None,
@@ -301,7 +315,7 @@ def register(app: typer.Typer) -> None:
             ),
         ] = None,
         scheme: Annotated[
-            str | None,
+            Literal["adaptive", "fixed", "schedule"] | None,
             typer.Option(
                 "--scheme",
                 help="Update interval: adaptive, fixed, or schedule (intervals from the \\[wear] table).",
@@ -328,7 +342,7 @@ def register(app: typer.Typer) -> None:
             int | None, typer.Option("--points", help="Points per layer (Nd).")
         ] = None,
         contact: Annotated[
-            str,
+            Literal["dynamics", "winkler"],
             typer.Option(
                 "--contact",
                 help="dynamics (the multibody simulation) or winkler (prescribed load, for tests).",
@@ -347,6 +361,7 @@ def register(app: typer.Typer) -> None:
 
         from jointwear import io
         from jointwear.errors import BadInputError, SimulationError
+        from jointwear.outputs import OutputError, OutputExistsError
         from jointwear.params import to_jsonable
         from jointwear.progress import progress_bar
         from jointwear.sim.wear import WearRun
@@ -378,6 +393,11 @@ def register(app: typer.Typer) -> None:
         else:
             raise BadInputError(f"--contact must be 'dynamics' or 'winkler', got {contact!r}")
         if not resume and ckpt.exists():
+            if not overwrite:  # the state of an earlier run: never thrown away unasked
+                raise OutputExistsError(
+                    f"checkpoint '{ckpt}' of an earlier run exists; continue that run with "
+                    "--resume, or give --overwrite to start over"
+                )
             typer.echo(
                 f"note: replacing the old checkpoint {ckpt} (use --resume to continue it)", err=True
             )
@@ -428,6 +448,8 @@ def register(app: typer.Typer) -> None:
                     err=True,
                 )
                 raise
+            except OutputError as exc:  # full disk while checkpointing: the last checkpoint stands
+                raise _resumable(exc, run.cycles_done, ckpt) from exc
             except SimulationError as exc:
                 io.save(
                     run.to_dataset(),
@@ -440,9 +462,16 @@ def register(app: typer.Typer) -> None:
                     f"{exc} [wear run stopped after {run.cycles_done} cycles; the wear map so far "
                     f"is in {out}, the last good state in {ckpt}]"
                 ) from exc
-        io.save(
-            ds, out, inputs=inputs, parameters=provenance_params, source="jointwear 0.1 (sim.wear)"
-        )
+        try:
+            io.save(
+                ds,
+                out,
+                inputs=inputs,
+                parameters=provenance_params,
+                source="jointwear 0.1 (sim.wear)",
+            )
+        except OutputError as exc:
+            raise _resumable(exc, run.cycles_done, ckpt) from exc
         if figure is not None:
             import matplotlib
 

@@ -73,14 +73,28 @@ def test_compare_cli_writes_metrics_and_table(files, tmp_path, capsys):
 
 def test_compare_cli_exit_codes(files, tmp_path, capsys):
     out = tmp_path / "m.nc"
-    bad = ["compare", str(files["sim_wear"]), str(files["meas_wear_bad"]), "--out", str(out)]
+    bad = [
+        "compare",
+        str(files["sim_wear"]),
+        str(files["meas_wear_bad"]),
+        "--out",
+        str(out),
+        "--overwrite",
+    ]
     assert main(bad) == 1  # a failed criterion exits 1 (no --strict needed)
     captured = capsys.readouterr()
     assert "FAIL            maximum wear depth" in captured.out
     assert "validation failed for: maximum wear depth" in captured.err
     # nothing fails, but V&V 20 is not assessed and the narrow scan leaves criteria not
     # comparable: exit 0 with a summary saying so; --strict makes it exit 1
-    undecided = ["compare", str(files["sim_wear"]), str(files["meas_wear"]), "-o", str(out)]
+    undecided = [
+        "compare",
+        str(files["sim_wear"]),
+        str(files["meas_wear"]),
+        "-o",
+        str(out),
+        "--overwrite",
+    ]
     assert main(undecided) == 0
     text = capsys.readouterr().out
     assert "not assessed (an uncertainty is unknown" in text
@@ -88,6 +102,7 @@ def test_compare_cli_exit_codes(files, tmp_path, capsys):
     assert main([*undecided, "--strict"]) == 1
     assert "--strict: not every criterion was decided" in capsys.readouterr().err
     unstated = ["compare", str(files["sim_wear"]), str(files["meas_unstated"]), "-o", str(out)]
+    unstated.append("--overwrite")
     assert main(unstated) == 3
     assert "angle_zero" in capsys.readouterr().err
 
@@ -105,6 +120,7 @@ def test_compare_cli_map_turned_180_degree_fails(files, tmp_path, capsys):
 def test_compare_cli_motion_variables(files, tmp_path, capsys):
     out = tmp_path / "m.nc"
     argv = ["compare", str(files["sim_motion"]), str(files["meas_motion"]), "-o", str(out)]
+    argv.append("--overwrite")  # the same --out for every run
     assert main([*argv, "--variable", "follower_velocity"]) == 0
     text = capsys.readouterr().out
     # z is out of the mechanism's plane: not compared unless asked for

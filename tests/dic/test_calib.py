@@ -657,5 +657,5 @@ def test_import_calibration_cli_two_opencv_files(tmp_path, rig, capsys):
     assert main(cmd) == 0
     assert read_calibration(out2).baseline == pytest.approx(true.baseline, rel=1e-12)
     capsys.readouterr()
-    assert main(["dic", "import-calibration", str(intr), *args, str(out2)]) == 3
+    assert main(["dic", "import-calibration", str(intr), *args, str(out2), "--overwrite"]) == 3
     assert "lacks R, T" in capsys.readouterr().err

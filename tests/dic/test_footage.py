@@ -642,7 +642,8 @@ def test_cli_shared_folders_patterns_and_resume(small, tmp_path, capsys):
     assert main(["dic", "calibrate", *both, *args]) == 0
     assert "calibrated from 8 views (0 rejected)" in capsys.readouterr().out
     # the folder alone holds two cameras: refused with the pattern to use
-    assert main(["dic", "calibrate", "--left", str(cal_dir), "--right", str(cal_dir), *args]) == 3
+    folders = ["--left", str(cal_dir), "--right", str(cal_dir), "--overwrite"]
+    assert main(["dic", "calibrate", *folders, *args]) == 3
     assert "'folder/*_0.tif'" in capsys.readouterr().err
 
     motion = tmp_path / "motion.nc"

@@ -162,7 +162,7 @@ def test_report_cli_html_pdf_and_comparison(report_files, tmp_path, capsys):
     assert main(["report", "--comparison", str(metrics), "--out", str(out3)]) == 1
     assert out3.read_bytes().startswith(b"%PDF")
     # usage errors
-    assert main(["report", "--out", str(out2)]) == 3
+    assert main(["report", "--out", str(out2), "--overwrite"]) == 3
     assert "no simulation given" in capsys.readouterr().err
 
 

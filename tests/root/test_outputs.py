@@ -217,3 +217,31 @@ def test_lock_file_is_gone_after_a_refused_claim(tmp_path):
         with outputs.claim({"--out": out}, overwrite=False):
             pass
     assert sorted(p.name for p in tmp_path.iterdir()) == ["a.nc"]
+
+
+def test_image_write_failure_names_the_file(tmp_path, tiny_disk):
+    img = (np.random.default_rng(0).random((400, 400)) * 255).astype(np.uint8)
+    path = tiny_disk / "frame_000001.png"
+    with pytest.raises(outputs.OutputError) as info:
+        outputs.write_image(path, img)
+    assert f"'{path}'" in str(info.value) and "disk is full" in str(info.value)
+    assert not path.exists()
+    assert outputs.write_image(tmp_path / "ok.png", img).stat().st_size > 1000
+
+
+def test_second_wear_run_on_the_same_out_leaves_the_first_runs_checkpoint_alone(tmp_path, capsys):
+    from jointwear.cli import main
+
+    out = tmp_path / "w.nc"
+    ckpt = tmp_path / "w.nc.ckpt"
+    ckpt.write_bytes(b"state of the first run")
+    proc = _child(HOLD.format(path=str(out)))  # the first run, busy with --out w.nc
+    try:
+        _wait_ready(proc)
+        code = main(["sim", "wear", "--contact", "winkler", "--cycles", "1e3", "--out", str(out)])
+        err = capsys.readouterr().err
+    finally:
+        proc.communicate("go\n", timeout=60)
+    assert code == 3 and f"process {proc.pid}" in err
+    assert ckpt.read_bytes() == b"state of the first run"
+    assert not out.exists()

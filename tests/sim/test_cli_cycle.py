@@ -73,5 +73,5 @@ def test_cycle_with_a_wear_map(tmp_path, capsys):
     assert any("wear.nc" in str(i) for i in io.parse_provenance(ds)["inputs"])
     bad = tmp_path / "bad.nc"
     io.save(xr.Dataset({"other": depth}), bad)
-    assert main(["sim", "cycle", "--out", str(out), "--wear", str(bad)]) == 3
+    assert main(["sim", "cycle", "--out", str(out), "--wear", str(bad), "--overwrite"]) == 3
     assert "has no 'wear_depth'" in capsys.readouterr().err
