@@ -6,9 +6,9 @@ from jointwear.reports.builder import (
     format_value,
     render_html,
     report_from_files,
-    write_pdf,
 )
 from jointwear.reports.demo import run_demo
+from jointwear.reports.pdf import write_pdf
 
 __all__ = [
     "ReportInput",
