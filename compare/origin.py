@@ -29,6 +29,8 @@ _SOURCE_PATTERNS = (
 def origin_of(ds: xr.Dataset) -> str:
     """``data_origin`` of one dataset (from its attribute, else its jointwear ``source``)."""
     value = str(ds.attrs.get("data_origin", "")).strip().lower()
+    if str(ds.attrs.get("data_origin_stated", "yes")).lower() == "no":
+        return NOT_STATED  # a foreign file taken for its role in the comparison, not by its word
     if value in ORIGINS:
         return value
     source = str(ds.attrs.get("source", ""))

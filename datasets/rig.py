@@ -851,6 +851,7 @@ def _write_bodies_toml(rig: VirtualRig, path: Path) -> Path:
         "# Regions of interest for `jointwear dic track`, written by `jointwear datasets rig`.",
         "# Polygons in pixels of the left camera's first frame.",
         "[track]",
+        'data_origin = "synthetic"   # rendered footage, not filmed: the report says so',
         "subset_size = 21",
         "step = 10",
         "# mechanism-frame position of the world origin when the calibration's world frame is the",

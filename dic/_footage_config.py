@@ -96,6 +96,10 @@ class TrackConfig:
         Most SIFT re-initialisations per body after tracking was lost (chunk starts do not
         count); beyond, lost frames are flagged ``tracking_failed`` without another attempt.
         0: never re-initialise. Each one is recorded (``<body>_reinitialised``).
+    data_origin : str
+        What the footage is: ``"measured"`` (filmed on a rig) or ``"synthetic"`` (rendered,
+        e.g. by ``jointwear datasets rig``, which writes it); empty: not stated. Recorded as
+        the result's ``data_origin``, which the validation report shows.
     workers : int
         Processes working on chunks in parallel (1: sequential, tracking carried across
         chunks; >1: each chunk starts from SIFT features of the reference images).
@@ -115,8 +119,13 @@ class TrackConfig:
     world_origin: list[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
     workers: int = 1
     max_reinit: int = 50
+    data_origin: str = ""
 
     def __post_init__(self) -> None:
+        if self.data_origin not in ("", "measured", "synthetic"):
+            raise ParameterError(
+                f"track.data_origin={self.data_origin!r}: expected 'measured' or 'synthetic'"
+            )
         if self.subset_size < 7 or self.subset_size % 2 == 0:
             raise ParameterError(
                 f"track.subset_size={self.subset_size}: expected an odd integer >= 7"

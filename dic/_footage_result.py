@@ -111,6 +111,8 @@ def _parameters(cfg: TrackConfig, bodies) -> dict[str, Any]:
 def _write(ds: xr.Dataset, out, inputs, cfg, bodies) -> None:
     from jointwear import io
 
+    if cfg.data_origin:
+        ds.attrs["data_origin"] = cfg.data_origin
     io.save(
         ds,
         out,

@@ -469,7 +469,11 @@ def import_cf(
         ).sortby("theta")
         ds = conventions.to_canonical(ds)
     if "z" in ds.coords and "z_zero" not in ds.coords["z"].attrs:
-        ds["z"].attrs.update(z_zero="bearing mid-width (assumed on import)", z_direction="+z")
+        ds["z"].attrs.update(
+            z_zero="bearing mid-width",
+            z_direction="+z",
+            z_note="the file did not state where z = 0 lies; taken as the bearing mid-width on import",
+        )
     ds = conventions.annotate(ds)
     ds.attrs.pop("provenance", None)
     return _stamp(ds, path, origin, tool or ds.attrs.get("source"), "dataset")
@@ -512,7 +516,14 @@ def load_for_comparison(
         if not path.is_file() or _has_provenance(path):
             raise
     command = "wearmap" if role == "measured" else "wearmap|motion"
-    stated = _stated_origin(path)
+    stated, z_stated = _stated_origin(path)
+    if not z_stated:
+        raise BadInputError(
+            f"'{path}' comes from another tool and its z coordinate does not say where z = 0 "
+            "lies (attribute z_zero); the wear map's axial position would be a guess. Add "
+            "z:z_zero = 'bearing mid-width' (with z measured from there), or convert it with "
+            f"jointwear import wearmap {path} --z-mid-width ... (docs/tutorial-own-data.md)"
+        )
     try:
         ds = import_cf(path, data_origin=None if stated else role)
     except BadInputError as exc:
@@ -547,7 +558,9 @@ def _has_provenance(path: Path) -> bool:
         return True  # not netCDF at all: io.load's message is the right one
 
 
-def _stated_origin(path: Path) -> str | None:
+def _stated_origin(path: Path) -> tuple[str | None, bool]:
+    """The file's ``data_origin`` (or None) and whether its z (if any) states ``z_zero``."""
     with xr.open_dataset(path, engine="netcdf4") as raw:
         origin = raw.attrs.get("data_origin")
-    return str(origin) if origin is not None else None
+        z_ok = "z" not in raw.coords or "z_zero" in raw.coords["z"].attrs
+    return (str(origin) if origin is not None else None), z_ok

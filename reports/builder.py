@@ -402,9 +402,11 @@ def report_from_files(
             raise BadInputError(
                 "no measurement given: pass --metrology FILE.nc (wear map) and/or --dic FILE.nc"
             )
-        sims = [io.load(p) for p in sim]
-        metros = [io.load(p) for p in metrology]
-        dics = [io.load(p) for p in dic]
+        from jointwear.external import load_for_comparison
+
+        sims = [load_for_comparison(p, role="simulated") for p in sim]
+        metros = [load_for_comparison(p, role="measured") for p in metrology]
+        dics = [load_for_comparison(p, role="measured") for p in dic]
         inputs += [ReportInput("simulation", Path(p), d) for p, d in zip(sim, sims, strict=True)]
         inputs += [
             ReportInput("metrology", Path(p), d) for p, d in zip(metrology, metros, strict=True)

@@ -651,6 +651,7 @@ def _dataset(params: SimParameters, t_rel: np.ndarray, diag: np.ndarray, t0: flo
         coords={"time": time, "axis": axis_c},
     )
     ds.attrs["title"] = "jointwear four-bar simulation with a 3D revolute clearance joint"
+    ds.attrs["data_origin"] = "simulated"
     ds.attrs["source"] = "jointwear (sim.dynamics)"
     ds.attrs["parameter_set"] = params.name
     ds.attrs["joint_model"] = params.joint.model

@@ -245,6 +245,7 @@ def wear_map_dataset(
     ds.attrs.update(
         {
             "title": "simulated wear map of the bearing bore",
+            "data_origin": "simulated",
             "bearing_radius_m": grid.radius,
             "bearing_width_m": grid.width,
             "n_layers": grid.n_layers,

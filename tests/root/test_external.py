@@ -277,8 +277,9 @@ def test_loading_a_foreign_cf_file_points_to_jointwear_import(tmp_path):
     assert "not written by jointwear" in str(info.value)
 
 
-def _foreign_wear(path, *, origin=None, convention=True):
+def _foreign_wear(path, *, origin=None, convention=True, z_zero=True):
     theta_c, z, depth = _wear_truth()
+    z_attrs = {"units": "mm", "z_zero": "bearing mid-width"} if z_zero else {"units": "mm"}
     theta_attrs = {"units": "degree"}
     if convention:
         theta_attrs.update(angle_zero="-x", angle_direction="clockwise")
@@ -287,7 +288,7 @@ def _foreign_wear(path, *, origin=None, convention=True):
         attrs["data_origin"] = origin
     xr.Dataset(
         {"wear_depth": (("z", "theta"), depth * 1e6, {"units": "um"})},
-        coords={"z": ("z", z * 1e3, {"units": "mm"}), "theta": ("theta", theta_c, theta_attrs)},
+        coords={"z": ("z", z * 1e3, z_attrs), "theta": ("theta", theta_c, theta_attrs)},
         attrs=attrs,
     ).to_netcdf(path)
     return depth
@@ -317,6 +318,13 @@ def test_foreign_cf_without_angle_convention_is_refused_for_comparison(tmp_path)
     path = tmp_path / "noconv.nc"
     _foreign_wear(path, convention=False)
     with pytest.raises(BadInputError, match="jointwear import wearmap"):
+        external.load_for_comparison(path, role="measured", warn=lambda s: None)
+
+
+def test_foreign_cf_without_z_zero_is_refused_for_comparison(tmp_path):
+    path = tmp_path / "noz.nc"
+    _foreign_wear(path, z_zero=False)
+    with pytest.raises(BadInputError, match="z_zero"):
         external.load_for_comparison(path, role="measured", warn=lambda s: None)
 
 

@@ -93,3 +93,46 @@ def test_csv_from_another_simulator_and_tool_reach_compare_and_report(tmp_path):
     html = report.read_text(encoding="utf-8")
     for tool in ("Adams 2024", "CMM", "VIC-3D"):
         assert f"external: {tool}" in html
+
+
+def test_foreign_cf_netcdf_goes_to_compare_with_a_warning(tmp_path, capsys):
+    import xarray as xr
+
+    # another tool's wear map in CF netCDF: contract names, its own units, a stated convention,
+    # but no jointwear provenance and no data_origin
+    theta_file = np.mod(180.0 - THETA, 360.0)  # 0 along +x, counter-clockwise = canonical mirrored
+    order = np.argsort(theta_file)
+    foreign = xr.Dataset(
+        {"wear_depth": (("z", "theta"), _depth(1.1)[:, order] * 1e6, {"units": "um"})},
+        coords={
+            "z": ("z", Z * 1e3, {"units": "mm", "z_zero": "bearing mid-width"}),
+            "theta": (
+                "theta",
+                theta_file[order],
+                {"units": "degree", "angle_zero": "+x", "angle_direction": "counterclockwise"},
+            ),
+        },
+        attrs={"Conventions": "CF-1.11", "title": "CMM wear map", "source": "CMM export"},
+    )
+    meas = tmp_path / "cmm.nc"
+    foreign.to_netcdf(meas)
+    _wear_csv(tmp_path / "adams_wear.csv", 1.0)
+    sim_w = tmp_path / "sim_wear.nc"
+    assert _run("import", "wearmap", tmp_path / "adams_wear.csv", "--angle-zero", "-x",
+                "--angle-direction", "clockwise", "--theta-unit", "deg", "--z-unit", "mm",
+                "--depth-unit", "um", "--columns", "theta_deg,z_mm,depth_um", "--origin",
+                "simulated", "--cycles", "1e6", "--out", sim_w) == 0  # fmt: skip
+    capsys.readouterr()
+    table = tmp_path / "m.csv"
+    code = _run("compare", sim_w, meas, "--cycles", "1e6", "--out", tmp_path / "m.nc",
+                "--table", table)  # fmt: skip
+    assert code in (0, 1)
+    err = capsys.readouterr().err
+    assert "not written by jointwear" in err and "--origin" in err
+    with table.open(encoding="utf-8", newline="") as fh:
+        rows = {(r["quantity"], r["metric"]): r for r in csv.DictReader(fh)}
+    # the convention was converted: same peak angle, depth ratio 1/1.1
+    assert float(rows[("wear_depth", "max_angle_error")]["value"]) == pytest.approx(0.0, abs=1e-9)
+    assert float(rows[("max_wear_depth", "relative_error")]["value"]) == pytest.approx(
+        -1 / 11, rel=1e-6
+    )
