@@ -160,33 +160,13 @@ def _simulate(folder: Path, size: DemoSize) -> tuple[Path, Path, Any, Path | Non
 def measured_wear_function(sim_wear: xr.Dataset) -> Any:
     """The demo's "true" wear of the tested bearing, built from the simulated map [m].
 
-    ``h(theta, z) = 1.10 h_sim(theta - 6 degree, z)``: 10 % deeper and turned by 6 degree.
-    Canonical theta [degree], z [m]; values outside the simulated width are clamped to its edge.
+    ``h(theta, z) = 1.10 h_sim(theta - 6 degree, z)``: 10 % deeper and turned by 6 degree
+    (:func:`jointwear.datasets.simulated_wear.wear_from_simulation`, the same function as
+    ``jointwear datasets instruments --wear-from``).
     """
-    da = sim_wear["wear_depth"].isel(cycles=-1).transpose("z", "theta")
-    z_s = np.asarray(da["z"].values, dtype=float)
-    th_s = np.asarray(da["theta"].values, dtype=float)
-    h = np.asarray(da.values, dtype=float)
-    th_ext = np.concatenate([th_s - 360.0, th_s, th_s + 360.0])
-    h_ext = np.concatenate([h, h, h], axis=1)
+    from jointwear.datasets.simulated_wear import wear_from_simulation
 
-    def truth(theta_deg: np.ndarray, z: np.ndarray) -> np.ndarray:
-        th = np.mod(np.asarray(theta_deg, dtype=float) - MEASURED_ROTATION_DEG, 360.0)
-        zz = np.clip(np.asarray(z, dtype=float), z_s.min(), z_s.max())
-        th_b, z_b = np.broadcast_arrays(th, zz)
-        out = np.empty(th_b.shape)
-        flat_t, flat_z, flat_o = th_b.ravel(), z_b.ravel(), out.ravel()
-        # bilinear: linear in z between layers, periodic linear in theta
-        k = np.clip(np.searchsorted(z_s, flat_z) - 1, 0, z_s.size - 2)
-        w = (flat_z - z_s[k]) / (z_s[k + 1] - z_s[k])
-        for i in np.unique(k):
-            sel = k == i
-            lo = np.interp(flat_t[sel], th_ext, h_ext[i])
-            hi = np.interp(flat_t[sel], th_ext, h_ext[i + 1])
-            flat_o[sel] = (1 - w[sel]) * lo + w[sel] * hi
-        return MEASURED_SCALE * flat_o.reshape(th_b.shape)
-
-    return truth
+    return wear_from_simulation(sim_wear, scale=MEASURED_SCALE, rotation_deg=MEASURED_ROTATION_DEG)
 
 
 def _measure_wear(folder: Path, sim_wear_path: Path, size: DemoSize) -> tuple[Path, Path]:
