@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Literal
@@ -264,8 +264,12 @@ def calibrate_stereo(
     max_rms: float = 1.0,
     accept_poor: bool = False,
     view_names: Sequence[str] | None = None,
+    progress: Callable[[int, int], None] | None = None,
 ) -> StereoCalibration:
     """Calibrate a camera pair from simultaneous views of a board.
+
+    ``progress(done, total)`` is called after the board search of each view pair (the slow
+    part), for a progress display.
 
     Boards are found with both of OpenCV's chessboard detectors (sector-based, then classic).
     The corner order of the two cameras is made consistent by geometry
@@ -354,6 +358,8 @@ def calibrate_stereo(
                 f"{Rimg.shape[1]}x{Rimg.shape[0]} differs from the first view's {size[0]}x{size[1]}"
             )
         fl, fr = detect_board(L, board), detect_board(Rimg, board)
+        if progress is not None:
+            progress(i + 1, n_total)
         if fl is None or fr is None:
             which = (
                 "both cameras" if fl is None and fr is None else ("left" if fl is None else "right")

@@ -164,18 +164,23 @@ def register(app: typer.Typer) -> None:
             "max_rms_px": max_rms,
             "accept_poor": accept_poor,
         }
+        from jointwear.progress import progress_bar
+
         try:
-            cal = calibrate_stereo(
-                lefts,
-                rights,
-                b,
-                min_views=min_views,
-                world_view=world_view,
-                max_rms=max_rms,
-                max_view_rms=max_view_rms,
-                accept_poor=accept_poor,
-                view_names=names,
-            )
+            with progress_bar("finding the board", total=min(len(lefts), len(rights))) as bar:
+                task = bar.tasks[0].id
+                cal = calibrate_stereo(
+                    lefts,
+                    rights,
+                    b,
+                    min_views=min_views,
+                    world_view=world_view,
+                    max_rms=max_rms,
+                    max_view_rms=max_view_rms,
+                    accept_poor=accept_poor,
+                    view_names=names,
+                    progress=lambda done, total: bar.update(task, completed=done),
+                )
         except PoorCalibration as exc:
             rejected = out.with_name(out.stem + ".rejected" + (out.suffix or ".nc"))
             exc.calibration.save(rejected, inputs=[left, right], parameters=params)

@@ -86,7 +86,9 @@ def test_rejected_views_are_counted_with_their_reason(boards, board):
     blank = np.zeros_like(boards[0][0])
     lefts = [b[0] for b in boards[:7]] + [blank]
     rights = [b[1] for b in boards[:7]] + [boards[7][1]]
-    cal = calibrate_stereo(lefts, rights, board)
+    seen: list[tuple[int, int]] = []
+    cal = calibrate_stereo(lefts, rights, board, progress=lambda *a: seen.append(a))
+    assert seen == [(k, 8) for k in range(1, 9)]  # every view pair reported, rejected one too
     assert cal.views_used == 7 and cal.views_rejected == 1
     assert cal.rejected == ("view 7: board not found (left) by either detector",)
 
