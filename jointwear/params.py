@@ -31,6 +31,12 @@ def read_toml(path: str | Path) -> dict[str, Any]:
         raise BadInputError(
             f"parameter file '{path}' is not valid TOML: {exc} - fix the syntax at that line"
         ) from None
+    except UnicodeDecodeError:
+        raise BadInputError(
+            f"parameter file '{path}' is not UTF-8 text (TOML files must be); is it the right file?"
+        ) from None
+    except IsADirectoryError:
+        raise BadInputError(f"parameter file '{path}' is a folder; give a .toml file") from None
 
 
 def _field_types(cls: type) -> dict[str, Any]:

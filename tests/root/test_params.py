@@ -80,3 +80,15 @@ def test_fixed_length_tuple_fields():
         from_mapping(WithTuple, {"pair": [1, 2.0, 3.0]})
     with pytest.raises(ParameterError, match=r"pair\[0\]: expected an integer"):
         from_mapping(WithTuple, {"pair": ["a", 2.0]})
+
+
+def test_binary_or_folder_toml_is_refused_naming_the_file(tmp_path):
+    from jointwear.errors import BadInputError
+    from jointwear.params import read_toml
+
+    binary = tmp_path / "criteria.toml"
+    binary.write_bytes(b"\xff\xfe\x00\x81binary")
+    with pytest.raises(BadInputError, match="criteria.toml' is not UTF-8"):
+        read_toml(binary)
+    with pytest.raises(BadInputError, match="is a folder"):
+        read_toml(tmp_path)
