@@ -77,7 +77,7 @@ def main() -> None:
         "max_depth_um_tol_0.05": round(d2, 3),
         "max_depth_u_um_tol_0.05": round(u2, 3),
         "difference_um": round(d2 - d1, 3),
-        "within_reported_accuracy_of_tol_0.1": abs(d2 - d1) < u1,
+        "within_reported_accuracy_of_tol_0.1": bool(abs(d2 - d1) < u1),
     }
     print("tol halved", tol_check, flush=True)
     write_results(

@@ -239,6 +239,8 @@ def register(app: typer.Typer) -> None:
                 resimulate=resimulator(sim) if resimulate else None,
                 rtol=rtol,
             )
+            what = "measured map" if quantity == "map" else meas[0].describe()
+            typer.echo(f"data used: {what} (at {cal.cycles:.6g} cycles)")
             typer.echo(f"kw (linear estimate): {cal.kw_linear:.4g} m²/N")
             if cal.linearity_error is not None:
                 typer.echo(
@@ -249,6 +251,10 @@ def register(app: typer.Typer) -> None:
                 typer.echo(
                     f"kw (calibrated, {state} after {len(cal.iterations) - 1} re-simulations): "
                     f"{cal.kw:.4g} m²/N"
+                )
+                typer.echo(
+                    f"residual of the last re-simulation: "
+                    f"{100 * (cal.iterations[-1][1] / cal.measured - 1):+.1f} %"
                 )
             return
         from jointwear.sim._kw_calibration import calibrate_kw_and_parameter, calibrate_kw_multi

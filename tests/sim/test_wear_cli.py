@@ -163,6 +163,9 @@ def test_calibrate_kw_command_recovers_the_kw_of_a_run(tmp_path, capsys):
     calibrated = float(out.split("re-simulations): ")[1].split()[0])
     assert abs(linear / 3e-13 - 1) > 0.05  # profile feedback: the linear guess is off
     assert calibrated == pytest.approx(3e-13, rel=0.03)
+    assert "data used: max_depth" in out and "at 30000 cycles" in out
+    residual = float(out.split("residual of the last re-simulation: ")[1].split()[0])
+    assert abs(residual) <= 1.0
     assert main(["sim", "calibrate-kw", str(sim)]) == 3
     assert "give one measurement" in capsys.readouterr().err
 
