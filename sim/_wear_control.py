@@ -18,7 +18,8 @@ pure functions that decide ``dN`` and estimate the error of the result:
 * the accuracy of the depth field is accumulated along the run (:class:`ErrorBudget`): the
   explicit-Euler truncation ``dN (r_new - r_old) / 2`` per update (signed sum: the systematic
   part adds up, the noise part telescopes) and the statistical error of each averaged rate,
-  ``dN^2 var(r_mean)``, added in quadrature over the updates.
+  ``dN^2 var(r_mean)``, added in quadrature over the updates; earlier errors are damped by the
+  per-point ratio of new to old rate (wear corrects its own errors).
 """
 
 from __future__ import annotations
@@ -193,10 +194,19 @@ class ErrorBudget:
         return cls(np.zeros(shape), np.zeros(shape), 0.0, 0.0)
 
     def add(self, dn: int, old: RateSample, new: RateSample) -> ErrorBudget:
-        """The budget after an accepted update of ``dn`` cycles from ``old`` to ``new``."""
+        """The budget after an accepted update of ``dn`` cycles from ``old`` to ``new``.
+
+        Errors made earlier are damped by wear's self-correction: for ``dh/dN = r(h)`` a depth
+        error evolves like ``de/dN = r'(h) e`` and ``r'(h) = (dr/dN) / r`` along the solution,
+        so it is multiplied by ``r_new / r_old`` over the update (per point, capped at 1: no
+        amplification is assumed where the load moves onto a point).
+        """
+        with np.errstate(divide="ignore", invalid="ignore"):
+            g = np.where(old.rate > 0, new.rate / old.rate, 1.0)
+        g = np.clip(g, 0.0, 1.0)
         return ErrorBudget(
-            self.depth_trunc + dn * (new.rate - old.rate) / 2.0,
-            self.depth_var + float(dn) ** 2 * old.var,
+            self.depth_trunc * g + dn * (new.rate - old.rate) / 2.0,
+            self.depth_var * g * g + float(dn) ** 2 * old.var,
             self.volume_trunc + dn * (new.volume_rate - old.volume_rate) / 2.0,
             self.volume_var + float(dn) ** 2 * old.volume_var,
         )
