@@ -114,8 +114,16 @@ def wear_metrics(al: xr.Dataset, rows: Rows, decisions: list[dict[str, Any]], sr
             peak_nc,
         )
     )
-    us = np.asarray(al["wear_depth_sim_u"].values) if "wear_depth_sim_u" in al else None
-    ud = np.asarray(al["wear_depth_meas_u"].values) if "wear_depth_meas_u" in al else None
+    def stated_u(name: str) -> np.ndarray | None:
+        # an all-NaN uncertainty (e.g. a fixed-interval wear run: accuracy not assessed) is
+        # not stated, the same as an absent one
+        if name not in al:
+            return None
+        u = np.asarray(al[name].values, dtype=float)
+        return u if np.isfinite(u).any() else None
+
+    us = stated_u("wear_depth_sim_u")
+    ud = stated_u("wear_depth_meas_u")
 
     def at_max(u: np.ndarray | None, f: np.ndarray) -> float | None:
         if u is None:

@@ -8,6 +8,7 @@ from typing import Annotated
 
 import typer
 
+from jointwear._cli import Overwrite
 from jointwear.errors import BadInputError
 
 
@@ -105,6 +106,7 @@ def register(app: typer.Typer) -> None:
             Path | None, typer.Option("--plot", help="Contour figure of the last image (png).")
         ] = None,
         threads: Annotated[int, typer.Option("--threads", help="numba threads (0: auto).")] = 0,
+        overwrite: Overwrite = False,
     ) -> None:
         """Displacement, shape and strain of a surface over a ROI (2D, or stereo with
         --left/--right/--calibration); still images need no --fps."""
@@ -209,6 +211,7 @@ def register_import(app: typer.Typer) -> None:
             float | None, typer.Option("--fps", help="Frames per second (omit: still images).")
         ] = None,
         out: Annotated[Path, typer.Option("--out", help="Output netCDF file.")] = Path("field.nc"),
+        overwrite: Overwrite = False,
     ) -> None:
         """Another DIC code's full-field results as a jointwear field dataset."""
         import numpy as np

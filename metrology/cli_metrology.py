@@ -263,13 +263,13 @@ def register(app: typer.Typer) -> None:
             typer.Option("--sheet", help="Worksheet of an Excel workbook with several sheets."),
         ] = None,
         layer_spacing_mm: Annotated[
-            float | None, typer.Option("--layer-spacing-mm", help="Layer spacing, in mm.")
+            float | None, typer.Option("--layer-spacing-mm", help="Layer spacing [mm].")
         ] = None,
         z_mid_mm: Annotated[
             float | None,
             typer.Option(
                 "--z-mid-mm",
-                help="Instrument height of the bearing mid-width, in mm (default: middle of the "
+                help="Instrument height of the bearing mid-width [mm] (default: middle of the "
                 "layers).",
             ),
         ] = None,
@@ -495,9 +495,7 @@ def register(app: typer.Typer) -> None:
         overwrite: Overwrite = False,
         angle_offset_deg: Annotated[
             float,
-            typer.Option(
-                "--angle-offset-deg", help="Set-up rotation of the before scan, in degrees."
-            ),
+            typer.Option("--angle-offset-deg", help="Set-up rotation of the before scan [degree]."),
         ] = 0.0,
         register: Annotated[
             bool, typer.Option("--register", help="Estimate the rotation from the unworn regions.")
@@ -510,7 +508,7 @@ def register(app: typer.Typer) -> None:
             float, typer.Option("--threshold", help="Unworn = within this many robust std devs.")
         ] = 3.0,
         radius_mm: Annotated[
-            float | None, typer.Option("--radius-mm", help="Bore radius for the volume, in mm.")
+            float | None, typer.Option("--radius-mm", help="Bore radius for the volume [mm].")
         ] = None,
         plot: Annotated[
             Path | None, typer.Option("--plot", help="Also save a wear-map figure (PNG).")

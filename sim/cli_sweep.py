@@ -7,6 +7,8 @@ from typing import Annotated, Any
 
 import typer
 
+from jointwear._cli import Overwrite
+
 __all__ = ["register"]
 
 
@@ -49,6 +51,7 @@ def register(app: typer.Typer) -> None:
             bool | None,
             typer.Option("--progress/--no-progress", help="Progress bar (default: on a terminal)."),
         ] = None,
+        overwrite: Overwrite = False,
     ) -> None:
         """Run a parameter sweep or ensemble of simulations; each run is one dask task.
 

@@ -733,7 +733,7 @@ def test_a_calibration_off_its_images_is_measured_and_the_gate_configurable(smal
     bad.save(out / "shifted.nc")
     args = ["dic", "track", "--left", str(imgs[0]), "--right", str(imgs[1]), "--bodies",
             str(written["bodies"]), "--calibration", str(out / "shifted.nc"), "--fps", "50",
-            "--max-frames", "2", "--out", str(out / "shifted_motion.nc")]  # fmt: skip
+            "--max-frames", "2", "--out", str(out / "shifted_motion.nc"), "--overwrite"]  # fmt: skip
     assert main(args) == 3
     assert "max_epipolar_px" in capsys.readouterr().err
     assert main([*args, "--max-epipolar-px", "30"]) == 0

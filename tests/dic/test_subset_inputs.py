@@ -99,7 +99,7 @@ def test_cli_points_tolerance_iterations_and_update_options(tmp_path):
     out = tmp_path / "seq.nc"
     args = ["dic", "correlate", str(tmp_path / "img_*.png"), "--points", str(pts)]
     args += ["--subset", "21", "--tolerance", "1e-4", "--max-iterations", "30"]
-    args += ["--reference", "incremental", "--update-every", "1", "--out", str(out)]
+    args += ["--sequence-mode", "incremental", "--update-every", "1", "--out", str(out)]
     assert main(args) == 0
     ds = io.load(out)
     assert list(ds.x.values) == [30.0, 50.5, 60.0]
