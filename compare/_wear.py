@@ -114,6 +114,7 @@ def wear_metrics(al: xr.Dataset, rows: Rows, decisions: list[dict[str, Any]], sr
             peak_nc,
         )
     )
+
     def stated_u(name: str) -> np.ndarray | None:
         # an all-NaN uncertainty (e.g. a fixed-interval wear run: accuracy not assessed) is
         # not stated, the same as an absent one
