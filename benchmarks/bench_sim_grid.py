@@ -122,6 +122,7 @@ def main(argv: list[str] | None = None) -> None:
     grids = [tuple(int(v) for v in g.split("x")) for g in args.grids.split(",")]
     figures: dict[str, object] = {
         "overrides": overrides,
+        "impact_latch": base.contact.impact_latch,
         "cycles": CYCLES,
         "fixed_dn": DN,
         "target": "<= 5 % coarsest pair, <= 3 % finest pair (edge wear work, max depth, volume)",
