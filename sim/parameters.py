@@ -198,11 +198,10 @@ class ContactParameters:
     contact is shorter than a layer spacing (bearing edges) the worn volume exceeds kw times
     the normal work. ``"lumped"``: the layer's force spread over its whole slice area (before
     issue 16; dilutes edge contacts shorter than the slice, so edge wear grows as the grid is
-    refined). ``impact_latch``: ``"region"`` latches the impact velocity of eq. 6 once per
-    impact, at the onset, for each run of adjacent contacting layers (eq. 6 as defined);
-    ``"layer"`` (default for now): each layer latches its own approach rate when it enters
-    contact. The default stays ``"layer"`` until the wear-update controller copes with the
-    larger cycle-to-cycle variability of the worn bore under ``"region"`` (issue 16 item 1).
+    refined). ``impact_latch``: ``"region"`` (default) latches the impact velocity of eq. 6
+    once per impact, at the onset, for each run of adjacent contacting layers (eq. 6 as
+    defined); ``"layer"``: each layer latches its own approach rate when it enters contact
+    (before issue 16).
     ``impact_velocity_floor`` [m/s]: lower bound of a latched impact velocity (an impact that
     starts slower, e.g. grazing, is damped as if it started at the floor); results do not
     depend on it (0.01 vs 0.001 m/s, docs/sim-wear.md).
@@ -214,7 +213,7 @@ class ContactParameters:
 
     formulation: Literal["slice", "per_point"] = "slice"
     wear_projection: Literal["local_conserving", "local", "lumped"] = "local_conserving"
-    impact_latch: Literal["layer", "region"] = "layer"
+    impact_latch: Literal["region", "layer"] = "region"
     stiffness: Literal["time_varying", "constant"] = "time_varying"
     worn_radius_in_denominator: bool = False
     exponent: float = 1.5
