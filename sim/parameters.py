@@ -191,14 +191,17 @@ class ContactParameters:
     share of the joint-level law at its deepest point) or ``"per_point"`` (the study's literal
     sum of a full law at every penetrating point; *grid-dependent*, for comparison only).
     ``wear_projection`` (slice formulation): how a layer's contact becomes wear work at its
-    points. ``"local_conserving"`` (default): the pressure follows the local law at each layer
+    points. ``"local_conserving"`` (recommended; the default once the wear-update controller of
+    issue 16 item 1 is in): the pressure follows the local law at each layer
     (line load K delta^n / wb at the layer's own penetration), scaled per contact region so
     that the worn volume is exactly kw times the normal work. ``"local"``: the local law
     unscaled - the wear work of one cycle at a point does not depend on the grid, but where a
     contact is shorter than a layer spacing (bearing edges) the worn volume exceeds kw times
-    the normal work. ``"lumped"``: the layer's force spread over its whole slice area (before
-    issue 16; dilutes edge contacts shorter than the slice, so edge wear grows as the grid is
-    refined). ``impact_latch``: ``"region"`` latches the impact velocity of eq. 6 once per
+    the normal work. ``"lumped"`` (default for now): the layer's force spread over its whole
+    slice area (dilutes edge contacts shorter than the slice, so edge wear grows as the grid
+    is refined). Both new options make the wear-rate field of the worn bore vary more from
+    cycle to cycle than the current adaptive controller tolerates on fine grids (it collapses
+    to dN = 1 at 40x400), hence the defaults. ``impact_latch``: ``"region"`` latches the impact velocity of eq. 6 once per
     impact, at the onset, for each run of adjacent contacting layers (eq. 6 as defined);
     ``"layer"`` (default for now): each layer latches its own approach rate when it enters
     contact. The default stays ``"layer"`` until the wear-update controller copes with the
@@ -213,7 +216,7 @@ class ContactParameters:
     """
 
     formulation: Literal["slice", "per_point"] = "slice"
-    wear_projection: Literal["local_conserving", "local", "lumped"] = "local_conserving"
+    wear_projection: Literal["lumped", "local_conserving", "local"] = "lumped"
     impact_latch: Literal["layer", "region"] = "layer"
     stiffness: Literal["time_varying", "constant"] = "time_varying"
     worn_radius_in_denominator: bool = False

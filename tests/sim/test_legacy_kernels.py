@@ -1,7 +1,7 @@
 """The options that reproduce the simulator before issue 16 still give its numbers.
 
-``contact.wear_projection = "lumped"`` with ``contact.impact_latch = "layer"`` (and the
-per-point formulation) must reproduce the kernels as they were before the edge projection,
+``contact.wear_projection = "lumped"`` with ``contact.impact_latch = "layer"`` (the defaults
+until the new wear-update controller is in; and the per-point formulation) must reproduce the kernels as they were before the edge projection,
 the per-region impact latch and the deduplication of ``sim/_kernels.py``. The reference
 ``data/legacy_kernels.npz`` was computed with the pre-issue-16 kernels (commit 00de2ba) on a
 worn profile; short runs, so that the impact dynamics cannot amplify last-bit differences of
@@ -60,8 +60,8 @@ def test_legacy_options_reproduce_the_kernels_before_issue_16(name):
         np.testing.assert_allclose(value, want, rtol=1e-9, atol=1e-9 * scale, err_msg=key)
 
 
-def test_defaults_differ_from_the_legacy_options():
-    # the reference would not catch a default silently equal to the legacy form
+def test_new_options_differ_from_the_legacy_options():
+    # the reference would not catch a new option silently equal to the legacy form
     p, cycles = CASES["slice"]
     new = replace_nested(
         p, **{"contact.wear_projection": "local_conserving", "contact.impact_latch": "region"}
