@@ -344,7 +344,7 @@ def test_reader_columns_record_the_resolved_meaning(tmp_path):
 def test_help_texts_keep_their_units(capsys):
     assert main(["metrology", "import", "--help"]) == 0
     out = " ".join(capsys.readouterr().out.replace("│", " ").split())
-    assert "Layer spacing, in mm" in out and "mid-width, in mm" in out
+    assert "Layer spacing [mm]" in out and "mid-width [mm]" in out
     assert main(["metrology", "assess", "--help"]) == 0
     out = " ".join(capsys.readouterr().out.replace("│", " ").split())
     assert "Bore radius in mm" in out and "cut-off in UPR" in out

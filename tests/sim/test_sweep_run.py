@@ -225,10 +225,10 @@ def test_cli_sweep_writes_the_file_and_reports_failures(tmp_path, capsys):
     assert "exceeds fail_above" in cap.err
     prov = io.parse_provenance(ds)
     assert any(str(spec) in i["path"] and "sha256" in i for i in prov["inputs"])
-    code = main(["sim", "sweep", str(spec), "--out", str(out), "--params", "x.toml"])
+    code = main(["sim", "sweep", str(spec), "--out", str(out), "--params", "x.toml", "--overwrite"])
     assert code == 3 and "--params does not apply" in capsys.readouterr().err
     spec.write_text(spec.read_text().replace('"lhs"', '"lhz"'))
-    code = main(["sim", "sweep", str(spec), "--out", str(out), "--workers", "0"])
+    code = main(["sim", "sweep", str(spec), "--out", str(tmp_path / "s2.nc"), "--workers", "0"])
     err = capsys.readouterr().err
     assert code == 3 and "method = 'lhz'" in err and "Traceback" not in err
 
