@@ -21,6 +21,7 @@ import pandas as pd
 import xarray as xr
 
 import jointwear.compare.verdicts as vd
+from jointwear import conventions
 from jointwear.compare._decide import DECISION_COLUMNS, Rows
 from jointwear.compare._motion import motion_metrics, rms_quantities
 from jointwear.compare._wear import sim_quantities, wear_metrics
@@ -405,6 +406,11 @@ def compare(
     decisions: list[dict[str, Any]] = []
     notes: list[str] = []
     partial: list[str] = []
+    for side, group in (("simulation", sims), ("measurement", meass)):
+        for ds in group:  # an interrupted run is never judged as if it had finished
+            status = conventions.describe_status(ds) if isinstance(ds, xr.Dataset) else None
+            if status:
+                partial.append(f"{side} input {ds.attrs.get('title', '')!r}: {status}")
     wear = motion = None
     field_values: dict[str, list[tuple[int, np.ndarray]]] = {}
     if s_wear is not None and m_wear is not None:

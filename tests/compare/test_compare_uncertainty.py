@@ -310,3 +310,15 @@ def test_partial_arc_is_not_interpolated_across_its_gap():
     assert "of the circumference" in c.decisions[c.decisions.key == "max_wear_depth"].reason.iloc[0]
     assert c.state("wear map shape") == "not_comparable"
     assert c.value("wear_depth", "volume_fraction_compared") < 0.5
+
+
+def test_an_interrupted_simulation_is_flagged_partial_and_never_complete(tmp_path):
+    sim = syn.sim_wear()
+    meas = syn.meas_wear(u=1e-6, n_layers=16)
+    assert not compare(sim, meas).partial
+    sim.attrs.update(status="partial", cycles_done=3e4, cycles_target=4e5)
+    c = compare(sim, meas)
+    assert any("stopped after 30000 of 400000 cycles" in p for p in c.partial)
+    assert not c.complete  # --strict exits 1
+    save_comparison(c, tmp_path / "m.nc")
+    assert any("stopped after 30000" in p for p in load_comparison(tmp_path / "m.nc").partial)
