@@ -79,6 +79,21 @@ def _strain_kernel(ref, cur, sig, pix, subset, ptr, idx, frames, min_count, E, U
     for k in range(N):
         if not np.isfinite(frames[k, 0, 0]):
             continue
+        cnt = ptr[k + 1] - ptr[k]
+        sv = np.empty(cnt)  # local coordinates of the neighbours in the point's frame
+        rv = np.empty(cnt)
+        for q in range(ptr[k], ptr[k + 1]):
+            j = idx[q]
+            s = 0.0
+            r = 0.0
+            for c in range(d):
+                s += (ref[j, c] - ref[k, c]) * frames[k, 0, c]
+                r += (ref[j, c] - ref[k, c]) * frames[k, 1, c]
+            sv[q - ptr[k]] = s
+            rv[q - ptr[k]] = r
+        used = np.zeros(cnt, np.bool_)
+        w1 = np.zeros(cnt)
+        w2 = np.zeros(cnt)
         for t in range(T):
             # normal equations of x_j = a + F (s_j, t_j), weights equal
             ata = np.zeros((3, 3))
@@ -89,14 +104,10 @@ def _strain_kernel(ref, cur, sig, pix, subset, ptr, idx, frames, min_count, E, U
                 ok = np.isfinite(sig[t, j])
                 for c in range(d):
                     ok = ok and np.isfinite(cur[t, j, c]) and np.isfinite(ref[j, c])
+                used[q - ptr[k]] = ok
                 if not ok:
                     continue
-                s = 0.0
-                r = 0.0
-                for c in range(d):
-                    s += (ref[j, c] - ref[k, c]) * frames[k, 0, c]
-                    r += (ref[j, c] - ref[k, c]) * frames[k, 1, c]
-                a = (1.0, s, r)
+                a = (1.0, sv[q - ptr[k]], rv[q - ptr[k]])
                 for i1 in range(3):
                     for i2 in range(3):
                         ata[i1, i2] += a[i1] * a[i2]
@@ -121,25 +132,9 @@ def _strain_kernel(ref, cur, sig, pix, subset, ptr, idx, frames, min_count, E, U
             E[t, k, 2] = 0.5 * c12
             # slope noise with the correlation of overlapping subsets: errors of two points
             # correlate by the shared fraction of their subsets' pixels
-            cnt = ptr[k + 1] - ptr[k]
-            w1 = np.zeros(cnt)
-            w2 = np.zeros(cnt)
-            used = np.zeros(cnt, np.bool_)
-            for q in range(ptr[k], ptr[k + 1]):
-                j = idx[q]
-                ok = np.isfinite(sig[t, j])
-                for c in range(d):
-                    ok = ok and np.isfinite(cur[t, j, c]) and np.isfinite(ref[j, c])
-                if not ok:
-                    continue
-                s = 0.0
-                r = 0.0
-                for c in range(d):
-                    s += (ref[j, c] - ref[k, c]) * frames[k, 0, c]
-                    r += (ref[j, c] - ref[k, c]) * frames[k, 1, c]
-                w1[q - ptr[k]] = inv[1, 0] + inv[1, 1] * s + inv[1, 2] * r
-                w2[q - ptr[k]] = inv[2, 0] + inv[2, 1] * s + inv[2, 2] * r
-                used[q - ptr[k]] = True
+            for a1 in range(cnt):
+                w1[a1] = inv[1, 0] + inv[1, 1] * sv[a1] + inv[1, 2] * rv[a1]
+                w2[a1] = inv[2, 0] + inv[2, 1] * sv[a1] + inv[2, 2] * rv[a1]
             v1 = 0.0
             v2 = 0.0
             v12 = 0.0
