@@ -113,7 +113,7 @@ def _strain_kernel(ref, cur, sig, pix, subset, ptr, idx, frames, min_count, E, U
                         ata[i1, i2] += a[i1] * a[i2]
                     for c in range(d):
                         atx[i1, c] += a[i1] * (cur[t, j, c] - ref[k, c])
-                    m += 1
+                m += 1
             if m < min_count:
                 continue
             if abs(np.linalg.det(ata)) < 1e-12 * (ata[1, 1] * ata[2, 2] + 1e-300) * m:

@@ -94,7 +94,9 @@ def test_csv_export_and_figure(affine, tmp_path):
     assert [f.name for f in files] == ["field_0000.csv", "field_0001.csv", "field_0002.csv"]
     rows = list(csv.DictReader(files[2].read_text().splitlines()))
     assert len(rows) == ds.sizes["point"]
-    k = next(i for i, r in enumerate(rows) if r["flag"] == "ok")
+    # a border point measures displacement but has too few window neighbours for strain
+    strained = np.isfinite(ds.strain.values[2, :, 0])
+    k = next(i for i, r in enumerate(rows) if r["flag"] == "ok" and strained[i])
     assert float(rows[k]["u [pixel]"]) == pytest.approx(ds.displacement.values[2, k, 0], rel=1e-8)
     assert float(rows[k]["exx"]) == pytest.approx(ds.strain.values[2, k, 0], rel=1e-8)
     fig = plot_field(ds)
@@ -128,3 +130,27 @@ def test_cli_2d_field_with_a_frame_rate_and_a_mask(affine, tmp_path):
     cv2.imwrite(str(tmp_path / "small.png"), mask[:50])
     bad = ["dic", "field", *names, "--roi", str(tmp_path / "small.png"), "--out", str(out)]
     assert main(bad) == 3
+
+
+def test_strain_needs_the_stated_share_of_the_window():
+    """A point whose window holds fewer valid neighbours than min_count gets no strain
+    (min_count counts points; it once counted three per point)."""
+    from jointwear.dic._strain import surface_strain
+
+    ys, xs = np.mgrid[0:7, 0:7]
+    ref = np.column_stack([xs.ravel(), ys.ravel()]).astype(float) * 10.0
+    cur = (ref * 1.003)[None]
+    sigma = np.full((1, ref.shape[0]), 0.01)
+    index = np.column_stack([ys.ravel(), xs.ravel()])
+    pixels = ref.copy()
+    E, _, _ = surface_strain(ref, cur, sigma, index, 5, pixels, 21)
+    centre = 3 * 7 + 3
+    assert E[0, centre, 0] == pytest.approx(0.5 * (1.003**2 - 1), rel=1e-9)
+    # 25 points in the 5x5 window, min_count = 15: keep 10 valid -> no strain
+    keep = np.zeros(ref.shape[0], bool)
+    win = [(r, c) for r in range(1, 6) for c in range(1, 6)]
+    for r, c in win[:10]:
+        keep[r * 7 + c] = True
+    thin = np.where(keep[None, :, None], cur, np.nan)
+    E, _, _ = surface_strain(ref, thin, sigma, index, 5, pixels, 21)
+    assert np.isnan(E[0, centre, 0])
