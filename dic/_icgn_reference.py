@@ -9,7 +9,7 @@ import numpy as np
 from numba import njit
 
 from jointwear.dic._flags import FLAG_INVALID_PIXELS, FLAG_NO_TEXTURE, FLAG_OK, FLAG_OUTSIDE
-from jointwear.dic._interp import PAD, interp_value
+from jointwear.dic._interp import PAD, interp_value, node_filters
 
 
 @njit(cache=True)
@@ -156,12 +156,7 @@ def subset_kappa(coef, order, gx, gy, centres, half, out):
     """Per subset, ``kappa = sum |g_c|^2 / sum g_c . g_s``: central-difference node gradients
     ``gx``, ``gy`` against the interpolant's exact node derivative ``g_s`` (from the padded
     coefficients), over the subset square around each centre (1 where undefined)."""
-    if order == 3:
-        val = np.array([1.0, 4.0, 1.0]) / 6.0
-        der = np.array([-0.5, 0.0, 0.5])
-    else:
-        val = np.array([1.0, 26.0, 66.0, 26.0, 1.0]) / 120.0
-        der = np.array([-1.0, -10.0, 0.0, 10.0, 1.0]) / 24.0
+    val, der = node_filters(order)
     r = val.shape[0] // 2
     h, w = gx.shape
     for i in range(centres.shape[0]):

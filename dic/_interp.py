@@ -440,15 +440,22 @@ def _central_gradients(img, gx, gy):
 
 
 @njit(cache=True)
+def node_filters(order):
+    """B-spline value and derivative weights at a pixel node, over its 2r+1 coefficients
+    (``order`` 3: cubic, r = 1; else quintic, r = 2)."""
+    if order == 3:
+        return np.array([1.0, 4.0, 1.0]) / 6.0, np.array([-0.5, 0.0, 0.5])
+    return (
+        np.array([1.0, 26.0, 66.0, 26.0, 1.0]) / 120.0,
+        np.array([-1.0, -10.0, 0.0, 10.0, 1.0]) / 24.0,
+    )
+
+
+@njit(cache=True)
 def _node_gradients(coef, order, gx, gy):
     """Exact derivatives of the interpolant at the pixel nodes [grey level / pixel]."""
     h, w = gx.shape
-    if order == 3:
-        val = np.array([1.0, 4.0, 1.0]) / 6.0
-        der = np.array([-0.5, 0.0, 0.5])
-    else:
-        val = np.array([1.0, 26.0, 66.0, 26.0, 1.0]) / 120.0
-        der = np.array([-1.0, -10.0, 0.0, 10.0, 1.0]) / 24.0
+    val, der = node_filters(order)
     r = val.shape[0] // 2
     # separable: along x first (value and derivative filters) on rows -r..h+r, then along y
     tv = np.empty((h + 2 * r, w))
