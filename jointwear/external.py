@@ -513,10 +513,11 @@ def load_for_comparison(
     try:
         return io.load(path)
     except BadInputError:
-        if not path.is_file() or _has_provenance(path):
+        header = _foreign_header(path)
+        if header is None:  # a jointwear file that breaks the contract, or not netCDF at all
             raise
     command = "wearmap" if role == "measured" else "wearmap|motion"
-    stated, z_stated = _stated_origin(path)
+    stated, z_stated = header
     if not z_stated:
         raise BadInputError(
             f"'{path}' comes from another tool and its z coordinate does not say where z = 0 "
@@ -550,17 +551,17 @@ def load_for_comparison(
     return ds
 
 
-def _has_provenance(path: Path) -> bool:
+def _foreign_header(path: Path) -> tuple[str | None, bool] | None:
+    """For a netCDF file without jointwear provenance: its stated ``data_origin`` (or None) and
+    whether its z (if any) states ``z_zero``; None for a jointwear file or a non-netCDF one."""
+    if not path.is_file():
+        return None
     try:
         with xr.open_dataset(path, engine="netcdf4") as raw:
-            return "provenance" in raw.attrs
+            if "provenance" in raw.attrs:
+                return None
+            origin = raw.attrs.get("data_origin")
+            z_ok = "z" not in raw.coords or "z_zero" in raw.coords["z"].attrs
     except (OSError, ValueError):
-        return True  # not netCDF at all: io.load's message is the right one
-
-
-def _stated_origin(path: Path) -> tuple[str | None, bool]:
-    """The file's ``data_origin`` (or None) and whether its z (if any) states ``z_zero``."""
-    with xr.open_dataset(path, engine="netcdf4") as raw:
-        origin = raw.attrs.get("data_origin")
-        z_ok = "z" not in raw.coords or "z_zero" in raw.coords["z"].attrs
+        return None  # not netCDF at all: io.load's message is the right one
     return (str(origin) if origin is not None else None), z_ok
