@@ -28,7 +28,7 @@ link, y up (gravity along -y), z out of the mechanism plane towards the cameras.
 from __future__ import annotations
 
 import json
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 from typing import Any
@@ -607,10 +607,15 @@ class VirtualRig:
 
     def board_images(self) -> list[tuple[np.ndarray, np.ndarray]]:
         """(left, right) board images, the world-frame view last."""
-        return [
-            (self.render_board("left", R, o, index=i), self.render_board("right", R, o, index=i))
-            for i, (R, o) in enumerate(self.board_poses())
-        ]
+        return list(self.iter_board_images())
+
+    def iter_board_images(self) -> Iterator[tuple[np.ndarray, np.ndarray]]:
+        """The board images of :meth:`board_images`, rendered one pair at a time."""
+        for i, (R, o) in enumerate(self.board_poses()):
+            yield (
+                self.render_board("left", R, o, index=i),
+                self.render_board("right", R, o, index=i),
+            )
 
     # ---- regions of interest ----------------------------------------------------------------
     def body_rois(self, *, shrink_px: float = 6.0) -> dict[str, list[list[float]]]:
@@ -812,12 +817,10 @@ def generate_rig(
         if images:
             written[f"{cam}_images"] = folder
     if calibration_images:
-        poses = rig.board_poses()
-        for i, (rot, origin) in enumerate(poses):
-            L = rig.render_board("left", rot, origin, index=i)
-            R = rig.render_board("right", rot, origin, index=i)
+        n_views = len(rig.board_poses())
+        for i, (L, R) in enumerate(rig.iter_board_images()):
             if progress is not None:
-                progress("calibration", i + 1, len(poses))
+                progress("calibration", i + 1, n_views)
             for cam, img in (("left", L), ("right", R)):
                 folder = out / "calibration" / cam
                 folder.mkdir(parents=True, exist_ok=True)
