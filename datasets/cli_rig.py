@@ -82,17 +82,20 @@ def register(app: typer.Typer) -> None:
             from jointwear import io
 
             motion_ds = io.load(motion)
-        from jointwear.datasets.rig import VirtualRig
         from jointwear.progress import progress_bar
 
-        n_views = len(VirtualRig(cfg, motion=motion_ds).board_poses())
-        total = 2 * cfg.n_frames + n_views
+        # frames of both cameras; the calibration views join the total when they start
         offsets = {"left": 0, "right": cfg.n_frames, "calibration": 2 * cfg.n_frames}
-        with progress_bar("rendering the rig", total=total) as bar:
+        with progress_bar("rendering the rig", total=2 * cfg.n_frames) as bar:
             task = bar.tasks[0].id
 
             def advance(stage: str, done: int, of: int) -> None:
-                bar.update(task, completed=offsets[stage] + done, description=f"rendering {stage}")
+                bar.update(
+                    task,
+                    completed=offsets[stage] + done,
+                    total=offsets[stage] + of if stage == "calibration" else None,
+                    description=f"rendering {stage}",
+                )
 
             written = generate_rig(
                 out,
