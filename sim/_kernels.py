@@ -330,12 +330,11 @@ def _slices(J0, u, V0, W, ctx, wrench, acc, hstep):
     Returns (energy, normal force sum, max penetration, K at the deepest layer, contacting
     layers, opposite-sides flag, contact length fraction).
     """
-    P, IP, H, HMIN, ZL, AREA = ctx[0], ctx[1], ctx[2], ctx[3], ctx[4], ctx[6]
+    P, IP, H, HMIN, ZL, WL, AREA = ctx[0], ctx[1], ctx[2], ctx[3], ctx[4], ctx[5], ctx[6]
     vimp, srate, son, WW, acc_out = ctx[7], ctx[8], ctx[9], ctx[11], ctx[12]
     Nl = IP[NL]
     Nd = IP[ND]
     nexp = P[NEXP]
-    lam = 1.0 / (Nl - 1)
     # one scratch block per call: bound, in-plane axis point, reach, results per layer
     scr = np.empty((Nl, 8))
     dest = scr[:, 0]
@@ -395,6 +394,7 @@ def _slices(J0, u, V0, W, ctx, wrench, acc, hstep):
         if a <= 0.0 and bb <= 0.0:
             continue
         j0, j1, g, frac = _seg(a, bb, nexp)
+        lam = (ZL[n] - ZL[n + 1]) / P[WB]  # the interval's share of the bearing width
         fel[n] += lam * kk[n] * j0
         fel[n + 1] += lam * kk[n + 1] * j1
         energy += lam * 0.5 * (kk[n] + kk[n + 1]) * g
@@ -439,7 +439,7 @@ def _slices(J0, u, V0, W, ctx, wrench, acc, hstep):
         srate[n] = rate
         son[n] = 1
         if acc:
-            fw = _wear_force(n, fn, sd, kk, fel, proj, P)
+            fw = _wear_force(n, fn, sd, kk, fel, WL, proj, P)
             if proj == WPROJ_CONSERVING:  # spread below, once each region's work is known
                 wsc[n, 0] = fn * vt
                 wsc[n, 1] = fw * vt
@@ -463,7 +463,7 @@ def _slices(J0, u, V0, W, ctx, wrench, acc, hstep):
 
 
 @njit(cache=True)
-def _wear_force(n, fn, sd, kk, fel, proj, P):
+def _wear_force(n, fn, sd, kk, fel, WL, proj, P):
     """Force of layer n whose pressure, spread over the layer's slice area, gives its wear work.
 
     ``fn`` is the layer's (damped) share of the contact force, the derivative of the
@@ -477,11 +477,9 @@ def _wear_force(n, fn, sd, kk, fel, proj, P):
     """
     if proj == WPROJ_LUMPED:
         return fn
-    Nl = sd.shape[0]
     if sd[n] <= 0.0:  # the law at the layer itself
         return 0.0
-    wl = 0.5 if (n == 0 or n == Nl - 1) else 1.0
-    return fn * kk[n] * sd[n] ** P[NEXP] * wl / ((Nl - 1) * fel[n])
+    return fn * kk[n] * sd[n] ** P[NEXP] * WL[n] / fel[n]
 
 
 @njit(cache=True)

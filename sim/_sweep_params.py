@@ -92,6 +92,7 @@ _DIMENSIONLESS = {
     "dn_max",
     "n_layers",
     "n_points",
+    "axial_grading",
     "reject_factor",
     "noise_floor",
 }

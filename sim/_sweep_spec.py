@@ -307,10 +307,10 @@ def read_spec(spec: str | Path | Mapping[str, Any]) -> SweepSpec:
                 f"{', '.join(allowed) or 'none'}"
             )
     if "wear_depth" in keep and any(
-        p.name in ("joint.n_layers", "joint.n_points") for p in parameters
+        p.name in ("joint.n_layers", "joint.n_points", "joint.axial_grading") for p in parameters
     ):
         raise ParameterError(
-            '[sweep] keep = ["wear_depth"] with joint.n_layers/n_points swept: the maps of the '
+            '[sweep] keep = ["wear_depth"] with joint.n_layers/n_points/axial_grading swept: the maps of the '
             "runs have different grids and cannot be stacked; drop wear_depth from keep"
         )
 

@@ -22,6 +22,7 @@ from jointwear.params import to_jsonable
 from jointwear.sim.contact import contact_constant
 from jointwear.sim.mechanism import loop_closure, quaternion_to_matrix, rotation_xzy_angles
 from jointwear.sim.parameters import SimParameters
+from jointwear.sim.wearmap import layer_positions
 
 __all__ = [
     "SimState",
@@ -114,11 +115,7 @@ class CycleResult:
 
 def _layers(params: SimParameters) -> tuple[np.ndarray, np.ndarray]:
     j = params.joint
-    nl = j.n_layers
-    z = j.bearing_width / 2 - np.arange(nl) * j.bearing_width / (nl - 1)
-    w = np.full(nl, 1.0 / (nl - 1))
-    w[0] = w[-1] = 0.5 / (nl - 1)
-    return z, w
+    return layer_positions(j.n_layers, j.bearing_width, j.axial_grading)
 
 
 def _pack(params: SimParameters) -> tuple[np.ndarray, np.ndarray]:
@@ -242,7 +239,8 @@ def wear_depth_on_grid(
         Wear depth [m] over ``z`` [m] and ``theta`` [degree] (any stated angle convention; it
         is converted to the canonical one), optionally with a ``cycles`` dimension.
     params : SimParameters
-        Gives the grid: layer n at z = wb/2 - n wb/(Nl-1), point m at m 360/Nd degrees.
+        Gives the grid: layer n at z_n of :func:`jointwear.sim.wearmap.layer_positions`
+        (``joint.axial_grading``), point m at m 360/Nd degrees.
     cycles : float, optional
         Snapshot to take along ``cycles`` (nearest); default the last.
 

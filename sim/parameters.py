@@ -130,7 +130,10 @@ class JointParameters:
     ``axial_clearance`` is the total axial play: the journal's shoulders sit at
     +-(bearing_width + axial_clearance)/2 from the journal centre along its axis, and touch the
     bearing's end faces on a circle of radius ``thrust_radius``. ``model = "ideal"`` makes joint C
-    an ideal revolute (planar four-bar), for validation.
+    an ideal revolute (planar four-bar), for validation. ``n_layers`` x ``n_points`` is the
+    bore grid; ``axial_grading`` in [0, 1) crowds the layers towards both bearing edges
+    (:func:`jointwear.sim.wearmap.layer_positions`; 0 = equal spacing as in the study's eq. 2),
+    where a tilted journal's contacts and their wear are shorter than an equal spacing.
     """
 
     model: Literal["clearance", "ideal"] = "clearance"
@@ -142,6 +145,7 @@ class JointParameters:
     thrust_radius: float = 9.5e-3
     n_layers: int = 20
     n_points: int = 200
+    axial_grading: float = 0.0
 
     def __post_init__(self) -> None:
         w = "joint"
@@ -170,6 +174,11 @@ class JointParameters:
             raise ParameterError(
                 f"joint.thrust_radius ({self.thrust_radius} m) must be >= bearing_radius "
                 f"({self.bearing_radius} m): the shoulders bear on the end faces outside the bore"
+            )
+        if not (math.isfinite(self.axial_grading) and 0.0 <= self.axial_grading < 1.0):
+            raise ParameterError(
+                f"joint.axial_grading must lie in [0, 1) (0: equally spaced layers), got "
+                f"{self.axial_grading!r}"
             )
         if self.n_layers < 2 or self.n_points < 8:
             raise ParameterError(

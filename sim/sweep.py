@@ -85,7 +85,7 @@ def _check_feasible(spec: SweepSpec, sim: Any, wear: Any) -> None:
                     f'[parameters."{p.name}"]: its {what} is not a valid value{hint}: {exc}'
                 ) from None
     if "wear_depth" in spec.keep:
-        shape = {"joint.n_layers", "joint.n_points", "joint.bearing_width"}
+        shape = {"joint.n_layers", "joint.n_points", "joint.bearing_width", "joint.axial_grading"}
         clash = sorted(shape & set(spec.names))
         if clash:
             raise ParameterError(
