@@ -29,7 +29,8 @@ NP = 34
 DRIVER, ON_COUPLER, IDEAL, PER_POINT, KVARY, KDEN_WORN, NL, ND = 0, 1, 2, 3, 4, 5, 6, 7
 WPROJ = 8  # wear projection of the slice formulation: 0 local, 1 lumped, 2 local_conserving
 LATCH = 9  # impact velocity latched 0 once per impact and contact region, 1 per layer
-NIP = 10
+GRADED = 10  # 0: layers equally spaced (eq. 2), 1: spacing from ZL (joint.axial_grading)
+NIP = 11
 WPROJ_LOCAL, WPROJ_LUMPED, WPROJ_CONSERVING = 0, 1, 2
 # ---- diagnostics row (recorded at output times) ----------------------------------------------
 D_TH1 = 0
@@ -394,7 +395,8 @@ def _slices(J0, u, V0, W, ctx, wrench, acc, hstep):
         if a <= 0.0 and bb <= 0.0:
             continue
         j0, j1, g, frac = _seg(a, bb, nexp)
-        lam = (ZL[n] - ZL[n + 1]) / P[WB]  # the interval's share of the bearing width
+        # the interval's share of the bearing width (written as 1/(Nl-1) for equal spacing)
+        lam = (ZL[n] - ZL[n + 1]) / P[WB] if IP[GRADED] else 1.0 / (Nl - 1)
         fel[n] += lam * kk[n] * j0
         fel[n + 1] += lam * kk[n + 1] * j1
         energy += lam * 0.5 * (kk[n] + kk[n + 1]) * g

@@ -169,6 +169,7 @@ def _pack(params: SimParameters) -> tuple[np.ndarray, np.ndarray]:
         "lumped": kn.WPROJ_LUMPED,
     }[c.wear_projection]
     IP[kn.LATCH] = 1 if c.impact_latch == "layer" else 0
+    IP[kn.GRADED] = 1 if j.axial_grading > 0 else 0
     return P, IP
 
 

@@ -145,7 +145,7 @@ class JointParameters:
     thrust_radius: float = 9.5e-3
     n_layers: int = 20
     n_points: int = 200
-    axial_grading: float = 0.0
+    axial_grading: float = 0.75
 
     def __post_init__(self) -> None:
         w = "joint"

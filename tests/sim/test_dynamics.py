@@ -261,6 +261,7 @@ def test_wear_map_resampled_onto_the_grid_in_the_canonical_convention():
     from jointwear.conventions import AngleConvention, theta_coord, z_coord
     from jointwear.errors import ConventionError
     from jointwear.sim import wear_depth_on_grid
+    from jointwear.sim.dynamics import _layers
 
     # a measured-style map: 13 layers 1 mm apart, 1 degree steps, 0 deg along +x, ccw
     psi = np.arange(360.0)  # physical angle, ccw from +x
@@ -278,7 +279,7 @@ def test_wear_map_resampled_onto_the_grid_in_the_canonical_convention():
     h = wear_depth_on_grid(da, BASE)
     assert h.shape == (20, 200)
     phi = np.arange(200) * 1.8  # canonical: from -x, clockwise
-    zn = np.clip(7.5e-3 - np.arange(20) * 15e-3 / 19, -6e-3, 6e-3)
+    zn = np.clip(_layers(BASE)[0], -6e-3, 6e-3)  # the simulator's (graded) layers
     expected = truth(180.0 - phi[None, :], zn[:, None])
     np.testing.assert_allclose(h, expected, atol=2e-9)
     stacked = xr.concat([da * 0, da], dim="cycles").assign_coords(cycles=[0.0, 1e5])

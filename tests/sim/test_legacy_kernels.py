@@ -1,7 +1,7 @@
 """The options that reproduce the simulator before issue 16 still give its numbers.
 
-``contact.wear_projection = "lumped"`` with ``contact.impact_latch = "layer"`` (and the
-per-point formulation) must reproduce the kernels as they were before the edge projection,
+``contact.wear_projection = "lumped"`` with ``contact.impact_latch = "layer"`` and equally
+spaced layers (``joint.axial_grading = 0``; and the per-point formulation) must reproduce the kernels as they were before the edge projection,
 the per-region impact latch and the deduplication of ``sim/_kernels.py``. The reference
 ``data/legacy_kernels.npz`` was computed with the pre-issue-16 kernels (commit 00de2ba) on a
 worn profile; short runs, so that the impact dynamics cannot amplify last-bit differences of
@@ -19,7 +19,11 @@ import pytest
 from jointwear.params import replace_nested
 from jointwear.sim import PARAMETER_SETS, run_cycles
 
-LEGACY = {"contact.wear_projection": "lumped", "contact.impact_latch": "layer"}
+LEGACY = {
+    "contact.wear_projection": "lumped",
+    "contact.impact_latch": "layer",
+    "joint.axial_grading": 0.0,
+}
 _BASE = replace_nested(PARAMETER_SETS["zhang2023"], **LEGACY)
 CASES = {
     "slice": (replace_nested(_BASE, **{"joint.n_layers": 12, "joint.n_points": 120}), 0.3),
@@ -64,7 +68,12 @@ def test_defaults_differ_from_the_legacy_options():
     # the reference would not catch a default silently equal to the legacy form
     p, cycles = CASES["slice"]
     new = replace_nested(
-        p, **{"contact.wear_projection": "local_conserving", "contact.impact_latch": "region"}
+        p,
+        **{
+            "contact.wear_projection": "local_conserving",
+            "contact.impact_latch": "region",
+            "joint.axial_grading": 0.75,
+        },
     )
     a = run_cycles(p, cycles=cycles, wear_depth=worn_profile(p), record=False)
     b = run_cycles(new, cycles=cycles, wear_depth=worn_profile(p), record=False)
