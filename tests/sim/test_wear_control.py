@@ -72,9 +72,11 @@ def test_noise_above_tol_finishes_and_reports_an_accuracy_that_covers_the_error(
         assert np.all(np.isfinite(u)) and np.all(u > 0)
         covered = np.mean(err <= u)
         assert covered >= 0.9, f"k=2 uncertainty covers {covered:.0%} of the points"
-        # and it matches the scatter: RMS error / RMS u = 0.5 for a matched k = 2 uncertainty
+        # and it follows the scatter: RMS error / RMS u = 0.5 for a matched k = 2 uncertainty;
+        # 40 % noise per cycle hides part of the self-correction, which is then not credited
+        # (conservative, about 2x here)
         ratio = np.sqrt(np.mean(err**2)) / np.sqrt(np.mean(u**2))
-        assert 0.3 < ratio < 0.8, f"RMS error / RMS u = {ratio:.2f}"
+        assert 0.18 < ratio < 0.8, f"RMS error / RMS u = {ratio:.2f}"
         i = int(np.argmax(h))
         assert abs(h.flat[i] - exact(c, model.pattern).flat[i]) <= float(ds["max_wear_depth_u"][k])
         vol_exact = float(np.sum(exact(c, model.pattern) * GRID.point_area))
@@ -164,3 +166,60 @@ def test_resume_mid_run_is_bit_identical_with_the_noise_aware_controller(tmp_pat
     ):
         np.testing.assert_array_equal(resumed[name].values, full[name].values)
     assert resumed.attrs["rate_noise"] == full.attrs["rate_noise"]
+
+
+class SteadyNoisyContact(DecayingNoisyContact):
+    """Mean rate independent of the depth (no self-correction), noisy per cycle; with
+    ``leave_at`` the load leaves the lower half of the angles after that depth is reached."""
+
+    def __init__(self, noise=0.4, seed=5, leave_at=None):
+        super().__init__(noise=noise, seed=seed)
+        self.leave_at = leave_at
+
+    def describe(self):
+        return {"model": "steady-noisy", "noise": self.noise, "leave": self.leave_at}
+
+    def run(self, wear_depth, *, cycles, state, progress=None):
+        rng = np.random.default_rng(self.seed)
+        if state is not None:
+            rng.bit_generator.state = state
+        mean = A_RATE * self.pattern * np.ones(self.grid.shape)
+        if self.leave_at is not None and wear_depth.max() >= self.leave_at:
+            mean[:, : self.grid.n_points // 2] = 0.0
+        factor = 1 + self.noise * rng.standard_normal(self.grid.shape) / np.sqrt(cycles)
+        w = mean * np.maximum(factor, 0.0) * cycles / KW
+        area = self.grid.point_area
+        return CycleWear(w, area, float(np.sum(w * area)), rng.bit_generator.state, cycles)
+
+
+@pytest.mark.parametrize("leave_at", [None, 4e-5])
+def test_noise_and_a_departing_load_do_not_erase_the_accuracy(leave_at):
+    """Without self-correction the depth errors never shrink: neither noise in the rate ratios
+    (which, clipped at 1, used to damp the budget a little at every update) nor a load that
+    leaves some points (their errors freeze) may remove them from the stated accuracy."""
+    errs, us = [], []
+    for seed in range(4):
+        model = SteadyNoisyContact(noise=0.4, seed=seed, leave_at=leave_at)
+        ds = simulate_wear(
+            contact=model,
+            cycles=100_000,
+            snapshots=[],
+            settings=WearSettings(kw=KW, tol=0.1, dn_max=2000),
+        )
+        h = ds["wear_depth"].values[-1, ::-1]
+        u = ds["wear_depth_u"].values[-1, ::-1]
+        hist = ds["update_dn"].values
+        assert hist.size > 5
+        # truth: the mean rate times the cycles each point was loaded; the model's load
+        # leaves at a depth, so compare only the always-loaded half when it leaves
+        cols = slice(None) if leave_at is None else slice(model.grid.n_points // 2, None)
+        truth = A_RATE * model.pattern * 100_000
+        errs.append((h - truth)[:, cols].ravel())
+        us.append(u[:, cols].ravel())
+        if leave_at is not None:  # the departed points keep an accuracy of their own
+            left = u[:, : model.grid.n_points // 2]
+            assert np.all(left > 0)
+    err, u = np.concatenate(errs), np.concatenate(us)
+    assert np.mean(np.abs(err) <= u) >= 0.9
+    ratio = np.sqrt(np.mean(err**2)) / np.sqrt(np.mean(u**2))
+    assert 0.25 < ratio < 0.8, f"RMS error / RMS u = {ratio:.2f}"
