@@ -1,14 +1,15 @@
 """Wear maps of the bearing bore: the discrete grid, the contract Dataset, volume, cylindricity, plots.
 
 The bearing's inner surface is discretised as in the reference study (eq. 2 of Zhang et al. 2023):
-``Nl`` layers equally spaced over the bearing width ``wb`` (layer ``n = 0`` at ``z = +wb/2`` ...
-layer ``Nl - 1`` at ``z = -wb/2``) times ``Nd`` points per layer at ``phi_m = m * 360 / Nd`` degrees
+``Nl`` layers over the bearing width ``wb`` (layer ``n = 0`` at ``z = +wb/2`` ... layer ``Nl - 1``
+at ``z = -wb/2``; equally spaced as in the study, or crowded towards both edges with
+``axial_grading``, :func:`layer_positions`) times ``Nd`` points per layer at ``phi_m = m * 360 / Nd`` degrees
 in the canonical angle convention (0 along -x of the bearing frame, clockwise seen from +z).
 Simulator arrays are indexed ``[n, m]`` (layer, point). The :mod:`jointwear.conventions` Dataset
 instead has ``z`` *ascending*, so the layer axis is reversed when a map is written.
 
 Each point stands for a patch of the bore: ``Rb * dphi`` around the circumference times the
-trapezoidal share of the width (``wb / (Nl - 1)``, half of it for the two edge layers), so the patch
+trapezoidal share of the width (half of each neighbouring layer spacing), so the patch
 areas add up to the bore area ``2 pi Rb wb`` for any grid.
 """
 
