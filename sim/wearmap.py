@@ -288,6 +288,7 @@ def wear_map_dataset(
             "bearing_width_m": grid.width,
             "n_layers": grid.n_layers,
             "n_points": grid.n_points,
+            "axial_grading": grid.axial_grading,
         }
     )
     ds.attrs.update(attrs or {})

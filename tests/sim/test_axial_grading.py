@@ -84,6 +84,7 @@ def test_graded_map_round_trips_through_the_dataset_and_the_resampler():
     h = 1e-6 * (2 + np.cos(th)[None, :]) * (1 + (grid.z / WB)[:, None] ** 2)
     ds = wear_map_dataset(h[None], np.array([1e5]), grid)
     zc = ds["z"].values
+    assert ds.attrs["axial_grading"] == 0.75
     np.testing.assert_allclose(zc, grid.z[::-1], atol=0)  # ascending, the graded positions
     np.testing.assert_allclose(wear_depth_on_grid(ds["wear_depth"], p), h, rtol=1e-12, atol=1e-18)
     # onto an equally spaced grid: linear interpolation between the graded layers
