@@ -123,13 +123,11 @@ def register(app: typer.Typer) -> None:
         crit = load_criteria(criteria)
         sim_paths = [sim, *(sim_extra or [])]
         meas_paths = [meas, *(meas_extra or [])]
+        from jointwear.compare.outcome import echo_warning
         from jointwear.external import load_for_comparison
 
-        def warn(text: str) -> None:
-            typer.echo(f"warning: {text}", err=True)
-
-        sims = [load_for_comparison(p, role="simulated", warn=warn) for p in sim_paths]
-        meass = [load_for_comparison(p, role="measured", warn=warn) for p in meas_paths]
+        sims = [load_for_comparison(p, role="simulated", warn=echo_warning) for p in sim_paths]
+        meass = [load_for_comparison(p, role="measured", warn=echo_warning) for p in meas_paths]
         ens = [io.load(p) for p in ensemble or []]
         vers = [io.load(p, validate=False) for p in verification or []]
         from jointwear.compare.ensemble import as_ensemble

@@ -11,7 +11,15 @@ import jointwear.compare.verdicts as vd
 from jointwear.compare.comparison import Comparison
 from jointwear.errors import ValidationFailed
 
-__all__ = ["card_lines", "origin_line", "outcome_lines", "raise_for_outcome"]
+__all__ = ["card_lines", "echo_warning", "origin_line", "outcome_lines", "raise_for_outcome"]
+
+
+def echo_warning(text: str) -> None:
+    """Print ``warning: TEXT`` as one plain line on stderr (the ``warn`` of
+    :func:`jointwear.external.load_for_comparison` for ``compare`` and ``report``)."""
+    import typer
+
+    typer.echo(f"warning: {text}", err=True)
 
 
 def origin_line(c: Comparison) -> str:

@@ -11,7 +11,7 @@ mapping is written in sorted order.
 from __future__ import annotations
 
 import json
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
@@ -349,6 +349,7 @@ def report_from_files(
     variables: Sequence[str] | None = None,
     ensemble: Sequence[str | Path] = (),
     axes: Sequence[str] | None = ("x", "y"),
+    warn: Callable[[str], None] | None = None,
 ) -> tuple[Path, Comparison]:
     """Build a report from files: simulation, metrology and DIC netCDF, or a saved comparison.
 
@@ -368,6 +369,10 @@ def report_from_files(
         Ensembles of simulations (``run`` dimension) whose spread is the input uncertainty.
     axes : sequence of str or None
         Motion components to compare (default in-plane x, y).
+    warn : callable, optional
+        Receives the warning text for a file from another tool (the CLI prints it on stderr);
+        by default it is a :class:`UserWarning` (see
+        :func:`jointwear.external.load_for_comparison`).
     criteria : Criteria, optional
         Validation criteria.
     title, pdf, command
@@ -404,9 +409,9 @@ def report_from_files(
             )
         from jointwear.external import load_for_comparison
 
-        sims = [load_for_comparison(p, role="simulated") for p in sim]
-        metros = [load_for_comparison(p, role="measured") for p in metrology]
-        dics = [load_for_comparison(p, role="measured") for p in dic]
+        sims = [load_for_comparison(p, role="simulated", warn=warn) for p in sim]
+        metros = [load_for_comparison(p, role="measured", warn=warn) for p in metrology]
+        dics = [load_for_comparison(p, role="measured", warn=warn) for p in dic]
         inputs += [ReportInput("simulation", Path(p), d) for p, d in zip(sim, sims, strict=True)]
         inputs += [
             ReportInput("metrology", Path(p), d) for p, d in zip(metrology, metros, strict=True)

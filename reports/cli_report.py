@@ -89,7 +89,12 @@ def register(app: typer.Typer) -> None:
             return
         from jointwear import io
         from jointwear.compare import load_criteria
-        from jointwear.compare.outcome import origin_line, outcome_lines, raise_for_outcome
+        from jointwear.compare.outcome import (
+            echo_warning,
+            origin_line,
+            outcome_lines,
+            raise_for_outcome,
+        )
         from jointwear.compare.verdicts import LABELS
         from jointwear.reports.builder import DEFAULT_TITLE, report_from_files
 
@@ -109,6 +114,7 @@ def register(app: typer.Typer) -> None:
             variables=variables or None,
             ensemble=ensemble or [],
             axes=axes or ("x", "y"),
+            warn=echo_warning,
         )
         typer.echo(origin_line(result))
         for row in result.decisions.itertuples():
