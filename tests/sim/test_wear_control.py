@@ -34,11 +34,15 @@ class DecayingNoisyContact:
     def describe(self):
         return {"model": "decaying-noisy", "noise": self.noise, "seed": self.seed}
 
+    def mean_rate(self, wear_depth):
+        """The mean wear rate per point [m/cycle] on the profile ``wear_depth``."""
+        return A_RATE * self.pattern * np.exp(-wear_depth / H0)
+
     def run(self, wear_depth, *, cycles, state, progress=None):
         rng = np.random.default_rng(self.seed)
         if state is not None:
             rng.bit_generator.state = state
-        mean = A_RATE * self.pattern * np.exp(-wear_depth / H0)
+        mean = self.mean_rate(wear_depth)
         factor = 1 + self.noise * rng.standard_normal(self.grid.shape) / np.sqrt(cycles)
         w = mean * np.maximum(factor, 0.0) * cycles / KW  # wear work [Pa m]
         area = self.grid.point_area
@@ -179,17 +183,11 @@ class SteadyNoisyContact(DecayingNoisyContact):
     def describe(self):
         return {"model": "steady-noisy", "noise": self.noise, "leave": self.leave_at}
 
-    def run(self, wear_depth, *, cycles, state, progress=None):
-        rng = np.random.default_rng(self.seed)
-        if state is not None:
-            rng.bit_generator.state = state
+    def mean_rate(self, wear_depth):
         mean = A_RATE * self.pattern * np.ones(self.grid.shape)
         if self.leave_at is not None and wear_depth.max() >= self.leave_at:
             mean[:, : self.grid.n_points // 2] = 0.0
-        factor = 1 + self.noise * rng.standard_normal(self.grid.shape) / np.sqrt(cycles)
-        w = mean * np.maximum(factor, 0.0) * cycles / KW
-        area = self.grid.point_area
-        return CycleWear(w, area, float(np.sum(w * area)), rng.bit_generator.state, cycles)
+        return mean
 
 
 @pytest.mark.parametrize("leave_at", [None, 4e-5])
