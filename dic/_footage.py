@@ -78,7 +78,14 @@ from jointwear.dic._footage_tracker import (  # noqa: F401 (re-exported)
     _match_sigma,
     _noise_sigma,
 )
-from jointwear.dic._video import FrameSource, check_stereo_pair, open_frames, prefetch
+from jointwear.dic._sequence import check_frame_names
+from jointwear.dic._video import (
+    FrameSource,
+    check_stereo_pair,
+    list_image_sequence,
+    open_frames,
+    prefetch,
+)
 from jointwear.errors import BadInputError
 
 __all__ = [
@@ -88,6 +95,19 @@ __all__ = [
     "track_footage",
     "FRAME_FLAGS",
 ]
+
+
+def _open_footage(source: str | Path | FrameSource, fps: float | None, what: str) -> FrameSource:
+    """Open one camera's footage. A folder whose images are not all named like its frames (a
+    mask, a stray image) is refused naming the odd files, as ``dic correlate`` and ``dic field``
+    refuse it (:func:`jointwear.dic._sequence.check_frame_names`): otherwise the odd file would
+    be tracked as one more frame."""
+    if isinstance(source, FrameSource):
+        return source
+    if Path(source).is_dir():
+        files, _ = list_image_sequence(source, what=what)
+        check_frame_names(files, f"{what} folder '{source}'")
+    return open_frames(source, fps=fps, what=what)
 
 
 def track_footage(
@@ -152,14 +172,10 @@ def track_footage(
         dropped frames found.
     """
     cfg = config or TrackConfig()
-    L = left if isinstance(left, FrameSource) else open_frames(left, fps=fps, what="left footage")
+    L = _open_footage(left, fps, "left footage")
     R = None
     if right is not None:
-        R = (
-            right
-            if isinstance(right, FrameSource)
-            else open_frames(right, fps=fps, what="right footage")
-        )
+        R = _open_footage(right, fps, "right footage")
         check_stereo_pair(L, R)
         if calibration is None:
             raise BadInputError(
