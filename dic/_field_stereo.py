@@ -53,7 +53,13 @@ def plane_guess(calibration, centres: np.ndarray) -> np.ndarray:
 
 def _point_cov(calibration, X, sl, sr):
     """Covariance (N, 3, 3) of triangulated points X (N, 3) from per-image standard
-    uncertainties ``sl``, ``sr`` (N, 2) [pixel] (undistorted-pixel Jacobians)."""
+    uncertainties ``sl``, ``sr`` (N, 2) [pixel] (undistorted-pixel Jacobians ``J``).
+
+    The triangulation minimises the unweighted reprojection error of the four image
+    coordinates, so a point moves by ``G d``, ``G = (J^T J)^-1 J^T``, for image errors ``d``:
+    ``cov = G diag(s^2) G^T`` (not the inverse-variance-weighted ``(J^T diag(s^-2) J)^-1``,
+    which is the covariance of a weighted triangulation and under-states Y, the coordinate
+    both cameras' rows fix, when the images' uncertainties differ)."""
     from jointwear.dic._stereo import _project_undistorted
 
     out = np.full((len(X), 3, 3), np.nan)
@@ -63,9 +69,9 @@ def _point_cov(calibration, X, sl, sr):
     _, Jl = _project_undistorted(calibration.left, X[ok])
     _, Jr = _project_undistorted(calibration.right, X[ok])
     J = np.concatenate([Jl, Jr], axis=1)  # (n, 4, 3)
-    w = 1.0 / np.maximum(np.concatenate([sl[ok], sr[ok]], axis=1), 1e-6) ** 2
-    A = np.einsum("nki,nk,nkj->nij", J, w, J)
-    out[ok] = np.linalg.inv(A)
+    G = np.linalg.solve(np.einsum("nki,nkj->nij", J, J), np.transpose(J, (0, 2, 1)))
+    v = np.concatenate([sl[ok], sr[ok]], axis=1) ** 2
+    out[ok] = np.einsum("nik,nk,njk->nij", G, v, G)
     return out
 
 
@@ -86,11 +92,13 @@ def best_fit_plane(P: np.ndarray, towards: np.ndarray) -> tuple[np.ndarray, np.n
     return np.stack([x, np.cross(z, x), z]), o
 
 
-def stereo_geometry(calibration, sub_x, sub_y, SL, SR, flag, prm):
+def stereo_geometry(calibration, sub_x, sub_y, DL, SR, DR, flag, prm):
     """Triangulate every image's matched pairs (see :mod:`jointwear.dic._field`).
 
-    ``sub_x``, ``sub_y`` (T, 2, N) [pixel] subset centres in the left and right images, ``SL``,
-    ``SR`` (T, N, 2) their match uncertainties [pixel], ``flag`` (T, N) updated in place
+    ``sub_x``, ``sub_y`` (T, 2, N) [pixel] subset centres in the left and right images, ``DL``,
+    ``DR`` (T, N, 2) the standard uncertainties [pixel] of every image's left and right match
+    relative to the camera's reference image (:mod:`jointwear.dic._field_mismatch`), ``SR``
+    (T, N, 2) the right matches' own (for ``position_u``), ``flag`` (T, N) updated in place
     (``epipolar_mismatch``; a point without a reference position is flagged at every time).
     Returns ``(ref_pos, disp, disp_u, data, coords, attrs)``: reference positions (N, 3) and
     displacements (T, N, 3) [m] in the output frame, their standard uncertainties, and the
@@ -117,14 +125,18 @@ def stereo_geometry(calibration, sub_x, sub_y, SL, SR, flag, prm):
         flag[:, flag[0] != _flags.FLAG_OK],
     )
     ref_pos = X[0]
-    tiny = np.full((n, 2), 1e-6)
+    zero = np.zeros((n, 2))
     cov_pos = _point_cov(calibration, X[0], SR[0], SR[0])
-    cov0 = _point_cov(calibration, X[0], tiny, SR[0] / np.sqrt(2))
     disp = X - X[0][None]
     cov_d = np.full((n_t, n, 3, 3), np.nan)
     cov_d[0] = 0.0
     for k in range(1, n_t):
-        cov_d[k] = _point_cov(calibration, X[k], SL[k] / np.sqrt(2), SR[k] / np.sqrt(2)) + cov0
+        # relative-match uncertainties (jointwear.dic._field_mismatch): the left one whole at
+        # X_k (the reference position has the unmatched grid centre), the right one half at
+        # X_0 (right reference image) and half at X_k (current right image)
+        cov0 = _point_cov(calibration, X[0], zero, DR[k] / np.sqrt(2))
+        sr = DR[k] / np.sqrt(2)
+        cov_d[k] = _point_cov(calibration, X[k], DL[k], sr) + cov0
     Rf, of = np.eye(3), np.zeros(3)
     if prm.frame == "plane":
         Rf, of = best_fit_plane(X[0][flag[0] == _flags.FLAG_OK], calibration.left.centre)
