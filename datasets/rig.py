@@ -15,7 +15,7 @@ attached to the bodies:
 Rendering is by exact ray casting: for every camera pixel the undistorted viewing ray (the
 inverse of the lens model, solved to 1e-12) is intersected with each patch plane, and the
 speckle texture - a band-limited field sampled at 1/4 of the pixel footprint - is sampled there
-with bicubic interpolation (OpenCV ``remap``); nearer patches hide farther ones. Optical blur is a
+with a cubic B-spline in double precision; nearer patches hide farther ones. Optical blur is a
 Gaussian point-spread function in the image, sensor noise is additive Gaussian, exposure scales
 the brightness (and, with ``motion_blur_samples`` > 1, averages sub-frames over the exposure time),
 and images are quantised to 8 bits. Calibration boards are rendered analytically with
@@ -27,6 +27,7 @@ link, y up (gravity along -y), z out of the mechanism plane towards the cameras.
 
 from __future__ import annotations
 
+import functools
 import json
 from collections.abc import Callable, Iterator
 from dataclasses import asdict, dataclass, field, replace
@@ -278,6 +279,26 @@ class Patch:
     texel: float
     texture: np.ndarray = field(repr=False)
 
+    @functools.cached_property
+    def spline(self) -> np.ndarray:
+        """Cubic B-spline coefficients of the texture (mirror boundary), for exact sampling."""
+        from scipy import ndimage
+
+        return ndimage.spline_filter(np.asarray(self.texture, np.float64), order=3, mode="mirror")
+
+    def sample(self, mx: np.ndarray, my: np.ndarray) -> np.ndarray:
+        """The texture at texel positions (mx, my), cubic B-spline in float64.
+
+        (OpenCV's ``remap`` quantises positions to 1/32 texel: at 4 texels per pixel an error
+        nearly constant over a subset, which biased the ground truth of the tracked motion by up
+        to 0.004 pixel - about 0.4 µm of out-of-plane displacement on the default rig.)
+        """
+        from scipy import ndimage
+
+        return ndimage.map_coordinates(
+            self.spline, [my, mx], order=3, mode="mirror", prefilter=False
+        )
+
     def corners_body(self) -> np.ndarray:
         a, b = self.size
         return np.array(
@@ -419,7 +440,6 @@ class VirtualRig:
 
     # ---- rendering -------------------------------------------------------------------------
     def _render_radiance(self, camera: str, t: float) -> np.ndarray:
-        import cv2
 
         c = self.config
         cam = self.calibration.cameras[camera]
@@ -455,17 +475,8 @@ class VirtualRig:
             inside &= tt < sub_depth
             if not np.any(inside):
                 continue
-            mx = (a / patch.texel + 2).astype(np.float32)
-            my = (b / patch.texel + 2).astype(np.float32)
-            sampled = cv2.remap(
-                patch.texture,
-                mx,
-                my,
-                interpolation=cv2.INTER_CUBIC,
-                borderMode=cv2.BORDER_REFLECT,
-            )
             sub = img[y0:y1, x0:x1]
-            sub[inside] = sampled[inside]
+            sub[inside] = patch.sample(a[inside] / patch.texel + 2, b[inside] / patch.texel + 2)
             sub_depth[inside] = tt[inside]
         return img
 
@@ -709,7 +720,7 @@ class VirtualRig:
                 "pixel_footprint_m": self.pixel_footprint,
                 "noise_floor_z_per_point_m_at_0p01px": self.noise_floor_z(0.01),
                 "world_board_origin_m": self.world_board_origin().tolist(),
-                "rendering": "exact ray casting + bicubic sampling of a band-limited speckle texture",
+                "rendering": "exact ray casting + cubic B-spline sampling (float64) of a band-limited speckle texture",
                 "motion": "analytic four-bar kinematics, z_c = z_amplitude sin(omega t + z_phase)"
                 if self.motion is None
                 else "prescribed from data (cubic splines of crank_angle and/or z of joint C)",
