@@ -22,7 +22,7 @@ from jointwear.dic._footage_tracker import (
     _match_sigma,
     _noise_sigma,
 )
-from jointwear.dic._rigid import fit_rigid_robust
+from jointwear.dic._rigid import fit_rigid_robust, pose_point_uncertainty
 from jointwear.dic._stereo import epipolar_distance, triangulate
 from jointwear.errors import BadInputError
 
@@ -37,6 +37,7 @@ class _BodyState:
     sigma_px: np.ndarray
     point_of_interest: np.ndarray
     rows: dict[str, list] = field(default_factory=dict)
+    ref_cov: np.ndarray | None = None  # (N, 3, 3) covariance of ref3d (stereo) [m^2]
 
 
 def _body_point(spec: BodySpec, ref: np.ndarray, cfg: TrackConfig) -> np.ndarray:
@@ -132,13 +133,16 @@ def _setup_bodies(L, R, bodies, calibration, cfg, ref_l, ref_r, pool) -> list[_B
             pts, pos_r, sig = pts[good], pos_r[good], sig[good]
             lt = _CameraBodyTracker(ref_l, pts, cfg, f"left/{spec.name}")
             rt = _CameraBodyTracker(ref_r, pos_r, cfg, f"right/{spec.name}")
-            X, _, _ = triangulate(calibration, pts, pos_r, sigma_px=sig)
+            X, ref_cov, _ = triangulate(calibration, pts, pos_r, sigma_px=sig)
             ref = X
         else:
             rt = None
             ref = pts.copy()
+            ref_cov = None
         lt.polygon = poly
-        states.append(_BodyState(spec, lt, rt, ref, sig, _body_point(spec, ref, cfg)))
+        states.append(
+            _BodyState(spec, lt, rt, ref, sig, _body_point(spec, ref, cfg), ref_cov=ref_cov)
+        )
     return states
 
 
@@ -367,10 +371,17 @@ def _finish_frame(states, fr, cfg, calibration, speculative) -> tuple[int, bool]
             pu = np.sqrt(np.einsum("nii->ni", cov))
         else:
             pu = np.full((n, d), st.sigma_px[:, None] if d == 2 else np.nan)
-        if st.right is not None and ok_pose:
-            # propagated: mean triangulation covariance / n, or the fit scatter if larger
-            cov_mean = np.nanmean(cov[inl], axis=0) / max(n_in, 1)
-            u = np.sqrt(np.maximum(np.diag(cov_mean), (rms**2 / 3) / max(n_in - 1, 1)))
+        if ok_pose:
+            # the pose's uncertainty (rotation and translation, from the points' covariances
+            # or the fit's residuals, whichever is larger) carried to the point of interest:
+            # a point away from the subsets moves with the rotation's uncertainty times its
+            # lever arm, which the centroid's uncertainty alone misses. At least the fit's
+            # scatter on every axis (stereo: shared by the three axes; the in-plane residuals
+            # are far below it, while the in-plane errors are not)
+            cov_q = cov if cov is not None else np.square(st.sigma_px)[:, None, None] * np.eye(d)
+            u = pose_point_uncertainty(st.ref3d, cur, Rm, tv, inl, st.point_of_interest, cov_q)
+            scatter = rms**2 / (3 if st.right is not None else 1) / max(n_in - 1, 1)
+            u = np.sqrt(np.maximum(np.square(u), scatter))
         else:
             u = np.full(d, rms / np.sqrt(max(n_in - 1, 1)))
         _append_row(
@@ -444,8 +455,18 @@ def _body_pose(st, left, right, cfg, calibration):
         good = gl
         cur = np.where(good[:, None], pl, np.nan)
     d = st.ref3d.shape[1]
+    if cov is None:  # one camera: isotropic match uncertainty of both point sets [pixel]
+        cov_p = np.square(st.sigma_px)[:, None, None] * np.eye(d)
+        cov_q = cov_p
+    else:
+        cov_p, cov_q = st.ref_cov, cov
     try:
-        Rm, tv, inl, rms = fit_rigid_robust(st.ref3d, cur, min_points=cfg.min_points)
+        # an outlier lies beyond the fit's MAD limit and beyond its own uncertainty: ordinary
+        # points stay in, so the inlier set (and the pose) does not flip with sub-noise
+        # changes of the matches
+        Rm, tv, inl, rms = fit_rigid_robust(
+            st.ref3d, cur, min_points=cfg.min_points, cov_p=cov_p, cov_q=cov_q
+        )
     except BadInputError:
         nan = np.full(d, np.nan)
         return False, np.full((d, d), np.nan), nan, good & False, np.nan, cur, cov, pl, pr, zn

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 from jointwear.errors import BadInputError
@@ -9,6 +11,7 @@ from jointwear.errors import BadInputError
 __all__ = [
     "fit_rigid",
     "fit_rigid_robust",
+    "pose_point_uncertainty",
     "time_derivative",
     "derivative_truncation",
     "rotation_angle_z",
@@ -64,10 +67,21 @@ def fit_rigid_robust(
     threshold: float = 4.0,
     iterations: int = 3,
     min_points: int = 3,
+    cov_p: np.ndarray | None = None,
+    cov_q: np.ndarray | None = None,
+    gate: float | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
     """Rigid fit with outlier rejection (residual > ``threshold`` x 1.4826 x MAD, iterated).
 
     NaN rows are ignored.
+
+    With the points' covariances (``cov_p`` and/or ``cov_q``, (N, d, d)), a point is an outlier
+    only if its residual is also beyond ``gate`` standard deviations of its own uncertainty
+    (Mahalanobis distance with the residual's covariance ``cov_q + R cov_p R^T``; default: the
+    chi-square(d) quantile at 1e-4, 4.6 in 3D). The MAD limit alone trims ordinary points of
+    the noise's tail too, and which of them it trims flips with sub-noise changes of the
+    matches (another IC-GN start); the excluded points of a thin plate can tilt the fitted
+    pose by much more than its uncertainty suggests. Gross mismatches lie far beyond both.
 
     Returns
     -------
@@ -88,11 +102,97 @@ def fit_rigid_robust(
     R = np.empty((d, d))
     t = np.empty(d)
     inl = np.empty(len(P), dtype=np.bool_)
+    n = len(P)
+    use_cov = cov_p is not None or cov_q is not None
+    cp, cq = (
+        np.zeros((n, d, d)) if c is None else np.ascontiguousarray(c, dtype=float).reshape(n, d, d)
+        for c in (cov_p, cov_q)
+    )
+    # points whose covariance is unknown get no gate (the MAD limit alone decides)
+    gated = ok & np.all(np.isfinite(cp), axis=(1, 2)) & np.all(np.isfinite(cq), axis=(1, 2))
+    if use_cov:
+        gate2 = float(gate) ** 2 if gate is not None else _chi2_gate(d)
+    else:
+        gate2 = -1.0
     rms = _robust_rigid(
         np.ascontiguousarray(P), np.ascontiguousarray(Q), ok, float(threshold), int(iterations),
-        int(min_points), R, t, inl,
+        int(min_points), np.where(gated[:, None, None], cp, 0.0),
+        np.where(gated[:, None, None], cq, 0.0), gated, gate2, R, t, inl,
     )  # fmt: skip
     return R, t, inl, float(rms)
+
+
+@functools.lru_cache(maxsize=4)
+def _chi2_gate(d: int) -> float:
+    """Squared Mahalanobis distance beyond which a point of a d-dimensional Gaussian lies with
+    probability 1e-4 (21.1 in 3D, 18.4 in 2D)."""
+    from scipy.stats import chi2
+
+    return float(chi2.isf(1e-4, d))
+
+
+def pose_point_uncertainty(
+    P: np.ndarray,
+    Q: np.ndarray,
+    R: np.ndarray,
+    t: np.ndarray,
+    inliers: np.ndarray,
+    point: np.ndarray,
+    cov_q: np.ndarray | None = None,
+) -> np.ndarray:
+    """Standard uncertainty (d,) of ``R point + t``, a body-fixed point moved with a fitted
+    rigid pose (per axis).
+
+    The least-squares pose of the inliers is linearised in a small rotation and a translation
+    at the inliers' centroid, ``Q_i ~ X_i + w x (X_i - c) + dt`` with ``X_i = R P_i + t``, and
+    the point's variance is the diagonal of the sandwich ``J A^-1 B A^-1 J^T`` (``J`` the
+    point's Jacobian, ``A = sum J_i^T J_i``). ``B`` is taken twice: from the points'
+    covariances ``cov_q`` (N, d, d), and from the fit's own residuals
+    (``sum J_i^T e_i e_i^T J_i``, scaled by n / (n - parameters)); the larger variance of each
+    axis is kept. Unlike the centroid's uncertainty, this holds the rotation's uncertainty
+    times the lever arm of the point: a point away from a narrow plate moves by the plate's
+    poorly determined tilt.
+    """
+    P = np.asarray(P, dtype=float)
+    Q = np.asarray(Q, dtype=float)
+    inl = np.asarray(inliers, dtype=bool) & np.all(np.isfinite(Q), axis=1)
+    d = P.shape[1]
+    n = int(inl.sum())
+    k = 3 if d == 2 else 6  # pose parameters
+    X = P[inl] @ R.T + t
+    c = X.mean(axis=0)
+    x = R @ np.asarray(point, dtype=float) + t
+
+    def jac(v):  # (m, d) offsets from the centroid -> (m, d, k)
+        J = np.zeros((len(v), d, k))
+        if d == 2:
+            J[:, 0, 0], J[:, 1, 0] = -v[:, 1], v[:, 0]
+            J[:, :, 1:] = np.eye(2)
+        else:
+            J[:, 0, 1], J[:, 0, 2] = v[:, 2], -v[:, 1]
+            J[:, 1, 0], J[:, 1, 2] = -v[:, 2], v[:, 0]
+            J[:, 2, 0], J[:, 2, 1] = v[:, 1], -v[:, 0]
+            J[:, :, 3:] = np.eye(3)
+        return J
+
+    if n <= k:
+        return np.full(d, np.nan)
+    J = jac(X - c)
+    A = np.einsum("nij,nik->jk", J, J)
+    try:
+        Ai = np.linalg.inv(A)
+    except np.linalg.LinAlgError:
+        return np.full(d, np.nan)
+    G = jac((x - c)[None])[0] @ Ai  # (d, k)
+    M = J @ G.T  # (n, d, d): the point's sensitivity to each inlier
+    e = Q[inl] - X
+    me = np.einsum("nia,ni->na", M, e)
+    var = np.einsum("na,na->a", me, me) * n / (n - k)
+    if cov_q is not None:
+        C = np.asarray(cov_q, dtype=float)[inl]
+        if np.all(np.isfinite(C)):
+            var = np.maximum(var, np.einsum("nia,nij,nja->a", M, C, M))
+    return np.sqrt(var)
 
 
 def _kabsch_impl(P, Q, mask, R, t):
@@ -122,24 +222,44 @@ def _kabsch_impl(P, Q, mask, R, t):
     t[:] = cq - R @ cp
 
 
-def _robust_rigid_impl(P, Q, ok, threshold, iterations, min_points, R, t, inl):
-    """The iterations of :func:`fit_rigid_robust` (fit, MAD limit, refit); returns the RMS."""
+def _robust_rigid_impl(
+    P, Q, ok, threshold, iterations, min_points, cov_p, cov_q, gated, gate2, R, t, inl
+):
+    """The iterations of :func:`fit_rigid_robust` (fit, MAD limit, refit); returns the RMS.
+    ``gate2`` >= 0: a ``gated`` point within that squared Mahalanobis distance (residual
+    covariance ``cov_q + R cov_p R^T``) is kept whatever the MAD limit."""
     n = P.shape[0]
+    d = P.shape[1]
     inl[:] = ok
     res = np.empty(n)
+    m2 = np.empty(n)
+    e = np.empty(d)
+    S = np.empty((d, d))
 
     def residuals():
         for i in range(n):
             if ok[i]:
                 s = 0.0
-                for a in range(P.shape[1]):
-                    e = Q[i, a] - t[a]
-                    for b in range(P.shape[1]):
-                        e -= R[a, b] * P[i, b]
-                    s += e * e
+                for a in range(d):
+                    e[a] = Q[i, a] - t[a]
+                    for b in range(d):
+                        e[a] -= R[a, b] * P[i, b]
+                    s += e[a] * e[a]
                 res[i] = np.sqrt(s)
+                m2[i] = np.inf
+                if gate2 >= 0.0 and gated[i]:
+                    # residual covariance cov_q + R cov_p R^T, and e^T S^-1 e by cofactors
+                    for a in range(d):
+                        for b in range(d):
+                            v = cov_q[i, a, b]
+                            for k in range(d):
+                                for m in range(d):
+                                    v += R[a, k] * cov_p[i, k, m] * R[b, m]
+                            S[a, b] = v
+                    m2[i] = _mahalanobis2(S, e, d)
             else:
                 res[i] = np.inf
+                m2[i] = np.inf
 
     for _ in range(iterations):
         _kabsch(P, Q, inl, R, t)
@@ -148,7 +268,7 @@ def _robust_rigid_impl(P, Q, ok, threshold, iterations, min_points, R, t, inl):
         med = np.median(r_in)
         mad = np.median(np.abs(r_in - med))
         limit = max(med + threshold * 1.4826 * max(mad, 1e-12) + 1e-12, 1e-9)
-        new = ok & (res <= limit)
+        new = ok & ((res <= limit) | (m2 <= gate2))
         if new.sum() < min_points or np.all(new == inl):
             break
         inl[:] = new
@@ -157,12 +277,34 @@ def _robust_rigid_impl(P, Q, ok, threshold, iterations, min_points, R, t, inl):
     return np.sqrt(np.mean(res[inl] ** 2))
 
 
+def _mahalanobis2_impl(S, e, d):
+    """``e^T S^-1 e`` for a symmetric 2 x 2 or 3 x 3 ``S`` (inf unless positive definite)."""
+    if d == 2:
+        det = S[0, 0] * S[1, 1] - S[0, 1] * S[1, 0]
+        if not (det > 0.0 and S[0, 0] > 0.0):
+            return np.inf
+        return (S[1, 1] * e[0] ** 2 - 2.0 * S[0, 1] * e[0] * e[1] + S[0, 0] * e[1] ** 2) / det
+    c00 = S[1, 1] * S[2, 2] - S[1, 2] * S[2, 1]
+    c01 = S[1, 2] * S[2, 0] - S[1, 0] * S[2, 2]
+    c02 = S[1, 0] * S[2, 1] - S[1, 1] * S[2, 0]
+    det = S[0, 0] * c00 + S[0, 1] * c01 + S[0, 2] * c02
+    if not (det > 0.0 and S[0, 0] > 0.0 and c00 > 0.0):
+        return np.inf
+    c11 = S[0, 0] * S[2, 2] - S[0, 2] * S[2, 0]
+    c12 = S[0, 1] * S[2, 0] - S[0, 0] * S[2, 1]
+    c22 = S[0, 0] * S[1, 1] - S[0, 1] * S[1, 0]
+    q = c00 * e[0] ** 2 + c11 * e[1] ** 2 + c22 * e[2] ** 2
+    q += 2.0 * (c01 * e[0] * e[1] + c02 * e[0] * e[2] + c12 * e[1] * e[2])
+    return q / det
+
+
 def _robust_rigid(*args):
     """Compiled on first use (numba), so importing this module stays light."""
-    global _robust_rigid, _kabsch
+    global _robust_rigid, _kabsch, _mahalanobis2
     from numba import njit
 
     _kabsch = njit(cache=True)(_kabsch_impl)
+    _mahalanobis2 = njit(cache=True)(_mahalanobis2_impl)
     _robust_rigid = njit(cache=True)(_robust_rigid_impl)
     return _robust_rigid(*args)
 

@@ -609,6 +609,12 @@ def test_resume_continues_a_stopped_run(small, tmp_path):
     d = resumed["follower_position"].values - whole["follower_position"].values
     assert np.nanmax(np.abs(d)) < 3e-6
     assert np.array_equal(np.isnan(d), np.isnan(whole["follower_position"].values))
+    # and within the results' own uncertainty (the point of interest lies 0.3 m off the
+    # follower here: a flipped rigid-fit inlier used to tilt it by 13x its stated u)
+    u = np.hypot(resumed["follower_position_u"].values, whole["follower_position_u"].values)
+    ok = np.isfinite(d)
+    assert np.all(np.abs(d[ok]) <= u[ok])
+    assert np.array_equal(resumed["follower_n_points"].values, whole["follower_n_points"].values)
     assert resumed.attrs["duplicated_frames"] == whole.attrs["duplicated_frames"] == "[4]"
     assert np.array_equal(resumed["frame_flag"].values, whole["frame_flag"].values)
     # a complete result is returned as it is
@@ -616,6 +622,66 @@ def test_resume_continues_a_stopped_run(small, tmp_path):
     assert np.array_equal(
         again["follower_velocity"].values, resumed["follower_velocity"].values, equal_nan=True
     )
+
+
+def test_position_uncertainty_holds_the_lever_arm_of_the_point_of_interest(small):
+    # with the exact cameras (world = mechanism frame), the bodies file's world_origin (meant
+    # for a calibration on the board view) puts each point of interest 0.3 m off its body:
+    # the poorly determined tilt of the narrow follower plate and the small journal cap moves
+    # it by tens of micrometres, which *_position_u must hold (it held only the subsets'
+    # centroid's uncertainty: errors of 40x and 70x u in z)
+    cfg, written, _ = small
+    truth = io.load(written["truth"])
+    rec = truth["frame_recorded"].values.astype(bool)
+    tc, _ = read_bodies(written["bodies"])
+    assert np.hypot(*tc.world_origin[:2]) > 0.25
+    ds = _track_small(small)
+    bodies = list(truth["body"].values)
+    for spec_name, poi in (("follower", "follower_position"), ("journal", "journal_position")):
+        spec = next(b for b in read_bodies(written["bodies"])[1] if b.name == spec_name)
+        p0 = np.asarray(spec.centroid_mechanism) - np.asarray(tc.world_origin)
+        k = bodies.index(spec_name)
+        Rk = truth["body_rotation"].values[rec][:, k]
+        ok = truth["body_origin"].values[rec][:, k]
+        true_pos = np.einsum("kij,j->ki", Rk, Rk[0].T @ (p0 - ok[0])) + ok
+        x, u = ds[poi].values, ds[f"{poi}_u"].values
+        err = (x - x[0]) - (true_pos - true_pos[0])
+        good = np.all(np.isfinite(err), axis=1)
+        good[0] = False
+        ratio = np.abs(err[good]) / u[good]
+        assert ratio.max() < 4, (spec_name, ratio.max(axis=0))
+        assert np.sqrt(np.mean(ratio**2)) > 0.2  # not vacuous
+
+
+def test_rigid_fit_keeps_ordinary_points_and_its_point_uncertainty_covers_a_lever_arm():
+    from jointwear.dic._rigid import fit_rigid_robust, pose_point_uncertainty
+
+    rng = np.random.default_rng(3)
+    # a thin plate (40 x 4 mm), z 10x noisier than x and y, as a stereo rig measures it
+    n = 60
+    P = np.column_stack([rng.uniform(-0.02, 0.02, n), rng.uniform(-0.002, 0.002, n), np.zeros(n)])
+    sig = np.array([1e-6, 1e-6, 1e-5])
+    cov = np.broadcast_to(np.diag(sig**2), (n, 3, 3)).copy()
+    poi = np.array([0.0, 0.3, 0.0])  # 0.3 m off the plate, across it
+    a = 0.2
+    R = np.array([[np.cos(a), -np.sin(a), 0], [np.sin(a), np.cos(a), 0], [0, 0, 1]])
+    t = np.array([0.1, 0.2, 0.0])
+    errs, us, kept = [], [], []
+    for _ in range(300):
+        Q = P @ R.T + t + rng.normal(size=(n, 3)) * sig
+        Q[:2] += 1e-3  # two wrong matches
+        Rf, tf, inl, _ = fit_rigid_robust(P, Q, cov_p=0 * cov, cov_q=cov)
+        assert not inl[:2].any()
+        kept.append(inl[2:].mean())
+        errs.append((Rf - R) @ poi + tf - t)
+        us.append(pose_point_uncertainty(P, Q, Rf, tf, inl, poi, cov))
+    errs, us = np.array(errs), np.array(us)
+    # ordinary points stay in (the MAD limit alone trims a few of every set)
+    assert np.mean(kept) > 0.999
+    # the tilt's lever arm: z uncertainty of the point far above the centroid's 1e-5 / sqrt(n)
+    assert np.median(us[:, 2]) > 20 * sig[2] / np.sqrt(n)
+    spread = errs.std(axis=0)
+    assert np.all(np.abs(np.median(us, axis=0) / spread - 1) < 0.2)
 
 
 def test_cli_shared_folders_patterns_and_resume(small, tmp_path, capsys):
