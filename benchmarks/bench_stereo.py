@@ -62,6 +62,9 @@ def main() -> None:
     ap.add_argument("--warmup", type=int, default=1)
     ap.add_argument("--workers", type=int, default=1)
     ap.add_argument("--seconds", type=float, default=10.0)
+    ap.add_argument(
+        "--interpolation", choices=["cubic", "quintic"], default=None, help="default: the TOML's"
+    )
     args = ap.parse_args()
 
     from jointwear.dic._footage import read_bodies, track_footage
@@ -76,6 +79,8 @@ def main() -> None:
         tc = dataclasses.replace(
             tc, step=14, world_origin=[0.0, 0.0, 0.0], workers=args.workers, chunk_size=250
         )
+        if args.interpolation:
+            tc = dataclasses.replace(tc, interpolation=args.interpolation)
         result = {}
 
         def run():
@@ -120,12 +125,14 @@ def main() -> None:
         jz_t = truth["journal_displacement"].sel(axis="z").values
         z_rms = float(np.sqrt(np.nanmean((jz - jz_t) ** 2)))
         write_results(
-            "stereo" if args.workers == 1 else f"stereo_workers{args.workers}",
+            ("stereo" if args.workers == 1 else f"stereo_workers{args.workers}")
+            + (f"_{args.interpolation}" if args.interpolation else ""),
             {
                 "footage": f"{args.seconds:g} s at 50 frames/s, two 1280x1024 {CODEC} AVI videos",
                 "frame_pairs": n_frames,
                 "points_per_frame_median": n_points,
                 "workers": args.workers,
+                "interpolation": tc.interpolation,
                 "wall_time_s_median": round(med, 2),
                 "wall_time_s_runs": [round(t, 2) for t in times],
                 "cpu_time_s_runs_main_process": [round(t, 2) for t in result["cpu"]],
