@@ -54,7 +54,7 @@ def _mean_se(values: list[float]) -> tuple[float, float]:
 
 
 def one_cycle_edge_work(
-    params, cycles: int = EDGE_CYCLES, wear_depth: np.ndarray | None = None
+    params, cycles: int | None = None, wear_depth: np.ndarray | None = None
 ) -> dict[str, list[float]]:
     """Mean and standard error over ``cycles`` single cycles (after one settling cycle) of the
     wear work at the edge layers and of the total wear work.
@@ -64,6 +64,7 @@ def one_cycle_edge_work(
     made on means with their standard errors. ``wear_depth`` (layer order, [m]): on that worn
     bore instead of the new one.
     """
+    cycles = EDGE_CYCLES if cycles is None else cycles
     st = run_cycles(params, cycles=1.0, wear_depth=wear_depth, record=False).state
     rows: dict[str, list[float]] = {
         "edge_work_first_layer_Pa_m": [],
@@ -157,9 +158,13 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--grids", default="20x200,40x400,80x800")
     ap.add_argument("--projections", default="local_conserving,local,lumped")
     ap.add_argument("--name", default="sim_grid")
+    ap.add_argument(
+        "--edge-cycles", type=int, default=EDGE_CYCLES, help="cycles averaged per edge wear work"
+    )
     ap.add_argument("--replicates", type=int, default=REPLICATES, help="4e5-cycle runs per grid")
     ap.add_argument("--no-floor", action="store_true", help="skip the impact-velocity floor study")
     args = ap.parse_args(argv)
+    globals()["EDGE_CYCLES"] = args.edge_cycles  # read by one_cycle_edge_work and wear_at
     base = PARAMETER_SETS["zhang2023"]
     overrides = dict(kv.split("=", 1) for kv in args.set)
     base = replace_nested(base, **{k: _value(v) for k, v in overrides.items()})
@@ -170,7 +175,7 @@ def main(argv: list[str] | None = None) -> None:
         "cycles": CYCLES,
         "fixed_dn": DN,
         "replicates": args.replicates,
-        "edge_cycles": EDGE_CYCLES,
+        "edge_cycles": args.edge_cycles,
         "target": "<= 5 % coarsest pair, <= 3 % finest pair (edge wear work, max depth, volume)",
     }
     for proj in args.projections.split(","):
