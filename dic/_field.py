@@ -284,13 +284,14 @@ def _relative_sigma(L, Rr, PL, PR, centres, cp, kappa):
         return DL, DR
     c0 = spline_coefficients(L[0], cp.interpolation)
     r0 = spline_coefficients(Rr[0], cp.interpolation) if len(Rr) else None
-    args = (c0, centres, cp.subset_size)
-    for k in range(1, n_t):
-        ck = spline_coefficients(L[k], cp.interpolation)
-        DL[k] = relative_sigma(*args, c0, PL[0], ck, PL[k], cp.interpolation)[0]
+    for k in range(1, n_t):  # both cameras in one call: the reference Jacobian is shared
+        pairs = [(c0, PL[0], spline_coefficients(L[k], cp.interpolation), PL[k])]
         if r0 is not None:
-            rk = spline_coefficients(Rr[k], cp.interpolation)
-            DR[k] = relative_sigma(*args, r0, PR[0], rk, PR[k], cp.interpolation)[0]
+            pairs.append((r0, PR[0], spline_coefficients(Rr[k], cp.interpolation), PR[k]))
+        out = relative_sigma(c0, centres, cp.subset_size, pairs, cp.interpolation)
+        DL[k] = out[0]
+        if r0 is not None:
+            DR[k] = out[1]
     return DL * kappa[None, :, None], DR * kappa[None, :, None]
 
 

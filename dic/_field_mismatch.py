@@ -18,7 +18,7 @@ subset to subset with the texture.
 The heteroscedasticity-consistent (sandwich) covariance ``H^-1 (sum_i J_i J_i^T r_i^2) H^-1
 n / (n - 6)`` weights every pixel's residual ``r_i`` by its own Jacobian ``J_i`` and so counts
 the mismatch where it acts; for white noise it equals ``s^2 H^-1``. :func:`relative_sigma`
-computes it (and the white value) from the residual between the two images whose difference
+computes it from the residual between the two images whose difference
 the displacement is: the left reference and the current left image (the match itself) and, in
 stereo, the right reference and the current right image, each sampled at its match of the left
 reference subsets (their common mismatch with the left reference - perspective, surface
@@ -61,21 +61,19 @@ def relative_sigma(
     ref_coef: np.ndarray,
     centres: np.ndarray,
     subset_size: int,
-    a_coef: np.ndarray,
-    a_params: np.ndarray,
-    b_coef: np.ndarray,
-    b_params: np.ndarray,
+    pairs: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]],
     interpolation: str,
-) -> np.ndarray:
+) -> list[np.ndarray]:
     """Standard uncertainties (N, 2) [pixel] of u and v of the relative position of two
     matches of the same subsets, from their residual: the sandwich ``H^-1 (sum J J^T r^2) H^-1
-    n / (n - 6)`` (see module docstring), and the white-noise ``s^2 H^-1`` of the same
-    residual; neither with the kappa factor of the central-difference gradients.
+    n / (n - 6)`` (see module docstring), without the kappa factor of the central-difference
+    gradients.
 
     ``ref_coef``: spline coefficients of the left reference image (its central differences at
-    the subset pixels are the Jacobian, as in the IC-GN); ``a_coef``/``a_params`` and
-    ``b_coef``/``b_params`` (N, 12): the two images and their matches of the left reference
-    subsets centred at ``centres`` (N, 2). NaN where either match is missing.
+    the subset pixels are the Jacobian, as in the IC-GN, computed once for all ``pairs``);
+    ``pairs``: ``(a_coef, a_params, b_coef, b_params)`` per result, two images and their
+    matches (N, 12) of the left reference subsets centred at ``centres`` (N, 2). One array per
+    pair, NaN where either match is missing.
     """
     from scipy import ndimage
 
@@ -85,14 +83,7 @@ def relative_sigma(
     dyg, dxg = np.meshgrid(off, off, indexing="ij")
     dx, dy = dxg.ravel()[None], dyg.ravel()[None]
     n = dx.size
-    out = np.full((len(centres), 2), np.nan)
-    out_w = np.full((len(centres), 2), np.nan)
-    ok = (
-        np.isfinite(centres).all(axis=1)
-        & np.isfinite(a_params).all(axis=1)
-        & np.isfinite(b_params).all(axis=1)
-    )
-    idx = np.flatnonzero(ok)
+    outs = [np.full((len(centres), 2), np.nan) for _ in pairs]
 
     def sample(coef, x, y):
         v = ndimage.map_coordinates(
@@ -100,28 +91,31 @@ def relative_sigma(
         )
         return v.reshape(x.shape)
 
+    idx = np.flatnonzero(np.isfinite(centres).all(axis=1))
     for s in range(0, len(idx), _CHUNK):
         i = idx[s : s + _CHUNK]
         c = centres[i]
         x0, y0 = c[:, :1] + dx, c[:, 1:] + dy
         gx = 0.5 * (sample(ref_coef, x0 + 1.0, y0) - sample(ref_coef, x0 - 1.0, y0))
         gy = 0.5 * (sample(ref_coef, x0, y0 + 1.0) - sample(ref_coef, x0, y0 - 1.0))
-        fa = sample(a_coef, *_warp(c, a_params[i], dx, dy))
-        fb = sample(b_coef, *_warp(c, b_params[i], dx, dy))
-        fa -= fa.mean(axis=1, keepdims=True)
-        fb -= fb.mean(axis=1, keepdims=True)
-        na = np.sqrt(np.sum(fa**2, axis=1, keepdims=True))
-        nb = np.sqrt(np.sum(fb**2, axis=1, keepdims=True))
-        r = fb * (na / np.maximum(nb, 1e-12)) - fa
         J = np.stack([gx, gx * dx, gx * dy, gy, gy * dx, gy * dy], axis=-1)  # (m, n, 6)
         H = np.einsum("mki,mkj->mij", J, J)
         good = np.linalg.det(H) > 0
         Hi = np.full_like(H, np.nan)
         Hi[good] = np.linalg.inv(H[good])
-        s2 = np.sum(r**2, axis=1) / (n - 6)
-        Om = np.einsum("mki,mk,mkj->mij", J, r**2, J) * (n / (n - 6))
-        cov = Hi @ Om @ Hi
-        for a, j in ((0, 0), (1, 3)):
-            out[i, a] = np.sqrt(np.maximum(cov[:, j, j], 0.0))
-            out_w[i, a] = np.sqrt(np.maximum(s2 * Hi[:, j, j], 0.0))
-    return out, out_w
+        for out, (a_coef, a_params, b_coef, b_params) in zip(outs, pairs, strict=True):
+            have = np.isfinite(a_params[i]).all(axis=1) & np.isfinite(b_params[i]).all(axis=1)
+            j = i[have]
+            fa = sample(a_coef, *_warp(c[have], a_params[j], dx, dy))
+            fb = sample(b_coef, *_warp(c[have], b_params[j], dx, dy))
+            fa -= fa.mean(axis=1, keepdims=True)
+            fb -= fb.mean(axis=1, keepdims=True)
+            na = np.sqrt(np.sum(fa**2, axis=1, keepdims=True))
+            nb = np.sqrt(np.sum(fb**2, axis=1, keepdims=True))
+            r = fb * (na / np.maximum(nb, 1e-12)) - fa
+            Jh, Hih = J[have], Hi[have]
+            Om = np.einsum("mki,mk,mkj->mij", Jh, r**2, Jh) * (n / (n - 6))
+            cov = Hih @ Om @ Hih
+            out[j, 0] = np.sqrt(np.maximum(cov[:, 0, 0], 0.0))
+            out[j, 1] = np.sqrt(np.maximum(cov[:, 3, 3], 0.0))
+    return outs

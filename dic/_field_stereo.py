@@ -134,9 +134,10 @@ def stereo_geometry(calibration, sub_x, sub_y, DL, SR, DR, flag, prm):
         # relative-match uncertainties (jointwear.dic._field_mismatch): the left one whole at
         # X_k (the reference position has the unmatched grid centre), the right one half at
         # X_0 (right reference image) and half at X_k (current right image)
-        cov0 = _point_cov(calibration, X[0], zero, DR[k] / np.sqrt(2))
         sr = DR[k] / np.sqrt(2)
-        cov_d[k] = _point_cov(calibration, X[k], DL[k], sr) + cov0
+        cov_d[k] = _point_cov(calibration, X[k], DL[k], sr) + _point_cov(
+            calibration, X[0], zero, sr
+        )
     Rf, of = np.eye(3), np.zeros(3)
     if prm.frame == "plane":
         Rf, of = best_fit_plane(X[0][flag[0] == _flags.FLAG_OK], calibration.left.centre)
