@@ -29,7 +29,7 @@ import hashlib
 import itertools
 import json
 import math
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -166,6 +166,25 @@ def _names(value: Any, where: str) -> tuple[str, ...]:
     if len(set(value)) != len(value):
         raise ParameterError(f"{where}: {list(value)} repeats a name")
     return tuple(value)
+
+
+#: Parameters that change the bearing grid of the wear maps (their z or theta coordinates).
+MAP_GRID_PARAMETERS = (
+    "joint.n_layers",
+    "joint.n_points",
+    "joint.bearing_width",
+    "joint.axial_grading",
+)
+
+
+def check_stackable_maps(keep: Sequence[str], names: Sequence[str]) -> None:
+    """Refuse ``keep = ["wear_depth"]`` when a swept parameter changes the maps' grid."""
+    clash = sorted(set(MAP_GRID_PARAMETERS) & set(names))
+    if "wear_depth" in keep and clash:
+        raise ParameterError(
+            f'[sweep] keep = ["wear_depth"] with {", ".join(clash)} swept: the wear maps of '
+            "the runs lie on different grids and cannot be stacked; drop wear_depth from keep"
+        )
 
 
 def read_spec(spec: str | Path | Mapping[str, Any]) -> SweepSpec:
@@ -306,13 +325,7 @@ def read_spec(spec: str | Path | Mapping[str, Any]) -> SweepSpec:
                 f"[sweep] keep: {k!r} is not a field of a {run!r} run; available: "
                 f"{', '.join(allowed) or 'none'}"
             )
-    if "wear_depth" in keep and any(
-        p.name in ("joint.n_layers", "joint.n_points", "joint.axial_grading") for p in parameters
-    ):
-        raise ParameterError(
-            '[sweep] keep = ["wear_depth"] with joint.n_layers/n_points/axial_grading swept: the maps of the '
-            "runs have different grids and cannot be stacked; drop wear_depth from keep"
-        )
+    check_stackable_maps(keep, [p.name for p in parameters])
 
     seed = _int(sw.get("seed", 0), "[sweep] seed", 0)
     levels = _int(sw.get("levels", 4), "[sweep] levels", 2)

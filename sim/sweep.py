@@ -23,7 +23,14 @@ import xarray as xr
 from jointwear.errors import BadInputError, ParameterError
 from jointwear.sim._sweep_outputs import FIELDS, available_outputs, phase_grid
 from jointwear.sim._sweep_run import RunResult, RunTask
-from jointwear.sim._sweep_spec import Design, SweepSpec, make_design, read_spec, spec_digest
+from jointwear.sim._sweep_spec import (
+    Design,
+    SweepSpec,
+    check_stackable_maps,
+    make_design,
+    read_spec,
+    spec_digest,
+)
 
 __all__ = ["run_sweep", "read_spec", "SweepSpec", "make_design", "to_grid", "STATUS"]
 
@@ -84,14 +91,7 @@ def _check_feasible(spec: SweepSpec, sim: Any, wear: Any) -> None:
                 raise ParameterError(
                     f'[parameters."{p.name}"]: its {what} is not a valid value{hint}: {exc}'
                 ) from None
-    if "wear_depth" in spec.keep:
-        shape = {"joint.n_layers", "joint.n_points", "joint.bearing_width", "joint.axial_grading"}
-        clash = sorted(shape & set(spec.names))
-        if clash:
-            raise ParameterError(
-                f'[sweep] keep = ["wear_depth"] with {", ".join(clash)} swept: the wear maps of '
-                "the runs lie on different grids and cannot be stacked; drop wear_depth from keep"
-            )
+    check_stackable_maps(spec.keep, spec.names)  # also for a SweepSpec built directly
 
 
 def _param_coord(spec: SweepSpec, p: Any, values: np.ndarray) -> xr.Variable:

@@ -275,3 +275,18 @@ def test_the_specs_in_the_guide_are_valid():
         s = read_spec(tomllib.loads(block))
         _check_feasible(s, BASE, WEAR)
         assert make_design(s).n_runs >= 32
+
+
+@pytest.mark.parametrize(
+    "name, values",
+    [
+        ("joint.n_layers", [10, 20]),
+        ("joint.axial_grading", [0.0, 0.5]),
+        ("joint.bearing_width", [0.01, 0.015]),
+    ],
+)
+def test_kept_wear_maps_refuse_a_swept_grid_parameter_naming_it(name, values):
+    # the maps of such runs lie on different grids (z or theta) and cannot be stacked
+    with pytest.raises(ParameterError, match=rf"with {name} swept: .* drop wear_depth from keep"):
+        read_spec(spec(method="grid", keep=["wear_depth"], parameters={name: {"values": values}}))
+    read_spec(spec(method="grid", keep=["contact_force"], parameters={name: {"values": values}}))
