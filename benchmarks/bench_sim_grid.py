@@ -54,7 +54,7 @@ def _mean_se(values: list[float]) -> tuple[float, float]:
 
 
 def one_cycle_edge_work(
-    params, cycles: int | None = None, wear_depth: np.ndarray | None = None
+    params, cycles: int = EDGE_CYCLES, wear_depth: np.ndarray | None = None
 ) -> dict[str, list[float]]:
     """Mean and standard error over ``cycles`` single cycles (after one settling cycle) of the
     wear work at the edge layers and of the total wear work.
@@ -64,7 +64,6 @@ def one_cycle_edge_work(
     made on means with their standard errors. ``wear_depth`` (layer order, [m]): on that worn
     bore instead of the new one.
     """
-    cycles = EDGE_CYCLES if cycles is None else cycles
     st = run_cycles(params, cycles=1.0, wear_depth=wear_depth, record=False).state
     rows: dict[str, list[float]] = {
         "edge_work_first_layer_Pa_m": [],
@@ -105,15 +104,19 @@ def _wear_once(params, cycles: float, dn: int, settle: float, edge_cycles: int) 
 
 
 def wear_at(
-    params, cycles: float = CYCLES, dn: int = DN, replicates: int = REPLICATES
+    params,
+    cycles: float = CYCLES,
+    dn: int = DN,
+    replicates: int = REPLICATES,
+    edge_cycles: int = EDGE_CYCLES,
 ) -> dict[str, list[float]]:
     """Figures of the wear map after ``cycles`` with a fixed update interval ``dn``: mean and
     standard error over ``replicates`` runs whose measured cycles start at different phases
     of the motion (2, 3, 4 ... initial settling cycles); the edge wear work on the final map
-    is averaged over 24 cycles in all."""
+    is averaged over ``edge_cycles`` cycles in all."""
     t0 = time.process_time()
-    edge_cycles = max(2, EDGE_CYCLES // replicates)
-    runs = [_wear_once(params, cycles, dn, 2.0 + k, edge_cycles) for k in range(replicates)]
+    per_run = max(2, edge_cycles // replicates)
+    runs = [_wear_once(params, cycles, dn, 2.0 + k, per_run) for k in range(replicates)]
     out = {k: list(_mean_se([r[k] for r in runs])) for k in runs[0]}
     out["cpu_s"] = [time.process_time() - t0, float("nan")]
     return out
@@ -135,14 +138,16 @@ def _changes(per_grid: dict[str, dict[str, list[float]]]) -> dict[str, dict[str,
     return out
 
 
-def grid_study(base, grids, replicates: int = REPLICATES) -> dict[str, object]:
+def grid_study(
+    base, grids, replicates: int = REPLICATES, edge_cycles: int = EDGE_CYCLES
+) -> dict[str, object]:
     """One-cycle and 4e5-cycle figures on each grid, and their changes between grids
     (each figure as [mean, standard error])."""
     one, long = {}, {}
     for nl, nd in grids:
         p = replace_nested(base, **{"joint.n_layers": nl, "joint.n_points": nd})
-        one[f"{nl}x{nd}"] = one_cycle_edge_work(p)
-        long[f"{nl}x{nd}"] = wear_at(p, replicates=replicates)
+        one[f"{nl}x{nd}"] = one_cycle_edge_work(p, edge_cycles)
+        long[f"{nl}x{nd}"] = wear_at(p, replicates=replicates, edge_cycles=edge_cycles)
         print(base.contact.wear_projection, f"{nl}x{nd}", one[f"{nl}x{nd}"], long[f"{nl}x{nd}"])
     return {
         "one_cycle_new_bore": one,
@@ -164,7 +169,6 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--replicates", type=int, default=REPLICATES, help="4e5-cycle runs per grid")
     ap.add_argument("--no-floor", action="store_true", help="skip the impact-velocity floor study")
     args = ap.parse_args(argv)
-    globals()["EDGE_CYCLES"] = args.edge_cycles  # read by one_cycle_edge_work and wear_at
     base = PARAMETER_SETS["zhang2023"]
     overrides = dict(kv.split("=", 1) for kv in args.set)
     base = replace_nested(base, **{k: _value(v) for k, v in overrides.items()})
@@ -180,7 +184,10 @@ def main(argv: list[str] | None = None) -> None:
     }
     for proj in args.projections.split(","):
         figures[f"projection_{proj}"] = grid_study(
-            replace_nested(base, **{"contact.wear_projection": proj}), grids, args.replicates
+            replace_nested(base, **{"contact.wear_projection": proj}),
+            grids,
+            args.replicates,
+            args.edge_cycles,
         )
     if not args.no_floor:
         nl, nd = grids[0]
@@ -194,8 +201,10 @@ def main(argv: list[str] | None = None) -> None:
                     "contact.impact_velocity_floor": floor,
                 },
             )
-            one[f"{floor:g}"] = one_cycle_edge_work(p)
-            long[f"{floor:g}"] = wear_at(p, replicates=args.replicates)
+            one[f"{floor:g}"] = one_cycle_edge_work(p, args.edge_cycles)
+            long[f"{floor:g}"] = wear_at(
+                p, replicates=args.replicates, edge_cycles=args.edge_cycles
+            )
         figures[f"impact_velocity_floor_{nl}x{nd}"] = {
             "one_cycle_new_bore": one,
             "one_cycle_changes": _changes(one),

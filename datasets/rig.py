@@ -440,7 +440,6 @@ class VirtualRig:
 
     # ---- rendering -------------------------------------------------------------------------
     def _render_radiance(self, camera: str, t: float) -> np.ndarray:
-
         c = self.config
         cam = self.calibration.cameras[camera]
         w, h = cam.image_size

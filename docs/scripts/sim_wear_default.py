@@ -21,8 +21,12 @@ matplotlib.use("Agg")
 import numpy as np  # noqa: E402
 
 from jointwear.io import atomic_path  # noqa: E402
-from jointwear.sim import plot_wear_history, plot_wear_map, simulate_wear  # noqa: E402
-from jointwear.sim._wear_settings import default_snapshots  # noqa: E402
+from jointwear.sim import (  # noqa: E402
+    default_snapshots,
+    plot_wear_history,
+    plot_wear_map,
+    simulate_wear,
+)
 
 IMG = Path(__file__).resolve().parent.parent / "img"
 MEASURED_CYLINDRICITY = {4e5: 28.32e-6, 1.2e6: 41.55e-6}  # study, Talyrond [m]
