@@ -39,6 +39,14 @@ class _BodyState:
     rows: dict[str, list] = field(default_factory=dict)
     ref_cov: np.ndarray | None = None  # (N, 3, 3) covariance of ref3d (stereo) [m^2]
 
+    def point_cov(self, cov: np.ndarray | None) -> np.ndarray:
+        """Covariance of the current points: the triangulated ``cov`` (stereo) or, with one
+        camera (``cov`` None), the isotropic match uncertainty ``sigma_px`` [pixel^2]."""
+        if cov is not None:
+            return cov
+        d = self.ref3d.shape[1]
+        return np.square(self.sigma_px)[:, None, None] * np.eye(d)
+
 
 def _body_point(spec: BodySpec, ref: np.ndarray, cfg: TrackConfig) -> np.ndarray:
     if spec.centroid is not None:
@@ -378,7 +386,7 @@ def _finish_frame(states, fr, cfg, calibration, speculative) -> tuple[int, bool]
             # lever arm, which the centroid's uncertainty alone misses. At least the fit's
             # scatter on every axis (stereo: shared by the three axes; the in-plane residuals
             # are far below it, while the in-plane errors are not)
-            cov_q = cov if cov is not None else np.square(st.sigma_px)[:, None, None] * np.eye(d)
+            cov_q = st.point_cov(cov)
             u = pose_point_uncertainty(st.ref3d, cur, Rm, tv, inl, st.point_of_interest, cov_q)
             scatter = rms**2 / (3 if st.right is not None else 1) / max(n_in - 1, 1)
             u = np.sqrt(np.maximum(np.square(u), scatter))
@@ -455,11 +463,8 @@ def _body_pose(st, left, right, cfg, calibration):
         good = gl
         cur = np.where(good[:, None], pl, np.nan)
     d = st.ref3d.shape[1]
-    if cov is None:  # one camera: isotropic match uncertainty of both point sets [pixel]
-        cov_p = np.square(st.sigma_px)[:, None, None] * np.eye(d)
-        cov_q = cov_p
-    else:
-        cov_p, cov_q = st.ref_cov, cov
+    cov_q = st.point_cov(cov)
+    cov_p = cov_q if cov is None else st.ref_cov  # one camera: the reference pixels alike
     try:
         # an outlier lies beyond the fit's MAD limit and beyond its own uncertainty: ordinary
         # points stay in, so the inlier set (and the pose) does not flip with sub-noise
