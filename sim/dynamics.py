@@ -316,8 +316,11 @@ def run_cycles(
     cycles : float
         Duration in crank revolutions at the nominal crank speed (fractions allowed).
     wear_depth : ndarray (Nl, Nd), optional
-        Wear depth h [m] of each bearing point: layer n (n = 0 at z = +wb/2), point m at
-        phi_m = m 360/Nd degrees (0 along -x of the bearing frame, clockwise seen from +z). The
+        Wear depth h [m] of each bearing point: layer n at the grid's z_n (n = 0 at z = +wb/2;
+        the positions depend on ``joint.axial_grading``, see
+        :func:`jointwear.sim.wearmap.layer_positions`), point m at phi_m = m 360/Nd degrees (0
+        along -x of the bearing frame, clockwise seen from +z). A bare array carries no
+        positions: resample a map from another grid with :func:`wear_depth_on_grid`. The
         worn radius Rb + h enters the contact geometry and K(t). Default: unworn.
     state : SimState, optional
         Continue from ``CycleResult.state`` of a previous run; default: :func:`initial_state`.
