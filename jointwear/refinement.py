@@ -333,6 +333,7 @@ def eca_hoekstra(
     *,
     formal_order: float = 1.0,
     quantity: str = "quantity",
+    resolution: float = 0.0,
 ) -> RefinementFit:
     """Numerical uncertainty of the finest level by the least-squares procedure of Eça & Hoekstra.
 
@@ -354,6 +355,11 @@ def eca_hoekstra(
         sets the upper bound ``1.05 formal_order`` of a credible observed order.
     quantity : str
         Name used in messages.
+    resolution : float
+        Step in which the quantity moves, if it is quantised (the location of the deepest wear
+        moves from grid point to grid point) [unit]; 0 for a continuous quantity. Identical
+        solutions at every level then mean "no change within one step":
+        ``u_refinement = resolution / sqrt(12)`` (uniform over one step) instead of *inert*.
 
     Returns
     -------
@@ -385,6 +391,28 @@ def eca_hoekstra(
             h_arr,
             m_arr,
             s_arr,
+        )
+    if np.ptp(m_arr) == 0 and resolution > 0:
+        u_ref = resolution / math.sqrt(12.0)
+        u_stat = 0.0 if deterministic or not np.isfinite(s_arr[0]) else float(s_arr[0])
+        return RefinementFit(
+            quantity,
+            True,
+            note,
+            f"no change with h at any level (quantised in steps of {resolution:.4g}): "
+            "u_refinement = step/√12",
+            tuple(map(float, h_arr)),
+            tuple(map(float, m_arr)),
+            tuple(map(float, s_arr)),
+            float(m_arr[0]),
+            float(m_arr[0]),
+            _NAN,
+            _NAN,
+            _NAN,
+            u_stat,
+            u_ref,
+            _NAN,
+            math.hypot(u_stat, u_ref),
         )
     if np.ptp(m_arr) == 0:
         return _not_assessed(
@@ -600,10 +628,13 @@ def study_uncertainty(
             f"{', '.join(map(str, study['quantity'].values))} (or pass fn to compute one "
             "from the stored wear maps)"
         )
-    period = None
+    period, resolution = None, 0.0
     if fn is None and "quantity_period" in study:
         per = float(study["quantity_period"].sel(quantity=quantity))
         period = per if math.isfinite(per) and per > 0 else None
+    if fn is None and "quantity_resolution" in study:
+        res = float(study["quantity_resolution"].sel(quantity=quantity))
+        resolution = res if math.isfinite(res) and res > 0 else 0.0
     lv, gv = _replicate_values(study, quantity, fn)
     mean, sem, _ = level_statistics(lv, period=period)
     h = np.asarray(study["h"].values, dtype=float)
@@ -615,6 +646,7 @@ def study_uncertainty(
         sem,
         formal_order=float(study.attrs.get("formal_order", 1.0)),
         quantity=quantity,
+        resolution=resolution,
     )
     if gv.size == 0:
         return fit.with_grid(_NAN, "the study has no grid runs: the grid term is not assessed")

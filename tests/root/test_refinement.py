@@ -264,3 +264,10 @@ def test_study_uncertainty_refuses_and_reports_missing_grid():
     ds.attrs["jointwear_file"] = "sweep"
     with pytest.raises(BadInputError, match="not a verification study"):
         study_uncertainty(ds, "max_wear_depth")
+
+
+def test_quantised_location_without_change_is_one_step_not_inert():
+    fit = eca_hoekstra(H, [90.0] * 4, [0.0] * 4, resolution=4.0)
+    assert fit.assessed and fit.branch.startswith("no change")
+    assert fit.u_refinement == pytest.approx(4.0 / math.sqrt(12))
+    assert fit.u_num == pytest.approx(4.0 / math.sqrt(12))
