@@ -332,7 +332,7 @@ def verify_wear(
     from jointwear._version import __version__
     from jointwear.sim._sweep_params import apply_values
     from jointwear.sim._sweep_run import RunTask
-    from jointwear.sim.sweep import _base
+    from jointwear.sim.sweep import _already_complete, _base
 
     if workers is not None and workers < 0:
         raise BadInputError(f"workers must be >= 0, got {workers}")
@@ -371,6 +371,10 @@ def verify_wear(
         )
         for i in range(len(values))
     ]
+    if resume and _already_complete(out, digest):
+        ds = io.load(out)
+        ds.attrs.update(runs_computed_now=0, executor="none (all runs resumed)")
+        return ds
     results, lost, state, store = _execute(
         tasks,
         values,
@@ -387,7 +391,7 @@ def verify_wear(
         ds = study_dataset(vspec, sim, values, where, results, lost)
         ds.attrs.update(
             {
-                "study_digest": digest,
+                "sweep_digest": digest,  # the sweep's resume check reads it
                 "runs_computed_now": state["computed"],
                 "runs_resumed": state.get("resumed", 0),
                 "executor": state["executor"] or "none (all runs resumed)",
@@ -530,7 +534,9 @@ def study_dataset(
                 np.arange(ng),
                 {"units": "1", "long_name": "replicate on the next grid (finest ΔN)"},
             ),
-            "quantity": xr.Variable("quantity", np.array(qnames), {"long_name": "quantity"}),
+            "quantity": xr.Variable(
+                "quantity", np.array(qnames), {"units": "1", "long_name": "studied quantity"}
+            ),
             "initial_settle_cycles": xr.Variable(
                 "replicate",
                 values[:nrep, 1],
