@@ -27,7 +27,7 @@ SMALL = replace_nested(PARAMETER_SETS["zhang2023"], **{"joint.n_layers": 12, "jo
 class Manufactured:
     """An executor computing manufactured wear runs (exact answer known)."""
 
-    def __init__(self, seed: int, *, d0=20e-6, c_dn=0.8, noise=0.004):
+    def __init__(self, seed: int, *, d0=20e-6, c_dn=2.0, noise=0.004):
         rng = np.random.default_rng(seed)
         self.seed, self.d0, self.c_dn, self.noise = seed, d0, c_dn, noise
         self.z0 = rng.uniform(-2e-3, 2e-3)
@@ -118,8 +118,8 @@ def test_study_file_holds_runs_maps_and_fits(manufactured, tmp_path):
     assert ds.attrs["cycles"] == 8000
     assert "parameters_json" in ds.attrs and "provenance" in ds.attrs
     assert list(ds["h"].values) == [100, 200, 400, 800]
-    assert ds["wear_depth_run"].shape == (4, 3, 6, 36)
-    assert ds["wear_depth_grid_run"].shape == (3, 12, 72)
+    assert ds["wear_depth_run"].shape == (4, 3, 12, 72)
+    assert ds["wear_depth_grid_run"].shape == (3, 24, 144)
     assert ds["u_num"].attrs["coverage_factor"] == 1
     assert str(ds["quantity_units"].sel(quantity="worn_volume").values) == "m3"
     # the stored figures are what a consumer recomputes from the file
