@@ -657,6 +657,12 @@ def _add_fits(ds: xr.Dataset, units: Mapping[str, tuple[str, str]]) -> xr.Datase
         ("u_stat", "statistical part: standard error of the finest level's mean"),
         ("u_refinement", "refinement part: Eça-Hoekstra U_phi / 2"),
         ("u_grid", "grid part: Roache two-grid estimate from the runs on the next grid"),
+        (
+            "u_num_run",
+            "numerical uncertainty of ONE run at the finest level: sqrt(sd_run^2 + "
+            "u_refinement^2 + u_grid^2) (u_num is that of the finest level's mean, value)",
+        ),
+        ("sd_run", "standard deviation of one run at the finest level (replicate scatter)"),
     ):
         ds[name] = (
             "quantity",

@@ -241,6 +241,10 @@ def test_study_uncertainty_stored_values_and_wear_map_function_agree():
     assert a.u_stat == pytest.approx(s[0])
     assert a.u_grid == pytest.approx(grid_term((m[0], s[0]), (gm, gs), ratio=2.0))
     assert a.u_num == pytest.approx(math.sqrt(a.u_stat**2 + a.u_refinement**2 + a.u_grid**2))
+    # one run scatters by the replicates' standard deviation, not by the mean's standard error
+    assert a.sd_run == pytest.approx(np.std(depth[0], ddof=1))
+    assert a.u_num_run == pytest.approx(math.sqrt(a.sd_run**2 + a.u_refinement**2 + a.u_grid**2))
+    assert a.u_num_run > a.u_num
 
 
 def test_study_uncertainty_of_an_angle_wraps():
