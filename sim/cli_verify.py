@@ -58,6 +58,14 @@ def register(app: typer.Typer) -> None:
                 "--resume", help="Continue an interrupted study: compute only the missing runs."
             ),
         ] = False,
+        band_mm: Annotated[
+            str | None,
+            typer.Option(
+                "--band-mm",
+                help="Axial band LO,HI [mm] (e.g. what the measurement covers): adds the "
+                "maximum depth, volume and cylindricity within it as quantities.",
+            ),
+        ] = None,
         progress: Annotated[
             bool | None,
             typer.Option("--progress/--no-progress", help="Progress bar (default: on a terminal)."),
@@ -77,6 +85,15 @@ def register(app: typer.Typer) -> None:
 
         if scheduler is not None and workers is not None:
             raise BadInputError("give --workers or --scheduler, not both")
+        band = None
+        if band_mm is not None:
+            try:
+                lo, hi = (1e-3 * float(v) for v in band_mm.split(","))
+            except ValueError:
+                raise BadInputError(
+                    f"--band-mm {band_mm!r}: expected LO,HI in mm, e.g. -6,6"
+                ) from None
+            band = (lo, hi)
         if spec is None and cycles is None:
             raise BadInputError("the default study needs --cycles N (or give a SPEC.toml)")
         with progress_bar("verify", total=None, enabled=progress) as bar:
@@ -96,6 +113,7 @@ def register(app: typer.Typer) -> None:
                 spec=spec,
                 workers=workers,
                 scheduler=scheduler,
+                band=band,
                 out=out,
                 resume=resume,
                 on_progress=on_progress,

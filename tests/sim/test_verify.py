@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from jointwear.cli import main
-from jointwear.errors import ParameterError
+from jointwear.errors import BadInputError, ParameterError
 from jointwear.params import replace_nested
 from jointwear.refinement import study_uncertainty
 from jointwear.sim import PARAMETER_SETS, VerifySpec, read_verify_spec, verify_wear
@@ -233,3 +233,22 @@ def test_cli_runs_and_info_summarises(manufactured, tmp_path, capsys):
     assert main(["info", str(out)]) == 0
     info = capsys.readouterr().out
     assert "verification study" in info and "worn_volume =" in info
+
+
+def test_band_quantities_from_the_run_maps(manufactured, tmp_path, capsys):
+    m = manufactured(4)
+    ds = verify_wear(SMALL, cycles=8000, workers=0, band=(-6e-3, 6e-3))
+    assert ds.attrs["band_z_m"] == [-6e-3, 6e-3]
+    whole = ds["replicate_value"].sel(quantity="worn_volume")
+    inband = ds["replicate_value"].sel(quantity="worn_volume_in_band")
+    # the bump (centre within +-2 mm, width 2.5 mm) lies nearly all inside +-6 mm
+    assert float((inband / whole).min()) > 0.95 and float((inband / whole).max()) < 1.02
+    assert abs(float(ds["value"].sel(quantity="worn_volume_in_band")) / m.exact_volume - 1) < 0.1
+    deep = ds["replicate_value"].sel(quantity="max_wear_depth_in_band")
+    assert bool((deep <= ds["replicate_value"].sel(quantity="max_wear_depth")).all())
+    assert int(ds["assessed"].sel(quantity="max_wear_depth_in_band")) == 1
+    with pytest.raises(BadInputError, match="needs two or more"):
+        verify_wear(SMALL, cycles=8000, workers=0, band=(0.0, 1e-4))
+    out = tmp_path / "s.nc"
+    assert main(["sim", "verify", "--cycles", "8000", "--out", str(out), "--band-mm", "6,-6"]) == 3
+    assert "z_min < z_max" in capsys.readouterr().err
