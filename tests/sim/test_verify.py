@@ -252,3 +252,15 @@ def test_band_quantities_from_the_run_maps(manufactured, tmp_path, capsys):
     out = tmp_path / "s.nc"
     assert main(["sim", "verify", "--cycles", "8000", "--out", str(out), "--band-mm", "6,-6"]) == 3
     assert "z_min < z_max" in capsys.readouterr().err
+
+
+def test_report_figure_plots_the_study(manufactured):
+    from jointwear.reports.figures import verification_figure
+
+    manufactured(5)
+    ds = verify_wear(SMALL, cycles=8000, workers=0)
+    fig = verification_figure([ds])
+    assert fig is not None
+    titles = [ax.get_title() for ax in fig.axes]
+    assert any(t.startswith("max_wear_depth") for t in titles)
+    assert any(t.startswith("worn_volume") for t in titles)
