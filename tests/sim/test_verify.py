@@ -150,10 +150,11 @@ def test_resume_computes_only_missing_runs(manufactured, tmp_path, monkeypatch):
     m.run = flaky
     with pytest.raises(KeyboardInterrupt):
         verify_wear(SMALL, cycles=8000, workers=0, out=out)
-    assert len(list(parts_dir(out).glob("run-*.npz"))) == 5
+    done = {int(p.stem.split("-")[1]) for p in parts_dir(out).glob("run-*.npz")}
+    assert done == set(m.calls) and 5 not in done and len(done) >= 1
     m2 = manufactured(1)
     ds = verify_wear(SMALL, cycles=8000, workers=0, out=out, resume=True)
-    assert sorted(m2.calls) == list(range(5, 4 * 4 + 4))
+    assert sorted(m2.calls) == sorted(set(range(4 * 4 + 4)) - done)
     assert ds.attrs["n_ok"] == 20
     assert not parts_dir(out).exists()
     # resuming a finished study computes nothing
