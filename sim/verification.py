@@ -22,7 +22,6 @@ import dataclasses
 import hashlib
 import json
 import math
-import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -235,57 +234,6 @@ def _digest(record: Mapping[str, Any]) -> str:
     return hashlib.sha256(json.dumps(record, sort_keys=True, default=str).encode()).hexdigest()
 
 
-def _execute(tasks, values, *, out, digest, record, resume, workers, scheduler, on_progress):
-    """Run the tasks through the sweep's part store and executor; (results, lost, executor)."""
-    from jointwear import io
-    from jointwear.sim._sweep_store import PartStore
-    from jointwear.sim.sweep import execute_runs
-
-    store = None
-    if out is not None:
-        io.check_writable(out, what="--out")
-        store = PartStore(out, digest, record, resume=resume)
-    results: dict[int, Any] = {}
-    lost: dict[int, str] = {}
-    state = {"done": 0, "failed": 0, "total": len(tasks), "computed": 0, "executor": ""}
-    try:
-        if store is not None:
-            results = store.load(values)
-        state["done"] = len(results)
-        state["resumed"] = len(results)
-        state["failed"] = sum(r.status == "failed" for r in results.values())
-        state["started"] = time.monotonic()
-
-        def started(what: str) -> None:
-            state["executor"] = what
-            if on_progress:
-                on_progress(dict(state))
-
-        def got(res: Any) -> None:
-            if store is not None:
-                store.write(res, values[res.index])
-            results[res.index] = res
-            state["done"] += 1
-            state["computed"] += 1
-            state["failed"] += res.status == "failed"
-            if on_progress:
-                on_progress(dict(state))
-
-        execute_runs(
-            [t for t in tasks if t.index not in results],
-            workers=workers,
-            scheduler=scheduler,
-            on_result=got,
-            on_lost=lambda i, why: lost.__setitem__(i, why),
-            on_start=started,
-        )
-    except BaseException:
-        if store is not None:
-            store.close(remove=False)
-        raise
-    return results, lost, state, store
-
-
 def verify_wear(
     params: Any = None,
     *,
@@ -343,7 +291,7 @@ def verify_wear(
     from jointwear._version import __version__
     from jointwear.sim._sweep_params import apply_values
     from jointwear.sim._sweep_run import RunTask
-    from jointwear.sim.sweep import _already_complete, _base
+    from jointwear.sim.sweep import _already_complete, _base, run_and_save
 
     if workers is not None and workers < 0:
         raise BadInputError(f"workers must be >= 0, got {workers}")
@@ -398,9 +346,16 @@ def verify_wear(
         ds = io.load(out)
         ds.attrs.update(runs_computed_now=0, executor="none (all runs resumed)")
         return ds
-    results, lost, state, store = _execute(
+
+    def build(results: dict[int, Any], lost: dict[int, str]) -> xr.Dataset:
+        ds = study_dataset(vspec, sim, values, where, results, lost, band=band)
+        ds.attrs["parameters_json"] = json.dumps(base_record, sort_keys=True)
+        return ds
+
+    return run_and_save(
         tasks,
         values,
+        build,
         out=out,
         digest=digest,
         record=record,
@@ -408,32 +363,9 @@ def verify_wear(
         workers=workers,
         scheduler=scheduler,
         on_progress=on_progress,
+        inputs=[*spec_file, *inputs],
+        source=f"jointwear {__version__} (sim.verification)",
     )
-    finished = False
-    try:
-        ds = study_dataset(vspec, sim, values, where, results, lost, band=band)
-        ds.attrs.update(
-            {
-                "sweep_digest": digest,  # the sweep's resume check reads it
-                "runs_computed_now": state["computed"],
-                "runs_resumed": state.get("resumed", 0),
-                "executor": state["executor"] or "none (all runs resumed)",
-                "parameters_json": json.dumps(base_record, sort_keys=True),
-            }
-        )
-        if out is not None:
-            io.save(
-                ds,
-                out,
-                inputs=[*spec_file, *inputs],
-                parameters=record,
-                source=f"jointwear {__version__} (sim.verification)",
-            )
-            finished = not lost
-    finally:
-        if store is not None:
-            store.close(remove=finished)
-    return ds
 
 
 def _relative_cost(row: np.ndarray, base: np.ndarray) -> float:
