@@ -82,22 +82,9 @@ def run(
 def _cluster(workers: int):
     """A local cluster as ``jointwear sim verify --workers N`` starts one (same environment),
     and a function giving the CPU seconds each worker process has used since it started."""
-    import logging
+    from jointwear.sim._sweep_exec import _client
 
-    from distributed import Client, LocalCluster
-
-    from jointwear.sim._sweep_exec import WORKER_ENV
-
-    cluster = LocalCluster(
-        n_workers=workers,
-        threads_per_worker=1,
-        processes=True,
-        dashboard_address=":0",
-        scheduler_kwargs={"dashboard": False},
-        env=dict(WORKER_ENV),
-        silence_logs=logging.ERROR,
-    )
-    client = Client(cluster, set_as_default=False)
+    client, cluster, _ = _client(workers, None)
 
     def cpu() -> dict[str, float]:
         used = client.run(lambda: sum(os.times()[:2]))

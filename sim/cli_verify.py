@@ -8,6 +8,7 @@ from typing import Annotated, Any
 import typer
 
 from jointwear._cli import Overwrite
+from jointwear.sim.cli_sweep import Progress, Resume, Scheduler, Workers
 
 __all__ = ["register"]
 
@@ -38,26 +39,9 @@ def register(app: typer.Typer) -> None:
                 "default the zhang2023 set.",
             ),
         ] = None,
-        workers: Annotated[
-            int | None,
-            typer.Option(
-                "--workers",
-                help="Local dask worker processes, one thread each (default: one per core; "
-                "0 = in this process, no dask).",
-            ),
-        ] = None,
-        scheduler: Annotated[
-            str | None,
-            typer.Option(
-                "--scheduler", help="Address of a running dask scheduler, e.g. tcp://host:8786."
-            ),
-        ] = None,
-        resume: Annotated[
-            bool,
-            typer.Option(
-                "--resume", help="Continue an interrupted study: compute only the missing runs."
-            ),
-        ] = False,
+        workers: Workers = None,
+        scheduler: Scheduler = None,
+        resume: Resume = False,
         band_mm: Annotated[
             str | None,
             typer.Option(
@@ -66,10 +50,7 @@ def register(app: typer.Typer) -> None:
                 "maximum depth, volume and cylindricity within it as quantities.",
             ),
         ] = None,
-        progress: Annotated[
-            bool | None,
-            typer.Option("--progress/--no-progress", help="Progress bar (default: on a terminal)."),
-        ] = None,
+        progress: Progress = None,
         overwrite: Overwrite = False,
     ) -> None:
         """Estimate u_num of a wear run: replicates at >= 4 update intervals dN and a grid run.
