@@ -397,10 +397,24 @@ def eca_hoekstra(
         n_arr = np.asarray(counts, dtype=float)[np.argsort(np.asarray(h, dtype=float))]
     deterministic = sems is None
     keep = np.isfinite(m_arr) & (deterministic | np.isfinite(s_arr))
+    if not keep[0]:
+        return _not_assessed(
+            quantity,
+            f"the finest level (h = {h_arr[0]:g}) has no value or standard error (its runs "
+            "failed or fewer than two succeeded): the uncertainty would be that of another level",
+            h_arr,
+            m_arr,
+            s_arr,
+        )
     dropped = int(np.sum(~keep))
     h_arr, m_arr, s_arr, n_arr = h_arr[keep], m_arr[keep], s_arr[keep], n_arr[keep]
     sd_run = 0.0 if deterministic else (float(s_arr[0] * np.sqrt(n_arr[0])) if len(s_arr) else _NAN)
-    note = f"{dropped} level(s) without a value left out" if dropped else ""
+    note = (
+        f"{dropped} level(s) without a value (or, with replicates, a standard error: fewer than "
+        "two runs ok) left out"
+        if dropped
+        else ""
+    )
     if h_arr.size < 4:
         return _not_assessed(
             quantity,

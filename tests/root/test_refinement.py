@@ -141,6 +141,11 @@ def test_too_few_levels_and_failed_levels():
     assert not fit.assessed and "at least 4" in fit.reason
     fit = eca_hoekstra(H, [1.0, np.nan, 1.2, 1.4])
     assert not fit.assessed and "1 level(s) without a value" in fit.reason
+    # without the finest level the figures would belong to another level: refused
+    fit = eca_hoekstra(H, [1.0, 1.1, 1.2, 1.4, 1.7][:4], [np.nan, 0.1, 0.1, 0.1])
+    assert not fit.assessed and "finest level" in fit.reason
+    fit = eca_hoekstra([0.5, *H], [0.9, 1.0, 1.1, 1.2, 1.4], [np.nan, 0.1, 0.1, 0.1, 0.1])
+    assert not fit.assessed and "h = 0.5" in fit.reason
 
 
 @pytest.mark.parametrize(
