@@ -23,9 +23,9 @@ import xarray as xr
 
 from jointwear import conventions
 from jointwear.errors import BadInputError
-from jointwear.sim._wear_settings import WearSettings
-from jointwear.sim._wear_settings import check_kw as _check_kw
-from jointwear.sim.wear import simulate_wear
+from jointwear.sim.wear._loop import simulate_wear
+from jointwear.sim.wear._settings import WearSettings
+from jointwear.sim.wear._settings import check_kw as _check_kw
 
 __all__ = [
     "KwCalibration",
@@ -50,7 +50,7 @@ def resimulator(ds: xr.Dataset, parameter: str | None = None) -> Callable[..., x
     """
     from jointwear.io import parse_provenance
     from jointwear.params import from_mapping
-    from jointwear.sim._wear_contact import contact_from_description
+    from jointwear.sim.wear._contact import contact_from_description
 
     params = parse_provenance(ds).get("parameters") or {}
     if "contact" not in params or "wear" not in params:
@@ -79,7 +79,7 @@ def resimulator(ds: xr.Dataset, parameter: str | None = None) -> Callable[..., x
             "which has no simulator parameters to vary"
         )
     from jointwear.params import replace_nested
-    from jointwear.sim._wear_contact import DynamicContact
+    from jointwear.sim.wear._contact import DynamicContact
 
     replace_nested(contact.params, **{parameter: _get(contact.params, parameter)})  # name check
 

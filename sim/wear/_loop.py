@@ -26,7 +26,7 @@ local error of an update, relative to its depth increment, is ``eta / 2``. Impac
 dynamics non-periodic, so every rate measurement averages several single cycles and their scatter
 re-estimates the cycle-to-cycle variability on the current profile; the noise part of ``eta`` is
 removed in quadrature, the controller aims at ``max(tol, detection limit)`` and averages more
-cycles when the noise hides changes of ``tol`` (details in :mod:`jointwear.sim._wear_control`).
+cycles when the noise hides changes of ``tol`` (details in :mod:`jointwear.sim.wear._control`).
 The next interval is ``dN * 0.9 tol_eff / eta`` (at most doubled, at least 0.2x); an update whose
 ``eta`` exceeds ``reject_factor * tol_eff`` is rejected and redone with a smaller interval. The
 run always finishes; its accuracy (expanded, k = 2) is reported per point (``wear_depth_u``), for
@@ -57,11 +57,11 @@ import xarray as xr
 from jointwear.errors import BadInputError, ParameterError
 from jointwear.io import check_writable
 from jointwear.params import to_jsonable
-from jointwear.sim import _wear_control as ctl
-from jointwear.sim._wear_checkpoint import read_checkpoint, write_checkpoint
-from jointwear.sim._wear_contact import CycleWear, describe_any
-from jointwear.sim._wear_output import build_dataset
-from jointwear.sim._wear_settings import (
+from jointwear.sim.wear import _control as ctl
+from jointwear.sim.wear._checkpoint import read_checkpoint, write_checkpoint
+from jointwear.sim.wear._contact import CycleWear, describe_any
+from jointwear.sim.wear._output import build_dataset
+from jointwear.sim.wear._settings import (
     DEFAULT_KW,
     KW_RANGE,
     WearSettings,
@@ -117,7 +117,7 @@ class WearRun:
         :func:`default_snapshots`.
     checkpoint : path, optional
         File written atomically after every accepted update (safe versioned format, see
-        :mod:`jointwear.sim._wear_checkpoint`).
+        :mod:`jointwear.sim.wear._checkpoint`).
     initial_wear : ndarray (Nl, Nd), optional
         Initial wear profile [m] (default unworn).
     on_update : callable, optional
@@ -599,7 +599,7 @@ def simulate_wear(
     if kw is not None:
         settings = dataclasses.replace(settings, kw=kw)
     if contact is None:
-        from jointwear.sim._wear_contact import DynamicContact
+        from jointwear.sim.wear._contact import DynamicContact
 
         if params is None:
             from jointwear.sim import PARAMETER_SETS

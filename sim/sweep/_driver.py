@@ -1,6 +1,6 @@
 """Parameter sweeps, ensembles and sensitivity analysis of the simulator, executed on dask.
 
-:func:`run_sweep` reads a sweep spec (:mod:`jointwear.sim._sweep_spec`, docs/sweeps.md), draws
+:func:`run_sweep` reads a sweep spec (:mod:`jointwear.sim.sweep._spec`, docs/sweeps.md), draws
 the design, runs every member as one dask task (in-process, on a local cluster of worker
 processes, or on an existing cluster by address), writes each finished run at once to
 ``<out>.parts/`` (so an interrupted sweep resumes with only the missing runs), and returns one
@@ -21,9 +21,9 @@ import numpy as np
 import xarray as xr
 
 from jointwear.errors import BadInputError, ParameterError
-from jointwear.sim._sweep_outputs import FIELDS, available_outputs, phase_grid
-from jointwear.sim._sweep_run import RunResult, RunTask
-from jointwear.sim._sweep_spec import (
+from jointwear.sim.sweep._outputs import FIELDS, available_outputs, phase_grid
+from jointwear.sim.sweep._run import RunResult, RunTask
+from jointwear.sim.sweep._spec import (
     Design,
     SweepSpec,
     check_stackable_maps,
@@ -41,7 +41,7 @@ STATUS = {"ok": 0, "failed": 1, "not_run": 2}
 def _base(spec: SweepSpec, params: Any, wear: Any) -> tuple[Any, Any, dict[str, Any], list]:
     """(SimParameters, WearSettings, JSON record, input files) of the base of every run."""
     from jointwear.params import from_mapping, read_toml, to_jsonable
-    from jointwear.sim.wear import WearSettings
+    from jointwear.sim.wear._settings import WearSettings
 
     if spec.run == "function":
         if params is not None:
@@ -72,7 +72,7 @@ def _base(spec: SweepSpec, params: Any, wear: Any) -> tuple[Any, Any, dict[str, 
 
 def _check_feasible(spec: SweepSpec, sim: Any, wear: Any) -> None:
     """Each swept value at its extremes must be a valid parameter (impossible bounds -> error)."""
-    from jointwear.sim._sweep_params import apply_values, check_simulator_names
+    from jointwear.sim.sweep._params import apply_values, check_simulator_names
 
     check_simulator_names(spec.parameters, sim, wear, run=spec.run)
     for p in spec.parameters:
@@ -95,7 +95,7 @@ def _check_feasible(spec: SweepSpec, sim: Any, wear: Any) -> None:
 
 
 def _param_coord(spec: SweepSpec, p: Any, values: np.ndarray) -> xr.Variable:
-    from jointwear.sim._sweep_params import DERIVED, parameter_units
+    from jointwear.sim.sweep._params import DERIVED, parameter_units
 
     units = "1" if spec.run == "function" else parameter_units(p.name)
     attrs = {"units": units, "long_name": f"swept parameter {p.name}"}
@@ -134,7 +134,7 @@ def assemble(
     sim: Any = None,
 ) -> xr.Dataset:
     """The sweep's Dataset along ``run`` from the runs' results (missing runs: ``not_run``)."""
-    from jointwear.sim._sweep_models import get_model
+    from jointwear.sim.sweep._models import get_model
 
     n = design.n_runs
     model = get_model(spec.function) if spec.run == "function" else None
@@ -476,7 +476,7 @@ def run_sweep(
     store = None
     results: dict[int, RunResult] = {}
     if out is not None:
-        from jointwear.sim._sweep_store import PartStore
+        from jointwear.sim.sweep._store import PartStore
 
         io.check_writable(out, what="--out")
         store = PartStore(out, digest, record, resume=resume)
@@ -546,7 +546,7 @@ def run_sweep(
 def _already_complete(out: str | Path | None, digest: str) -> bool:
     """True if ``out`` is the finished result of this very sweep (nothing left to resume)."""
     from jointwear import io
-    from jointwear.sim._sweep_store import parts_dir
+    from jointwear.sim.sweep._store import parts_dir
 
     if out is None or not Path(out).exists() or parts_dir(out).exists():
         return False
@@ -559,6 +559,6 @@ def _already_complete(out: str | Path | None, digest: str) -> bool:
 
 def execute_runs(tasks: list[RunTask], **kwargs: Any) -> None:
     """Indirection so that tests can count what an executor is given."""
-    from jointwear.sim._sweep_exec import execute
+    from jointwear.sim.sweep._exec import execute
 
     execute(tasks, **kwargs)
