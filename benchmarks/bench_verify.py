@@ -82,7 +82,7 @@ def run(
 def _cluster(workers: int):
     """A local cluster as ``jointwear sim verify --workers N`` starts one (same environment),
     and a function giving the CPU seconds each worker process has used since it started."""
-    from jointwear.sim._sweep_exec import _client
+    from jointwear.sim.sweep._exec import _client
 
     client, cluster, _ = _client(workers, None)
 

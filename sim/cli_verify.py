@@ -62,7 +62,7 @@ def register(app: typer.Typer) -> None:
         from jointwear.errors import BadInputError, SimulationError
         from jointwear.progress import progress_bar
         from jointwear.refinement import describe_study
-        from jointwear.sim.verification import verify_wear
+        from jointwear.sim.sweep._verify import verify_wear
 
         if scheduler is not None and workers is not None:
             raise BadInputError("give --workers or --scheduler, not both")

@@ -40,8 +40,8 @@ class Manufactured:
         return self.d0 * R * math.pi * self.wz * math.radians(self.wth)
 
     def run(self, task):
-        from jointwear.sim._sweep_params import apply_values
-        from jointwear.sim._sweep_run import RunResult
+        from jointwear.sim.sweep._params import apply_values
+        from jointwear.sim.sweep._run import RunResult
         from jointwear.sim.wearmap import BearingGrid, wear_map_dataset
 
         params, wear = apply_values(task.sim_params, task.wear_settings, task.values)
@@ -76,7 +76,7 @@ class Manufactured:
 def manufactured(monkeypatch):
     def install(seed, **kw):
         m = Manufactured(seed, **kw)
-        monkeypatch.setattr("jointwear.sim.sweep.execute_runs", m)
+        monkeypatch.setattr("jointwear.sim.sweep._driver.execute_runs", m)
         return m
 
     return install
@@ -136,7 +136,7 @@ def test_study_file_holds_runs_maps_and_fits(manufactured, tmp_path):
 
 
 def test_resume_computes_only_missing_runs(manufactured, tmp_path, monkeypatch):
-    from jointwear.sim._sweep_store import parts_dir
+    from jointwear.sim.sweep._store import parts_dir
 
     out = tmp_path / "study.nc"
     m = manufactured(1)
