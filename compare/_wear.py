@@ -107,10 +107,18 @@ def _edge_max(f: np.ndarray) -> int:
     return -1 if i == 0 else (1 if i == f.shape[0] - 1 else 0)
 
 
-def _stated_volume_u(al: xr.Dataset) -> tuple[float, str] | None:
-    """The measurement's own worn_volume_u when the band is its whole map (converted by k)."""
+def _stated_volume_u(al: xr.Dataset, d_volume: float) -> tuple[float, str] | None:
+    """The measurement's own worn_volume_u (converted by k) when it is of the compared band.
+
+    It is, when the band is the map's whole width and circumference and the map's own
+    ``worn_volume`` agrees with the volume of the compared map ``d_volume`` within 5 % (a map
+    cut after the volume was computed keeps a stale value: then the per-point u is used).
+    """
     value = al.attrs.get("worn_volume_u_meas")
+    own = float(al.attrs.get("worn_volume_meas_stated", np.nan))
     if value is None or not np.isfinite(float(value)):
+        return None
+    if not (np.isfinite(d_volume) and abs(own - d_volume) <= 0.05 * abs(d_volume)):
         return None
     lo, hi = (float(v) for v in np.ravel(al.attrs["z_overlap_m"]))
     zlo, zhi = (float(v) for v in np.ravel(al.attrs["z_range_meas_m"]))
@@ -149,7 +157,7 @@ def _stated(al: xr.Dataset, s: np.ndarray, d: np.ndarray) -> dict[str, tuple]:
             math.sqrt(2) * float(np.sqrt(np.nanmean(u**2))),
             f"√2 · rms of the per-point u (peak-to-valley of two independent points; {basis})",
         )
-    vol_meas = _stated_volume_u(al)
+    vol_meas = _stated_volume_u(al, mt.worn_volume(d, z, th, float(radius)) if radius else np.nan)
     if vol_meas is not None:
         out["worn_volume"]["meas"] = (
             vol_meas[0],

@@ -374,9 +374,11 @@ def align_wear_maps(
     )
     if radius is not None:
         out.attrs["bearing_radius_m"] = radius
-    if "worn_volume_u" in m_ds.data_vars and m_ds["worn_volume_u"].ndim == 0:
+    have = all(v in m_ds.data_vars and m_ds[v].ndim == 0 for v in ("worn_volume", "worn_volume_u"))
+    if have:
         var = m_ds["worn_volume_u"]
         if str(var.attrs.get("units", "m3")) == "m3":
+            out.attrs["worn_volume_meas_stated"] = float(m_ds["worn_volume"].values)
             value, note = to_standard(var.values, var.attrs, "measured worn_volume_u")
             out.attrs["worn_volume_u_meas"] = float(value)
             out.attrs["worn_volume_u_meas_basis"] = f"worn_volume_u: {note}"

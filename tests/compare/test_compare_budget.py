@@ -134,3 +134,30 @@ def test_no_threshold_pass_without_uncertainties():
     assert vv.value.str.contains("screening only").all()
     assert not c.any_failed and c.summary().count("pass") == 1  # the shape/location ones only
     assert "3 not assessed" in c.summary()
+
+
+def test_u_d_from_the_maps_per_point_and_derived_u_with_k():
+    sim = syn.sim_wear()
+    meas = syn.meas_wear(n_layers=16, u=0.4e-6)  # covers the simulated width
+    meas["worn_volume_u"] = ((), 2e-12, {"units": "m3", "coverage_factor": 2.0})
+    crit = Criteria(wear_u_num_rel=0.01, wear_u_input_rel=0.05)
+    meas["worn_volume"] = (
+        (),
+        compare(sim, meas).value("worn_volume", "value_meas"),
+        {"units": "m3"},
+    )
+    c = compare(sim, meas, criteria=crit)
+    # max depth: the per-point u at the maximum; volume: the map's own derived worn_volume_u / k
+    assert c.value("max_wear_depth", "u_D") == pytest.approx(0.4e-6, rel=1e-9)
+    assert c.value("worn_volume", "u_D") == pytest.approx(1e-12)
+    basis = c.metrics.set_index(["quantity", "metric"]).loc[("worn_volume", "u_D"), "basis"]
+    assert "worn_volume_u" in basis and "divided by 2" in basis
+    # combined with u_num and u_input in quadrature
+    s = c.value("worn_volume", "value_sim")
+    expected = np.sqrt((0.01 * s) ** 2 + (0.05 * s) ** 2 + 1e-24)
+    assert c.value("worn_volume", "u_val") == pytest.approx(expected)
+    # a map cut after its volume was computed: its worn_volume_u is of another width, so the
+    # per-point u is integrated instead (fully correlated: an upper bound), and the basis says so
+    narrow = compare(sim, meas.isel(z=slice(2, 14)), criteria=crit)
+    basis = narrow.metrics.set_index(["quantity", "metric"]).loc[("worn_volume", "u_D"), "basis"]
+    assert "fully correlated" in basis
