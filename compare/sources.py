@@ -87,13 +87,13 @@ class Sources:
             comps.append(self._verification_component(g, s))
         if stated is not None and np.isfinite(stated):
             note = f" ({stated_note})" if stated_note else ""
+            what, covers = (
+                (": update interval and cycle-to-cycle variability of the wear rate", SIM_U_COVERS)
+                if family == "wear"
+                else ("", frozenset({"the simulation's own statement"}))
+            )
             comps.append(
-                Component(
-                    float(stated),
-                    f"the simulation file's <name>_u{note}: update interval and cycle-to-cycle "
-                    "variability of the wear rate",
-                    SIM_U_COVERS,
-                )
+                Component(float(stated), f"the simulation file's <name>_u{note}{what}", covers)
             )
         if any(c.known for c in comps):
             return combine("u_num", comps)
