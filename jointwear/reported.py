@@ -114,8 +114,25 @@ def _unknown_keys(table: Mapping[str, Any], allowed: set[str], path: Path, prefi
         )
 
 
+def _same_unit(value: float, unit: str, target: str, field: str) -> float:
+    """``value`` in ``unit`` expressed in ``target`` (a quantity of kind "other")."""
+    import pint
+
+    from jointwear.external import _pint_unit, _registry
+
+    try:
+        return float(_registry().Quantity(value, _pint_unit(unit)).to(_pint_unit(target)).magnitude)
+    except (pint.errors.PintError, ValueError, AssertionError) as exc:
+        raise ParameterError(
+            f"{field}: {unit!r} cannot be converted to {target!r} ({exc})"
+        ) from None
+
+
 def _amount(value: Any, unit: str, kind: str, field: str) -> float:
-    """A number in ``unit`` or a string ``"<number> <unit>"``, converted to SI (degree)."""
+    """A number in ``unit`` or a string ``"<number> <unit>"``, converted to SI (degree).
+
+    ``kind = "any"``: kept in ``unit`` (a string's own unit is converted to it).
+    """
     from jointwear.external import to_si
 
     if isinstance(value, bool):
@@ -131,9 +148,13 @@ def _amount(value: Any, unit: str, kind: str, field: str) -> float:
             ) from None
         if not own_unit.strip():
             raise ParameterError(f"{field} = {value!r}: give the unit after the number")
+        if kind == "any":
+            return _same_unit(num, own_unit.strip(), unit, field)
         return float(to_si(num, own_unit.strip(), kind=kind, option=field))
     if not isinstance(value, (int, float)):
         raise ParameterError(f"{field} = {value!r}: expected a number")
+    if kind == "any":
+        return float(value)
     return float(to_si(float(value), unit, kind=kind, option=field))
 
 
@@ -399,9 +420,7 @@ def _quantity(
             )
     u_table = _require(q, "uncertainty", path, p, "a table of components, or { not_stated = true }")
     try:
-        u, budget = standard_uncertainty(
-            u_table, str(unit), phys if phys != "any" else "length", p + "uncertainty"
-        )
+        u, budget = standard_uncertainty(u_table, str(unit), phys, p + "uncertainty")
     except ParameterError as exc:
         raise ParameterError(_where(path, str(exc))) from None
     u_attrs = {
