@@ -357,8 +357,8 @@ def _combine(
     if len(outcomes) == 1:
         _, rows, decs = outcomes[0]
         return rows.rows, decs
-    all_rows = []
-    for label, rows, _ in outcomes:
+    all_rows = list(outcomes[0][1].rows)  # the first reading under the plain name
+    for label, rows, _ in outcomes[1:]:
         for row in rows.rows:
             all_rows.append({**row, "quantity": f"{name} [{label}]"})
     shapes = {tuple(d["criterion"] for d in decs) for _, _, decs in outcomes}
@@ -445,6 +445,7 @@ def reported_metrics(
                 why = f"the simulation cannot give it at {cycles:g} cycles: {exc}"
         if why:
             d = float(rep[name].values)
+            rows.add(name, "value_sim", float("nan"), q["units"])
             rows.add(name, "value_meas", d, q["units"])
             decisions.append(
                 decision(
