@@ -25,8 +25,10 @@ enumerated: each reading is decided, and the verdict stands only when every read
 same state; otherwise the quantity is *not comparable*, the reason listing each reading's
 outcome and the field that settles it.
 
-u_num: a verification dataset with a variable of the quantity's own name, or one that keeps a
-wear map per refinement level (``wear_depth`` over ``(h, [cycles,] z, theta)``: the quantity
+u_num: a verification study of ``jointwear sim verify`` (``jointwear_file =
+"verification_study"``, run to the quantity's cycles: the quantity on every stored run's map
+through :func:`jointwear.refinement.study_uncertainty`), a verification dataset with a variable
+of the quantity's own name, or one that keeps a wear map per refinement level (``wear_depth`` over ``(h, [cycles,] z, theta)``: the quantity
 is computed on each level, then the GCI of :mod:`jointwear.compare.verification`); else the
 criteria's ``wear_u_num_rel`` (not for angles); else not assessed. u_input: an ensemble that
 keeps its wear maps (the quantity per member, the spread of
@@ -239,11 +241,41 @@ def _level_values(
     return h, np.asarray(values, dtype=float)
 
 
+def _study_u_num(
+    study: xr.Dataset, name, q, attrs, reading, s: float, cycles: float
+) -> Uncertainty:
+    """u_num from a ``jointwear sim verify`` study: the quantity on every stored run's map."""
+    try:
+        from jointwear.refinement import study_uncertainty
+    except ImportError:  # pragma: no cover - the refinement module ships with sim verify
+        return unknown("this installation cannot read verification studies (jointwear.refinement)")
+    ran = float(study.attrs.get("cycles", np.nan))
+    if not np.isclose(ran, cycles, rtol=1e-6):
+        return unknown(
+            f"the verification study was run for {ran:g} cycles, the quantity is at {cycles:g}: "
+            "its numerical uncertainty is not that of this quantity - run the study to "
+            f"{cycles:g} cycles"
+        )
+
+    def fn(wear: xr.DataArray) -> float:
+        value = evaluate(wear, q, attrs, reading)[0]
+        if q["kind"] == "max_wear_angle":  # continuous around S for the level statistics
+            return s + float(mt.wrap_angle_deg(value - s))
+        return value
+
+    fit = study_uncertainty(study, name, fn)
+    if not fit.assessed:
+        return unknown(f"verification study: {fit.reason}")
+    return Uncertainty(float(fit.u_num), "verification study: " + fit.describe())
+
+
 def _u_num(
     name: str, q, attrs, reading, s: float, cycles: float, studies, criteria: Criteria
 ) -> Uncertainty:
     angle = q["kind"] == "max_wear_angle"
     for ds in studies:
+        if ds.attrs.get("jointwear_file") == "verification_study":
+            return _study_u_num(ds, name, q, attrs, reading, s, cycles)
         if name in ds.data_vars and ds[name].ndim == 1 and ds[name].dims[0] in ds.coords:
             h, values = np.asarray(ds[ds[name].dims[0]].values, float), ds[name].values
         else:

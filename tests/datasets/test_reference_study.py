@@ -34,6 +34,19 @@ def study(tmp_path_factory):
 
 
 @pytest.mark.slow
+def test_reference_study_command(study, tmp_path, capsys):
+    """``jointwear datasets reference-study --reduced`` gives the library's verdicts."""
+    _, result = study
+    code = main(["datasets", "reference-study", str(tmp_path / "r"), "--reduced"])
+    printed = capsys.readouterr().out
+    print(printed)
+    assert code == (1 if result.any_failed else 0)
+    back = load_comparison(io.load(tmp_path / "r" / "metrics.nc"))
+    assert list(back.decisions.state) == list(result.decisions.state)  # deterministic
+    assert result.summary() in printed
+
+
+@pytest.mark.slow
 def test_library_run_decides_every_reported_quantity(study):
     out, result = study
     print("\n".join(card_lines(result)))  # the verdict per quantity (pytest -s)
