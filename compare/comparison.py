@@ -132,8 +132,14 @@ class Comparison:
         return float(rows["value"].iloc[0])
 
     def state(self, quantity: str, basis: str | None = None) -> str:
-        """State of the (first) decision on ``quantity`` (optionally of one ``basis``)."""
-        d = self.decisions[self.decisions.quantity == quantity]
+        """State of the (first) decision on ``quantity`` (optionally of one ``basis``).
+
+        ``quantity`` is the card's label, with or without its band (``"maximum wear depth"``
+        finds ``"maximum wear depth within z = −6…+6 mm"``).
+        """
+        label = self.decisions.quantity.astype(str)
+        # a wear criterion is labelled with its band ("maximum wear depth within z = ...")
+        d = self.decisions[(label == quantity) | label.str.startswith(quantity + " within ")]
         if basis is not None:
             d = d[d.basis == basis]
         if d.empty:
@@ -423,7 +429,9 @@ def compare(
             if band is not None:
                 wear["wear_depth_sim_ensemble"] = band
         src = Sources(criteria, ens, gci, float(wear.attrs["cycles_sim"]), field_values)
-        wear_metrics(wear, rows, decisions, src)
+        domain = wear_metrics(wear, rows, decisions, src)
+        if domain:
+            notes.append(domain)
         if cycles is None and not np.isfinite(float(wear.attrs.get("cycles_meas", np.nan))):
             notes.append(
                 "wear cycles: the measured map does not state after how many crank cycles it was "

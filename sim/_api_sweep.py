@@ -3,6 +3,7 @@
 from jointwear.sim._sweep_models import analytic_sobol
 from jointwear.sim._sweep_spec import SweepSpec, make_design, read_spec
 from jointwear.sim.sweep import STATUS, run_sweep, to_grid
+from jointwear.sim.verification import VerifySpec, read_verify_spec, verify_wear
 
 __all__ = [
     "run_sweep",
@@ -12,4 +13,7 @@ __all__ = [
     "to_grid",
     "analytic_sobol",
     "STATUS",
+    "verify_wear",
+    "VerifySpec",
+    "read_verify_spec",
 ]

@@ -1,0 +1,706 @@
+"""Verification study of a wear run (``jointwear sim verify``): u_num from replicates, ΔN and grid.
+
+The wear-cycle dynamics are chaotic: single runs differ by their start, so a refinement study on
+single runs has a random sign of convergence. The study therefore runs, as one sweep of dask
+tasks (the machinery of :func:`jointwear.sim.run_sweep`: part files, resume, local or remote
+cluster):
+
+* at each of ``>= 4`` wear-update intervals ΔN (the refinement parameter ``h``; the fixed update
+  scheme, so that ΔN is the only thing that changes), ``replicates`` runs whose measurement
+  starts at different phases of the motion (``wear.initial_settle_cycles`` = base, base + 1, ...);
+* at the finest ΔN, ``replicates`` runs on the next bearing grid (``joint.n_layers`` and
+  ``joint.n_points`` times ``grid``) for the grid term.
+
+Each run keeps its final wear map and its scalar outputs (:data:`QUANTITIES`); the study file
+(:func:`study_dataset`) holds them all with, per quantity, the Eça-Hoekstra fit on the replicate
+means and u_num = sqrt(u_stat^2 + u_refinement^2 + u_grid^2) (:mod:`jointwear.refinement`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import json
+import math
+import time
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import xarray as xr
+
+from jointwear.errors import BadInputError, ParameterError
+
+__all__ = ["VerifySpec", "read_verify_spec", "verify_wear", "study_dataset", "QUANTITIES"]
+
+#: Quantities of the study: sweep output name -> circular period (None: linear quantity).
+QUANTITIES: dict[str, float | None] = {
+    "max_wear_depth": None,
+    "worn_volume": None,
+    "cylindricity": None,
+    "max_wear_theta": 360.0,
+    "max_wear_z": None,
+    "follower_velocity_rms": None,
+    "rms_contact_force": None,
+    "peak_contact_force": None,
+    "max_penetration": None,
+}
+
+#: Default number of ΔN levels, their ratio, and the finest ΔN as a fraction of the cycles.
+DEFAULT_LEVELS, LEVEL_RATIO, FINEST_UPDATES = 4, 2, 80
+DEFAULT_REPLICATES = 4
+DEFAULT_GRID_FACTOR = 2
+
+_KEYS = {
+    "cycles": "wear cycles of every run (the --cycles option overrides it)",
+    "levels": "wear-update intervals ΔN [cycles], >= 4 distinct whole numbers",
+    "replicates": "runs per level, starting at different phases of the motion (>= 2)",
+    "grid": "refinement factor of the next grid (n_layers and n_points times it), >= 2",
+    "grid_replicates": "runs at the next grid (default: replicates)",
+    "formal_order": "formal order of the ΔN update (1: explicit Euler)",
+}
+
+
+@dataclass(frozen=True)
+class VerifySpec:
+    """What a verification study runs (see the module docstring and docs/sim-wear.md).
+
+    Attributes
+    ----------
+    cycles : float
+        Wear cycles of every run.
+    levels : tuple of int
+        Wear-update intervals ΔN [cycles], finest first.
+    replicates : int
+        Runs per level (different start phases).
+    grid : int
+        Refinement factor of the next grid (cell size ratio ``r``).
+    grid_replicates : int
+        Runs at the next grid, at the finest ΔN.
+    formal_order : float
+        Formal order of the update in ΔN (explicit Euler: 1).
+    """
+
+    cycles: float
+    levels: tuple[int, ...]
+    replicates: int = DEFAULT_REPLICATES
+    grid: int = DEFAULT_GRID_FACTOR
+    grid_replicates: int = DEFAULT_REPLICATES
+    formal_order: float = 1.0
+
+    def __post_init__(self) -> None:
+        c = self.cycles
+        if isinstance(c, bool) or not isinstance(c, (int, float)) or not (c >= 1):
+            raise ParameterError(f"cycles must be a whole number >= 1, got {c!r}")
+        if not float(c).is_integer():
+            raise ParameterError(f"cycles = {c!r}: a wear run needs a whole number of cycles")
+        levels = tuple(sorted(_whole(v, "levels", 1) for v in self.levels))
+        if len(levels) < 4:
+            raise ParameterError(
+                f"levels = {list(self.levels)}: the least-squares procedure needs >= 4 ΔN levels"
+            )
+        if len(set(levels)) != len(levels):
+            raise ParameterError(f"levels = {list(self.levels)} repeats a ΔN; give distinct ones")
+        if levels[-1] > c:
+            raise ParameterError(
+                f"levels: ΔN = {levels[-1]} exceeds the {c:g} cycles of a run (one update would "
+                "overshoot the target); choose ΔN <= cycles"
+            )
+        object.__setattr__(self, "cycles", float(c))
+        object.__setattr__(self, "levels", levels)
+        object.__setattr__(self, "replicates", _whole(self.replicates, "replicates", 2))
+        object.__setattr__(self, "grid", _whole(self.grid, "grid", 2))
+        object.__setattr__(
+            self, "grid_replicates", _whole(self.grid_replicates, "grid_replicates", 2)
+        )
+        fo = self.formal_order
+        if isinstance(fo, bool) or not isinstance(fo, (int, float)) or not fo > 0:
+            raise ParameterError(f"formal_order must be > 0, got {fo!r}")
+
+    @classmethod
+    def default(cls, cycles: float, **changes: Any) -> VerifySpec:
+        """The documented default study of ``cycles`` cycles: 4 levels ΔN = N/80 x (1, 2, 4, 8),
+        4 replicates each, 4 runs on the grid refined 2x."""
+        finest = max(1, round(float(cycles) / FINEST_UPDATES))
+        levels = tuple(finest * LEVEL_RATIO**k for k in range(DEFAULT_LEVELS))
+        return cls(cycles=cycles, levels=changes.pop("levels", levels), **changes)
+
+    def describe(self) -> dict[str, Any]:
+        """JSON-ready record (provenance, digest)."""
+        return json.loads(json.dumps(dataclasses.asdict(self)))
+
+
+def _whole(v: Any, name: str, lo: int) -> int:
+    if isinstance(v, bool) or not isinstance(v, (int, float)) or not float(v).is_integer():
+        raise ParameterError(f"{name}: expected a whole number, got {v!r}")
+    if v < lo:
+        raise ParameterError(f"{name} must be >= {lo}, got {v!r}")
+    return int(v)
+
+
+def read_verify_spec(spec: str | Path | Mapping[str, Any], *, cycles: float | None) -> VerifySpec:
+    """A study spec from a TOML file (``[verify]`` table) or mapping; ``cycles`` overrides.
+
+    Raises
+    ------
+    ParameterError
+        Unknown keys (with the known ones), bad values; the message names the key.
+    """
+    where = ""
+    if not isinstance(spec, Mapping):
+        from jointwear.params import read_toml
+
+        where = f"study spec '{spec}': "
+        spec = read_toml(spec)
+    data = dict(spec)
+    if set(data) != {"verify"}:
+        raise ParameterError(
+            f"{where}expected one [verify] table, got {', '.join(map(str, data)) or 'nothing'}"
+        )
+    table = dict(data["verify"] or {})
+    bad = sorted(set(table) - set(_KEYS))
+    if bad:
+        raise ParameterError(
+            f"{where}[verify]: unknown key(s) {', '.join(bad)}; known: "
+            + "; ".join(f"{k} ({v})" for k, v in _KEYS.items())
+        )
+    if cycles is not None:
+        table["cycles"] = cycles
+    if "cycles" not in table:
+        raise ParameterError(f"{where}[verify] has no cycles: give cycles = N or --cycles N")
+    try:
+        if "levels" in table:
+            return VerifySpec(**table)
+        return VerifySpec.default(**table)
+    except ParameterError as exc:
+        raise ParameterError(f"{where}[verify] {exc}") from None
+    except TypeError as exc:
+        raise ParameterError(f"{where}[verify]: {exc}") from None
+
+
+# --- the runs ------------------------------------------------------------------------------
+
+#: Columns of the run table (the sweep's "parameter values" of each run).
+_COLUMNS = ("wear.dn", "wear.initial_settle_cycles", "joint.n_layers", "joint.n_points")
+
+
+def _run_table(spec: VerifySpec, sim: Any, wear: Any) -> tuple[np.ndarray, list[tuple]]:
+    """Values of every run (rows, :data:`_COLUMNS`) and its place (kind, level, replicate)."""
+    nl, nd = sim.joint.n_layers, sim.joint.n_points
+    s0 = float(wear.initial_settle_cycles)
+    rows, where = [], []
+    for i, dn in enumerate(spec.levels):
+        for r in range(spec.replicates):
+            rows.append((dn, s0 + r, nl, nd))
+            where.append(("level", i, r))
+    for r in range(spec.grid_replicates):
+        rows.append((spec.levels[0], s0 + r, nl * spec.grid, nd * spec.grid))
+        where.append(("grid", 0, r))
+    return np.asarray(rows, dtype=float), where
+
+
+def _sweep_spec(spec: VerifySpec, table: np.ndarray, wear: Any) -> Any:
+    from jointwear.sim._sweep_params import ParameterSpec
+    from jointwear.sim._sweep_spec import SweepSpec
+
+    params = tuple(
+        ParameterSpec(name, values=tuple(sorted(set(table[:, j].tolist()))))
+        for j, name in enumerate(_COLUMNS)
+    )
+    # the fixed scheme simulates 1 + settle cycles per update: a budget that cannot bite
+    per_update = 1.0 + float(wear.settle_cycles)
+    budget = per_update * math.ceil(spec.cycles / spec.levels[0]) + table[:, 1].max() + 10
+    return SweepSpec(
+        run="wear",
+        method="grid",
+        parameters=params,
+        cycles=spec.cycles,
+        seed=0,
+        outputs=tuple(QUANTITIES),
+        keep=("wear_depth",),
+        max_cycles_simulated=max(1000.0, budget),
+    )
+
+
+def _digest(record: Mapping[str, Any]) -> str:
+    return hashlib.sha256(json.dumps(record, sort_keys=True, default=str).encode()).hexdigest()
+
+
+def _execute(tasks, values, *, out, digest, record, resume, workers, scheduler, on_progress):
+    """Run the tasks through the sweep's part store and executor; (results, lost, executor)."""
+    from jointwear import io
+    from jointwear.sim._sweep_store import PartStore
+    from jointwear.sim.sweep import execute_runs
+
+    store = None
+    if out is not None:
+        io.check_writable(out, what="--out")
+        store = PartStore(out, digest, record, resume=resume)
+    results: dict[int, Any] = {}
+    lost: dict[int, str] = {}
+    state = {"done": 0, "failed": 0, "total": len(tasks), "computed": 0, "executor": ""}
+    try:
+        if store is not None:
+            results = store.load(values)
+        state["done"] = len(results)
+        state["resumed"] = len(results)
+        state["failed"] = sum(r.status == "failed" for r in results.values())
+        state["started"] = time.monotonic()
+
+        def started(what: str) -> None:
+            state["executor"] = what
+            if on_progress:
+                on_progress(dict(state))
+
+        def got(res: Any) -> None:
+            if store is not None:
+                store.write(res, values[res.index])
+            results[res.index] = res
+            state["done"] += 1
+            state["computed"] += 1
+            state["failed"] += res.status == "failed"
+            if on_progress:
+                on_progress(dict(state))
+
+        execute_runs(
+            [t for t in tasks if t.index not in results],
+            workers=workers,
+            scheduler=scheduler,
+            on_result=got,
+            on_lost=lambda i, why: lost.__setitem__(i, why),
+            on_start=started,
+        )
+    except BaseException:
+        if store is not None:
+            store.close(remove=False)
+        raise
+    return results, lost, state, store
+
+
+def verify_wear(
+    params: Any = None,
+    *,
+    cycles: float | None = None,
+    spec: str | Path | Mapping[str, Any] | VerifySpec | None = None,
+    levels: Sequence[int] | None = None,
+    replicates: int | None = None,
+    grid: int | None = None,
+    wear: Any = None,
+    workers: int | None = None,
+    scheduler: str | None = None,
+    out: str | Path | None = None,
+    resume: bool = False,
+    on_progress: Callable[[dict[str, Any]], None] | None = None,
+) -> xr.Dataset:
+    """Run a verification study of the wear simulation and return the study Dataset.
+
+    Parameters
+    ----------
+    params : path or SimParameters, optional
+        The rig (a ``--params`` TOML, possibly with a ``[wear]`` table; default ``zhang2023``).
+    cycles : float, optional
+        Wear cycles of every run (overrides the spec's).
+    spec : path, mapping or VerifySpec, optional
+        The study (``[verify]`` table, docs/sim-wear.md); default :meth:`VerifySpec.default`.
+    levels, replicates, grid : optional
+        Override the spec's ΔN levels [cycles], replicates per level, grid refinement factor.
+    wear : WearSettings, optional
+        Base wear settings (kw, settling); the scheme is set to ``"fixed"`` with each level's ΔN.
+    workers, scheduler :
+        As for :func:`jointwear.sim.run_sweep` (0: in this process; N: a local dask cluster;
+        an address: a running scheduler).
+    out : path, optional
+        Study file (netCDF); runs go to ``<out>.parts/`` first, so an interrupted study resumes.
+    resume : bool
+        Continue an interrupted study writing ``out``.
+    on_progress : callable, optional
+        Called after each run with ``{"done", "failed", "total", "computed", "executor"}``.
+
+    Returns
+    -------
+    Dataset
+        The study (:func:`study_dataset`).
+
+    Raises
+    ------
+    ParameterError, BadInputError
+        A bad spec or parameter (named), an unwritable ``out``, resume of another study.
+    """
+    from jointwear import io
+    from jointwear._version import __version__
+    from jointwear.sim._sweep_params import apply_values
+    from jointwear.sim._sweep_run import RunTask
+    from jointwear.sim.sweep import _already_complete, _base
+
+    if workers is not None and workers < 0:
+        raise BadInputError(f"workers must be >= 0, got {workers}")
+    if resume and out is None:
+        raise BadInputError("resume needs the study's result file (out=/--out)")
+    spec_file = [Path(spec)] if isinstance(spec, (str, Path)) else []
+    if isinstance(spec, VerifySpec):
+        vspec = dataclasses.replace(spec, cycles=cycles) if cycles is not None else spec
+    elif spec is None:
+        if cycles is None:
+            raise BadInputError("verify_wear needs cycles (or a spec that gives them)")
+        vspec = VerifySpec.default(cycles)
+    else:
+        vspec = read_verify_spec(spec, cycles=cycles)
+    changes = {
+        k: v
+        for k, v in (("levels", levels), ("replicates", replicates), ("grid", grid))
+        if v is not None
+    }
+    if replicates is not None and "grid_replicates" not in changes:
+        changes["grid_replicates"] = replicates
+    if changes:
+        vspec = dataclasses.replace(vspec, **changes)
+    sim, base_wear, base_record, inputs = _base(_WearKind, params, wear)
+    base_wear = dataclasses.replace(base_wear, scheme="fixed")
+    base_record["wear"]["scheme"] = "fixed"
+    values, where = _run_table(vspec, sim, base_wear)
+    sweep = _sweep_spec(vspec, values, base_wear)
+    for row in {tuple(r) for r in values}:  # refuse impossible runs before starting any
+        apply_values(sim, base_wear, dict(zip(_COLUMNS, row, strict=True)))
+    record = {"study": vspec.describe(), "base": base_record}
+    digest = _digest(record)
+    tasks = [
+        RunTask(
+            i, dict(zip(_COLUMNS, map(float, values[i]), strict=True)), i, sweep, sim, base_wear
+        )
+        for i in range(len(values))
+    ]
+    if resume and _already_complete(out, digest):
+        ds = io.load(out)
+        ds.attrs.update(runs_computed_now=0, executor="none (all runs resumed)")
+        return ds
+    results, lost, state, store = _execute(
+        tasks,
+        values,
+        out=out,
+        digest=digest,
+        record=record,
+        resume=resume,
+        workers=workers,
+        scheduler=scheduler,
+        on_progress=on_progress,
+    )
+    finished = False
+    try:
+        ds = study_dataset(vspec, sim, values, where, results, lost)
+        ds.attrs.update(
+            {
+                "sweep_digest": digest,  # the sweep's resume check reads it
+                "runs_computed_now": state["computed"],
+                "runs_resumed": state.get("resumed", 0),
+                "executor": state["executor"] or "none (all runs resumed)",
+                "parameters_json": json.dumps(base_record, sort_keys=True),
+            }
+        )
+        if out is not None:
+            io.save(
+                ds,
+                out,
+                inputs=[*spec_file, *inputs],
+                parameters=record,
+                source=f"jointwear {__version__} (sim.verification)",
+            )
+            finished = not lost
+    finally:
+        if store is not None:
+            store.close(remove=finished)
+    return ds
+
+
+class _WearKind:
+    """Stands for a ``run = "wear"`` sweep spec where :func:`jointwear.sim.sweep._base` asks."""
+
+    run = "wear"
+
+
+# --- the study file ------------------------------------------------------------------------
+
+
+def _units() -> dict[str, tuple[str, str]]:
+    from jointwear.sim._sweep_outputs import available_outputs
+
+    avail = available_outputs("wear")
+    return {q: avail[q] for q in QUANTITIES}
+
+
+def _grid_coords(sim: Any, suffix: str = "") -> dict[str, xr.DataArray]:
+    from jointwear.sim.wearmap import BearingGrid, wear_map_dataset
+
+    grid = BearingGrid.from_params(sim)
+    empty = wear_map_dataset(np.zeros((1, *grid.shape)), np.ones(1), grid, cylindricity=False)
+    z, th = empty["z"], empty["theta"]
+    if not suffix:
+        return {"z": z, "theta": th}
+    return {
+        "z" + suffix: xr.DataArray(z.values, dims="z" + suffix, attrs=z.attrs),
+        "theta" + suffix: xr.DataArray(th.values, dims="theta" + suffix, attrs=th.attrs),
+    }
+
+
+def study_dataset(
+    spec: VerifySpec,
+    sim: Any,
+    values: np.ndarray,
+    where: Sequence[tuple],
+    results: Mapping[int, Any],
+    lost: Mapping[int, str] | None = None,
+) -> xr.Dataset:
+    """The study Dataset from the runs' results, with the u_num of every quantity.
+
+    Parameters
+    ----------
+    spec : VerifySpec
+    sim : SimParameters
+        The base rig (its grid gives ``z``, ``theta``; ``grid`` times it ``z_grid``,
+        ``theta_grid``).
+    values : ndarray (runs, 4)
+        Each run's ΔN, initial settling, n_layers, n_points.
+    where : sequence of (kind, level, replicate)
+        ``kind`` ``"level"`` or ``"grid"``.
+    results : mapping run index -> RunResult
+        ``status``, ``outputs`` (:data:`QUANTITIES`), ``fields["wear_depth"]`` (z, theta) [m].
+    lost : mapping, optional
+        Runs a cluster lost (index -> reason); they count as not run.
+    """
+    from jointwear.params import replace_nested
+    from jointwear.refinement import COVERAGE_K
+
+    lost = dict(lost or {})
+    nq, nlev, nrep, ng = len(QUANTITIES), len(spec.levels), spec.replicates, spec.grid_replicates
+    fine = replace_nested(
+        sim,
+        **{
+            "joint.n_layers": sim.joint.n_layers * spec.grid,
+            "joint.n_points": sim.joint.n_points * spec.grid,
+        },
+    )
+    coords = {**_grid_coords(sim), **_grid_coords(fine, "_grid")}
+    rv = np.full((nq, nlev, nrep), np.nan)
+    gv = np.full((nq, ng), np.nan)
+    maps = np.full((nlev, nrep, coords["z"].size, coords["theta"].size), np.nan)
+    gmaps = np.full((ng, coords["z_grid"].size, coords["theta_grid"].size), np.nan)
+    status = np.full(len(where), 2, dtype=np.int8)  # not run
+    errors = np.full(len(where), "", dtype=object)
+    for i, (kind, lev, rep) in enumerate(where):
+        res = results.get(i)
+        if res is None:
+            errors[i] = f"not run: {lost[i]}" if i in lost else "not run"
+            continue
+        status[i] = 0 if res.status == "ok" else 1
+        errors[i] = res.error
+        if res.status != "ok":
+            continue
+        out = np.array([res.outputs.get(q, np.nan) for q in QUANTITIES], dtype=float)
+        depth = res.fields.get("wear_depth")
+        if kind == "level":
+            rv[:, lev, rep] = out
+            if depth is not None:
+                maps[lev, rep] = depth
+        else:
+            gv[:, rep] = out
+            if depth is not None:
+                gmaps[rep] = depth
+    units = _units()
+    qnames = list(QUANTITIES)
+    coords.update(
+        {
+            "level": xr.Variable("level", np.arange(nlev), {"units": "1", "long_name": "ΔN level"}),
+            "h": xr.Variable(
+                "level",
+                np.asarray(spec.levels, dtype=float),
+                {
+                    "units": "1",
+                    "long_name": "refinement parameter h: wear-update interval ΔN [crank cycles] "
+                    "(wear.dn, fixed update scheme)",
+                    "refinement_parameter": "wear.dn",
+                },
+            ),
+            "replicate": xr.Variable(
+                "replicate",
+                np.arange(nrep),
+                {
+                    "units": "1",
+                    "long_name": "replicate: run started at another phase of the motion",
+                },
+            ),
+            "grid_replicate": xr.Variable(
+                "grid_replicate",
+                np.arange(ng),
+                {"units": "1", "long_name": "replicate on the next grid (finest ΔN)"},
+            ),
+            "quantity": xr.Variable(
+                "quantity", np.array(qnames), {"units": "1", "long_name": "studied quantity"}
+            ),
+            "initial_settle_cycles": xr.Variable(
+                "replicate",
+                values[:nrep, 1],
+                {"units": "1", "long_name": "cycles discarded before the first measurement"},
+            ),
+        }
+    )
+    ds = xr.Dataset(coords=coords)
+    ds["replicate_value"] = (
+        ("quantity", "level", "replicate"),
+        rv,
+        {"units": "1", "long_name": "value of each run (units: quantity_units)"},
+    )
+    ds["grid_replicate_value"] = (
+        ("quantity", "grid_replicate"),
+        gv,
+        {"units": "1", "long_name": "value of each run on the next grid (units: quantity_units)"},
+    )
+    ds["quantity_units"] = ("quantity", np.array([units[q][0] for q in qnames], dtype=object))
+    ds["quantity_units"].attrs = {"units": "1", "long_name": "units of each quantity"}
+    ds["quantity_long_name"] = ("quantity", np.array([units[q][1] for q in qnames], dtype=object))
+    ds["quantity_long_name"].attrs = {"units": "1", "long_name": "meaning of each quantity"}
+    ds["quantity_period"] = (
+        "quantity",
+        np.array([QUANTITIES[q] or np.nan for q in qnames]),
+        {"units": "1", "long_name": "period of a circular quantity (NaN: not circular)"},
+    )
+    step = {
+        "max_wear_theta": 360.0 / coords["theta"].size,
+        "max_wear_z": float(np.max(np.diff(coords["z"].values))) if coords["z"].size > 1 else 0.0,
+    }
+    ds["quantity_resolution"] = (
+        "quantity",
+        np.array([step.get(q, np.nan) for q in qnames]),
+        {
+            "units": "1",
+            "long_name": "step of a quantised quantity (a location on the wear grid; NaN: "
+            "continuous), units: quantity_units",
+        },
+    )
+    ds["wear_depth_run"] = (
+        ("level", "replicate", "z", "theta"),
+        maps,
+        {"units": "m", "long_name": "final wear map of each run"},
+    )
+    ds["wear_depth_grid_run"] = (
+        ("grid_replicate", "z_grid", "theta_grid"),
+        gmaps,
+        {"units": "m", "long_name": "final wear map of each run on the next grid"},
+    )
+    ds["run_status"] = xr.Variable(
+        "run",
+        status,
+        {
+            "units": "1",
+            "long_name": "outcome of each run (levels x replicates, then the grid runs)",
+            "flag_values": np.array([0, 1, 2], dtype=np.int8),
+            "flag_meanings": "ok failed not_run",
+        },
+    )
+    ds["run_error"] = xr.Variable(
+        "run", errors.astype(str), {"units": "1", "long_name": "error of a failed run"}
+    )
+    ds.attrs.update(
+        {
+            "title": "jointwear verification study: u_num from replicates, ΔN levels and a grid run",
+            "jointwear_file": "verification_study",
+            "data_origin": "simulated",
+            "cycles": spec.cycles,
+            "formal_order": spec.formal_order,
+            "grid_ratio": float(spec.grid),
+            "grid_order": 1.0,
+            "grid_level": 0,
+            "grid_n_layers": int(fine.joint.n_layers),
+            "grid_n_points": int(fine.joint.n_points),
+            "study_spec": json.dumps(spec.describe(), sort_keys=True),
+            "n_runs": len(where),
+            "n_ok": int(np.sum(status == 0)),
+            "n_failed": int(np.sum(status == 1)),
+            "n_not_run": int(np.sum(status == 2)),
+            "method": "Eça & Hoekstra (2014) least squares on replicate means "
+            "(jointwear.refinement); grid term: Roache two-grid, Fs = 3, assumed order 1; "
+            f"u_refinement = U_phi / {COVERAGE_K:g}",
+        }
+    )
+    return _add_fits(ds, units)
+
+
+def _add_fits(ds: xr.Dataset, units: Mapping[str, tuple[str, str]]) -> xr.Dataset:
+    """Per quantity: level statistics and the fit (value, u_num and its parts, order, branch)."""
+    from jointwear.refinement import level_statistics, study_uncertainty
+
+    qnames = [str(q) for q in ds["quantity"].values]
+    fits = [study_uncertainty(ds, q) for q in qnames]
+    periods = [QUANTITIES.get(q) for q in qnames]
+    lm = np.full((len(qnames), ds.sizes["level"]), np.nan)
+    ls = np.full_like(lm, np.nan)
+    for k, q in enumerate(qnames):
+        vals = ds["replicate_value"].sel(quantity=q).transpose("level", "replicate").values
+        lm[k], ls[k], _ = level_statistics(vals, period=periods[k])
+    ds["level_mean"] = (
+        ("quantity", "level"),
+        lm,
+        {"units": "1", "long_name": "mean of the replicates per level (units: quantity_units)"},
+    )
+    ds["level_sem"] = (
+        ("quantity", "level"),
+        ls,
+        {"units": "1", "long_name": "standard error of the level mean (units: quantity_units)"},
+    )
+    u_attrs = {
+        "units": "1",
+        "coverage_factor": 1,
+        "comment": "standard uncertainty (k = 1) in the units of quantity_units",
+    }
+    for name, long in (
+        ("u_num", "numerical uncertainty sqrt(u_stat^2 + u_refinement^2 + u_grid^2)"),
+        ("u_stat", "statistical part: standard error of the finest level's mean"),
+        ("u_refinement", "refinement part: Eça-Hoekstra U_phi / 2"),
+        ("u_grid", "grid part: Roache two-grid estimate from the runs on the next grid"),
+    ):
+        ds[name] = (
+            "quantity",
+            np.array([getattr(f, name) for f in fits]),
+            {**u_attrs, "long_name": long},
+        )
+    ds["value"] = (
+        "quantity",
+        np.array([f.value for f in fits]),
+        {
+            "units": "1",
+            "long_name": "best estimate: mean of the finest level (units: quantity_units)",
+            "ancillary_variables": "u_num",
+        },
+    )
+    ds["extrapolated"] = (
+        "quantity",
+        np.array([f.extrapolated for f in fits]),
+        {"units": "1", "long_name": "phi_0 of the fit used (units: quantity_units)"},
+    )
+    for name, long in (
+        ("order", "observed order p of the fit phi = phi_0 + alpha h^p"),
+        ("order_sd", "standard deviation of the observed order"),
+        ("safety_factor", "safety factor Fs of the branch taken"),
+    ):
+        ds[name] = (
+            "quantity",
+            np.array([getattr(f, name) for f in fits]),
+            {"units": "1", "long_name": long},
+        )
+    for name, long in (
+        ("branch", "Eça-Hoekstra branch taken and why"),
+        ("reason", "why not assessed / notes"),
+    ):
+        ds[name] = ("quantity", np.array([getattr(f, name) for f in fits], dtype=object))
+        ds[name].attrs = {"units": "1", "long_name": long}
+    ds["assessed"] = (
+        "quantity",
+        np.array([f.assessed for f in fits], dtype=np.int8),
+        {
+            "units": "1",
+            "long_name": "u_num assessed",
+            "flag_values": np.array([0, 1], dtype=np.int8),
+            "flag_meanings": "not_assessed assessed",
+        },
+    )
+    return ds
