@@ -14,8 +14,8 @@ states of :mod:`jointwear.compare.verdicts`:
   simulated values with their half-difference as a rectangular term of u_D. Without the
   new-bore value u_D is not assessed.
 * **angle of maximum wear** at a layer: a circular quantity; ``E`` is wrapped to (-180, 180]
-  degree before it meets ``U_val``; the fallback threshold (V&V 20 not assessed) is
-  ``max_angle_error_deg`` of the criteria.
+  degree before it meets ``U_val``; the screening threshold shown when V&V 20 is not
+  assessed is ``max_angle_error_deg`` of the criteria (never a verdict).
 * **maximum wear depth** at a layer or over the measured layers.
 * ``kind = "other"``, a place outside the simulated bore, cycles beyond the simulation, the
   new bearing itself (0 cycles): *not comparable*, with the reason.
@@ -58,7 +58,7 @@ from jointwear.compare._reported_quantities import (
 from jointwear.compare.align import _prepare_map
 from jointwear.compare.criteria import Criteria
 from jointwear.compare.ensemble import Ensemble, not_a_distribution, spread
-from jointwear.compare.verification import gci
+from jointwear.compare.verification import _formal_order, gci
 from jointwear.errors import BadInputError
 from jointwear.reported import is_reported
 
@@ -89,7 +89,8 @@ def circular_decision(
     """V&V 20 of an angle [degree]: ``E = wrap(S - D)`` in (-180, 180] against ``U_val``.
 
     Like :func:`jointwear.compare._decide.scalar_decision`, but the error is circular and the
-    fallback threshold (V&V 20 not assessed) is an angle, ``|E| <= max_error_deg``.
+    screening threshold shown when V&V 20 is not assessed is an angle, ``|E| <= max_error_deg``
+    (screening only, never a pass or a fail).
     """
     finite = bool(np.isfinite(s) and np.isfinite(d))
     e = float(mt.wrap_angle_deg(s - d)) if finite else float("nan")
@@ -109,26 +110,20 @@ def circular_decision(
         )
         return
     missing = [name for name, u in parts if not u.known]
-    if missing:
+    if missing:  # screening against max_error_deg is shown, never counted as a verdict
         reason = "; ".join(f"{name} not assessed ({u.basis})" for name, u in parts if not u.known)
-        decisions.append(
-            decision(
-                label,
-                criterion,
-                f"E = {e:+.1f} degree ({shown})",
-                vd.NOT_ASSESSED,
-                "V&V 20",
-                reason,
-                key=quantity,
-            )
+        screen = (
+            f"; screening only, not a verdict: |E| {'<=' if abs(e) <= max_error_deg else '>'} "
+            f"{max_error_deg:g} degree"
         )
         decisions.append(
             decision(
                 label,
-                f"|E| <= {max_error_deg:g} degree (threshold; V&V 20 not assessed)",
-                f"E = {e:+.1f} degree ({shown})",
-                vd.PASS if abs(e) <= max_error_deg else vd.FAIL,
-                "threshold",
+                criterion,
+                f"E = {e:+.1f} degree ({shown}){screen}",
+                vd.NOT_ASSESSED,
+                "V&V 20",
+                reason,
                 key=quantity,
             )
         )
@@ -220,6 +215,10 @@ def _measured(
     )
 
 
+def _level_dim(ds: xr.Dataset) -> str:
+    return str(next(d for d in ds["wear_depth"].dims if d not in ("cycles", "z", "theta")))
+
+
 def _level_values(
     ds: xr.Dataset, q, attrs, reading, cycles
 ) -> tuple[np.ndarray, np.ndarray] | None:
@@ -287,7 +286,11 @@ def _u_num(
         if angle:  # unwrap around the finest level's angle
             ref = values[np.nanargmin(np.where(np.isfinite(values), h, np.inf))]
             values = ref + mt.wrap_angle_deg(values - ref)
-        g = gci(h, values, quantity=name)
+        dim = ds[name].dims[0] if name in ds.data_vars else _level_dim(ds)
+        order, note = _formal_order(ds, str(dim))
+        g = gci(
+            h, values, quantity=name, formal_order=order, formal_order_note=note, refined=str(dim)
+        )
         if not g.assessed:
             return unknown(f"verification study: {g.reason}")
         return Uncertainty(g.u_num_rel * abs(g.values[0]), "verification: " + g.describe())
