@@ -45,10 +45,14 @@ class Reading:
         ``"stated"`` when the file states it and the values are already canonical).
     first : str
         End of the bore where layer 1 lies (``"+z"``/``"-z"``, or ``""`` without layers).
+    z_centre : float or None
+        Axial position of the middle of the layer stack [m] when the file leaves it unstated
+        (None: as stated).
     """
 
     direction: str
     first: str
+    z_centre: float | None = None
 
     def label(self, attrs: Mapping[str, Any]) -> str:
         """E.g. ``"angles counterclockwise, layer 1 at +z"`` (only the unstated parts)."""
@@ -57,36 +61,63 @@ class Reading:
             parts.append(f"angles {self.direction}")
         if attrs.get("layers_first") == "unstated" and self.first:
             parts.append(f"layer 1 at {self.first}")
+        if self.z_centre is not None:
+            parts.append(f"layers centred at z = {self.z_centre * 1e3:+.2f} mm")
         return ", ".join(parts)
 
 
-def readings(rep: xr.Dataset) -> list[Reading]:
-    """Every combination of the unstated angle direction and layer order of ``rep``."""
+#: positions of an unstated layer stack tried across the simulated bore (both ends included)
+STACK_POSITIONS = 5
+
+
+def readings(
+    attrs: Mapping[str, Any], q: Mapping[str, Any], z_range: tuple[float, float] | None = None
+) -> list[Reading]:
+    """Every reading of what the file leaves unstated that matters for quantity ``q``.
+
+    The angle direction matters for an angle, the layer order for a quantity at one layer, the
+    position of the stack (``z_centre`` unstated) for any quantity on the layers: it is tried at
+    :data:`STACK_POSITIONS` positions from one end of the simulated bore (``z_range``) to the
+    other.
+    """
     directions = ["stated"]
-    if any(
-        v.attrs.get("kind") == "max_wear_angle" and v.attrs.get("angle_direction") == "unstated"
-        for v in rep.data_vars.values()
-    ):
+    if q.get("kind") == "max_wear_angle" and q.get("angle_direction") == "unstated":
         directions = list(_DIRECTIONS)
-    first = str(rep.attrs.get("layers_first", ""))
-    firsts = ["+z", "-z"] if first == "unstated" else [first]
-    return [Reading(d, f) for d, f in itertools.product(directions, firsts)]
+    on_layers = "z_m" not in q and "layers_count" in attrs
+    first = str(attrs.get("layers_first", ""))
+    firsts = [first]
+    if not on_layers or int(q.get("layer", 0)) == 0:
+        firsts = ["+z"] if on_layers else [""]  # the order of the whole stack does not matter
+    elif first == "unstated":
+        firsts = ["+z", "-z"]
+    centres: list[float | None] = [None]
+    if on_layers and not np.isfinite(float(attrs.get("layers_z_centre_m", 0.0))):
+        span = (int(attrs["layers_count"]) - 1) * float(attrs["layers_spacing_m"])
+        lo, hi = z_range if z_range is not None else (0.0, 0.0)
+        if hi - lo >= span - 1e-12:
+            half = 0.5 * (hi - lo - span)
+            mid = 0.5 * (hi + lo)
+            centres = [float(c) for c in np.linspace(mid - half, mid + half, STACK_POSITIONS)]
+        else:
+            centres = [float("nan")]  # longer than the simulated bore: nowhere inside
+    return [Reading(d, f, c) for d, f, c in itertools.product(directions, firsts, centres)]
 
 
-def layer_z(attrs: Mapping[str, Any], first: str) -> np.ndarray:
+def layer_z(attrs: Mapping[str, Any], first: str, z_centre: float | None = None) -> np.ndarray:
     """Axial position [m] of measured layers 1..n (z from the bearing mid-width)."""
     n = int(attrs["layers_count"])
     step = float(attrs["layers_spacing_m"])
     offsets = (np.arange(n) - (n - 1) / 2.0) * step
     sign = -1.0 if first == "+z" else 1.0  # layer 1 at the +z end: z decreases with the number
-    return float(attrs["layers_z_centre_m"]) + sign * offsets
+    centre = float(attrs["layers_z_centre_m"]) if z_centre is None else z_centre
+    return centre + sign * offsets
 
 
 def quantity_z(q: Mapping[str, Any], attrs: Mapping[str, Any], reading: Reading) -> np.ndarray:
     """Axial positions [m] where quantity ``q`` (variable attributes) was measured."""
     if "z_m" in q:
         return np.array([float(q["z_m"])])
-    zs = layer_z(attrs, reading.first)
+    zs = layer_z(attrs, reading.first, reading.z_centre)
     layer = int(q.get("layer", 0))
     return zs if layer == 0 else zs[layer - 1 : layer]
 
@@ -97,7 +128,7 @@ def profile_at(wear: xr.DataArray, z: np.ndarray) -> np.ndarray | None:
     None when a position lies outside the simulated layers (never extrapolated).
     """
     zs = np.asarray(wear["z"].values, dtype=float)
-    if np.any(z < zs.min() - 1e-12) or np.any(z > zs.max() + 1e-12):
+    if not np.all(np.isfinite(z)) or np.any(z < zs.min() - 1e-12) or np.any(z > zs.max() + 1e-12):
         return None
     values = np.asarray(wear.transpose("z", "theta").values, dtype=float)
     out = np.empty((z.size, values.shape[1]))

@@ -20,8 +20,8 @@ states of :mod:`jointwear.compare.verdicts`:
 * ``kind = "other"``, a place outside the simulated bore, cycles beyond the simulation, the
   new bearing itself (0 cycles): *not comparable*, with the reason.
 
-What the source leaves unstated (the direction of its angles, which end layer 1 is at) is
-enumerated: each reading is decided, and the verdict stands only when every reading gives the
+What the source leaves unstated (the direction of its angles, which end layer 1 is at, where
+the stack of layers lies along the bore) is enumerated (:func:`readings`): each reading is decided, and the verdict stands only when every reading gives the
 same state; otherwise the quantity is *not comparable*, the reason listing each reading's
 outcome and the field that settles it.
 
@@ -447,17 +447,27 @@ def reported_metrics(
         As for :func:`jointwear.compare.compare` (verification as datasets).
     """
     studies = [v for v in verification if isinstance(v, xr.Dataset)]
-    reads = readings(rep)
-    unstated = []
-    if any(r.direction != "stated" for r in reads):
-        unstated.append("angle.direction")
-    if rep.attrs.get("layers_first") == "unstated":
-        unstated.append("layers.first")
+    a = rep.attrs
+    unstated = [
+        field
+        for field, missing in (
+            (
+                "angle.direction",
+                any(v.attrs.get("angle_direction") == "unstated" for v in rep.data_vars.values()),
+            ),
+            ("layers.first", a.get("layers_first") == "unstated"),
+            (
+                "layers.z_centre",
+                "layers_count" in a and not np.isfinite(float(a.get("layers_z_centre_m", 0.0))),
+            ),
+        )
+        if missing
+    ]
     if unstated:
         notes.append(
-            f"reported measurements '{rep.attrs.get('title', '')}': the source does not state "
-            f"{' and '.join(unstated)}; each quantity was decided under all {len(reads)} "
-            "readings and its verdict stands only where they agree"
+            f"reported measurements '{a.get('title', '')}': the source does not state "
+            f"{', '.join(unstated)}; each quantity was decided under every reading of what "
+            "matters to it, and its verdict stands only where they agree"
         )
     names = [str(n) for n, v in rep.data_vars.items() if "kind" in v.attrs]
     for name in names:
@@ -494,15 +504,13 @@ def reported_metrics(
                 )
             )
             continue
+        zs = np.asarray(wear["z"].values, dtype=float)
         outcomes = []
-        for reading in reads:
+        for reading in readings(a, q, (float(zs.min()), float(zs.max()))):
             r_rows, r_decs = _one_reading(
                 rep, name, q, reading, wear, cycles, studies, ensemble, criteria, label
             )
             outcomes.append((reading.label(rep.attrs), r_rows, r_decs))
-        distinct = {tuple(sorted(str(row["value"]) for row in o[1].rows)) for o in outcomes}
-        if len(distinct) == 1:  # the unstated parts do not touch this quantity
-            outcomes = outcomes[:1]
         new_rows, new_decs = _combine(name, outcomes, " / ".join(unstated))
         rows.rows.extend(new_rows)
         decisions.extend(new_decs)

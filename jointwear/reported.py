@@ -252,11 +252,13 @@ def _layers(data: Mapping[str, Any], path: Path) -> dict[str, Any]:
     )
     if count > 1 and not spacing > 0:
         raise ParameterError(_where(path, "layers.spacing must be > 0"))
-    centre = _amount(
-        _require(table, "z_centre", path, "layers.", fix + " (z from the bearing mid-width)"),
-        "m",
-        "length",
-        "layers.z_centre",
+    centre_text = _require(
+        table, "z_centre", path, "layers.", fix + " (z from the bearing mid-width, or 'unstated')"
+    )
+    centre = (
+        float("nan")
+        if centre_text == "unstated"
+        else _amount(centre_text, "m", "length", "layers.z_centre")
     )
     first = _require(table, "first", path, "layers.", "'+z', '-z' or 'unstated'")
     if first not in _FIRST:
@@ -270,7 +272,7 @@ def _layers(data: Mapping[str, Any], path: Path) -> dict[str, Any]:
     return {
         "layers_count": int(count),
         "layers_spacing_m": spacing,
-        "layers_z_centre_m": centre,
+        "layers_z_centre_m": centre,  # NaN: unstated (anywhere in the bore)
         "layers_first": str(first),
         "layers_note": str(table.get("note", "")),
     }

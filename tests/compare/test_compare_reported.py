@@ -363,3 +363,30 @@ def test_u_num_from_a_sim_verify_study():
     other = compare(sim_map(bump=20e-6), rep, ensemble=ens, verification=[verify_study(cycles=1e6)])
     row = vv20(other, "ang")
     assert row.state == vd.NOT_ASSESSED and "run for 1e+06 cycles" in row.reason
+
+
+def test_unstated_stack_position_tried_along_the_bore():
+    # a taper plus ovality has the same cylindricity wherever the 4 mm stack lies: decided
+    data = cyl_file()
+    data["layers"]["z_centre"] = "unstated"
+    rep = reported_dataset(data)
+    assert np.isnan(rep.attrs["layers_z_centre_m"])
+    row = vv20(compare(sim_map(), rep, criteria=STATED), "cyl")
+    assert row.state == vd.PASS, row
+    # a wear growing with z^2 has a cylindricity that depends on where the stack lies: the
+    # centred truth is not enough to decide - not comparable, naming the field
+    sim = sim_map()
+    z = sim["z"].values
+    bowl = 2.0 * (z * 1e3) ** 2 * 1e-6  # 2 um/mm^2
+    sim["wear_depth"] = (
+        sim["wear_depth"] + bowl[None, :, None] * sim["cycles"].values[:, None, None] / N_REF
+    )
+    centred = compare(sim, reported_dataset(cyl_file()), criteria=STATED)
+    s_centre = centred.value("cyl", "value_sim")
+    truth = reported_dataset(cyl_file(value_um=5.0 + s_centre * 1e6))
+    assert vv20(compare(sim, truth, criteria=STATED), "cyl").state == vd.PASS
+    data = cyl_file(value_um=5.0 + s_centre * 1e6)
+    data["layers"]["z_centre"] = "unstated"
+    row = vv20(compare(sim, reported_dataset(data), criteria=STATED), "cyl")
+    assert row.state == vd.NOT_COMPARABLE
+    assert "layers.z_centre" in row.reason and "centred at z = +5.50 mm" in row.reason

@@ -61,13 +61,11 @@ def test_library_run_decides_every_reported_quantity(study):
     m = result.metrics.set_index(["quantity", "metric"])
     assert "ensemble" in m.loc[("cylindricity_1_2e6", "u_input"), "basis"]
     assert np.isfinite(m.loc[("cylindricity_1_2e6", "u_input"), "value"])
-    assert m.loc[("cylindricity_1_2e6", "u_D"), "value"] == pytest.approx(
-        np.sqrt(2 * ((0.03 / np.sqrt(3)) ** 2 + (0.01 / np.sqrt(12)) ** 2) + 5.02**2 / 3) * 1e-6,
-        rel=0.05,  # plus the LS/MZ half-difference of the simulated bore
-    )
-    assert m.loc[("cylindricity_1_2e6", "u_D"), "value"] >= 5.02e-6 / np.sqrt(3)
+    floor = np.sqrt(2 * ((0.03 / np.sqrt(3)) ** 2 + (0.01 / np.sqrt(12)) ** 2) + 5.02**2 / 3)
+    u_d = m.loc[("cylindricity_1_2e6", "u_D"), "value"] * 1e6
+    assert floor <= u_d <= floor + 2.0  # plus the LS/MZ half-difference of the simulated bore
     # the angles: the paper leaves their direction and the layer order unstated
-    assert any("angle.direction" in n for n in result.notes)
+    assert any("angle.direction, layers.first, layers.z_centre" in n for n in result.notes)
     back = load_comparison(io.load(out / "metrics.nc"))
     assert list(back.decisions.state) == list(result.decisions.state)
     assert io.load(out / "reported.nc").attrs["data_origin"] == "measured"

@@ -168,6 +168,7 @@ def test_example_file_holds_the_papers_numbers():
     assert ds.attrs["layers_count"] == 13 and ds.attrs["layers_spacing_m"] == pytest.approx(1e-3)
     assert ds["max_wear_angle_first_1_2e6"].attrs["angle_direction"] == "unstated"
     assert ds.attrs["layers_first"] == "unstated"
+    assert np.isnan(ds.attrs["layers_z_centre_m"])  # the paper does not say where the 13 lie
 
 
 def test_cli_import_writes_measured_cf_file_with_source(tmp_path):
