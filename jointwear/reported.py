@@ -435,6 +435,26 @@ def _quantity(
     return xr.DataArray(value, attrs=attrs), xr.DataArray(u, attrs=u_attrs), {}
 
 
+def _one_baseline(ds: xr.Dataset, path: Path) -> None:
+    """Refuse two new-bore cylindricities that a growth could take as its baseline."""
+    seen: dict[tuple[Any, ...], str] = {}
+    for name, var in ds.data_vars.items():
+        a = var.attrs
+        if a.get("kind") != "cylindricity" or a.get("cycles") != 0.0:
+            continue
+        key = (a.get("reference"), a.get("layer"), a.get("z_m"))
+        if key in seen:
+            raise ParameterError(
+                _where(
+                    path,
+                    f"quantity.{seen[key]} and quantity.{name} are both the new bore's "
+                    "cylindricity (cycles = 0, same reference and place): a growth would not know "
+                    "which to subtract - keep one (or their mean, with its uncertainty)",
+                )
+            )
+        seen[key] = str(name)
+
+
 def reported_dataset(data: Mapping[str, Any], path: str | Path = "<mapping>") -> xr.Dataset:
     """Check a parsed reported-measurement mapping and build its CF dataset.
 
@@ -485,6 +505,7 @@ def reported_dataset(data: Mapping[str, Any], path: str | Path = "<mapping>") ->
         value, u, _ = _quantity(str(name), q, path, layers, angle)
         ds[str(name)] = value
         ds[f"{name}_u"] = u
+    _one_baseline(ds, path)
     ds.attrs.update(
         {
             "title": str(data.get("title", "reported measurements")),

@@ -202,3 +202,21 @@ def test_cli_refuses_a_missing_field_with_exit_3(tmp_path, capsys):
     code = main(["import", "reported", str(tmp_path / "r.toml"), "--out", str(tmp_path / "x.nc")])
     assert code == 3
     assert "quantity.cylindricity_new.cycles is missing" in capsys.readouterr().err
+
+
+def test_two_new_bore_baselines_are_refused():
+    data = base()
+    data["quantity"]["cyl_new2"] = dict(data["quantity"]["cyl_new"], value=5.5)
+    with pytest.raises(
+        ParameterError, match=r"cyl_new and quantity\.cyl_new2 are both the new bore"
+    ):
+        reported_dataset(data)
+
+
+def test_angle_in_radians_is_converted():
+    data = base()
+    data["quantity"]["angle"].update(value=math.pi / 2, unit="rad")
+    data["quantity"]["angle"]["uncertainty"] = {"figure_reading": 0.1}
+    ds = reported_dataset(data)
+    assert float(ds["angle"]) == pytest.approx(90.0)
+    assert float(ds["angle_u"]) == pytest.approx(np.degrees(0.1) / math.sqrt(3))
