@@ -409,13 +409,19 @@ def _combine(
                 base["value"] = " | ".join(f"{label}: {d['value']}" for label, d in each)
             out.append(base)
             continue
-        listing = "; ".join(f"{label}: {vd.LABELS[d['state']]} ({d['value']})" for label, d in each)
+        groups = {st: [label for label, d in each if d["state"] == st] for st in vd.STATES}
+        listing = "; ".join(
+            f"{vd.LABELS[st]} under {len(labels)} of {len(each)} ({' | '.join(labels)})"
+            for st, labels in groups.items()
+            if labels
+        )
         base.update(
             state=vd.NOT_COMPARABLE,
             passed=False,
             value="depends on the reading",
-            reason=f"the verdict depends on what the source leaves unstated - {listing}; "
-            f"state {settle} in the reported file to decide it",
+            reason=f"the verdict depends on what the source leaves unstated - {listing} (each "
+            f"reading's numbers: metrics '{name} [reading]'); state {settle} in the reported "
+            "file to decide it",
         )
         out.append(base)
     return all_rows, out
@@ -505,12 +511,22 @@ def reported_metrics(
             )
             continue
         zs = np.asarray(wear["z"].values, dtype=float)
+        reads = readings(a, q, (float(zs.min()), float(zs.max())))
+        settle = [
+            field
+            for field, varies in (
+                ("angle.direction", len({r.direction for r in reads}) > 1),
+                ("layers.first", len({r.first for r in reads}) > 1),
+                ("layers.z_centre", len({r.z_centre for r in reads}) > 1),
+            )
+            if varies
+        ]
         outcomes = []
-        for reading in readings(a, q, (float(zs.min()), float(zs.max()))):
+        for reading in reads:
             r_rows, r_decs = _one_reading(
                 rep, name, q, reading, wear, cycles, studies, ensemble, criteria, label
             )
             outcomes.append((reading.label(rep.attrs), r_rows, r_decs))
-        new_rows, new_decs = _combine(name, outcomes, " / ".join(unstated))
+        new_rows, new_decs = _combine(name, outcomes, " / ".join(settle))
         rows.rows.extend(new_rows)
         decisions.extend(new_decs)
