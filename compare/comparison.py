@@ -27,10 +27,11 @@ from jointwear.compare._motion import motion_metrics, rms_quantities
 from jointwear.compare._wear import sim_quantities, wear_metrics
 from jointwear.compare.align import MOTION_VARIABLES, align_time_series, align_wear_maps
 from jointwear.compare.criteria import Criteria, load_criteria
-from jointwear.compare.ensemble import Ensemble, as_ensemble
+from jointwear.compare.ensemble import WEAR_QUANTITIES, Ensemble, as_ensemble
 from jointwear.compare.origin import side_origin
 from jointwear.compare.reported import reported_metrics, split_reported
 from jointwear.compare.sources import Sources
+from jointwear.compare.study import band_study_uncertainty, is_study
 from jointwear.compare.verification import GCI, numerical_uncertainty
 from jointwear.errors import BadInputError
 
@@ -382,8 +383,10 @@ def compare(
         Ensembles of simulations over uncertain inputs (``run`` dimension); their spread is
         the u_input of each compared quantity (:mod:`jointwear.compare.ensemble`).
     verification : Dataset(s) or mapping of GCI, optional
-        Verification studies (quantities over a refinement parameter) for u_num
-        (:mod:`jointwear.compare.verification`).
+        Verification studies for u_num: a ``jointwear sim verify`` study (its stored wear maps
+        give u_num of every band quantity, :mod:`jointwear.compare.study`), or older 1-D
+        refinement datasets (quantities over a refinement parameter, GCI,
+        :mod:`jointwear.compare.verification`).
 
     Returns
     -------
@@ -399,10 +402,16 @@ def compare(
     """
     criteria = criteria or Criteria()
     ens = as_ensemble(ensemble)
+    studies: list[xr.Dataset] = []
     if verification is None:
         gci: Mapping[str, GCI] = {}
     elif isinstance(verification, xr.Dataset) or not isinstance(verification, Mapping):
-        gci = numerical_uncertainty(verification)  # a Dataset is a Mapping too: test it first
+        # a Dataset is a Mapping too: test it first. sim verify studies (contract) apart from
+        # the older 1-D refinement datasets (GCI)
+        items = [verification] if isinstance(verification, xr.Dataset) else list(verification)
+        studies = [ds for ds in items if is_study(ds)]
+        older = [ds for ds in items if not is_study(ds)]
+        gci = numerical_uncertainty(older) if older else {}
     else:
         gci = verification
     sims = [sim] if isinstance(sim, (xr.Dataset, xr.DataArray)) else list(sim)
@@ -428,7 +437,20 @@ def compare(
             field_values.update(values)
             if band is not None:
                 wear["wear_depth_sim_ensemble"] = band
-        src = Sources(criteria, ens, gci, float(wear.attrs["cycles_sim"]), field_values)
+        band_u = (
+            band_study_uncertainty(
+                studies,
+                m_wear,
+                WEAR_QUANTITIES,
+                theta_step_deg=theta_step_deg,
+                radius=wear.attrs.get("bearing_radius_m"),
+            )
+            if studies
+            else {}
+        )
+        src = Sources(
+            criteria, ens, gci, float(wear.attrs["cycles_sim"]), field_values, studies=band_u
+        )
         domain = wear_metrics(wear, rows, decisions, src)
         if domain:
             notes.append(domain)

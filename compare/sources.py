@@ -24,6 +24,7 @@ from jointwear.compare._decide import Uncertainty, unknown
 from jointwear.compare.budget import Component, combine
 from jointwear.compare.criteria import Criteria
 from jointwear.compare.ensemble import Ensemble, spread
+from jointwear.compare.study import StudyResult, study_component
 from jointwear.compare.verification import GCI
 
 __all__ = ["Sources", "SIM_U_COVERS"]
@@ -49,6 +50,9 @@ class Sources:
     field_values : mapping
         Quantity -> per-ensemble per-run values computed from ensemble fields (preferred over
         the ensemble's scalar outputs).
+    studies : mapping
+        Quantity -> u_num of a ``jointwear sim verify`` study on the measured band
+        (:mod:`jointwear.compare.study`).
     """
 
     criteria: Criteria
@@ -56,6 +60,7 @@ class Sources:
     gci: Mapping[str, GCI] = field(default_factory=dict)
     compared_cycles: float | None = None
     field_values: Mapping[str, Sequence[tuple[int, np.ndarray]]] = field(default_factory=dict)
+    studies: Mapping[str, StudyResult] = field(default_factory=dict)
 
     def u_num(
         self,
@@ -74,18 +79,21 @@ class Sources:
         is taken first). A user-stated fraction is used only when no file gives u_num.
         """
         comps: list[Component] = []
+        if quantity in self.studies:
+            cyc = self.compared_cycles if family == "wear" else None
+            comps.append(study_component(self.studies[quantity], s, cyc))
         g = self.gci.get(quantity)
         if g is not None:
             comps.append(self._verification_component(g, s))
         if stated is not None and np.isfinite(stated):
             note = f" ({stated_note})" if stated_note else ""
+            what, covers = (
+                (": update interval and cycle-to-cycle variability of the wear rate", SIM_U_COVERS)
+                if family == "wear"
+                else ("", frozenset({"the simulation's own statement"}))
+            )
             comps.append(
-                Component(
-                    float(stated),
-                    f"the simulation file's <name>_u{note}: update interval and cycle-to-cycle "
-                    "variability of the wear rate",
-                    SIM_U_COVERS,
-                )
+                Component(float(stated), f"the simulation file's <name>_u{note}{what}", covers)
             )
         if any(c.known for c in comps):
             return combine("u_num", comps)
@@ -94,8 +102,8 @@ class Sources:
             return Uncertainty(
                 rel * abs(s), f"user-stated {rel:.3g}·|S| (criteria {family}_u_num_rel)"
             )
-        if g is not None:
-            return unknown(f"verification study: {g.reason}")
+        if comps:
+            return combine("u_num", comps)
         if self.gci:
             return unknown(
                 f"the verification study has no '{quantity}', the simulation states none "

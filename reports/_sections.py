@@ -176,6 +176,11 @@ def _verdict(c: Comparison, counts: dict[str, int]) -> tuple[str, str]:
     )
     if n == 0:
         return "NO DECISION: nothing was compared", "undecided"
+    if c.wear is not None and any(str(t).startswith("validation domain") for t in c.notes):
+        from jointwear.compare._wear import band_label
+
+        # the wear is judged on the measured band only; the rest of the simulation is not
+        synthetic += f"; wear judged {band_label(c.wear)}, outside it extrapolated"
     if counts[vd.FAIL]:
         return f"NOT VALIDATED: {counts[vd.FAIL]} of {n} criteria failed{synthetic}", "fail"
     undecided = counts[vd.NOT_ASSESSED] + counts[vd.NOT_COMPARABLE]

@@ -64,14 +64,18 @@ class DemoSize:
     motion_cycles: float
     rig_size: tuple[int, int] | None  # stereo footage (width, height) [px]; None = no footage
     rig_duration: float  # recorded time [s]
-    verification_tols: tuple[float, ...]  # coarser wear-update tolerances for the study
     ensemble_runs: int = 0  # members of the input-uncertainty ensemble (0: none)
     ensemble_cycles: float = 0.0  # wear cycles of each member (reduced)
     ensemble_updates: int = 4  # fixed wear updates per member
+    verify_levels: tuple[int, ...] = ()  # ΔN levels of the sim verify study (empty: none)
+    verify_cycles: float = 0.0  # wear cycles of every study run (reduced)
+    verify_replicates: int = 2  # runs per level (start phases) and on the refined grid
 
 
-FULL = DemoSize(2e5, (2e5,), 10, 90, 18000, 1.5, (640, 512), 0.6, (0.4, 0.2), 8, 5e4, 4)
-QUICK = DemoSize(5e4, (5e4,), 8, 72, 3600, 1.2, None, 0.0, ())
+FULL = DemoSize(
+    2e5, (2e5,), 10, 90, 18000, 1.5, (640, 512), 0.6, 8, 5e4, 4, (2500, 5000, 10000, 20000), 5e4
+)
+QUICK = DemoSize(5e4, (5e4,), 8, 72, 3600, 1.2, None, 0.0)
 
 
 def _say(msg: str) -> None:
@@ -88,9 +92,9 @@ def _available(module: str, *names: str) -> bool:
     return all(hasattr(mod, n) for n in names)
 
 
-def _simulate(folder: Path, size: DemoSize) -> tuple[Path, Path, Any, Path | None, float]:
+def _simulate(folder: Path, size: DemoSize) -> tuple[Path, Path, Any, list[Path]]:
     from jointwear.params import replace_nested
-    from jointwear.sim import PARAMETER_SETS, WearSettings, run_cycles, simulate_wear
+    from jointwear.sim import PARAMETER_SETS, run_cycles, simulate_wear
 
     params = replace_nested(
         PARAMETER_SETS["zhang2023"],
@@ -134,27 +138,35 @@ def _simulate(folder: Path, size: DemoSize) -> tuple[Path, Path, Any, Path | Non
     _say(
         f"  simulated motion: {size.motion_cycles:g} crank cycles ({time.perf_counter() - t0:.0f} s)"
     )
-    verification_path, u_num_rel = None, 0.0
-    if size.verification_tols:
+    paths: list[Path] = []
+    if size.verify_levels:
         from jointwear.compare import numerical_uncertainty
+        from jointwear.refinement import describe_study
 
         t0 = time.perf_counter()
-        ver, u_num_rel = wear_verification(params, size, wear, WearSettings().tol)
-        ver = xr.merge([ver, motion_verification(params, size, motion)], combine_attrs="override")
-        verification_path = io.save(
-            ver,
-            folder / "sim_verification.nc",
-            parameters={
-                "simulation": params,
-                "update_tolerances": list(ver["update_tolerance"].values),
-                "solver_rtols": list(ver["solver_rtol"].values),
-            },
-            source="jointwear (sim.wear, sim.dynamics) via jointwear demo",
+        study = wear_verification(params, size, folder / "sim_verify.nc")
+        paths.append(folder / "sim_verify.nc")
+        _say(
+            f"  verification study of the wear, jointwear sim verify ({time.perf_counter() - t0:.0f} s):"
         )
-        _say(f"  verification studies ({time.perf_counter() - t0:.0f} s):")
+        for line in describe_study(study).splitlines():
+            _say(f"      {line}")
+        t0 = time.perf_counter()
+        ver = motion_verification(params, size, motion)
+        paths.append(
+            io.save(
+                ver,
+                folder / "sim_verification_motion.nc",
+                parameters={"simulation": params, "solver_rtols": list(ver["solver_rtol"].values)},
+                source="jointwear (sim.dynamics) via jointwear demo",
+            )
+        )
+        _say(
+            f"  verification of the motion with the solver tolerance ({time.perf_counter() - t0:.0f} s):"
+        )
         for g in numerical_uncertainty(ver).values():
             _say(f"      {g.describe()}")
-    return sim_wear, sim_motion, params, verification_path, u_num_rel
+    return sim_wear, sim_motion, params, paths
 
 
 def measured_wear_function(sim_wear: xr.Dataset) -> Any:
@@ -378,16 +390,18 @@ def run_demo(out: Path, *, quick: bool = False) -> Path:
     ]
     sims: list[Path] = []
     meas: list[tuple[str, Path]] = []
-    sim_wear_path = sim_motion_path = verification_path = ensemble_path = None
+    sim_wear_path = sim_motion_path = ensemble_path = None
+    verification_paths: list[Path] = []
     params = None
     _phase(1, "simulating the reference mechanism: wear and motion")
     if _available("jointwear.sim", "simulate_wear", "run_cycles", "PARAMETER_SETS"):
-        sim_wear_path, sim_motion_path, params, verification_path, _ = _simulate(out, size)
+        sim_wear_path, sim_motion_path, params, verification_paths = _simulate(out, size)
         sims += [sim_wear_path, sim_motion_path]
-        if verification_path is None:
+        if not verification_paths:
             missing.append(
-                "verification: the convergence study of the wear update is skipped with --quick, "
-                "so u_num is not assessed"
+                "verification: the sim verify study is skipped with --quick; u_num of the wear is "
+                "the simulation's own wear_depth_u (update interval and cycle-to-cycle "
+                "variability; the wear grid is not assessed)"
             )
     else:
         missing.append("simulation: jointwear.sim is not available, nothing was simulated")
@@ -464,7 +478,7 @@ def run_demo(out: Path, *, quick: bool = False) -> Path:
             "calibration's world frame (the board), not the mechanism frame, and are not compared."
         )
     ens_ds = [io.load(ensemble_path)] if ensemble_path is not None else []
-    ver_ds = [io.load(verification_path)] if verification_path is not None else []
+    ver_ds = [io.load(p) for p in verification_paths]
     result = compare(
         sim_ds,
         [_in_plane(d) if role == "DIC" else d for (role, _), d in zip(meas, meas_ds, strict=True)],
@@ -482,8 +496,8 @@ def run_demo(out: Path, *, quick: bool = False) -> Path:
     inputs += [ReportInput(role, p, d) for (role, p), d in zip(meas, meas_ds, strict=True)]
     if ensemble_path is not None:
         inputs.append(ReportInput("ensemble", ensemble_path, ens_ds[0]))
-    if verification_path is not None:
-        inputs.append(ReportInput("verification", verification_path, ver_ds[0]))
+    for p, d in zip(verification_paths, ver_ds, strict=True):
+        inputs.append(ReportInput("verification", p, d))
     report = build_report(
         result,
         out / "report.html",

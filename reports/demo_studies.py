@@ -10,6 +10,8 @@ import xarray as xr
 from jointwear.errors import JointwearError
 
 if TYPE_CHECKING:
+    from pathlib import Path
+
     from jointwear.reports.demo import DemoSize
 
 __all__ = [
@@ -28,77 +30,26 @@ def _say(msg: str) -> None:
     typer.echo(msg, err=True)
 
 
-def wear_verification(
-    params: Any, size: DemoSize, main: xr.Dataset, main_tol: float
-) -> tuple[xr.Dataset, float]:
-    """Convergence of the simulated wear with the cycle-update tolerance (verification).
+def wear_verification(params: Any, size: DemoSize, path: Path) -> xr.Dataset:
+    """The verification study of the wear simulation: ``jointwear sim verify`` (the library).
 
-    The wear run is repeated with coarser tolerances of the adaptive update interval
-    (``WearSettings.tol``). :func:`jointwear.compare.compare` turns the study into ``u_num`` by
-    the GCI (:mod:`jointwear.compare.verification`) only where the three solutions converge
-    monotonically; otherwise u_num is reported as not assessed, with the reason. The returned
-    relative change between the two finest runs is for the console only.
-
-    Returns
-    -------
-    (Dataset, float)
-        ``max_wear_depth`` [m] and ``worn_volume`` [m³] over ``update_tolerance`` [1], and the
-        relative numerical uncertainty [1].
+    :func:`jointwear.sim.verify_wear` runs replicates at :attr:`DemoSize.verify_levels`
+    wear-update intervals ΔN and runs on the grid refined 2x, for
+    :attr:`DemoSize.verify_cycles` cycles (reduced: :func:`jointwear.compare.compare` applies
+    its relative u_num to the compared run), and writes the study file ``path``. compare
+    computes every wear criterion on the measured band of each stored run and turns it into
+    u_num (Eça & Hoekstra 2014, :mod:`jointwear.refinement`).
     """
-    from jointwear.sim import WearSettings, simulate_wear
+    from jointwear.sim import VerifySpec, verify_wear
 
-    tols = [*size.verification_tols, main_tol]
-    depth, volume, cyl = [], [], []
-    for tol in size.verification_tols:
-        run = simulate_wear(
-            params,
-            cycles=size.cycles,
-            snapshots=list(size.snapshots),
-            settings=WearSettings(tol=tol),
-        )
-        depth.append(float(run["max_wear_depth"][-1]))
-        volume.append(float(run["worn_volume"][-1]))
-        cyl.append(float(run["cylindricity"][-1]))
-    depth.append(float(main["max_wear_depth"][-1]))
-    volume.append(float(main["worn_volume"][-1]))
-    cyl.append(float(main["cylindricity"][-1]))
-    rel = max(abs(depth[-1] - depth[-2]) / depth[-1], abs(volume[-1] - volume[-2]) / volume[-1])
-    ds = xr.Dataset(
-        {
-            "max_wear_depth": (
-                "update_tolerance",
-                depth,
-                {"units": "m", "long_name": "largest simulated wear depth"},
-            ),
-            "worn_volume": (
-                "update_tolerance",
-                volume,
-                {"units": "m3", "long_name": "simulated worn volume"},
-            ),
-            "cylindricity": (
-                "update_tolerance",
-                cyl,
-                {"units": "m", "long_name": "cylindricity of the simulated worn bore"},
-            ),
-        },
-        coords={
-            "update_tolerance": (
-                "update_tolerance",
-                tols,
-                {
-                    "units": "1",
-                    "long_name": "tolerance of the adaptive wear-update interval (WearSettings.tol)",
-                },
-            )
-        },
-        attrs={
-            "title": "verification: simulated wear versus the cycle-update tolerance",
-            "data_origin": "simulated",
-            "u_num_rel": rel,
-            "cycles": size.cycles,
-        },
+    spec = VerifySpec(
+        cycles=size.verify_cycles,
+        levels=size.verify_levels,
+        replicates=size.verify_replicates,
+        grid=2,
+        grid_replicates=size.verify_replicates,
     )
-    return ds, rel
+    return verify_wear(params, spec=spec, workers=0, out=path)
 
 
 #: solver tolerances of the motion verification study (the default 1e-6 is the finest)
@@ -165,14 +116,24 @@ ENSEMBLE_INPUTS: dict[str, tuple[float, str]] = {
 }
 
 
-def ensemble_spec(params: Any, size: DemoSize) -> dict[str, Any]:
-    """The demo's sweep spec (``jointwear sim sweep`` format): LHS over :data:`ENSEMBLE_INPUTS`."""
+def ensemble_spec(params: Any, size: Any, *, kw: float | None = None) -> dict[str, Any]:
+    """The demo's sweep spec (``jointwear sim sweep`` format): LHS over :data:`ENSEMBLE_INPUTS`.
+
+    ``size`` gives ``ensemble_cycles`` and ``ensemble_runs``; ``kw`` the nominal wear
+    coefficient (default :data:`jointwear.sim.DEFAULT_KW`). An input whose nominal value is 0
+    (e.g. a frictionless model) is not varied: a relative spread of 0 is no distribution.
+    """
     from jointwear.sim import DEFAULT_KW
 
     parameters: dict[str, Any] = {}
     for name, (rel, _) in ENSEMBLE_INPUTS.items():
         section, field = name.split(".")
-        mean = DEFAULT_KW if name == "wear.kw" else float(getattr(getattr(params, section), field))
+        if name == "wear.kw":
+            mean = DEFAULT_KW if kw is None else float(kw)
+        else:
+            mean = float(getattr(getattr(params, section), field))
+        if mean == 0:
+            continue
         spec = {"distribution": "truncnormal", "mean": mean, "std": rel * mean}
         spec["bounds"] = [mean * (1 - 4 * rel), mean * (1 + 4 * rel)]
         parameters[name] = spec

@@ -267,6 +267,20 @@ def motion_figure(motion: xr.Dataset, *, k: float = 2.0) -> Any:
 _DISPLAY = {"m": (1e6, "µm"), "m3": (1e9, "mm³")}
 
 
+def _study_series(ds: xr.Dataset) -> list[tuple]:
+    """Replicate means of each quantity of a sim verify study against ΔN (level coordinate h)."""
+    out = []
+    x = np.asarray(ds["h"].values, dtype=float)
+    for q in ds["quantity"].values:
+        vals = np.asarray(ds["replicate_value"].sel(quantity=q).transpose("level", ...).values)
+        if not np.isfinite(vals).any():
+            continue
+        units = str(ds["quantity_units"].sel(quantity=q).values) if "quantity_units" in ds else ""
+        attrs = {"units": units, "long_name": f"{q}: replicate mean per ΔN level"}
+        out.append((str(q), "h", x, np.nanmean(vals, axis=1), attrs, ds))
+    return out
+
+
 def verification_figure(datasets: Sequence[xr.Dataset]) -> Any | None:
     """Convergence plots of verification data: every 1-D variable against its dimension.
 
@@ -280,6 +294,9 @@ def verification_figure(datasets: Sequence[xr.Dataset]) -> Any | None:
 
     series = []
     for ds in datasets:
+        if ds.attrs.get("jointwear_file") == "verification_study":  # jointwear sim verify
+            series += _study_series(ds)
+            continue
         for name, var in ds.data_vars.items():
             if var.ndim != 1 or var.size < 2 or var.dtype.kind not in "fiu":
                 continue
