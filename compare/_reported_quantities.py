@@ -21,6 +21,7 @@ import jointwear.compare.metrics as mt
 from jointwear.conventions import CANONICAL, AngleConvention
 
 __all__ = [
+    "SEPARATION",
     "Reading",
     "readings",
     "layer_z",
@@ -65,6 +66,9 @@ class Reading:
             parts.append(f"layers centred at z = {self.z_centre * 1e3:+.2f} mm")
         return ", ".join(parts)
 
+
+#: the derived kind: angle between the maxima of two reported layers at the same cycles
+SEPARATION = "max_wear_angle_separation"
 
 #: positions of an unstated layer stack tried across the simulated bore (both ends included)
 STACK_POSITIONS = 5
@@ -187,6 +191,11 @@ def evaluate(
         it (a position outside the simulated bore, no wear there, a definition it lacks).
     """
     kind = q["kind"]
+    if kind == SEPARATION:
+        (a, why_a), (b, why_b) = (evaluate(wear, p, attrs, reading) for p in q["pair"])
+        if why_a or why_b:
+            return float("nan"), why_a or why_b
+        return abs(float(mt.wrap_angle_deg(a - b))), ""
     if kind == "other":
         return float("nan"), (
             f"jointwear's simulation has no quantity of this definition "

@@ -38,6 +38,7 @@ ensemble at the same cycles); else ``wear_u_input_rel`` (not for angles); else n
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Mapping, Sequence
 from typing import Any
@@ -49,6 +50,7 @@ import jointwear.compare.metrics as mt
 import jointwear.compare.verdicts as vd
 from jointwear.compare._decide import Rows, Uncertainty, decision, fmt, scalar_decision, unknown
 from jointwear.compare._reported_quantities import (
+    SEPARATION,
     Reading,
     evaluate,
     measured_angle,
@@ -158,6 +160,9 @@ def _label(name: str, q: Mapping[str, Any]) -> str:
         if int(q.get("layer", 0)) > 0
         else (f"z = {float(q['z_m']) * 1e3:+.2f} mm" if "z_m" in q else "measured layers")
     )
+    if kind == SEPARATION:
+        a, b = (int(p["layer"]) for p in q["pair"])
+        return f"{name} (angle between the maxima at layers {a} and {b}, {cyc:g} cycles)"
     what = {
         "cylindricity": "cylindricity growth since new",
         "max_wear_angle": "angle of maximum wear",
@@ -186,6 +191,16 @@ def _measured(
     rep: xr.Dataset, name: str, q: Mapping[str, Any], reading: Reading
 ) -> tuple[float, Uncertainty]:
     """The measured value D and its u_D as compared (growth for a cylindricity)."""
+    if q["kind"] == SEPARATION:  # one file, one convention: its zero and direction cancel
+        (va, ua), (vb, ub) = (
+            (float(rep[p].values), float(rep[f"{p}_u"].values)) for p in q["names"]
+        )
+        d = abs(float(mt.wrap_angle_deg(va - vb)))
+        if not (np.isfinite(ua) and np.isfinite(ub)):
+            return d, unknown("the reported file states no uncertainty of one of the two angles")
+        return d, Uncertainty(
+            math.hypot(ua, ub), f"u = sqrt(u_a^2 + u_b^2) of {q['names'][0]}, {q['names'][1]}"
+        )
     d = float(rep[name].values)
     u = float(rep[f"{name}_u"].values)
     basis = f"reported file: {rep[f'{name}_u'].attrs.get('comment', '')}"
@@ -271,7 +286,7 @@ def _study_u_num(
 def _u_num(
     name: str, q, attrs, reading, s: float, cycles: float, studies, criteria: Criteria
 ) -> Uncertainty:
-    angle = q["kind"] == "max_wear_angle"
+    angle = q["kind"] in ("max_wear_angle", SEPARATION)
     for ds in studies:
         if ds.attrs.get("jointwear_file") == "verification_study":
             return _study_u_num(ds, name, q, attrs, reading, s, cycles)
@@ -283,7 +298,7 @@ def _u_num(
                 continue
             h, values = found
         values = np.asarray(values, dtype=float)
-        if angle:  # unwrap around the finest level's angle
+        if q["kind"] == "max_wear_angle":  # unwrap around the finest level's angle
             ref = values[np.nanargmin(np.where(np.isfinite(values), h, np.inf))]
             values = ref + mt.wrap_angle_deg(values - ref)
         dim = ds[name].dims[0] if name in ds.data_vars else _level_dim(ds)
@@ -306,7 +321,7 @@ def _u_num(
 def _u_input(
     q, attrs, reading, s: float, cycles: float, ens: Ensemble | None, criteria: Criteria
 ) -> Uncertainty:
-    angle = q["kind"] == "max_wear_angle"
+    angle = q["kind"] in ("max_wear_angle", SEPARATION)
     found = ens.field("wear_depth") if ens is not None else []
     parts = []
     for i, da in found:
@@ -331,7 +346,8 @@ def _u_input(
                     f"{ens.names[i]} was run for {run_cycles} cycles: the spread of an angle "
                     f"cannot be scaled to {cycles:g} cycles - run the ensemble to that number"
                 )
-            v = s + mt.wrap_angle_deg(v - s)
+            if q["kind"] == "max_wear_angle":
+                v = s + mt.wrap_angle_deg(v - s)
         parts.append((ens.names[i], v, cycles if same else run_cycles))
     if parts:
         return spread(parts, s, compared_cycles=None if angle else cycles)
@@ -427,6 +443,33 @@ def _combine(
     return all_rows, out
 
 
+def _separations(quantities: list[tuple[str, dict[str, Any]]]) -> list[tuple[str, dict[str, Any]]]:
+    """Derived quantities: the angle between the maxima of two reported layers, same cycles.
+
+    ``|wrap(theta_a - theta_b)|`` does not depend on where the angles' zero is, on their
+    direction, nor on which end of the bore layer 1 is at: it can be decided when those are
+    unstated.
+    """
+    angles = [
+        (n, q)
+        for n, q in quantities
+        if q["kind"] == "max_wear_angle" and int(q.get("layer", 0)) > 0 and q["cycles"] > 0
+    ]
+    out = []
+    for (na, qa), (nb, qb) in itertools.combinations(angles, 2):
+        if qa["cycles"] == qb["cycles"] and qa["layer"] != qb["layer"]:
+            q = {
+                "kind": SEPARATION,
+                "cycles": qa["cycles"],
+                "units": "degree",
+                "layer": 0,
+                "pair": (qa, qb),
+                "names": (na, nb),
+            }
+            out.append((f"angle_between_{na}_and_{nb}", q))
+    return out
+
+
 def reported_metrics(
     sim_wear: xr.Dataset | None,
     rep: xr.Dataset,
@@ -476,8 +519,9 @@ def reported_metrics(
             "matters to it, and its verdict stands only where they agree"
         )
     names = [str(n) for n, v in rep.data_vars.items() if "kind" in v.attrs]
-    for name in names:
-        q = {**rep[name].attrs, "units": rep[name].attrs["units"]}
+    quantities = [(n, {**rep[n].attrs, "units": rep[n].attrs["units"]}) for n in names]
+    quantities += _separations(quantities)
+    for name, q in quantities:
         label = _label(name, q)
         cycles = float(q["cycles"])
         why = ""
@@ -495,7 +539,7 @@ def reported_metrics(
             except BadInputError as exc:
                 why = f"the simulation cannot give it at {cycles:g} cycles: {exc}"
         if why:
-            d = float(rep[name].values)
+            d = _measured(rep, name, q, Reading("stated", ""))[0]
             rows.add(name, "value_sim", float("nan"), q["units"])
             rows.add(name, "value_meas", d, q["units"])
             decisions.append(

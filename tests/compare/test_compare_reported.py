@@ -35,20 +35,23 @@ def theta0(z):
     return 90.0 + 20.0 * np.asarray(z) * 1e3
 
 
-def field(z, theta, *, bump=0.0, rotate=0.0, scale=1.0):
+def field(z, theta, *, bump=0.0, rotate=0.0, scale=1.0, twist=20.0):
     z = np.asarray(z)[:, None]
     th = np.asarray(theta)[None, :]
     oval = E_OVAL if bump == 0 else 0.0  # the angle maps: taper and bump only (no shift)
     h = C_TAPER * (z + WIDTH / 2) + 0.5 * oval * (1 + np.cos(np.deg2rad(2 * (th - 30.0))))
-    d = (th - theta0(z) - rotate + 180.0) % 360.0 - 180.0
+    d = (th - (90.0 + twist * z * 1e3) - rotate + 180.0) % 360.0 - 180.0
     return scale * (h + bump * np.exp(-0.5 * (d / 20.0) ** 2))
 
 
-def sim_map(*, bump=0.0, rotate=0.0, scale=1.0, cycles=(1e5, 4e5, 1e6), n_layers=31):
+def sim_map(*, bump=0.0, rotate=0.0, scale=1.0, cycles=(1e5, 4e5, 1e6), n_layers=31, twist=20.0):
     z = np.linspace(-WIDTH / 2, WIDTH / 2, n_layers)
     theta = np.arange(360) * 1.0
     depth = np.stack(
-        [field(z, theta, bump=bump, rotate=rotate, scale=scale) * c / N_REF for c in cycles]
+        [
+            field(z, theta, bump=bump, rotate=rotate, scale=scale, twist=twist) * c / N_REF
+            for c in cycles
+        ]
     )
     ds = xr.Dataset(
         coords={
@@ -390,3 +393,51 @@ def test_unstated_stack_position_tried_along_the_bore():
     row = vv20(compare(sim, reported_dataset(data), criteria=STATED), "cyl")
     assert row.state == vd.NOT_COMPARABLE
     assert "layers.z_centre" in row.reason and "centred at z = +5.50 mm" in row.reason
+
+
+def twisted(twist, *, study=False):
+    """Ensemble with twists twist + (-0.5, 0, 0.5) degree/mm (separation over 4 mm: sd 2 degree),
+    or a study over h = 1, 2, 4 with twist + 0.125 h (separation converging like 0.5 h)."""
+    if study:
+        maps = [
+            sim_map(bump=20e-6, twist=twist + 0.125 * h, cycles=(N_REF,))["wear_depth"]
+            for h in (1, 2, 4)
+        ]
+        ds = xr.Dataset({"wear_depth": xr.concat(maps, dim="dn")})
+        return ds.assign_coords(dn=("dn", [1.0, 2.0, 4.0], {"units": "1", "long_name": "dN"}))
+    base = sim_map(bump=20e-6, cycles=(N_REF,))
+    members = [
+        sim_map(bump=20e-6, twist=twist + t, cycles=(N_REF,))["wear_depth"] for t in (-0.5, 0, 0.5)
+    ]
+    ens = xr.Dataset({"wear_depth": xr.concat(members, dim="run")})
+    ens = ens.assign_coords(run=np.arange(3), twist=("run", [twist - 0.5, twist, twist + 0.5]))
+    ens.attrs.update({"cycles": N_REF, "probabilistic_sample": "true"})
+    ens["wear_depth"].attrs = base["wear_depth"].attrs
+    return ens
+
+
+def test_angle_between_two_layers_needs_no_convention():
+    # layer 1 (z = +2 mm) at 130 degree, layer 5 (z = -2 mm) at 50 degree: 80 degree apart in
+    # any convention; the file states neither the direction nor the layer order
+    data = angle_file(130.0, direction="unstated")
+    data["layers"]["first"] = "unstated"
+    data["quantity"]["ang5"] = dict(data["quantity"]["ang"], value=50.0, layer=5)
+    rep = reported_dataset(data)
+    right = compare(
+        sim_map(bump=20e-6), rep, ensemble=twisted(20.0), verification=[twisted(20.0, study=True)]
+    )
+    assert vv20(right, "ang").state == vd.NOT_COMPARABLE  # each angle alone: readings disagree
+    sep = "angle_between_ang_and_ang5"
+    assert right.value(sep, "value_meas") == pytest.approx(80.0)
+    assert right.value(sep, "value_sim") == pytest.approx(80.0, abs=0.5)
+    assert vv20(right, sep).state == vd.PASS
+    # a model whose wear does not turn along the bore (10 degree/mm instead of 20): FAIL
+    wrong = compare(
+        sim_map(bump=20e-6, twist=10.0),
+        rep,
+        ensemble=twisted(10.0),
+        verification=[twisted(10.0, study=True)],
+    )
+    assert wrong.value(sep, "u_input") == pytest.approx(2.0, rel=0.05)
+    assert wrong.value(sep, "value_sim") == pytest.approx(40.0, abs=0.5)
+    assert vv20(wrong, sep).state == vd.FAIL
