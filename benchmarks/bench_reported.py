@@ -55,9 +55,43 @@ def band_sensitivity(out: Path) -> dict[str, dict[str, float]]:
     return table
 
 
+def card(result) -> list[dict]:
+    """Every decision as JSON-ready records."""
+    return [
+        {k: (str(v) if k != "passed" else bool(v)) for k, v in row.items()}
+        for row in result.decisions.to_dict("records")
+    ]
+
+
+def decided_with_studies(out: Path, studies: list[Path]) -> dict:
+    """The same comparison with u_num also from 'jointwear sim verify' studies."""
+    from jointwear import io
+    from jointwear.compare import as_ensemble, compare
+
+    sim, rep = io.load(out / "sim_wear.nc"), io.load(out / "reported.nc")
+    ens = as_ensemble([io.load(out / "ensemble.nc")], ["ensemble.nc"])
+    vers = [io.load(p, validate=False) for p in studies] + [io.load(out / "verification.nc")]
+    result = compare(sim, rep, ensemble=ens, verification=vers)
+    for line in card_lines(result):
+        print(line)
+    return {
+        "studies": [str(p) for p in studies],
+        "summary": result.summary(),
+        "decisions": card(result),
+        "metrics": [{**r, "value": float(r["value"])} for r in result.metrics.to_dict("records")],
+    }
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", type=Path, default=None, help="keep the files in this folder")
+    parser.add_argument(
+        "--verify-study",
+        type=Path,
+        action="append",
+        default=[],
+        help="a 'jointwear sim verify' study (repeatable): also decide with its u_num",
+    )
     args = parser.parse_args()
     with tempfile.TemporaryDirectory() as tmp:
         out = args.out or Path(tmp)
@@ -65,12 +99,10 @@ def main() -> None:
         result = run_reference_study(out, FULL, say=lambda s: print(s, flush=True))
         wall, cpu = time.perf_counter() - t0, time.process_time() - c0
         sensitivity = band_sensitivity(out)
+        with_studies = decided_with_studies(out, args.verify_study) if args.verify_study else None
     for line in card_lines(result):
         print(line)
-    decisions = [
-        {k: (str(v) if k != "passed" else bool(v)) for k, v in row.items()}
-        for row in result.decisions.to_dict("records")
-    ]
+    decisions = card(result)
     metrics = [{**row, "value": float(row["value"])} for row in result.metrics.to_dict("records")]
     write_results(
         "reported",
@@ -89,6 +121,7 @@ def main() -> None:
             "metrics": metrics,
             "wall_s": round(wall, 1),
             "cpu_s_main_process": round(cpu, 1),
+            "with_sim_verify_studies": with_studies,
         },
     )
 

@@ -17,6 +17,9 @@ states of :mod:`jointwear.compare.verdicts`:
   degree before it meets ``U_val``; the screening threshold shown when V&V 20 is not
   assessed is ``max_angle_error_deg`` of the criteria (never a verdict).
 * **maximum wear depth** at a layer or over the measured layers.
+* derived: the **angle between the maxima** of two reported layers at the same cycles,
+  ``|wrap(theta_a - theta_b)|``, which does not depend on the angles' zero, their direction or
+  the layer order (decidable when those are unstated); u_D = sqrt(u_a^2 + u_b^2).
 * ``kind = "other"``, a place outside the simulated bore, cycles beyond the simulation, the
   new bearing itself (0 cycles): *not comparable*, with the reason.
 
@@ -287,9 +290,14 @@ def _u_num(
     name: str, q, attrs, reading, s: float, cycles: float, studies, criteria: Criteria
 ) -> Uncertainty:
     angle = q["kind"] in ("max_wear_angle", SEPARATION)
+    skipped = []
     for ds in studies:
         if ds.attrs.get("jointwear_file") == "verification_study":
-            return _study_u_num(ds, name, q, attrs, reading, s, cycles)
+            u = _study_u_num(ds, name, q, attrs, reading, s, cycles)
+            if u.known or "was run for" not in u.basis:
+                return u
+            skipped.append(u)  # another study may be run to these cycles
+            continue
         if name in ds.data_vars and ds[name].ndim == 1 and ds[name].dims[0] in ds.coords:
             h, values = np.asarray(ds[ds[name].dims[0]].values, float), ds[name].values
         else:
@@ -312,6 +320,8 @@ def _u_num(
     if criteria.wear_u_num_rel is not None and not angle:
         rel = criteria.wear_u_num_rel
         return Uncertainty(rel * abs(s), f"user-stated {rel:.3g}·|S| (criteria wear_u_num_rel)")
+    if skipped:
+        return skipped[0]
     return unknown(
         "no verification study with this quantity or with a wear map per refinement level "
         "(--verification)" + ("" if angle else ", and the criteria state no wear_u_num_rel")
@@ -539,7 +549,11 @@ def reported_metrics(
             except BadInputError as exc:
                 why = f"the simulation cannot give it at {cycles:g} cycles: {exc}"
         if why:
-            d = _measured(rep, name, q, Reading("stated", ""))[0]
+            d = (
+                _measured(rep, name, q, Reading("stated", ""))[0]
+                if q["kind"] == SEPARATION
+                else float(rep[name].values)  # as reported (a baseline is not its own growth)
+            )
             rows.add(name, "value_sim", float("nan"), q["units"])
             rows.add(name, "value_meas", d, q["units"])
             decisions.append(

@@ -153,6 +153,7 @@ def test_cylindricity_new_bore_is_baseline_not_a_prediction():
     result = compare(sim_map(), reported_dataset(cyl_file()), criteria=STATED)
     row = vv20(result, "cyl_new")
     assert row.state == vd.NOT_COMPARABLE and "baseline" in row.reason
+    assert result.value("cyl_new", "value_meas") == pytest.approx(5e-6)  # as reported
 
 
 def test_cylindricity_without_new_bore_is_not_assessed():

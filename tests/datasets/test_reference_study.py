@@ -24,6 +24,8 @@ QUANTITIES = (
     "max_wear_angle_first_4e5",
     "max_wear_angle_first_1_2e6",
     "max_wear_angle_last_1_2e6",
+    # derived: the angle between the two layers' maxima, free of the unstated conventions
+    "angle_between_max_wear_angle_first_1_2e6_and_max_wear_angle_last_1_2e6",
 )
 
 
