@@ -283,7 +283,15 @@ def _study_u_num(
     fit = study_uncertainty(study, name, fn)
     if not fit.assessed:
         return unknown(f"verification study: {fit.reason}")
-    return Uncertainty(float(fit.u_num), "verification study: " + fit.describe())
+    # the compared simulation is one run: its u_num has the run-to-run scatter, not the
+    # standard error of the replicates' mean
+    u_run = float(getattr(fit, "u_num_run", float("nan")))
+    if not np.isfinite(u_run):
+        return unknown(
+            "the verification study does not give the uncertainty of a single run (replicate "
+            "counts unknown); the compared simulation is one run"
+        )
+    return Uncertainty(u_run, "verification study, u_num of one run: " + fit.describe())
 
 
 def _u_num(

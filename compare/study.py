@@ -5,7 +5,9 @@ A study (``jointwear_file = "verification_study"``, the contract with
 wear-update intervals ΔN and runs on a refined grid. The compared quantities are computed on the
 *measured band* of every stored map (each map aligned with the measurement exactly like the
 simulation), and :func:`jointwear.refinement.study_uncertainty` turns them into u_num (Eça &
-Hoekstra 2014: replicate statistics, the ΔN refinement, the grid term; k = 1).
+Hoekstra 2014: replicate statistics, the ΔN refinement, the grid term; k = 1). The compared
+simulation is one run, so its u_num is the study's ``u_num_run`` (the scatter of one run, not
+the standard error of the replicate mean).
 
 The study covers the wear-update interval, the cycle-to-cycle variability (replicates starting at
 different phases) and, when its grid term is assessed, the wear grid. A study run for another
@@ -124,8 +126,20 @@ def study_component(res: StudyResult, s: float, compared_cycles: float | None) -
     covers = STUDY_COVERS | ({GRID} if np.isfinite(getattr(fit, "u_grid", np.nan)) else set())
     if not fit.assessed:
         return Component(None, f"verification study (sim verify): {fit.reason}", covers)
-    u = float(fit.u_num)
-    note = f"verification study (sim verify, on the measured band): {fit.describe()}"
+    # the compared simulation is one run: its u_num has the scatter of one run (sd_run), not the
+    # standard error of the replicate mean
+    u = float(getattr(fit, "u_num_run", np.nan))
+    if not np.isfinite(u):
+        return Component(
+            None,
+            "verification study: the u_num of one run (u_num_run) is not available - the study "
+            "needs replicates at its finest level",
+            covers,
+        )
+    note = (
+        f"verification study (sim verify, on the measured band), u_num of one run = "
+        f"{u:.3g} (sd_run {fit.sd_run:.3g}; the mean's: {fit.describe()})"
+    )
     same = compared_cycles is None or np.isclose(res.cycles, compared_cycles, rtol=1e-6)
     if not same:
         if not (np.isfinite(res.cycles) and fit.value):

@@ -112,7 +112,14 @@ class RefinementFit:
     u_stat, u_refinement, u_grid, u_num : float
         Standard uncertainties (k = 1, absolute) [unit]: statistical, refinement (U_phi / 2),
         grid (NaN when not included) and their root sum of squares (the grid term included
-        only when it is finite; see ``reason``).
+        only when it is finite; see ``reason``). They are the uncertainty of ``value``, the
+        *mean* of the finest level's replicates.
+    sd_run : float
+        Standard deviation of a single run at the finest level (replicate scatter) [unit]; 0
+        for deterministic solutions, NaN when the replicate counts are not known.
+    u_num_run : float
+        u_num of a *single* run at the finest level (what a comparison of one simulated run
+        needs): ``sqrt(sd_run^2 + u_refinement^2 + u_grid^2)`` [unit].
     """
 
     quantity: str
@@ -131,6 +138,8 @@ class RefinementFit:
     u_refinement: float
     u_grid: float
     u_num: float
+    sd_run: float = _NAN
+    u_num_run: float = _NAN
 
     def describe(self) -> str:
         """One line for the report: value, u_num and its parts, or why it is not assessed."""
@@ -161,9 +170,11 @@ class RefinementFit:
                 reason=note or "the grid term is not assessed",
                 u_grid=_NAN,
                 u_num=_NAN,
+                u_num_run=_NAN,
             )
         u = math.sqrt(self.u_stat**2 + self.u_refinement**2 + u_grid**2)
-        return replace(self, u_grid=float(u_grid), u_num=u, reason=note)
+        u_run = math.sqrt(self.sd_run**2 + self.u_refinement**2 + u_grid**2)
+        return replace(self, u_grid=float(u_grid), u_num=u, u_num_run=u_run, reason=note)
 
 
 @dataclass(frozen=True)
@@ -335,6 +346,7 @@ def eca_hoekstra(
     formal_order: float = 1.0,
     quantity: str = "quantity",
     resolution: float = 0.0,
+    counts: Sequence[int] | None = None,
 ) -> RefinementFit:
     """Numerical uncertainty of the finest level by the least-squares procedure of Eça & Hoekstra.
 
@@ -361,6 +373,8 @@ def eca_hoekstra(
         moves from grid point to grid point) [unit]; 0 for a continuous quantity. Identical
         solutions at every level then mean "no change within one step":
         ``u_refinement = resolution / sqrt(12)`` (uniform over one step) instead of *inert*.
+    counts : sequence of int, optional
+        Replicates per level (gives ``sd_run = s_1 sqrt(n_1)`` and ``u_num_run``).
 
     Returns
     -------
@@ -378,11 +392,29 @@ def eca_hoekstra(
     if not (isinstance(formal_order, (int, float)) and formal_order > 0):
         raise BadInputError(f"formal_order must be > 0, got {formal_order!r}")
     h_arr, m_arr, s_arr = _check(h, means, sems, quantity)
+    n_arr = np.full(h_arr.shape, np.nan)
+    if counts is not None:
+        n_arr = np.asarray(counts, dtype=float)[np.argsort(np.asarray(h, dtype=float))]
     deterministic = sems is None
     keep = np.isfinite(m_arr) & (deterministic | np.isfinite(s_arr))
+    if not keep[0]:
+        return _not_assessed(
+            quantity,
+            f"the finest level (h = {h_arr[0]:g}) has no value or standard error (its runs "
+            "failed or fewer than two succeeded): the uncertainty would be that of another level",
+            h_arr,
+            m_arr,
+            s_arr,
+        )
     dropped = int(np.sum(~keep))
-    h_arr, m_arr, s_arr = h_arr[keep], m_arr[keep], s_arr[keep]
-    note = f"{dropped} level(s) without a value left out" if dropped else ""
+    h_arr, m_arr, s_arr, n_arr = h_arr[keep], m_arr[keep], s_arr[keep], n_arr[keep]
+    sd_run = 0.0 if deterministic else (float(s_arr[0] * np.sqrt(n_arr[0])) if len(s_arr) else _NAN)
+    note = (
+        f"{dropped} level(s) without a value (or, with replicates, a standard error: fewer than "
+        "two runs ok) left out"
+        if dropped
+        else ""
+    )
     if h_arr.size < 4:
         return _not_assessed(
             quantity,
@@ -414,6 +446,8 @@ def eca_hoekstra(
             u_ref,
             _NAN,
             math.hypot(u_stat, u_ref),
+            sd_run,
+            math.hypot(sd_run, u_ref),
         )
     if np.ptp(m_arr) == 0:
         return _not_assessed(
@@ -487,6 +521,8 @@ def eca_hoekstra(
         u_ref,
         _NAN,
         math.sqrt(u_stat**2 + u_ref**2),
+        sd_run,
+        math.sqrt(sd_run**2 + u_ref**2),
     )
 
 
@@ -637,7 +673,7 @@ def study_uncertainty(
         res = float(study["quantity_resolution"].sel(quantity=quantity))
         resolution = res if math.isfinite(res) and res > 0 else 0.0
     lv, gv = _replicate_values(study, quantity, fn)
-    mean, sem, _ = level_statistics(lv, period=period)
+    mean, sem, count = level_statistics(lv, period=period)
     h = np.asarray(study["h"].values, dtype=float)
     if period:
         mean = _unwrap_levels(mean, h, period)
@@ -648,6 +684,7 @@ def study_uncertainty(
         formal_order=float(study.attrs.get("formal_order", 1.0)),
         quantity=quantity,
         resolution=resolution,
+        counts=count,
     )
     if gv.size == 0:
         return fit.with_grid(_NAN, "the study has no grid runs: the grid term is not assessed")

@@ -35,6 +35,7 @@ from jointwear import io
 from jointwear.errors import JointwearError, ValidationFailed
 from jointwear.reports.demo_studies import (
     ENSEMBLE_INPUTS,
+    main_wear_settings,
     motion_verification,
     run_ensemble,
     wear_verification,
@@ -64,18 +65,14 @@ class DemoSize:
     motion_cycles: float
     rig_size: tuple[int, int] | None  # stereo footage (width, height) [px]; None = no footage
     rig_duration: float  # recorded time [s]
+    verification_replicates: int  # runs per dN level of the verification study (0: none)
     ensemble_runs: int = 0  # members of the input-uncertainty ensemble (0: none)
     ensemble_cycles: float = 0.0  # wear cycles of each member (reduced)
     ensemble_updates: int = 4  # fixed wear updates per member
-    verify_levels: tuple[int, ...] = ()  # ΔN levels of the sim verify study (empty: none)
-    verify_cycles: float = 0.0  # wear cycles of every study run (reduced)
-    verify_replicates: int = 2  # runs per level (start phases) and on the refined grid
 
 
-FULL = DemoSize(
-    2e5, (2e5,), 10, 90, 18000, 1.5, (640, 512), 0.6, 8, 5e4, 4, (2500, 5000, 10000, 20000), 5e4
-)
-QUICK = DemoSize(5e4, (5e4,), 8, 72, 3600, 1.2, None, 0.0)
+FULL = DemoSize(2e5, (2e5,), 10, 90, 18000, 1.5, (640, 512), 0.6, 3, 8, 5e4, 4)
+QUICK = DemoSize(5e4, (5e4,), 8, 72, 3600, 1.2, None, 0.0, 0)
 
 
 def _say(msg: str) -> None:
@@ -92,7 +89,7 @@ def _available(module: str, *names: str) -> bool:
     return all(hasattr(mod, n) for n in names)
 
 
-def _simulate(folder: Path, size: DemoSize) -> tuple[Path, Path, Any, list[Path]]:
+def _simulate(folder: Path, size: DemoSize) -> tuple[Path, Path, Any, list[Path], float]:
     from jointwear.params import replace_nested
     from jointwear.sim import PARAMETER_SETS, run_cycles, simulate_wear
 
@@ -101,7 +98,12 @@ def _simulate(folder: Path, size: DemoSize) -> tuple[Path, Path, Any, list[Path]
         **{"joint.n_layers": size.n_layers, "joint.n_points": size.n_points},
     )
     t0 = time.perf_counter()
-    wear = simulate_wear(params, cycles=size.cycles, snapshots=list(size.snapshots))
+    wear = simulate_wear(
+        params,
+        cycles=size.cycles,
+        snapshots=list(size.snapshots),
+        settings=main_wear_settings(size),
+    )
     wear.attrs["data_origin"] = "simulated"
     sim_wear = io.save(
         wear,
@@ -138,35 +140,26 @@ def _simulate(folder: Path, size: DemoSize) -> tuple[Path, Path, Any, list[Path]
     _say(
         f"  simulated motion: {size.motion_cycles:g} crank cycles ({time.perf_counter() - t0:.0f} s)"
     )
-    paths: list[Path] = []
-    if size.verify_levels:
+    verification_paths: list[Path] = []
+    if size.verification_replicates:
         from jointwear.compare import numerical_uncertainty
         from jointwear.refinement import describe_study
 
         t0 = time.perf_counter()
-        study = wear_verification(params, size, folder / "sim_verify.nc")
-        paths.append(folder / "sim_verify.nc")
-        _say(
-            f"  verification study of the wear, jointwear sim verify ({time.perf_counter() - t0:.0f} s):"
-        )
-        for line in describe_study(study).splitlines():
-            _say(f"      {line}")
-        t0 = time.perf_counter()
+        study_path, study = wear_verification(params, size, folder)
         ver = motion_verification(params, size, motion)
-        paths.append(
-            io.save(
-                ver,
-                folder / "sim_verification_motion.nc",
-                parameters={"simulation": params, "solver_rtols": list(ver["solver_rtol"].values)},
-                source="jointwear (sim.dynamics) via jointwear demo",
-            )
+        motion_path = io.save(
+            ver,
+            folder / "sim_verification_motion.nc",
+            parameters={"simulation": params, "solver_rtols": list(ver["solver_rtol"].values)},
+            source="jointwear (sim.dynamics) via jointwear demo",
         )
-        _say(
-            f"  verification of the motion with the solver tolerance ({time.perf_counter() - t0:.0f} s):"
-        )
+        verification_paths = [study_path, motion_path]
+        _say(f"  verification studies ({time.perf_counter() - t0:.0f} s):")
+        _say("      " + describe_study(study).replace("\n", "\n      "))
         for g in numerical_uncertainty(ver).values():
             _say(f"      {g.describe()}")
-    return sim_wear, sim_motion, params, paths
+    return sim_wear, sim_motion, params, verification_paths, 0.0
 
 
 def measured_wear_function(sim_wear: xr.Dataset) -> Any:
@@ -395,7 +388,7 @@ def run_demo(out: Path, *, quick: bool = False) -> Path:
     params = None
     _phase(1, "simulating the reference mechanism: wear and motion")
     if _available("jointwear.sim", "simulate_wear", "run_cycles", "PARAMETER_SETS"):
-        sim_wear_path, sim_motion_path, params, verification_paths = _simulate(out, size)
+        sim_wear_path, sim_motion_path, params, verification_paths, _ = _simulate(out, size)
         sims += [sim_wear_path, sim_motion_path]
         if not verification_paths:
             missing.append(
@@ -496,8 +489,9 @@ def run_demo(out: Path, *, quick: bool = False) -> Path:
     inputs += [ReportInput(role, p, d) for (role, p), d in zip(meas, meas_ds, strict=True)]
     if ensemble_path is not None:
         inputs.append(ReportInput("ensemble", ensemble_path, ens_ds[0]))
-    for p, d in zip(verification_paths, ver_ds, strict=True):
-        inputs.append(ReportInput("verification", p, d))
+    inputs += [
+        ReportInput("verification", p, d) for p, d in zip(verification_paths, ver_ds, strict=True)
+    ]
     report = build_report(
         result,
         out / "report.html",

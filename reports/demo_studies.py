@@ -10,14 +10,15 @@ import xarray as xr
 from jointwear.errors import JointwearError
 
 if TYPE_CHECKING:
-    from pathlib import Path
-
     from jointwear.reports.demo import DemoSize
 
 __all__ = [
+    "DEMO_STUDY_UPDATES",
     "ENSEMBLE_INPUTS",
     "MOTION_RTOLS",
+    "demo_study",
     "ensemble_spec",
+    "main_wear_settings",
     "motion_verification",
     "run_ensemble",
     "wear_verification",
@@ -30,26 +31,65 @@ def _say(msg: str) -> None:
     typer.echo(msg, err=True)
 
 
-def wear_verification(params: Any, size: DemoSize, path: Path) -> xr.Dataset:
-    """The verification study of the wear simulation: ``jointwear sim verify`` (the library).
+#: The demo's verification study: ΔN levels as a fraction of the demo's cycles, replicates per
+#: level and runs on the grid refined 2x (a reduced :meth:`jointwear.sim.VerifySpec.default`).
+DEMO_STUDY_UPDATES = 40  # updates of the finest level
+DEMO_STUDY_GRID_REPLICATES = 2
 
-    :func:`jointwear.sim.verify_wear` runs replicates at :attr:`DemoSize.verify_levels`
-    wear-update intervals ΔN and runs on the grid refined 2x, for
-    :attr:`DemoSize.verify_cycles` cycles (reduced: :func:`jointwear.compare.compare` applies
-    its relative u_num to the compared run), and writes the study file ``path``. compare
-    computes every wear criterion on the measured band of each stored run and turns it into
-    u_num (Eça & Hoekstra 2014, :mod:`jointwear.refinement`).
+
+def demo_study(size: DemoSize) -> Any:
+    """The demo's verification study (``jointwear sim verify`` spec) at demo size.
+
+    ΔN = cycles/40 x (1, 2, 4, 8), ``size.verification_replicates`` runs per level starting at
+    different phases of the motion, and 2 runs on the grid refined 2x at the finest ΔN.
     """
-    from jointwear.sim import VerifySpec, verify_wear
+    from jointwear.sim import VerifySpec
 
-    spec = VerifySpec(
-        cycles=size.verify_cycles,
-        levels=size.verify_levels,
-        replicates=size.verify_replicates,
-        grid=2,
-        grid_replicates=size.verify_replicates,
+    finest = max(1, round(size.cycles / DEMO_STUDY_UPDATES))
+    return VerifySpec(
+        cycles=size.cycles,
+        levels=tuple(finest * 2**k for k in range(4)),
+        replicates=size.verification_replicates,
+        grid_replicates=DEMO_STUDY_GRID_REPLICATES,
     )
-    return verify_wear(params, spec=spec, workers=0, out=path)
+
+
+def main_wear_settings(size: DemoSize) -> Any:
+    """Wear settings of the demo's compared wear run.
+
+    With a verification study the compared run is the verified configuration: the fixed update
+    scheme at the study's finest ΔN (replicate 0 of its finest level), so the study's
+    ``u_num_run`` is its numerical uncertainty. Without one (``--quick``): the default adaptive
+    scheme.
+    """
+    from jointwear.sim import WearSettings
+
+    if not size.verification_replicates:
+        return WearSettings()
+    return WearSettings(scheme="fixed", dn=demo_study(size).levels[0])
+
+
+def wear_verification(params: Any, size: DemoSize, folder: Any) -> tuple[Any, xr.Dataset]:
+    """The demo's verification study of the simulated wear (:func:`jointwear.sim.verify_wear`).
+
+    Replicates at four wear-update intervals ΔN and runs on the next grid (:func:`demo_study`),
+    in this process; :func:`jointwear.refinement.study_uncertainty` turns the study into u_num of
+    any wear quantity (Eça & Hoekstra 2014 on the replicate means, plus the grid term), so max
+    depth, volume and cylindricity are assessed with a value (the earlier refinement of the
+    adaptive update's ``tol`` was inert: the noise floor, not ``tol``, set the interval).
+
+    Returns
+    -------
+    (Path, Dataset)
+        The study file ``sim_verification.nc`` in ``folder`` and the study.
+    """
+    from pathlib import Path
+
+    from jointwear.sim import verify_wear
+
+    path = Path(folder) / "sim_verification.nc"
+    study = verify_wear(params, spec=demo_study(size), workers=0, out=path)
+    return path, study
 
 
 #: solver tolerances of the motion verification study (the default 1e-6 is the finest)

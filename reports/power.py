@@ -240,7 +240,12 @@ def run_power(
         say(f"wrong models ({time.perf_counter() - t0:.0f} s)")
         crit = Criteria()
         right, turned, wrong_out = [], [], {name: [] for name in WRONG_MODELS}
+        coverage: list[dict[str, float]] = []
         for r, m in enumerate(meas):
+            # the measurement against its own truth: E is the measurement error, to be set
+            # against u_D (coverage of the measured map's stated uncertainty)
+            own = _outcome(compare(truth, m, ensemble=[ens[None]], criteria=crit))["budget"]
+            coverage.append({q: b["E"] / b["u_D"] for q, b in own.items() if b.get("u_D")})
             tol = size.tolerances[r % len(size.tolerances)]
             model = _simulate(size, {}, tol)
             c = compare(model, m, ensemble=[ens[None]], criteria=crit)
@@ -270,6 +275,14 @@ def run_power(
                 ),
             }
             for name, outs in wrong_out.items()
+        },
+        "measurement_error_over_u_D": {
+            "definition": "(truth - D) / u_D of each band quantity, per noise replicate; the "
+            "truth's own band value on the common grid",
+            "replicates": coverage,
+            "max_abs": {q: max(abs(c[q]) for c in coverage) for q in coverage[0]}
+            if coverage
+            else {},
         },
         "turned_180": {
             "exit_codes": [o["exit_code"] for o in turned],

@@ -8,6 +8,7 @@ from typing import Annotated, Any
 import typer
 
 from jointwear._cli import Overwrite
+from jointwear.sim.cli_sweep import Progress, Resume, Scheduler, Workers
 
 __all__ = ["register"]
 
@@ -38,30 +39,18 @@ def register(app: typer.Typer) -> None:
                 "default the zhang2023 set.",
             ),
         ] = None,
-        workers: Annotated[
-            int | None,
-            typer.Option(
-                "--workers",
-                help="Local dask worker processes, one thread each (default: one per core; "
-                "0 = in this process, no dask).",
-            ),
-        ] = None,
-        scheduler: Annotated[
+        workers: Workers = None,
+        scheduler: Scheduler = None,
+        resume: Resume = False,
+        band_mm: Annotated[
             str | None,
             typer.Option(
-                "--scheduler", help="Address of a running dask scheduler, e.g. tcp://host:8786."
+                "--band-mm",
+                help="Axial band LO,HI [mm] (e.g. what the measurement covers): adds the "
+                "maximum depth, volume and cylindricity within it as quantities.",
             ),
         ] = None,
-        resume: Annotated[
-            bool,
-            typer.Option(
-                "--resume", help="Continue an interrupted study: compute only the missing runs."
-            ),
-        ] = False,
-        progress: Annotated[
-            bool | None,
-            typer.Option("--progress/--no-progress", help="Progress bar (default: on a terminal)."),
-        ] = None,
+        progress: Progress = None,
         overwrite: Overwrite = False,
     ) -> None:
         """Estimate u_num of a wear run: replicates at >= 4 update intervals dN and a grid run.
@@ -77,6 +66,15 @@ def register(app: typer.Typer) -> None:
 
         if scheduler is not None and workers is not None:
             raise BadInputError("give --workers or --scheduler, not both")
+        band = None
+        if band_mm is not None:
+            try:
+                lo, hi = (1e-3 * float(v) for v in band_mm.split(","))
+            except ValueError:
+                raise BadInputError(
+                    f"--band-mm {band_mm!r}: expected LO,HI in mm, e.g. -6,6"
+                ) from None
+            band = (lo, hi)
         if spec is None and cycles is None:
             raise BadInputError("the default study needs --cycles N (or give a SPEC.toml)")
         with progress_bar("verify", total=None, enabled=progress) as bar:
@@ -96,6 +94,7 @@ def register(app: typer.Typer) -> None:
                 spec=spec,
                 workers=workers,
                 scheduler=scheduler,
+                band=band,
                 out=out,
                 resume=resume,
                 on_progress=on_progress,

@@ -22,7 +22,6 @@ import dataclasses
 import hashlib
 import json
 import math
-import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -33,7 +32,14 @@ import xarray as xr
 
 from jointwear.errors import BadInputError, ParameterError
 
-__all__ = ["VerifySpec", "read_verify_spec", "verify_wear", "study_dataset", "QUANTITIES"]
+__all__ = [
+    "VerifySpec",
+    "read_verify_spec",
+    "verify_wear",
+    "study_dataset",
+    "band_quantities",
+    "QUANTITIES",
+]
 
 #: Quantities of the study: sweep output name -> circular period (None: linear quantity).
 QUANTITIES: dict[str, float | None] = {
@@ -228,57 +234,6 @@ def _digest(record: Mapping[str, Any]) -> str:
     return hashlib.sha256(json.dumps(record, sort_keys=True, default=str).encode()).hexdigest()
 
 
-def _execute(tasks, values, *, out, digest, record, resume, workers, scheduler, on_progress):
-    """Run the tasks through the sweep's part store and executor; (results, lost, executor)."""
-    from jointwear import io
-    from jointwear.sim._sweep_store import PartStore
-    from jointwear.sim.sweep import execute_runs
-
-    store = None
-    if out is not None:
-        io.check_writable(out, what="--out")
-        store = PartStore(out, digest, record, resume=resume)
-    results: dict[int, Any] = {}
-    lost: dict[int, str] = {}
-    state = {"done": 0, "failed": 0, "total": len(tasks), "computed": 0, "executor": ""}
-    try:
-        if store is not None:
-            results = store.load(values)
-        state["done"] = len(results)
-        state["resumed"] = len(results)
-        state["failed"] = sum(r.status == "failed" for r in results.values())
-        state["started"] = time.monotonic()
-
-        def started(what: str) -> None:
-            state["executor"] = what
-            if on_progress:
-                on_progress(dict(state))
-
-        def got(res: Any) -> None:
-            if store is not None:
-                store.write(res, values[res.index])
-            results[res.index] = res
-            state["done"] += 1
-            state["computed"] += 1
-            state["failed"] += res.status == "failed"
-            if on_progress:
-                on_progress(dict(state))
-
-        execute_runs(
-            [t for t in tasks if t.index not in results],
-            workers=workers,
-            scheduler=scheduler,
-            on_result=got,
-            on_lost=lambda i, why: lost.__setitem__(i, why),
-            on_start=started,
-        )
-    except BaseException:
-        if store is not None:
-            store.close(remove=False)
-        raise
-    return results, lost, state, store
-
-
 def verify_wear(
     params: Any = None,
     *,
@@ -287,6 +242,7 @@ def verify_wear(
     levels: Sequence[int] | None = None,
     replicates: int | None = None,
     grid: int | None = None,
+    band: tuple[float, float] | None = None,
     wear: Any = None,
     workers: int | None = None,
     scheduler: str | None = None,
@@ -306,6 +262,9 @@ def verify_wear(
         The study (``[verify]`` table, docs/sim-wear.md); default :meth:`VerifySpec.default`.
     levels, replicates, grid : optional
         Override the spec's ΔN levels [cycles], replicates per level, grid refinement factor.
+    band : (z_min, z_max), optional
+        Axial band [m] whose maximum depth, volume and cylindricity are added as quantities
+        (:func:`study_dataset`).
     wear : WearSettings, optional
         Base wear settings (kw, settling); the scheme is set to ``"fixed"`` with each level's ΔN.
     workers, scheduler :
@@ -332,7 +291,7 @@ def verify_wear(
     from jointwear._version import __version__
     from jointwear.sim._sweep_params import apply_values
     from jointwear.sim._sweep_run import RunTask
-    from jointwear.sim.sweep import _already_complete, _base
+    from jointwear.sim.sweep import _already_complete, _base, run_and_save
 
     if workers is not None and workers < 0:
         raise BadInputError(f"workers must be >= 0, got {workers}")
@@ -363,7 +322,17 @@ def verify_wear(
     sweep = _sweep_spec(vspec, values, base_wear)
     for row in {tuple(r) for r in values}:  # refuse impossible runs before starting any
         apply_values(sim, base_wear, dict(zip(_COLUMNS, row, strict=True)))
-    record = {"study": vspec.describe(), "base": base_record}
+    if band is not None:
+        band = (float(band[0]), float(band[1]))
+        _band_units(band)  # refuse a bad band before any run
+        z = np.asarray(_grid_coords(sim)["z"].values)
+        if np.sum((z >= band[0]) & (z <= band[1])) < 2:
+            raise BadInputError(
+                f"band {1e3 * band[0]:g} .. {1e3 * band[1]:g} mm holds fewer than two layers of "
+                f"the wear grid (z = {1e3 * z.min():g} .. {1e3 * z.max():g} mm, "
+                f"{z.size} layers); it needs two or more (widen it)"
+            )
+    record = {"study": vspec.describe(), "base": base_record, "band_m": band}
     digest = _digest(record)
     tasks = [
         RunTask(
@@ -371,13 +340,22 @@ def verify_wear(
         )
         for i in range(len(values))
     ]
+    # the longest runs first, so that no worker is left with a long run at the end
+    tasks.sort(key=lambda t: -_relative_cost(values[t.index], values[0]))
     if resume and _already_complete(out, digest):
         ds = io.load(out)
         ds.attrs.update(runs_computed_now=0, executor="none (all runs resumed)")
         return ds
-    results, lost, state, store = _execute(
+
+    def build(results: dict[int, Any], lost: dict[int, str]) -> xr.Dataset:
+        ds = study_dataset(vspec, sim, values, where, results, lost, band=band)
+        ds.attrs["parameters_json"] = json.dumps(base_record, sort_keys=True)
+        return ds
+
+    return run_and_save(
         tasks,
         values,
+        build,
         out=out,
         digest=digest,
         record=record,
@@ -385,32 +363,16 @@ def verify_wear(
         workers=workers,
         scheduler=scheduler,
         on_progress=on_progress,
+        inputs=[*spec_file, *inputs],
+        source=f"jointwear {__version__} (sim.verification)",
     )
-    finished = False
-    try:
-        ds = study_dataset(vspec, sim, values, where, results, lost)
-        ds.attrs.update(
-            {
-                "sweep_digest": digest,  # the sweep's resume check reads it
-                "runs_computed_now": state["computed"],
-                "runs_resumed": state.get("resumed", 0),
-                "executor": state["executor"] or "none (all runs resumed)",
-                "parameters_json": json.dumps(base_record, sort_keys=True),
-            }
-        )
-        if out is not None:
-            io.save(
-                ds,
-                out,
-                inputs=[*spec_file, *inputs],
-                parameters=record,
-                source=f"jointwear {__version__} (sim.verification)",
-            )
-            finished = not lost
-    finally:
-        if store is not None:
-            store.close(remove=finished)
-    return ds
+
+
+def _relative_cost(row: np.ndarray, base: np.ndarray) -> float:
+    """Relative cost of a run: its updates, times (grid points)^0.4 (measured: a 4x finer grid
+    costs 1.7x per cycle, benchmarks/results/sim_cycle.json)."""
+    points = row[2] * row[3] / (base[2] * base[3])
+    return float(points**0.4 / row[0])
 
 
 class _WearKind:
@@ -450,6 +412,8 @@ def study_dataset(
     where: Sequence[tuple],
     results: Mapping[int, Any],
     lost: Mapping[int, str] | None = None,
+    *,
+    band: tuple[float, float] | None = None,
 ) -> xr.Dataset:
     """The study Dataset from the runs' results, with the u_num of every quantity.
 
@@ -467,12 +431,20 @@ def study_dataset(
         ``status``, ``outputs`` (:data:`QUANTITIES`), ``fields["wear_depth"]`` (z, theta) [m].
     lost : mapping, optional
         Runs a cluster lost (index -> reason); they count as not run.
+    band : (z_min, z_max), optional
+        Axial band [m] (e.g. what the measurement covers): adds the quantities
+        ``max_wear_depth_in_band``, ``worn_volume_in_band`` and ``cylindricity_in_band``,
+        computed from every run's final wear map within it.
     """
     from jointwear.params import replace_nested
     from jointwear.refinement import COVERAGE_K
 
     lost = dict(lost or {})
-    nq, nlev, nrep, ng = len(QUANTITIES), len(spec.levels), spec.replicates, spec.grid_replicates
+    units = _units()
+    band_units = _band_units(band) if band is not None else {}
+    qnames = [*QUANTITIES, *band_units]
+    units.update(band_units)
+    nq, nlev, nrep, ng = len(qnames), len(spec.levels), spec.replicates, spec.grid_replicates
     fine = replace_nested(
         sim,
         **{
@@ -496,8 +468,16 @@ def study_dataset(
         errors[i] = res.error
         if res.status != "ok":
             continue
-        out = np.array([res.outputs.get(q, np.nan) for q in QUANTITIES], dtype=float)
         depth = res.fields.get("wear_depth")
+        outputs = dict(res.outputs)
+        if band is not None and depth is not None:
+            sfx = "" if kind == "level" else "_grid"
+            outputs.update(
+                band_quantities(
+                    depth, coords["z" + sfx], coords["theta" + sfx], band, sim.joint.bearing_radius
+                )
+            )
+        out = np.array([outputs.get(q, np.nan) for q in qnames], dtype=float)
         if kind == "level":
             rv[:, lev, rep] = out
             if depth is not None:
@@ -506,8 +486,6 @@ def study_dataset(
             gv[:, rep] = out
             if depth is not None:
                 gmaps[rep] = depth
-    units = _units()
-    qnames = list(QUANTITIES)
     coords.update(
         {
             "level": xr.Variable("level", np.arange(nlev), {"units": "1", "long_name": "ΔN level"}),
@@ -561,7 +539,7 @@ def study_dataset(
     ds["quantity_long_name"].attrs = {"units": "1", "long_name": "meaning of each quantity"}
     ds["quantity_period"] = (
         "quantity",
-        np.array([QUANTITIES[q] or np.nan for q in qnames]),
+        np.array([QUANTITIES.get(q) or np.nan for q in qnames]),
         {"units": "1", "long_name": "period of a circular quantity (NaN: not circular)"},
     )
     step = {
@@ -613,6 +591,7 @@ def study_dataset(
             "grid_n_layers": int(fine.joint.n_layers),
             "grid_n_points": int(fine.joint.n_points),
             "study_spec": json.dumps(spec.describe(), sort_keys=True),
+            **({"band_z_m": [float(band[0]), float(band[1])]} if band is not None else {}),
             "n_runs": len(where),
             "n_ok": int(np.sum(status == 0)),
             "n_failed": int(np.sum(status == 1)),
@@ -623,6 +602,64 @@ def study_dataset(
         }
     )
     return _add_fits(ds, units)
+
+
+def _band_units(band: tuple[float, float]) -> dict[str, tuple[str, str]]:
+    lo, hi = band
+    if not (math.isfinite(lo) and math.isfinite(hi) and lo < hi):
+        raise BadInputError(f"band = {band!r}: expected (z_min, z_max) [m] with z_min < z_max")
+    where = f"within the axial band z = {1e3 * lo:g} .. {1e3 * hi:g} mm"
+    return {
+        "max_wear_depth_in_band": ("m", f"largest wear depth {where}"),
+        "worn_volume_in_band": ("m3", f"worn volume {where} (trapezoid in z)"),
+        "cylindricity_in_band": ("m", f"cylindricity (minimum zone) of the worn bore {where}"),
+    }
+
+
+def band_quantities(
+    depth: np.ndarray,
+    z: xr.DataArray,
+    theta: xr.DataArray,
+    band: tuple[float, float],
+    radius: float,
+) -> dict[str, float]:
+    """Maximum depth [m], volume [m³] and cylindricity [m] of a wear map within an axial band.
+
+    Parameters
+    ----------
+    depth : ndarray (z, theta)
+        Final wear map [m].
+    z, theta : DataArray
+        Its coordinates [m], [degree] (with their convention attributes).
+    band : (z_min, z_max)
+        The band [m]; at least two layers must lie in it.
+    radius : float
+        Bore radius [m].
+    """
+    from jointwear.sim.wearmap import bore_cylindricity, bore_radius
+
+    zv = np.asarray(z.values, dtype=float)
+    inside = (zv >= band[0]) & (zv <= band[1])
+    if inside.sum() < 2:
+        raise BadInputError(
+            f"band {1e3 * band[0]:g} .. {1e3 * band[1]:g} mm holds {int(inside.sum())} layer(s) "
+            "of the wear grid; it needs two or more (widen it)"
+        )
+    h = np.asarray(depth, dtype=float)[inside]
+    ring = h.sum(axis=1) * radius * 2 * np.pi / h.shape[1]  # wear area of each layer's ring
+    wear = xr.DataArray(
+        h,
+        dims=("z", "theta"),
+        coords={
+            "z": ("z", zv[inside], dict(z.attrs)),
+            "theta": ("theta", np.asarray(theta.values), dict(theta.attrs)),
+        },
+    )
+    return {
+        "max_wear_depth_in_band": float(h.max()),
+        "worn_volume_in_band": float(np.trapezoid(ring, zv[inside])),
+        "cylindricity_in_band": bore_cylindricity(bore_radius(wear, radius)),
+    }
 
 
 def _add_fits(ds: xr.Dataset, units: Mapping[str, tuple[str, str]]) -> xr.Dataset:
@@ -657,6 +694,12 @@ def _add_fits(ds: xr.Dataset, units: Mapping[str, tuple[str, str]]) -> xr.Datase
         ("u_stat", "statistical part: standard error of the finest level's mean"),
         ("u_refinement", "refinement part: Eça-Hoekstra U_phi / 2"),
         ("u_grid", "grid part: Roache two-grid estimate from the runs on the next grid"),
+        (
+            "u_num_run",
+            "numerical uncertainty of ONE run at the finest level: sqrt(sd_run^2 + "
+            "u_refinement^2 + u_grid^2) (u_num is that of the finest level's mean, value)",
+        ),
+        ("sd_run", "standard deviation of one run at the finest level (replicate scatter)"),
     ):
         ds[name] = (
             "quantity",

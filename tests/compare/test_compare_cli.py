@@ -105,6 +105,14 @@ def test_compare_cli_exit_codes(files, tmp_path, capsys):
     text = capsys.readouterr().out
     assert "not assessed (an uncertainty is unknown" in text
     assert "validation domain: the wear criteria are decided within z = −6…+6 mm only" in text
+    # the criteria file's switch restores the strict rule: the narrow scan is not comparable
+    strict = tmp_path / "strict.toml"
+    strict.write_text("[criteria]\nstrict_coverage = true\n")
+    assert main([*undecided, "--criteria", str(strict)]) == 0
+    assert "not comparable (the data do not cover it): wear map shape" in capsys.readouterr().out
+    strict.write_text("[criteria]\nwear_u_num_rel = 0\n")  # a stated 0 is refused: exit 3
+    assert main([*undecided, "--criteria", str(strict)]) == 3
+    assert "exactly zero" in capsys.readouterr().err
     assert main([*undecided, "--strict"]) == 1
     assert "--strict: not every criterion was decided" in capsys.readouterr().err
     unstated = ["compare", str(files["sim_wear"]), str(files["meas_unstated"]), "-o", str(out)]

@@ -383,3 +383,26 @@ def test_an_interrupted_simulation_is_flagged_partial_and_never_complete(tmp_pat
     assert not c.complete  # --strict exits 1
     save_comparison(c, tmp_path / "m.nc")
     assert any("stopped after 30000" in p for p in load_comparison(tmp_path / "m.nc").partial)
+
+
+def test_each_wear_criterion_fails_on_a_wrong_model():
+    """Within the band, every wear criterion can fail: a model wrong in what it judges."""
+    meas = syn.meas_wear(u=0.2e-6)  # +-6 mm
+    crit = Criteria(wear_u_num_rel=0.02, wear_u_input_rel=0.05)
+    right = compare(syn.sim_wear(), meas, criteria=crit)
+    assert not right.any_failed
+    # mirrored axially: the maximum at the other end of the band (axial position), wrong shape
+    sim = syn.sim_wear()
+    mirrored = sim.assign_coords(z=-sim["z"]).sortby("z")
+    mirrored["z"].attrs = sim["z"].attrs
+    c = compare(mirrored, meas, criteria=crit)
+    assert c.state("axial position of maximum wear") == "fail"
+    assert c.state("wear map shape") == "fail"
+    # twice as deep: maximum depth, volume and cylindricity of the wear
+    deep = sim.assign(wear_depth=sim["wear_depth"] * 2.0)
+    c = compare(deep, meas, criteria=crit)
+    for name in ("maximum wear depth", "worn volume", "cylindricity of the wear (LSCY)"):
+        assert c.state(name) == "fail", name
+    # turned: the angle of the maximum
+    c = compare(syn.sim_wear(rotate_deg=90.0), meas, criteria=crit)
+    assert c.state("angle of maximum wear") == "fail"

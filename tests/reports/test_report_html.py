@@ -237,3 +237,15 @@ def test_generated_scan_stays_synthetic_into_the_decision_card(tmp_path):
     plain = tmp_path / "plain"
     instruments.write(instruments.generate(**kw), plain, layout="folder", header=False)
     assert read_talyrond(plain, convention=conv).attrs["data_origin"] == "measured"
+
+
+def test_a_sim_verify_study_is_plotted(built):
+    from test_compare_study import study
+
+    from jointwear.reports import render_html
+
+    _, result = built
+    page = _Page()
+    page.feed(render_html(result, verification=[study()], command="t"))
+    # polar plots, motion and the study's level means against ΔN
+    assert page.tags.get("svg", 0) == 3

@@ -141,6 +141,11 @@ def test_too_few_levels_and_failed_levels():
     assert not fit.assessed and "at least 4" in fit.reason
     fit = eca_hoekstra(H, [1.0, np.nan, 1.2, 1.4])
     assert not fit.assessed and "1 level(s) without a value" in fit.reason
+    # without the finest level the figures would belong to another level: refused
+    fit = eca_hoekstra(H, [1.0, 1.1, 1.2, 1.4, 1.7][:4], [np.nan, 0.1, 0.1, 0.1])
+    assert not fit.assessed and "finest level" in fit.reason
+    fit = eca_hoekstra([0.5, *H], [0.9, 1.0, 1.1, 1.2, 1.4], [np.nan, 0.1, 0.1, 0.1, 0.1])
+    assert not fit.assessed and "h = 0.5" in fit.reason
 
 
 @pytest.mark.parametrize(
@@ -241,6 +246,10 @@ def test_study_uncertainty_stored_values_and_wear_map_function_agree():
     assert a.u_stat == pytest.approx(s[0])
     assert a.u_grid == pytest.approx(grid_term((m[0], s[0]), (gm, gs), ratio=2.0))
     assert a.u_num == pytest.approx(math.sqrt(a.u_stat**2 + a.u_refinement**2 + a.u_grid**2))
+    # one run scatters by the replicates' standard deviation, not by the mean's standard error
+    assert a.sd_run == pytest.approx(np.std(depth[0], ddof=1))
+    assert a.u_num_run == pytest.approx(math.sqrt(a.sd_run**2 + a.u_refinement**2 + a.u_grid**2))
+    assert a.u_num_run > a.u_num
 
 
 def test_study_uncertainty_of_an_angle_wraps():
