@@ -30,6 +30,7 @@ def register(app: typer.Typer) -> None:
     @app.command("reference-study")
     def reference_study_cmd(
         out: Annotated[Path, typer.Argument(help="Output folder.")],
+        overwrite: Overwrite = False,
         reduced: Annotated[
             bool,
             typer.Option("--reduced", help="Coarse grid, 3 ensemble members (about a minute)."),

@@ -35,7 +35,7 @@ QUANTITIES = (
 @pytest.fixture(scope="module")
 def study(tmp_path_factory):
     """``jointwear datasets reference-study --reduced``, run once; its saved comparison."""
-    out = tmp_path_factory.mktemp("reference")
+    out = tmp_path_factory.mktemp("reference") / "study"
     code = main(["datasets", "reference-study", str(out), "--reduced"])
     result = load_comparison(io.load(out / "metrics.nc"))
     assert code == (1 if result.any_failed else 0)
