@@ -5,9 +5,14 @@ Runs :func:`jointwear.datasets.reference_study.run_reference_study` with
 study over the wear-update interval dN = 1e5, 5e4, 2.5e4 and a 10-member Latin-hypercube
 ensemble over kw, the bore radius and friction) and writes every decision - state, value,
 reason - and every metric of the reported quantities to ``results/reported.json``, with the
-wall and CPU time of the run. docs/compare-report.md quotes the verdicts from that file.
+wall and CPU time of the run. With ``--verify-study`` (``jointwear sim verify`` studies run to
+the reported cycles, e.g. from ``benchmarks/reported_verify_4e5.toml`` and
+``reported_verify_1.2e6.toml``) the comparison is repeated with their u_num as well
+(``with_sim_verify_studies``). docs/compare-report.md quotes the verdicts from that file.
 
-    python benchmarks/bench_reported.py [--out DIR]
+    jointwear sim verify benchmarks/reported_verify_4e5.toml --out v4e5.nc --workers 0
+    jointwear sim verify benchmarks/reported_verify_1.2e6.toml --out v12.nc --workers 0
+    python benchmarks/bench_reported.py [--out DIR] [--verify-study v4e5.nc --verify-study v12.nc]
 """
 
 from __future__ import annotations
