@@ -442,3 +442,25 @@ def test_angle_between_two_layers_needs_no_convention():
     assert wrong.value(sep, "u_input") == pytest.approx(2.0, rel=0.05)
     assert wrong.value(sep, "value_sim") == pytest.approx(40.0, abs=0.5)
     assert vv20(wrong, sep).state == vd.FAIL
+
+
+def test_max_wear_depth_right_model_passes_kw_x2_fails():
+    # the taper map at layer 1 (z = +2 mm): c (z + W/2) + e (the ovality's peak), at N_REF
+    depth_um = (C_TAPER * (2e-3 + WIDTH / 2) + E_OVAL) * 1e6
+    data = cyl_file()
+    data["quantity"] = {
+        "depth": {
+            "kind": "max_wear_depth",
+            "value": depth_um,
+            "unit": "um",
+            "cycles": N_REF,
+            "layer": 1,
+            "source": "sheet",
+            "uncertainty": {"standard": 0.5},
+        }
+    }
+    rep = reported_dataset(data)
+    right = compare(sim_map(), rep, criteria=STATED)
+    assert right.value("depth", "value_sim") == pytest.approx(depth_um * 1e-6, rel=1e-6)
+    assert vv20(right, "depth").state == vd.PASS
+    assert vv20(compare(sim_map(scale=2.0), rep, criteria=STATED), "depth").state == vd.FAIL
