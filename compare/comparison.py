@@ -29,6 +29,7 @@ from jointwear.compare.align import MOTION_VARIABLES, align_time_series, align_w
 from jointwear.compare.criteria import Criteria, load_criteria
 from jointwear.compare.ensemble import WEAR_QUANTITIES, Ensemble, as_ensemble
 from jointwear.compare.origin import side_origin
+from jointwear.compare.reported import reported_metrics, split_reported
 from jointwear.compare.sources import Sources
 from jointwear.compare.study import band_study_uncertainty, is_study
 from jointwear.compare.verification import GCI, numerical_uncertainty
@@ -416,7 +417,8 @@ def compare(
     sims = [sim] if isinstance(sim, (xr.Dataset, xr.DataArray)) else list(sim)
     meass = [meas] if isinstance(meas, (xr.Dataset, xr.DataArray)) else list(meas)
     s_wear, s_motion = _split(sims)
-    m_wear, m_motion = _split(meass)
+    reported, meass_maps = split_reported(meass)
+    m_wear, m_motion = _split(meass_maps)
     rows = Rows()
     decisions: list[dict[str, Any]] = []
     notes: list[str] = []
@@ -458,7 +460,7 @@ def compare(
                 f"taken; it was compared with the simulation after {wear.attrs['cycles_sim']:g} "
                 "cycles (its last snapshot) - give cycles= / --cycles, or a 'cycles' attribute"
             )
-    elif s_wear is not None or m_wear is not None:
+    elif (s_wear is not None and not reported) or m_wear is not None:
         side = "measurement" if s_wear is not None else "simulation"
         partial.append(f"wear maps not compared: the {side} has no wear map (wear_depth)")
     if s_motion is not None and m_motion is not None:
@@ -487,7 +489,13 @@ def compare(
     elif s_motion is not None or m_motion is not None:
         side = "measurement" if s_motion is not None else "simulation"
         partial.append(f"motion not compared: the {side} has no motion record over time")
-    if wear is None and motion is None:
+    for rep in reported:  # reported measurements (a lab sheet's or a paper's numbers)
+        reported_metrics(
+            s_wear, rep, rows, decisions, notes, criteria=criteria, ensemble=ens,
+            verification=verification if isinstance(verification, Sequence) else
+            [verification] if isinstance(verification, xr.Dataset) else [],
+        )  # fmt: skip
+    if wear is None and motion is None and not reported:
         raise BadInputError(
             "nothing to compare: give a wear map (wear_depth over z, theta) and/or a motion "
             "record (follower_velocity, journal_offset, ... over time) on both sides"

@@ -350,6 +350,7 @@ def report_from_files(
     ensemble: Sequence[str | Path] = (),
     axes: Sequence[str] | None = ("x", "y"),
     warn: Callable[[str], None] | None = None,
+    reported: Sequence[str | Path] = (),
 ) -> tuple[Path, Comparison]:
     """Build a report from files: simulation, metrology and DIC netCDF, or a saved comparison.
 
@@ -369,6 +370,9 @@ def report_from_files(
         Ensembles of simulations (``run`` dimension) whose spread is the input uncertainty.
     axes : sequence of str or None
         Motion components to compare (default in-plane x, y).
+    reported : sequence of path
+        Reported measurements (``jointwear import reported``), judged beside or instead of the
+        metrology and DIC files (:mod:`jointwear.compare.reported`).
     warn : callable, optional
         Receives the warning text for a file from another tool (the CLI prints it on stderr);
         by default it is a :class:`UserWarning` (see
@@ -393,9 +397,10 @@ def report_from_files(
     vers = [io.load(p, validate=False) for p in verification]
     ens_ds = [io.load(p) for p in ensemble]
     if comparison is not None:
-        if sim or metrology or dic or ensemble:
+        if sim or metrology or dic or ensemble or reported:
             raise BadInputError(
-                "give either --comparison or --sim/--metrology/--dic/--ensemble, not both"
+                "give either --comparison or --sim/--metrology/--dic/--reported/--ensemble, "
+                "not both"
             )
         ds = io.load(comparison)
         result = load_comparison(ds)
@@ -403,27 +408,30 @@ def report_from_files(
     else:
         if not sim:
             raise BadInputError("no simulation given: pass --sim FILE.nc (wear map and/or motion)")
-        if not metrology and not dic:
+        if not metrology and not dic and not reported:
             raise BadInputError(
-                "no measurement given: pass --metrology FILE.nc (wear map) and/or --dic FILE.nc"
+                "no measurement given: pass --metrology FILE.nc (wear map), --dic FILE.nc "
+                "and/or --reported FILE.nc (reported values)"
             )
         from jointwear.external import load_for_comparison
 
         sims = [load_for_comparison(p, role="simulated", warn=warn) for p in sim]
         metros = [load_for_comparison(p, role="measured", warn=warn) for p in metrology]
         dics = [load_for_comparison(p, role="measured", warn=warn) for p in dic]
+        reps = [io.load(p) for p in reported]
         inputs += [ReportInput("simulation", Path(p), d) for p, d in zip(sim, sims, strict=True)]
         inputs += [
             ReportInput("metrology", Path(p), d) for p, d in zip(metrology, metros, strict=True)
         ]
         inputs += [ReportInput("DIC", Path(p), d) for p, d in zip(dic, dics, strict=True)]
+        inputs += [ReportInput("reported", Path(p), d) for p, d in zip(reported, reps, strict=True)]
         if not metrology:
             missing.append("wear maps: no metrology file was given (--metrology)")
         if not dic:
             missing.append("motion: no DIC file was given (--dic)")
         result = compare(
             sims,
-            [*metros, *dics],
+            [*metros, *dics, *reps],
             criteria=criteria,
             cycles=cycles,
             period_s=period_s,
