@@ -392,8 +392,9 @@ def run_demo(out: Path, *, quick: bool = False) -> Path:
         sims += [sim_wear_path, sim_motion_path]
         if not verification_paths:
             missing.append(
-                "verification: the convergence study of the wear update is skipped with --quick, "
-                "so u_num is not assessed"
+                "verification: the sim verify study is skipped with --quick; u_num of the wear is "
+                "the simulation's own wear_depth_u (update interval and cycle-to-cycle "
+                "variability; the wear grid is not assessed)"
             )
     else:
         missing.append("simulation: jointwear.sim is not available, nothing was simulated")

@@ -156,14 +156,24 @@ ENSEMBLE_INPUTS: dict[str, tuple[float, str]] = {
 }
 
 
-def ensemble_spec(params: Any, size: DemoSize) -> dict[str, Any]:
-    """The demo's sweep spec (``jointwear sim sweep`` format): LHS over :data:`ENSEMBLE_INPUTS`."""
+def ensemble_spec(params: Any, size: Any, *, kw: float | None = None) -> dict[str, Any]:
+    """The demo's sweep spec (``jointwear sim sweep`` format): LHS over :data:`ENSEMBLE_INPUTS`.
+
+    ``size`` gives ``ensemble_cycles`` and ``ensemble_runs``; ``kw`` the nominal wear
+    coefficient (default :data:`jointwear.sim.DEFAULT_KW`). An input whose nominal value is 0
+    (e.g. a frictionless model) is not varied: a relative spread of 0 is no distribution.
+    """
     from jointwear.sim import DEFAULT_KW
 
     parameters: dict[str, Any] = {}
     for name, (rel, _) in ENSEMBLE_INPUTS.items():
         section, field = name.split(".")
-        mean = DEFAULT_KW if name == "wear.kw" else float(getattr(getattr(params, section), field))
+        if name == "wear.kw":
+            mean = DEFAULT_KW if kw is None else float(kw)
+        else:
+            mean = float(getattr(getattr(params, section), field))
+        if mean == 0:
+            continue
         spec = {"distribution": "truncnormal", "mean": mean, "std": rel * mean}
         spec["bounds"] = [mean * (1 - 4 * rel), mean * (1 + 4 * rel)]
         parameters[name] = spec
