@@ -121,6 +121,12 @@ def main(argv: list[str] | None = None) -> None:
     with tempfile.TemporaryDirectory() as tmp:
         folder = args.folder or Path(tmp)
         folder.mkdir(parents=True, exist_ok=True)
+        if args.reuse:
+            figures["reused"] = (
+                "studies and their costs taken from earlier runs kept in --folder (their time "
+                "and load are in default_cost / doubled_cost and the studies' history); the "
+                "machine record below is of this rewrite"
+            )
         ds1, c1 = run(args.cycles, default.replicates, args.workers, folder, args.reuse)
         figures["default_cost"] = c1
         figures["default_runs"] = int(ds1.attrs["n_runs"])

@@ -65,6 +65,7 @@ __all__ = [
     "grid_term",
     "study_uncertainty",
     "describe_study",
+    "location_jump",
     "level_statistics",
     "COVERAGE_K",
     "P_LOW",
@@ -673,8 +674,13 @@ def study_uncertainty(
         res = float(study["quantity_resolution"].sel(quantity=quantity))
         resolution = res if math.isfinite(res) and res > 0 else 0.0
     lv, gv = _replicate_values(study, quantity, fn)
-    mean, sem, count = level_statistics(lv, period=period)
     h = np.asarray(study["h"].values, dtype=float)
+    if resolution > 0:
+        jump = location_jump(lv, gv, h, resolution=resolution, period=period)
+        if jump:
+            fit = eca_hoekstra(h, np.full(h.size, np.nan), quantity=quantity)
+            return replace(fit, reason=jump)
+    mean, sem, count = level_statistics(lv, period=period)
     if period:
         mean = _unwrap_levels(mean, h, period)
     fit = eca_hoekstra(
@@ -701,6 +707,60 @@ def study_uncertainty(
         period=period,
     )
     return fit.with_grid(u_grid, fit.reason)
+
+
+#: Runs of one level whose location of the maximum differs by more than this many grid steps
+#: have their maximum on separate wear peaks.
+JUMP_STEPS = 5
+
+
+def location_jump(
+    levels: np.ndarray,
+    grid_runs: np.ndarray,
+    h: np.ndarray,
+    *,
+    resolution: float,
+    period: float | None = None,
+) -> str:
+    """Why the location of a maximum is not one quantity, or '' when it is.
+
+    Two wear peaks of nearly equal depth make the location of the maximum jump between them from
+    run to run (the reference rig: 124 and 301 degree). Its replicate mean is then a point
+    between two peaks, and its scatter no uncertainty of a location: when the runs of one level
+    (or the grid runs) differ by more than :data:`JUMP_STEPS` grid steps the quantity is *not
+    assessed*.
+
+    Parameters
+    ----------
+    levels : ndarray (level, replicate)
+        Each run's location [unit]; NaN for a failed run.
+    grid_runs : ndarray (grid_replicate,)
+    h : ndarray (level,)
+        Refinement parameter of each level.
+    resolution : float
+        Grid step of the location [unit].
+    period : float, optional
+        Period of a circular location (360 degree).
+    """
+    groups = [
+        (f"h = {hv:g}", np.asarray(row, dtype=float)) for hv, row in zip(h, levels, strict=True)
+    ]
+    groups.append(("the finer grid", np.asarray(grid_runs, dtype=float)))
+    for label, v in groups:
+        v = v[np.isfinite(v)]
+        if v.size < 2:
+            continue
+        d = v[:, None] - v[None, :]
+        if period:
+            d = (d + period / 2) % period - period / 2
+        i, j = np.unravel_index(np.argmax(np.abs(d)), d.shape)
+        if abs(d[i, j]) > JUMP_STEPS * resolution:
+            return (
+                f"the location of the maximum jumps between separate wear peaks from run to run "
+                f"({label}: {v[i]:.4g} and {v[j]:.4g}, more than {JUMP_STEPS} grid steps apart): "
+                "it is not one quantity, its mean would lie between the peaks"
+            )
+    return ""
 
 
 def _unwrap_levels(mean: np.ndarray, h: np.ndarray, period: float) -> np.ndarray:

@@ -280,3 +280,19 @@ def test_quantised_location_without_change_is_one_step_not_inert():
     assert fit.assessed and fit.branch.startswith("no change")
     assert fit.u_refinement == pytest.approx(4.0 / math.sqrt(12))
     assert fit.u_num == pytest.approx(4.0 / math.sqrt(12))
+
+
+def test_a_maximum_jumping_between_peaks_is_not_assessed():
+    from jointwear.refinement import location_jump, study_uncertainty
+
+    ds, _, _ = _hand_study(np.random.default_rng(0))
+    ds["quantity_resolution"] = ("quantity", [np.nan, 1.8])
+    assert study_uncertainty(ds, "max_wear_theta").assessed  # 359.5 .. 3 degree: one peak
+    # one run of the coarsest level finds its maximum on the opposite peak (the reference rig)
+    ds["replicate_value"].loc[{"quantity": "max_wear_theta", "level": 3, "replicate": 2}] = 124.2
+    fit = study_uncertainty(ds, "max_wear_theta")
+    assert not fit.assessed and "separate wear peaks" in fit.reason and "h = 8000" in fit.reason
+    assert math.isnan(fit.u_num)
+    # a drift of the location with refinement is not a jump; 359 and 1 degree are neighbours
+    lv = np.array([[359.0, 1.0], [4.0, 5.0], [8.0, 9.0], [12.0, 13.0]])
+    assert location_jump(lv, np.array([0.5, 359.5]), H, resolution=1.8, period=360.0) == ""

@@ -234,6 +234,13 @@ def test_cli_runs_and_info_summarises(manufactured, tmp_path, capsys):
     assert main(["info", str(out)]) == 0
     info = capsys.readouterr().out
     assert "verification study" in info and "worn_volume =" in info
+    # an existing study is not replaced silently; --resume of a finished study computes nothing
+    args = ["sim", "verify", "--cycles", "8000", "--out", str(out), "--workers", "0"]
+    assert main(args) == 3
+    assert "--overwrite" in capsys.readouterr().err
+    m = manufactured(2)
+    assert main([*args, "--resume"]) == 0
+    assert m.calls == []
 
 
 def test_band_quantities_from_the_run_maps(manufactured, tmp_path, capsys):
