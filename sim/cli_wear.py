@@ -8,6 +8,8 @@ from typing import Annotated, Any, Literal
 import typer
 
 from jointwear._cli import Overwrite
+from jointwear._version import source_attribute
+from jointwear.sim.wear._settings import DEFAULT_KW
 
 __all__ = ["register"]
 
@@ -82,21 +84,16 @@ def _load_settings(params_file: Path | None, overrides: dict[str, Any]) -> tuple
 
 def _sim_parameters(params_file: Path | None, rest: dict[str, Any], grid: tuple) -> Any:
     """The simulator's parameters: the named set, updated from the TOML file and grid options."""
-    from jointwear.errors import BadInputError
+    from jointwear.sim.parameters import (
+        DEFAULT_PARAMETER_SET,
+        PARAMETER_SETS,
+        parameters_from_tables,
+    )
 
-    try:
-        from jointwear import sim
-    except ImportError as exc:  # pragma: no cover
-        raise BadInputError(f"jointwear.sim cannot be imported: {exc}") from None
-    if not hasattr(sim, "PARAMETER_SETS"):
-        raise BadInputError(
-            "the multibody dynamics are not available in this installation; "
-            "use --contact winkler (prescribed contact) instead"
-        )
-    if params_file is not None and rest:
-        params = sim.load_parameters(params_file)
+    if params_file is not None and rest:  # the TOML file is read once, by _load_settings
+        params = parameters_from_tables(rest, where=f"parameter file '{params_file}'")
     else:
-        params = sim.PARAMETER_SETS["zhang2023"]
+        params = PARAMETER_SETS[DEFAULT_PARAMETER_SET]
     layers, points = grid
     changes = {}
     if layers is not None:
@@ -296,7 +293,8 @@ def register(app: typer.Typer) -> None:
         kw: Annotated[
             float | None,
             typer.Option(
-                "--kw", help="Archard wear coefficient \\[m²/N = m³/(N m)]; default 9e-16."
+                "--kw",
+                help=f"Archard wear coefficient \\[m²/N = m³/(N m)]; default {DEFAULT_KW:g}.",
             ),
         ] = None,
         params: Annotated[
@@ -446,7 +444,7 @@ def register(app: typer.Typer) -> None:
                     out,
                     inputs=inputs,
                     parameters=provenance_params,
-                    source="jointwear 0.1 (sim.wear)",
+                    source=source_attribute("sim.wear"),
                 )
                 typer.echo(
                     f"interrupted after {run.cycles_done} cycles: partial wear map in {out}, "
@@ -462,7 +460,7 @@ def register(app: typer.Typer) -> None:
                     out,
                     inputs=inputs,
                     parameters=provenance_params,
-                    source="jointwear 0.1 (sim.wear)",
+                    source=source_attribute("sim.wear"),
                 )
                 raise SimulationError(
                     f"{exc} [wear run stopped after {run.cycles_done} cycles; the wear map so far "
@@ -474,7 +472,7 @@ def register(app: typer.Typer) -> None:
                 out,
                 inputs=inputs,
                 parameters=provenance_params,
-                source="jointwear 0.1 (sim.wear)",
+                source=source_attribute("sim.wear"),
             )
         except OutputError as exc:
             raise _resumable(exc, run.cycles_done, ckpt) from exc

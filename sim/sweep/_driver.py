@@ -47,12 +47,17 @@ def _base(spec: SweepSpec, params: Any, wear: Any) -> tuple[Any, Any, dict[str, 
         if params is not None:
             raise BadInputError('--params does not apply to run = "function" sweeps')
         return None, None, {}, []
-    from jointwear.sim.parameters import PARAMETER_SETS, SimParameters, load_parameters
+    from jointwear.sim.parameters import (
+        DEFAULT_PARAMETER_SET,
+        PARAMETER_SETS,
+        SimParameters,
+        load_parameters,
+    )
 
     inputs = []
     table: dict[str, Any] = {}
     if params is None:
-        sim = PARAMETER_SETS["zhang2023"]
+        sim = PARAMETER_SETS[DEFAULT_PARAMETER_SET]
     elif isinstance(params, SimParameters):
         sim = params
     else:
@@ -421,7 +426,7 @@ def run_sweep(
         once ``out`` is written); without ``out`` nothing is written and nothing can resume.
     params : path or SimParameters, optional
         Base parameters of every run (a ``--params`` TOML, possibly with a ``[wear]`` table);
-        default the ``"zhang2023"`` set.
+        default the :data:`~jointwear.sim.DEFAULT_PARAMETER_SET`.
     wear : WearSettings, optional
         Base wear settings (default: the ``[wear]`` table of ``params``, else the defaults).
     workers : int, optional

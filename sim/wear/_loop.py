@@ -560,7 +560,7 @@ def simulate_wear(
     Parameters
     ----------
     params : SimParameters, optional
-        Mechanism and joint parameters (default ``PARAMETER_SETS["zhang2023"]``); ignored when
+        Mechanism and joint parameters (default ``PARAMETER_SETS[DEFAULT_PARAMETER_SET]``, the reference study); ignored when
         ``contact`` is given.
     cycles : float
         Target number of cycles.
@@ -602,9 +602,9 @@ def simulate_wear(
         from jointwear.sim.wear._contact import DynamicContact
 
         if params is None:
-            from jointwear.sim import PARAMETER_SETS
+            from jointwear.sim.parameters import DEFAULT_PARAMETER_SET, PARAMETER_SETS
 
-            params = PARAMETER_SETS["zhang2023"]
+            params = PARAMETER_SETS[DEFAULT_PARAMETER_SET]
         params, settings = apply_overrides(params, settings, overrides)
         contact = DynamicContact(params, cycle_function)
     elif overrides:
