@@ -308,6 +308,28 @@ def build_report(
     -------
     Path
         The HTML file.
+
+    Examples
+    --------
+    The self-contained HTML report of a comparison (see :func:`jointwear.compare.compare`):
+
+    >>> from jointwear.sim import BearingGrid, WearSettings, WinklerContact, simulate_wear
+    >>> sim = simulate_wear(
+    ...     contact=WinklerContact(BearingGrid(4, 36), load=20.0, sliding=0.02),
+    ...     cycles=2000,
+    ...     snapshots=[1000, 2000],
+    ...     settings=WearSettings(scheme="fixed", dn=500),
+    ... )
+    >>> meas = sim[["wear_depth"]].isel(cycles=-1, drop=True) * 1.5  # measured 50 % deeper
+    >>> meas["wear_depth"].attrs = sim["wear_depth"].attrs
+    >>> meas.attrs = {"data_origin": "synthetic", "cycles": 2000}
+    >>> from jointwear.compare import compare
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from jointwear.reports import build_report
+    >>> page = build_report(compare(sim, meas), Path(tempfile.mkdtemp()) / "report.html")
+    >>> page.name, "maximum wear depth" in page.read_text(encoding="utf-8")
+    ('report.html', True)
     """
     html = render_html(
         comparison,

@@ -452,6 +452,22 @@ def run_sweep(
         A bad spec (named entry), impossible bounds, unknown parameter names.
     BadInputError
         Unreachable scheduler, resume of another sweep, unwritable ``out``.
+
+    Examples
+    --------
+    A grid over the analytic model ``y = x1 + 2 x2 + 3 x3 + 4 x4``, run in-process
+    (``workers=0``; by default a local dask cluster):
+
+    >>> from jointwear.sim import run_sweep, to_grid
+    >>> spec = {
+    ...     "sweep": {"run": "function", "function": "linear", "method": "grid"},
+    ...     "parameters": {"x1": {"values": [0.0, 1.0]}, "x2": {"values": [0.0, 0.5]}},
+    ... }
+    >>> ds = run_sweep(spec, workers=0)
+    >>> ds["y"].values.tolist()
+    [0.0, 1.0, 1.0, 2.0]
+    >>> to_grid(ds)["y"].dims
+    ('x1', 'x2')
     """
     from jointwear import io
     from jointwear._version import __version__
