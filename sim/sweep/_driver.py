@@ -443,8 +443,8 @@ def run_sweep(
     Returns
     -------
     Dataset
-        Along ``run``: parameter values (coordinates), outputs, ``status``
-        (ok/failed/not_run), ``error``; Sobol/Morris indices for those methods.
+        Along ``run``: parameter values (coordinates), outputs, ``status`` (ok/failed/not_run),
+        ``error``; Sobol/Morris indices for those methods.
 
     Raises
     ------
@@ -455,22 +455,14 @@ def run_sweep(
 
     Examples
     --------
-    A grid over the analytic model ``y = x1 + 2 x2 + 3 x3 + 4 x4``, run in-process
-    (``workers=0``; by default a local dask cluster):
-
-    >>> from jointwear.sim import run_sweep, to_grid
-    >>> spec = {
-    ...     "sweep": {"run": "function", "function": "linear", "method": "grid"},
-    ...     "parameters": {"x1": {"values": [0.0, 1.0]}, "x2": {"values": [0.0, 0.5]}},
-    ... }
-    >>> ds = run_sweep(spec, workers=0)
-    >>> ds["y"].values.tolist()
+    >>> from jointwear.sim import run_sweep  # below: y = x1 + 2 x2 on a grid, in-process
+    >>> sweep = {"run": "function", "function": "linear", "method": "grid"}
+    >>> grid = {"x1": {"values": [0.0, 1.0]}, "x2": {"values": [0.0, 0.5]}}
+    >>> run_sweep({"sweep": sweep, "parameters": grid}, workers=0)["y"].values.tolist()
     [0.0, 1.0, 1.0, 2.0]
-    >>> to_grid(ds)["y"].dims
-    ('x1', 'x2')
     """
     from jointwear import io
-    from jointwear._version import __version__
+    from jointwear._version import source_attribute
 
     if resume and out is None:
         raise BadInputError("resume needs the sweep's result file (out=/--out)")
@@ -555,7 +547,7 @@ def run_sweep(
                 out,
                 inputs=[*spec_file, *inputs],
                 parameters=record,
-                source=f"jointwear {__version__} (sim.sweep)",
+                source=source_attribute("sim.sweep"),
             )
             finished = not lost
     finally:
