@@ -399,6 +399,28 @@ def compare(
         Nothing to compare, inputs that cannot be aligned, or a malformed ensemble.
     ConventionError
         A wear map does not state its angle convention.
+
+    Examples
+    --------
+    A simulated wear map (prescribed contact) against itself as the "measurement", with stated
+    uncertainties: every decided criterion passes (the maximum lies on the edge layer, so its
+    axial position is not comparable); a bearing that wore 50 % more fails the depth and the
+    cylindricity:
+
+    >>> from jointwear.compare import Criteria, compare
+    >>> from jointwear.sim import BearingGrid, WearSettings, WinklerContact, simulate_wear
+    >>> fixed, contact = WearSettings(scheme="fixed", dn=500), WinklerContact(BearingGrid(4, 36))
+    >>> sim = simulate_wear(contact=contact, cycles=2000, snapshots=[1000, 2000], settings=fixed)
+    >>> meas = sim.isel(cycles=-1, drop=True)[["wear_depth"]].copy(deep=True)
+    >>> meas = meas.assign_attrs(data_origin="synthetic", cycles=2000)
+    >>> u_d = 0.02 * float(meas["wear_depth"].max())  # the measurement's u_D [m]
+    >>> meas["wear_depth_u"] = meas["wear_depth"].copy(data=0 * meas["wear_depth"].values + u_d)
+    >>> stated = Criteria(wear_u_num_rel=0.05, wear_u_input_rel=0.1)  # u_num 5 %, u_input 10 %
+    >>> compare(sim, meas, criteria=stated).summary()
+    '6 criteria: 5 pass, 1 not comparable'
+    >>> meas["wear_depth"].values *= 1.5  # a bearing that wore 50 % more
+    >>> compare(sim, meas, criteria=stated).failed()
+    ['maximum wear depth within z = −7.5…+7.5 mm', 'cylindricity of the wear (LSCY) within z = −7.5…+7.5 mm']
     """
     criteria = criteria or Criteria()
     ens = as_ensemble(ensemble)

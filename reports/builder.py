@@ -21,7 +21,7 @@ import xarray as xr
 
 from jointwear import io
 from jointwear._version import __version__
-from jointwear.compare import Comparison, Criteria, compare
+from jointwear.compare import DEFAULT_AXES, Comparison, Criteria, compare
 from jointwear.errors import BadInputError
 from jointwear.params import to_jsonable
 from jointwear.provenance import command_line, sha256_file, software_versions
@@ -308,6 +308,24 @@ def build_report(
     -------
     Path
         The HTML file.
+
+    Examples
+    --------
+    The self-contained HTML report of a simulated wear map compared with itself, labelled as
+    synthetic measurement data:
+
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from jointwear.compare import compare
+    >>> from jointwear.reports import build_report
+    >>> from jointwear.sim import BearingGrid, WearSettings, WinklerContact, simulate_wear
+    >>> run = {"contact": WinklerContact(BearingGrid(4, 36)), "snapshots": [1000, 2000]}
+    >>> sim = simulate_wear(cycles=2000, settings=WearSettings(scheme="fixed", dn=500), **run)
+    >>> meas = sim.isel(cycles=-1, drop=True)[["wear_depth"]]
+    >>> comparison = compare(sim, meas.assign_attrs(data_origin="synthetic", cycles=2000))
+    >>> page = build_report(comparison, Path(tempfile.mkdtemp()) / "report.html")
+    >>> page.name, "maximum wear depth" in page.read_text(encoding="utf-8")
+    ('report.html', True)
     """
     html = render_html(
         comparison,
@@ -348,7 +366,7 @@ def report_from_files(
     period_s: float | None = None,
     variables: Sequence[str] | None = None,
     ensemble: Sequence[str | Path] = (),
-    axes: Sequence[str] | None = ("x", "y"),
+    axes: Sequence[str] | None = DEFAULT_AXES,
     warn: Callable[[str], None] | None = None,
     reported: Sequence[str | Path] = (),
 ) -> tuple[Path, Comparison]:

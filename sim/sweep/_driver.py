@@ -47,12 +47,17 @@ def _base(spec: SweepSpec, params: Any, wear: Any) -> tuple[Any, Any, dict[str, 
         if params is not None:
             raise BadInputError('--params does not apply to run = "function" sweeps')
         return None, None, {}, []
-    from jointwear.sim.parameters import PARAMETER_SETS, SimParameters, load_parameters
+    from jointwear.sim.parameters import (
+        DEFAULT_PARAMETER_SET,
+        PARAMETER_SETS,
+        SimParameters,
+        load_parameters,
+    )
 
     inputs = []
     table: dict[str, Any] = {}
     if params is None:
-        sim = PARAMETER_SETS["zhang2023"]
+        sim = PARAMETER_SETS[DEFAULT_PARAMETER_SET]
     elif isinstance(params, SimParameters):
         sim = params
     else:
@@ -421,7 +426,7 @@ def run_sweep(
         once ``out`` is written); without ``out`` nothing is written and nothing can resume.
     params : path or SimParameters, optional
         Base parameters of every run (a ``--params`` TOML, possibly with a ``[wear]`` table);
-        default the ``"zhang2023"`` set.
+        default the :data:`~jointwear.sim.DEFAULT_PARAMETER_SET`.
     wear : WearSettings, optional
         Base wear settings (default: the ``[wear]`` table of ``params``, else the defaults).
     workers : int, optional
@@ -438,8 +443,8 @@ def run_sweep(
     Returns
     -------
     Dataset
-        Along ``run``: parameter values (coordinates), outputs, ``status``
-        (ok/failed/not_run), ``error``; Sobol/Morris indices for those methods.
+        Along ``run``: parameter values (coordinates), outputs, ``status`` (ok/failed/not_run),
+        ``error``; Sobol/Morris indices for those methods.
 
     Raises
     ------
@@ -447,9 +452,17 @@ def run_sweep(
         A bad spec (named entry), impossible bounds, unknown parameter names.
     BadInputError
         Unreachable scheduler, resume of another sweep, unwritable ``out``.
+
+    Examples
+    --------
+    >>> from jointwear.sim import run_sweep  # below: y = x1 + 2 x2 on a grid, in-process
+    >>> sweep = {"run": "function", "function": "linear", "method": "grid"}
+    >>> grid = {"x1": {"values": [0.0, 1.0]}, "x2": {"values": [0.0, 0.5]}}
+    >>> run_sweep({"sweep": sweep, "parameters": grid}, workers=0)["y"].values.tolist()
+    [0.0, 1.0, 1.0, 2.0]
     """
     from jointwear import io
-    from jointwear._version import __version__
+    from jointwear._version import source_attribute
 
     if resume and out is None:
         raise BadInputError("resume needs the sweep's result file (out=/--out)")
@@ -489,7 +502,7 @@ def run_sweep(
         scheduler=scheduler,
         on_progress=on_progress,
         inputs=[*spec_file, *inputs],
-        source=f"jointwear {__version__} (sim.sweep)",
+        source=source_attribute("sim.sweep"),
     )
 
 

@@ -288,7 +288,7 @@ def verify_wear(
         A bad spec or parameter (named), an unwritable ``out``, resume of another study.
     """
     from jointwear import io
-    from jointwear._version import __version__
+    from jointwear._version import source_attribute
     from jointwear.sim.sweep._driver import _already_complete, _base, run_and_save
     from jointwear.sim.sweep._params import apply_values
     from jointwear.sim.sweep._run import RunTask
@@ -364,7 +364,7 @@ def verify_wear(
         scheduler=scheduler,
         on_progress=on_progress,
         inputs=[*spec_file, *inputs],
-        source=f"jointwear {__version__} (sim.sweep.verify)",
+        source=source_attribute("sim.sweep.verify"),
     )
 
 
