@@ -41,7 +41,7 @@ def _spell(key: str, value: object) -> str:
     if isinstance(value, bool):
         return f"{key}={value}"
     if isinstance(value, str):
-        return f"{key}='{value}'"
+        return f"{key}={value}" if value.startswith("<") else f"{key}='{value}'"
     return f"{key}=<{'m' if key in _METRES else 'value'}>"
 
 

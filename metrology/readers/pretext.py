@@ -35,8 +35,8 @@ def normalise(text: str, path: str, thousands: str | None) -> tuple[str, dict[st
     head = text.lstrip()[:1]
     if head in ("{", "["):
         raise Refusal(
-            f"'{path}' is JSON, which the readers do not support (no delimiter or header option "
-            "makes it readable); export the trace as text/CSV (one angle and one value per "
+            f"'{path}' is JSON, which the readers do not support (no reader option makes it "
+            "readable); export the trace as text/CSV (one angle and one value per "
             "line) or convert it to CSV first"
         )
     body = [ln for ln in text.splitlines()[:400] if ln.strip()]

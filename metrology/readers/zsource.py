@@ -147,7 +147,12 @@ def _find_z(layers, parsed, layout, folder, z, layer_spacing, z_units, z_source,
         named = bool(col) and str(col[0]) in parsed[0].column_units
         return "z column", not named and z_units is not None, False
     numbers = [lay.index for lay in layers]
-    if all(v is not None for v in numbers) and (auto or z_source in ("numbers", "spacing")):
+    heights = layout == "blocks" and all(
+        _z_from_meta(pf.metadata, pf.z_units, f"'{pf.path}'") is not None for pf in parsed
+    )
+    if all(v is not None for v in numbers) and (
+        (auto and not heights) or z_source in ("numbers", "spacing")
+    ):
         sp = _spacing(layer_spacing, meta, z_units, where)
         if sp is None:
             raise _need_spacing(
@@ -277,7 +282,7 @@ def _z_wide(layers, pf, layer_spacing, z_units, z_source, where, meta):
         if sp is None:
             raise _need_spacing(
                 where,
-                f"the value columns are named by layer number ({', '.join(names[i] for i in vidx[:3])}"
+                f"the value columns are numbered as layers ({', '.join(names[i] for i in vidx[:3])}"
                 f"{', ...' if len(vidx) > 3 else ''}), which says nothing of their height",
             )
         for lay in layers:
