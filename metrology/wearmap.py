@@ -39,7 +39,14 @@ from jointwear.conventions import (
     z_coord,
 )
 from jointwear.errors import BadInputError
+from jointwear.metrology.baseline import (
+    FormBasis,
+    correlation_length,
+    noise_sigma,
+    select_harmonics,
+)
 from jointwear.metrology.form import cylinder_zone
+from jointwear.metrology.wear_quantities import derived_quantities, uncertainty_attrs
 
 __all__ = ["wear_map", "worn_volume", "register_angle"]
 
@@ -150,6 +157,8 @@ class _LayerBasis:
 
 def _lsq(X, d: np.ndarray, mask: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Least squares of d on the masked rows: (coefficients, fitted values, normal matrix)."""
+    if isinstance(X, FormBasis):
+        return X.lsq(d, mask)
     if isinstance(X, _LayerBasis):
         B = X.block
         m = mask.reshape(X.nz, -1).astype(float)
@@ -167,6 +176,8 @@ def _lsq(X, d: np.ndarray, mask: np.ndarray) -> tuple[np.ndarray, np.ndarray, np
 def _fit_variance(X, G: np.ndarray, s2: float) -> np.ndarray:
     """Variance of the fitted reference at every point [m^2]."""
     cov = np.linalg.inv(G) * s2
+    if isinstance(X, FormBasis):
+        return X.fit_variance(cov)
     if isinstance(X, _LayerBasis):
         return np.einsum("jn,ljk,kn->ln", X.block, cov, X.block).ravel()
     return np.einsum("nj,jk,nk->n", X, cov, X)
@@ -203,6 +214,7 @@ def _robust_reference(
     theta_deg: np.ndarray | None = None,
     margin_deg: float = 5.0,
     smooth_deg: float = 2.0,
+    start: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, float, int]:
     """Fit X b ~ d on the unworn points (found iteratively unless given).
 
@@ -213,6 +225,8 @@ def _robust_reference(
     """
     finite = np.isfinite(d)
     mask = finite.copy() if unworn is None else (finite & unworn)
+    if start is not None and unworn is None:
+        mask = finite & start
     n_iter = 0
     win = 1
     if shape is not None and theta_deg is not None:
@@ -348,7 +362,7 @@ def wear_map(
     *,
     angle_offset_deg: float = 0.0,
     register: bool = False,
-    shape: str = "cylinder",
+    shape: str = "auto",
     threshold: float = 3.0,
     unworn: np.ndarray | xr.DataArray | None = None,
     surface: str = "bore",
@@ -356,6 +370,8 @@ def wear_map(
     margin_deg: float = 5.0,
     exact_centring: bool = True,
     max_iter: int = 30,
+    harmonics: int = 15,
+    axial_degree: int = 2,
 ) -> xr.Dataset:
     """Wear depth over (z, theta) from a worn scan and a before-scan or a fitted reference.
 
@@ -374,9 +390,13 @@ def wear_map(
     register : bool
         Estimate the offset by correlating the unworn regions instead (added to
         ``angle_offset_deg``). Only when asked.
-    shape : {"cylinder", "circle"}
-        Reference fitted to the unworn points: a limaçon cylinder (centre and tilt, default) or
-        one circle per layer.
+    shape : {"auto", "cylinder", "circle", "form"}
+        Reference fitted to the unworn points: a limaçon cylinder (centre and tilt), one circle
+        per layer, or the form model of :mod:`~jointwear.metrology.baseline` (a centre per layer,
+        taper/barrel and lobing smooth in z). ``auto``: cylinder with a before-scan (the form
+        cancels in the difference), form without one.
+    harmonics, axial_degree : int
+        Highest lobing harmonic and degree in z of the form model (``shape="form"``).
     threshold : float
         Unworn points lie within ``threshold`` robust standard deviations of the reference.
     unworn : bool array (z, theta), optional
@@ -404,8 +424,12 @@ def wear_map(
         ``worn_volume`` and ``worn_volume_u`` [m^3], ``cylindricity_before`` and
         ``cylindricity_after`` [m] (MZ), ``angle_offset`` [degree]; method in attrs.
     """
-    if shape not in ("cylinder", "circle"):
-        raise BadInputError(f"wear_map: shape must be 'cylinder' or 'circle', got {shape!r}")
+    if shape not in ("auto", "cylinder", "circle", "form"):
+        raise BadInputError(
+            f"wear_map: shape must be 'auto', 'cylinder', 'circle' or 'form', got {shape!r}"
+        )
+    if shape == "auto":
+        shape = "cylinder" if before is not None else "form"
     if surface not in ("bore", "shaft"):
         raise BadInputError(f"wear_map: surface must be 'bore' or 'shaft', got {surface!r}")
     if not threshold > 0:
@@ -415,7 +439,10 @@ def wear_map(
     th = np.asarray(w["theta"].values, dtype=float)
     rw = np.asarray(w.values, dtype=float)
     sign = 1.0 if surface == "bore" else -1.0
-    X = _basis(z, th, shape)
+    if shape == "form":
+        X = FormBasis(z, th, harmonics, axial_degree)
+    else:
+        X = _basis(z, th, shape)
     Xcyl = X if shape == "cylinder" else _basis(z, th, "cylinder")
     mask_in = None
     if unworn is not None:
@@ -494,14 +521,18 @@ def wear_map(
             raise BadInputError("wear_map: register=True needs a before scan")
         d = sign * rw.ravel()
         rbz = None
+        model = {
+            "cylinder": "a limaçon cylinder",
+            "circle": "a limaçon circle per layer",
+            "form": f"the form model (a centre per layer; radius and lobing 2..{getattr(X, 'harmonics', 0)} UPR "
+            f"as polynomials of degree {getattr(X, 'deg', 0)} in z)",
+        }[shape]
         method = (
-            "residual from a least-squares limaçon "
-            + ("cylinder" if shape == "cylinder" else "circle per layer")
-            + " fitted to the unworn part of the worn scan (no before-wear scan)"
+            f"residual from {model} fitted by least squares to the unworn part of the worn "
+            "scan (no before-wear scan)"
         )
-    resid, mask, var_fit, s2, n_iter = _robust_reference(
-        d, X, threshold, mask_in, max_iter, "wear_map", rw.shape, th, margin_deg
-    )
+    fit = _reference(d, X, shape, z, th, harmonics, threshold, mask_in, max_iter, margin_deg)
+    X, (resid, mask, var_fit, s2, n_iter) = fit
     # exact centring: the limaçon leaves each scan's e^2/(4R) second harmonic, which differs
     # between set-ups; with the bore radius known, re-centre each scan exactly on its own axis
     # (fitted to the unworn points) and redo the fit
@@ -517,9 +548,8 @@ def wear_map(
             d = sign * (rw_c - rb_c).ravel()
         else:
             d = sign * (rw_c - r0_w).ravel()
-        resid, mask, var_fit, s2, n_iter = _robust_reference(
-            d, X, threshold, mask_in, max_iter, "wear_map", rw.shape, th, margin_deg
-        )
+        fit = _reference(d, X, shape, z, th, harmonics, threshold, mask_in, max_iter, margin_deg)
+        X, (resid, mask, var_fit, s2, n_iter) = fit
         centring = (
             "exact: each scan re-centred on its own least-squares axis (unworn points), then the "
             "limaçon reference fitted to the unworn points"
@@ -527,53 +557,24 @@ def wear_map(
     wear = resid.reshape(rw.shape)
     u = np.sqrt(s2 + var_fit).reshape(rw.shape)
     mask2 = mask.reshape(rw.shape)
-
-    # radius for the volume
-    if radius is None:
-        if wname == "radius":
-            radius = float(np.nanmean(rw))
-        else:
-            radius = _attr_radius(worn, w)
-    if radius is None or not np.isfinite(radius) or radius <= 0:
-        raise BadInputError(
-            "wear_map: the worn scan holds radial deviations without a 'nominal_radius' "
-            "attribute; pass radius=<bore radius in m> for the worn volume"
-        )
-    vol = worn_volume(wear, z, th, radius)
+    radius = _volume_radius(radius, wname, rw, worn, w)
     wts = _z_weights(z)[:, None] * _theta_weights(th)[None, :] * radius
-    sd_fit = np.sqrt(var_fit).reshape(rw.shape)
-    vol_u = float(np.hypot(np.sum(wts * sd_fit), np.sqrt(np.sum(wts**2) * s2)))
+    _, _, G = _lsq(X, d, mask)
+    cov = np.linalg.inv(G) * s2
+    if cov.ndim == 3:  # one block per layer (circle per layer)
+        from scipy.linalg import block_diag
 
-    cyl_after = (
-        cylinder_zone(
-            np.broadcast_to(z[:, None], rw.shape), np.broadcast_to(th, rw.shape), rw
-        ).total
-        if z.size > 1
-        else float("nan")
+        cov = block_diag(*cov)
+    tau = correlation_length(wear, mask2)
+    q = derived_quantities(
+        wear, var_fit.reshape(rw.shape), s2, tau, _design_sum(X, wts), cov, wts, z, th
     )
-    if rbz is not None:
-        cyl_before = (
-            cylinder_zone(
-                np.broadcast_to(z[:, None], rbz.shape), np.broadcast_to(thb, rbz.shape), rbz
-            ).total
-            if z.size > 1
-            else float("nan")
-        )
-        cyl_before_note = "MZ cylindricity of the before-wear scan"
-    else:
-        masked = np.where(mask2, rw, np.nan)
-        cyl_before = (
-            cylinder_zone(
-                np.broadcast_to(z[:, None], rw.shape), np.broadcast_to(th, rw.shape), masked
-            ).total
-            if z.size > 1
-            else float("nan")
-        )
-        cyl_before_note = (
-            "MZ cylindricity of the unworn points of the worn scan (estimate of the "
-            "cylindricity before wear; no before-wear scan)"
-        )
-
+    noise = noise_sigma(rw)
+    if rbz is None:
+        _separable(q, s2, noise, mask2, threshold)
+    cyl_after, cyl_before, cyl_before_note = _cylindricities(
+        rw, rbz, z, th, thb if rbz is not None else th, mask2
+    )
     zc = z_coord(z)
     tc = theta_coord(th, CANONICAL)
     out = xr.Dataset(
@@ -590,7 +591,14 @@ def wear_map(
             "wear_depth_u": (
                 ("z", "theta"),
                 u,
-                {"units": "m", "long_name": "standard uncertainty of wear_depth"},
+                {
+                    "units": "m",
+                    "long_name": "standard uncertainty of wear_depth",
+                    **uncertainty_attrs(
+                        "scatter of the unworn points about the reference (instrument noise, "
+                        "unmodelled form and set-up) and the fitted reference's standard error"
+                    ),
+                },
             ),
             "unworn": (
                 ("z", "theta"),
@@ -602,26 +610,7 @@ def wear_map(
                     "flag_meanings": "worn_or_outlier unworn_reference",
                 },
             ),
-            "worn_volume": (
-                (),
-                vol,
-                {
-                    "units": "m3",
-                    "long_name": "volume of material removed over the measured band",
-                    "ancillary_variables": "worn_volume_u",
-                },
-            ),
-            "worn_volume_u": (
-                (),
-                vol_u,
-                {"units": "m3", "long_name": "standard uncertainty of worn_volume"},
-            ),
-            "cylindricity_before": ((), cyl_before, {"units": "m", "long_name": cyl_before_note}),
-            "cylindricity_after": (
-                (),
-                cyl_after,
-                {"units": "m", "long_name": "MZ cylindricity of the worn scan"},
-            ),
+            **_scalars(q, cyl_before, cyl_after, cyl_before_note, noise),
             "angle_offset": (
                 (),
                 offset,
@@ -642,6 +631,8 @@ def wear_map(
             ),
             "n_unworn_points": int(mask.sum()),
             "reference_rms_residual": float(np.sqrt(s2)),
+            "residual_correlation_length_samples": float(tau),
+            "instrument_noise_estimate": float(noise),
             "volume_radius": float(radius),
             "surface": surface,
             "registered": bool(register),
@@ -679,3 +670,139 @@ def _attr_radius(orig: xr.Dataset | xr.DataArray, da: xr.DataArray) -> float | N
                 except (TypeError, ValueError):
                     pass
     return None
+
+
+def _volume_radius(radius, wname, rw, worn, w) -> float:
+    """Bore radius for the volume [m]: given, the mean radius, or the nominal radius."""
+    if radius is None:
+        radius = float(np.nanmean(rw)) if wname == "radius" else _attr_radius(worn, w)
+    if radius is None or not np.isfinite(radius) or radius <= 0:
+        raise BadInputError(
+            "wear_map: the worn scan holds radial deviations without a 'nominal_radius' "
+            "attribute; pass radius=<bore radius in m> for the worn volume"
+        )
+    return float(radius)
+
+
+def _design_sum(X, w: np.ndarray) -> np.ndarray:
+    """sum_i w_i X_i over all points (p,): the volume's sensitivity to the coefficients."""
+    if isinstance(X, FormBasis):
+        return X.weighted_sum(w)
+    if isinstance(X, _LayerBasis):
+        return (w @ X.block.T).ravel()
+    return w.ravel() @ X
+
+
+def _separable(q: dict, s2: float, noise: float, unworn: np.ndarray, threshold: float) -> None:
+    """Refuse a map without a before-scan where wear cannot be told from form."""
+    frac = float(unworn.mean())
+    fix = (
+        "pass the scan of the bore before wear (before=..., CLI --before BEFORE.nc), or an "
+        "explicit unworn mask"
+    )
+    if frac < 0.25:
+        raise BadInputError(
+            f"wear_map: only {frac:.0%} of the points look unworn: too little of the bore is "
+            f"left to fit its unworn form, so wear cannot be separated from form; {fix}"
+        )
+    depth, u_depth, _ = q["max_wear_depth"]
+    s = float(np.sqrt(s2))
+    if np.isfinite(noise) and s > 3.0 * noise and depth < 5.0 * s and frac < 0.999:
+        raise BadInputError(
+            f"wear_map: without a before-wear scan the form model leaves {s * 1e6:.3g} µm RMS "
+            f"on the unworn points (instrument noise {noise * 1e6:.3g} µm): unmodelled form of "
+            f"the size of the wear found (max {depth * 1e6:.3g} ± {u_depth * 1e6:.2g} µm), so "
+            f"wear cannot be separated from form; {fix}"
+        )
+
+
+def _cylindricities(rw, rbz, z, th, thb, unworn):
+    """(MZ cylindricity of the worn scan, of the before-scan or the unworn points, note)."""
+    if z.size < 2:
+        return float("nan"), float("nan"), "not assessed: one layer"
+
+    def zone(v, t):
+        return cylinder_zone(
+            np.broadcast_to(z[:, None], v.shape), np.broadcast_to(t, v.shape), v
+        ).total
+
+    if rbz is not None:
+        return zone(rw, th), zone(rbz, thb), "MZ cylindricity of the before-wear scan"
+    return (
+        zone(rw, th),
+        zone(np.where(unworn, rw, np.nan), th),
+        "MZ cylindricity of the unworn points of the worn scan (estimate of the cylindricity "
+        "before wear; no before-wear scan)",
+    )
+
+
+_LONG = {
+    "worn_volume": ("m3", "volume of material removed over the measured band"),
+    "max_wear_depth": ("m", "largest wear depth (map averaged over about 1 degree)"),
+    "wear_cylindricity": ("m", "MZ cylindricity of the wear map"),
+}
+
+
+def _scalars(q: dict, cyl_before, cyl_after, note: str, noise: float) -> dict:
+    """The map's scalar quantities with their ``_u`` variables."""
+    out = {}
+    for name, (v, u, comment) in q.items():
+        unit, long_name = _LONG[name]
+        out[name] = (
+            (),
+            v,
+            {"units": unit, "long_name": long_name, "ancillary_variables": f"{name}_u"},
+        )
+        out[f"{name}_u"] = (
+            (),
+            u,
+            {
+                "units": unit,
+                "long_name": f"standard uncertainty of {name}",
+                **uncertainty_attrs(comment),
+            },
+        )
+    u_zone = float(np.sqrt(2.0) * noise) if np.isfinite(cyl_after) else float("nan")
+    zone_comment = (
+        "instrument noise (from successive differences) at the zone's two extreme points; the "
+        "upward bias of a zone by noise is not corrected"
+    )
+    for name, v, long_name in (
+        ("cylindricity_before", cyl_before, note),
+        ("cylindricity_after", cyl_after, "MZ cylindricity of the worn scan"),
+    ):
+        out[name] = (
+            (),
+            v,
+            {"units": "m", "long_name": long_name, "ancillary_variables": f"{name}_u"},
+        )
+        out[f"{name}_u"] = (
+            (),
+            u_zone,
+            {
+                "units": "m",
+                "long_name": f"standard uncertainty of {name}",
+                **uncertainty_attrs(zone_comment),
+            },
+        )
+    return out
+
+
+def _reference(d, X, shape, z, th, harmonics, threshold, mask_in, max_iter, margin_deg):
+    """(basis used, robust fit): for the form model, the lobing order is chosen by BIC on the
+    points a low-order fit (centres and axial trend) finds unworn, then refitted robustly from
+    there (twice); a high-order model fitted to all points at once would absorb the wear."""
+    shape2d = (z.size, th.size)
+    args = (threshold, mask_in, max_iter, "wear_map", shape2d, th, margin_deg)
+    if not isinstance(X, FormBasis):
+        return X, _robust_reference(d, X, *args)
+    low = FormBasis(z, th, 1, X.deg)
+    fit = _robust_reference(d, low, *args)
+    basis, k_prev = low, 1
+    for _ in range(2):
+        k, _ = select_harmonics(X, d, fit[1])
+        if k == k_prev and basis is not low:
+            break
+        basis, k_prev = FormBasis(z, th, k, X.deg), k
+        fit = _robust_reference(d, basis, *args, start=fit[1])
+    return basis, fit
