@@ -20,7 +20,13 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["FormBasis", "correlation_length", "noise_sigma", "select_harmonics"]
+__all__ = [
+    "FormBasis",
+    "correlation_length",
+    "lower_quantile_fit",
+    "noise_sigma",
+    "select_harmonics",
+]
 
 
 class FormBasis:
@@ -57,34 +63,63 @@ class FormBasis:
         self.shape = (self.nz * self.nt, self.n_centre + self.n_shared)
         self.harmonics = kmax
 
+    def _shared(self) -> np.ndarray:
+        return np.concatenate([np.ones((self.nt, 1)), self.lobes], axis=1)  # (nt, q)
+
+    def _cols(self, i: int) -> np.ndarray:
+        """Columns that are non-zero in layer ``i``: its centre, then every shared column."""
+        return np.concatenate([[2 * i, 2 * i + 1], np.arange(self.n_centre, self.shape[1])])
+
     def layer(self, i: int) -> np.ndarray:
-        """The rows of layer ``i`` (nt, p)."""
-        X = np.zeros((self.nt, self.shape[1]))
-        X[:, 2 * i : 2 * i + 2] = self.centre
-        shared = np.concatenate([np.ones((self.nt, 1)), self.lobes], axis=1)
-        powers = self.zeta[i] ** np.arange(self.deg + 1)
-        X[:, self.n_centre :] = np.concatenate([p * shared for p in powers], axis=1)
-        return X
+        """The non-zero columns (:meth:`_cols`) of layer ``i``'s rows (nt, 2 + shared)."""
+        pw = self.zeta[i] ** np.arange(self.deg + 1)
+        S = self._shared()
+        return np.concatenate([self.centre] + [p * S for p in pw], axis=1)
 
     def normal(self, d: np.ndarray, mask: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
-        """Normal matrix, right-hand side and sum of squares of ``d`` on the masked points."""
+        """Normal matrix, right-hand side and sum of squares of ``d`` on the masked points,
+        assembled from per-layer products of the (nt, 2) centre and (nt, q) shared blocks."""
         p = self.shape[1]
         G = np.zeros((p, p))
         rhs = np.zeros(p)
-        dd = d.reshape(self.nz, self.nt)
-        mm = mask.reshape(self.nz, self.nt)
+        mm = np.asarray(mask, dtype=float).reshape(self.nz, self.nt)  # a mask or weights
+        dd = np.where(mm > 0, d.reshape(self.nz, self.nt), 0.0) * mm
+        S, C = self._shared(), self.centre
+        q = S.shape[1]
+        nc = self.n_centre
         for i in range(self.nz):
-            Xi = self.layer(i)[mm[i]]
-            G += Xi.T @ Xi
-            rhs += Xi.T @ dd[i, mm[i]]
-        return G, rhs, float(np.sum(dd[mm] ** 2))
+            pw = self.zeta[i] ** np.arange(self.deg + 1)
+            mS = S * mm[i][:, None]
+            A = S.T @ mS
+            B = C.T @ mS
+            c = slice(2 * i, 2 * i + 2)
+            G[c, c] = C.T @ (C * mm[i][:, None])
+            rhs[c] = C.T @ dd[i]
+            rs = S.T @ dd[i]
+            for j, pj in enumerate(pw):
+                sj = slice(nc + j * q, nc + (j + 1) * q)
+                G[c, sj] = pj * B
+                G[sj, c] = pj * B.T
+                rhs[sj] += pj * rs
+                for k, pk in enumerate(pw):
+                    G[sj, nc + k * q : nc + (k + 1) * q] += pj * pk * A
+        return G, rhs, float(np.sum(np.where(mm > 0, dd**2 / np.where(mm > 0, mm, 1), 0.0)))
+
+    def fitted(self, b: np.ndarray) -> np.ndarray:
+        """The model surface for coefficients ``b`` (all points, layer by layer)."""
+        S, q, nc = self._shared(), self._shared().shape[1], self.n_centre
+        out = []
+        for i in range(self.nz):
+            pw = self.zeta[i] ** np.arange(self.deg + 1)
+            bs = sum(p * b[nc + j * q : nc + (j + 1) * q] for j, p in enumerate(pw))
+            out.append(self.centre @ b[2 * i : 2 * i + 2] + S @ bs)
+        return np.concatenate(out)
 
     def columns(self, k: int) -> np.ndarray:
         """Indices of the columns of the sub-model with lobing harmonics 2 .. k."""
         m = self.lobes.shape[1] // 2
-        keep = (
-            [0] + [1 + j for j in range(min(k - 1, m))] + [1 + m + j for j in range(min(k - 1, m))]
-        )
+        kk = min(k - 1, m)
+        keep = [0] + [1 + j for j in range(kk)] + [1 + m + j for j in range(kk)]
         per = 1 + 2 * m
         idx = list(range(self.n_centre))
         for j in range(self.deg + 1):
@@ -96,18 +131,23 @@ class FormBasis:
         G, rhs, _ = self.normal(d, mask)
         # columns with no support (a layer without unworn points) make G singular
         b = np.linalg.solve(G, rhs)
-        fitted = np.concatenate([self.layer(i) @ b for i in range(self.nz)])
-        return b, fitted, G
+        return b, self.fitted(b), G
 
     def fit_variance(self, cov: np.ndarray) -> np.ndarray:
         """Variance of the fitted surface at every point [m^2]."""
-        return np.concatenate(
-            [np.einsum("nj,jk,nk->n", Xi, cov, Xi) for Xi in map(self.layer, range(self.nz))]
-        )
+        out = []
+        for i in range(self.nz):
+            c = self._cols(i)
+            Xi = self.layer(i)
+            out.append(np.einsum("nj,jk,nk->n", Xi, cov[np.ix_(c, c)], Xi))
+        return np.concatenate(out)
 
     def weighted_sum(self, w: np.ndarray) -> np.ndarray:
         """sum_i w_i X_i (p,) for point weights ``w`` (nz, nt)."""
-        return sum(w[i] @ self.layer(i) for i in range(self.nz))
+        a = np.zeros(self.shape[1])
+        for i in range(self.nz):
+            a[self._cols(i)] += w[i] @ self.layer(i)
+        return a
 
 
 def correlation_length(resid: np.ndarray, mask: np.ndarray) -> float:
@@ -136,13 +176,13 @@ def correlation_length(resid: np.ndarray, mask: np.ndarray) -> float:
 
 
 def noise_sigma(values: np.ndarray) -> float:
-    """Point-to-point noise of a profile [same unit]: 1.4826 MAD of successive differences / √2
-    (form varies slowly between neighbouring samples, noise does not)."""
-    d = np.diff(np.asarray(values, dtype=float), axis=-1).ravel()
+    """Point-to-point noise of a profile [same unit]: 1.4826 MAD of second differences / √6
+    (form and set-up vary smoothly between neighbouring samples, noise does not)."""
+    d = np.diff(np.asarray(values, dtype=float), n=2, axis=-1).ravel()
     d = d[np.isfinite(d)]
     if d.size == 0:
         return float("nan")
-    return float(1.4826 * np.median(np.abs(d - np.median(d))) / np.sqrt(2.0))
+    return float(1.4826 * np.median(np.abs(d - np.median(d))) / np.sqrt(6.0))
 
 
 def select_harmonics(basis: FormBasis, d: np.ndarray, mask: np.ndarray) -> tuple[int, dict]:
@@ -164,3 +204,25 @@ def select_harmonics(basis: FormBasis, d: np.ndarray, mask: np.ndarray) -> tuple
         rss = max(dd - float(rhs[idx] @ b), 1e-300)
         table[k] = n * np.log(rss / n) + idx.size * np.log(n)
     return min(table, key=table.get), table
+
+
+def lower_quantile_fit(
+    basis: FormBasis, d: np.ndarray, finite: np.ndarray, tau: float = 0.25, iters: int = 40
+) -> np.ndarray:
+    """Residual of a ``tau``-quantile fit of the form model (iteratively reweighted).
+
+    Wear only removes material, so it lies above the unworn surface: a low quantile of the
+    data is hardly pulled by it (a least-squares fit to all points is), while the model still
+    follows taper and lobing. Used to find a first unworn set.
+    """
+    w = finite.astype(float)
+    dd = np.where(finite, d, 0.0)
+    scale = max(float(np.std(dd[finite])), 1e-12)
+    for _ in range(iters):
+        G, rhs, _ = basis.normal(dd, w)
+        b = np.linalg.solve(G, rhs)
+        r = dd - basis.fitted(b)
+        a = np.maximum(np.abs(r), 1e-4 * scale)
+        w = np.where(finite, np.where(r > 0, tau, 1.0 - tau) / a, 0.0)
+        scale = max(float(np.median(np.abs(r[finite]))), 1e-12)
+    return np.where(finite, r, np.nan)

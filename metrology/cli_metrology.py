@@ -62,8 +62,10 @@ class FilterKind(StrEnum):
 class Shape(StrEnum):
     """Unworn reference shape."""
 
+    auto = "auto"
     cylinder = "cylinder"
     circle = "circle"
+    form = "form"
 
 
 class Reference(StrEnum):
@@ -547,8 +549,12 @@ def wearmap_cmd(
     ] = False,
     shape: Annotated[
         Shape,
-        typer.Option("--shape", help="Unworn reference: cylinder or circle (per layer)."),
-    ] = Shape.cylinder,
+        typer.Option(
+            "--shape",
+            help="Unworn reference: auto (cylinder with --before, else form), cylinder, circle "
+            "(per layer) or form (centre per layer, taper and lobing smooth in z).",
+        ),
+    ] = Shape.auto,
     threshold: Annotated[
         float, typer.Option("--threshold", help="Unworn = within this many robust std devs.")
     ] = 3.0,
@@ -591,12 +597,7 @@ def wearmap_cmd(
                 "threshold": threshold,
             },
         )
-        typer.echo(
-            f"{target}: max wear {float(ds['wear_depth'].max()) * 1e6:.2f} µm, worn volume "
-            f"{float(ds['worn_volume']) * 1e9:.4f} mm³ ± {float(ds['worn_volume_u']) * 1e9:.4f}, "
-            f"cylindricity {float(ds['cylindricity_before']) * 1e6:.2f} -> "
-            f"{float(ds['cylindricity_after']) * 1e6:.2f} µm (MZ)"
-        )
+        typer.echo(f"{target}: {_wear_summary(ds)}")
         if plot is not None:
             from jointwear.metrology.plot import plot_wear_map
 
@@ -635,6 +636,21 @@ def plot_cmd(
         raise BadInputError(f"--layers {layers!r}: expected integers like 0,6,12") from None
     plt.close(plot_wear_map(ds, layers=idx, path=out, title=title))
     typer.echo(f"wrote {out}")
+
+
+def _wear_summary(ds) -> str:
+    """One line: every wear-map quantity with its standard uncertainty."""
+    from jointwear.metrology.wear_quantities import format_pm
+
+    def pm(name: str, scale: float, unit: str) -> str:
+        return format_pm(float(ds[name]), float(ds[f"{name}_u"]), scale, unit)
+
+    return (
+        f"max wear {pm('max_wear_depth', 1e-6, 'µm')}, worn volume "
+        f"{pm('worn_volume', 1e-9, 'mm³')}, wear cylindricity {pm('wear_cylindricity', 1e-6, 'µm')}, "
+        f"cylindricity {pm('cylindricity_before', 1e-6, 'µm')} -> "
+        f"{pm('cylindricity_after', 1e-6, 'µm')} (MZ; standard uncertainties, k = 1)"
+    )
 
 
 def register(app: typer.Typer) -> None:

@@ -77,6 +77,8 @@ def derived_quantities(
     sm = _smooth(np.nan_to_num(wear), win)
     s2_sm = s2 * min(1.0, tau / win)
     k = np.unravel_index(int(np.argmax(sm)), sm.shape)
+    near = sm >= sm[k] - 2.0 * math.sqrt(s2_sm)  # values that could be the maximum
+    n_top = max(1.0, float(np.count_nonzero(near)) / max(win, tau))
     out = {
         "worn_volume": (
             vol,
@@ -86,9 +88,10 @@ def derived_quantities(
         ),
         "max_wear_depth": (
             float(sm[k]),
-            math.sqrt(float(var_fit[k]) + s2_sm),
+            math.sqrt(float(var_fit[k]) + s2_sm * (1.0 + 2.0 * math.log(n_top))),
             f"maximum of the map averaged over {win} sample(s) in theta; fitted reference at "
-            "that point and the averaged scatter of the unworn points",
+            "that point and the averaged scatter of the unworn points, widened for the "
+            f"maximum of {n_top:.3g} independent values near the top (extreme-value bias)",
         ),
     }
     if z.size > 1:

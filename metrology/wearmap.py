@@ -215,6 +215,7 @@ def _robust_reference(
     margin_deg: float = 5.0,
     smooth_deg: float = 2.0,
     start: np.ndarray | None = None,
+    one_sided: bool = False,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, float, int]:
     """Fit X b ~ d on the unworn points (found iteratively unless given).
 
@@ -251,13 +252,18 @@ def _robust_reference(
         med = np.median(rm)
         # floor: 10 pm, far below any instrument's resolution (noise-free synthetic data)
         scale = max(1.4826 * np.median(np.abs(rm - med)), _SCALE_FLOOR)
-        new = finite & (np.abs(resid - med) <= threshold * scale)
+        if one_sided:  # wear removes material: only a high residual can be wear
+            new = finite & (resid - med <= threshold * scale)
+            new &= resid - med >= -2.0 * threshold * scale  # dents and spikes
+        else:
+            new = finite & (np.abs(resid - med) <= threshold * scale)
         if shape is not None and theta_deg is not None:
             sm = _smooth_theta(resid.reshape(shape), win)
             smm = sm.ravel()[mask]
             smed = np.nanmedian(smm)
             sscale = max(1.4826 * np.nanmedian(np.abs(smm - smed)), _SCALE_FLOOR)
-            region = ~(np.abs(sm - smed) > threshold * sscale)
+            high = (sm - smed) if one_sided else np.abs(sm - smed)
+            region = ~(high > threshold * sscale)
             region = _dilate(region, theta_deg, margin_deg)
             new &= region.ravel()
         changed = int(np.count_nonzero(new != mask))
@@ -367,10 +373,10 @@ def wear_map(
     unworn: np.ndarray | xr.DataArray | None = None,
     surface: str = "bore",
     radius: float | None = None,
-    margin_deg: float = 5.0,
+    margin_deg: float | None = None,
     exact_centring: bool = True,
     max_iter: int = 30,
-    harmonics: int = 15,
+    harmonics: int = 4,
     axial_degree: int = 2,
 ) -> xr.Dataset:
     """Wear depth over (z, theta) from a worn scan and a before-scan or a fitted reference.
@@ -407,8 +413,9 @@ def wear_map(
     radius : float, optional
         Bore radius for the worn volume [m]; by default the mean worn radius (``radius`` data) or
         the ``nominal_radius`` attribute (deviation data).
-    margin_deg : float
-        Points within this angle [degree] of a worn region are not used as unworn reference.
+    margin_deg : float, optional
+        Points within this angle [degree] of a worn region are not used as unworn reference
+        (default 5, or 15 for the form model, where faint wear tails would bias the form).
     exact_centring : bool
         Re-centre each scan exactly on its own axis before differencing (needs the bore radius:
         ``radius`` data, the ``nominal_radius`` attribute or ``radius=``); removes the
@@ -430,6 +437,8 @@ def wear_map(
         )
     if shape == "auto":
         shape = "cylinder" if before is not None else "form"
+    if margin_deg is None:  # without a before-scan faint wear tails would bias the form fit
+        margin_deg = 15.0 if shape == "form" else 5.0
     if surface not in ("bore", "shaft"):
         raise BadInputError(f"wear_map: surface must be 'bore' or 'shaft', got {surface!r}")
     if not threshold > 0:
@@ -531,8 +540,10 @@ def wear_map(
             f"residual from {model} fitted by least squares to the unworn part of the worn "
             "scan (no before-wear scan)"
         )
-    fit = _reference(d, X, shape, z, th, harmonics, threshold, mask_in, max_iter, margin_deg)
-    X, (resid, mask, var_fit, s2, n_iter) = fit
+    X, fit, alt = _reference(
+        d, X, shape, z, th, harmonics, threshold, mask_in, max_iter, margin_deg
+    )
+    resid, mask, var_fit, s2, n_iter = fit
     # exact centring: the limaçon leaves each scan's e^2/(4R) second harmonic, which differs
     # between set-ups; with the bore radius known, re-centre each scan exactly on its own axis
     # (fitted to the unworn points) and redo the fit
@@ -540,7 +551,11 @@ def wear_map(
     centring = "limaçon only (bore radius unknown: pass radius= for exact centring)"
     if not exact_centring:
         centring = "limaçon only (exact_centring=False)"
-    elif r0_w is not None:
+    elif isinstance(X, FormBasis):
+        centring = (
+            "form model: its second harmonic, quadratic in z, holds the limaçon's e^2/(4R) term"
+        )
+    elif r0_w is not None and not isinstance(X, FormBasis):
         rw_c = _recentre(rw + r0_w, z, th, mask)
         if rbz is not None:
             r0_b = 0.0 if bname == "radius" else (radius or _attr_radius(before, b) or r0_w)
@@ -548,8 +563,10 @@ def wear_map(
             d = sign * (rw_c - rb_c).ravel()
         else:
             d = sign * (rw_c - r0_w).ravel()
-        fit = _reference(d, X, shape, z, th, harmonics, threshold, mask_in, max_iter, margin_deg)
-        X, (resid, mask, var_fit, s2, n_iter) = fit
+        X, fit, alt = _reference(
+            d, X, shape, z, th, harmonics, threshold, mask_in, max_iter, margin_deg
+        )
+        resid, mask, var_fit, s2, n_iter = fit
         centring = (
             "exact: each scan re-centred on its own least-squares axis (unworn points), then the "
             "limaçon reference fitted to the unworn points"
@@ -569,7 +586,11 @@ def wear_map(
     q = derived_quantities(
         wear, var_fit.reshape(rw.shape), s2, tau, _design_sum(X, wts), cov, wts, z, th
     )
-    noise = noise_sigma(rw)
+    if alt is not None:
+        other = alt[0].reshape(rw.shape)
+        _model_order_term(q, other, wts, z, th)
+        u = np.hypot(u, wear - other)  # each depth's dependence on the model order
+    noise = noise_sigma(wear)  # successive differences of the residual: the probe noise
     if rbz is None:
         _separable(q, s2, noise, mask2, threshold)
     cyl_after, cyl_before, cyl_before_note = _cylindricities(
@@ -707,7 +728,14 @@ def _separable(q: dict, s2: float, noise: float, unworn: np.ndarray, threshold: 
         )
     depth, u_depth, _ = q["max_wear_depth"]
     s = float(np.sqrt(s2))
-    if np.isfinite(noise) and s > 3.0 * noise and depth < 5.0 * s and frac < 0.999:
+    if u_depth > 0.3 * depth and not (np.isfinite(noise) and u_depth <= 5.0 * noise):
+        raise BadInputError(
+            f"wear_map: without a before-wear scan the wear found (max {depth * 1e6:.3g} µm) "
+            f"depends on the form model (standard uncertainty {u_depth * 1e6:.2g} µm, including "
+            "the change at the neighbouring lobing order): the worn region is as wide as the "
+            f"bore's lobes, so wear cannot be separated from form; {fix}"
+        )
+    if np.isfinite(noise) and s > 3.0 * noise and depth < 5.0 * s:
         raise BadInputError(
             f"wear_map: without a before-wear scan the form model leaves {s * 1e6:.3g} µm RMS "
             f"on the unworn points (instrument noise {noise * 1e6:.3g} µm): unmodelled form of "
@@ -789,20 +817,40 @@ def _scalars(q: dict, cyl_before, cyl_after, note: str, noise: float) -> dict:
 
 
 def _reference(d, X, shape, z, th, harmonics, threshold, mask_in, max_iter, margin_deg):
-    """(basis used, robust fit): for the form model, the lobing order is chosen by BIC on the
-    points a low-order fit (centres and axial trend) finds unworn, then refitted robustly from
-    there (twice); a high-order model fitted to all points at once would absorb the wear."""
+    """(basis used, robust fit, fit at the neighbouring lobing order or None).
+
+    For the form model the lobing order starts at 2 (which also holds the limaçon's
+    e^2/(4R) second harmonic) and grows one harmonic at a time, up to ``harmonics``, while the
+    Bayesian information criterion on the current unworn points asks for more; every stage is
+    refitted robustly (one-sided: only material removed is wear) from the previous stage's
+    unworn points, so that wear found at a low order is not absorbed by a higher one. The fit
+    at the neighbouring order measures how much the result depends on that choice.
+    """
     shape2d = (z.size, th.size)
     args = (threshold, mask_in, max_iter, "wear_map", shape2d, th, margin_deg)
     if not isinstance(X, FormBasis):
-        return X, _robust_reference(d, X, *args)
-    low = FormBasis(z, th, 1, X.deg)
-    fit = _robust_reference(d, low, *args)
-    basis, k_prev = low, 1
-    for _ in range(2):
-        k, _ = select_harmonics(X, d, fit[1])
-        if k == k_prev and basis is not low:
+        return X, _robust_reference(d, X, *args), None
+    k = min(2, X.harmonics)
+    basis = FormBasis(z, th, k, X.deg)
+    fit = _robust_reference(d, basis, *args, one_sided=True)
+    while k < X.harmonics:
+        best, _ = select_harmonics(X, d, fit[1])
+        if best <= k:
             break
-        basis, k_prev = FormBasis(z, th, k, X.deg), k
-        fit = _robust_reference(d, basis, *args, start=fit[1])
-    return basis, fit
+        k += 1
+        basis = FormBasis(z, th, k, X.deg)
+        fit = _robust_reference(d, basis, *args, start=fit[1], one_sided=True)
+    k_alt = k + 1 if k < max(X.harmonics, 3) else k - 1
+    alt = _robust_reference(d, FormBasis(z, th, k_alt, X.deg), *args, start=fit[1], one_sided=True)
+    return basis, fit, alt
+
+
+def _model_order_term(q: dict, other: np.ndarray, wts: np.ndarray, z, th) -> None:
+    """Add, in quadrature, how much each quantity changes at the neighbouring lobing order
+    (the choice of the form model's order is a source of uncertainty)."""
+    zeros = np.zeros_like(other)
+    alt = derived_quantities(other, zeros, 0.0, 1.0, np.zeros(1), np.zeros((1, 1)), wts, z, th)
+    for name, (v, u, comment) in list(q.items()):
+        dv = abs(alt[name][0] - v)
+        if np.isfinite(dv):
+            q[name] = (v, float(np.hypot(u, dv)), comment + f"; form-model order ({dv:.3g})")
