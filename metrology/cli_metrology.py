@@ -329,6 +329,12 @@ def import_cmd(
             help="Relative tolerance of the radius against the header's nominal (default 0.05).",
         ),
     ] = None,
+    min_form_nm: Annotated[
+        float | None,
+        typer.Option(
+            "--min-form-nm", help="Smallest plausible peak-to-valley of deviations [nm] (10)."
+        ),
+    ] = None,
 ) -> None:
     """Import roundness/cylindricity text exports into contract netCDF files."""
     from jointwear import io
@@ -360,6 +366,7 @@ def import_cmd(
         radius_range=tuple(v * 1e-3 for v in radius_range_mm) if radius_range_mm else None,
         max_deviation=max_deviation_mm * 1e-3 if max_deviation_mm is not None else None,
         nominal_tolerance=nominal_tolerance,
+        min_form=min_form_nm * 1e-9 if min_form_nm is not None else None,
     )
     if instrument is not None:
         opts["instrument"] = instrument

@@ -592,7 +592,8 @@ def wear_map(
         u = np.hypot(u, wear - other)  # each depth's dependence on the model order
     noise = noise_sigma(wear)  # successive differences of the residual: the probe noise
     if rbz is None:
-        _separable(q, s2, noise, mask2, threshold)
+        lobing = _lobing_rms((d - resid).reshape(rw.shape)) if isinstance(X, FormBasis) else 0.0
+        _separable(q, s2, noise, mask2, threshold, lobing)
     cyl_after, cyl_before, cyl_before_note = _cylindricities(
         rw, rbz, z, th, thb if rbz is not None else th, mask2
     )
@@ -714,7 +715,15 @@ def _design_sum(X, w: np.ndarray) -> np.ndarray:
     return w.ravel() @ X
 
 
-def _separable(q: dict, s2: float, noise: float, unworn: np.ndarray, threshold: float) -> None:
+def _lobing_rms(surface: np.ndarray) -> float:
+    """RMS of the harmonics 2 and up of a fitted surface (nz, nt) [m]."""
+    spec = np.fft.rfft(surface, axis=1) / surface.shape[1]
+    return float(np.sqrt(np.mean(2.0 * np.sum(np.abs(spec[:, 2:]) ** 2, axis=1))))
+
+
+def _separable(
+    q: dict, s2: float, noise: float, unworn: np.ndarray, threshold: float, lobing: float
+) -> None:
     """Refuse a map without a before-scan where wear cannot be told from form."""
     frac = float(unworn.mean())
     fix = (
@@ -728,6 +737,13 @@ def _separable(q: dict, s2: float, noise: float, unworn: np.ndarray, threshold: 
         )
     depth, u_depth, _ = q["max_wear_depth"]
     s = float(np.sqrt(s2))
+    if frac > 0.99 and np.isfinite(noise) and lobing > 10.0 * noise:
+        raise BadInputError(
+            f"wear_map: without a before-wear scan no worn region stands out, but the bore's "
+            f"lobing ({lobing * 1e6:.3g} µm RMS, instrument noise {noise * 1e6:.3g} µm) could "
+            "hold wear as broad as its lobes: whether the bore is unworn or evenly worn "
+            f"cannot be separated from its form; {fix}"
+        )
     if u_depth > 0.3 * depth and not (np.isfinite(noise) and u_depth <= 5.0 * noise):
         raise BadInputError(
             f"wear_map: without a before-wear scan the wear found (max {depth * 1e6:.3g} µm) "

@@ -45,7 +45,7 @@ def _spell(key: str, value: object) -> str:
     return f"{key}=<{'m' if key in _METRES else 'value'}>"
 
 
-_METRES = ("layer_spacing", "max_deviation")
+_METRES = ("layer_spacing", "max_deviation", "min_form")
 
 
 def advise(options: list[tuple[Mapping, str]]) -> tuple[str, tuple[dict, ...]]:
@@ -73,6 +73,7 @@ PLAUSIBILITY: dict[str, float] = {
     "radius_min": 0.5e-3,  # [m] smallest bore/shaft radius a roundness instrument measures here
     "radius_max": 2.0,  # [m] largest
     "max_deviation": 1e-3,  # [m] largest |radial deviation| (a roundness gauge's range)
+    "min_form": 10e-9,  # [m] smallest peak-to-valley of a deviation trace (below any probe noise)
     "nominal_tolerance": 0.05,  # relative: measured radius within 5 % of the stated nominal
     "deviation_fraction": 0.05,  # |deviation| at most 5 % of the stated nominal radius
     "spacing_tolerance": 0.01,  # relative: stated layer spacing vs the layers found

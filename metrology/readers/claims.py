@@ -215,6 +215,25 @@ def check_magnitude(
             f"{limits['deviation_fraction']:.0%} of the header's nominal radius "
             f"{_fmt(nominal[1])} (deviation_fraction)"
         )
+    ptp = float(np.ptp(v)) * f
+    if 0 < ptp < limits["min_form"]:
+        larger = [
+            u
+            for u in ("um", "mm")
+            if unit_factor(u) > f
+            and ptp / f * unit_factor(u) >= limits["min_form"]
+            and float(np.max(np.abs(v))) * unit_factor(u) <= limit
+        ][:1]
+        alts = [(_units_fix(stated_by_file, u), f"if the values are in {u}") for u in larger]
+        text, sugg = advise(alts) if alts else ("", ())
+        raise Refusal(
+            f"{where}: the values are read in {unit!r} ({unit_source}) as radial deviations "
+            f"with a peak-to-valley of {_fmt(ptp)}, below any roundness probe's noise "
+            f"(min_form = {_fmt(limits['min_form'])}): a wrong unit"
+            + (f"? {text}" if alts else "?")
+            + "; if the trace really is that flat, lower the limit with min_form=<m>",
+            sugg,
+        )
     if dmax > limit:
         smaller = [
             u for u in ("mm", "um") if unit_factor(u) < f and dmax / f * unit_factor(u) <= limit

@@ -105,6 +105,7 @@ def read_scan(
     radius_range: tuple[float, float] | None = None,
     max_deviation: float | None = None,
     nominal_tolerance: float | None = None,
+    min_form: float | None = None,
 ) -> xr.Dataset:
     """Read a roundness / cylindricity scan from text exports into a contract Dataset.
 
@@ -165,6 +166,8 @@ def read_scan(
         Largest plausible |radial deviation| [m] (default 1 mm).
     nominal_tolerance : float, optional
         Relative tolerance of the measured radius against a stated nominal (default 0.05).
+    min_form : float, optional
+        Smallest plausible peak-to-valley of a deviation trace [m] (default 10 nm).
 
     Returns
     -------
@@ -232,6 +235,7 @@ def read_scan(
         radius_max=None if radius_range is None else radius_range[1],
         max_deviation=max_deviation,
         nominal_tolerance=nominal_tolerance,
+        min_form=min_form,
     )
     parsed = [pf for f in files for pf in parse_blocks(f, base)]
     blocks = len(files) == 1 and len(parsed) > 1
