@@ -737,9 +737,10 @@ def _separable(
         )
     depth, u_depth, _ = q["max_wear_depth"]
     s = float(np.sqrt(s2))
-    if frac > 0.99 and np.isfinite(noise) and lobing > 10.0 * noise:
+    if depth < 5.0 * u_depth and np.isfinite(noise) and lobing > 5.0 * noise:
         raise BadInputError(
-            f"wear_map: without a before-wear scan no worn region stands out, but the bore's "
+            f"wear_map: without a before-wear scan no significant wear stands out (max "
+            f"{depth * 1e6:.3g} ± {u_depth * 1e6:.2g} µm), but the bore's "
             f"lobing ({lobing * 1e6:.3g} µm RMS, instrument noise {noise * 1e6:.3g} µm) could "
             "hold wear as broad as its lobes: whether the bore is unworn or evenly worn "
             f"cannot be separated from its form; {fix}"

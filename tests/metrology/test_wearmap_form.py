@@ -72,7 +72,7 @@ def test_tapered_lobed_bores_right_within_u_or_refused():
             out = wear_map(scan)
         except BadInputError as exc:
             assert "--before" in str(exc) and "cannot be separated" in str(exc)
-            assert lobe > 0, f"a bore without lobing must be read: {exc}"
+            assert lobe > 0 or depth == 0, f"a bore without lobing must be read: {exc}"
             continue
         accepted += 1
         true_v = worn_volume(wear, Z, TH, R)
@@ -119,12 +119,22 @@ def test_issue_case_tapered_bore_through_the_cli(tmp_path, capsys):
 
 def test_wear_as_wide_as_the_lobes_is_refused_not_absorbed():
     scan, _ = _bore(5, 1.5, 8.0, 20, seed=2)
-    with pytest.raises(BadInputError, match=r"depends on the form model.*cannot be separated"):
+    with pytest.raises(BadInputError, match=r"cannot be separated.*--before"):
         wear_map(scan)
 
 
-def test_unworn_bore_reports_no_wear_within_u():
-    scan, _ = _bore(20, 1.0, 0.0, seed=5)
+def test_unworn_bore_reports_no_wear_within_u_or_refuses_when_lobed():
+    scan, _ = _bore(20, 0.0, 0.0, seed=5)
     out = wear_map(scan)
     assert abs(out["worn_volume"].item()) <= 3 * out["worn_volume_u"].item()
     assert out["max_wear_depth"].item() <= 3 * out["max_wear_depth_u"].item()
+    # lobed: an even, broad wear would hide in the lobes - not "unworn", refused
+    lobed, _ = _bore(20, 1.0, 0.0, seed=5)
+    with pytest.raises(BadInputError, match=r"no significant wear.*lobing.*--before"):
+        wear_map(lobed)
+
+
+def test_broad_shallow_groove_on_a_lobed_bore_is_refused_not_absorbed():
+    scan, _ = _bore(22, 0.3, 1.0, 31, seed=3)
+    with pytest.raises(BadInputError, match="cannot be separated"):
+        wear_map(scan)
