@@ -236,14 +236,16 @@ def _robust_reference(
         if mask.sum() < X.shape[1] + 2:
             raise BadInputError(
                 f"{what}: only {int(mask.sum())} unworn points left to fit the reference; "
-                "pass a before-wear scan, a larger threshold, or an explicit unworn mask"
+                "pass a before-wear scan (before=..., CLI --before BEFORE.nc), a larger threshold, "
+                "or an explicit unworn mask"
             )
         try:
             b, fitted, G = _lsq(X, d, mask)
         except np.linalg.LinAlgError:
             raise BadInputError(
                 f"{what}: the unworn points do not determine the reference (they cover too "
-                "little of the circumference); pass a before-wear scan or an explicit unworn mask"
+                "little of the circumference), so wear cannot be separated from form; pass a "
+                "before-wear scan (before=..., CLI --before BEFORE.nc) or an explicit unworn mask"
             ) from None
         resid = d - fitted
         if unworn is not None:
