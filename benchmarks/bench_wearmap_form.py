@@ -21,7 +21,7 @@ sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT.parent / "tests" / "metrology"))
 
 from _common import write_results  # noqa: E402
-from test_wearmap_form import R, TH, Z, _bore  # noqa: E402
+from test_wearmap_form import TH, R, Z, _bore  # noqa: E402
 
 from jointwear.errors import BadInputError  # noqa: E402
 from jointwear.metrology.wearmap import wear_map, worn_volume  # noqa: E402
