@@ -515,21 +515,13 @@ def assess_cmd(
         typer.echo(f"{scan_path}  (filter: {result.attrs['filter']}; values in µm)")
         typer.echo(table.to_string(index=False, float_format=lambda v: f"{v:.3f}"))
         if target is not None:
-            result.attrs["source"] = _SOURCE
-            io.save(
-                result,
-                target,
-                inputs=[scan_path],
-                parameters={
-                    "filter_upr": filter_upr,
-                    "filter_kind": filter_kind,
-                    "references": list(refs),
-                    "outliers": outliers,
-                },
-                source=_SOURCE,
-                parents=[scan],
-            )
-            typer.echo(f"wrote {target}")
+            params = {
+                "filter_upr": filter_upr,
+                "filter_kind": filter_kind,
+                "references": list(refs),
+                "outliers": outliers,
+            }
+            _save_form(result, target, scan_path, scan, params)
         table.insert(0, "scan", str(scan_path))
         tables.append(table)
     if csv is not None and tables:
@@ -643,6 +635,15 @@ def plot_cmd(
         raise BadInputError(f"--layers {layers!r}: expected integers like 0,6,12") from None
     plt.close(plot_wear_map(ds, layers=idx, path=out, title=title))
     typer.echo(f"wrote {out}")
+
+
+def _save_form(result, target: Path, scan_path: Path, scan, params: dict) -> None:
+    """Write one scan's form assessment (netCDF, provenance of the scan)."""
+    from jointwear import io
+
+    result.attrs["source"] = _SOURCE
+    io.save(result, target, inputs=[scan_path], parameters=params, source=_SOURCE, parents=[scan])
+    typer.echo(f"wrote {target}")
 
 
 def _wear_summary(ds) -> str:

@@ -347,3 +347,27 @@ def test_gradians_when_stated(tmp_path):
         read_scan(h, convention=CONV, value="deviation")
     ds = _apply(h, e.value, base={"value": "deviation"})
     np.testing.assert_allclose(np.sort(ds["theta"].values), TH, atol=1e-6)
+
+
+def test_cli_speaks_the_suggested_flags_and_they_work(tmp_path, capsys):
+    """The command line names the refusal's fix as flags; running them reads the file right."""
+    import re as _re
+    import shlex
+
+    from jointwear import io
+    from jointwear.cli import main
+
+    r_mm = 8.0 + 1e-3 * DEV_UM
+    f = _write(
+        tmp_path / "um.txt", _rows(TH, r_mm, fv="{:.7f}"), "Units: um\nAngle (deg)\tRadius\n"
+    )
+    conv = ["--angle-zero", "-x", "--angle-direction", "clockwise"]
+    out = tmp_path / "s.nc"
+    assert main(["metrology", "import", str(f), "--out", str(out), *conv]) == 3
+    err = capsys.readouterr().err
+    m = _re.search(r"pass (--ignore-header units --units mm)", err)
+    assert m, err
+    flags = shlex.split(m.group(1))
+    assert main(["metrology", "import", str(f), "--out", str(out), *conv, *flags]) == 0
+    ds = io.load(out)
+    np.testing.assert_allclose(ds["radius"].values[0], np.round(r_mm, 7) * 1e-3, rtol=1e-12)
