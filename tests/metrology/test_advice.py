@@ -8,6 +8,7 @@ suggestion applied must read the file right or lead to a different refusal."""
 from __future__ import annotations
 
 import os
+import re
 
 import numpy as np
 import pytest
@@ -121,9 +122,15 @@ def _write_corpus_file(d, c):
                 lines.append("\t".join(([aname] if acells else []) + [vname or "Value"]))
             for i in range(rows_of):
                 lines.append("\t".join(([acells[i]] if acells else []) + [vcells[k][i]]))
+    dress = c.get("dress", "plain")
+    if dress == "thousands":  # radii in um written as 8,001.2345
+        lines = [re.sub(r"(?<![\d.,])(\d)(\d{3}\.\d+)", r"\1,\2", ln) for ln in lines]
+    elif dress == "quoted":
+        lines = [",".join(f'"{t}"' for t in ln.split("\t")) for ln in lines]
     text = "\n".join(lines) + "\n"
     p = d / "scan.txt"
-    p.write_bytes(text.replace("\n", "\r\n" if c["crlf"] else "\n").encode())
+    raw = text.replace("\n", "\r\n" if c["crlf"] else "\n").encode()
+    p.write_bytes(raw + (b"\x1a" if dress == "ctrlz" else b""))
     return p, truth_opts, (th, z - 0.5 * (z[0] + z[-1]), r if kind == "radius" else r - R0)
 
 
@@ -218,6 +225,7 @@ def _random_case(rng) -> dict:
         },
         crlf=bool(rng.integers(2)),
         given_truth={k for k in ("units", "value", "angle_unit", "arc") if rng.integers(2)},
+        dress=pick(["plain", "plain", "quoted", "ctrlz", "thousands"]),
     )
     if case["layout"] == "long" and case["zname"] == "probe":
         case["zname"] = "z"
