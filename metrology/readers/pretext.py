@@ -39,7 +39,7 @@ def normalise(text: str, path: str, thousands: str | None) -> tuple[str, dict[st
             "readable); export the trace as text/CSV (one angle and one value per "
             "line) or convert it to CSV first"
         )
-    body = [ln for ln in text.splitlines()[:400] if ln.strip()]
+    body = [ln for ln in text[:65536].splitlines()[:400] if ln.strip()]
     if sum(bool(_DMS.search(ln)) for ln in body) > max(3, len(body) // 4):
         raise Refusal(
             f"'{path}': the angles are written in degrees-minutes-seconds (e.g. 12°30'15\"), "
@@ -72,7 +72,7 @@ def _is_data(line: str) -> bool:
 
 def _thousands(text: str) -> str | None:
     """A thousands separator shown unambiguously: a number holding both separators."""
-    lines = [ln for ln in text.splitlines()[:400] if _is_data(ln)]
+    lines = [ln for ln in text[:65536].splitlines()[:400] if _is_data(ln)]
     for sep, dec in ((",", "."), (".", ","), ("'", "."), ("'", ",")):
         pat = re.compile(rf"\b\d{{1,3}}(?:{re.escape(sep)}\d{{3}})+{re.escape(dec)}\d+")
         if sum(bool(pat.search(ln)) for ln in lines) >= max(1, len(lines) // 10):
@@ -109,6 +109,10 @@ def _numeric(line: str) -> bool:
     )
 
 
+_FIRST_NUMBER = re.compile(r"^[ \t]*[-+]?(?:\d|[.,]\d)", re.M)
+_WORDY = re.compile(r"[A-DF-Za-df-z]")
+
+
 def split_blocks(text: str) -> list[tuple[str, list[int]]] | None:
     """Concatenated per-layer blocks: [(block text, file line number of each block line)], or
     None when the file is one table.
@@ -118,6 +122,9 @@ def split_blocks(text: str) -> list[tuple[str, list[int]]] | None:
     file's own header (before the first block) is repeated in every block; a block's own lines
     override it. A line like ``Layer 2`` becomes ``Layer number: 2``.
     """
+    first = _FIRST_NUMBER.search(text)
+    if first is None or not _WORDY.search(text, first.start()):
+        return None  # no line with words after the table starts: one table (fast path)
     lines = text.splitlines()
     runs: list[tuple[int, int]] = []  # [start, end) of numeric runs (blank lines inside allowed)
     i = 0
