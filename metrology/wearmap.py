@@ -215,7 +215,7 @@ def _robust_reference(
     margin_deg: float = 5.0,
     smooth_deg: float = 2.0,
     start: np.ndarray | None = None,
-    one_sided: bool = False,
+    one_sided: bool = True,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, float, int]:
     """Fit X b ~ d on the unworn points (found iteratively unless given).
 
@@ -226,6 +226,8 @@ def _robust_reference(
     """
     finite = np.isfinite(d)
     mask = finite.copy() if unworn is None else (finite & unworn)
+    if start is None and unworn is None and one_sided and not isinstance(X, FormBasis):
+        start = _lower_quantile_start(X, d, finite, threshold)
     if start is not None and unworn is None:
         mask = finite & start
     n_iter = 0
@@ -590,8 +592,22 @@ def wear_map(
     )
     if alt is not None:
         other = alt[0].reshape(rw.shape)
-        _model_order_term(q, other, wts, z, th)
+        _model_order_term(q, other, wts, z, th, "form-model order")
         u = np.hypot(u, wear - other)  # each depth's dependence on the model order
+    if rbz is not None and mask_in is None and not mask2.all():
+        # faint wear tails next to the worn region bias the reference: refit without the
+        # points within a further 10 degree of it and count the change
+        narrower = _dilate(mask2, th, 10.0).ravel()
+        if narrower.sum() > 0.1 * narrower.size:
+            try:
+                sel, *_ = _robust_reference(
+                    d, X, threshold, narrower, 1, "wear_map", rw.shape, th, margin_deg
+                )
+                other = sel.reshape(rw.shape)
+                _model_order_term(q, other, wts, z, th, "unworn selection")
+                u = np.hypot(u, wear - other)
+            except BadInputError:
+                pass
     noise = noise_sigma(wear)  # successive differences of the residual: the probe noise
     if rbz is None:
         lobing = _lobing_rms((d - resid).reshape(rw.shape)) if isinstance(X, FormBasis) else 0.0
@@ -864,12 +880,39 @@ def _reference(d, X, shape, z, th, harmonics, threshold, mask_in, max_iter, marg
     return basis, fit, alt
 
 
-def _model_order_term(q: dict, other: np.ndarray, wts: np.ndarray, z, th) -> None:
-    """Add, in quadrature, how much each quantity changes at the neighbouring lobing order
-    (the choice of the form model's order is a source of uncertainty)."""
+def _model_order_term(q: dict, other: np.ndarray, wts: np.ndarray, z, th, what: str) -> None:
+    """Add, in quadrature, how much each quantity changes under another defensible choice
+    (the form model's order, the unworn selection): a source of uncertainty."""
     zeros = np.zeros_like(other)
     alt = derived_quantities(other, zeros, 0.0, 1.0, np.zeros(1), np.zeros((1, 1)), wts, z, th)
     for name, (v, u, comment) in list(q.items()):
         dv = abs(alt[name][0] - v)
         if np.isfinite(dv):
-            q[name] = (v, float(np.hypot(u, dv)), comment + f"; form-model order ({dv:.3g})")
+            q[name] = (v, float(np.hypot(u, dv)), comment + f"; {what} ({dv:.3g})")
+
+
+def _lower_quantile_start(X, d: np.ndarray, finite: np.ndarray, threshold: float, tau=0.25):
+    """First unworn set from a ``tau``-quantile fit (iteratively reweighted least squares).
+
+    Wear only removes material, so it lies above the unworn surface: a low quantile of the
+    data is hardly pulled by a broad groove, which a least-squares fit to all points absorbs
+    (into the centre terms, then nothing stands out and the map reads zero wear).
+    """
+    dd = np.where(finite, d, 0.0)
+    w = finite.astype(float)
+    r = dd
+    for _ in range(30):
+        try:
+            _, fitted, _ = _lsq(X, dd, w)
+        except np.linalg.LinAlgError:
+            return finite
+        r = dd - fitted
+        scale = max(float(np.median(np.abs(r[finite]))), _SCALE_FLOOR)
+        w = np.where(
+            finite, np.where(r > 0, tau, 1.0 - tau) / np.maximum(np.abs(r), 1e-3 * scale), 0.0
+        )
+    rf = r[finite]
+    med = np.median(rf[rf <= np.percentile(rf, 50)])  # centre of the lower half
+    low = rf[rf <= np.percentile(rf, 50)]
+    scale = max(1.4826 * np.median(np.abs(low - np.median(low))) * 1.5, _SCALE_FLOOR)
+    return finite & (r - med <= threshold * scale)

