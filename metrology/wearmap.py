@@ -39,7 +39,14 @@ from jointwear.conventions import (
     z_coord,
 )
 from jointwear.errors import BadInputError
+from jointwear.metrology.baseline import (
+    FormBasis,
+    correlation_length,
+    noise_sigma,
+    select_harmonics,
+)
 from jointwear.metrology.form import cylinder_zone
+from jointwear.metrology.wear_quantities import derived_quantities, uncertainty_attrs
 
 __all__ = ["wear_map", "worn_volume", "register_angle"]
 
@@ -150,6 +157,8 @@ class _LayerBasis:
 
 def _lsq(X, d: np.ndarray, mask: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Least squares of d on the masked rows: (coefficients, fitted values, normal matrix)."""
+    if isinstance(X, FormBasis):
+        return X.lsq(d, mask)
     if isinstance(X, _LayerBasis):
         B = X.block
         m = mask.reshape(X.nz, -1).astype(float)
@@ -167,6 +176,8 @@ def _lsq(X, d: np.ndarray, mask: np.ndarray) -> tuple[np.ndarray, np.ndarray, np
 def _fit_variance(X, G: np.ndarray, s2: float) -> np.ndarray:
     """Variance of the fitted reference at every point [m^2]."""
     cov = np.linalg.inv(G) * s2
+    if isinstance(X, FormBasis):
+        return X.fit_variance(cov)
     if isinstance(X, _LayerBasis):
         return np.einsum("jn,ljk,kn->ln", X.block, cov, X.block).ravel()
     return np.einsum("nj,jk,nk->n", X, cov, X)
@@ -203,6 +214,8 @@ def _robust_reference(
     theta_deg: np.ndarray | None = None,
     margin_deg: float = 5.0,
     smooth_deg: float = 2.0,
+    start: np.ndarray | None = None,
+    one_sided: bool = True,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, float, int]:
     """Fit X b ~ d on the unworn points (found iteratively unless given).
 
@@ -213,6 +226,10 @@ def _robust_reference(
     """
     finite = np.isfinite(d)
     mask = finite.copy() if unworn is None else (finite & unworn)
+    if start is None and unworn is None and one_sided and not isinstance(X, FormBasis):
+        start = _lower_quantile_start(X, d, finite, threshold)
+    if start is not None and unworn is None:
+        mask = finite & start
     n_iter = 0
     win = 1
     if shape is not None and theta_deg is not None:
@@ -221,14 +238,16 @@ def _robust_reference(
         if mask.sum() < X.shape[1] + 2:
             raise BadInputError(
                 f"{what}: only {int(mask.sum())} unworn points left to fit the reference; "
-                "pass a before-wear scan, a larger threshold, or an explicit unworn mask"
+                "pass a before-wear scan (before=..., CLI --before BEFORE.nc), a larger threshold, "
+                "or an explicit unworn mask"
             )
         try:
             b, fitted, G = _lsq(X, d, mask)
         except np.linalg.LinAlgError:
             raise BadInputError(
                 f"{what}: the unworn points do not determine the reference (they cover too "
-                "little of the circumference); pass a before-wear scan or an explicit unworn mask"
+                "little of the circumference), so wear cannot be separated from form; pass a "
+                "before-wear scan (before=..., CLI --before BEFORE.nc) or an explicit unworn mask"
             ) from None
         resid = d - fitted
         if unworn is not None:
@@ -237,13 +256,18 @@ def _robust_reference(
         med = np.median(rm)
         # floor: 10 pm, far below any instrument's resolution (noise-free synthetic data)
         scale = max(1.4826 * np.median(np.abs(rm - med)), _SCALE_FLOOR)
-        new = finite & (np.abs(resid - med) <= threshold * scale)
+        if one_sided:  # wear removes material: only a high residual can be wear
+            new = finite & (resid - med <= threshold * scale)
+            new &= resid - med >= -2.0 * threshold * scale  # dents and spikes
+        else:
+            new = finite & (np.abs(resid - med) <= threshold * scale)
         if shape is not None and theta_deg is not None:
             sm = _smooth_theta(resid.reshape(shape), win)
             smm = sm.ravel()[mask]
             smed = np.nanmedian(smm)
             sscale = max(1.4826 * np.nanmedian(np.abs(smm - smed)), _SCALE_FLOOR)
-            region = ~(np.abs(sm - smed) > threshold * sscale)
+            high = (sm - smed) if one_sided else np.abs(sm - smed)
+            region = ~(high > threshold * sscale)
             region = _dilate(region, theta_deg, margin_deg)
             new &= region.ravel()
         changed = int(np.count_nonzero(new != mask))
@@ -348,14 +372,16 @@ def wear_map(
     *,
     angle_offset_deg: float = 0.0,
     register: bool = False,
-    shape: str = "cylinder",
+    shape: str = "auto",
     threshold: float = 3.0,
     unworn: np.ndarray | xr.DataArray | None = None,
     surface: str = "bore",
     radius: float | None = None,
-    margin_deg: float = 5.0,
+    margin_deg: float | None = None,
     exact_centring: bool = True,
     max_iter: int = 30,
+    harmonics: int = 4,
+    axial_degree: int = 2,
 ) -> xr.Dataset:
     """Wear depth over (z, theta) from a worn scan and a before-scan or a fitted reference.
 
@@ -374,9 +400,13 @@ def wear_map(
     register : bool
         Estimate the offset by correlating the unworn regions instead (added to
         ``angle_offset_deg``). Only when asked.
-    shape : {"cylinder", "circle"}
-        Reference fitted to the unworn points: a limaçon cylinder (centre and tilt, default) or
-        one circle per layer.
+    shape : {"auto", "cylinder", "circle", "form"}
+        Reference fitted to the unworn points: a limaçon cylinder (centre and tilt), one circle
+        per layer, or the form model of :mod:`~jointwear.metrology.baseline` (a centre per layer,
+        taper/barrel and lobing smooth in z). ``auto``: cylinder with a before-scan (the form
+        cancels in the difference), form without one.
+    harmonics, axial_degree : int
+        Highest lobing harmonic and degree in z of the form model (``shape="form"``).
     threshold : float
         Unworn points lie within ``threshold`` robust standard deviations of the reference.
     unworn : bool array (z, theta), optional
@@ -387,8 +417,9 @@ def wear_map(
     radius : float, optional
         Bore radius for the worn volume [m]; by default the mean worn radius (``radius`` data) or
         the ``nominal_radius`` attribute (deviation data).
-    margin_deg : float
-        Points within this angle [degree] of a worn region are not used as unworn reference.
+    margin_deg : float, optional
+        Points within this angle [degree] of a worn region are not used as unworn reference
+        (default 5, or 15 for the form model, where faint wear tails would bias the form).
     exact_centring : bool
         Re-centre each scan exactly on its own axis before differencing (needs the bore radius:
         ``radius`` data, the ``nominal_radius`` attribute or ``radius=``); removes the
@@ -404,8 +435,14 @@ def wear_map(
         ``worn_volume`` and ``worn_volume_u`` [m^3], ``cylindricity_before`` and
         ``cylindricity_after`` [m] (MZ), ``angle_offset`` [degree]; method in attrs.
     """
-    if shape not in ("cylinder", "circle"):
-        raise BadInputError(f"wear_map: shape must be 'cylinder' or 'circle', got {shape!r}")
+    if shape not in ("auto", "cylinder", "circle", "form"):
+        raise BadInputError(
+            f"wear_map: shape must be 'auto', 'cylinder', 'circle' or 'form', got {shape!r}"
+        )
+    if shape == "auto":
+        shape = "cylinder" if before is not None else "form"
+    if margin_deg is None:  # without a before-scan faint wear tails would bias the form fit
+        margin_deg = 15.0 if shape == "form" else 5.0
     if surface not in ("bore", "shaft"):
         raise BadInputError(f"wear_map: surface must be 'bore' or 'shaft', got {surface!r}")
     if not threshold > 0:
@@ -415,7 +452,10 @@ def wear_map(
     th = np.asarray(w["theta"].values, dtype=float)
     rw = np.asarray(w.values, dtype=float)
     sign = 1.0 if surface == "bore" else -1.0
-    X = _basis(z, th, shape)
+    if shape == "form":
+        X = FormBasis(z, th, harmonics, axial_degree)
+    else:
+        X = _basis(z, th, shape)
     Xcyl = X if shape == "cylinder" else _basis(z, th, "cylinder")
     mask_in = None
     if unworn is not None:
@@ -494,14 +534,20 @@ def wear_map(
             raise BadInputError("wear_map: register=True needs a before scan")
         d = sign * rw.ravel()
         rbz = None
+        model = {
+            "cylinder": "a limaçon cylinder",
+            "circle": "a limaçon circle per layer",
+            "form": f"the form model (a centre per layer; radius and lobing 2..{getattr(X, 'harmonics', 0)} UPR "
+            f"as polynomials of degree {getattr(X, 'deg', 0)} in z)",
+        }[shape]
         method = (
-            "residual from a least-squares limaçon "
-            + ("cylinder" if shape == "cylinder" else "circle per layer")
-            + " fitted to the unworn part of the worn scan (no before-wear scan)"
+            f"residual from {model} fitted by least squares to the unworn part of the worn "
+            "scan (no before-wear scan)"
         )
-    resid, mask, var_fit, s2, n_iter = _robust_reference(
-        d, X, threshold, mask_in, max_iter, "wear_map", rw.shape, th, margin_deg
+    X, fit, alt = _reference(
+        d, X, shape, z, th, harmonics, threshold, mask_in, max_iter, margin_deg
     )
+    resid, mask, var_fit, s2, n_iter = fit
     # exact centring: the limaçon leaves each scan's e^2/(4R) second harmonic, which differs
     # between set-ups; with the bore radius known, re-centre each scan exactly on its own axis
     # (fitted to the unworn points) and redo the fit
@@ -509,7 +555,11 @@ def wear_map(
     centring = "limaçon only (bore radius unknown: pass radius= for exact centring)"
     if not exact_centring:
         centring = "limaçon only (exact_centring=False)"
-    elif r0_w is not None:
+    elif isinstance(X, FormBasis):
+        centring = (
+            "form model: its second harmonic, quadratic in z, holds the limaçon's e^2/(4R) term"
+        )
+    elif r0_w is not None and not isinstance(X, FormBasis):
         rw_c = _recentre(rw + r0_w, z, th, mask)
         if rbz is not None:
             r0_b = 0.0 if bname == "radius" else (radius or _attr_radius(before, b) or r0_w)
@@ -517,9 +567,10 @@ def wear_map(
             d = sign * (rw_c - rb_c).ravel()
         else:
             d = sign * (rw_c - r0_w).ravel()
-        resid, mask, var_fit, s2, n_iter = _robust_reference(
-            d, X, threshold, mask_in, max_iter, "wear_map", rw.shape, th, margin_deg
+        X, fit, alt = _reference(
+            d, X, shape, z, th, harmonics, threshold, mask_in, max_iter, margin_deg
         )
+        resid, mask, var_fit, s2, n_iter = fit
         centring = (
             "exact: each scan re-centred on its own least-squares axis (unworn points), then the "
             "limaçon reference fitted to the unworn points"
@@ -527,53 +578,43 @@ def wear_map(
     wear = resid.reshape(rw.shape)
     u = np.sqrt(s2 + var_fit).reshape(rw.shape)
     mask2 = mask.reshape(rw.shape)
-
-    # radius for the volume
-    if radius is None:
-        if wname == "radius":
-            radius = float(np.nanmean(rw))
-        else:
-            radius = _attr_radius(worn, w)
-    if radius is None or not np.isfinite(radius) or radius <= 0:
-        raise BadInputError(
-            "wear_map: the worn scan holds radial deviations without a 'nominal_radius' "
-            "attribute; pass radius=<bore radius in m> for the worn volume"
-        )
-    vol = worn_volume(wear, z, th, radius)
+    radius = _volume_radius(radius, wname, rw, worn, w)
     wts = _z_weights(z)[:, None] * _theta_weights(th)[None, :] * radius
-    sd_fit = np.sqrt(var_fit).reshape(rw.shape)
-    vol_u = float(np.hypot(np.sum(wts * sd_fit), np.sqrt(np.sum(wts**2) * s2)))
+    _, _, G = _lsq(X, d, mask)
+    cov = np.linalg.inv(G) * s2
+    if cov.ndim == 3:  # one block per layer (circle per layer)
+        from scipy.linalg import block_diag
 
-    cyl_after = (
-        cylinder_zone(
-            np.broadcast_to(z[:, None], rw.shape), np.broadcast_to(th, rw.shape), rw
-        ).total
-        if z.size > 1
-        else float("nan")
+        cov = block_diag(*cov)
+    tau = correlation_length(wear, mask2)
+    q = derived_quantities(
+        wear, var_fit.reshape(rw.shape), s2, tau, _design_sum(X, wts), cov, wts, z, th
     )
-    if rbz is not None:
-        cyl_before = (
-            cylinder_zone(
-                np.broadcast_to(z[:, None], rbz.shape), np.broadcast_to(thb, rbz.shape), rbz
-            ).total
-            if z.size > 1
-            else float("nan")
-        )
-        cyl_before_note = "MZ cylindricity of the before-wear scan"
-    else:
-        masked = np.where(mask2, rw, np.nan)
-        cyl_before = (
-            cylinder_zone(
-                np.broadcast_to(z[:, None], rw.shape), np.broadcast_to(th, rw.shape), masked
-            ).total
-            if z.size > 1
-            else float("nan")
-        )
-        cyl_before_note = (
-            "MZ cylindricity of the unworn points of the worn scan (estimate of the "
-            "cylindricity before wear; no before-wear scan)"
-        )
-
+    if alt is not None:
+        other = alt[0].reshape(rw.shape)
+        _model_order_term(q, other, wts, z, th, "form-model order")
+        u = np.hypot(u, wear - other)  # each depth's dependence on the model order
+    if rbz is not None and mask_in is None and not mask2.all():
+        # faint wear tails next to the worn region bias the reference: refit without the
+        # points within a further 10 degree of it and count the change
+        narrower = _dilate(mask2, th, 10.0).ravel()
+        if narrower.sum() > 0.1 * narrower.size:
+            try:
+                sel, *_ = _robust_reference(
+                    d, X, threshold, narrower, 1, "wear_map", rw.shape, th, margin_deg
+                )
+                other = sel.reshape(rw.shape)
+                _model_order_term(q, other, wts, z, th, "unworn selection")
+                u = np.hypot(u, wear - other)
+            except BadInputError:
+                pass
+    noise = noise_sigma(wear)  # successive differences of the residual: the probe noise
+    if rbz is None:
+        lobing = _lobing_rms((d - resid).reshape(rw.shape)) if isinstance(X, FormBasis) else 0.0
+        _separable(q, s2, noise, mask2, threshold, lobing)
+    cyl_after, cyl_before, cyl_before_note = _cylindricities(
+        rw, rbz, z, th, thb if rbz is not None else th, mask2
+    )
     zc = z_coord(z)
     tc = theta_coord(th, CANONICAL)
     out = xr.Dataset(
@@ -590,7 +631,14 @@ def wear_map(
             "wear_depth_u": (
                 ("z", "theta"),
                 u,
-                {"units": "m", "long_name": "standard uncertainty of wear_depth"},
+                {
+                    "units": "m",
+                    "long_name": "standard uncertainty of wear_depth",
+                    **uncertainty_attrs(
+                        "scatter of the unworn points about the reference (instrument noise, "
+                        "unmodelled form and set-up) and the fitted reference's standard error"
+                    ),
+                },
             ),
             "unworn": (
                 ("z", "theta"),
@@ -602,26 +650,7 @@ def wear_map(
                     "flag_meanings": "worn_or_outlier unworn_reference",
                 },
             ),
-            "worn_volume": (
-                (),
-                vol,
-                {
-                    "units": "m3",
-                    "long_name": "volume of material removed over the measured band",
-                    "ancillary_variables": "worn_volume_u",
-                },
-            ),
-            "worn_volume_u": (
-                (),
-                vol_u,
-                {"units": "m3", "long_name": "standard uncertainty of worn_volume"},
-            ),
-            "cylindricity_before": ((), cyl_before, {"units": "m", "long_name": cyl_before_note}),
-            "cylindricity_after": (
-                (),
-                cyl_after,
-                {"units": "m", "long_name": "MZ cylindricity of the worn scan"},
-            ),
+            **_scalars(q, cyl_before, cyl_after, cyl_before_note, noise),
             "angle_offset": (
                 (),
                 offset,
@@ -642,6 +671,8 @@ def wear_map(
             ),
             "n_unworn_points": int(mask.sum()),
             "reference_rms_residual": float(np.sqrt(s2)),
+            "residual_correlation_length_samples": float(tau),
+            "instrument_noise_estimate": float(noise),
             "volume_radius": float(radius),
             "surface": surface,
             "registered": bool(register),
@@ -679,3 +710,209 @@ def _attr_radius(orig: xr.Dataset | xr.DataArray, da: xr.DataArray) -> float | N
                 except (TypeError, ValueError):
                     pass
     return None
+
+
+def _volume_radius(radius, wname, rw, worn, w) -> float:
+    """Bore radius for the volume [m]: given, the mean radius, or the nominal radius."""
+    if radius is None:
+        radius = float(np.nanmean(rw)) if wname == "radius" else _attr_radius(worn, w)
+    if radius is None or not np.isfinite(radius) or radius <= 0:
+        raise BadInputError(
+            "wear_map: the worn scan holds radial deviations without a 'nominal_radius' "
+            "attribute; pass radius=<bore radius in m> for the worn volume"
+        )
+    return float(radius)
+
+
+def _design_sum(X, w: np.ndarray) -> np.ndarray:
+    """sum_i w_i X_i over all points (p,): the volume's sensitivity to the coefficients."""
+    if isinstance(X, FormBasis):
+        return X.weighted_sum(w)
+    if isinstance(X, _LayerBasis):
+        return (w @ X.block.T).ravel()
+    return w.ravel() @ X
+
+
+def _lobing_rms(surface: np.ndarray) -> float:
+    """RMS of the harmonics 2 and up of a fitted surface (nz, nt) [m]."""
+    spec = np.fft.rfft(surface, axis=1) / surface.shape[1]
+    return float(np.sqrt(np.mean(2.0 * np.sum(np.abs(spec[:, 2:]) ** 2, axis=1))))
+
+
+def _separable(
+    q: dict, s2: float, noise: float, unworn: np.ndarray, threshold: float, lobing: float
+) -> None:
+    """Refuse a map without a before-scan where wear cannot be told from form."""
+    frac = float(unworn.mean())
+    fix = (
+        "pass the scan of the bore before wear (before=..., CLI --before BEFORE.nc), or an "
+        "explicit unworn mask"
+    )
+    if frac < 0.25:
+        raise BadInputError(
+            f"wear_map: only {frac:.0%} of the points look unworn: too little of the bore is "
+            f"left to fit its unworn form, so wear cannot be separated from form; {fix}"
+        )
+    depth, u_depth, _ = q["max_wear_depth"]
+    s = float(np.sqrt(s2))
+    if depth < 5.0 * u_depth and np.isfinite(noise) and lobing > 5.0 * noise:
+        raise BadInputError(
+            f"wear_map: without a before-wear scan no significant wear stands out (max "
+            f"{depth * 1e6:.3g} ± {u_depth * 1e6:.2g} µm), but the bore's "
+            f"lobing ({lobing * 1e6:.3g} µm RMS, instrument noise {noise * 1e6:.3g} µm) could "
+            "hold wear as broad as its lobes: whether the bore is unworn or evenly worn "
+            f"cannot be separated from its form; {fix}"
+        )
+    if u_depth > 0.3 * depth and not (np.isfinite(noise) and u_depth <= 5.0 * noise):
+        raise BadInputError(
+            f"wear_map: without a before-wear scan the wear found (max {depth * 1e6:.3g} µm) "
+            f"depends on the form model (standard uncertainty {u_depth * 1e6:.2g} µm, including "
+            "the change at the neighbouring lobing order): the worn region is as wide as the "
+            f"bore's lobes, so wear cannot be separated from form; {fix}"
+        )
+    if np.isfinite(noise) and s > 3.0 * noise and depth < 5.0 * s:
+        raise BadInputError(
+            f"wear_map: without a before-wear scan the form model leaves {s * 1e6:.3g} µm RMS "
+            f"on the unworn points (instrument noise {noise * 1e6:.3g} µm): unmodelled form of "
+            f"the size of the wear found (max {depth * 1e6:.3g} ± {u_depth * 1e6:.2g} µm), so "
+            f"wear cannot be separated from form; {fix}"
+        )
+
+
+def _cylindricities(rw, rbz, z, th, thb, unworn):
+    """(MZ cylindricity of the worn scan, of the before-scan or the unworn points, note)."""
+    if z.size < 2:
+        return float("nan"), float("nan"), "not assessed: one layer"
+
+    def zone(v, t):
+        return cylinder_zone(
+            np.broadcast_to(z[:, None], v.shape), np.broadcast_to(t, v.shape), v
+        ).total
+
+    if rbz is not None:
+        return zone(rw, th), zone(rbz, thb), "MZ cylindricity of the before-wear scan"
+    return (
+        zone(rw, th),
+        zone(np.where(unworn, rw, np.nan), th),
+        "MZ cylindricity of the unworn points of the worn scan (estimate of the cylindricity "
+        "before wear; no before-wear scan)",
+    )
+
+
+_LONG = {
+    "worn_volume": ("m3", "volume of material removed over the measured band"),
+    "max_wear_depth": ("m", "largest wear depth (map averaged over about 1 degree)"),
+    "wear_cylindricity": ("m", "MZ cylindricity of the wear map"),
+}
+
+
+def _scalars(q: dict, cyl_before, cyl_after, note: str, noise: float) -> dict:
+    """The map's scalar quantities with their ``_u`` variables."""
+    out = {}
+    for name, (v, u, comment) in q.items():
+        unit, long_name = _LONG[name]
+        out[name] = (
+            (),
+            v,
+            {"units": unit, "long_name": long_name, "ancillary_variables": f"{name}_u"},
+        )
+        out[f"{name}_u"] = (
+            (),
+            u,
+            {
+                "units": unit,
+                "long_name": f"standard uncertainty of {name}",
+                **uncertainty_attrs(comment),
+            },
+        )
+    u_zone = float(np.sqrt(2.0) * noise) if np.isfinite(cyl_after) else float("nan")
+    zone_comment = (
+        "instrument noise (from successive differences) at the zone's two extreme points; the "
+        "upward bias of a zone by noise is not corrected"
+    )
+    for name, v, long_name in (
+        ("cylindricity_before", cyl_before, note),
+        ("cylindricity_after", cyl_after, "MZ cylindricity of the worn scan"),
+    ):
+        out[name] = (
+            (),
+            v,
+            {"units": "m", "long_name": long_name, "ancillary_variables": f"{name}_u"},
+        )
+        out[f"{name}_u"] = (
+            (),
+            u_zone,
+            {
+                "units": "m",
+                "long_name": f"standard uncertainty of {name}",
+                **uncertainty_attrs(zone_comment),
+            },
+        )
+    return out
+
+
+def _reference(d, X, shape, z, th, harmonics, threshold, mask_in, max_iter, margin_deg):
+    """(basis used, robust fit, fit at the neighbouring lobing order or None).
+
+    For the form model the lobing order starts at 2 (which also holds the limaçon's
+    e^2/(4R) second harmonic) and grows one harmonic at a time, up to ``harmonics``, while the
+    Bayesian information criterion on the current unworn points asks for more; every stage is
+    refitted robustly (one-sided: only material removed is wear) from the previous stage's
+    unworn points, so that wear found at a low order is not absorbed by a higher one. The fit
+    at the neighbouring order measures how much the result depends on that choice.
+    """
+    shape2d = (z.size, th.size)
+    args = (threshold, mask_in, max_iter, "wear_map", shape2d, th, margin_deg)
+    if not isinstance(X, FormBasis):
+        return X, _robust_reference(d, X, *args), None
+    k = min(2, X.harmonics)
+    basis = FormBasis(z, th, k, X.deg)
+    fit = _robust_reference(d, basis, *args, one_sided=True)
+    while k < X.harmonics:
+        best, _ = select_harmonics(X, d, fit[1])
+        if best <= k:
+            break
+        k += 1
+        basis = FormBasis(z, th, k, X.deg)
+        fit = _robust_reference(d, basis, *args, start=fit[1], one_sided=True)
+    k_alt = k + 1 if k < max(X.harmonics, 3) else k - 1
+    alt = _robust_reference(d, FormBasis(z, th, k_alt, X.deg), *args, start=fit[1], one_sided=True)
+    return basis, fit, alt
+
+
+def _model_order_term(q: dict, other: np.ndarray, wts: np.ndarray, z, th, what: str) -> None:
+    """Add, in quadrature, how much each quantity changes under another defensible choice
+    (the form model's order, the unworn selection): a source of uncertainty."""
+    zeros = np.zeros_like(other)
+    alt = derived_quantities(other, zeros, 0.0, 1.0, np.zeros(1), np.zeros((1, 1)), wts, z, th)
+    for name, (v, u, comment) in list(q.items()):
+        dv = abs(alt[name][0] - v)
+        if np.isfinite(dv):
+            q[name] = (v, float(np.hypot(u, dv)), comment + f"; {what} ({dv:.3g})")
+
+
+def _lower_quantile_start(X, d: np.ndarray, finite: np.ndarray, threshold: float, tau=0.25):
+    """First unworn set from a ``tau``-quantile fit (iteratively reweighted least squares).
+
+    Wear only removes material, so it lies above the unworn surface: a low quantile of the
+    data is hardly pulled by a broad groove, which a least-squares fit to all points absorbs
+    (into the centre terms, then nothing stands out and the map reads zero wear).
+    """
+    dd = np.where(finite, d, 0.0)
+    w = finite.astype(float)
+    r = dd
+    for _ in range(30):
+        try:
+            _, fitted, _ = _lsq(X, dd, w)
+        except np.linalg.LinAlgError:
+            return finite
+        r = dd - fitted
+        scale = max(float(np.median(np.abs(r[finite]))), _SCALE_FLOOR)
+        w = np.where(
+            finite, np.where(r > 0, tau, 1.0 - tau) / np.maximum(np.abs(r), 1e-3 * scale), 0.0
+        )
+    rf = r[finite]
+    med = np.median(rf[rf <= np.percentile(rf, 50)])  # centre of the lower half
+    low = rf[rf <= np.percentile(rf, 50)]
+    scale = max(1.4826 * np.median(np.abs(low - np.median(low))) * 1.5, _SCALE_FLOOR)
+    return finite & (r - med <= threshold * scale)

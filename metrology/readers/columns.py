@@ -15,10 +15,12 @@ COLUMN_KINDS = (
     "angle",  # unit from the header, the user (angle_unit) or the values - else refused
     "angle_deg",
     "angle_rad",
+    "angle_grad",  # gradians (gon): 400 per turn
     "index",
     "x",
     "y",
     "z",
+    "layer",  # layer number: z = number x layer spacing
     "radius",
     "deviation",
     "value",  # radius or deviation: from the user (value_kind) or the values - else refused
@@ -37,6 +39,7 @@ _NAME_RULES: list[tuple[str, str]] = [
     (r"^(y|y[ _-]?coord.*|cart.*y)$", "y"),
     (rf"^{_ANG}[ _-]*(rad|radians?)$|^radians?$", "angle_rad"),
     (rf"^{_ANG}[ _-]*(deg|degrees?|°)$|^(deg|degrees?|°)$", "angle_deg"),
+    (rf"^{_ANG}[ _-]*(gon|grad|gradians?)$|^(gon|gradians?)$", "angle_grad"),
     (rf"^{_ANG}\b", "angle"),  # an angle of unstated unit
     (r"^(index|point|pt|no\.?|n|#|sample|idx|nr\.?)$", "index"),
     (r"^(z|height|level|layer|position|pos|zpos|h)\b", "z"),
@@ -65,10 +68,12 @@ def _kind_from_name(name: str) -> tuple[str | None, str | None]:
         return "angle_rad", None
     if unit and unit.lower() in ("index", "point", "points", "#"):
         return "index", None
+    if unit and unit.lower() in ("gon", "grad", "grads", "gradian", "gradians"):
+        return "angle_grad", None
     if re.match(r"^(z|h|height|layer|level|plane)\s*[=:_]?\s*[-+]?\d", low):
         return None, None  # a per-layer value column of a wide file, named by its z
-    if low_base.startswith("layer") and unit is None:
-        return "z", None
+    if re.fullmatch(r"(layer|plane|trace)[ _]?(no\.?|nr\.?|number|#|index|idx)?", low_base):
+        return ("layer", None) if unit is None else ("z", unit)
     for pat, kind in _NAME_RULES:
         if re.search(pat, low_base):
             return kind, unit
@@ -166,6 +171,10 @@ def _guess_columns(
     # wide: angle + one value column per layer
     if kinds[0] is None and _looks_monotonic(c0):
         kinds[0] = "angle"
+    if kinds[0] in ("angle", "angle_deg", "angle_rad", "angle_grad", "index"):
+        for i in range(1, ncol):  # a second angle column: another probe's trace, not a layer
+            if kinds[i] is None and _looks_monotonic(data[:, i]):
+                kinds[i] = "angle"
     start = 0 if kinds[0] is None else 1  # no angle column: every column is a layer
     vk = next((k for k in kinds[start:] if k in ("radius", "deviation")), None) or "value"
     for i in range(ncol):

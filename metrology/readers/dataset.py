@@ -72,6 +72,9 @@ def _assemble(
         j = np.arange(lay.value.size)
         th0 = float(np.mean(lay.theta_deg - j * step))
         if lay.value.size == n and np.max(np.abs(lay.theta_deg - th0 - j * step)) < 1e-3 * step:
+            k0 = round(th0 / step)
+            if abs(th0 - k0 * step) < 1e-6 * step:  # on the grid: no 359.9999999 for 0
+                th0 = k0 * step
             lay.theta_deg = round(th0, 9) + j * step
             notes["angles_snapped"] = (
                 "angles within 0.1 % of a sample step of a uniform grid were set to that grid"

@@ -20,6 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from jointwear.errors import BadInputError
+from jointwear.metrology.readers.advice import Refusal
 
 __all__ = [
     "ANGLE_UNITS",
@@ -32,13 +33,15 @@ __all__ = [
 ]
 
 #: Units an angle column may have (``index`` = sample number over one full turn).
-ANGLE_UNITS = ("deg", "rad", "index")
+ANGLE_UNITS = ("deg", "rad", "index", "grad")
+#: One full turn in each angle unit that has one.
+TURN = {"deg": 360.0, "rad": 2.0 * np.pi, "grad": 400.0}
 #: Angular spans a layer may have.
 ARCS = ("full", "partial")
 #: Meanings of a value column.
 VALUE_KINDS = ("radius", "deviation")
 
-_ANGLE_FLAG = "angle_unit= (CLI --angle-unit deg|rad|index)"
+_ANGLE_FLAG = "angle_unit= (CLI --angle-unit deg|rad|index|grad)"
 _ARC_FLAG = "arc= (CLI --arc full|partial)"
 _VALUE_FLAG = "value_kind= (CLI --value-kind radius|deviation)"
 
@@ -69,7 +72,12 @@ class AngleReading:
     span_deg: float
 
     def describe(self) -> str:
-        name = {"deg": "degrees", "rad": "radians", "index": "a point index"}[self.unit]
+        name = {
+            "deg": "degrees",
+            "rad": "radians",
+            "index": "a point index",
+            "grad": "gradians",
+        }[self.unit]
         n = self.theta_deg.size
         if self.arc == "full":
             what = f"one full turn of {n} points, {self.span_deg / n:.4g} degree apart"
@@ -129,11 +137,63 @@ def _is_index(a: np.ndarray) -> bool:
     )
 
 
-def _candidates(a: np.ndarray) -> dict[str, np.ndarray]:
+def _candidates(a: np.ndarray, grad: bool = False) -> dict[str, np.ndarray]:
     out = {"deg": a.astype(float), "rad": np.degrees(a)}
     if _is_index(a):
         out["index"] = (a - a[0]) * 360.0 / a.size
+    if grad:  # gradians only when stated: 0..300 is a partial arc in degrees or in gradians
+        out["grad"] = a * 0.9
     return out
+
+
+def closed_profile(a: np.ndarray, unit: str | None) -> list[str]:
+    """Units in which the angle column ends one full turn after it starts (a closed profile
+    repeating its first point as the last), strictly increasing or decreasing."""
+    a = np.asarray(a, dtype=float)
+    if a.size < 5 or not np.all(np.isfinite(a)):
+        return []
+    d = np.diff(a)
+    if not (np.all(d > 0) or np.all(d < 0)):
+        return []
+    step = float(np.median(np.abs(d)))
+    out = []
+    for u, turn in TURN.items():
+        if (unit is None and u == "grad") or (unit is not None and u != unit):
+            continue
+        if abs(abs(a[-1] - a[0]) - turn) <= 1e-9 * turn + 1e-3 * step:
+            out.append(u)
+    return out
+
+
+def rounded_full_turn(a: np.ndarray, unit: str | None) -> tuple[str, np.ndarray, float] | None:
+    """A dense full turn whose angles were written with too few decimals (consecutive rows
+    share an angle): (unit, angles from the row index [degree], rounding step [degree]) when
+    exactly one unit makes every written angle the uniform full-turn grid rounded to the
+    column's resolution, else None."""
+    a = np.asarray(a, dtype=float)
+    if a.size < 8 or not np.all(np.isfinite(a)):
+        return None
+    d = np.diff(a)
+    sgn = 1.0 if np.sum(d > 0) >= np.sum(d < 0) else -1.0
+    d = d * sgn
+    if not np.any(d == 0) or np.any(d < 0):
+        return None
+    res = float(np.min(d[d > 0])) if np.any(d > 0) else 0.0
+    if res <= 0:
+        return None
+    n = a.size
+    fits = []
+    for u, turn in TURN.items():
+        if (unit is None and u == "grad") or (unit is not None and u != unit):
+            continue
+        th = a * (360.0 / turn) * sgn
+        r = res * 360.0 / turn
+        step = 360.0 / n
+        i = np.arange(n)
+        th0 = float(np.median(th - i * step))
+        if np.max(np.abs(th - th0 - i * step)) <= 0.5 * r * (1 + 1e-6) + 1e-9:
+            fits.append((u, sgn * (th0 + i * step), r))
+    return fits[0] if len(fits) == 1 else None
 
 
 def angle_reading(
@@ -169,10 +229,10 @@ def angle_reading(
     """
     a = np.asarray(values, dtype=float)
     if unit is not None and unit not in ANGLE_UNITS:
-        raise BadInputError(f"angle unit {unit!r} is not known; use deg, rad or index")
+        raise BadInputError(f"angle unit {unit!r} is not known; use deg, rad, index or grad")
     if arc is not None and arc not in ARCS:
         raise BadInputError(f"arc {arc!r} is not known; use full or partial")
-    cands = _candidates(a)
+    cands = _candidates(a, grad=unit == "grad")
     if unit == "index" and "index" not in cands:
         raise BadInputError(
             f"{where}: the angle unit is 'index' but the values are not the point numbers "
@@ -211,11 +271,21 @@ def angle_reading(
     if arc is not None:
         readings = [r for r in readings if r.arc == arc]
     if not readings:
-        raise BadInputError(
+        g_kind, _ = _classify(a * 0.9)
+        grad = g_kind in ("full", "partial") and (arc is None or g_kind == arc)
+        raise Refusal(
             f"{where}: no reading of the angle column gives "
             f"{'one full turn' if arc == 'full' else 'a partial arc' if arc else 'at most one turn'}"
-            f" (values {a.min():.6g} to {a.max():.6g}, {a.size} points); check the column "
-            f"meaning (columns=... / --columns) and {_ARC_FLAG}"
+            f" (values {a.min():.6g} to {a.max():.6g}, {a.size} points); "
+            + (
+                "read as gradians (400 per turn) they give "
+                f"{'one full turn' if g_kind == 'full' else 'a partial arc'}: pass "
+                "angle_unit='grad' if they are; otherwise "
+                if grad
+                else ""
+            )
+            + f"check the column meaning (columns=... / --columns) and {_ARC_FLAG}",
+            ({"angle_unit": "grad"},) if grad else (),
         )
     distinct: list[AngleReading] = []
     for r in readings:
@@ -230,12 +300,16 @@ def angle_reading(
         if len(arcs) == len(distinct) and "turns" not in arcs:
             settle.append(_ARC_FLAG)
         settle.append(_ANGLE_FLAG)
-        raise BadInputError(
+        sugg = [{"angle_unit": r.unit} for r in distinct if r.arc != "turns"]
+        if _ARC_FLAG in settle:
+            sugg += [{"arc": r.arc} for r in distinct]
+        raise Refusal(
             f"{where}: the angle unit is ambiguous (values {a.min():.6g} to {a.max():.6g}, "
             f"{a.size} points, no unit in the column name or header): "
             + "; ".join(r.describe() for r in distinct)
             + ". Say which with "
-            + " or ".join(settle)
+            + " or ".join(settle),
+            tuple(sugg),
         )
     r = distinct[0]
     if r.arc == "turns":
@@ -319,26 +393,29 @@ def value_kind(
         bad = np.flatnonzero(np.any(flat <= 0, axis=1))
         if bad.size:
             r = int(bad[0])
-            raise BadInputError(
+            raise Refusal(
                 f"{where}{line(r)}: radius {flat[r][flat[r] <= 0][0]:g} is not positive "
                 f"(the other radii are about {med:g}); a corrupt value? fix or delete the line"
                 + (
                     ""
                     if stated
                     else f", or if the column holds deviations say so with {_VALUE_FLAG}"
-                )
+                ),
+                () if stated else ({"value": "deviation"},),
             )
         if stated is None and robust_dev and not robust_radius:
-            raise BadInputError(
+            raise Refusal(
                 f"{where}: the column name says radius but the values ({finite.min():g} to "
-                f"{finite.max():g}) look like deviations about zero; say which with {_VALUE_FLAG}"
+                f"{finite.max():g}) look like deviations about zero; say which with {_VALUE_FLAG}",
+                ({"value": "radius"}, {"value": "deviation"}),
             )
         return "radius", ("stated" if stated else "from the column name")
     if kind == "deviation":
         if stated is None and robust_radius and not robust_dev:
-            raise BadInputError(
+            raise Refusal(
                 f"{where}: the column name says deviation but the values (median {med:g}, spread "
-                f"{spread:g}) look like radii; say which with {_VALUE_FLAG}"
+                f"{spread:g}) look like radii; say which with {_VALUE_FLAG}",
+                ({"value": "deviation"}, {"value": "radius"}),
             )
         return "deviation", ("stated" if stated else "from the column name")
     if robust_radius and rows_bad.size == 0 and ptp < med / 25:
@@ -353,17 +430,19 @@ def value_kind(
             if rows_bad.size
             else int(np.argmax(np.max(np.abs(flat - med), axis=1)))
         )
-        raise BadInputError(
+        raise Refusal(
             f"{where}{line(r)}: the values look like radii (median {med:g}) except "
             f"{flat[r][np.argmax(np.abs(flat[r] - med))]:g} here - a corrupt value would turn "
             "them into deviations; fix or delete the line, or say what the column holds with "
-            + _VALUE_FLAG
+            + _VALUE_FLAG,
+            ({"value": "radius"}, {"value": "deviation"}),
         )
-    raise BadInputError(
+    raise Refusal(
         f"{where}: cannot tell radius from deviation (median {med:g}, spread {spread:g}, no "
         f"'radius' or 'deviation' in the column name): as radius the bore would be about "
         f"{med:g} with a form error of {ptp:g}; as deviation the offset from the nominal "
-        f"would be {med:g}; say which with {_VALUE_FLAG}"
+        f"would be {med:g}; say which with {_VALUE_FLAG}",
+        ({"value": "radius"}, {"value": "deviation"}),
     )
 
 

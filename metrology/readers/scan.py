@@ -48,15 +48,12 @@ from jointwear.conventions import (
     AngleConvention,
 )
 from jointwear.errors import BadInputError
+from jointwear.metrology.readers.advice import plausibility
+from jointwear.metrology.readers.claims import check_layers
 from jointwear.metrology.readers.dataset import _as_convention, _assemble
-from jointwear.metrology.readers.heights import (
-    _layer_index_from_name,
-    _number_from_name,
-    _read_manifest,
-    _z_from_meta,
-)
 from jointwear.metrology.readers.layers import _Layer, _layers_from_file
-from jointwear.metrology.readers.table import _NUM, TextFormat, parse_file, unit_factor
+from jointwear.metrology.readers.table import TextFormat, parse_blocks
+from jointwear.metrology.readers.zsource import assign_z, layer_numbers_from_meta
 
 __all__ = ["read_text", "read_scan"]
 
@@ -102,6 +99,13 @@ def read_scan(
     resample: bool = False,
     pattern: str = "*",
     instrument: str | None = None,
+    ignore_header: Sequence[str] = (),
+    z_source: str = "auto",
+    thousands: str | None = None,
+    radius_range: tuple[float, float] | None = None,
+    max_deviation: float | None = None,
+    nominal_tolerance: float | None = None,
+    min_form: float | None = None,
 ) -> xr.Dataset:
     """Read a roundness / cylindricity scan from text exports into a contract Dataset.
 
@@ -147,6 +151,23 @@ def read_scan(
         Glob pattern of the per-layer files in a folder (manifest files are skipped).
     instrument : str, optional
         Instrument name for ``source`` (default: from the header, else ``"roundness instrument"``).
+    ignore_header : sequence of str
+        Header claims known to be wrong, dropped before reading (``units``, ``nominal_radius``,
+        ``points``, ``filter``, ``layers``, ``layer_spacing``, ``z``); recorded.
+    z_source : str
+        Where z comes from (:data:`~.zsource.Z_SOURCES`; ``auto``: the one source there is,
+        refused when two disagree).
+    thousands : str, optional
+        Thousands separator of the numbers (sniffed only where unambiguous).
+    radius_range : (float, float), optional
+        Plausible bore radius [m] (default 0.5 mm to 2 m): a unit that puts the radii outside
+        is refused.
+    max_deviation : float, optional
+        Largest plausible |radial deviation| [m] (default 1 mm).
+    nominal_tolerance : float, optional
+        Relative tolerance of the measured radius against a stated nominal (default 0.05).
+    min_form : float, optional
+        Smallest plausible peak-to-valley of a deviation trace [m] (default 10 nm).
 
     Returns
     -------
@@ -171,9 +192,9 @@ def read_scan(
     conv = _as_convention(convention)
     if value not in ("auto", "radius", "deviation"):
         raise BadInputError(f"value must be 'auto', 'radius' or 'deviation', got {value!r}")
-    if layout not in ("auto", "single", "folder", "long", "wide"):
+    if layout not in ("auto", "single", "folder", "long", "wide", "blocks"):
         raise BadInputError(
-            f"layout {layout!r} is not known; use auto, single, folder, long or wide"
+            f"layout {layout!r} is not known; use auto, single, folder, long, wide or blocks"
         )
     base = fmt or TextFormat()
     over = {
@@ -186,6 +207,8 @@ def read_scan(
             units=units,
             z_units=z_units,
             sheet=sheet,
+            ignore_header=tuple(ignore_header) if ignore_header else None,
+            thousands=thousands,
         ).items()
         if v is not None
     }
@@ -220,7 +243,15 @@ def read_scan(
     if layout == "folder" and len(files) < 1:
         raise BadInputError("layout='folder' needs a folder or several files")
     value_kind = None if value == "auto" else value
-    parsed = [parse_file(f, base) for f in files]
+    limits = plausibility(
+        radius_min=None if radius_range is None else radius_range[0],
+        radius_max=None if radius_range is None else radius_range[1],
+        max_deviation=max_deviation,
+        nominal_tolerance=nominal_tolerance,
+        min_form=min_form,
+    )
+    parsed = [pf for f in files for pf in parse_blocks(f, base)]
+    blocks = len(files) == 1 and len(parsed) > 1
     layers: list[_Layer] = []
     metadata: dict = {}
     notes: dict = {}
@@ -233,16 +264,26 @@ def read_scan(
             angle_unit=angle_unit,
             arc=arc or pf.arc,
             notes=decided,
+            limits=limits,
         )
         if pf.guessed or decided:
-            notes[Path(pf.path).name] = {**pf.guessed, **decided}
+            key = Path(pf.path).name + (f" block {pf.block}" if pf.block else "")
+            notes[key] = {**pf.guessed, **decided}
         if len(parsed) > 1 and len(ls) > 1:
             raise BadInputError(
-                f"'{pf.path}' holds {len(ls)} layers; a folder layout expects one layer per file"
+                f"'{pf.path}' holds {len(ls)} layers"
+                + (f" in block {pf.block}" if pf.block else "")
+                + "; per-layer files or blocks hold one layer each"
             )
+        if pf.block is not None:
+            num = layer_numbers_from_meta(pf)
+            ls[0].index = num
         layers.extend(ls)
         if not metadata:
             metadata = dict(pf.metadata)
+    if blocks and any(lay.index is None for lay in layers):
+        for lay in layers:
+            lay.index = None
     if expected_points is not None and allow_partial:
         for k, lay in enumerate(layers):
             if lay.value.size > expected_points:
@@ -251,9 +292,11 @@ def read_scan(
                     f"expected {expected_points}"
                 )
     if layout == "auto":
-        if len(parsed) > 1:
+        if blocks:
+            layout_used = "blocks"
+        elif len(parsed) > 1:
             layout_used = "folder"
-        elif any(c == "z" for c in parsed[0].columns):
+        elif any(c in ("z", "layer") for c in parsed[0].columns):
             layout_used = "long"
         elif len(layers) > 1:
             layout_used = "wide"
@@ -261,101 +304,23 @@ def read_scan(
             layout_used = "single"
     else:
         layout_used = layout
-        expected_layers = {"single": 1}
-        if layout in expected_layers and len(layers) != 1:
+        if layout == "single" and len(layers) != 1:
             raise BadInputError(
                 f"layout='single' but '{files[0]}' holds {len(layers)} layers; use layout='long' "
                 "or 'wide'"
             )
-    # z of each layer
-    zsrc = ""
-    if z is not None:
-        zv = [float(v) for v in z]
-        if len(zv) != len(layers):
-            raise BadInputError(
-                f"z gives {len(zv)} heights but the scan has {len(layers)} layers; give one per layer"
-            )
-        for lay, v in zip(layers, zv, strict=True):
-            lay.z = v
-        zsrc = "option z"
-    elif all(lay.z is not None for lay in layers):
-        zsrc = "z column"
-    elif layout_used == "folder":
-        found = _read_manifest(folder, z_units) if folder is not None else None
-        manifest = found[1] if found else None
-        if found:
-            for lay in layers:
-                name = Path(lay.source).name
-                key = name if name in manifest else Path(name).stem
-                if key not in manifest:
-                    raise BadInputError(
-                        f"manifest '{found[0]}' has no entry for '{name}'; add a line '{name}, <z>'"
-                    )
-                lay.z = manifest[key]
-            zsrc = "manifest"
-        else:
-            zh = [_z_from_meta(pf.metadata, pf.z_units, f"'{pf.path}'") for pf in parsed]
-            if all(v is not None for v in zh):
-                for lay, v in zip(layers, zh, strict=True):
-                    lay.z = v
-                zsrc = "header keyword"
-            else:
-                zn = [_number_from_name(Path(lay.source).name, z_units) for lay in layers]
-                if all(v is not None for v in zn) and len(set(zn)) == len(zn):
-                    for lay, v in zip(layers, zn, strict=True):
-                        lay.z = v
-                    zsrc = "file names"
-                elif layer_spacing is not None:
-                    idx = [_layer_index_from_name(Path(lay.source).name) for lay in layers]
-                    if any(i is None for i in idx) or len(set(idx)) != len(idx):
-                        idx = list(range(len(layers)))
-                    for lay, i in zip(layers, idx, strict=True):
-                        lay.z = float(i) * float(layer_spacing)
-                    zsrc = "layer_spacing x layer number (from the file names, else file order)"
-                elif len(layers) == 1:
-                    layers[0].z = 0.0
-                    zsrc = "single layer"
-                else:
-                    raise BadInputError(
-                        f"cannot tell the z of the {len(layers)} layer files in "
-                        f"'{folder or files[0].parent}': no manifest.csv, no height keyword in the "
-                        "headers, no z in the file names; pass layer_spacing=<m> or z=[...]"
-                    )
-    elif layout_used == "wide":
-        names = parsed[0].column_names
-        vidx = [i for i, c in enumerate(parsed[0].columns) if c in ("radius", "deviation", "value")]
-        zn = None
-        if names and len(names) == len(parsed[0].columns):
-            zn = []
-            for i in vidx:
-                m = re.search(rf"({_NUM})\s*(mm|um|µm|m|in)?", names[i])
-                if not m:
-                    zn = None
-                    break
-                u = m.group(2) or parsed[0].z_units
-                if u is None:
-                    raise BadInputError(
-                        f"'{files[0]}': column name {names[i]!r} gives z without a unit; pass "
-                        "z_units=... (--z-units mm)"
-                    )
-                zn.append(float(m.group(1).replace(",", ".")) * unit_factor(u))
-        if zn is not None and len(set(zn)) == len(zn):
-            for lay, v in zip(layers, zn, strict=True):
-                lay.z = v
-            zsrc = "column names"
-        elif layer_spacing is not None:
-            for i, lay in enumerate(layers):
-                lay.z = i * float(layer_spacing)
-            zsrc = "layer_spacing x column order"
-        else:
-            raise BadInputError(
-                f"'{files[0]}': wide file with {len(layers)} value columns but no z in the column "
-                "names; pass layer_spacing=<m> or z=[...]"
-            )
-    else:
-        for lay in layers:
-            lay.z = 0.0
-        zsrc = "single layer (z = 0)"
+    zsrc = assign_z(
+        layers,
+        parsed,
+        layout_used,
+        folder,
+        z=None if z is None else list(z),
+        layer_spacing=layer_spacing,
+        z_units=z_units,
+        z_source=z_source,
+        where=f"'{folder or files[0]}'",
+    )
+    check_layers(layers, metadata, zsrc, limits, f"'{files[0] if len(files) == 1 else folder}'")
     notes["z_from"] = zsrc
     if instrument is None:
         instrument = next(

@@ -64,7 +64,7 @@ def _read_text(path: Path, encoding: str | None, sheet: str | None = None) -> st
         )
     if text is None:
         head = raw[:8192]
-        ctrl = sum(1 for b in head if b < 32 and b not in (9, 10, 13, 12))
+        ctrl = sum(1 for b in head if b < 32 and b not in (9, 10, 13, 12, 26))
         if b"\x00" in head or ctrl > 0.01 * len(head):
             raise BadInputError(
                 f"'{path}' looks like a binary file (line 1 holds control bytes), not a text "
@@ -76,7 +76,7 @@ def _read_text(path: Path, encoding: str | None, sheet: str | None = None) -> st
         except UnicodeDecodeError:
             text = raw.decode("latin-1")
     else:
-        ctrl = sum(1 for c in text[:8192] if ord(c) < 32 and c not in "\t\n\r\f")
+        ctrl = sum(1 for c in text[:8192] if ord(c) < 32 and c not in "\t\n\r\f\x1a")
         if ctrl > 0.01 * min(len(text), 8192):
             raise BadInputError(
                 f"'{path}' decoded as {codec} holds control characters; not a text export"

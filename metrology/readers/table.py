@@ -12,11 +12,21 @@ import numpy as np
 import pandas as pd
 
 from jointwear.errors import BadInputError
+from jointwear.metrology.readers.claims import drop_ignored
 from jointwear.metrology.readers.columns import COLUMN_KINDS, _guess_columns, _kind_from_name
+from jointwear.metrology.readers.pretext import normalise, split_blocks
 from jointwear.metrology.readers.source import _read_text
-from jointwear.metrology.readers.units import UNITS, _file_units, unit_factor
+from jointwear.metrology.readers.units import _LENGTH_KINDS, UNITS, _file_units, unit_factor
 
-__all__ = ["UNITS", "TextFormat", "ParsedFile", "unit_factor", "sniff", "parse_file"]
+__all__ = [
+    "UNITS",
+    "TextFormat",
+    "ParsedFile",
+    "unit_factor",
+    "sniff",
+    "parse_file",
+    "parse_blocks",
+]
 
 
 _DELIMS = {"\t": "tab", ";": "semicolon", ",": "comma", " ": "whitespace"}
@@ -56,6 +66,11 @@ class TextFormat:
         Unit of the z column / z in file names and headers, when the file does not state it.
     sheet : str, optional
         Worksheet of an Excel workbook (needed when it has several with data).
+    ignore_header : tuple of str
+        Header claims to drop (names of :data:`~.claims.CLAIMS`: ``units``, ``nominal_radius``,
+        ``points``, ``filter``, ``layers``, ``layer_spacing``, ``z``) when the header is wrong.
+    thousands : {",", ".", "'", " "}, optional
+        Thousands separator (``8,001.234``); sniffed only where unambiguous.
     """
 
     delimiter: str | None = None
@@ -66,6 +81,8 @@ class TextFormat:
     encoding: str | None = None
     z_units: str | None = None
     sheet: str | None = None
+    ignore_header: tuple[str, ...] = ()
+    thousands: str | None = None
 
     def __post_init__(self) -> None:
         if self.delimiter is not None and self.delimiter not in _DELIMS:
@@ -92,6 +109,11 @@ class TextFormat:
             unit_factor(self.units, where="option units (--units)")
         if self.z_units is not None:
             unit_factor(self.z_units, where="option z_units (--z-units)")
+        if self.thousands not in (None, ",", ".", "'", " "):
+            raise BadInputError(f"thousands {self.thousands!r} must be ',', '.', \"'\" or ' '")
+        if self.thousands is not None and self.thousands == self.decimal:
+            raise BadInputError("thousands and decimal separators must differ")
+        object.__setattr__(self, "ignore_header", tuple(self.ignore_header))
         if self.header_lines is not None and self.header_lines < 0:
             raise BadInputError(f"header_lines must be >= 0, got {self.header_lines}")
 
@@ -114,6 +136,7 @@ class ParsedFile:
     angle_unit: str | None = None  # stated in the header ("Angle unit: deg")
     z_units: str | None = None  # stated in the header ("Z unit: mm") or by the user
     arc: str | None = None  # stated in the header ("Arc: full")
+    block: int | None = None  # number of the block in a file of concatenated layer blocks
 
 
 def _split(line: str, delim: str) -> list[str]:
@@ -320,7 +343,31 @@ def parse_file(path: str | Path, fmt: TextFormat = TextFormat()) -> ParsedFile:
     """
     path = Path(path)
     text = _read_text(path, fmt.encoding, fmt.sheet)
+    text, pre = normalise(text, str(path), fmt.thousands)
+    return _parse_text(path, text, fmt, pre)
+
+
+def parse_blocks(path: str | Path, fmt: TextFormat = TextFormat()) -> list[ParsedFile]:
+    """Like :func:`parse_file`, but a file of concatenated per-layer blocks (each with its own
+    header lines) gives one :class:`ParsedFile` per block (line numbers are the file's)."""
+    path = Path(path)
+    text = _read_text(path, fmt.encoding, fmt.sheet)
+    text, pre = normalise(text, str(path), fmt.thousands)
+    blocks = split_blocks(text) if fmt.header_lines is None else None
+    if not blocks:
+        return [_parse_text(path, text, fmt, pre)]
+    out = []
+    for k, (btext, numbers) in enumerate(blocks, start=1):
+        pf = _parse_text(path, btext, fmt, {**pre, "block": f"block {k} of {len(blocks)}"})
+        pf.line_numbers = np.asarray(numbers)[pf.line_numbers - 1]
+        pf.block = k
+        out.append(pf)
+    return out
+
+
+def _parse_text(path: Path, text: str, fmt: TextFormat, pre: dict[str, str]) -> ParsedFile:
     fmt, guessed = sniff(text, fmt, path=str(path))
+    guessed.update(pre)
     lines = text.splitlines()
     hl = fmt.header_lines or 0
     tail = lines[hl:]
@@ -371,6 +418,7 @@ def parse_file(path: str | Path, fmt: TextFormat = TextFormat()) -> ParsedFile:
     if "header_lines" in guessed:
         _no_data_in_header(str(path), lines[:hl], fmt, ncol)
     meta, names = _parse_header(lines[:hl], fmt.delimiter or " ", ncol)
+    meta = drop_ignored(meta, fmt.ignore_header)
     if fmt.columns is not None:
         cols = fmt.columns
         if len(cols) != ncol:
@@ -386,6 +434,9 @@ def parse_file(path: str | Path, fmt: TextFormat = TextFormat()) -> ParsedFile:
     else:
         cols, name_units = _guess_columns(data, names)
         guessed["columns"] = ",".join(cols)
+    if "units" in fmt.ignore_header:
+        name_units = {k: u for k, u in name_units.items() if cols[int(k)] not in _LENGTH_KINDS}
+        guessed["ignored_header"] = "units (header and column names; ignore_header)"
     units = _file_units(str(path), lines[:hl], meta, cols, name_units, fmt.units, guessed)
     _check_last_line(str(path), text, lines, body_idx, fmt, guessed)
     angle_unit = _keyword(meta, _ANGLE_UNIT_KEYS)
@@ -394,7 +445,7 @@ def parse_file(path: str | Path, fmt: TextFormat = TextFormat()) -> ParsedFile:
         if angle_unit is None:
             raise BadInputError(
                 f"'{path}': header angle unit {_keyword(meta, _ANGLE_UNIT_KEYS)!r} is not known "
-                "(deg, rad or index)"
+                "(deg, rad, index or grad)"
             )
     z_units = _keyword(meta, _Z_UNIT_KEYS)
     if z_units is not None:
@@ -441,6 +492,10 @@ _ANGLE_UNIT_WORDS = {
     "index": "index",
     "point": "index",
     "points": "index",
+    "grad": "grad",
+    "gon": "grad",
+    "gradian": "grad",
+    "gradians": "grad",
 }
 
 

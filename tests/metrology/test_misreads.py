@@ -271,7 +271,7 @@ def test_long_file_z_column_unit_is_not_borrowed_from_the_values(tmp_path):
     ]
     f = tmp_path / "long.txt"
     f.write_text("Units: um\nAngle unit: deg\n" + "\n".join(rows) + "\n")
-    with pytest.raises(BadInputError, match=r"unit of the z column is not stated.*--z-units"):
+    with pytest.raises(BadInputError, match=r"unit of the z column is not stated.*z_units="):
         read_scan(f, convention=CONV)
     ds = read_scan(f, convention=CONV, z_units="mm")
     assert float(np.ptp(ds["z"].values)) == pytest.approx(2e-3)

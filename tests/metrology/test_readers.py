@@ -95,6 +95,7 @@ def test_overrides_win_where_the_file_is_silent(tmp_path, scan):
         convention=AngleConvention("+y", "counterclockwise"),
         columns=("angle_deg", "deviation"),
         units="mm",  # the file does not say: the option is the truth
+        max_deviation=0.1,  # ... even where it makes deviations of 31 mm (limit overridden)
     )
     np.testing.assert_allclose(
         ds["radial_deviation"].values[0],

@@ -155,5 +155,9 @@ def test_circle_per_layer_reference():
     circ = wear_map(_scan(worn), shape="circle")
     assert np.sqrt(np.mean((circ["wear_depth"].values - WEAR) ** 2)) < 1.05 * sigma
     assert "circle per layer" in circ.attrs["wear_reference"]
-    cyl = wear_map(_scan(worn), shape="cylinder")
-    assert np.sqrt(np.mean((cyl["wear_depth"].values - WEAR) ** 2)) > 10 * sigma
+    # a straight-axis cylinder cannot hold those centres: refused, never a wrong map
+    with pytest.raises(BadInputError, match=r"leaves .* µm RMS.*cannot be separated.*--before"):
+        wear_map(_scan(worn), shape="cylinder")
+    # the form model (default without a before-scan) has a centre per layer
+    form = wear_map(_scan(worn))
+    assert np.sqrt(np.mean((form["wear_depth"].values - WEAR) ** 2)) < 1.1 * sigma

@@ -1,0 +1,101 @@
+"""Refusals that carry their own advice, in a form a program can apply.
+
+A reader that refuses an ambiguous or contradictory file names the option(s) that settle it. A
+:class:`Refusal` keeps those options as data (``suggestions``: alternative keyword sets of
+:func:`~jointwear.metrology.readers.read_scan`) next to the message that names them, so that a
+test can apply every suggestion to the same file and check that it reads the file right or
+refuses again for a different reason (``tests/metrology/test_advice.py``). The message text is
+made from the same data (:func:`advise`), so the two cannot drift apart; the command line
+rewrites ``keyword=value`` into its ``--flag value`` (:func:`jointwear._cli.speak_flags`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+from jointwear.errors import BadInputError
+
+__all__ = ["Refusal", "advise", "plausibility", "PLAUSIBILITY"]
+
+
+class Refusal(BadInputError):
+    """A :class:`~jointwear.errors.BadInputError` with the options that settle it.
+
+    Attributes
+    ----------
+    suggestions : tuple of dict
+        Alternative option sets (keywords of ``read_scan``), each one a complete fix for one
+        reading of the file; empty when nothing but a corrected file can help.
+    """
+
+    def __init__(self, message: str, suggestions: tuple[dict, ...] = ()):
+        super().__init__(message)
+        self.suggestions = tuple(dict(s) for s in suggestions)
+
+
+def _spell(key: str, value: object) -> str:
+    if isinstance(value, (tuple, list)):
+        if key == "ignore_header":
+            return " ".join(f"ignore_header={v}" for v in value)
+        return f"{key}=({','.join(str(v) for v in value)})"
+    if isinstance(value, bool):
+        return f"{key}={value}"
+    if isinstance(value, str):
+        return f"{key}={value}" if value.startswith("<") else f"{key}='{value}'"
+    return f"{key}=<{'m' if key in _METRES else 'value'}>"
+
+
+_METRES = ("layer_spacing", "max_deviation", "min_form")
+
+
+def advise(options: list[tuple[Mapping, str]]) -> tuple[str, tuple[dict, ...]]:
+    """Text naming each alternative fix, and the fixes as data.
+
+    Parameters
+    ----------
+    options : list of (dict, str)
+        Each alternative: the options to pass and when it is the right one.
+
+    Returns
+    -------
+    (str, tuple of dict)
+        "pass A (when ...), or B (when ...)" and the option sets.
+    """
+    parts = [
+        " ".join(_spell(k, v) for k, v in opts.items()) + (f" ({why})" if why else "")
+        for opts, why in options
+    ]
+    return "pass " + ", or ".join(parts), tuple(dict(o) for o, _ in options)
+
+
+#: Plausibility limits of the header cross-checks (override with the same-named options).
+PLAUSIBILITY: dict[str, float] = {
+    "radius_min": 0.5e-3,  # [m] smallest bore/shaft radius a roundness instrument measures here
+    "radius_max": 2.0,  # [m] largest
+    "max_deviation": 1e-3,  # [m] largest |radial deviation| (a roundness gauge's range)
+    "min_form": 10e-9,  # [m] smallest peak-to-valley of a deviation trace (below any probe noise)
+    "nominal_tolerance": 0.05,  # relative: measured radius within 5 % of the stated nominal
+    "deviation_fraction": 0.05,  # |deviation| at most 5 % of the stated nominal radius
+    "spacing_tolerance": 0.01,  # relative: stated layer spacing vs the layers found
+    "points_tolerance": 0.01,  # relative: stated angular step vs the step of the angles
+    "filter_ratio": 0.1,  # high-band / mid-band amplitude above which a filter claim is false
+}
+
+
+def plausibility(**overrides: float | None) -> dict[str, float]:
+    """The plausibility limits with the given overrides (``None`` keeps the default)."""
+    out = dict(PLAUSIBILITY)
+    for k, v in overrides.items():
+        if v is None:
+            continue
+        if k not in out:
+            raise BadInputError(f"unknown plausibility limit {k!r}; known: {', '.join(out)}")
+        if not float(v) > 0:
+            raise BadInputError(f"plausibility limit {k}={v!r} must be > 0")
+        out[k] = float(v)
+    if out["radius_min"] >= out["radius_max"]:
+        raise BadInputError(
+            f"radius_range=({out['radius_min']:g}, {out['radius_max']:g}) m is empty; give "
+            "(min, max) with min < max"
+        )
+    return out

@@ -1,0 +1,423 @@
+"""Header claims checked against the numbers.
+
+A header line is a claim about the table under it; a claim the numbers contradict is refused,
+naming both and the option that settles it (:class:`~.advice.Refusal`), never silently
+believed or silently overridden. Checked here (limits in :data:`~.advice.PLAUSIBILITY`,
+overridable):
+
+* the length unit against the magnitude of the values: a radius must make a bore of plausible
+  size (``radius_min`` .. ``radius_max``), a deviation must stay within a gauge's range
+  (``max_deviation``) and within ``deviation_fraction`` of a stated nominal radius;
+* the nominal radius against the measured radius (``nominal_tolerance``);
+* the points per revolution against the rows of a layer and its angular step;
+* a stated Gaussian filter against the spectrum (a profile filtered at k_c UPR holds almost
+  nothing above 3 k_c);
+* the stated number of layers and layer spacing against the layers found (:func:`check_layers`).
+
+A claim the user knows to be wrong is dropped with ``ignore_header=<claim>`` (CLI
+``--ignore-header``), and the dropped claim is recorded.
+"""
+
+from __future__ import annotations
+
+import re
+
+import numpy as np
+
+from jointwear.metrology.readers.advice import Refusal, advise
+from jointwear.metrology.readers.units import unit_factor
+
+__all__ = ["CLAIMS", "claim", "drop_ignored", "check_magnitude", "check_points", "check_filter"]
+
+_NUMU = r"[-+]?(?:\d+(?:[.,]\d*)?|[.,]\d+)(?:[eE][-+]?\d+)?"
+
+#: Header claims by name (the names ``ignore_header`` takes) -> pattern of their keys.
+CLAIMS: dict[str, re.Pattern] = {
+    "units": re.compile(r"^(units?|length[ _]?units?|einheit|unit of measure|scale units?)$", re.I),
+    "nominal_radius": re.compile(
+        r"^(nominal[ _]?radius|radius|nominal[ _]?diameter|diameter|bore (radius|diameter))$",
+        re.I,
+    ),
+    "points": re.compile(
+        r"^(points?( per (rev(olution)?|turn|layer|trace))?|n[ _]?points|number of points|"
+        r"no\.? of points|samples( per (rev(olution)?|turn))?|data points|ppr)$",
+        re.I,
+    ),
+    "filter": re.compile(r"^(filter( type)?|filter cut-?off|cut-?off|lpf)$", re.I),
+    "layers": re.compile(
+        r"^(layers|number of (layers|planes|traces)|n[ _]?layers|planes|no\.? of layers|"
+        r"layer count)$",
+        re.I,
+    ),
+    "layer_spacing": re.compile(
+        r"^((layer|plane|trace)[ _]?(spacing|pitch|step|distance)|spacing|pitch)$", re.I
+    ),
+    "z": re.compile(
+        r"^(z|z[ _]?position|height|level|layer[ _]?height|position|axial position|"
+        r"plane height|z \(mm\)|height \(mm\))$",
+        re.I,
+    ),
+}
+
+
+def drop_ignored(meta: dict[str, str], ignore: tuple[str, ...]) -> dict[str, str]:
+    """``meta`` without the header lines of the claims in ``ignore`` (names of :data:`CLAIMS`)."""
+    bad = [c for c in ignore if c not in CLAIMS]
+    if bad:
+        raise Refusal(f"ignore_header={bad[0]!r} is not a header claim; known: {', '.join(CLAIMS)}")
+    return {k: v for k, v in meta.items() if not any(CLAIMS[c].match(k.strip()) for c in ignore)}
+
+
+def claim(meta: dict[str, str], name: str) -> tuple[str, str] | None:
+    """(key, value) of the first header line stating claim ``name``, else None."""
+    for k, v in meta.items():
+        if CLAIMS[name].match(k.strip()) and str(v).strip():
+            return k, str(v).strip()
+    return None
+
+
+def _length(text: str, default_unit: str | None) -> float | None:
+    m = re.match(rf"^\s*({_NUMU})\s*([A-Za-zµμ\"]+)?", text)
+    if not m:
+        return None
+    unit = m.group(2) or default_unit
+    if unit is None:
+        return None
+    try:
+        return float(m.group(1).replace(",", ".")) * unit_factor(unit)
+    except Exception:  # a word after the number that is no unit: not a length claim
+        return None
+
+
+def nominal_radius(meta: dict[str, str], file_unit: str | None) -> tuple[str, float] | None:
+    """(header key, nominal radius [m]) from a nominal radius/diameter line, else None."""
+    c = claim(meta, "nominal_radius")
+    if c is None:
+        return None
+    val = _length(c[1], file_unit)
+    if val is None or not val > 0:
+        return None
+    return c[0], val / 2 if "diam" in c[0].lower() else val
+
+
+def _units_fix(stated_by_file: bool, unit: str) -> dict:
+    return {"ignore_header": ("units",), "units": unit} if stated_by_file else {"units": unit}
+
+
+def _fmt(v_m: float) -> str:
+    a = abs(v_m)
+    if a >= 1.0:
+        return f"{v_m:.4g} m"
+    if a >= 1e-3:
+        return f"{v_m * 1e3:.4g} mm"
+    if a >= 1e-6:
+        return f"{v_m * 1e6:.4g} µm"
+    return f"{v_m * 1e9:.4g} nm"
+
+
+_TRY_UNITS = ("um", "mm", "m", "inch")
+
+
+def check_magnitude(
+    values: np.ndarray,
+    kind: str,
+    unit: str,
+    unit_source: str,
+    stated_by_file: bool,
+    meta: dict[str, str],
+    limits: dict[str, float],
+    where: str,
+    notes: dict[str, str],
+) -> None:
+    """Refuse a unit the magnitudes contradict, and a nominal radius the radii contradict.
+
+    Parameters
+    ----------
+    values : ndarray
+        The value column(s) as written (file unit).
+    kind : {"radius", "deviation"}
+    unit : str
+        The unit the values are read in; ``unit_source`` says who stated it.
+    stated_by_file : bool
+        The unit comes from the file (a fix must then drop the header's unit).
+    meta : dict
+        Header metadata (for the nominal radius).
+    limits : dict
+        Plausibility limits (:data:`~.advice.PLAUSIBILITY` with overrides).
+    """
+    v = np.asarray(values, dtype=float)
+    v = v[np.isfinite(v)]
+    if v.size == 0:
+        return
+    f = unit_factor(unit)
+    med = float(np.median(v))
+    nominal = nominal_radius(meta, unit if stated_by_file else None)
+    if kind == "radius":
+        r = med * f
+        if not limits["radius_min"] <= r <= limits["radius_max"]:
+            alts = [
+                u
+                for u in _TRY_UNITS
+                if unit_factor(u) != f
+                and limits["radius_min"] <= med * unit_factor(u) <= limits["radius_max"]
+                and (nominal is None or _agree(med * unit_factor(u), nominal[1], limits))
+            ]
+            text, sugg = advise(
+                [
+                    (
+                        _units_fix(stated_by_file, u),
+                        f"if the values are in {u}: a radius of {_fmt(med * unit_factor(u))}",
+                    )
+                    for u in alts
+                ]
+            )
+            raise Refusal(
+                f"{where}: the values are read in {unit!r} ({unit_source}), which makes the radii "
+                f"about {_fmt(r)} - not a plausible bore (limits {_fmt(limits['radius_min'])} to "
+                f"{_fmt(limits['radius_max'])}); "
+                + (text + "; " if alts else "")
+                + "if the part really is that size, widen the limits with radius_range=<m>",
+                sugg,
+            )
+        if nominal is not None and not _agree(r, nominal[1], limits):
+            alts = [
+                (_units_fix(stated_by_file, u), f"if the values are in {u}")
+                for u in _TRY_UNITS
+                if unit_factor(u) != f and _agree(med * unit_factor(u), nominal[1], limits)
+            ]
+            alts.append(
+                ({"ignore_header": ("nominal_radius",)}, f"if the header's {nominal[0]!r} is wrong")
+            )
+            text, sugg = advise(alts)
+            twice = (
+                " (twice the nominal: is the header's radius a diameter?)"
+                if abs(r / nominal[1] - 2) < limits["nominal_tolerance"]
+                else ""
+            )
+            raise Refusal(
+                f"{where}: the header says {nominal[0]} = {meta[nominal[0]]!r} ({_fmt(nominal[1])} "
+                f"radius) but the measured radii are about {_fmt(r)} ({r / nominal[1]:.3g} x)"
+                f"{twice}, beyond the {limits['nominal_tolerance']:.0%} tolerance "
+                f"(nominal_tolerance); {text}",
+                sugg,
+            )
+        if nominal is not None:
+            notes["nominal_radius_check"] = (
+                f"measured radius {_fmt(r)} agrees with the header's {_fmt(nominal[1])}"
+            )
+        return
+    dmax = float(np.percentile(np.abs(v), 90)) * f  # a unit scales all values, a spike one
+    limit = limits["max_deviation"]
+    why = f"a gauge's range (max_deviation = {_fmt(limit)})"
+    if nominal is not None and limits["deviation_fraction"] * nominal[1] < limit:
+        limit = limits["deviation_fraction"] * nominal[1]
+        why = (
+            f"{limits['deviation_fraction']:.0%} of the header's nominal radius "
+            f"{_fmt(nominal[1])} (deviation_fraction)"
+        )
+    ptp = float(np.ptp(v)) * f
+    if 0 < ptp < limits["min_form"]:
+        larger = [
+            u
+            for u in ("um", "mm")
+            if unit_factor(u) > f
+            and ptp / f * unit_factor(u) >= limits["min_form"]
+            and float(np.max(np.abs(v))) * unit_factor(u) <= limit
+        ][:1]
+        alts = [(_units_fix(stated_by_file, u), f"if the values are in {u}") for u in larger]
+        text, sugg = advise(alts) if alts else ("", ())
+        raise Refusal(
+            f"{where}: the values are read in {unit!r} ({unit_source}) as radial deviations "
+            f"with a peak-to-valley of {_fmt(ptp)}, below any roundness probe's noise "
+            f"(min_form = {_fmt(limits['min_form'])}): a wrong unit"
+            + (f"? {text}" if alts else "?")
+            + "; if the trace really is that flat, lower the limit with min_form=<m>",
+            sugg,
+        )
+    if dmax > limit:
+        smaller = [
+            u for u in ("mm", "um") if unit_factor(u) < f and dmax / f * unit_factor(u) <= limit
+        ][:1]
+        alts = [(_units_fix(stated_by_file, u), f"if the values are in {u}") for u in smaller]
+        text, sugg = advise(alts) if alts else ("", ())
+        raise Refusal(
+            f"{where}: the values are read in {unit!r} ({unit_source}) as radial deviations of "
+            f"{_fmt(dmax)} and more (a tenth of them), more than {why}: a wrong unit"
+            + (f"? {text}" if alts else "?")
+            + "; if the deviations really are that large, raise the limit with "
+            "max_deviation=<m> (or pass value='radius' if the column holds radii)",
+            sugg,
+        )
+
+
+def _agree(r: float, nominal: float, limits: dict[str, float]) -> bool:
+    return abs(r - nominal) <= limits["nominal_tolerance"] * nominal
+
+
+def stated_points(meta: dict[str, str], where: str) -> int | None:
+    """Points per revolution stated by the header, else None."""
+    c = claim(meta, "points")
+    if c is None:
+        return None
+    m = re.match(r"^\s*(\d+)(?:\s|$|[^\d.,])", c[1].replace("'", "").replace(" ", " "))
+    if not m:
+        raise Refusal(
+            f"{where}: header {c[0]} = {c[1]!r} is not a whole number of points; correct the "
+            "line, or pass ignore_header='points'",
+            ({"ignore_header": ("points",)},),
+        )
+    return int(m.group(1))
+
+
+def check_points(
+    n_stated: int,
+    rows: int,
+    angles: dict[str, np.ndarray],
+    arc: str | None,
+    unit_stated: bool,
+    where: str,
+    limits: dict[str, float],
+) -> None:
+    """Refuse a layer whose rows or angular step contradict the stated points per revolution.
+
+    Parameters
+    ----------
+    n_stated : int
+        Points per revolution the header states.
+    rows : int
+        Points in the layer.
+    angles : dict
+        The layer's angles [degree] under each possible reading of its angle column (unit ->
+        angles; one entry when the unit is stated, none without an angle column).
+    arc : {"full", "partial"} or None
+        The span the user (or header) states.
+    unit_stated : bool
+        The angle unit is stated (a fix cannot change it).
+    """
+    step = 360.0 / n_stated
+    tol = limits["points_tolerance"]
+
+    def steps_ok(th: np.ndarray) -> bool:
+        d = np.diff(th)
+        return th.size > 1 and abs(float(np.median(np.abs(d))) - step) <= tol * step
+
+    matching = [u for u, th in angles.items() if steps_ok(th)]
+    if rows == n_stated and (not angles or matching):
+        return
+    ignore = ({"ignore_header": ("points",)}, "if the header's points per revolution is wrong")
+    if rows != n_stated and not angles:
+        text, sugg = advise([ignore])
+        raise Refusal(
+            f"{where}: the header states {n_stated} points per revolution but the layer has "
+            f"{rows} rows and no angle column; a truncated or decimated export? re-export it, "
+            f"or {text}",
+            sugg,
+        )
+    alts = []
+    if rows < n_stated and matching and arc != "full":
+        if arc == "partial":
+            return  # a partial arc sampled at the stated step: consistent
+        u = matching[0]
+        partial = {"arc": "partial"} if unit_stated else {"arc": "partial", "angle_unit": u}
+        alts.append((partial, f"if it is a partial arc of {rows * step:.4g} degree"))
+    if not unit_stated and matching and rows == n_stated:
+        alts += [({"angle_unit": u}, f"if the angles are in {u}") for u in matching]
+    alts.append(ignore)
+    text, sugg = advise(alts)
+    got = ", ".join(
+        f"as {u}: a step of {float(np.median(np.abs(np.diff(th)))):.6g} degree"
+        for u, th in angles.items()
+        if th.size > 1
+    )
+    raise Refusal(
+        f"{where}: the header states {n_stated} points per revolution (a step of {step:.6g} "
+        f"degree) but the layer has {rows} rows ({got}); "
+        + ("a truncated trace (re-export it) or " if rows < n_stated else "")
+        + text,
+        sugg,
+    )
+
+
+def stated_filter(meta: dict[str, str]) -> tuple[str, str, float | None] | None:
+    """(key, value, cut-off in UPR or None for 'no filter' / a filter that cannot be checked)."""
+    c = claim(meta, "filter")
+    if c is None:
+        return None
+    v = c[1].lower()
+    if re.search(r"\b(none|off|no|unfiltered|raw)\b", v):
+        return c[0], c[1], None
+    if re.search(r"2\s*rc|\brc\b|analog", v):
+        return c[0], c[1], None  # 2RC passes 37 % at 3 k_c: the spectrum cannot test it
+    nums = [float(x) for x in re.findall(r"\d+(?:\.\d+)?", v)]
+    return (c[0], c[1], max(nums)) if nums else (c[0], c[1], None)
+
+
+def check_filter(
+    values: np.ndarray, stated: tuple[str, str, float | None], where: str, limits: dict
+) -> str:
+    """Refuse a layer that holds what a stated Gaussian filter removes; returns a note.
+
+    A profile filtered at k_c UPR (Gaussian, ISO 16610-21) keeps 2^-9 = 0.2 % of the amplitude
+    at 3 k_c and 84 % at k_c / 2; the median harmonic amplitude over (3 k_c, 6 k_c) against that
+    over (k_c / 4, k_c / 2) is therefore below 0.003 for filtered data. A ratio above
+    ``filter_ratio`` (0.1) contradicts the claim. (The test is one-sided: an unfiltered profile
+    whose high band is far weaker than its form passes it.)
+    """
+    key, text, kc = stated
+    if kc is None:
+        return f"header {key} = {text!r} (not checked against the data)"
+    v = np.asarray(values, dtype=float)
+    n = v.size
+    if not np.all(np.isfinite(v)) or n < 12 * kc or kc < 4:
+        return f"header {key} = {text!r} (too few points to check it)"
+    amp = np.abs(np.fft.rfft(v - v.mean()))
+    hi = amp[int(3 * kc) + 1 : int(min(6 * kc, n // 2))]
+    mid = amp[max(2, int(kc / 4)) : int(kc / 2) + 1]
+    if hi.size < 3 or mid.size < 2:
+        return f"header {key} = {text!r} (too few harmonics to check it)"
+    ratio = float(np.median(hi) / max(np.median(mid), 1e-300))
+    if ratio > limits["filter_ratio"]:
+        msg, sugg = advise(
+            [({"ignore_header": ("filter",)}, "if the header's filter line is wrong")]
+        )
+        raise Refusal(
+            f"{where}: the header says {key} = {text!r} (a {kc:g} UPR low-pass) but the trace "
+            f"holds {ratio:.2g} x as much amplitude per harmonic above {3 * kc:g} UPR as below "
+            f"{kc / 2:g} UPR, where such a filter leaves less than 0.003 x: the data are not "
+            f"filtered as stated; {msg}",
+            sugg,
+        )
+    return f"header {key} = {text!r}: consistent with the spectrum (ratio {ratio:.2g})"
+
+
+def check_layers(layers, meta: dict[str, str], zsrc: str, limits: dict, where: str) -> None:
+    """Refuse a stated number of layers or layer spacing that the layers found contradict."""
+    c = claim(meta, "layers")
+    if c is not None:
+        m = re.match(r"^\s*(\d+)\s*$", c[1])
+        if m and int(m.group(1)) != len(layers):
+            text, sugg = advise(
+                [({"ignore_header": ("layers",)}, "if the header's count is wrong")]
+            )
+            raise Refusal(
+                f"{where}: the header says {c[0]} = {c[1]!r} but {len(layers)} layer(s) were "
+                f"found; a missing or extra layer file/block? restore it, or {text}",
+                sugg,
+            )
+    c = claim(meta, "layer_spacing")
+    if c is None or "header" in zsrc and c[0] in zsrc or len(layers) < 2:
+        return
+    stated = _length(c[1], None)
+    if stated is None:
+        return
+    d = np.diff(np.sort([lay.z for lay in layers]))
+    found = float(np.median(d))
+    if abs(found - stated) > limits["spacing_tolerance"] * stated:
+        text, sugg = advise(
+            [({"ignore_header": ("layer_spacing",)}, "if the header's spacing is wrong")]
+        )
+        raise Refusal(
+            f"{where}: the header says {c[0]} = {c[1]!r} ({_fmt(stated)}) but the layers are "
+            f"{_fmt(found)} apart (z from the {zsrc}); {text}",
+            sugg,
+        )
