@@ -1,0 +1,176 @@
+"""The lumped tilt spring-damper of joint C (``joint.tilt_stiffness``, ``joint.tilt_damping``).
+
+Truths: the simulator before the spring (``data/pre_tilt_default.npz``, computed with the
+kernels of commit 7a7587e on a worn profile) for stiffness 0; the closed-form oscillator
+theta(t) = (w0 / wn) exp(-zeta wn t) sin(wd t) of the follower rocking about its own axis
+(body y, moment of inertia I3y) on the spring, without gravity, drive or contact; conservation
+of the mechanical energy (which then includes k theta^2 / 2) with impacts; and the wear on the
+default rig, which a stiff spring moves from the bearing edges to the whole width.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from jointwear.errors import ParameterError
+from jointwear.params import replace_nested
+from jointwear.sim import (
+    DEFAULT_KW,
+    PARAMETER_SETS,
+    WearSettings,
+    edge_volume_share,
+    initial_state,
+    run_cycles,
+    simulate_wear,
+)
+
+BASE = PARAMETER_SETS["zhang2023"]
+REFERENCE = Path(__file__).parent / "data" / "pre_tilt_default.npz"
+
+
+def worn_profile(params):
+    """A smooth worn bore: a band around theta = 240 degrees, deeper at the edges [m]."""
+    j = params.joint
+    th = np.arange(j.n_points) * 2 * math.pi / j.n_points
+    z = np.linspace(1, -1, j.n_layers)
+    return 8e-6 * np.maximum(np.cos(th - 4.2), 0)[None, :] ** 2 * (1 + 0.8 * z[:, None] ** 2)
+
+
+def test_zero_tilt_stiffness_reproduces_the_simulator_before_the_spring():
+    ref = np.load(REFERENCE)
+    p = replace_nested(
+        BASE,
+        **{
+            "joint.n_layers": 12,
+            "joint.n_points": 120,
+            "joint.tilt_stiffness": 0.0,
+            "joint.tilt_damping": 0.0,
+        },
+    )
+    r = run_cycles(p, cycles=0.3, wear_depth=worn_profile(p))
+    got = {
+        "wear_work": r.wear_work,
+        "sliding": r.sliding_distance,
+        "y": r.state.y,
+        "vimp": r.state.impact_velocity,
+        "work": np.array([r.normal_work, r.axial_normal_work, r.normal_impulse]),
+        "tilt": r.dataset["journal_tilt"].values,
+        "energy": r.dataset["mechanical_energy"].values,
+    }
+    for key, value in got.items():
+        want = ref[key]
+        scale = float(np.max(np.abs(want))) or 1.0
+        np.testing.assert_allclose(value, want, rtol=1e-9, atol=1e-9 * scale, err_msg=key)
+    assert float(np.max(ref["tilt"])) > 0.01  # the journal tilted: the reference is not trivial
+
+
+def _rocking(k: float, c: float, w0: float = 0.5, t_end: float = 0.02):
+    """Follower rocking about its own axis on the tilt spring: no gravity, crank held."""
+    p = replace_nested(
+        BASE,
+        **{
+            "mechanism.gravity": 0.0,
+            "mechanism.crank_speed_rpm": 0.0,
+            "joint.tilt_stiffness": k,
+            "joint.tilt_damping": c,
+            "solver.output_interval": 1e-5,
+        },
+    )
+    st = initial_state(p)
+    y = st.y.copy()
+    y[8:11] = (0.0, w0, 0.0)  # body-frame angular velocity of the follower: about its axis
+    st = dataclasses.replace(st, y=y)
+    ds = run_cycles(p, duration=t_end, state=st).dataset
+    # signed tilt: the journal axis leans along the bearing's x when the follower turns about y
+    signed = np.arcsin(np.clip(ds["journal_axis"].sel(axis="x").values, -1, 1))
+    return p, ds, ds["time"].values, signed
+
+
+@pytest.mark.parametrize("damping_ratio", [0.0, 0.05])
+def test_follower_rocks_on_the_tilt_spring_as_the_closed_form_oscillator(damping_ratio):
+    k = 1000.0
+    inertia = BASE.mechanism.follower_inertia[1]  # about the link axis through D and the COM
+    wn = math.sqrt(k / inertia)
+    c = damping_ratio * 2.0 * math.sqrt(k * inertia)
+    w0 = 0.5
+    p, ds, t, signed = _rocking(k, c, w0)
+    assert int(np.max(ds["contact_mode"].values)) == 0  # no contact: the spring alone
+    wd = wn * math.sqrt(1.0 - damping_ratio**2)
+    exact = w0 / wd * np.exp(-damping_ratio * wn * t) * np.sin(wd * t)
+    amplitude = w0 / wn
+    assert amplitude > 5e-3 * 0.9 and np.max(np.abs(signed)) > 0.5 * amplitude
+    sign = np.sign(np.sum(signed * exact))  # the axis sign convention of the record
+    np.testing.assert_allclose(sign * signed, exact, atol=0.01 * amplitude)
+    assert ds["journal_tilt"].values == pytest.approx(np.abs(exact), abs=0.01 * amplitude)
+
+
+def test_an_anti_restoring_spring_would_fail_the_oscillator_check():
+    # the check above can fail: a spring without stiffness lets the follower drift instead
+    _, _, t, signed = _rocking(0.0, 0.0, 0.5, t_end=0.005)
+    wn = math.sqrt(1000.0 / BASE.mechanism.follower_inertia[1])
+    exact = 0.5 / wn * np.sin(wn * t)
+    assert np.max(np.abs(np.abs(signed) - np.abs(exact))) > 0.1 * 0.5 / wn
+
+
+def test_energy_is_conserved_with_the_spring_and_impacts():
+    p = replace_nested(
+        BASE,
+        **{
+            "mechanism.driver": False,
+            "friction.enabled": False,
+            "contact.restitution": 1.0,
+            "joint.tilt_stiffness": 300.0,
+        },
+    )
+    ds = run_cycles(p, cycles=1.0).dataset
+    e = ds["mechanical_energy"].values
+    assert np.abs(e - e[0]).max() / abs(e[0]) < 1e-4
+    assert ds["contact_force"].max() > 100.0  # impacts happened
+    spring = 0.5 * 300.0 * float(ds["journal_tilt"].max()) ** 2
+    assert spring > 10 * 1e-4 * abs(e[0])  # the spring's energy is visible at that tolerance
+
+
+def test_tilt_damping_dissipates():
+    p = replace_nested(
+        BASE,
+        **{
+            "mechanism.driver": False,
+            "friction.enabled": False,
+            "contact.restitution": 1.0,
+            "joint.tilt_stiffness": 300.0,
+            "joint.tilt_damping": 2.0,
+        },
+    )
+    e = run_cycles(p, cycles=0.5).dataset["mechanical_energy"].values
+    assert e[-1] < e[0] - 1e-3 * abs(e[0])
+    assert np.all(np.diff(e) < 1e-6 * abs(e[0]))  # never gains energy
+
+
+@pytest.mark.parametrize("name", ["joint.tilt_stiffness", "joint.tilt_damping"])
+def test_negative_tilt_parameters_are_refused(name):
+    with pytest.raises(ParameterError, match=name.split(".")[1]):
+        replace_nested(BASE, **{name: -1.0})
+
+
+def test_a_stiff_tilt_spring_spreads_the_wear_over_the_width():
+    # reduced size: 10 x 60 grid, kw x 100 and 4000 cycles (the study-equivalent 4e5)
+    params = replace_nested(BASE, **{"joint.n_layers": 10, "joint.n_points": 60})
+    settings = WearSettings(kw=DEFAULT_KW * 100, tol=0.2, dn=50)
+    share = {}
+    for k in (0.0, 1e3):
+        ds = simulate_wear(
+            params,
+            cycles=4000,
+            snapshots=[],
+            settings=settings,
+            overrides={"joint.tilt_stiffness": k},
+        )
+        share[k] = float(edge_volume_share(ds["wear_depth"].isel(cycles=-1)))
+    # uniform wear along z puts 20 % of the volume outside |z| <= 6 mm (15 mm bearing)
+    assert share[0.0] > 0.5
+    assert share[1e3] < 0.3
