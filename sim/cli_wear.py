@@ -28,7 +28,7 @@ def _parse_snapshots(text: str | None) -> list[float] | None:
 def _measurements(given: dict[str, list[str] | None], default_cycles: float) -> list[Any]:
     """Measurements from ``value`` or ``value@cycles`` strings (µm, or mm³ for the volume)."""
     from jointwear.errors import BadInputError
-    from jointwear.sim._kw_calibration import Measurement
+    from jointwear.sim.wear._calibration import Measurement
 
     flags = {
         "max_depth": "--max-depth-um",
@@ -72,7 +72,7 @@ def _load_settings(params_file: Path | None, overrides: dict[str, Any]) -> tuple
     """WearSettings from the [wear] table of the TOML file plus command-line overrides;
     also returns the rest of the TOML (the simulator's parameters)."""
     from jointwear.params import from_mapping, read_toml
-    from jointwear.sim.wear import WearSettings
+    from jointwear.sim.wear._settings import WearSettings
 
     table: dict[str, Any] = read_toml(params_file) if params_file is not None else {}
     wear = dict(table.pop("wear", {}) or {})
@@ -126,7 +126,7 @@ def demo_winkler_contact(grid: Any) -> Any:
     direction swings sinusoidally between 45 and 135 degrees over the cycle, slightly tilted."""
     import numpy as np
 
-    from jointwear.sim._wear_contact import WinklerContact
+    from jointwear.sim.wear._contact import WinklerContact
 
     n = 24
     t = (np.arange(n) + 0.5) / n
@@ -208,7 +208,7 @@ def register(app: typer.Typer) -> None:
         """
         from jointwear import io
         from jointwear.errors import BadInputError
-        from jointwear.sim._kw_calibration import calibrate_kw, resimulator
+        from jointwear.sim.wear._calibration import calibrate_kw, resimulator
 
         sim = io.load(simulated)
         last = float(sim["cycles"].values[-1])
@@ -257,7 +257,7 @@ def register(app: typer.Typer) -> None:
                     f"{100 * (cal.iterations[-1][1] / cal.measured - 1):+.1f} %"
                 )
             return
-        from jointwear.sim._kw_calibration import calibrate_kw_and_parameter, calibrate_kw_multi
+        from jointwear.sim.wear._calibration import calibrate_kw_and_parameter, calibrate_kw_multi
 
         two_sim = None
         if vary is not None:
@@ -370,7 +370,7 @@ def register(app: typer.Typer) -> None:
         from jointwear.outputs import OutputError, OutputExistsError
         from jointwear.params import to_jsonable
         from jointwear.progress import progress_bar
-        from jointwear.sim.wear import WearRun
+        from jointwear.sim.wear._loop import WearRun
         from jointwear.sim.wearmap import BearingGrid
 
         # the accuracy warning is printed below with the result; without this handler Python's
@@ -386,7 +386,7 @@ def register(app: typer.Typer) -> None:
         settings, rest = _load_settings(params, overrides)
         if contact == "dynamics":
             sim_params = _sim_parameters(params, rest, (layers, points))
-            from jointwear.sim._wear_contact import DynamicContact
+            from jointwear.sim.wear._contact import DynamicContact
 
             model = DynamicContact(sim_params)
         elif contact == "winkler":
