@@ -121,6 +121,34 @@ def _resumable(exc: Exception, cycles_done: float, ckpt: Path) -> Exception:
     )
 
 
+def _check_kinds(given: list[str] | None) -> tuple[str, ...]:
+    from jointwear.errors import BadInputError
+    from jointwear.sim.wear._check import CHECK_KINDS
+
+    kinds = tuple(dict.fromkeys(k.strip() for v in (given or []) for k in v.split(",") if k))
+    bad = [k for k in kinds if k not in CHECK_KINDS]
+    if bad:
+        raise BadInputError(
+            f"--check {', '.join(bad)}: unknown check; choose from {', '.join(CHECK_KINDS)}"
+        )
+    return kinds
+
+
+def _run_checks(ds, model, settings, kinds, out, inputs, provenance) -> str | None:
+    """Run the accuracy checks, record them in ``out`` (rewritten) and print one line each."""
+    if not kinds:
+        return None
+    from jointwear import io
+    from jointwear.sim.wear._check import check_accuracy, describe_check
+
+    res = check_accuracy(ds, model, settings, kinds=kinds)
+    ds.attrs.update(res["attrs"])
+    io.save(ds, out, inputs=inputs, parameters=provenance, source="jointwear 0.1 (sim.wear)")
+    for kind in kinds:
+        typer.echo(describe_check(kind, res[kind]), err=True)
+    return ds.attrs["accuracy_check_status"]
+
+
 def demo_winkler_contact(grid: Any) -> Any:
     """The prescribed contact of ``--contact winkler``: a 20 N load on a Winkler lining whose
     direction swings sinusoidally between 45 and 135 degrees over the cycle, slightly tilted."""
@@ -361,6 +389,15 @@ def register(app: typer.Typer) -> None:
             bool | None,
             typer.Option("--progress/--no-progress", help="Progress bar (default: on a terminal)."),
         ] = None,
+        check: Annotated[
+            list[str] | None,
+            typer.Option(
+                "--check",
+                help="After the run, repeat it with 'interval' (every update interval halved) "
+                "or 'grid' (spacing halved) and compare with the stated accuracy; repeatable. "
+                "Exit 1 if a change exceeds it.",
+            ),
+        ] = None,
     ) -> None:
         """Simulate Archard wear of joint C over many cycles; checkpoint after every update."""
         import logging
@@ -382,6 +419,7 @@ def register(app: typer.Typer) -> None:
         ckpt = checkpoint if checkpoint is not None else out.with_name(out.name + ".ckpt")
         io.check_writable(ckpt, what="--checkpoint")
         snaps = _parse_snapshots(snapshots)
+        kinds = _check_kinds(check)
         overrides = {"kw": kw, "scheme": scheme, "dn": dn, "tol": tol, "settle_cycles": settle}
         settings, rest = _load_settings(params, overrides)
         if contact == "dynamics":
@@ -478,6 +516,7 @@ def register(app: typer.Typer) -> None:
             )
         except OutputError as exc:
             raise _resumable(exc, run.cycles_done, ckpt) from exc
+        checked = _run_checks(ds, model, settings, kinds, out, inputs, provenance_params)
         if figure is not None:
             import matplotlib
 
@@ -487,7 +526,7 @@ def register(app: typer.Typer) -> None:
             fig = plot_wear_map(ds, kind="both")
             with io.atomic_path(figure) as tmp:
                 fig.savefig(tmp, dpi=110, format="png")
-        for key in ("convergence_warning", "accuracy_warning"):
+        for key in ("convergence_warning", "accuracy_warning", "contact_validity_warning"):
             if key in ds.attrs:
                 typer.echo(f"warning: {ds.attrs[key]}", err=True)
         u_max = float(ds["max_wear_depth_u"][-1])
@@ -500,3 +539,11 @@ def register(app: typer.Typer) -> None:
             f"(accuracy {ds.attrs['accuracy_status']}, k = 2), {ds.attrs['n_updates']} updates, "
             f"{run.cycles_simulated:g} cycles simulated"
         )
+        if checked == "inconsistent":
+            from jointwear.errors import ValidationFailed
+
+            raise ValidationFailed(
+                f"{out}: the accuracy check found a change larger than the stated accuracy "
+                "(attribute accuracy_check_status); the run's *_u do not cover its numerical "
+                "error - use a smaller tol or a finer grid"
+            )

@@ -75,7 +75,7 @@ def test_wear_command_check_option(tmp_path, capsys, monkeypatch):
     assert "interval halved: consistent" in capsys.readouterr().err
     assert main([*args, "--check", "tol", "--overwrite"]) == 3
     # a failed check exits 1 (the result file is written and says so)
-    import jointwear.sim._wear_check as chk
+    import jointwear.sim.wear._check as chk
 
     real = chk.check_accuracy
 
