@@ -111,7 +111,7 @@ def register(app: typer.Typer) -> None:
         )
         for i in np.flatnonzero(status == 1)[:5]:
             typer.echo(f"  run {int(i)} failed: {ds['error'].values[i]}", err=True)
-        from jointwear.sim.sweep._report import warning_summary
+        from jointwear.sim import warning_summary
 
         for line in warning_summary(ds):
             typer.echo(f"warning: {line}", err=True)
