@@ -63,6 +63,7 @@ from jointwear.sim.wear._checkpoint import read_checkpoint, write_checkpoint
 from jointwear.sim.wear._contact import CycleWear, describe_any
 from jointwear.sim.wear._output import build_dataset
 from jointwear.sim.wear._settings import (
+    DEFAULT_CYCLES,
     DEFAULT_KW,
     KW_RANGE,
     WearSettings,
@@ -232,6 +233,36 @@ class WearRun:
         if path is None:
             raise BadInputError("no checkpoint path given")
         return write_checkpoint(path, self.fingerprint(), self._s)
+
+    @classmethod
+    def start(
+        cls,
+        contact: Any,
+        settings: WearSettings | None = None,
+        *,
+        cycles: float,
+        snapshots: Sequence[float] | None = None,
+        checkpoint: str | Path | None = None,
+        resume: bool = False,
+        initial_wear: np.ndarray | None = None,
+        on_update: Callable[[dict[str, Any]], None] | None = None,
+    ) -> WearRun:
+        """A new run, or with ``resume`` the run of ``checkpoint`` continued (:meth:`resume`)."""
+        if not resume:
+            return cls(
+                contact,
+                settings,
+                cycles=cycles,
+                snapshots=snapshots,
+                checkpoint=checkpoint,
+                initial_wear=initial_wear,
+                on_update=on_update,
+            )
+        if checkpoint is None:
+            raise BadInputError("resume=True needs the checkpoint path")
+        return cls.resume(
+            checkpoint, contact, settings, cycles=cycles, snapshots=snapshots, on_update=on_update
+        )
 
     @classmethod
     def resume(
@@ -581,7 +612,7 @@ def halved_schedule(ds: xr.Dataset) -> tuple[int, ...]:
 def simulate_wear(
     params: Any = None,
     *,
-    cycles: float = 1e6,
+    cycles: float = DEFAULT_CYCLES,
     kw: float | None = None,
     settings: WearSettings | None = None,
     contact: Any = None,
@@ -598,7 +629,7 @@ def simulate_wear(
     Parameters
     ----------
     params : SimParameters, optional
-        Mechanism and joint parameters (default ``PARAMETER_SETS["zhang2023"]``); ignored when
+        Mechanism and joint parameters (default ``PARAMETER_SETS[DEFAULT_PARAMETER_SET]``, the reference study); ignored when
         ``contact`` is given.
     cycles : float
         Target number of cycles.
@@ -632,6 +663,26 @@ def simulate_wear(
         ``cylindricity``, ``normal_work``, their expanded uncertainties ``wear_depth_u``,
         ``max_wear_depth_u``, ``worn_volume_u`` (adaptive scheme; NaN = not assessed), and the
         update history ``update_*``.
+
+    Examples
+    --------
+    A prescribed 20 N load sliding 0.02 m per cycle on a Winkler lining (no multibody
+    dynamics, so it runs in a second); the worn volume follows Archard's law, kw F s N:
+
+    >>> from jointwear.sim import BearingGrid, WearSettings, WinklerContact, simulate_wear
+    >>> sim = simulate_wear(
+    ...     contact=WinklerContact(BearingGrid(4, 36), load=20.0, sliding=0.02),
+    ...     cycles=2000,
+    ...     snapshots=[1000, 2000],
+    ...     settings=WearSettings(scheme="fixed", dn=500),
+    ... )
+    >>> from jointwear.sim import DEFAULT_KW
+    >>> print(
+    ...     f"{float(sim['worn_volume'][-1]):.3g} m³, Archard {DEFAULT_KW * 20.0 * 0.02 * 2000:.3g} m³"
+    ... )
+    7.2e-13 m³, Archard 7.2e-13 m³
+    >>> sim["wear_depth"].dims
+    ('cycles', 'z', 'theta')
     """
     settings = settings or WearSettings()
     if kw is not None:
@@ -640,29 +691,23 @@ def simulate_wear(
         from jointwear.sim.wear._contact import DynamicContact
 
         if params is None:
-            from jointwear.sim import PARAMETER_SETS
+            from jointwear.sim.parameters import DEFAULT_PARAMETER_SET, PARAMETER_SETS
 
-            params = PARAMETER_SETS["zhang2023"]
+            params = PARAMETER_SETS[DEFAULT_PARAMETER_SET]
         params, settings = apply_overrides(params, settings, overrides)
         contact = DynamicContact(params, cycle_function)
     elif overrides:
         _, settings = apply_overrides(None, settings, overrides)
-    if resume:
-        if checkpoint is None:
-            raise BadInputError("resume=True needs the checkpoint path")
-        run = WearRun.resume(
-            checkpoint, contact, settings, cycles=cycles, snapshots=snapshots, on_update=on_update
-        )
-    else:
-        run = WearRun(
-            contact,
-            settings,
-            cycles=cycles,
-            snapshots=snapshots,
-            checkpoint=checkpoint,
-            initial_wear=initial_wear,
-            on_update=on_update,
-        )
+    run = WearRun.start(
+        contact,
+        settings,
+        cycles=cycles,
+        snapshots=snapshots,
+        checkpoint=checkpoint,
+        resume=resume,
+        initial_wear=initial_wear,
+        on_update=on_update,
+    )
     ds = run.run()
     if overrides:
         ds.attrs["parameter_overrides"] = json.dumps(

@@ -16,7 +16,7 @@ from jointwear import io
 from jointwear.cli import main
 from jointwear.errors import BadInputError
 from jointwear.sim import BearingGrid, WearSettings, check_accuracy, simulate_wear
-from jointwear.sim.cli_wear import demo_winkler_contact
+from jointwear.sim.wear._files import demo_winkler_contact
 
 SETTINGS = WearSettings(kw=9e-16, tol=0.1)
 
