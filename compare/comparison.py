@@ -401,26 +401,25 @@ def compare(
 
     Examples
     --------
-    A simulated wear map (prescribed contact) against a "measured" one 50 % deeper: the
-    shape and the place of the maximum agree, the depth, volume and cylindricity fail their
-    threshold (V&V 20 is not assessed: neither side states an uncertainty):
+    A simulated wear map (prescribed contact) against itself as the "measurement", with stated
+    uncertainties: every decided criterion passes (the maximum lies on the edge layer, so its
+    axial position is not comparable); a bearing that wore 50 % more fails the depth and the
+    cylindricity:
 
+    >>> from jointwear.compare import Criteria, compare
     >>> from jointwear.sim import BearingGrid, WearSettings, WinklerContact, simulate_wear
-    >>> sim = simulate_wear(
-    ...     contact=WinklerContact(BearingGrid(4, 36), load=20.0, sliding=0.02),
-    ...     cycles=2000,
-    ...     snapshots=[1000, 2000],
-    ...     settings=WearSettings(scheme="fixed", dn=500),
-    ... )
-    >>> meas = sim[["wear_depth"]].isel(cycles=-1, drop=True) * 1.5  # measured 50 % deeper
-    >>> meas["wear_depth"].attrs = sim["wear_depth"].attrs
-    >>> meas.attrs = {"data_origin": "synthetic", "cycles": 2000}
-    >>> from jointwear.compare import compare
-    >>> result = compare(sim, meas)
-    >>> result.summary()
-    '9 criteria: 3 pass, 3 fail, 3 not assessed'
-    >>> result.failed()
-    ['maximum wear depth', 'worn volume (compared width)', 'cylindricity of the wear (LSCY, common grid)']
+    >>> fixed, contact = WearSettings(scheme="fixed", dn=500), WinklerContact(BearingGrid(4, 36))
+    >>> sim = simulate_wear(contact=contact, cycles=2000, snapshots=[1000, 2000], settings=fixed)
+    >>> meas = sim.isel(cycles=-1, drop=True)[["wear_depth"]].copy(deep=True)
+    >>> meas = meas.assign_attrs(data_origin="synthetic", cycles=2000)
+    >>> u_d = 0.02 * float(meas["wear_depth"].max())  # the measurement's u_D [m]
+    >>> meas["wear_depth_u"] = meas["wear_depth"].copy(data=0 * meas["wear_depth"].values + u_d)
+    >>> stated = Criteria(wear_u_num_rel=0.05, wear_u_input_rel=0.1)  # u_num 5 %, u_input 10 %
+    >>> compare(sim, meas, criteria=stated).summary()
+    '6 criteria: 5 pass, 1 not comparable'
+    >>> meas["wear_depth"].values *= 1.5  # a bearing that wore 50 % more
+    >>> compare(sim, meas, criteria=stated).failed()
+    ['maximum wear depth within z = −7.5…+7.5 mm', 'cylindricity of the wear (LSCY) within z = −7.5…+7.5 mm']
     """
     criteria = criteria or Criteria()
     ens = as_ensemble(ensemble)
