@@ -59,11 +59,23 @@ def _refined(contact: Any) -> Any:
         params = replace_nested(
             contact.params, **{"joint.n_layers": 2 * nl - 1, "joint.n_points": 2 * nd}
         )
-        return type(contact)(params, getattr(contact, "_fn", None))
+        return type(contact)(params, contact.cycle_function)
     grid = getattr(contact, "grid", None)
-    if dataclasses.is_dataclass(contact) and isinstance(grid, BearingGrid):  # prescribed models
+    fields = dataclasses.fields(contact) if dataclasses.is_dataclass(contact) else ()
+    on_grid = [
+        f.name
+        for f in fields
+        if isinstance(getattr(contact, f.name), np.ndarray)
+        and getattr(contact, f.name).shape == (nl, nd)
+    ]
+    if fields and isinstance(grid, BearingGrid) and not on_grid:  # prescribed models
         finer = dataclasses.replace(grid, n_layers=2 * nl - 1, n_points=2 * nd)
         return dataclasses.replace(contact, grid=finer)
+    if on_grid:
+        raise BadInputError(
+            f"the grid check cannot refine {type(contact).__name__}: its {', '.join(on_grid)} "
+            "is given on the run's grid - check the intervals only"
+        )
     raise BadInputError(
         f"the grid check needs a contact model with a grid it can refine; "
         f"{type(contact).__name__} has none - check the intervals only"

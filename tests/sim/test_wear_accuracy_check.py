@@ -15,7 +15,7 @@ import pytest
 from jointwear import io
 from jointwear.cli import main
 from jointwear.errors import BadInputError
-from jointwear.sim import BearingGrid, WearSettings, check_accuracy, simulate_wear
+from jointwear.sim import BearingGrid, ConstantContact, WearSettings, check_accuracy, simulate_wear
 from jointwear.sim.wear._files import demo_winkler_contact
 
 SETTINGS = WearSettings(kw=9e-16, tol=0.1)
@@ -62,6 +62,13 @@ def test_unknown_check_and_partial_run_are_refused(winkler_run):
     partial.attrs["status"] = "partial"
     with pytest.raises(BadInputError, match="complete wear run"):
         check_accuracy(partial, contact, SETTINGS)
+    # a prescribed pressure field lives on the run's grid: no finer grid can be made of it
+    grid = BearingGrid(4, 36)
+    const = ConstantContact(grid, pressure=np.full(grid.shape, 1e6), sliding=0.01)
+    fixed = WearSettings(kw=9e-16, scheme="fixed", dn=50)
+    run = simulate_wear(contact=const, cycles=100, settings=fixed, snapshots=[])
+    with pytest.raises(BadInputError, match="cannot refine ConstantContact: its pressure"):
+        check_accuracy(run, const, fixed, kinds=("grid",))
 
 
 def test_wear_command_check_option(tmp_path, capsys, monkeypatch):
