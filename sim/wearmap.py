@@ -195,11 +195,23 @@ def edge_volume_share(wear_depth: xr.DataArray, inner_half_width: float = 6e-3) 
     -------
     DataArray
         The share (over ``cycles`` if the map has it); NaN where nothing has worn.
+
+    Raises
+    ------
+    BadInputError
+        The map does not extend beyond the central band on both sides (e.g. a measured map of a
+        narrower band), or lacks ``z``/``theta``.
     """
     if "z" not in wear_depth.dims or "theta" not in wear_depth.dims:
         raise BadInputError(f"wear_depth has dims {wear_depth.dims}, expected z and theta")
     prof = wear_depth.sum("theta").sortby("z")
     z = prof["z"].values
+    if not (z[0] < -inner_half_width and z[-1] > inner_half_width):
+        raise BadInputError(
+            f"the wear map covers z = {z[0] * 1e3:.3g} ... {z[-1] * 1e3:.3g} mm, which does not "
+            f"reach beyond the central band |z| <= {inner_half_width * 1e3:g} mm on both sides: "
+            "the share outside it would mean nothing; give a smaller inner_half_width"
+        )
     edges = np.unique(
         np.clip(np.concatenate([z, [-inner_half_width, inner_half_width]]), z[0], z[-1])
     )

@@ -133,3 +133,20 @@ def test_a_stiff_tilt_spring_spreads_the_wear_over_the_width():
     # uniform wear along z puts 20 % of the volume outside |z| <= 6 mm (15 mm bearing)
     assert share[0.0] > 0.5
     assert share[1e3] < 0.3
+
+
+def test_edge_share_of_uniform_and_edge_wear_and_a_map_too_narrow():
+    import xarray as xr
+
+    from jointwear.errors import BadInputError
+
+    z = np.linspace(-7.5e-3, 7.5e-3, 9) ** 3 / 7.5e-3**2  # unequal spacing: exact anyway
+    th = np.arange(8.0) * 45.0
+    uniform = xr.DataArray(np.ones((9, 8)), dims=("z", "theta"), coords={"z": z, "theta": th})
+    assert float(edge_volume_share(uniform)) == pytest.approx(0.2, abs=1e-12)  # 3 of 15 mm
+    zl = np.array([-7.5, -6.0, -3.0, 0.0, 3.0, 6.0, 7.5]) * 1e-3
+    ramp = np.maximum(np.abs(zl) - 6e-3, 0.0)[:, None] * np.ones((1, 8))  # zero inside +-6 mm
+    edge = xr.DataArray(ramp, dims=("z", "theta"), coords={"z": zl, "theta": th})
+    assert float(edge_volume_share(edge)) == pytest.approx(1.0, abs=1e-12)
+    with pytest.raises(BadInputError, match="does not reach beyond"):
+        edge_volume_share(uniform.assign_coords(z=z * 0.7))  # a measured band of +-5.25 mm
