@@ -101,3 +101,15 @@ def test_metal_wear_run_records_no_breach():
     ds = simulate_wear(p, cycles=100, snapshots=[], settings=settings)
     assert ds.attrs["contact_validity_status"] == "within limits"
     assert "contact_validity_warning" not in ds.attrs
+
+
+def test_cycle_command_prints_and_records_the_breach(tmp_path, capsys):
+    from jointwear import io
+    from jointwear.cli import main
+
+    params = tmp_path / "ptfe.toml"
+    params.write_text("[contact]\nbearing_modulus = 0.5e9\nbearing_poisson = 0.46\n")
+    out = tmp_path / "c.nc"
+    assert main(["sim", "cycle", "--cycles", "1", "--out", str(out), "--params", str(params)]) == 0
+    assert "left its validity range" in capsys.readouterr().err
+    assert io.load(out).attrs["contact_validity_status"] == "exceeded"
