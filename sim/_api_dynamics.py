@@ -24,6 +24,7 @@ from jointwear.sim.parameters import (
     load_parameters,
 )
 from jointwear.sim.plot import plot_cycle
+from jointwear.sim.validity import CONTACT_LIMITS, contact_validity
 
 __all__ = [
     "SimParameters",
@@ -48,4 +49,6 @@ __all__ = [
     "friction_coefficient",
     "loop_closure",
     "plot_cycle",
+    "CONTACT_LIMITS",
+    "contact_validity",
 ]

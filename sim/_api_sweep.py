@@ -2,6 +2,7 @@
 
 from jointwear.sim.sweep._driver import STATUS, run_sweep, to_grid
 from jointwear.sim.sweep._models import analytic_sobol
+from jointwear.sim.sweep._report import warning_summary
 from jointwear.sim.sweep._spec import SweepSpec, make_design, read_spec
 from jointwear.sim.sweep._verify import VerifySpec, read_verify_spec, verify_wear
 
@@ -13,6 +14,7 @@ __all__ = [
     "to_grid",
     "analytic_sobol",
     "STATUS",
+    "warning_summary",
     "verify_wear",
     "VerifySpec",
     "read_verify_spec",

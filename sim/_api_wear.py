@@ -9,6 +9,7 @@ from jointwear.sim.wear._calibration import (
     calibrate_kw_multi,
     resimulator,
 )
+from jointwear.sim.wear._check import check_accuracy
 from jointwear.sim.wear._contact import (
     ConstantContact,
     ContactModel,
@@ -30,6 +31,7 @@ from jointwear.sim.wearmap import (
     BearingGrid,
     bore_cylindricity,
     bore_radius,
+    edge_volume_share,
     plot_wear_history,
     plot_wear_map,
     wear_map_dataset,
@@ -51,10 +53,12 @@ __all__ = [
     "calibrate_kw_multi",
     "calibrate_kw_and_parameter",
     "halved_schedule",
+    "check_accuracy",
     "resimulator",
     "BearingGrid",
     "wear_map_dataset",
     "worn_volume",
+    "edge_volume_share",
     "bore_radius",
     "bore_cylindricity",
     "plot_wear_map",

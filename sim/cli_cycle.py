@@ -101,6 +101,8 @@ def register(app: typer.Typer) -> None:
                     ) from None
                 raise
         io.save(result.dataset, out, inputs=inputs, parameters=p, source=source)
+        if "contact_validity_warning" in result.dataset.attrs:
+            typer.echo(f"warning: {result.dataset.attrs['contact_validity_warning']}", err=True)
         ds = result.dataset
         typer.echo(
             f"{out}: {cycles:g} cycle(s), {ds.sizes['time']} samples, "

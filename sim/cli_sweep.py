@@ -61,12 +61,16 @@ def register(app: typer.Typer) -> None:
         with --resume; a failing run is recorded with its error and the sweep goes on. For
         method = "sobol" or "morris" the result holds SALib's sensitivity indices.
         """
+        import logging
+
         import numpy as np
 
         from jointwear.errors import BadInputError, SimulationError
         from jointwear.progress import progress_bar
         from jointwear.sim.sweep._driver import run_sweep
 
+        # printed below, once (the runs keep their warnings in the record)
+        logging.getLogger("jointwear.sim.sweep").addHandler(logging.NullHandler())
         if scheduler is not None and workers is not None:
             raise BadInputError("give --workers or --scheduler, not both")
         with progress_bar("sweep", total=None, enabled=progress) as bar:
@@ -109,6 +113,12 @@ def register(app: typer.Typer) -> None:
         )
         for i in np.flatnonzero(status == 1)[:5]:
             typer.echo(f"  run {int(i)} failed: {ds['error'].values[i]}", err=True)
+        from jointwear.sim import warning_summary
+
+        for line in warning_summary(ds):
+            typer.echo(f"warning: {line}", err=True)
+        if "sensitivity_sample_warning" in ds.attrs:
+            typer.echo(f"warning: {ds.attrs['sensitivity_sample_warning']}", err=True)
         if "sensitivity_not_assessed" in ds.attrs:
             typer.echo(
                 f"sensitivity not assessed for: {ds.attrs['sensitivity_not_assessed']}", err=True

@@ -70,6 +70,20 @@ def _parse_vary(text: str) -> tuple[str, tuple[float, float]]:
     return name.strip(), bounds
 
 
+def _check_kinds(given: list[str] | None) -> tuple[str, ...]:
+    """The accuracy checks asked for (``--check interval --check grid`` or comma-separated)."""
+    from jointwear.errors import BadInputError
+    from jointwear.sim.wear._check import CHECK_KINDS
+
+    kinds = tuple(dict.fromkeys(k.strip() for v in (given or []) for k in v.split(",") if k))
+    bad = [k for k in kinds if k not in CHECK_KINDS]
+    if bad:
+        raise BadInputError(
+            f"--check {', '.join(bad)}: unknown check; choose from {', '.join(CHECK_KINDS)}"
+        )
+    return kinds
+
+
 def _progress_text(info: dict[str, Any]) -> str:
     """The progress bar's description after an update."""
     return f"wear: dN={info['dn']:d} max depth={info['max_depth'] * 1e6:.2f} µm" + (
@@ -288,6 +302,15 @@ def wear(
         bool | None,
         typer.Option("--progress/--no-progress", help="Progress bar (default: on a terminal)."),
     ] = None,
+    check: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--check",
+            help="After the run, repeat it with 'interval' (every update interval halved) or "
+            "'grid' (spacing halved) and compare with the stated accuracy; repeatable. Exit 1 "
+            "if a change exceeds it.",
+        ),
+    ] = None,
 ) -> None:
     """Simulate Archard wear of joint C over many cycles; checkpoint after every update."""
     import logging
@@ -303,6 +326,7 @@ def wear(
     if figure is not None:
         io.check_writable(figure, what="--figure")
     snaps = _parse_snapshots(snapshots)
+    kinds = _check_kinds(check)
     overrides = {"kw": kw, "scheme": scheme, "dn": dn, "tol": tol, "settle_cycles": settle}
     with progress_bar("wear", total=float(cycles), enabled=progress) as bar:
         task = bar.tasks[0].id
@@ -323,13 +347,22 @@ def wear(
                 task, completed=info["cycles_done"], description=_progress_text(info)
             ),
             warn=lambda message: typer.echo(message, err=True),
+            checks=kinds,
         )
     if figure is not None:
         _write_figure(ds, figure)
-    for key in ("convergence_warning", "accuracy_warning"):
+    for key in ("convergence_warning", "accuracy_warning", "contact_validity_warning"):
         if key in ds.attrs:
             typer.echo(f"warning: {ds.attrs[key]}", err=True)
     typer.echo(_summary(out, ds, run))
+    if ds.attrs.get("accuracy_check_status") == "inconsistent":
+        from jointwear.errors import ValidationFailed
+
+        raise ValidationFailed(
+            f"{out}: the accuracy check found a change larger than the stated accuracy "
+            "(attribute accuracy_check_status); the run's *_u do not cover its numerical "
+            "error - use a smaller tol or a finer grid"
+        )
 
 
 def register(app: typer.Typer) -> None:

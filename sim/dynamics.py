@@ -23,6 +23,7 @@ from jointwear.sim.kernels import _layout as kn
 from jointwear.sim.kernels._integrator import integrate
 from jointwear.sim.mechanism import loop_closure, quaternion_to_matrix, rotation_xzy_angles
 from jointwear.sim.parameters import SimParameters
+from jointwear.sim.validity import contact_validity
 from jointwear.sim.wearmap import layer_positions
 
 __all__ = [
@@ -100,6 +101,9 @@ class CycleResult:
         Accepted integration steps.
     sliding_distance : ndarray (Nl, Nd)
         Integral of |ds| at each bearing point while it is in contact [m].
+    max_penetration : float
+        Largest penetration (bore or end faces) at the end of an accepted step [m]; NaN = not
+        known (a result not made by :func:`run_cycles`).
     """
 
     dataset: xr.Dataset | None
@@ -112,6 +116,7 @@ class CycleResult:
     normal_impulse: float = 0.0
     n_steps: int = 0
     sliding_distance: np.ndarray | None = None
+    max_penetration: float = math.nan
 
 
 def _layers(params: SimParameters) -> tuple[np.ndarray, np.ndarray]:
@@ -156,6 +161,7 @@ def _pack(params: SimParameters) -> tuple[np.ndarray, np.ndarray]:
     P[kn.MUON] = 1.0 if f.enabled else 0.0
     P[kn.BAUM] = s.baumgarte
     P[kn.DPHI] = 2 * math.pi / j.n_points
+    P[kn.KTILT], P[kn.CTILT] = j.tilt_stiffness, j.tilt_damping
     IP = np.zeros(kn.NIP, dtype=np.int64)
     IP[kn.DRIVER] = 1 if m.driver else 0
     IP[kn.ON_COUPLER] = 1 if m.bearing_on == "coupler" else 0
@@ -376,7 +382,7 @@ def run_cycles(
     hmin = h.min(axis=1).copy()
     area = point_area(params, h)
     ww = np.zeros((2, *h.shape))
-    acc = np.zeros(3)
+    acc = np.zeros(4)  # normal work, axial normal work, normal impulse, max penetration
     y = st.y.astype(float).copy()
     vimp = st.impact_velocity.astype(float).copy()
     hstep = float(st.step)
@@ -431,6 +437,8 @@ def run_cycles(
     ds = _dataset(params, t_rel, diag, t0) if record else None
     if ds is not None:
         ds = _add_maps(ds, params, ww, area)
+        if model == "clearance":
+            ds.attrs.update(contact_validity(params, float(acc[3]))["attrs"])
     return CycleResult(
         dataset=ds,
         wear_work=ww[0],
@@ -442,6 +450,7 @@ def run_cycles(
         axial_normal_work=float(acc[1]),
         normal_impulse=float(acc[2]),
         n_steps=int(nacc_total),
+        max_penetration=float(acc[3]),
     )
 
 

@@ -148,6 +148,8 @@ class JointParameters:
     n_layers: int = 20
     n_points: int = 200
     axial_grading: float = 0.75
+    tilt_stiffness: float = 0.0
+    tilt_damping: float = 0.0
 
     def __post_init__(self) -> None:
         w = "joint"
@@ -159,7 +161,12 @@ class JointParameters:
             bearing_width=self.bearing_width,
             thrust_radius=self.thrust_radius,
         )
-        _non_negative(w, axial_clearance=self.axial_clearance)
+        _non_negative(
+            w,
+            axial_clearance=self.axial_clearance,
+            tilt_stiffness=self.tilt_stiffness,
+            tilt_damping=self.tilt_damping,
+        )
         if self.bearing_radius <= self.journal_radius:
             raise ParameterError(
                 f"joint.journal_radius ({self.journal_radius} m) must be smaller than "

@@ -30,6 +30,7 @@ __all__ = [
     "layer_positions",
     "wear_map_dataset",
     "worn_volume",
+    "edge_volume_share",
     "bore_radius",
     "bore_cylindricity",
     "plot_wear_map",
@@ -172,6 +173,66 @@ def worn_volume(wear_depth: np.ndarray, grid: BearingGrid) -> float:
     0.3 % for 50 µm in an 8 mm bore).
     """
     return float(np.sum(grid.check(wear_depth, "wear_depth") * grid.point_area))
+
+
+def edge_volume_share(wear_depth: xr.DataArray, inner_half_width: float = 6e-3) -> xr.DataArray:
+    """Share of the worn volume that lies outside ``|z| <= inner_half_width`` [1].
+
+    The profile is integrated exactly as the piecewise-linear function of z that the map's
+    layers define (patch widths in theta are equal, so the angle sum stands for the area), so
+    the share does not depend on where the layers lie. Uniform wear along the width gives
+    ``1 - 2 inner_half_width / wb`` (0.2 for the study's 15-mm bearing and 6 mm); wear that
+    sits at the bearing edges gives values near 1.
+
+    Parameters
+    ----------
+    wear_depth : DataArray
+        Wear depth [m] over ``z`` [m] and ``theta`` (and optionally ``cycles``).
+    inner_half_width : float
+        Half-width of the central band [m].
+
+    Returns
+    -------
+    DataArray
+        The share (over ``cycles`` if the map has it); NaN where nothing has worn.
+
+    Raises
+    ------
+    BadInputError
+        The map does not extend beyond the central band on both sides (e.g. a measured map of a
+        narrower band), or lacks ``z``/``theta``.
+    """
+    if "z" not in wear_depth.dims or "theta" not in wear_depth.dims:
+        raise BadInputError(f"wear_depth has dims {wear_depth.dims}, expected z and theta")
+    prof = wear_depth.sum("theta").sortby("z")
+    z = prof["z"].values
+    if not (z[0] < -inner_half_width and z[-1] > inner_half_width):
+        raise BadInputError(
+            f"the wear map covers z = {z[0] * 1e3:.3g} ... {z[-1] * 1e3:.3g} mm, which does not "
+            f"reach beyond the central band |z| <= {inner_half_width * 1e3:g} mm on both sides: "
+            "the share outside it would mean nothing; give a smaller inner_half_width"
+        )
+    edges = np.unique(
+        np.clip(np.concatenate([z, [-inner_half_width, inner_half_width]]), z[0], z[-1])
+    )
+    fine = prof.interp(z=edges)  # exact: the profile is linear between layers
+    seg = 0.5 * (fine.isel(z=slice(1, None)).values + fine.isel(z=slice(None, -1)).values)
+    seg = np.moveaxis(seg, fine.get_axis_num("z"), -1) * np.diff(edges)
+    mid = 0.5 * (edges[1:] + edges[:-1])
+    total = seg.sum(axis=-1)
+    outside = seg[..., np.abs(mid) > inner_half_width].sum(axis=-1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        share = np.where(total > 0, outside / np.where(total > 0, total, 1.0), np.nan)
+    dims = [d for d in fine.dims if d != "z"]
+    return xr.DataArray(
+        share,
+        dims=dims,
+        coords={d: fine[d] for d in dims},
+        attrs={
+            "units": "1",
+            "long_name": f"share of the worn volume outside |z| <= {inner_half_width * 1e3:g} mm",
+        },
+    )
 
 
 def bore_radius(wear_depth: xr.DataArray, radius: float) -> xr.DataArray:

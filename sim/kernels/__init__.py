@@ -4,6 +4,7 @@
 * ``_geometry``: follower rotation, bore/journal nodes, contact search, layer axes;
 * ``_friction``: smoothed Coulomb friction (eq. 12);
 * ``_contact``: Lankarani-Nikravesh contact forces (eqs. 6-10), wear work, impact latch;
+* ``_tilt``: the lumped tilt spring-damper of joint C (``joint.tilt_stiffness``);
 * ``_equations``: equations of motion of the clearance and ideal models;
 * ``_integrator``: DOPRI5 integration with output times.
 

@@ -13,6 +13,7 @@ from jointwear.sim.kernels._contact import _contact
 from jointwear.sim.kernels._geometry import _quat_matrix
 from jointwear.sim.kernels._layout import (
     BAUM,
+    CTILT,
     D_AXIS,
     D_BEAR_POS,
     D_COUP_POS,
@@ -53,6 +54,7 @@ from jointwear.sim.kernels._layout import (
     I_PEN,
     IDEAL,
     JOFF,
+    KTILT,
     L1,
     L2,
     L3,
@@ -64,6 +66,7 @@ from jointwear.sim.kernels._layout import (
     ND_DIAG,
     ON_COUPLER,
 )
+from jointwear.sim.kernels._tilt import _tilt_spring
 
 
 @njit(cache=True)
@@ -138,6 +141,8 @@ def _eval_clearance(t, y, ctx, dy, acc, hstep, diag):
     energy, fnsum, pen_rad, pen_ax, mode, kdeep, nslice, fax = _contact(
         J0, u, V0, W, ctx, wrench, acc, hstep
     )
+    if P[KTILT] != 0.0 or P[CTILT] != 0.0:
+        energy += _tilt_spring(u, W, P[KTILT], P[CTILT], wrench)
     # wrench on the bearing, global: force F, moment M about Og
     Fx = Rb[0, 0] * wrench[0] + Rb[0, 1] * wrench[1] + Rb[0, 2] * wrench[2]
     Fy = Rb[1, 0] * wrench[0] + Rb[1, 1] * wrench[1] + Rb[1, 2] * wrench[2]

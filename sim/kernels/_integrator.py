@@ -97,6 +97,8 @@ def integrate(
 
     Returns (status, t, hstep, i_out, n_accepted, n_rejected). status: 0 done, 1 step-size
     collapse, 2 penetration beyond ``pen_limit``, 3 non-finite state, 4 journal axis flipped.
+    ``acc_out``: normal work, axial normal work, normal impulse (accumulated) and the largest
+    penetration at the end of an accepted step (bore or end faces, kept as a maximum).
     """
     n = y.shape[0]
     Nl = IP[NL]
@@ -223,6 +225,8 @@ def integrate(
                 son[k] = 0
         pen0 = pen1
         contact0 = contact1
+        if pen0 > acc_out[3]:
+            acc_out[3] = pen0
         _latch_impacts(vimp, srate, son, Nl, P[VFLOOR], IP[LATCH])
         if pen0 > pen_limit:
             return 2, t, h, i_out, nacc, nrej

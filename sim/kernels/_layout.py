@@ -29,7 +29,10 @@ MUS, MUD, VS, VD, MUON = 27, 28, 29, 30, 31
 BAUM, DPHI = 32, 33
 
 
-NP = 34
+KTILT, CTILT = 34, 35  # lumped tilt spring [N m/rad] and damper [N m s/rad] of joint C
+
+
+NP = 36
 
 
 # ---- integer parameters (IP) ------------------------------------------------------------------

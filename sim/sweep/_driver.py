@@ -11,6 +11,7 @@ for ``method = "sobol"``/``"morris"``, the sensitivity indices computed by SALib
 from __future__ import annotations
 
 import json
+import logging
 import time
 import warnings
 from collections.abc import Callable
@@ -21,7 +22,14 @@ import numpy as np
 import xarray as xr
 
 from jointwear.errors import BadInputError, ParameterError
-from jointwear.sim.sweep._outputs import FIELDS, available_outputs, phase_grid
+from jointwear.sim.sweep._outputs import (
+    ANGLE_UNITS,
+    FIELDS,
+    available_outputs,
+    phase_grid,
+    uncertainty_note,
+)
+from jointwear.sim.sweep._report import circular_summary, sample_size_check
 from jointwear.sim.sweep._run import RunResult, RunTask
 from jointwear.sim.sweep._spec import (
     Design,
@@ -168,12 +176,48 @@ def assemble(
         elapsed[i] = r.elapsed
         host[i] = r.host
     for name in spec.outputs:
-        arr = np.full(n, np.nan)
+        units, long_name = avail[name]
+        value, u = (np.full(n, np.nan) for _ in range(2))
         for i, r in results.items():
             if r.status == "ok":
-                arr[i] = r.outputs.get(name, np.nan)
-        units, long_name = avail[name]
-        ds[name] = xr.Variable("run", arr, {"units": units, "long_name": long_name})
+                value[i] = r.outputs.get(name, np.nan)
+                u[i] = r.outputs.get(f"{name}_u", np.nan)
+        attrs = {"units": units, "long_name": long_name, "ancillary_variables": f"{name}_u"}
+        if units == ANGLE_UNITS:
+            attrs.update(circular_summary(value))
+        ds[name] = xr.Variable("run", value, attrs)
+        ds[f"{name}_u"] = xr.Variable(
+            "run",
+            u,
+            {
+                "units": units,
+                "long_name": f"standard uncertainty of {name}",
+                "coverage_factor": 1,
+                "comment": uncertainty_note(name),
+            },
+        )
+    accuracy = np.full(n, "", dtype=object)
+    warned = np.full(n, "", dtype=object)
+    for i, r in results.items():
+        accuracy[i] = r.accuracy_status if r.status == "ok" else ""
+        warned[i] = json.dumps(list(r.warnings)) if r.warnings else ""
+    ds["accuracy_status"] = xr.Variable(
+        "run",
+        accuracy.astype(str),
+        {
+            "units": "1",
+            "long_name": "accuracy_status of the run (reached, not reached, not assessed; "
+            "empty if it did not finish)",
+        },
+    )
+    ds["run_warnings"] = xr.Variable(
+        "run",
+        warned.astype(str),
+        {
+            "units": "1",
+            "long_name": "the run's warnings as a JSON list of 'kind: message' (empty: none)",
+        },
+    )
     for name in spec.keep:
         dims, units, long_name = FIELDS[name]
         shape = tuple(ds.sizes[d] for d in dims)
@@ -233,6 +277,16 @@ def assemble(
     return ds
 
 
+_log = logging.getLogger("jointwear.sim.sweep")
+
+#: Why Sobol/Morris indices of an angle output are refused.
+_ANGLE_REFUSED = (
+    "an angle (circular: a variance-based index depends on where the cut at 0/360 lies); "
+    "request its cosine and sine (max_wear_theta_cos, max_wear_theta_sin), the documented "
+    "transform"
+)
+
+
 def _salib_problem(spec: SweepSpec) -> dict[str, Any]:
     names = [p.name for p in spec.random_parameters]
     return {"num_vars": len(names), "names": names, "bounds": [[0.0, 1.0]] * len(names)}
@@ -272,6 +326,9 @@ def sensitivity(ds: xr.Dataset, spec: SweepSpec, design: Design) -> xr.Dataset:
         )
         for i, out in enumerate(spec.outputs):
             y = np.asarray(ds[out].values, dtype=float)
+            if ds[out].attrs.get("units") == ANGLE_UNITS:
+                not_assessed[out] = _ANGLE_REFUSED
+                continue
             if not np.all(np.isfinite(y)):
                 not_assessed[out] = f"{int(np.sum(~np.isfinite(y)))} run(s) failed or not run"
                 continue
@@ -322,8 +379,13 @@ def sensitivity(ds: xr.Dataset, spec: SweepSpec, design: Design) -> xr.Dataset:
         for out in spec.outputs:
             y = np.asarray(ds[out].values, dtype=float)
             units = ds[out].attrs["units"]
-            if not np.all(np.isfinite(y)):
-                not_assessed[out] = f"{int(np.sum(~np.isfinite(y)))} run(s) failed or not run"
+            angle = units == ANGLE_UNITS
+            if angle or not np.all(np.isfinite(y)):
+                not_assessed[out] = (
+                    _ANGLE_REFUSED
+                    if angle
+                    else f"{int(np.sum(~np.isfinite(y)))} run(s) failed or not run"
+                )
                 res = {
                     k: np.full(len(names), np.nan)
                     for k in ("mu", "mu_star", "sigma", "mu_star_conf")
@@ -379,6 +441,17 @@ def sensitivity(ds: xr.Dataset, spec: SweepSpec, design: Design) -> xr.Dataset:
             )
     if not_assessed:
         ds.attrs["sensitivity_not_assessed"] = json.dumps(not_assessed, sort_keys=True)
+    check = sample_size_check(ds, spec.method, spec.samples)
+    ds.attrs["sensitivity_recommended_samples"] = check["recommended_samples"]
+    if not check["ok"]:
+        msg = (
+            f"{spec.method} with samples = {spec.samples} is too small for the indices asked: "
+            + "; ".join(check["problems"])
+            + f"; use samples = {check['recommended_samples']} (the indices in this file are "
+            "not reliable)"
+        )
+        ds.attrs["sensitivity_sample_warning"] = msg
+        _log.warning("%s", msg)
     if notes:
         ds.attrs["sensitivity_warnings"] = json.dumps(sorted(set(notes)))
     return ds

@@ -17,7 +17,10 @@ from typing import Any
 from jointwear.errors import BadInputError
 from jointwear.sim.sweep._run import RunResult, RunTask, evaluate_run
 
-__all__ = ["execute", "WORKER_ENV"]
+__all__ = ["execute", "WORKER_ENV", "LOOPBACK"]
+
+#: Address every socket of a local cluster listens on (no other machine can reach it).
+LOOPBACK = "127.0.0.1"
 
 #: Environment of local workers: one thread each for numba and BLAS (one run per core).
 WORKER_ENV = {
@@ -53,9 +56,11 @@ def _client(workers: int | None, scheduler: str | None) -> tuple[Any, Any, str]:
         n_workers=n,
         threads_per_worker=1,
         processes=True,
-        # no dashboard; the scheduler's HTTP endpoints (health, metrics) take a free port
-        # instead of 8787, which another cluster on the machine may hold (a warning)
-        dashboard_address=":0",
+        # everything on the loopback interface: scheduler, workers and nannies (host), and the
+        # scheduler's HTTP endpoints (health, metrics), which take a free port instead of 8787
+        # (another cluster on the machine may hold it); no dashboard
+        host=LOOPBACK,
+        dashboard_address=f"{LOOPBACK}:0",
         scheduler_kwargs={"dashboard": False},
         env=dict(WORKER_ENV),
         silence_logs=logging.ERROR,

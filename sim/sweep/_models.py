@@ -59,6 +59,10 @@ def _linear(
     return {"y": y, "y2": 2.0 * y}
 
 
+def _angle(x: Mapping[str, float], *, start: float = 350.0, span: float = 20.0) -> dict[str, float]:
+    return {"theta": (start + span * x["x1"]) % 360.0, "theta_linear": start + span * x["x1"]}
+
+
 MODELS: dict[str, FunctionModel] = {
     "ishigami": FunctionModel(
         "ishigami",
@@ -76,6 +80,15 @@ MODELS: dict[str, FunctionModel] = {
         defaults={"x1": 0.0, "x2": 0.0, "x3": 0.0, "x4": 0.0},
         options=("a",),
         doc="y = sum a_i x_i (inputs not swept are 0), y2 = 2 y",
+    ),
+    "angle": FunctionModel(
+        "angle",
+        ("x1",),
+        {"theta": "degree", "theta_linear": "1"},
+        _angle,
+        options=("start", "span"),
+        doc="theta = (start + span x1) mod 360 [degree] (an angle crossing 0/360 for the "
+        "defaults), theta_linear = start + span x1 (the same without the wrap)",
     ),
 }
 

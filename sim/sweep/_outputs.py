@@ -13,7 +13,15 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-__all__ = ["WEAR_OUTPUTS", "MOTION_OUTPUTS", "FIELDS", "wear_outputs", "motion_outputs"]
+__all__ = [
+    "WEAR_OUTPUTS",
+    "MOTION_OUTPUTS",
+    "FIELDS",
+    "ANGLE_UNITS",
+    "wear_outputs",
+    "motion_outputs",
+    "uncertainty_note",
+]
 
 #: Scalar outputs of a wear run: name -> (units, long_name).
 WEAR_OUTPUTS: dict[str, tuple[str, str]] = {
@@ -25,6 +33,12 @@ WEAR_OUTPUTS: dict[str, tuple[str, str]] = {
         "angle of the largest wear depth (canonical convention: 0 along -x, clockwise from +z; "
         "NaN if nothing wore)",
     ),
+    "max_wear_theta_cos": (
+        "1",
+        "cosine of max_wear_theta: with max_wear_theta_sin the documented transform of the "
+        "angle for sensitivity analysis (NaN if nothing wore)",
+    ),
+    "max_wear_theta_sin": ("1", "sine of max_wear_theta (NaN if nothing wore)"),
     "max_wear_z": (
         "m",
         "axial position of the largest wear depth (0 at bearing mid-width, +z; NaN if nothing wore)",
@@ -49,6 +63,30 @@ MOTION_OUTPUTS: dict[str, tuple[str, str]] = {
     "contact_fraction": ("1", "fraction of the time joint C is in contact"),
 }
 
+#: Outputs whose run states its accuracy: output -> variable of the wear map (expanded, k = 2).
+ACCURACY_OF = {"max_wear_depth": "max_wear_depth_u", "worn_volume": "worn_volume_u"}
+
+#: Counts, exact by definition (standard uncertainty 0).
+EXACT_OUTPUTS = ("cycles_simulated", "n_updates")
+
+#: Units of an output that is an angle around the bearing axis: a circular quantity (circular
+#: mean and spread; no Sobol/Morris indices, use its cosine and sine).
+ANGLE_UNITS = "degree"
+
+
+def uncertainty_note(name: str) -> str:
+    """What the ``<name>_u`` of a sweep output covers (its ``comment``)."""
+    if name in ACCURACY_OF:
+        return (
+            "standard uncertainty from the run's update control (its expanded k = 2 accuracy "
+            f"{ACCURACY_OF[name]} / 2): time integration and cycle-to-cycle variability, not "
+            "the model or its parameters; NaN = not assessed"
+        )
+    if name in EXACT_OUTPUTS:
+        return "an exact count: standard uncertainty 0"
+    return "not assessed (NaN): the run does not state the accuracy of this output"
+
+
 #: Fields a sweep can keep per run: name -> (dims besides run, units, long_name).
 FIELDS: dict[str, tuple[tuple[str, ...], str, str]] = {
     "wear_depth": (("z", "theta"), "m", "wear depth at the target cycles"),
@@ -71,11 +109,21 @@ def wear_outputs(ds: xr.Dataset) -> dict[str, float]:
     k = int(np.argmax(depth.values))
     iz, it = np.unravel_index(k, depth.shape)
     worn = float(depth.values.flat[k]) > 0  # an unworn bore has no location of maximum wear
+    theta = float(depth["theta"].values[it]) if worn else float("nan")
+    accuracy = {
+        f"{name}_u": float(last[var]) / 2.0 if var in ds else float("nan")
+        for name, var in ACCURACY_OF.items()
+    }
+    exact = {f"{name}_u": 0.0 for name in EXACT_OUTPUTS}
     return {
+        **accuracy,
+        **exact,
         "max_wear_depth": float(last["max_wear_depth"]),
         "worn_volume": float(last["worn_volume"]),
         "cylindricity": float(last["cylindricity"]),
-        "max_wear_theta": float(depth["theta"].values[it]) if worn else float("nan"),
+        "max_wear_theta": theta,
+        "max_wear_theta_cos": float(np.cos(np.radians(theta))),
+        "max_wear_theta_sin": float(np.sin(np.radians(theta))),
         "max_wear_z": float(depth["z"].values[iz]) if worn else float("nan"),
         "normal_work": float(last["normal_work"]) if "normal_work" in ds else float("nan"),
         "cycles_simulated": float(ds.attrs.get("cycles_simulated", np.nan)),

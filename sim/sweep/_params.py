@@ -70,6 +70,8 @@ _UNITS_BY_NAME = {
     "joint_offset": "m",
     "axial_clearance": "m",
     "radial_clearance": "m",
+    "tilt_stiffness": "N m rad-1",
+    "tilt_damping": "N m s rad-1",
 }
 _UNITS_BY_SUFFIX = (
     ("_length", "m"),

@@ -7,6 +7,7 @@ and the run's own seed), so a run gives the same numbers wherever it runs.
 
 from __future__ import annotations
 
+import logging
 import os
 import socket
 import time
@@ -42,6 +43,8 @@ class RunResult:
     error: str = ""
     elapsed: float = 0.0
     host: str = ""
+    accuracy_status: str = "not assessed"
+    warnings: tuple[str, ...] = ()  # "kind: message", kind an attribute name of the run's file
 
 
 def _record_cycles(params: Any, h: np.ndarray | None, settle: float, cycles: float) -> Any:
@@ -51,6 +54,29 @@ def _record_cycles(params: Any, h: np.ndarray | None, settle: float, cycles: flo
     if settle > 0:
         state = run_cycles(params, cycles=settle, wear_depth=h, record=False).state
     return run_cycles(params, cycles=cycles, wear_depth=h, state=state, record=True).dataset
+
+
+#: Attributes of a wear map that hold a warning (their names are the kinds of warnings).
+WARNING_ATTRS = ("accuracy_warning", "convergence_warning", "contact_validity_warning")
+
+
+class _Quiet(logging.Handler):
+    """Keeps the wear module's log records from the console: the run's record holds them."""
+
+    def emit(self, record: logging.LogRecord) -> None:  # pragma: no cover - nothing to do
+        pass
+
+
+def _run_quietly(run: Any) -> Any:
+    log = logging.getLogger("jointwear.sim.wear")
+    handler, propagate = _Quiet(), log.propagate
+    log.addHandler(handler)
+    log.propagate = False
+    try:
+        return run.run()
+    finally:
+        log.removeHandler(handler)
+        log.propagate = propagate
 
 
 def _wear(task: RunTask) -> tuple[dict[str, float], dict[str, np.ndarray]]:
@@ -88,8 +114,10 @@ def _wear(task: RunTask) -> tuple[dict[str, float], dict[str, np.ndarray]]:
         snapshots=[spec.cycles],
         on_update=within_budget,
     )
-    ds = run.run()
+    ds = _run_quietly(run)
     out = wear_outputs(ds)
+    out["__accuracy_status"] = ds.attrs.get("accuracy_status", "not assessed")
+    out["__warnings"] = tuple(f"{k}: {ds.attrs[k]}" for k in WARNING_ATTRS if k in ds.attrs)
     fields: dict[str, np.ndarray] = {}
     if "wear_depth" in spec.keep:
         fields["wear_depth"] = np.asarray(ds["wear_depth"].isel(cycles=-1).values)
@@ -147,5 +175,10 @@ def evaluate_run(task: RunTask) -> RunResult:
         return RunResult(
             task.index, "failed", {}, {}, _error_text(exc), time.perf_counter() - t0, host
         )
-    outputs = {name: float(out.get(name, np.nan)) for name in task.spec.outputs}
-    return RunResult(task.index, "ok", outputs, fields, "", time.perf_counter() - t0, host)
+    status = str(out.pop("__accuracy_status", "not assessed"))
+    warned = tuple(out.pop("__warnings", ()))
+    names = [*task.spec.outputs, *(f"{n}_u" for n in task.spec.outputs)]
+    outputs = {name: float(out.get(name, np.nan)) for name in names}
+    return RunResult(
+        task.index, "ok", outputs, fields, "", time.perf_counter() - t0, host, status, warned
+    )

@@ -131,6 +131,8 @@ class PartStore:
             "host": np.str_(result.host),
             "digest": np.str_(self.digest),
             "values": np.asarray(values, dtype=float),
+            "accuracy_status": np.str_(result.accuracy_status),
+            "warnings": np.str_(json.dumps(list(result.warnings))),
         }
         for k, v in result.outputs.items():
             arrays[f"out__{k}"] = np.float64(v)
@@ -168,6 +170,9 @@ class PartStore:
                 str(data["error"]),
                 float(data["elapsed"]),
                 str(data["host"]),
+                # parts written before these were recorded: the run's accuracy is unknown
+                str(data.get("accuracy_status", "not assessed")),
+                tuple(json.loads(str(data["warnings"]))) if "warnings" in data else (),
             )
         return done
 

@@ -18,6 +18,7 @@ All models are deterministic; their ``state`` is opaque and picklable.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from typing import Any, Protocol
 
@@ -47,6 +48,8 @@ class CycleWear:
         Opaque, picklable state to continue from.
     cycles : float
         Number of cycles simulated.
+    max_penetration : float
+        Largest contact penetration over the interval [m] (NaN: the model does not know it).
     """
 
     wear_work: np.ndarray
@@ -54,6 +57,7 @@ class CycleWear:
     normal_work: float
     state: Any
     cycles: float
+    max_penetration: float = math.nan
 
 
 class ContactModel(Protocol):
@@ -287,6 +291,7 @@ class DynamicContact:
             normal_work=float(res.normal_work),
             state=res.state,
             cycles=float(res.cycles),
+            max_penetration=float(getattr(res, "max_penetration", math.nan)),
         )
 
 

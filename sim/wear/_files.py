@@ -133,6 +133,7 @@ def run_wear_to_file(
     on_start: Callable[[Any], None] | None = None,
     on_update: Callable[[dict[str, Any]], None] | None = None,
     warn: Callable[[str], None] | None = None,
+    checks: Sequence[str] = (),
 ) -> tuple[xr.Dataset, Any]:
     """Run a wear computation with checkpoints and write its wear map to ``out``.
 
@@ -159,7 +160,12 @@ def run_wear_to_file(
     on_update : callable, optional
         Progress callback (see :class:`WearRun`).
     warn : callable, optional
-        Receives notes for the user (a replaced checkpoint, an interruption).
+        Receives notes for the user (a replaced checkpoint, an interruption, one line per
+        accuracy check).
+    checks : sequence of str
+        Accuracy checks run after the run (:func:`~jointwear.sim.check_accuracy`:
+        ``"interval"``, ``"grid"``); their result is added to the file's attributes
+        (``accuracy_check_status`` ...). The run's own map is written first.
 
     Returns
     -------
@@ -229,6 +235,14 @@ def run_wear_to_file(
         save(ds)
     except OutputError as exc:
         raise _resumable(exc, run.cycles_done, ckpt) from exc
+    if checks:
+        from jointwear.sim.wear._check import check_accuracy, describe_check
+
+        res = check_accuracy(ds, contact, settings, kinds=tuple(checks))
+        ds.attrs.update(res["attrs"])
+        save(ds)
+        for kind in checks:
+            warn(describe_check(kind, res[kind]))
     return ds, run
 
 

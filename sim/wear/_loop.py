@@ -57,6 +57,7 @@ import xarray as xr
 from jointwear.errors import BadInputError, ParameterError
 from jointwear.io import check_writable
 from jointwear.params import to_jsonable
+from jointwear.sim.validity import contact_validity
 from jointwear.sim.wear import _control as ctl
 from jointwear.sim.wear._checkpoint import read_checkpoint, write_checkpoint
 from jointwear.sim.wear._contact import CycleWear, describe_any
@@ -167,6 +168,7 @@ class WearRun:
             "cycles_simulated": 0.0,
             # accepted updates whose detection limit exceeded tol with max_average_cycles averaged
             "noise_limited": 0,
+            "max_penetration": -math.inf,  # largest contact penetration simulated [m]
             "worst_detection": 0.0,
             "history": [],  # tuples, columns HISTORY
             "snapshots": [],  # (cycles, h, normal_work, depth_u, volume_u)
@@ -320,27 +322,30 @@ class WearRun:
     # --- the loop ---------------------------------------------------------------------------
     def _measure(
         self, h: np.ndarray, state: Any, settle: float, n: int
-    ) -> tuple[ctl.RateSample, Any, float]:
+    ) -> tuple[ctl.RateSample, Any, float, float]:
         """Settle on profile ``h``, then measure ``n`` single cycles.
 
-        Returns (rate sample, contact state, cycles simulated).
+        Returns (rate sample, contact state, cycles simulated, largest penetration [m]).
         """
         simulated = 0.0
+        pen = -math.inf
         if settle > 0:
             res = self.contact.run(h, cycles=settle, state=state)
             state = res.state
             simulated += res.cycles
+            pen = _max_known(pen, getattr(res, "max_penetration", math.nan))
         rates, works = [], []
         for _ in range(n):
             res: CycleWear = self.contact.run(h, cycles=1.0, state=state)
             state = res.state
             simulated += res.cycles
+            pen = _max_known(pen, getattr(res, "max_penetration", math.nan))
             rate = self.settings.kw * np.asarray(res.wear_work, dtype=float) / res.cycles
             if np.any(rate < 0):
                 raise BadInputError("the contact model returned negative wear work")
             rates.append(rate)
             works.append(res.normal_work / res.cycles)
-        return ctl.sample_rates(rates, works, self.grid.point_area), state, simulated
+        return ctl.sample_rates(rates, works, self.grid.point_area), state, simulated, pen
 
     def _propose(self, rate: np.ndarray, stop: int) -> tuple[int, int]:
         """(dn to use now, dn proposed before clipping to the next stop)."""
@@ -372,9 +377,10 @@ class WearRun:
         adaptive = st.scheme == "adaptive"
         if self._s["sample"] is None:
             s = dict(self._s)
-            s["sample"], s["state"], n_sim = self._measure(
+            s["sample"], s["state"], n_sim, pen = self._measure(
                 s["h"], s["state"], st.initial_settle_cycles, s["m_next"]
             )
+            s["max_penetration"] = _max_known(s.get("max_penetration", -math.inf), pen)
             s["noise_hist"] = [s["sample"].rel_noise]
             if adaptive:
                 sigma = self._sigma(s["noise_hist"])
@@ -391,11 +397,14 @@ class WearRun:
         before: ctl.RateSample = old["sample"]
         dn, dn_wanted = self._propose(before.rate, stop)
         h_new = old["h"] + dn * before.rate
-        new, state_new, n_sim = self._measure(h_new, old["state"], st.settle_cycles, old["m_next"])
+        new, state_new, n_sim, pen = self._measure(
+            h_new, old["state"], st.settle_cycles, old["m_next"]
+        )
         area = self.grid.point_area
         eta_raw = ctl.rate_change(new.rate, before.rate, area)
         s = dict(old)
         s["cycles_simulated"] = old["cycles_simulated"] + n_sim
+        s["max_penetration"] = _max_known(old.get("max_penetration", -math.inf), pen)
         s["noise_hist"] = [*old["noise_hist"][-3:], new.rel_noise]
         sigma = self._sigma(s["noise_hist"])
         sig_eta = ctl.change_noise(sigma, new.n, before.n) if adaptive else 0.0
@@ -465,11 +474,24 @@ class WearRun:
         while self.step():
             pass
         ds = self.to_dataset()
-        if "accuracy_warning" in ds.attrs:
-            _log.warning("%s", ds.attrs["accuracy_warning"])
+        for key in ("accuracy_warning", "contact_validity_warning"):
+            if key in ds.attrs:
+                _log.warning("%s", ds.attrs[key])
         return ds
 
     # --- verdicts ---------------------------------------------------------------------------
+    def contact_validity(self) -> dict[str, Any]:
+        """The run's contact model against its validity limits (:mod:`jointwear.sim.validity`).
+
+        Only the dynamics know their parameters and penetration; other contact models give
+        an empty record.
+        """
+        params = getattr(self.contact, "params", None)
+        if params is None:
+            return {"status": "not assessed", "warning": None, "attrs": {}}
+        pen = float(self._s.get("max_penetration", math.nan))
+        return contact_validity(params, pen if pen > -math.inf else math.nan, kw=self.settings.kw)
+
     def convergence_warning(self) -> str | None:
         """A message if an accepted update changed the wear-rate field too much, else None.
 
@@ -506,13 +528,21 @@ class WearRun:
             return "reached", None
         sigma = self._sigma(self._s["noise_hist"])
         n_acc = int(np.sum(self.history()[:, 3] == 1))
+        inert = (
+            " tol was inert: every interval was set by the noise, so a smaller tol repeats this "
+            "run (the same intervals); check the accuracy by halving the intervals (jointwear sim wear "
+            "--check interval)."
+            if n >= n_acc
+            else ""
+        )
         return "not reached", (
             f"the cycle-to-cycle variability of the wear rate ({100 * sigma:.0f} % per cycle) hid "
             f"rate changes below {100 * self._s['worst_detection']:.0f} % even with up to "
             f"{st.max_average_cycles} cycles averaged per update, more than tol = {st.tol:g}: "
             f"in {n} of {n_acc} updates the interval was set by the noise. The run finished; "
             "its accuracy is stated in wear_depth_u, max_wear_depth_u and worn_volume_u "
-            "(expanded, k = 2); raise wear.max_average_cycles or tol to remove this warning"
+            "(expanded, k = 2); raise wear.max_average_cycles or tol to remove this warning."
+            + inert
         )
 
     # --- output -----------------------------------------------------------------------------
@@ -546,12 +576,20 @@ class WearRun:
         }
         if warning:
             attrs["accuracy_warning"] = warning
+        attrs.update(self.contact_validity()["attrs"])
         conv = self.convergence_warning()
         if conv:
             attrs["convergence_warning"] = conv
         return build_dataset(
             snaps, self.history(), self.grid, kw=st.kw, attrs=attrs, cylindricity=cylindricity
         )
+
+
+def _max_known(a: float, b: float) -> float:
+    """The larger of two penetrations; NaN (unknown) wins, -inf is "none measured yet"."""
+    if math.isnan(a) or math.isnan(b):
+        return math.nan
+    return max(a, b)
 
 
 def _noise_limited(tol_eff: float, tol: float) -> bool:

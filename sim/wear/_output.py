@@ -23,7 +23,12 @@ _U_NOTE = (
 
 
 def _u_attrs(units: str, of: str) -> dict[str, Any]:
-    return {"units": units, "long_name": f"expanded uncertainty of {of}", "comment": _U_NOTE}
+    return {
+        "units": units,
+        "long_name": f"expanded uncertainty of {of}",
+        "coverage_factor": COVERAGE,  # the data contract: readers divide by it for a standard u
+        "comment": _U_NOTE,
+    }
 
 
 def build_dataset(
