@@ -5,8 +5,10 @@ connecting rod B-C, the slider C on an ideal prismatic guide along the x axis th
 offset), gravity along -y. The clearance joint is either rod-slider (C, the benchmark of Flores
 et al.) or crank-rod (B); the other revolute joints are ideal. The equations of motion are in
 :mod:`jointwear.sim._kernels_slider`; ``docs/sim.md`` ("The slider-crank") has the model.
+``PARAMETER_SETS["slider_crank"]`` (:mod:`jointwear.sim.parameters`) holds the benchmark: the
+mechanism table below and :data:`BENCHMARK_TABLES`.
 
-Sources of the benchmark values (``SLIDER_CRANK`` below):
+Sources of the benchmark values:
 
 [F04] P. Flores, J. Ambrosio, J.C.P. Claro, H.M. Lankarani, C.S. Koshy, "A study on dynamics of
       mechanical systems including joints with clearance and lubrication", Mech. Mach. Theory
@@ -33,15 +35,8 @@ from typing import Literal
 import numpy as np
 
 from jointwear.errors import ParameterError
-from jointwear.sim.parameters import (
-    ContactParameters,
-    FrictionParameters,
-    JointParameters,
-    SimParameters,
-    SolverParameters,
-)
 
-__all__ = ["SliderCrankParameters", "SLIDER_CRANK", "slider_crank_kinematics"]
+__all__ = ["SliderCrankParameters", "BENCHMARK_TABLES", "slider_crank_kinematics"]
 
 #: Which revolute joint of the slider-crank has the clearance.
 CLEARANCE_JOINTS = ("rod_slider", "crank_rod")
@@ -234,32 +229,31 @@ def slider_crank_kinematics(
     }
 
 
-#: The slider-crank benchmark (see the module docstring for the sources).
-SLIDER_CRANK = SimParameters(
-    name="slider_crank",
-    mechanism=SliderCrankParameters(),  # type: ignore[arg-type]
-    joint=JointParameters(
-        journal_radius=9.5e-3,  # [F04/F08, not verified]
-        bearing_radius=10.0e-3,  # [F04/F08, not verified]: radial clearance 0.5 mm
+#: The benchmark's joint, contact, friction and solver values as overrides of the four-bar's
+#: tables (``PARAMETER_SETS["slider_crank"]`` is built from them; sources in the module
+#: docstring).
+BENCHMARK_TABLES: dict[str, dict[str, object]] = {
+    "joint": {
+        "journal_radius": 9.5e-3,  # [F04/F08, not verified]
+        "bearing_radius": 10.0e-3,  # [F04/F08, not verified]: radial clearance 0.5 mm
         # the dry planar benchmark has no bearing length: jointwear choice (it sets the contact
         # pressure, hence the wear depth per cycle, not the joint force of the planar model)
-        bearing_width=20e-3,
-        journal_length=22e-3,
-        axial_clearance=1e-3,  # jointwear choice (3D model only)
-        thrust_radius=11.5e-3,  # jointwear choice (3D model only)
-        n_layers=8,
-        n_points=200,
-        axial_grading=0.0,
-    ),
-    contact=ContactParameters(
-        restitution=0.9,  # [F04/F08, not verified]
-        journal_modulus=207e9,  # [F04/F08, not verified]
-        journal_poisson=0.3,  # [F04/F08, not verified]
-        bearing_modulus=207e9,  # [F04/F08, not verified]
-        bearing_poisson=0.3,  # [F04/F08, not verified]
-    ),
+        "bearing_width": 20e-3,
+        "journal_length": 22e-3,
+        "axial_clearance": 1e-3,  # jointwear choice (3D model only)
+        "thrust_radius": 11.5e-3,  # jointwear choice (3D model only)
+        "n_layers": 8,  # jointwear choice: enough for the planar line contact
+        "axial_grading": 0.0,
+    },
+    "contact": {
+        "restitution": 0.9,  # [F04/F08, not verified]
+        "journal_modulus": 207e9,  # [F04/F08, not verified]
+        "journal_poisson": 0.3,  # [F04/F08, not verified]
+        "bearing_modulus": 207e9,  # [F04/F08, not verified]
+        "bearing_poisson": 0.3,  # [F04/F08, not verified]
+    },
     # friction: not verified for the benchmark; off (frictionless dry contact), set [friction]
-    friction=FrictionParameters(enabled=False),
+    "friction": {"enabled": False},
     # one revolution lasts 12 ms at 5000 rpm: sample every 10 us to resolve the impacts
-    solver=SolverParameters(max_step=1e-4, output_interval=1e-5),
-)
+    "solver": {"max_step": 1e-4, "output_interval": 1e-5},
+}
