@@ -69,6 +69,7 @@ from jointwear.sim._kernels import (
     _quat_matrix,
     clearance_joint,
 )
+from jointwear.sim._slider_kinematics import closed_form
 
 # ---- integer parameters of the slider-crank (IP slots after the four-bar's) -------------------
 SC_CASE = 12  # 0: clearance at rod-slider (C), 1: at crank-rod (B)
@@ -294,13 +295,7 @@ def _eval_slider_ideal(t, y, ctx, dy, diag):
     l1, l2, joff = P[L1], P[L2], P[JOFF]
     m1, mr, ms, g = P[M1], P[M2], P[M3], P[GRAV]
     s1, c1 = math.sin(th1), math.cos(th1)
-    S = math.sqrt(l2 * l2 - l1 * l1 * s1 * s1)
-    x = l1 * c1 + S
-    dx = -l1 * s1 - l1 * l1 * s1 * c1 / S
-    ddx = -l1 * c1 - l1 * l1 * (c1 * c1 - s1 * s1) / S - l1**4 * s1 * s1 * c1 * c1 / S**3
-    phi = math.atan2(-l1 * s1, S)
-    dphi = -l1 * c1 / S
-    ddphi = l1 * s1 / S - l1**3 * s1 * c1 * c1 / S**3
+    x, dx, ddx, phi, dphi, ddphi = closed_form(th1, l1, l2)
     cp, sp = math.cos(phi), math.sin(phi)
     h = 0.5 * l2
     wphi = dphi * w1

@@ -210,15 +210,10 @@ def slider_crank_kinematics(
         raise ParameterError(
             f"slider-crank needs rod_length > crank_length > 0, got {l2!r} and {l1!r}"
         )
+    from jointwear.sim._slider_kinematics import closed_form  # numba: loaded on first use
+
     th = np.asarray(theta, dtype=float)
-    s, c = np.sin(th), np.cos(th)
-    S = np.sqrt(l2 * l2 - l1 * l1 * s * s)
-    x = l1 * c + S
-    dx = -l1 * s - l1 * l1 * s * c / S
-    ddx = -l1 * c - l1 * l1 * (c * c - s * s) / S - l1**4 * s * s * c * c / S**3
-    phi = np.arctan2(-l1 * s, S)
-    dphi = -l1 * c / S  # d phi / d theta
-    ddphi = l1 * s / S - l1**3 * s * c * c / S**3
+    x, dx, ddx, phi, dphi, ddphi = closed_form(th, l1, l2)
     return {
         "slider_position": x,
         "slider_velocity": dx * omega,
