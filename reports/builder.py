@@ -21,7 +21,7 @@ import xarray as xr
 
 from jointwear import io
 from jointwear._version import __version__
-from jointwear.compare import Comparison, Criteria, compare
+from jointwear.compare import DEFAULT_AXES, Comparison, Criteria, compare
 from jointwear.errors import BadInputError
 from jointwear.params import to_jsonable
 from jointwear.provenance import command_line, sha256_file, software_versions
@@ -348,7 +348,7 @@ def report_from_files(
     period_s: float | None = None,
     variables: Sequence[str] | None = None,
     ensemble: Sequence[str | Path] = (),
-    axes: Sequence[str] | None = ("x", "y"),
+    axes: Sequence[str] | None = DEFAULT_AXES,
     warn: Callable[[str], None] | None = None,
 ) -> tuple[Path, Comparison]:
     """Build a report from files: simulation, metrology and DIC netCDF, or a saved comparison.

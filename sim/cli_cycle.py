@@ -8,6 +8,7 @@ from typing import Annotated
 import typer
 
 from jointwear._cli import Overwrite
+from jointwear.sim.parameters import DEFAULT_PARAMETER_SET
 
 __all__ = ["register"]
 
@@ -28,7 +29,7 @@ def register(app: typer.Typer) -> None:
         ] = None,
         base: Annotated[
             str, typer.Option("--base", help="Named parameter set the overrides apply to.")
-        ] = "zhang2023",
+        ] = DEFAULT_PARAMETER_SET,
         wear: Annotated[
             Path | None,
             typer.Option(

@@ -8,6 +8,8 @@ from typing import Annotated, Any, Literal
 import typer
 
 from jointwear._cli import Overwrite
+from jointwear._version import source_attribute
+from jointwear.sim.wear._settings import DEFAULT_KW
 
 __all__ = ["register"]
 
@@ -28,7 +30,7 @@ def _parse_snapshots(text: str | None) -> list[float] | None:
 def _measurements(given: dict[str, list[str] | None], default_cycles: float) -> list[Any]:
     """Measurements from ``value`` or ``value@cycles`` strings (µm, or mm³ for the volume)."""
     from jointwear.errors import BadInputError
-    from jointwear.sim._kw_calibration import Measurement
+    from jointwear.sim.wear._calibration import Measurement
 
     flags = {
         "max_depth": "--max-depth-um",
@@ -72,7 +74,7 @@ def _load_settings(params_file: Path | None, overrides: dict[str, Any]) -> tuple
     """WearSettings from the [wear] table of the TOML file plus command-line overrides;
     also returns the rest of the TOML (the simulator's parameters)."""
     from jointwear.params import from_mapping, read_toml
-    from jointwear.sim.wear import WearSettings
+    from jointwear.sim.wear._settings import WearSettings
 
     table: dict[str, Any] = read_toml(params_file) if params_file is not None else {}
     wear = dict(table.pop("wear", {}) or {})
@@ -82,21 +84,16 @@ def _load_settings(params_file: Path | None, overrides: dict[str, Any]) -> tuple
 
 def _sim_parameters(params_file: Path | None, rest: dict[str, Any], grid: tuple) -> Any:
     """The simulator's parameters: the named set, updated from the TOML file and grid options."""
-    from jointwear.errors import BadInputError
+    from jointwear.sim.parameters import (
+        DEFAULT_PARAMETER_SET,
+        PARAMETER_SETS,
+        parameters_from_tables,
+    )
 
-    try:
-        from jointwear import sim
-    except ImportError as exc:  # pragma: no cover
-        raise BadInputError(f"jointwear.sim cannot be imported: {exc}") from None
-    if not hasattr(sim, "PARAMETER_SETS"):
-        raise BadInputError(
-            "the multibody dynamics are not available in this installation; "
-            "use --contact winkler (prescribed contact) instead"
-        )
-    if params_file is not None and rest:
-        params = sim.load_parameters(params_file)
+    if params_file is not None and rest:  # the TOML file is read once, by _load_settings
+        params = parameters_from_tables(rest, where=f"parameter file '{params_file}'")
     else:
-        params = sim.PARAMETER_SETS["zhang2023"]
+        params = PARAMETER_SETS[DEFAULT_PARAMETER_SET]
     layers, points = grid
     changes = {}
     if layers is not None:
@@ -126,7 +123,7 @@ def demo_winkler_contact(grid: Any) -> Any:
     direction swings sinusoidally between 45 and 135 degrees over the cycle, slightly tilted."""
     import numpy as np
 
-    from jointwear.sim._wear_contact import WinklerContact
+    from jointwear.sim.wear._contact import WinklerContact
 
     n = 24
     t = (np.arange(n) + 0.5) / n
@@ -208,7 +205,7 @@ def register(app: typer.Typer) -> None:
         """
         from jointwear import io
         from jointwear.errors import BadInputError
-        from jointwear.sim._kw_calibration import calibrate_kw, resimulator
+        from jointwear.sim.wear._calibration import calibrate_kw, resimulator
 
         sim = io.load(simulated)
         last = float(sim["cycles"].values[-1])
@@ -257,7 +254,7 @@ def register(app: typer.Typer) -> None:
                     f"{100 * (cal.iterations[-1][1] / cal.measured - 1):+.1f} %"
                 )
             return
-        from jointwear.sim._kw_calibration import calibrate_kw_and_parameter, calibrate_kw_multi
+        from jointwear.sim.wear._calibration import calibrate_kw_and_parameter, calibrate_kw_multi
 
         two_sim = None
         if vary is not None:
@@ -296,7 +293,8 @@ def register(app: typer.Typer) -> None:
         kw: Annotated[
             float | None,
             typer.Option(
-                "--kw", help="Archard wear coefficient \\[m²/N = m³/(N m)]; default 9e-16."
+                "--kw",
+                help=f"Archard wear coefficient \\[m²/N = m³/(N m)]; default {DEFAULT_KW:g}.",
             ),
         ] = None,
         params: Annotated[
@@ -370,7 +368,7 @@ def register(app: typer.Typer) -> None:
         from jointwear.outputs import OutputError, OutputExistsError
         from jointwear.params import to_jsonable
         from jointwear.progress import progress_bar
-        from jointwear.sim.wear import WearRun
+        from jointwear.sim.wear._loop import WearRun
         from jointwear.sim.wearmap import BearingGrid
 
         # the accuracy warning is printed below with the result; without this handler Python's
@@ -386,7 +384,7 @@ def register(app: typer.Typer) -> None:
         settings, rest = _load_settings(params, overrides)
         if contact == "dynamics":
             sim_params = _sim_parameters(params, rest, (layers, points))
-            from jointwear.sim._wear_contact import DynamicContact
+            from jointwear.sim.wear._contact import DynamicContact
 
             model = DynamicContact(sim_params)
         elif contact == "winkler":
@@ -446,7 +444,7 @@ def register(app: typer.Typer) -> None:
                     out,
                     inputs=inputs,
                     parameters=provenance_params,
-                    source="jointwear 0.1 (sim.wear)",
+                    source=source_attribute("sim.wear"),
                 )
                 typer.echo(
                     f"interrupted after {run.cycles_done} cycles: partial wear map in {out}, "
@@ -462,7 +460,7 @@ def register(app: typer.Typer) -> None:
                     out,
                     inputs=inputs,
                     parameters=provenance_params,
-                    source="jointwear 0.1 (sim.wear)",
+                    source=source_attribute("sim.wear"),
                 )
                 raise SimulationError(
                     f"{exc} [wear run stopped after {run.cycles_done} cycles; the wear map so far "
@@ -474,7 +472,7 @@ def register(app: typer.Typer) -> None:
                 out,
                 inputs=inputs,
                 parameters=provenance_params,
-                source="jointwear 0.1 (sim.wear)",
+                source=source_attribute("sim.wear"),
             )
         except OutputError as exc:
             raise _resumable(exc, run.cycles_done, ckpt) from exc
