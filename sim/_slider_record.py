@@ -2,7 +2,7 @@
 
 :mod:`jointwear.sim.dynamics` drives the integrator and builds the clearance joint's part of
 the record for every mechanism; this module adds what is particular to the slider-crank (its
-kernel is :mod:`jointwear.sim._kernels_slider`).
+kernel is :mod:`jointwear.sim.kernels._slider_crank`).
 """
 
 from __future__ import annotations
@@ -11,9 +11,9 @@ import math
 
 import numpy as np
 
-import jointwear.sim._kernels as kn
-import jointwear.sim._kernels_slider as ks
+import jointwear.sim.kernels._slider_crank as ks
 from jointwear import conventions
+from jointwear.sim.kernels import _layout as kn
 from jointwear.sim.parameters import SimParameters
 from jointwear.sim.slider_crank import SliderCrankParameters, slider_crank_kinematics
 

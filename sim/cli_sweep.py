@@ -8,6 +8,7 @@ from typing import Annotated, Any
 import typer
 
 from jointwear._cli import Overwrite
+from jointwear.sim.parameters import DEFAULT_PARAMETER_SET
 
 __all__ = ["register"]
 
@@ -47,6 +48,14 @@ def register(app: typer.Typer) -> None:
                 "\\[wear] table).",
             ),
         ] = None,
+        base: Annotated[
+            str,
+            typer.Option(
+                "--base",
+                help=f"Named parameter set of the base: the four-bar's {DEFAULT_PARAMETER_SET} "
+                "or slider_crank.",
+            ),
+        ] = DEFAULT_PARAMETER_SET,
         progress: Annotated[
             bool | None,
             typer.Option("--progress/--no-progress", help="Progress bar (default: on a terminal)."),
@@ -87,6 +96,7 @@ def register(app: typer.Typer) -> None:
                     scheduler=scheduler,
                     resume=resume,
                     on_progress=on_progress,
+                    base=base,
                 )
             except KeyboardInterrupt:
                 from jointwear.sim.sweep._store import parts_dir

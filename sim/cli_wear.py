@@ -9,6 +9,7 @@ import typer
 
 from jointwear._cli import Overwrite
 from jointwear._version import source_attribute
+from jointwear.sim.parameters import DEFAULT_PARAMETER_SET
 from jointwear.sim.wear._settings import DEFAULT_KW
 
 __all__ = ["register"]
@@ -82,18 +83,23 @@ def _load_settings(params_file: Path | None, overrides: dict[str, Any]) -> tuple
     return from_mapping(WearSettings, wear, where="wear"), table
 
 
-def _sim_parameters(params_file: Path | None, rest: dict[str, Any], grid: tuple) -> Any:
+def _sim_parameters(
+    params_file: Path | None,
+    rest: dict[str, Any],
+    grid: tuple,
+    base: str = DEFAULT_PARAMETER_SET,
+) -> Any:
     """The simulator's parameters: the named set, updated from the TOML file and grid options."""
-    from jointwear.sim.parameters import (
-        DEFAULT_PARAMETER_SET,
-        PARAMETER_SETS,
-        parameters_from_tables,
-    )
+    from jointwear.errors import BadInputError
+    from jointwear.sim.parameters import PARAMETER_SETS, parameters_from_tables
 
-    if params_file is not None and rest:  # the TOML file is read once, by _load_settings
-        params = parameters_from_tables(rest, where=f"parameter file '{params_file}'")
-    else:
-        params = PARAMETER_SETS[DEFAULT_PARAMETER_SET]
+    try:
+        if params_file is not None and rest:  # the TOML file is read once, by _load_settings
+            params = parameters_from_tables(rest, base, where=f"parameter file '{params_file}'")
+        else:
+            params = PARAMETER_SETS[base]
+    except KeyError as exc:
+        raise BadInputError(f"--base: {exc.args[0]}") from None
     layers, points = grid
     changes = {}
     if layers is not None:
@@ -304,6 +310,14 @@ def register(app: typer.Typer) -> None:
                 help="TOML file: simulator parameters, and a \\[wear] table (kw, scheme, dn, tol, ...).",
             ),
         ] = None,
+        base: Annotated[
+            str,
+            typer.Option(
+                "--base",
+                help="Named parameter set the --params overrides apply to: the four-bar's "
+                f"{DEFAULT_PARAMETER_SET} or slider_crank.",
+            ),
+        ] = DEFAULT_PARAMETER_SET,
         resume: Annotated[
             bool, typer.Option("--resume", help="Continue from the checkpoint of an earlier run.")
         ] = False,
@@ -383,7 +397,7 @@ def register(app: typer.Typer) -> None:
         overrides = {"kw": kw, "scheme": scheme, "dn": dn, "tol": tol, "settle_cycles": settle}
         settings, rest = _load_settings(params, overrides)
         if contact == "dynamics":
-            sim_params = _sim_parameters(params, rest, (layers, points))
+            sim_params = _sim_parameters(params, rest, (layers, points), base)
             from jointwear.sim.wear._contact import DynamicContact
 
             model = DynamicContact(sim_params)

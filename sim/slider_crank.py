@@ -4,7 +4,7 @@ Crank pivot A at the origin, crank A-B turning counter-clockwise about +z at con
 connecting rod B-C, the slider C on an ideal prismatic guide along the x axis through A (no
 offset), gravity along -y. The clearance joint is either rod-slider (C, the benchmark of Flores
 et al.) or crank-rod (B); the other revolute joints are ideal. The equations of motion are in
-:mod:`jointwear.sim._kernels_slider`; ``docs/sim.md`` ("The slider-crank") has the model.
+:mod:`jointwear.sim.kernels._slider_crank`; ``docs/sim.md`` ("The slider-crank") has the model.
 ``PARAMETER_SETS["slider_crank"]`` (:mod:`jointwear.sim.parameters`) holds the benchmark: the
 mechanism table below and :data:`BENCHMARK_TABLES`.
 
@@ -210,7 +210,7 @@ def slider_crank_kinematics(
         raise ParameterError(
             f"slider-crank needs rod_length > crank_length > 0, got {l2!r} and {l1!r}"
         )
-    from jointwear.sim._slider_kinematics import closed_form  # numba: loaded on first use
+    from jointwear.sim.kernels._slider_kinematics import closed_form  # numba: loaded on first use
 
     th = np.asarray(theta, dtype=float)
     x, dx, ddx, phi, dphi, ddphi = closed_form(th, l1, l2)

@@ -30,7 +30,9 @@ import math
 import numpy as np
 from numba import njit
 
-from jointwear.sim._kernels import (
+from jointwear.sim.kernels._geometry import body_rotation
+from jointwear.sim.kernels._joint import clearance_joint
+from jointwear.sim.kernels._layout import (
     D_AXIS,
     D_BEAR_POS,
     D_ENERGY,
@@ -66,10 +68,8 @@ from jointwear.sim._kernels import (
     M3,
     MODE_IDEAL,
     ND_DIAG,
-    _quat_matrix,
-    clearance_joint,
 )
-from jointwear.sim._slider_kinematics import closed_form
+from jointwear.sim.kernels._slider_kinematics import closed_form
 
 # ---- integer parameters of the slider-crank (IP slots after the four-bar's) -------------------
 SC_CASE = 12  # 0: clearance at rod-slider (C), 1: at crank-rod (B)
@@ -101,11 +101,7 @@ def _eval_slider_clearance(t, y, ctx, dy, acc, hstep, diag):
     Bx, By = l1 * c1, l1 * s1
     vBx, vBy = -l1 * w1 * s1, l1 * w1 * c1
     R = np.empty((3, 3))
-    _quat_matrix(y[4], y[5], y[6], y[7], R)
-    ob0, ob1, ob2 = y[8], y[9], y[10]
-    wgx = R[0, 0] * ob0 + R[0, 1] * ob1 + R[0, 2] * ob2
-    wgy = R[1, 0] * ob0 + R[1, 1] * ob1 + R[1, 2] * ob2
-    wgz = R[2, 0] * ob0 + R[2, 1] * ob1 + R[2, 2] * ob2
+    ob0, ob1, ob2, wgx, wgy, wgz = body_rotation(y, R)  # the rod
     # rod pivot P (position, velocity, acceleration without the slider's unknown xdd)
     if case_b:
         Px, Py, vPx, vPy, aP0x, aP0y = xs, 0.0, vs, 0.0, 0.0, 0.0

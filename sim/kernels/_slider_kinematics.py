@@ -1,7 +1,7 @@
 """Closed-form kinematics of the in-line slider-crank, compiled by numba.
 
 One source for :func:`jointwear.sim.slider_crank.slider_crank_kinematics` (arrays) and the
-ideal-joint kernel in :mod:`jointwear.sim._kernels_slider` (scalars); kept apart from the
+ideal-joint kernel in :mod:`jointwear.sim.kernels._slider_crank` (scalars); kept apart from the
 kernels so that the kinematics load without them.
 """
 
