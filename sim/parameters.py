@@ -14,6 +14,8 @@ from pathlib import Path
 from typing import Literal
 
 from jointwear.errors import ParameterError
+from jointwear.params import check_non_negative as _non_negative
+from jointwear.params import check_positive as _positive
 from jointwear.params import from_mapping, read_toml
 from jointwear.sim.slider_crank import BENCHMARK_TABLES, SliderCrankParameters
 
@@ -29,21 +31,6 @@ __all__ = [
     "load_parameters",
     "parameters_from_tables",
 ]
-
-
-def _positive(where: str, **values: float) -> None:
-    for name, value in values.items():
-        if not (value > 0 and math.isfinite(value)):
-            raise ParameterError(
-                f"{where}.{name} must be a positive finite number, got {value!r}; "
-                "set a physical (SI) value"
-            )
-
-
-def _non_negative(where: str, **values: float) -> None:
-    for name, value in values.items():
-        if not (value >= 0 and math.isfinite(value)):
-            raise ParameterError(f"{where}.{name} must be >= 0, got {value!r}")
 
 
 @dataclasses.dataclass(frozen=True)

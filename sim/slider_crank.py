@@ -35,6 +35,7 @@ from typing import Literal
 import numpy as np
 
 from jointwear.errors import ParameterError
+from jointwear.params import check_non_negative, check_positive
 
 __all__ = ["SliderCrankParameters", "BENCHMARK_TABLES", "slider_crank_kinematics"]
 
@@ -42,15 +43,6 @@ __all__ = ["SliderCrankParameters", "BENCHMARK_TABLES", "slider_crank_kinematics
 CLEARANCE_JOINTS = ("rod_slider", "crank_rod")
 #: Bodies that may carry the bearing, per clearance joint.
 BEARING_BODIES = {"rod_slider": ("slider", "rod"), "crank_rod": ("crank", "rod")}
-
-
-def _check_positive(**values: float) -> None:
-    for name, value in values.items():
-        if not (value > 0 and math.isfinite(value)):
-            raise ParameterError(
-                f"mechanism.{name} must be a positive finite number, got {value!r}; "
-                "set a physical (SI) value"
-            )
 
 
 @dataclasses.dataclass(frozen=True)
@@ -117,7 +109,8 @@ class SliderCrankParameters:
     planar: bool = True
 
     def __post_init__(self) -> None:
-        _check_positive(
+        check_positive(
+            "mechanism",
             crank_length=self.crank_length,
             rod_length=self.rod_length,
             crank_mass=self.crank_mass,
@@ -132,9 +125,8 @@ class SliderCrankParameters:
             )
         object.__setattr__(self, "rod_inertia", tuple(float(v) for v in self.rod_inertia))
         for i, v in enumerate(self.rod_inertia):
-            _check_positive(**{f"rod_inertia[{i}]": v})
-        if not (self.gravity >= 0 and math.isfinite(self.gravity)):
-            raise ParameterError(f"mechanism.gravity must be >= 0, got {self.gravity!r}")
+            check_positive("mechanism", **{f"rod_inertia[{i}]": v})
+        check_non_negative("mechanism", gravity=self.gravity)
         for name in ("joint_offset", "crank_speed_rpm", "initial_crank_angle_deg"):
             if not math.isfinite(getattr(self, name)):
                 raise ParameterError(f"mechanism.{name} must be finite")
