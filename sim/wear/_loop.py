@@ -62,6 +62,7 @@ from jointwear.sim.wear._checkpoint import read_checkpoint, write_checkpoint
 from jointwear.sim.wear._contact import CycleWear, describe_any
 from jointwear.sim.wear._output import build_dataset
 from jointwear.sim.wear._settings import (
+    DEFAULT_CYCLES,
     DEFAULT_KW,
     KW_RANGE,
     WearSettings,
@@ -230,6 +231,36 @@ class WearRun:
         if path is None:
             raise BadInputError("no checkpoint path given")
         return write_checkpoint(path, self.fingerprint(), self._s)
+
+    @classmethod
+    def start(
+        cls,
+        contact: Any,
+        settings: WearSettings | None = None,
+        *,
+        cycles: float,
+        snapshots: Sequence[float] | None = None,
+        checkpoint: str | Path | None = None,
+        resume: bool = False,
+        initial_wear: np.ndarray | None = None,
+        on_update: Callable[[dict[str, Any]], None] | None = None,
+    ) -> WearRun:
+        """A new run, or with ``resume`` the run of ``checkpoint`` continued (:meth:`resume`)."""
+        if not resume:
+            return cls(
+                contact,
+                settings,
+                cycles=cycles,
+                snapshots=snapshots,
+                checkpoint=checkpoint,
+                initial_wear=initial_wear,
+                on_update=on_update,
+            )
+        if checkpoint is None:
+            raise BadInputError("resume=True needs the checkpoint path")
+        return cls.resume(
+            checkpoint, contact, settings, cycles=cycles, snapshots=snapshots, on_update=on_update
+        )
 
     @classmethod
     def resume(
@@ -543,7 +574,7 @@ def halved_schedule(ds: xr.Dataset) -> tuple[int, ...]:
 def simulate_wear(
     params: Any = None,
     *,
-    cycles: float = 1e6,
+    cycles: float = DEFAULT_CYCLES,
     kw: float | None = None,
     settings: WearSettings | None = None,
     contact: Any = None,
@@ -609,22 +640,16 @@ def simulate_wear(
         contact = DynamicContact(params, cycle_function)
     elif overrides:
         _, settings = apply_overrides(None, settings, overrides)
-    if resume:
-        if checkpoint is None:
-            raise BadInputError("resume=True needs the checkpoint path")
-        run = WearRun.resume(
-            checkpoint, contact, settings, cycles=cycles, snapshots=snapshots, on_update=on_update
-        )
-    else:
-        run = WearRun(
-            contact,
-            settings,
-            cycles=cycles,
-            snapshots=snapshots,
-            checkpoint=checkpoint,
-            initial_wear=initial_wear,
-            on_update=on_update,
-        )
+    run = WearRun.start(
+        contact,
+        settings,
+        cycles=cycles,
+        snapshots=snapshots,
+        checkpoint=checkpoint,
+        resume=resume,
+        initial_wear=initial_wear,
+        on_update=on_update,
+    )
     ds = run.run()
     if overrides:
         ds.attrs["parameter_overrides"] = json.dumps(

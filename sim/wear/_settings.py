@@ -9,10 +9,20 @@ from typing import Literal
 
 from jointwear.errors import ParameterError
 
-__all__ = ["DEFAULT_KW", "KW_RANGE", "WearSettings", "check_kw", "default_snapshots"]
+__all__ = [
+    "DEFAULT_KW",
+    "DEFAULT_CYCLES",
+    "KW_RANGE",
+    "WearSettings",
+    "check_kw",
+    "default_snapshots",
+]
 
 #: Default Archard wear coefficient [m²/N = m³/(N m)]; derivation in docs/sim-wear.md.
 DEFAULT_KW: float = 9.0e-16
+
+#: Default target of a wear run [cycles].
+DEFAULT_CYCLES: float = 1e6
 
 #: Accepted range of kw [m²/N]. Above 1e-11 (1e-2 mm³/(N m), beyond severe dry wear) the bore of
 #: the study would wear through in hours; below 1e-20 nothing measurable wears in any lifetime.

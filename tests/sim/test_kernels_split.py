@@ -37,14 +37,13 @@ def test_split_kernels_reproduce_the_single_module(name):
     p = replace_nested(PARAMETER_SETS["zhang2023"], **changes)
     r = run_cycles(p, cycles=cycles, wear_depth=worn_profile(p), record=False)
     assert np.max(r.wear_work) > 0  # the worn bore is in contact: every array is exercised
-    got = {
-        "wear_work": r.wear_work,
-        "sliding": r.sliding_distance,
-        "y": r.state.y,
-        "vimp": r.state.impact_velocity,
-        "work": np.array([r.normal_work, r.axial_normal_work, r.normal_impulse]),
-    }
-    for key, value in got.items():
+    works = [r.normal_work, r.axial_normal_work, r.normal_impulse]
+    arrays = zip(
+        ("wear_work", "sliding", "y", "vimp", "work"),
+        (r.wear_work, r.sliding_distance, r.state.y, r.state.impact_velocity, np.array(works)),
+        strict=True,
+    )
+    for key, value in arrays:
         want = ref[f"{name}_{key}"]
-        scale = float(np.max(np.abs(want))) or 1.0
-        np.testing.assert_allclose(value, want, rtol=1e-9, atol=1e-9 * scale, err_msg=key)
+        tol = 1e-9 * (float(np.max(np.abs(want))) or 1.0)
+        np.testing.assert_allclose(value, want, rtol=1e-9, atol=tol, err_msg=key)
