@@ -12,9 +12,11 @@ Sources of the benchmark values:
 
 [F04] P. Flores, J. Ambrosio, J.C.P. Claro, H.M. Lankarani, C.S. Koshy, "A study on dynamics of
       mechanical systems including joints with clearance and lubrication", Mech. Mach. Theory
-      41 (2006) 247-261, and P. Flores, J. Ambrosio, "Revolute joints with clearance in
-      multibody systems", Computers & Structures 82 (2004) 1359-1369: the slider-crank with a
-      dry revolute clearance joint between connecting rod and slider.
+      41 (2006) 247-261, doi:10.1016/j.mechmachtheory.2005.10.002 (as listed in the survey of
+      Q. Tian, P. Flores, H.M. Lankarani, Mech. Mach. Theory 2018, doi:10.1016/
+      j.mechmachtheory.2017.12.002), and P. Flores, J. Ambrosio, "Revolute joints with clearance
+      in multibody systems", Computers & Structures 82 (2004) (pages not verified): the
+      slider-crank with a dry revolute clearance joint between connecting rod and slider.
 [F08] P. Flores, J. Ambrosio, J.C.P. Claro, H.M. Lankarani, "Kinematics and Dynamics of
       Multibody Systems with Imperfect Joints", Springer (2008), the same benchmark.
 
