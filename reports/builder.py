@@ -308,6 +308,24 @@ def build_report(
     -------
     Path
         The HTML file.
+
+    Examples
+    --------
+    The self-contained HTML report of a simulated wear map compared with itself, labelled as
+    synthetic measurement data:
+
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from jointwear.compare import compare
+    >>> from jointwear.reports import build_report
+    >>> from jointwear.sim import BearingGrid, WearSettings, WinklerContact, simulate_wear
+    >>> run = {"contact": WinklerContact(BearingGrid(4, 36)), "snapshots": [1000, 2000]}
+    >>> sim = simulate_wear(cycles=2000, settings=WearSettings(scheme="fixed", dn=500), **run)
+    >>> meas = sim.isel(cycles=-1, drop=True)[["wear_depth"]]
+    >>> comparison = compare(sim, meas.assign_attrs(data_origin="synthetic", cycles=2000))
+    >>> page = build_report(comparison, Path(tempfile.mkdtemp()) / "report.html")
+    >>> page.name, "maximum wear depth" in page.read_text(encoding="utf-8")
+    ('report.html', True)
     """
     html = render_html(
         comparison,
