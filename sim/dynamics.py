@@ -1,4 +1,5 @@
-"""Running the four-bar simulator: initial state, integration in chunks, results as xarray.
+"""Running the simulator (four-bar or slider-crank): initial state, integration in chunks,
+results as xarray.
 
 The equations of motion (minimal coordinates, see ``docs/sim.md``) and the contact model run
 in numba (:mod:`jointwear.sim.kernels`); this module packs parameters, drives the integrator
@@ -328,7 +329,10 @@ def run_cycles(
     progress: Callable[[float], None] | None = None,
     duration: float | None = None,
 ) -> CycleResult:
-    """Simulate the four-bar with clearance joint C over a number of crank cycles.
+    """Simulate the mechanism with its clearance joint over a number of crank cycles.
+
+    The four-bar (clearance joint C) or the slider-crank (``PARAMETER_SETS["slider_crank"]``,
+    docs/sim.md), chosen by the type of ``params.mechanism``.
 
     Parameters
     ----------
