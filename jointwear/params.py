@@ -14,7 +14,14 @@ from typing import Any, TypeVar
 
 from jointwear.errors import BadInputError, ParameterError
 
-__all__ = ["from_mapping", "read_toml", "to_jsonable", "replace_nested"]
+__all__ = [
+    "from_mapping",
+    "read_toml",
+    "to_jsonable",
+    "replace_nested",
+    "check_positive",
+    "check_non_negative",
+]
 
 T = TypeVar("T")
 
@@ -111,6 +118,25 @@ def _coerce(value: Any, tp: Any, where: str) -> Any:
             raise ParameterError(f"{where}: expected a string, got {value!r}")
         return value
     return value
+
+
+def check_positive(where: str, **values: float) -> None:
+    """Raise :class:`~jointwear.errors.ParameterError` naming ``where.name`` unless every value
+    is a positive finite number."""
+    for name, value in values.items():
+        if not (value > 0 and math.isfinite(value)):
+            raise ParameterError(
+                f"{where}.{name} must be a positive finite number, got {value!r}; "
+                "set a physical (SI) value"
+            )
+
+
+def check_non_negative(where: str, **values: float) -> None:
+    """Raise :class:`~jointwear.errors.ParameterError` naming ``where.name`` unless every value
+    is a finite number >= 0."""
+    for name, value in values.items():
+        if not (value >= 0 and math.isfinite(value)):
+            raise ParameterError(f"{where}.{name} must be >= 0, got {value!r}")
 
 
 def from_mapping(cls: type[T], mapping: Mapping[str, Any], *, where: str | None = None) -> T:

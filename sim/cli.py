@@ -7,7 +7,8 @@ import typer
 from jointwear._cli import discover_commands
 
 app = typer.Typer(
-    help="Simulate the four-bar linkage with a 3D clearance joint: dynamics, contact, wear.",
+    help="Simulate the four-bar linkage (or the slider-crank, --base slider_crank) with a 3D "
+    "clearance joint: dynamics, contact, wear.",
     no_args_is_help=True,
 )
 discover_commands(app, "jointwear.sim")

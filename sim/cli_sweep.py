@@ -8,6 +8,7 @@ from typing import Annotated, Any
 import typer
 
 from jointwear._cli import Overwrite
+from jointwear.sim.parameters import DEFAULT_PARAMETER_SET
 
 __all__ = ["register", "Workers", "Scheduler", "Resume", "Progress"]
 
@@ -52,6 +53,14 @@ def register(app: typer.Typer) -> None:
                 "\\[wear] table).",
             ),
         ] = None,
+        base: Annotated[
+            str,
+            typer.Option(
+                "--base",
+                help=f"Named parameter set of the base: the four-bar's {DEFAULT_PARAMETER_SET} "
+                "or slider_crank.",
+            ),
+        ] = DEFAULT_PARAMETER_SET,
         progress: Progress = None,
         overwrite: Overwrite = False,
     ) -> None:
@@ -93,6 +102,7 @@ def register(app: typer.Typer) -> None:
                     scheduler=scheduler,
                     resume=resume,
                     on_progress=on_progress,
+                    base=base,
                 )
             except KeyboardInterrupt:
                 from jointwear.sim.sweep._store import parts_dir

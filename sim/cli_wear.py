@@ -8,7 +8,7 @@ from typing import Annotated, Any, Literal
 import typer
 
 from jointwear._cli import Overwrite
-from jointwear.sim.parameters import JointParameters
+from jointwear.sim.parameters import DEFAULT_PARAMETER_SET, JointParameters
 from jointwear.sim.wear._settings import DEFAULT_CYCLES, DEFAULT_KW, WearSettings
 
 __all__ = ["register"]
@@ -229,6 +229,14 @@ def wear(
             help="TOML file: simulator parameters, and a \\[wear] table (kw, scheme, dn, tol, ...).",
         ),
     ] = None,
+    base: Annotated[
+        str,
+        typer.Option(
+            "--base",
+            help="Named parameter set the --params overrides apply to: the four-bar's "
+            f"{DEFAULT_PARAMETER_SET} or slider_crank.",
+        ),
+    ] = DEFAULT_PARAMETER_SET,
     resume: Annotated[
         bool, typer.Option("--resume", help="Continue from the checkpoint of an earlier run.")
     ] = False,
@@ -337,6 +345,7 @@ def wear(
             contact=contact,
             layers=layers,
             points=points,
+            base=base,
             cycles=cycles,
             snapshots=snaps,
             checkpoint=checkpoint,

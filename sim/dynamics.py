@@ -1,4 +1,5 @@
-"""Running the four-bar simulator: initial state, integration in chunks, results as xarray.
+"""Running the simulator (four-bar or slider-crank): initial state, integration in chunks,
+results as xarray.
 
 The equations of motion (minimal coordinates, see ``docs/sim.md``) and the contact model run
 in numba (:mod:`jointwear.sim.kernels`); this module packs parameters, drives the integrator
@@ -18,6 +19,11 @@ import xarray as xr
 from jointwear import conventions
 from jointwear.errors import BadInputError, ParameterError, SimulationError
 from jointwear.params import to_jsonable
+from jointwear.sim._slider_record import ANGLE_FLAGS as SLIDER_ANGLE_FLAGS
+from jointwear.sim._slider_record import initial_vector as slider_crank_state
+from jointwear.sim._slider_record import is_slider_crank
+from jointwear.sim._slider_record import pack_mechanism as pack_slider_crank
+from jointwear.sim._slider_record import variables as slider_variables
 from jointwear.sim.contact import contact_constant
 from jointwear.sim.kernels import _layout as kn
 from jointwear.sim.kernels._integrator import integrate
@@ -64,6 +70,8 @@ class SimState:
         two end faces) [m/s]; 0 = not in contact.
     model : str
         ``"clearance"`` or ``"ideal"``.
+    mechanism : str
+        ``"four_bar"`` or ``"slider_crank"`` (the state vectors have the same length).
     """
 
     time: float
@@ -71,6 +79,7 @@ class SimState:
     step: float
     impact_velocity: np.ndarray
     model: str
+    mechanism: str = "four_bar"
 
 
 @dataclasses.dataclass(frozen=True)
@@ -124,15 +133,9 @@ def _layers(params: SimParameters) -> tuple[np.ndarray, np.ndarray]:
     return layer_positions(j.n_layers, j.bearing_width, j.axial_grading)
 
 
-def _pack(params: SimParameters) -> tuple[np.ndarray, np.ndarray]:
-    m, j, c, f, s = (
-        params.mechanism,
-        params.joint,
-        params.contact,
-        params.friction,
-        params.solver,
-    )
-    P = np.zeros(kn.NP)
+def _pack_four_bar(params: SimParameters, P: np.ndarray, IP: np.ndarray) -> None:
+    """Write the four-bar's slots of the kernel parameter arrays."""
+    m = params.mechanism
     P[kn.L1], P[kn.L2], P[kn.L3], P[kn.L4] = (
         m.crank_length,
         m.coupler_length,
@@ -145,6 +148,19 @@ def _pack(params: SimParameters) -> tuple[np.ndarray, np.ndarray]:
     P[kn.GRAV] = m.gravity
     P[kn.JOFF] = m.joint_offset
     P[kn.OMEGA] = m.crank_speed
+    IP[kn.DRIVER] = 1 if m.driver else 0
+    IP[kn.ON_COUPLER] = 1 if m.bearing_on == "coupler" else 0
+
+
+def _pack(params: SimParameters) -> tuple[np.ndarray, np.ndarray]:
+    """Kernel parameter arrays: the mechanism's slots, then the joint, contact and solver."""
+    j, c, f, s = params.joint, params.contact, params.friction, params.solver
+    P = np.zeros(kn.NP)
+    IP = np.zeros(kn.NIP, dtype=np.int64)
+    if is_slider_crank(params):
+        pack_slider_crank(params, P, IP)
+    else:
+        _pack_four_bar(params, P, IP)
     P[kn.RJ], P[kn.LJ], P[kn.RB], P[kn.WB] = (
         j.journal_radius,
         j.journal_length,
@@ -162,9 +178,6 @@ def _pack(params: SimParameters) -> tuple[np.ndarray, np.ndarray]:
     P[kn.BAUM] = s.baumgarte
     P[kn.DPHI] = 2 * math.pi / j.n_points
     P[kn.KTILT], P[kn.CTILT] = j.tilt_stiffness, j.tilt_damping
-    IP = np.zeros(kn.NIP, dtype=np.int64)
-    IP[kn.DRIVER] = 1 if m.driver else 0
-    IP[kn.ON_COUPLER] = 1 if m.bearing_on == "coupler" else 0
     IP[kn.IDEAL] = 1 if j.model == "ideal" else 0
     IP[kn.PER_POINT] = 1 if c.formulation == "per_point" else 0
     IP[kn.KVARY] = 1 if c.stiffness == "time_varying" else 0
@@ -180,17 +193,25 @@ def _pack(params: SimParameters) -> tuple[np.ndarray, np.ndarray]:
     return P, IP
 
 
+def _mechanism(params: SimParameters) -> str:
+    return "slider_crank" if is_slider_crank(params) else "four_bar"
+
+
 def initial_state(params: SimParameters) -> SimState:
     """The documented initial configuration.
 
     Crank at ``initial_crank_angle_deg`` turning at the nominal speed; coupler and follower at
     the ideal four-bar's loop-closure angles and rates (joint C above the ground line); the
-    journal centred in the bearing and aligned with it; follower not rotated out of plane.
+    journal centred in the bearing and aligned with it; follower not rotated out of plane. The
+    slider-crank: :func:`jointwear.sim._slider_record.initial_vector`.
     """
     m = params.mechanism
+    nl = params.joint.n_layers
+    if is_slider_crank(params):
+        y = slider_crank_state(params)
+        return SimState(0.0, y, 1e-6, np.zeros(nl + 2), params.joint.model, "slider_crank")
     th1 = math.radians(m.initial_crank_angle_deg)
     th2, th3, w2, w3 = (float(v) for v in loop_closure(th1, m))
-    nl = params.joint.n_layers
     if params.joint.model == "ideal":
         if not m.driver:
             raise ParameterError(
@@ -314,7 +335,10 @@ def run_cycles(
     progress: Callable[[float], None] | None = None,
     duration: float | None = None,
 ) -> CycleResult:
-    """Simulate the four-bar with clearance joint C over a number of crank cycles.
+    """Simulate the mechanism with its clearance joint over a number of crank cycles.
+
+    The four-bar (clearance joint C) or the slider-crank (``PARAMETER_SETS["slider_crank"]``,
+    docs/sim.md), chosen by the type of ``params.mechanism``.
 
     Parameters
     ----------
@@ -365,6 +389,11 @@ def run_cycles(
     P, IP = _pack(params)
     st = state if state is not None else initial_state(params)
     model = params.joint.model
+    if st.mechanism != _mechanism(params):
+        raise BadInputError(
+            f"state comes from a {st.mechanism} run; these parameters are a "
+            f"{_mechanism(params)}'s - pass state=None to start from the initial configuration"
+        )
     if st.model != model or st.impact_velocity.shape != (params.joint.n_layers + 2,):
         raise BadInputError(
             f"state comes from a '{st.model}' run with {st.impact_velocity.shape[0] - 2} layers; "
@@ -412,7 +441,7 @@ def run_cycles(
             vimp,
             ww,
             acc,
-            _ANG[model],
+            (SLIDER_ANGLE_FLAGS if is_slider_crank(params) else _ANG)[model],
             s.rtol,
             s.atol,
             s.max_step,
@@ -433,7 +462,7 @@ def run_cycles(
             )
         if progress is not None:
             progress((k + 1) / n_chunks)
-    new_state = SimState(t, y.copy(), hstep, vimp.copy(), model)
+    new_state = SimState(t, y.copy(), hstep, vimp.copy(), model, _mechanism(params))
     ds = _dataset(params, t_rel, diag, t0) if record else None
     if ds is not None:
         ds = _add_maps(ds, params, ww, area)
@@ -494,8 +523,8 @@ def _vec(diag: np.ndarray, k: int) -> np.ndarray:
     return diag[:, k : k + 3]
 
 
-def _dataset(params: SimParameters, t_rel: np.ndarray, diag: np.ndarray, t0: float) -> xr.Dataset:
-    """Build the contract Dataset from the recorded diagnostics."""
+def _four_bar_variables(diag: np.ndarray) -> dict:
+    """The four-bar's record variables (name -> (dims, values, attrs))."""
     axis = ("time", "axis")
     v = conventions.variable_attrs
     quat = diag[:, kn.D_QUAT : kn.D_QUAT + 4]
@@ -503,11 +532,7 @@ def _dataset(params: SimParameters, t_rel: np.ndarray, diag: np.ndarray, t0: flo
     rot = np.full((len(diag), 3), np.nan)
     if ok.any():
         rot[ok] = rotation_xzy_angles(quaternion_to_matrix(quat[ok]))
-    fmag = diag[:, kn.D_FMAG]
-    fn = diag[:, kn.D_FN]
-    mode = np.where(np.isfinite(diag[:, kn.D_MODE]), diag[:, kn.D_MODE], 0).astype(np.int8)
-    pen = np.maximum(np.maximum(diag[:, kn.D_PEN], diag[:, kn.D_PENAX]), 0.0)
-    data = {
+    return {
         "crank_angle": (
             "time",
             np.mod(diag[:, kn.D_TH1], 2 * math.pi),
@@ -562,6 +587,19 @@ def _dataset(params: SimParameters, t_rel: np.ndarray, diag: np.ndarray, t0: flo
             _vec(diag, kn.D_FOLL_OMEGA),
             {"units": "rad s-1", "long_name": "angular velocity of the follower, global frame"},
         ),
+    }
+
+
+def _joint_variables(diag: np.ndarray, joint: str = "C") -> dict:
+    """The clearance joint's record variables, the same for every mechanism (``joint``: its
+    name in the long names)."""
+    axis = ("time", "axis")
+    v = conventions.variable_attrs
+    fmag = diag[:, kn.D_FMAG]
+    fn = diag[:, kn.D_FN]
+    mode = np.where(np.isfinite(diag[:, kn.D_MODE]), diag[:, kn.D_MODE], 0).astype(np.int8)
+    pen = np.maximum(np.maximum(diag[:, kn.D_PEN], diag[:, kn.D_PENAX]), 0.0)
+    return {
         "journal_offset": (
             axis,
             _vec(diag, kn.D_OFFSET),
@@ -573,12 +611,27 @@ def _dataset(params: SimParameters, t_rel: np.ndarray, diag: np.ndarray, t0: flo
         "bearing_centre_position": (
             axis,
             _vec(diag, kn.D_BEAR_POS),
-            {"units": "m", "long_name": "position of the bearing centre of joint C, global frame"},
+            {
+                "units": "m",
+                "long_name": f"position of the bearing centre of joint {joint}, global frame",
+            },
         ),
         "journal_centre_position": (
             axis,
             _vec(diag, kn.D_JOUR_POS),
-            {"units": "m", "long_name": "position of the journal centre of joint C, global frame"},
+            {
+                "units": "m",
+                "long_name": f"position of the journal centre of joint {joint}, global frame",
+            },
+        ),
+        "eccentricity": (
+            "time",
+            np.hypot(diag[:, kn.D_OFFSET], diag[:, kn.D_OFFSET + 1]),
+            {
+                "units": "m",
+                "long_name": "radial eccentricity of the journal centre in the bearing "
+                "(|journal_offset| in the bearing's x-y plane)",
+            },
         ),
         "journal_axis": (
             axis,
@@ -619,7 +672,7 @@ def _dataset(params: SimParameters, t_rel: np.ndarray, diag: np.ndarray, t0: flo
             mode,
             {
                 "units": "1",
-                "long_name": "contact mode of joint C",
+                "long_name": f"contact mode of joint {joint}",
                 "flag_values": np.array(sorted(CONTACT_MODES), dtype=np.int8),
                 "flag_meanings": " ".join(CONTACT_MODES[k] for k in sorted(CONTACT_MODES)),
             },
@@ -627,7 +680,10 @@ def _dataset(params: SimParameters, t_rel: np.ndarray, diag: np.ndarray, t0: flo
         "penetration": (
             "time",
             pen,
-            {"units": "m", "long_name": "largest penetration in joint C (bore or end faces)"},
+            {
+                "units": "m",
+                "long_name": f"largest penetration in joint {joint} (bore or end faces)",
+            },
         ),
         "contact_stiffness": (
             "time",
@@ -646,6 +702,15 @@ def _dataset(params: SimParameters, t_rel: np.ndarray, diag: np.ndarray, t0: flo
             },
         ),
     }
+
+
+def _dataset(params: SimParameters, t_rel: np.ndarray, diag: np.ndarray, t0: float) -> xr.Dataset:
+    """Build the contract Dataset from the recorded diagnostics."""
+    data = (
+        _four_bar_variables(diag) if not is_slider_crank(params) else slider_variables(params, diag)
+    )
+    joint = "B" if getattr(params.mechanism, "clearance_at", "") == "crank_rod" else "C"
+    data.update(_joint_variables(diag, joint))
     time = xr.DataArray(
         t_rel,
         dims="time",
@@ -662,7 +727,8 @@ def _dataset(params: SimParameters, t_rel: np.ndarray, diag: np.ndarray, t0: flo
         {k: xr.Variable(d, np.asarray(val), attrs=a) for k, (d, val, a) in data.items()},
         coords={"time": time, "axis": axis_c},
     )
-    ds.attrs["title"] = "jointwear four-bar simulation with a 3D revolute clearance joint"
+    mech = "slider-crank" if is_slider_crank(params) else "four-bar"
+    ds.attrs["title"] = f"jointwear {mech} simulation with a 3D revolute clearance joint"
     ds.attrs["data_origin"] = "simulated"
     ds.attrs["source"] = "jointwear (sim.dynamics)"
     ds.attrs["parameter_set"] = params.name
@@ -676,5 +742,8 @@ def _dataset(params: SimParameters, t_rel: np.ndarray, diag: np.ndarray, t0: flo
     ds.attrs["impact_latch"] = params.contact.impact_latch
     ds.attrs["contact_stiffness_model"] = params.contact.stiffness
     ds.attrs["bearing_on"] = params.mechanism.bearing_on
+    if is_slider_crank(params):
+        ds.attrs["clearance_at"] = params.mechanism.clearance_at
+        ds.attrs["planar"] = int(params.mechanism.planar)
     ds.attrs["parameters_json"] = json.dumps(to_jsonable(params))
     return ds

@@ -14,7 +14,10 @@ from pathlib import Path
 from typing import Literal
 
 from jointwear.errors import ParameterError
+from jointwear.params import check_non_negative as _non_negative
+from jointwear.params import check_positive as _positive
 from jointwear.params import from_mapping, read_toml
+from jointwear.sim.slider_crank import BENCHMARK_TABLES, SliderCrankParameters
 
 __all__ = [
     "MechanismParameters",
@@ -28,21 +31,6 @@ __all__ = [
     "load_parameters",
     "parameters_from_tables",
 ]
-
-
-def _positive(where: str, **values: float) -> None:
-    for name, value in values.items():
-        if not (value > 0 and math.isfinite(value)):
-            raise ParameterError(
-                f"{where}.{name} must be a positive finite number, got {value!r}; "
-                "set a physical (SI) value"
-            )
-
-
-def _non_negative(where: str, **values: float) -> None:
-    for name, value in values.items():
-        if not (value >= 0 and math.isfinite(value)):
-            raise ParameterError(f"{where}.{name} must be >= 0, got {value!r}")
 
 
 @dataclasses.dataclass(frozen=True)
@@ -327,10 +315,14 @@ DEFAULT_PARAMETER_SET = "zhang2023"
 
 @dataclasses.dataclass(frozen=True)
 class SimParameters:
-    """All parameters of a simulation (nested: mechanism, joint, contact, friction, solver)."""
+    """All parameters of a simulation (nested: mechanism, joint, contact, friction, solver).
+
+    ``mechanism`` is the four-bar's :class:`MechanismParameters` or the slider-crank's
+    :class:`~jointwear.sim.slider_crank.SliderCrankParameters` (``kind = "slider_crank"``).
+    """
 
     name: str = DEFAULT_PARAMETER_SET
-    mechanism: MechanismParameters = MechanismParameters()
+    mechanism: MechanismParameters | SliderCrankParameters = MechanismParameters()
     joint: JointParameters = JointParameters()
     contact: ContactParameters = ContactParameters()
     friction: FrictionParameters = FrictionParameters()
@@ -344,9 +336,24 @@ class _ParameterSets(dict):
         )
 
 
+def _slider_crank_set() -> SimParameters:
+    t = BENCHMARK_TABLES
+    return SimParameters(
+        name="slider_crank",
+        mechanism=SliderCrankParameters(),
+        joint=JointParameters(**t["joint"]),  # type: ignore[arg-type]
+        contact=ContactParameters(**t["contact"]),  # type: ignore[arg-type]
+        friction=FrictionParameters(**t["friction"]),  # type: ignore[arg-type]
+        solver=SolverParameters(**t["solver"]),  # type: ignore[arg-type]
+    )
+
+
 #: Named parameter sets. :data:`DEFAULT_PARAMETER_SET` (``"zhang2023"``): Tables 1-2 of the
-#: reference study.
-PARAMETER_SETS: dict[str, SimParameters] = _ParameterSets({DEFAULT_PARAMETER_SET: SimParameters()})
+#: reference study (the four-bar); ``"slider_crank"``: the slider-crank benchmark of Flores et
+#: al. (:mod:`jointwear.sim.slider_crank`).
+PARAMETER_SETS: dict[str, SimParameters] = _ParameterSets(
+    {DEFAULT_PARAMETER_SET: SimParameters(), "slider_crank": _slider_crank_set()}
+)
 
 
 #: Top-level TOML tables read by other parts of jointwear (ignored here).
@@ -401,6 +408,16 @@ def parameters_from_tables(
         raise ParameterError(
             f"{where}: unknown table(s)/name(s) {', '.join(unknown)}; known: {', '.join(merged)}"
         )
+    kind = (
+        data.get("mechanism", {}).get("kind") if isinstance(data.get("mechanism"), dict) else None
+    )
+    base_kind = getattr(base_params.mechanism, "kind", "four_bar")
+    if kind is not None and kind != base_kind:
+        raise ParameterError(
+            f"{where}: mechanism.kind = {kind!r} does not match the base "
+            f"set {base!r} ({base_kind}); choose the mechanism with the base set (e.g. "
+            "--base slider_crank) and drop mechanism.kind"
+        )
     for key, value in data.items():
         if isinstance(merged[key], dict):
             if not isinstance(value, dict):
@@ -409,6 +426,10 @@ def parameters_from_tables(
         else:
             merged[key] = value
     try:
+        # the base set names the mechanism: no guessing between the mechanism tables
+        merged["mechanism"] = from_mapping(
+            type(base_params.mechanism), merged["mechanism"], where="mechanism"
+        )
         return from_mapping(SimParameters, merged)
     except ParameterError as exc:
         raise ParameterError(f"{where}: {exc}") from None

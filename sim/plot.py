@@ -18,13 +18,14 @@ def plot_cycle(ds: xr.Dataset, path: str | Path | None = None, *, clearance: flo
 
     Three panels: the journal centre's orbit in the bearing (x-y of the bearing frame, um, with
     the clearance circle), the contact force magnitude against the crank angle (coloured by
-    contact mode), and the follower's centre-of-mass velocity components.
+    contact mode), and the follower's centre-of-mass velocity components (the slider's velocity
+    for a slider-crank record).
 
     Parameters
     ----------
     ds : Dataset
         Record with ``journal_offset``, ``contact_force``, ``contact_mode``, ``crank_angle``,
-        ``follower_velocity`` over ``time``.
+        ``follower_velocity`` (or ``slider_velocity``) over ``time``.
     path : path, optional
         Write the figure there (PNG/PDF/SVG by suffix, atomically).
     clearance : float, optional
@@ -40,7 +41,12 @@ def plot_cycle(ds: xr.Dataset, path: str | Path | None = None, *, clearance: flo
         matplotlib.use("Agg", force=False)
     import matplotlib.pyplot as plt
 
-    needed = ["journal_offset", "contact_force", "contact_mode", "crank_angle", "follower_velocity"]
+    body, body_name = (
+        ("slider_velocity", "slider")
+        if "slider_velocity" in ds and "follower_velocity" not in ds
+        else ("follower_velocity", "follower centre of mass")
+    )
+    needed = ["journal_offset", "contact_force", "contact_mode", "crank_angle", body]
     missing = [n for n in needed if n not in ds]
     if missing:
         raise BadInputError(
@@ -73,15 +79,15 @@ def plot_cycle(ds: xr.Dataset, path: str | Path | None = None, *, clearance: flo
     ax.set_xlabel("crank angle [deg]")
     ax.set_ylabel("contact force [N]")
     ax.set_yscale("symlog", linthresh=10.0)
-    ax.set_title("contact force in joint C")
+    ax.set_title("contact force in the clearance joint")
     ax.legend(markerscale=6, fontsize=8)
     ax = axes[2]
-    fv = ds.follower_velocity.values
+    fv = ds[body].values
     for i, comp in enumerate(("x", "y", "z")):
         ax.plot(crank, fv[:, i], lw=0.8, label=f"v{comp}")
     ax.set_xlabel("crank angle [deg]")
-    ax.set_ylabel("follower centre velocity [m/s]")
-    ax.set_title("follower centre of mass")
+    ax.set_ylabel(f"{body_name} velocity [m/s]")
+    ax.set_title(body_name)
     ax.legend(fontsize=8)
     if path is not None:
         from jointwear.io import atomic_path

@@ -1,11 +1,15 @@
-"""numba kernels of the four-bar simulator, one module per piece of physics.
+"""numba kernels of the simulator (four-bar, slider-crank), one module per piece of physics.
 
 * ``_layout``: indices into the parameter vectors, the diagnostics row and the info array;
 * ``_geometry``: follower rotation, bore/journal nodes, contact search, layer axes;
 * ``_friction``: smoothed Coulomb friction (eq. 12);
 * ``_contact``: Lankarani-Nikravesh contact forces (eqs. 6-10), wear work, impact latch;
-* ``_tilt``: the lumped tilt spring-damper of joint C (``joint.tilt_stiffness``);
-* ``_equations``: equations of motion of the clearance and ideal models;
+* ``_tilt``: the lumped tilt spring-damper of the clearance joint (``joint.tilt_stiffness``);
+* ``_joint``: the clearance joint's side of the mechanism interface (poses in, wrench out);
+* ``_equations``: equations of motion of the four-bar's clearance and ideal models, and the
+  dispatch to the mechanism (``IP[MECH]``);
+* ``_slider_crank``, ``_slider_kinematics``: the slider-crank's equations of motion and its
+  closed-form kinematics;
 * ``_integrator``: DOPRI5 integration with output times.
 
 Everything here works on plain float arrays; :mod:`jointwear.sim.dynamics` packs the parameters
@@ -14,5 +18,6 @@ functions call each other across these modules.
 
 State vector, clearance model (11): theta1, theta2, theta1_dot, theta2_dot, q_w, q_x, q_y, q_z
 (follower orientation, body -> global), omega_x, omega_y, omega_z (follower angular velocity in
-its body frame). Ideal model (6): theta1, theta2, theta3, and their rates.
+its body frame). Ideal model (6): theta1, theta2, theta3, and their rates. The slider-crank's
+states: :mod:`._slider_crank`.
 """

@@ -9,11 +9,10 @@ import math
 import numpy as np
 from numba import njit
 
-from jointwear.sim.kernels._contact import _contact
-from jointwear.sim.kernels._geometry import _quat_matrix
+from jointwear.sim.kernels._geometry import body_rotation
+from jointwear.sim.kernels._joint import clearance_joint
 from jointwear.sim.kernels._layout import (
     BAUM,
-    CTILT,
     D_AXIS,
     D_BEAR_POS,
     D_COUP_POS,
@@ -54,7 +53,6 @@ from jointwear.sim.kernels._layout import (
     I_PEN,
     IDEAL,
     JOFF,
-    KTILT,
     L1,
     L2,
     L3,
@@ -62,17 +60,19 @@ from jointwear.sim.kernels._layout import (
     M1,
     M2,
     M3,
+    MECH,
+    MECH_SLIDER_CRANK,
     MODE_IDEAL,
     ND_DIAG,
     ON_COUPLER,
 )
-from jointwear.sim.kernels._tilt import _tilt_spring
+from jointwear.sim.kernels._slider_crank import eval_slider_crank
 
 
 @njit(cache=True)
 def _eval_clearance(t, y, ctx, dy, acc, hstep, diag):
     """Right-hand side of the clearance model; optionally accumulates wear work / fills diag."""
-    P, IP, info = ctx[0], ctx[1], ctx[10]
+    P, IP = ctx[0], ctx[1]
     th1, th2, w1, w2 = y[0], y[1], y[2], y[3]
     c1, s1 = math.cos(th1), math.sin(th1)
     c2, s2 = math.cos(th2), math.sin(th2)
@@ -81,12 +81,7 @@ def _eval_clearance(t, y, ctx, dy, acc, hstep, diag):
     vBx, vBy = -l1 * w1 * s1, l1 * w1 * c1
     Ccx, Ccy = Bx + l2 * c2, By + l2 * s2
     R = np.empty((3, 3))
-    _quat_matrix(y[4], y[5], y[6], y[7], R)
-    ob0, ob1, ob2 = y[8], y[9], y[10]
-    # follower angular velocity, global
-    wgx = R[0, 0] * ob0 + R[0, 1] * ob1 + R[0, 2] * ob2
-    wgy = R[1, 0] * ob0 + R[1, 1] * ob1 + R[1, 2] * ob2
-    wgz = R[2, 0] * ob0 + R[2, 1] * ob1 + R[2, 2] * ob2
+    ob0, ob1, ob2, wgx, wgy, wgz = body_rotation(y, R)  # the follower
     dz = P[JOFF]
     Cfx = l4 + l3 * R[0, 1] + dz * R[0, 2]
     Cfy = l3 * R[1, 1] + dz * R[1, 2]
@@ -124,32 +119,14 @@ def _eval_clearance(t, y, ctx, dy, acc, hstep, diag):
     else:
         V0g = (vcx - vfx, vcy - vfy, vcz - vfz)
         Wg = (-wgx, -wgy, w2 - wgz)
+    FM = np.empty(6)
     J0 = np.empty(3)
     u = np.empty(3)
-    V0 = np.empty(3)
-    W = np.empty(3)
-    for i in range(3):
-        J0[i] = Rb[0, i] * (Cj[0] - Og[0]) + Rb[1, i] * (Cj[1] - Og[1]) + Rb[2, i] * (Cj[2] - Og[2])
-        u[i] = Rb[0, i] * ug[0] + Rb[1, i] * ug[1] + Rb[2, i] * ug[2]
-        V0[i] = Rb[0, i] * V0g[0] + Rb[1, i] * V0g[1] + Rb[2, i] * V0g[2]
-        W[i] = Rb[0, i] * Wg[0] + Rb[1, i] * Wg[1] + Rb[2, i] * Wg[2]
-    wrench = np.zeros(12)
-    info[I_BAD] = 0.0
-    if u[2] < 0.5:
-        info[I_BAD] = 1.0
-        u[2] = 0.5
-    energy, fnsum, pen_rad, pen_ax, mode, kdeep, nslice, fax = _contact(
-        J0, u, V0, W, ctx, wrench, acc, hstep
+    energy, fnsum, pen_rad, pen_ax, mode, kdeep, nslice, fax, wrench = clearance_joint(
+        Rb, Og, Cj, ug, V0g, Wg, ctx, acc, hstep, FM, J0, u
     )
-    if P[KTILT] != 0.0 or P[CTILT] != 0.0:
-        energy += _tilt_spring(u, W, P[KTILT], P[CTILT], wrench)
     # wrench on the bearing, global: force F, moment M about Og
-    Fx = Rb[0, 0] * wrench[0] + Rb[0, 1] * wrench[1] + Rb[0, 2] * wrench[2]
-    Fy = Rb[1, 0] * wrench[0] + Rb[1, 1] * wrench[1] + Rb[1, 2] * wrench[2]
-    Fz = Rb[2, 0] * wrench[0] + Rb[2, 1] * wrench[1] + Rb[2, 2] * wrench[2]
-    Mx = Rb[0, 0] * wrench[3] + Rb[0, 1] * wrench[4] + Rb[0, 2] * wrench[5]
-    My = Rb[1, 0] * wrench[3] + Rb[1, 1] * wrench[4] + Rb[1, 2] * wrench[5]
-    Mz = Rb[2, 0] * wrench[3] + Rb[2, 1] * wrench[4] + Rb[2, 2] * wrench[5]
+    Fx, Fy, Fz, Mx, My, Mz = FM[0], FM[1], FM[2], FM[3], FM[4], FM[5]
     sgn_c = 1.0 if on_coupler else -1.0  # sign of the contact wrench acting on the coupler
     # coupler generalised forces
     Q1c = sgn_c * (Fx * (-l1 * s1) + Fy * (l1 * c1))
@@ -331,8 +308,16 @@ def _eval_ideal(t, y, P, IP, dy, diag):
 
 @njit(cache=True)
 def _eval(t, y, ctx, dy, acc, hstep, diag):
-    """Right-hand side dy of either model; ``ctx`` as in :func:`_contact`."""
-    if ctx[1][IDEAL] == 1:
+    """Right-hand side dy of the mechanism (``IP[MECH]``) and joint model; ``ctx`` as in
+    :func:`~jointwear.sim.kernels._contact._contact`.
+
+    One integrator serves every mechanism through this branch: numba's cache does not keep
+    integrators specialised on a function argument or a closure (they compile again in every
+    process), so the mechanisms are told apart by an integer.
+    """
+    if ctx[1][MECH] == MECH_SLIDER_CRANK:
+        eval_slider_crank(t, y, ctx, dy, acc, hstep, diag)
+    elif ctx[1][IDEAL] == 1:
         _eval_ideal(t, y, ctx[0], ctx[1], dy, diag)
         info = ctx[10]
         info[I_PEN] = -1.0

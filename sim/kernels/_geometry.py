@@ -26,6 +26,18 @@ def _quat_matrix(q0, q1, q2, q3, R):
     R[2, 2] = 1 - 2 * (x * x + y * y)
 
 
+@njit(cache=True, inline="always")
+def body_rotation(y, R):
+    """Fill ``R`` from the quaternion y[4:8]; return the body's angular velocity y[8:11] in its
+    own axes and in global axes (the rotating body of the clearance-model states)."""
+    _quat_matrix(y[4], y[5], y[6], y[7], R)
+    ob0, ob1, ob2 = y[8], y[9], y[10]
+    wgx = R[0, 0] * ob0 + R[0, 1] * ob1 + R[0, 2] * ob2
+    wgy = R[1, 0] * ob0 + R[1, 1] * ob1 + R[1, 2] * ob2
+    wgz = R[2, 0] * ob0 + R[2, 1] * ob1 + R[2, 2] * ob2
+    return ob0, ob1, ob2, wgx, wgy, wgz
+
+
 @njit(cache=True)
 def _node(n, m, J0, u, P, H, ZL, Nd):
     """Signed penetration of bearing point (n, m) by the journal and its geometry (bearing frame).

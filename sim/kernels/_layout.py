@@ -48,7 +48,9 @@ LATCH = 9  # impact velocity latched 0 once per impact and contact region, 1 per
 GRADED = 10  # 0: layers equally spaced (eq. 2), 1: spacing from ZL (joint.axial_grading)
 
 
-NIP = 11
+MECH = 11  # the mechanism: MECH_FOUR_BAR or MECH_SLIDER_CRANK (its own slots follow, _slider_crank)
+NIP = 15
+MECH_FOUR_BAR, MECH_SLIDER_CRANK = 0, 1
 
 
 WPROJ_LOCAL, WPROJ_LUMPED, WPROJ_CONSERVING = 0, 1, 2

@@ -46,7 +46,9 @@ __all__ = ["run_sweep", "read_spec", "SweepSpec", "make_design", "to_grid", "STA
 STATUS = {"ok": 0, "failed": 1, "not_run": 2}
 
 
-def _base(spec: SweepSpec, params: Any, wear: Any) -> tuple[Any, Any, dict[str, Any], list]:
+def _base(
+    spec: SweepSpec, params: Any, wear: Any, base: str | None = None
+) -> tuple[Any, Any, dict[str, Any], list]:
     """(SimParameters, WearSettings, JSON record, input files) of the base of every run."""
     from jointwear.params import from_mapping, read_toml, to_jsonable
     from jointwear.sim.wear._settings import WearSettings
@@ -65,13 +67,16 @@ def _base(spec: SweepSpec, params: Any, wear: Any) -> tuple[Any, Any, dict[str, 
     inputs = []
     table: dict[str, Any] = {}
     if params is None:
-        sim = PARAMETER_SETS[DEFAULT_PARAMETER_SET]
+        try:
+            sim = PARAMETER_SETS[base or DEFAULT_PARAMETER_SET]
+        except KeyError as exc:
+            raise ParameterError(f"base: {exc.args[0]}") from None
     elif isinstance(params, SimParameters):
         sim = params
     else:
         path = Path(params)
         table = read_toml(path)
-        sim = load_parameters(path)
+        sim = load_parameters(path, base=base or DEFAULT_PARAMETER_SET)
         inputs.append(path)
     if wear is None:
         wear = from_mapping(WearSettings, dict(table.get("wear", {}) or {}), where="wear")
@@ -487,6 +492,7 @@ def run_sweep(
     scheduler: str | None = None,
     resume: bool = False,
     on_progress: Callable[[dict[str, Any]], None] | None = None,
+    base: str | None = None,
 ) -> xr.Dataset:
     """Run a parameter sweep / ensemble and return it as one Dataset along ``run``.
 
@@ -498,8 +504,8 @@ def run_sweep(
         Result file (netCDF). Each finished run is first written to ``<out>.parts/`` (removed
         once ``out`` is written); without ``out`` nothing is written and nothing can resume.
     params : path or SimParameters, optional
-        Base parameters of every run (a ``--params`` TOML, possibly with a ``[wear]`` table);
-        default the :data:`~jointwear.sim.DEFAULT_PARAMETER_SET`.
+        Base parameters of every run (a ``--params`` TOML, possibly with a ``[wear]`` table,
+        over the named set ``base``); default the named set ``base``.
     wear : WearSettings, optional
         Base wear settings (default: the ``[wear]`` table of ``params``, else the defaults).
     workers : int, optional
@@ -512,6 +518,9 @@ def run_sweep(
         computed (the spec and base parameters must be the same).
     on_progress : callable, optional
         Called after each run with ``{"done", "failed", "total", "computed", "executor"}``.
+    base : str, optional
+        Named parameter set (``PARAMETER_SETS``) of the base, e.g. ``"slider_crank"``; default
+        :data:`~jointwear.sim.DEFAULT_PARAMETER_SET`.
 
     Returns
     -------
@@ -541,7 +550,7 @@ def run_sweep(
         raise BadInputError("resume needs the sweep's result file (out=/--out)")
     spec_file = [Path(spec)] if isinstance(spec, (str, Path)) else []
     spec = spec if isinstance(spec, SweepSpec) else read_spec(spec)
-    sim, wear, base_record, inputs = _base(spec, params, wear)
+    sim, wear, base_record, inputs = _base(spec, params, wear, base)
     if spec.run != "function":
         _check_feasible(spec, sim, wear)
     if workers is not None and workers < 0:

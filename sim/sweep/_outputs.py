@@ -56,7 +56,11 @@ MOTION_OUTPUTS: dict[str, tuple[str, str]] = {
     "mean_axial_force": ("N", "time-mean normal force of the end-face (thrust) contacts"),
     "follower_velocity_rms": (
         "m s-1",
-        "root mean square of the follower's centre-of-mass speed (|v|)",
+        "root mean square of the follower's centre-of-mass speed (|v|; four-bar, NaN otherwise)",
+    ),
+    "slider_velocity_rms": (
+        "m s-1",
+        "root mean square of the slider's speed (slider-crank, NaN otherwise)",
     ),
     "max_penetration": ("m", "largest penetration in joint C (bore or end faces)"),
     "max_journal_tilt": ("rad", "largest angle between the journal and bearing axes"),
@@ -134,14 +138,20 @@ def wear_outputs(ds: xr.Dataset) -> dict[str, float]:
 def motion_outputs(rec: xr.Dataset) -> dict[str, float]:
     """Force and motion statistics of a cycle record (``jointwear.sim.run_cycles`` dataset)."""
     f = np.asarray(rec["contact_force"].values, dtype=float)
-    v = np.asarray(rec["follower_velocity"].values, dtype=float)
-    speed2 = np.sum(v * v, axis=1)
+
+    def speed_rms(name: str) -> float:  # NaN: the mechanism has no such body (not assessed)
+        if name not in rec:
+            return float("nan")
+        v = np.asarray(rec[name].values, dtype=float)
+        return float(np.sqrt(np.mean(np.sum(v * v, axis=1))))
+
     return {
         "mean_contact_force": float(np.mean(f)),
         "peak_contact_force": float(np.max(f)),
         "rms_contact_force": float(np.sqrt(np.mean(f * f))),
         "mean_axial_force": float(np.mean(rec["axial_force"].values)),
-        "follower_velocity_rms": float(np.sqrt(np.mean(speed2))),
+        "follower_velocity_rms": speed_rms("follower_velocity"),
+        "slider_velocity_rms": speed_rms("slider_velocity"),
         "max_penetration": float(np.max(rec["penetration"].values)),
         "max_journal_tilt": float(np.nanmax(rec["journal_tilt"].values)),
         "contact_fraction": float(np.mean(np.asarray(rec["contact_mode"].values) != 0)),

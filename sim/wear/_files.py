@@ -52,6 +52,7 @@ def wear_inputs(
     contact: str = "dynamics",
     layers: int | None = None,
     points: int | None = None,
+    base: str | None = None,
 ) -> tuple[WearSettings, Any]:
     """Settings and contact model of a wear run.
 
@@ -66,6 +67,9 @@ def wear_inputs(
         which takes only a ``[wear]`` table).
     layers, points : int, optional
         Grid of the bore (default: the parameter set's ``joint.n_layers`` x ``joint.n_points``).
+    base : str, optional
+        Named parameter set the file's tables override (default
+        :data:`~jointwear.sim.DEFAULT_PARAMETER_SET`; ``"slider_crank"``).
 
     Returns
     -------
@@ -95,10 +99,14 @@ def wear_inputs(
         return settings, demo_winkler_contact(grid)
     if contact != "dynamics":
         raise BadInputError(f"--contact must be 'dynamics' or 'winkler', got {contact!r}")
-    if table:
-        params = parameters_from_tables(table, where=f"parameter file '{params_file}'")
-    else:
-        params = PARAMETER_SETS[DEFAULT_PARAMETER_SET]
+    base = base or DEFAULT_PARAMETER_SET
+    try:
+        if table:
+            params = parameters_from_tables(table, base, where=f"parameter file '{params_file}'")
+        else:
+            params = PARAMETER_SETS[base]
+    except KeyError as exc:
+        raise BadInputError(f"--base: {exc.args[0]}") from None
     grid_changes = {"joint.n_layers": layers, "joint.n_points": points}
     changes = {k: v for k, v in grid_changes.items() if v is not None}
     if changes:
@@ -254,13 +262,14 @@ def simulate_wear_to_file(
     contact: str = "dynamics",
     layers: int | None = None,
     points: int | None = None,
+    base: str | None = None,
     **run: Any,
 ) -> tuple[xr.Dataset, Any]:
     """A wear run from a parameter file to a wear-map file: :func:`wear_inputs`, then
     :func:`run_wear_to_file` (``run``: its keyword arguments; the file is a recorded input).
     """
     settings, model = wear_inputs(
-        params_file, overrides, contact=contact, layers=layers, points=points
+        params_file, overrides, contact=contact, layers=layers, points=points, base=base
     )
     inputs = [params_file] if params_file is not None else []
     return run_wear_to_file(out, model, settings, inputs=inputs, **run)

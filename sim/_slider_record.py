@@ -1,0 +1,155 @@
+"""The slider-crank's side of the simulator: packing its parameters, initial state, record.
+
+:mod:`jointwear.sim.dynamics` drives the integrator and builds the clearance joint's part of
+the record for every mechanism; this module adds what is particular to the slider-crank (its
+kernel is :mod:`jointwear.sim.kernels._slider_crank`).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+import jointwear.sim.kernels._slider_crank as ks
+from jointwear import conventions
+from jointwear.sim.kernels import _layout as kn
+from jointwear.sim.parameters import SimParameters
+from jointwear.sim.slider_crank import SliderCrankParameters, slider_crank_kinematics
+
+__all__ = ["is_slider_crank", "pack_mechanism", "initial_vector", "ANGLE_FLAGS", "variables"]
+
+#: State components integrated with absolute tolerance only (positions and angles).
+ANGLE_FLAGS = {
+    "clearance": np.array([1, 1, 0, 0, 1, 1, 1, 1, 0, 0, 0], dtype=np.int64),
+    "ideal": np.array([1, 0], dtype=np.int64),
+}
+
+
+def is_slider_crank(params: SimParameters) -> bool:
+    """Whether ``params`` describe the slider-crank (``mechanism.kind``)."""
+    return isinstance(params.mechanism, SliderCrankParameters)
+
+
+def pack_mechanism(params: SimParameters, P: np.ndarray, IP: np.ndarray) -> None:
+    """Write the slider-crank's slots of the kernel parameter arrays."""
+    m: SliderCrankParameters = params.mechanism  # type: ignore[assignment]
+    P[kn.L1], P[kn.L2] = m.crank_length, m.rod_length
+    P[kn.M1], P[kn.M2], P[kn.M3] = m.crank_mass, m.rod_mass, m.slider_mass
+    P[kn.I1] = m.crank_inertia
+    P[kn.I3X], P[kn.I3Y], P[kn.I3Z] = m.rod_inertia
+    P[kn.GRAV] = m.gravity
+    P[kn.JOFF] = m.joint_offset
+    P[kn.OMEGA] = m.crank_speed
+    IP[kn.MECH] = kn.MECH_SLIDER_CRANK
+    IP[kn.DRIVER] = 1
+    IP[ks.SC_CASE] = 1 if m.clearance_at == "crank_rod" else 0
+    IP[ks.SC_BEARING_ROD] = 1 if m.bearing_on == "rod" else 0
+    IP[ks.SC_PLANAR] = 1 if m.planar else 0
+
+
+def initial_vector(params: SimParameters) -> np.ndarray:
+    """State at the documented initial configuration.
+
+    Crank at ``initial_crank_angle_deg`` turning at the nominal speed; rod and slider at the
+    ideal slider-crank's closed-form position and velocity; the journal centred in the bearing
+    and aligned with it (rod in plane).
+    """
+    m: SliderCrankParameters = params.mechanism  # type: ignore[assignment]
+    th1 = math.radians(m.initial_crank_angle_deg)
+    if params.joint.model == "ideal":
+        return np.array([th1, m.crank_speed])
+    k = slider_crank_kinematics(th1, m.crank_length, m.rod_length, m.crank_speed)
+    phi = float(k["rod_angle"])
+    # rod body y from the pivot to the clearance joint: B -> C, or C -> B
+    direction = phi if m.clearance_at == "rod_slider" else phi + math.pi
+    a = direction - 0.5 * math.pi
+    q = [math.cos(a / 2), 0.0, 0.0, math.sin(a / 2)]
+    x, v = float(k["slider_position"]), float(k["slider_velocity"])
+    w = float(k["rod_angular_velocity"])
+    return np.array([th1, x, m.crank_speed, v, *q, 0.0, 0.0, w])
+
+
+def _vec(diag: np.ndarray, k: int) -> np.ndarray:
+    return diag[:, k : k + 3]
+
+
+def _along_x(values: np.ndarray) -> np.ndarray:
+    out = np.zeros((values.shape[0], 3))
+    out[:, 0] = values
+    return out
+
+
+def variables(params: SimParameters, diag: np.ndarray) -> dict:
+    """The slider-crank's record variables (name -> (dims, values, attrs))."""
+    m: SliderCrankParameters = params.mechanism  # type: ignore[assignment]
+    axis = ("time", "axis")
+    th1 = diag[:, kn.D_TH1]
+    rod = diag[:, ks.D_ROD_ANGLE]
+    if m.clearance_at == "crank_rod" and params.joint.model != "ideal":
+        rod = rod + math.pi  # the kernel's rod axis runs C -> B
+    rod = np.angle(np.exp(1j * rod))
+    crank_pos = np.stack([0.5 * m.crank_length * np.cos(th1), 0.5 * m.crank_length * np.sin(th1)])
+    crank_pos = np.column_stack([crank_pos.T, np.zeros_like(th1)])
+    w1 = m.crank_speed
+    crank_vel = np.column_stack([-w1 * crank_pos[:, 1], w1 * crank_pos[:, 0], np.zeros_like(th1)])
+    return {
+        "crank_angle": (
+            "time",
+            np.mod(th1, 2 * math.pi),
+            conventions.variable_attrs("crank_angle", note="wrapped to [0, 2 pi)"),
+        ),
+        "rod_angle": (
+            "time",
+            rod,
+            {
+                "units": "rad",
+                "long_name": "connecting rod angle (B to C) from +x, counter-clockwise",
+            },
+        ),
+        "slider_position": (
+            axis,
+            _along_x(diag[:, ks.D_SLIDER_POS]),
+            {"units": "m", "long_name": "position of the slider pin C (guide along x)"},
+        ),
+        "slider_velocity": (
+            axis,
+            _along_x(diag[:, ks.D_SLIDER_VEL]),
+            {"units": "m s-1", "long_name": "velocity of the slider"},
+        ),
+        "slider_acceleration": (
+            axis,
+            _along_x(diag[:, ks.D_SLIDER_ACC]),
+            {"units": "m s-2", "long_name": "acceleration of the slider"},
+        ),
+        "crank_position": (
+            axis,
+            crank_pos,
+            {"units": "m", "long_name": "position of the crank centre of mass"},
+        ),
+        "crank_velocity": (
+            axis,
+            crank_vel,
+            {"units": "m s-1", "long_name": "velocity of the crank centre of mass"},
+        ),
+        "rod_position": (
+            axis,
+            _vec(diag, ks.D_ROD_POS),
+            {"units": "m", "long_name": "position of the connecting rod centre of mass"},
+        ),
+        "rod_velocity": (
+            axis,
+            _vec(diag, ks.D_ROD_VEL),
+            {"units": "m s-1", "long_name": "velocity of the connecting rod centre of mass"},
+        ),
+        "rod_angular_velocity": (
+            axis,
+            _vec(diag, ks.D_ROD_OMEGA),
+            {"units": "rad s-1", "long_name": "angular velocity of the connecting rod, global"},
+        ),
+        "driver_torque": (
+            "time",
+            diag[:, ks.D_DRIVER_TORQUE],
+            {"units": "N m", "long_name": "torque that keeps the crank at constant speed"},
+        ),
+    }
