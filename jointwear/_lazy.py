@@ -8,12 +8,14 @@ start without loading numba, scipy or xarray.
 from __future__ import annotations
 
 import importlib
+import importlib.abc
+import importlib.machinery
 import sys
 import types
 from collections.abc import Callable, Sequence
 from typing import Any
 
-__all__ = ["lazy_api"]
+__all__ = ["lazy_api", "after_import"]
 
 
 def lazy_api(
@@ -83,3 +85,41 @@ class _ShadowingModule(types.ModuleType):
         ):
             value = getattr(value, name)
         super().__setattr__(name, value)
+
+
+def after_import(name: str, callback: Callable[[], None]) -> None:
+    """Run ``callback()`` right after the top-level module ``name`` has been imported.
+
+    At once if it is imported already; otherwise from a one-shot import hook (nothing is
+    imported here), so that start-up code can prepare a heavy dependency without loading it.
+    """
+    if name in sys.modules:
+        callback()
+        return
+    sys.meta_path.insert(0, _AfterImport(name, callback))
+
+
+class _AfterImport(importlib.abc.MetaPathFinder):
+    """Runs a callback right after the module ``name`` itself has been imported, then leaves."""
+
+    def __init__(self, name: str, callback: Callable[[], None]) -> None:
+        self.name = name
+        self.callback = callback
+
+    def find_spec(self, name: str, path: Any, target: Any = None) -> Any:
+        if name != self.name:
+            return None
+        sys.meta_path.remove(self)
+        spec = importlib.machinery.PathFinder.find_spec(name, path)
+        if spec is None or spec.loader is None:
+            return spec
+        loader = spec.loader
+        exec_module = loader.exec_module
+        callback = self.callback
+
+        def exec_then_notify(module: Any) -> None:
+            exec_module(module)
+            callback()
+
+        loader.exec_module = exec_then_notify  # type: ignore[method-assign]
+        return spec
