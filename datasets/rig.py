@@ -37,7 +37,7 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from jointwear.dic._calib import Camera, StereoCalibration
+from jointwear.dic.calibration._camera import Camera, StereoCalibration
 from jointwear.errors import BadInputError
 from jointwear.outputs import write_image
 

@@ -41,9 +41,9 @@ from collections.abc import Sequence
 import numpy as np
 import xarray as xr
 
-from jointwear.dic._quicklook import plot_displacement, save_quicklook
-from jointwear.dic._sequence import correlate_sequence, read_frames
-from jointwear.dic._subset import CorrelationParams, MatchResult, SubsetCorrelator
+from jointwear.dic.subset._correlator import CorrelationParams, MatchResult, SubsetCorrelator
+from jointwear.dic.subset._quicklook import plot_displacement, save_quicklook
+from jointwear.dic.subset._sequence import correlate_sequence, read_frames
 
 __all__ = [
     "correlate",

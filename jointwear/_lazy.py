@@ -47,7 +47,7 @@ def lazy_api(
     loading = False
 
     def __getattr__(name: str) -> Any:
-        # Private names are submodules (``from jointwear.dic import _flags``): answering
+        # Private names are submodules (``from jointwear.dic import _api2d``): answering
         # AttributeError lets the import system load them without pulling in the whole API,
         # and so does any lookup made while the API modules themselves are being imported.
         nonlocal loading

@@ -1,5 +1,5 @@
 """Uncertainty of a match relative to its camera's reference image, sub-pixel pattern
-mismatch included (:mod:`jointwear.dic._field`).
+mismatch included (:mod:`jointwear.dic.field._measure`).
 
 The IC-GN's standard uncertainty ``s^2 H^-1`` treats the match residual as white noise of equal
 variance at every pixel. That holds between two images of a static specimen (the residual is
@@ -12,7 +12,7 @@ large, so it moves the match more than white noise of the same residual variance
 (noise-free 8-bit speckle on the virtual rig, 25-pixel subsets, quintic: 1.24 / 1.73 mpx RMS
 error along the motion at 0.25 / 0.5 pixel of sub-pixel shift, against 1.01 / 1.37 mpx from
 ``s^2 H^-1``; zero at whole-pixel shifts). It is not the mean S-curve bias of the interpolant
-(0.4 mpx here, see :mod:`jointwear.dic._interp`) but a zero-mean error that differs from
+(0.4 mpx here, see :mod:`jointwear.dic.icgn._interp`) but a zero-mean error that differs from
 subset to subset with the texture.
 
 The heteroscedasticity-consistent (sandwich) covariance ``H^-1 (sum_i J_i J_i^T r_i^2) H^-1

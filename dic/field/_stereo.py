@@ -1,13 +1,13 @@
 """Stereo part of the full-field measurement: the plane-induced initial guess of the right
 image's matches, triangulation with per-point covariance, the left-right consistency flag, and
-the best-fit-plane output frame (see :mod:`jointwear.dic._field`)."""
+the best-fit-plane output frame (see :mod:`jointwear.dic.field._measure`)."""
 
 from __future__ import annotations
 
 import numpy as np
 import xarray as xr
 
-from jointwear.dic import _flags
+from jointwear.dic.icgn import _flags
 from jointwear.errors import BadInputError
 
 __all__ = ["plane_guess", "best_fit_plane", "stereo_geometry"]
@@ -60,7 +60,7 @@ def _point_cov(calibration, X, sl, sr):
     ``cov = G diag(s^2) G^T`` (not the inverse-variance-weighted ``(J^T diag(s^-2) J)^-1``,
     which is the covariance of a weighted triangulation and under-states Y, the coordinate
     both cameras' rows fix, when the images' uncertainties differ)."""
-    from jointwear.dic._stereo import _project_undistorted
+    from jointwear.dic.calibration._stereo import _project_undistorted
 
     out = np.full((len(X), 3, 3), np.nan)
     ok = np.isfinite(X).all(axis=1) & np.isfinite(sl).all(axis=1) & np.isfinite(sr).all(axis=1)
@@ -93,18 +93,18 @@ def best_fit_plane(P: np.ndarray, towards: np.ndarray) -> tuple[np.ndarray, np.n
 
 
 def stereo_geometry(calibration, sub_x, sub_y, DL, SR, DR, flag, prm):
-    """Triangulate every image's matched pairs (see :mod:`jointwear.dic._field`).
+    """Triangulate every image's matched pairs (see :mod:`jointwear.dic.field._measure`).
 
     ``sub_x``, ``sub_y`` (T, 2, N) [pixel] subset centres in the left and right images, ``DL``,
     ``DR`` (T, N, 2) the standard uncertainties [pixel] of every image's left and right match
-    relative to the camera's reference image (:mod:`jointwear.dic._field_mismatch`), ``SR``
+    relative to the camera's reference image (:mod:`jointwear.dic.field._mismatch`), ``SR``
     (T, N, 2) the right matches' own (for ``position_u``), ``flag`` (T, N) updated in place
     (``epipolar_mismatch``; a point without a reference position is flagged at every time).
     Returns ``(ref_pos, disp, disp_u, data, coords, attrs)``: reference positions (N, 3) and
     displacements (T, N, 3) [m] in the output frame, their standard uncertainties, and the
     dataset's stereo variables, coordinates and attributes.
     """
-    from jointwear.dic._stereo import triangulate
+    from jointwear.dic.calibration._stereo import triangulate
 
     n_t, _, n = sub_x.shape
     data: dict[str, xr.DataArray] = {}
@@ -131,7 +131,7 @@ def stereo_geometry(calibration, sub_x, sub_y, DL, SR, DR, flag, prm):
     cov_d = np.full((n_t, n, 3, 3), np.nan)
     cov_d[0] = 0.0
     for k in range(1, n_t):
-        # relative-match uncertainties (jointwear.dic._field_mismatch): the left one whole at
+        # relative-match uncertainties (jointwear.dic.field._mismatch): the left one whole at
         # X_k (the reference position has the unmatched grid centre), the right one half at
         # X_0 (right reference image) and half at X_k (current right image)
         sr = DR[k] / np.sqrt(2)

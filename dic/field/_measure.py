@@ -2,7 +2,7 @@
 
 ``measure_field(left, right=None, *, calibration=None, roi=None, ...)`` is what VIC-3D and
 DICe report for a specimen: subsets on a grid over the ROI of the left reference image, each
-matched (affine IC-GN, :mod:`jointwear.dic._subset`) in every image,
+matched (affine IC-GN, :mod:`jointwear.dic.subset._correlator`) in every image,
 
 * 2D (one camera): in every later left image (absolute reference, guess from the previous
   image); displacement in pixels;
@@ -14,10 +14,10 @@ matched (affine IC-GN, :mod:`jointwear.dic._subset`) in every image,
   the best-fit-plane frame of the reference surface.
 
 Uncertainty (``displacement_u``): every match carries its standard uncertainty from the IC-GN
-residual (:mod:`jointwear.dic._icgn`; in 2D within 0.75-1.3 of the scatter). For the
+residual (:mod:`jointwear.dic.icgn._match`; in 2D within 0.75-1.3 of the scatter). For the
 displacement, each camera's current match is taken relative to that camera's reference image
 and its uncertainty recomputed from the residual between the two
-(:mod:`jointwear.dic._field_mismatch`) with the heteroscedasticity-consistent (sandwich)
+(:mod:`jointwear.dic.field._mismatch`) with the heteroscedasticity-consistent (sandwich)
 covariance: it counts the *sub-pixel pattern mismatch* of a moved image (re-sampled at another
 sub-pixel phase, the speckle aliases and interpolates differently; the mismatch sits on the
 steep speckle edges and moves the match more than white noise of its variance would), which the
@@ -49,7 +49,7 @@ from typing import Literal
 import numpy as np
 import xarray as xr
 
-from jointwear.dic import _flags
+from jointwear.dic.icgn import _flags
 from jointwear.errors import BadInputError, ParameterError
 
 __all__ = ["FieldParams", "measure_field", "FIELD_FLAG_MEANINGS"]
@@ -124,7 +124,7 @@ class FieldParams:
             raise ParameterError(f"epipolar_max_px={self.epipolar_max_px!r}: expected > 0 pixel")
 
     def correlation(self):
-        from jointwear.dic._subset import CorrelationParams
+        from jointwear.dic.subset._correlator import CorrelationParams
 
         return CorrelationParams(
             subset_size=self.subset_size,
@@ -142,13 +142,13 @@ def _frames(source, what: str) -> tuple[list[np.ndarray], list[str]]:
     """Images of one camera (first = reference) and their names."""
     from pathlib import Path
 
-    from jointwear.dic._sequence import read_frames, read_image
-    from jointwear.dic._subset import check_image
+    from jointwear.dic.subset._correlator import check_image
+    from jointwear.dic.subset._sequence import read_frames, read_image
 
     if isinstance(source, np.ndarray) and source.ndim == 2:
         return [check_image(source, f"{what} image 0")], ["0"]
     if isinstance(source, (str, Path)):
-        from jointwear.dic._video import is_image_sequence, list_image_sequence
+        from jointwear.dic.footage._video import is_image_sequence, list_image_sequence
 
         if is_image_sequence(source):
             files, _ = list_image_sequence(source, what=f"{what} images")
@@ -201,7 +201,7 @@ def left_right_deviation(corr_params, right_img, left_img, centres, rx, ry, subs
     surface sees different things in the two views: its forward and backward matches disagree
     by tenths of a pixel while the ZNCC can stay above 0.8. Also returns the backward match's
     standard uncertainty (RMS over x and y times sqrt(2)) [pixel]."""
-    from jointwear.dic._subset import SubsetCorrelator
+    from jointwear.dic.subset._correlator import SubsetCorrelator
 
     rc = np.column_stack([rx, ry])
     dev = np.full(len(centres), np.nan)
@@ -227,7 +227,7 @@ def _match_images(corr, L, Rr, calibration, centres):
     ``SR`` (T, N, 2) [pixel] (NaN where the match failed), ZNCC ``Z`` and flags ``F``
     (T, cameras, N).
     """
-    from jointwear.dic._field_stereo import plane_guess
+    from jointwear.dic.field._stereo import plane_guess
 
     stereo = len(Rr) > 0
     n_t, n = len(L), corr.n_points
@@ -273,9 +273,9 @@ def _relative_sigma(L, Rr, PL, PR, centres, cp, kappa):
     """Standard uncertainties ``DL``, ``DR`` (T, N, 2) [pixel] of every image's match relative
     to its camera's reference image (left: the match itself; right: against the right
     reference's match), from the residual between the two images, pattern mismatch included
-    (:mod:`jointwear.dic._field_mismatch`), times the engine's ``kappa``; 0 at the reference
+    (:mod:`jointwear.dic.field._mismatch`), times the engine's ``kappa``; 0 at the reference
     image, NaN where a match is missing."""
-    from jointwear.dic._field_mismatch import relative_sigma, spline_coefficients
+    from jointwear.dic.field._mismatch import relative_sigma, spline_coefficients
 
     n_t, n = PL.shape[:2]
     DL = np.zeros((n_t, n, 2))
@@ -320,7 +320,7 @@ def measure_field(
         :class:`~jointwear.dic.StereoCalibration`).
     roi : optional
         Rectangle ``(x0, y0, x1, y1)`` [pixel], polygon TOML, mask image or array (see
-        :func:`jointwear.dic._field_roi.read_roi`); default the whole image.
+        :func:`jointwear.dic.field._roi.read_roi`); default the whole image.
     times : sequence of float, optional
         Time of every image [s]; or ``frame_rate`` [1/s]. Without either (still images), the
         ``time`` dimension has no time coordinate, only the image index.
@@ -339,9 +339,9 @@ def measure_field(
         ``strain_engineering`` [1] (``component`` xx, yy, xy) with ``strain_u``; coordinates
         ``x``, ``y`` [pixel] (left reference image) and the grid ``row``/``col``.
     """
-    from jointwear.dic._field_roi import grid_points, read_roi
-    from jointwear.dic._field_stereo import stereo_geometry
-    from jointwear.dic._subset import SubsetCorrelator, check_pair
+    from jointwear.dic.field._roi import grid_points, read_roi
+    from jointwear.dic.field._stereo import stereo_geometry
+    from jointwear.dic.subset._correlator import SubsetCorrelator, check_pair
 
     base = params or FieldParams()
     if options:
@@ -367,7 +367,7 @@ def measure_field(
             "(--right) for a stereo field, or drop the calibration for a 2D field"
         )
     if stereo and not hasattr(calibration, "left"):
-        from jointwear.dic._calib import read_calibration
+        from jointwear.dic.calibration._importers import read_calibration
 
         calibration = read_calibration(calibration)
     L, lnames = _frames(left, "left" if stereo else "")
@@ -535,7 +535,7 @@ def measure_field(
             },
         )
     if prm.strain_window:
-        from jointwear.dic._strain import strain_variables
+        from jointwear.dic.field._strain import strain_variables
 
         strain, comp = strain_variables(
             np.where(ok[0][:, None], ref_pos, np.nan), ref_pos[None] + disp, disp_u,

@@ -1,7 +1,7 @@
 """IC-GN drivers (numba): many points in parallel, preloaded reference subsets for trackers,
 and reliability-guided propagation from seeds.
 
-Arguments come packed as in :mod:`jointwear.dic._icgn_solve` (``ref``, ``dfm``, ``opts``), and
+Arguments come packed as in :mod:`jointwear.dic.icgn._solve` (``ref``, ``dfm``, ``opts``), and
 the per-point outputs as ``out`` = ``(zncc, iterations, flags, sigma)``.
 """
 
@@ -10,10 +10,10 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from jointwear.dic._flags import FLAG_LOW_CORRELATION, FLAG_NO_TEXTURE, FLAG_OK
-from jointwear.dic._icgn_reference import _load_reference
-from jointwear.dic._icgn_solve import _affine_system, _iterate_affine, make_work, solve_point
-from jointwear.dic._icgn_warp import _extrapolate
+from jointwear.dic.icgn._flags import FLAG_LOW_CORRELATION, FLAG_NO_TEXTURE, FLAG_OK
+from jointwear.dic.icgn._reference import _load_reference
+from jointwear.dic.icgn._solve import _affine_system, _iterate_affine, make_work, solve_point
+from jointwear.dic.icgn._warp import _extrapolate
 
 
 @njit(cache=True, inline="always")

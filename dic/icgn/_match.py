@@ -4,14 +4,14 @@ Criterion: zero-normalised sum of squared differences (ZNSSD, insensitive to off
 the intensities), ``C = sum [ (f - fm)/fn - (g - gm)/gn ]**2 = 2 (1 - ZNCC)``, minimised by IC-GN
 (Baker & Matthews 2004; Pan, Li & Tong 2013). The numerics live in one module per concern:
 
-* :mod:`jointwear.dic._icgn_warp`: warp algebra (composition, 6x6 second-order matrices after
+* :mod:`jointwear.dic.icgn._warp`: warp algebra (composition, 6x6 second-order matrices after
   Gao et al. 2015, small solves, extrapolation to a neighbour);
-* :mod:`jointwear.dic._icgn_reference`: reference subsets (values, central-difference
+* :mod:`jointwear.dic.icgn._reference`: reference subsets (values, central-difference
   gradients, texture, invalid pixels, the Gauss-Newton uncertainty);
-* :mod:`jointwear.dic._icgn_sample`: B-spline weights written once, sampling of the warped
+* :mod:`jointwear.dic.icgn._sample`: B-spline weights written once, sampling of the warped
   subset (one source for cubic and quintic);
-* :mod:`jointwear.dic._icgn_solve`: one subset's Gauss-Newton systems and iterations;
-* :mod:`jointwear.dic._icgn_drive`: many points in parallel, preloaded references,
+* :mod:`jointwear.dic.icgn._solve`: one subset's Gauss-Newton systems and iterations;
+* :mod:`jointwear.dic.icgn._drive`: many points in parallel, preloaded references,
   reliability-guided propagation.
 
 Shape parameters (always a 12-vector, the affine case uses 6 of them)::
@@ -43,17 +43,17 @@ from __future__ import annotations
 
 import numpy as np
 
-from jointwear.dic._icgn_drive import (
+from jointwear.dic.icgn._drive import (
     affine_references,
     icgn_affine_loaded,
     icgn_many,
     icgn_serial,
     rg_propagate,
 )
-from jointwear.dic._icgn_reference import _box_has_invalid, _load_reference, subset_std
-from jointwear.dic._icgn_sample import interp_point, sample_affine
-from jointwear.dic._icgn_solve import make_work, solve_point
-from jointwear.dic._icgn_warp import _compose_inverse, _extrapolate
+from jointwear.dic.icgn._reference import _box_has_invalid, _load_reference, subset_std
+from jointwear.dic.icgn._sample import interp_point, sample_affine
+from jointwear.dic.icgn._solve import make_work, solve_point
+from jointwear.dic.icgn._warp import _compose_inverse, _extrapolate
 
 __all__ = [
     "QUADRATIC_INDEX",

@@ -85,7 +85,7 @@ def read_frames(
             )
         return [np.asarray(f) for f in source[sel]], None
     if isinstance(source, (str, Path)):
-        from jointwear.dic._video import is_image_sequence, list_image_sequence
+        from jointwear.dic.footage._video import is_image_sequence, list_image_sequence
 
         path = Path(source)
         if is_image_sequence(source):
@@ -236,8 +236,13 @@ def correlate_sequence(
         ``converged``, ``flag`` over ``time`` and ``point`` (or ``y``, ``x``), and
         ``reference_frame``.
     """
-    from jointwear.dic import _flags as _icgn
-    from jointwear.dic._subset import SubsetCorrelator, check_image, check_pair, result_dataset
+    from jointwear.dic.icgn import _flags as _icgn
+    from jointwear.dic.subset._correlator import (
+        SubsetCorrelator,
+        check_image,
+        check_pair,
+        result_dataset,
+    )
     from jointwear.progress import progress_bar
 
     if update_every is not None and (not isinstance(update_every, int) or update_every < 1):

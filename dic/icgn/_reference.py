@@ -8,8 +8,8 @@ import math
 import numpy as np
 from numba import njit
 
-from jointwear.dic._flags import FLAG_INVALID_PIXELS, FLAG_NO_TEXTURE, FLAG_OK, FLAG_OUTSIDE
-from jointwear.dic._interp import PAD, interp_value, node_filters
+from jointwear.dic.icgn._flags import FLAG_INVALID_PIXELS, FLAG_NO_TEXTURE, FLAG_OK, FLAG_OUTSIDE
+from jointwear.dic.icgn._interp import PAD, interp_value, node_filters
 
 
 @njit(cache=True)
@@ -79,7 +79,7 @@ def _load_reference(
                 k += 1
     else:
         # off the pixel grid: the values and the central differences of the interpolant (the
-        # node gradients are central differences of the pixels, see jointwear.dic._interp)
+        # node gradients are central differences of the pixels, see jointwear.dic.icgn._interp)
         for r in range(-half, half + 1):
             for c in range(-half, half + 1):
                 x = xc + c

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from jointwear.dic._footage_config import TrackConfig
-from jointwear.dic._footage_features import _homography_guess, _sift_features, _sift_homography
-from jointwear.dic._interp import prefilter_region
+from jointwear.dic.footage._config import TrackConfig
+from jointwear.dic.footage._features import _homography_guess, _sift_features, _sift_homography
+from jointwear.dic.icgn._interp import prefilter_region
 
 
 # ---------------------------------------------------------------------------------------------

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from numba import njit
 
-from jointwear.dic._interp import PAD
+from jointwear.dic.icgn._interp import PAD
 
 _FM = {"nsz", "arcp", "contract", "reassoc"}  # fastmath without no-NaN/no-inf assumptions
 

@@ -9,7 +9,7 @@ from typing import Literal
 
 import numpy as np
 
-from jointwear.dic._calib import Camera, StereoCalibration, _check_enough_views
+from jointwear.dic.calibration._camera import Camera, StereoCalibration, _check_enough_views
 from jointwear.errors import BadInputError, CalibrationError
 
 __all__ = ["CalibrationBoard", "calibrate_stereo", "detect_board", "board_world_frame"]
@@ -126,7 +126,7 @@ def detect_board(image: np.ndarray, board: CalibrationBoard, *, with_detector: b
         # OpenCV may return the grid in either of two orders; fix it so that the first corner
         # is the top-left one in this image (a convention for a single image, such as the
         # world-frame view; the two cameras of a calibration pair are made consistent by
-        # geometry, see jointwear.dic._calib_order)
+        # geometry, see jointwear.dic.calibration._order)
         if (corners[-1] - corners[0]) @ np.array([1.0, 1.0]) < 0:
             corners = corners[::-1].copy()
         return (
@@ -273,12 +273,12 @@ def calibrate_stereo(
 
     Boards are found with both of OpenCV's chessboard detectors (sector-based, then classic).
     The corner order of the two cameras is made consistent by geometry
-    (:mod:`jointwear.dic._calib_order`): a view whose left and right images do not show the
+    (:mod:`jointwear.dic.calibration._order`): a view whose left and right images do not show the
     board in the pose the other views agree on is rejected. Each camera is then calibrated on
     its own (``cv2.calibrateCameraExtended``); views whose reprojection RMS exceeds
     ``max_view_rms`` are rejected and the calibration is repeated; then ``cv2.stereoCalibrate``
     refines intrinsics and the relative pose (``CALIB_USE_INTRINSIC_GUESS``). Finally the result
-    passes a sanity gate (:func:`~jointwear.dic._calib_gate.check_calibration`): stereo RMS,
+    passes a sanity gate (:func:`~jointwear.dic.calibration._gate.check_calibration`): stereo RMS,
     field of view, pixel aspect, principal point, baseline against the board distance, and
     which side the right camera is on.
 
@@ -301,7 +301,7 @@ def calibrate_stereo(
         Largest acceptable stereo reprojection RMS [pixel] (sanity gate).
     accept_poor : bool
         Return a calibration that fails the sanity gate (its ``status`` says so) instead of
-        raising :class:`~jointwear.dic._calib_gate.PoorCalibration`.
+        raising :class:`~jointwear.dic.calibration._gate.PoorCalibration`.
     view_names : sequence of str, optional
         Names of the views in messages and in the per-view table; default: the image file
         names, or ``"view <i>"`` for arrays.
@@ -322,8 +322,8 @@ def calibrate_stereo(
     """
     import cv2
 
-    from jointwear.dic._calib_gate import PoorCalibration, check_calibration
-    from jointwear.dic._calib_order import consistent_order, grid_symmetries, pair_poses
+    from jointwear.dic.calibration._gate import PoorCalibration, check_calibration
+    from jointwear.dic.calibration._order import consistent_order, grid_symmetries, pair_poses
 
     left_images = list(left_images)
     right_images = list(right_images)

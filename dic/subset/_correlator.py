@@ -10,7 +10,7 @@ graph. Then, for each deformed image:
 
 * ``initial_guess`` ``(N, 2)`` displacements ``(u, v)`` [pixel], or ``(N, 6)`` affine
   ``(u, du/dx, du/dy, v, dv/dx, dv/dy)``, or ``(N, 12)`` full shape parameters (layout of
-  :mod:`jointwear.dic._icgn`): every point is refined from its guess in parallel, and points
+  :mod:`jointwear.dic.icgn._match`): every point is refined from its guess in parallel, and points
   that fail are retried by reliability-guided propagation from their converged neighbours.
 * otherwise seeds are found by OpenCV template matching (``search_radius``; rotated templates
   when the plain search fails) and the solution propagates from the best-correlated points to
@@ -31,9 +31,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 import xarray as xr
 
-import jointwear.dic._flags as _flags
-from jointwear.dic._subset_output import result_dataset
-from jointwear.dic._subset_params import (
+import jointwear.dic.icgn._flags as _flags
+from jointwear.dic.subset._output import result_dataset
+from jointwear.dic.subset._params import (
     CorrelationParams,
     _integral_invalid,
     check_image,
@@ -43,7 +43,7 @@ from jointwear.dic._subset_params import (
 from jointwear.errors import BadInputError, ParameterError
 
 if TYPE_CHECKING:
-    from jointwear.dic._interp import SplineImage
+    from jointwear.dic.icgn._interp import SplineImage
 
 __all__ = [
     "CorrelationParams",
@@ -66,7 +66,7 @@ _GRID_SLACK = 2
 class MatchResult:
     """Raw per-point output of :meth:`SubsetCorrelator.match`.
 
-    ``params`` (N, 12) shape parameters (layout of :mod:`jointwear.dic._icgn`), ``zncc`` (N,),
+    ``params`` (N, 12) shape parameters (layout of :mod:`jointwear.dic.icgn._match`), ``zncc`` (N,),
     ``iterations`` (N,), ``flag`` (N,) int8, ``sigma`` (N, 2) standard uncertainty of (u, v)
     [pixel] from the match residual (NaN unless ok).
     """
@@ -123,7 +123,7 @@ class SubsetCorrelator:
                 )
             base = CorrelationParams(**{**asdict(base), **options})
         self.params = base
-        from jointwear.dic._interp import prefilter
+        from jointwear.dic.icgn._interp import prefilter
 
         self.reference_raw = check_image(reference, "reference image")
         self.ref = prefilter(self.reference_raw, base.interpolation)
@@ -229,7 +229,7 @@ class SubsetCorrelator:
 
     def _texture_and_usable(self) -> tuple[np.ndarray, np.ndarray]:
         """Intensity std of every reference subset, and which points can be seeds."""
-        from jointwear.dic import _icgn
+        from jointwear.dic.icgn import _match as _icgn
 
         if self._texture is None:
             tex = _icgn.subset_std(
@@ -245,7 +245,7 @@ class SubsetCorrelator:
 
     # ------------------------------------------------------------------ matching
     def _prepare_deformed(self, deformed) -> tuple[SplineImage, np.ndarray, np.ndarray]:
-        from jointwear.dic._interp import SplineImage, prefilter
+        from jointwear.dic.icgn._interp import SplineImage, prefilter
 
         if isinstance(deformed, SplineImage):
             spl = deformed
@@ -260,7 +260,7 @@ class SubsetCorrelator:
         return spl, inv, raw
 
     def _kernel_args(self, dspl, dinv) -> tuple[tuple, tuple]:
-        """The kernels' packed ``ref`` and ``dfm`` arguments (see :mod:`jointwear.dic._icgn`)."""
+        """The kernels' packed ``ref`` and ``dfm`` arguments (see :mod:`jointwear.dic.icgn._match`)."""
         r = self.ref
         return (r.image, r.gx, r.gy, r.coef, self._ref_invalid), (dspl.coef, dinv)
 
@@ -295,7 +295,7 @@ class SubsetCorrelator:
         thousands of points, not for dense fields. Affine shape only; the kernel then runs on
         one thread without holding the GIL, so several correlators can work in threads.
         """
-        from jointwear.dic import _icgn
+        from jointwear.dic.icgn import _match as _icgn
 
         if self.params.quadratic:
             raise ParameterError("preload_references: only the affine shape function")
@@ -311,7 +311,7 @@ class SubsetCorrelator:
         self._loaded = (F, GX, GY, HINV, JF, JS, FN, FLAG0)
 
     def _run_many(self, dspl, dinv, P, active, st, serial=False):
-        from jointwear.dic import _icgn
+        from jointwear.dic.icgn import _match as _icgn
 
         ref, dfm = self._kernel_args(dspl, dinv)
         out = (st.zncc, st.iterations, st.flag, st.sigma)
@@ -323,7 +323,7 @@ class SubsetCorrelator:
         kernel(ref, dfm, opts, self.centres, P, active, out)
 
     def _propagate(self, dspl, dinv, st, done, group, n_groups):
-        from jointwear.dic import _icgn
+        from jointwear.dic.icgn import _match as _icgn
 
         ref, dfm = self._kernel_args(dspl, dinv)
         _icgn.rg_propagate(
@@ -367,7 +367,7 @@ class SubsetCorrelator:
 
         If every attempt fails, the point keeps the outcome of the plain attempt.
         """
-        from jointwear.dic._guess import integer_search
+        from jointwear.dic.subset._guess import integer_search
 
         p = self.params
         xc, yc = self.centres[i]
@@ -460,7 +460,7 @@ class SubsetCorrelator:
         else:
             import numba
 
-            from jointwear.dic._guess import pick_seeds
+            from jointwear.dic.subset._guess import pick_seeds
 
             n_groups = int(min(2 * numba.get_num_threads(), max(1, n // 64)))
             group, candidates = pick_seeds(self.centres, usable, tex, n_groups)
@@ -489,14 +489,14 @@ class SubsetCorrelator:
         """Per-point factor on the IC-GN's ``sigma^2 H^-1`` uncertainty (N,).
 
         The Jacobian uses central-difference gradients ``g_c`` (less biased, see
-        :mod:`jointwear.dic._interp`), which on fine speckle are smaller than the interpolant's
+        :mod:`jointwear.dic.icgn._interp`), which on fine speckle are smaller than the interpolant's
         true gradient ``g_s``; the solution's actual covariance is then the sandwich
         ``s2 H_cs^-1 H_cc H_cs^-T``, about ``kappa^2`` times ``s2 H_cc^-1`` with
         ``kappa = sum |g_c|^2 / sum g_c . g_s`` over the subset (< 1; without it the reported
         uncertainty exceeds the scatter by 1.2-1.3 on 3-4 px speckle).
         """
         if getattr(self, "_kappa", None) is None:
-            from jointwear.dic._icgn_reference import subset_kappa
+            from jointwear.dic.icgn._reference import subset_kappa
 
             r = self.ref
             k = np.ones(self.n_points)
@@ -566,7 +566,7 @@ class SubsetCorrelator:
             if idx.size:
                 _, near = cKDTree(self.centres[good]).query(self.centres[idx])
                 src = good[near]
-                from jointwear.dic._icgn import _extrapolate
+                from jointwear.dic.icgn._match import _extrapolate
 
                 for j, i in zip(idx, src, strict=True):
                     d = self.centres[j] - self.centres[i]

@@ -1,7 +1,7 @@
 """IC-GN warp algebra (numba): small linear solves, inverse-compositional updates of affine
 and second-order warps, extrapolation of shape parameters to a neighbour.
 
-Shape parameters are always a 12-vector (layout in :mod:`jointwear.dic._icgn`); second-order
+Shape parameters are always a 12-vector (layout in :mod:`jointwear.dic.icgn._match`); second-order
 warps are composed through their 6x6 matrix representation (Gao et al. 2015).
 """
 

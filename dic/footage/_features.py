@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from jointwear.dic._stereo import epipolar_distance
+from jointwear.dic.calibration._stereo import epipolar_distance
 
 #: candidates per feature in the epipolar-guided matching
 _K_CANDIDATES = 8
@@ -83,7 +83,7 @@ def epipolar_band(
     """
     import cv2
 
-    from jointwear.dic._stereo import _undistorted_pixels
+    from jointwear.dic.calibration._stereo import _undistorted_pixels
 
     h, w = shape
     gx = np.arange(0, w + _BAND_STEP, _BAND_STEP, dtype=float)

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from jointwear.dic._calib import StereoCalibration
+from jointwear.dic.calibration._camera import StereoCalibration
 from jointwear.errors import EXIT_VALIDATION_FAILED, CalibrationError
 
 __all__ = ["PoorCalibration", "check_calibration", "view_table"]

@@ -5,7 +5,7 @@ Pipeline (``track_footage``)
 1. The first frame of each camera is the reference. Each body's region of interest (a polygon
    in the left reference image, from a small TOML file) is filled with a grid of subsets.
 2. Stereo correspondence at the reference: SIFT features of the region are matched (FLANN,
-   guided by the epipolar lines, :mod:`jointwear.dic._footage_features`) with the right image's
+   guided by the epipolar lines, :mod:`jointwear.dic.footage._features`) with the right image's
    features in the regions' epipolar band, kept within the epipolar gate
    (``max(3, max_epipolar_px)`` px), and a RANSAC homography gives every subset an initial guess (position and affine gradients); the
    2D engine (:class:`jointwear.dic.SubsetCorrelator`, affine IC-GN) refines it. Matches with an
@@ -32,11 +32,11 @@ Pipeline (``track_footage``)
    (threads inside a daemonic process such as a dask worker; tasks on a dask cluster with
    ``scheduler``).
 
-Modules: :mod:`~jointwear.dic._footage_config` (options, bodies, flags),
-:mod:`~jointwear.dic._footage_features` (SIFT, matching, homography),
-:mod:`~jointwear.dic._footage_tracker` (one body in one camera),
-:mod:`~jointwear.dic._footage_frames` (set-up and per-frame pipeline),
-:mod:`~jointwear.dic._footage_result` (the dataset, its file, resuming), and this one.
+Modules: :mod:`~jointwear.dic.footage._config` (options, bodies, flags),
+:mod:`~jointwear.dic.footage._features` (SIFT, matching, homography),
+:mod:`~jointwear.dic.footage._tracker` (one body in one camera),
+:mod:`~jointwear.dic.footage._frames` (set-up and per-frame pipeline),
+:mod:`~jointwear.dic.footage._result` (the dataset, its file, resuming), and this one.
 """
 
 from __future__ import annotations
@@ -49,21 +49,21 @@ from pathlib import Path
 
 import xarray as xr
 
-from jointwear.dic._calib import StereoCalibration
-from jointwear.dic._footage_config import FRAME_FLAGS, BodySpec, TrackConfig, read_bodies
-from jointwear.dic._footage_features import (  # noqa: F401 (re-exported)
+from jointwear.dic.calibration._camera import StereoCalibration
+from jointwear.dic.footage._config import FRAME_FLAGS, BodySpec, TrackConfig, read_bodies
+from jointwear.dic.footage._features import (  # noqa: F401 (re-exported)
     _as_uint8,
     _homography_guess,
     _sift_features,
     _sift_homography,
 )
-from jointwear.dic._footage_frames import (  # noqa: F401 (re-exported)
+from jointwear.dic.footage._frames import (  # noqa: F401 (re-exported)
     _BodyState,
     _run_frames,
     _setup_states,
     _stereo_prediction,
 )
-from jointwear.dic._footage_result import (  # noqa: F401 (re-exported)
+from jointwear.dic.footage._result import (  # noqa: F401 (re-exported)
     _RESUMABLE_CHANGES,
     _assemble,
     _load_partial,
@@ -71,21 +71,21 @@ from jointwear.dic._footage_result import (  # noqa: F401 (re-exported)
     _restore_rows,
     _write,
 )
-from jointwear.dic._footage_tracker import (  # noqa: F401 (re-exported)
+from jointwear.dic.footage._tracker import (  # noqa: F401 (re-exported)
     _affine_fit,
     _CameraBodyTracker,
     _grid_in_polygon,
     _match_sigma,
     _noise_sigma,
 )
-from jointwear.dic._sequence import check_frame_names
-from jointwear.dic._video import (
+from jointwear.dic.footage._video import (
     FrameSource,
     check_stereo_pair,
     list_image_sequence,
     open_frames,
     prefetch,
 )
+from jointwear.dic.subset._sequence import check_frame_names
 from jointwear.errors import BadInputError
 
 __all__ = [
@@ -100,7 +100,7 @@ __all__ = [
 def _open_footage(source: str | Path | FrameSource, fps: float | None, what: str) -> FrameSource:
     """Open one camera's footage. A folder whose images are not all named like its frames (a
     mask, a stray image) is refused naming the odd files, as ``dic correlate`` and ``dic field``
-    refuse it (:func:`jointwear.dic._sequence.check_frame_names`): otherwise the odd file would
+    refuse it (:func:`jointwear.dic.subset._sequence.check_frame_names`): otherwise the odd file would
     be tracked as one more frame."""
     if isinstance(source, FrameSource):
         return source

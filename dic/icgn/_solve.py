@@ -4,7 +4,7 @@ order, from one reference loading (:func:`solve_point`).
 Criterion: zero-normalised sum of squared differences (ZNSSD), minimised by the
 inverse-compositional Gauss-Newton (Baker & Matthews 2004; Pan, Li & Tong 2013): the Hessian is
 built once per subset from the reference gradients (central differences, see
-:mod:`jointwear.dic._interp`), each iteration samples the deformed image once at the warped
+:mod:`jointwear.dic.icgn._interp`), each iteration samples the deformed image once at the warped
 subset and updates ``W(p) <- W(p) o W(dp)^-1``. Kernel arguments come packed: ``ref`` =
 ``(image, gx, gy, coef, invalid)`` of the reference, ``dfm`` = ``(coef, invalid)`` of the
 deformed image, ``opts`` = ``(half, quadratic, max_iter, tol, min_std, max_shift, border,
@@ -18,7 +18,7 @@ import math
 import numpy as np
 from numba import njit
 
-from jointwear.dic._flags import (
+from jointwear.dic.icgn._flags import (
     AFFINE_INDEX,
     FLAG_DIVERGED,
     FLAG_INVALID_PIXELS,
@@ -27,10 +27,10 @@ from jointwear.dic._flags import (
     FLAG_OK,
     FLAG_OUTSIDE,
 )
-from jointwear.dic._icgn_reference import _box_has_invalid, _load_reference, _store_sigma
-from jointwear.dic._icgn_sample import interp_point, sample_affine
-from jointwear.dic._icgn_warp import _compose_affine, _compose_quadratic, _solve_spd
-from jointwear.dic._interp import PAD
+from jointwear.dic.icgn._interp import PAD
+from jointwear.dic.icgn._reference import _box_has_invalid, _load_reference, _store_sigma
+from jointwear.dic.icgn._sample import interp_point, sample_affine
+from jointwear.dic.icgn._warp import _compose_affine, _compose_quadratic, _solve_spd
 
 # a subset still below this ZNCC after this many iterations is not going to match
 _HOPELESS_AFTER = 10

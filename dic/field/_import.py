@@ -110,7 +110,7 @@ def _table(path: Path, fmt: str) -> dict[str, np.ndarray]:
 
 def _files(files) -> list[Path]:
     if isinstance(files, (str, Path)):
-        from jointwear.dic._video import _GLOB_CHARS, _natural_key
+        from jointwear.dic.footage._video import _GLOB_CHARS, _natural_key
 
         p = Path(files)
         if p.is_file():

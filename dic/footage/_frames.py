@@ -8,22 +8,22 @@ from typing import Any
 
 import numpy as np
 
-from jointwear.dic._footage_config import FRAME_FLAGS, BodySpec, TrackConfig
-from jointwear.dic._footage_features import (
+from jointwear.dic.calibration._stereo import epipolar_distance, triangulate
+from jointwear.dic.footage._config import FRAME_FLAGS, BodySpec, TrackConfig
+from jointwear.dic.footage._features import (
     MatchReport,
     _homography_guess,
     _sift_features,
     _sift_homography,
     epipolar_band,
 )
-from jointwear.dic._footage_tracker import (
+from jointwear.dic.footage._rigid import fit_rigid_robust, pose_point_uncertainty
+from jointwear.dic.footage._tracker import (
     _CameraBodyTracker,
     _grid_in_polygon,
     _match_sigma,
     _noise_sigma,
 )
-from jointwear.dic._rigid import fit_rigid_robust, pose_point_uncertainty
-from jointwear.dic._stereo import epipolar_distance, triangulate
 from jointwear.errors import BadInputError
 
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from jointwear.dic._calib import Camera, StereoCalibration
+from jointwear.dic.calibration._camera import Camera, StereoCalibration
 from jointwear.errors import BadInputError
 
 __all__ = ["triangulate", "epipolar_distance", "stereo_noise_floor"]

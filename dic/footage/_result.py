@@ -10,14 +10,14 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from jointwear.dic._footage_config import FRAME_FLAGS, TrackConfig
-from jointwear.dic._rigid import (
+from jointwear.dic.footage._config import FRAME_FLAGS, TrackConfig
+from jointwear.dic.footage._rigid import (
     derivative_truncation,
     position_noise,
     rotation_angle_z,
     time_derivative,
 )
-from jointwear.dic._video import FrameSource
+from jointwear.dic.footage._video import FrameSource
 from jointwear.errors import BadInputError
 
 #: tracking options that may change between a partial run and its resumption
@@ -127,9 +127,9 @@ def velocity_budget(t, pos, pos_u, vel, gain, cfg: TrackConfig, calibration) -> 
 
     * noise: the positions' noise times the differentiator's noise gain; the noise is the
       larger of the propagated uncertainty (median over frames) and the empirical scatter
-      about a local polynomial (:func:`~jointwear.dic._rigid.position_noise`);
+      about a local polynomial (:func:`~jointwear.dic.footage._rigid.position_noise`);
     * truncation: the differentiator's model error,
-      :func:`~jointwear.dic._rigid.derivative_truncation` (dominant for fast mechanisms at a
+      :func:`~jointwear.dic.footage._rigid.derivative_truncation` (dominant for fast mechanisms at a
       few tens of frames per second);
     * calibration: the calibration's relative length uncertainty ``length_scale_u_rel`` times
       the speed, on every axis (a scale error of the world frame changes every component in
@@ -277,7 +277,7 @@ def _assemble(states, times, flags, duplicates, L, R, cfg, calibration, status) 
         sig_med = float(np.median(st.sigma_px))
         attrs_extra[f"{name}_match_sigma_px"] = sig_med
         if stereo:
-            from jointwear.dic._stereo import stereo_noise_floor
+            from jointwear.dic.calibration._stereo import stereo_noise_floor
 
             floor = stereo_noise_floor(calibration, np.nanmean(st.ref3d, axis=0), sig_med)
             attrs_extra[f"{name}_noise_floor_z_per_point_m"] = floor

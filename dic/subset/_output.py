@@ -7,10 +7,10 @@ from typing import TYPE_CHECKING
 import numpy as np
 import xarray as xr
 
-import jointwear.dic._flags as _flags
+import jointwear.dic.icgn._flags as _flags
 
 if TYPE_CHECKING:
-    from jointwear.dic._subset_params import CorrelationParams
+    from jointwear.dic.subset._params import CorrelationParams
 
 __all__ = ["result_dataset"]
 
