@@ -22,7 +22,7 @@ def rig_boards():
 
 
 def test_inner_corners_given_as_squares_are_named(rig_boards):
-    from jointwear.dic._calib_board import CalibrationBoard, calibrate_stereo
+    from jointwear.dic.calibration._board import CalibrationBoard, calibrate_stereo
 
     rig, boards = rig_boards
     sx, sy = rig.config.board_squares  # 10 x 8 squares: 9 x 7 inner corners
@@ -34,7 +34,7 @@ def test_inner_corners_given_as_squares_are_named(rig_boards):
 
 
 def test_baseline_is_stored_in_the_calibration_length_unit(rig_boards):
-    from jointwear.dic._calib_board import CalibrationBoard, calibrate_stereo
+    from jointwear.dic.calibration._board import CalibrationBoard, calibrate_stereo
 
     rig, boards = rig_boards
     sx, sy = rig.config.board_squares
@@ -87,7 +87,7 @@ def mono(tmp_path_factory):
 def test_one_camera_track_refuses_a_world_centroid_and_takes_a_pixel_one(mono):
     import dataclasses
 
-    from jointwear.dic._footage import read_bodies, track_footage
+    from jointwear.dic.footage._track import read_bodies, track_footage
 
     tc, bodies = read_bodies(mono["bodies"])
     plain = [dataclasses.replace(b, centroid=None, centroid_mechanism=None) for b in bodies]

@@ -62,7 +62,7 @@ def test_strain_at_the_edges_is_nan_with_a_flag_and_exact_inside(specimen):
 def test_surface_strain_with_an_unmeasured_centre_point_gives_nan_not_an_error():
     """The reference position of the centre point unknown (flagged in the reference image),
     its neighbours known: the fit has no origin; it used to raise LinAlgError."""
-    from jointwear.dic._strain import surface_strain
+    from jointwear.dic.field._strain import surface_strain
 
     ys, xs = np.mgrid[0:7, 0:7]
     ref = np.column_stack([xs.ravel(), ys.ravel()]).astype(float) * 10.0
