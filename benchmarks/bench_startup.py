@@ -109,7 +109,7 @@ def main() -> None:
     figures: dict = {"repeat": repeat, "numba_threads": 2}
     with tempfile.TemporaryDirectory() as tmp:
         work = Path(tmp)
-        small = _images(work, 256, "small")
+        _images(work, 256, "small")
         corr = ["dic", "correlate", "small/reference.png", "small/deformed.png", "--subset", "31"]
         corr += ["--step", "8", "--out", "small/field.nc", "--overwrite"]
         field = ["dic", "field", "small/reference.png", "small/deformed.png", "--subset", "31"]
