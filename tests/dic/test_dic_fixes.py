@@ -221,3 +221,25 @@ def test_field_points(pair, capsys):
     assert "--strain-window" in capsys.readouterr().err
     both = ["dic", "field", *names, "--points", str(pts), "--roi", "0,0,50,50", "--out", out]
     assert main([*both, "--overwrite"]) == 2
+
+
+@pytest.mark.parametrize(
+    "extra, named",
+    [
+        (["--calibration", "cal.nc"], "--calibration"),
+        (["--max-epipolar-px", "3"], "--max-epipolar"),
+    ],
+)
+def test_track_stereo_flags_with_one_camera_are_errors(mono, tmp_path, extra, named, capsys):
+    args = ["dic", "track", "--left", str(mono["left_images"]), "--bodies", str(mono["bodies"])]
+    code = main([*args, *extra, "--fps", "50", "--out", str(tmp_path / "m.nc")])
+    assert code == 2
+    assert named in capsys.readouterr().err
+
+
+def test_calibrate_marker_on_a_chessboard_is_an_error(tmp_path, capsys):
+    args = ["dic", "calibrate", "--left", str(tmp_path), "--right", str(tmp_path)]
+    args += ["--board", "chessboard"]
+    args += ["--square", "25", "--unit", "mm", "--marker", "18", "--out", str(tmp_path / "c.nc")]
+    assert main(args) == 2
+    assert "--marker" in capsys.readouterr().err
