@@ -29,18 +29,18 @@ class FlagReport:
     lines : tuple of str
         One line per image with mostly flagged points (or one for all of them when they
         agree).
-    empty : tuple of int
-        Indices (along ``time``; ``(0,)`` without it) of the images with no valid point.
+    empty : tuple of str
+        The images with no valid point (their names, or indices along ``time``).
     """
 
     lines: tuple[str, ...]
-    empty: tuple[int, ...]
+    empty: tuple[str, ...]
 
     def empty_message(self) -> str | None:
         """The error line for images without a valid point (None when there are none)."""
         if not self.empty:
             return None
-        which = ", ".join(map(str, self.empty[:8])) + (" ..." if len(self.empty) > 8 else "")
+        which = ", ".join(self.empty[:8]) + (" ..." if len(self.empty) > 8 else "")
         return (
             f"no valid point in image(s) {which}: the result holds only flagged points "
             "(the reasons above); --allow-empty writes it with exit code 0"
@@ -126,19 +126,19 @@ def flag_report(ds: xr.Dataset, *, name: str = "flag", names=None) -> FlagReport
     has_time = "time" in flag.dims
     arr = flag.values if has_time else flag.values[None]
     groups: dict[str, list] = {}  # dominant flag -> [labels, worst line]
-    empty: list[int] = []
+    empty: list[str] = []
     for k in range(arr.shape[0]):
         f = np.asarray(arr[k]).ravel()
         bad = f != 0
         if f.size == 0 or bad.mean() <= MOSTLY:
             continue
+        label = repr(str(names[k])) if names is not None else str(k)
         if not (~bad).any():
-            empty.append(k)
+            empty.append(label)
         codes, counts = np.unique(f[bad], return_counts=True)
         top = int(codes[np.argmax(counts)])
         idx = np.flatnonzero(values == top)
         meaning = meanings[int(idx[0])] if idx.size else f"flag {top}"
-        label = repr(str(names[k])) if names is not None else str(k)
         if meaning in groups:
             groups[meaning][0].append(label)
             continue
