@@ -81,7 +81,9 @@ class _ShadowingModule(types.ModuleType):
             isinstance(value, types.ModuleType)
             and not name.startswith("_")
             and value.__name__ == f"{self.__name__}.{name}"
-            and name in getattr(value, "__all__", ())
+            # the module's own __all__ only: a lazy subpackage computes its __all__ on first
+            # use, and binding it must not load it
+            and name in vars(value).get("__all__", ())
         ):
             value = getattr(value, name)
         super().__setattr__(name, value)

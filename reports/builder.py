@@ -21,7 +21,7 @@ import xarray as xr
 
 from jointwear import io
 from jointwear._version import __version__
-from jointwear.compare import Comparison, Criteria, compare
+from jointwear.compare import DEFAULT_AXES, Comparison, Criteria, compare
 from jointwear.errors import BadInputError
 from jointwear.params import to_jsonable
 from jointwear.provenance import command_line, sha256_file, software_versions
@@ -308,6 +308,28 @@ def build_report(
     -------
     Path
         The HTML file.
+
+    Examples
+    --------
+    The self-contained HTML report of a comparison (see :func:`jointwear.compare.compare`):
+
+    >>> from jointwear.sim import BearingGrid, WearSettings, WinklerContact, simulate_wear
+    >>> sim = simulate_wear(
+    ...     contact=WinklerContact(BearingGrid(4, 36), load=20.0, sliding=0.02),
+    ...     cycles=2000,
+    ...     snapshots=[1000, 2000],
+    ...     settings=WearSettings(scheme="fixed", dn=500),
+    ... )
+    >>> meas = sim[["wear_depth"]].isel(cycles=-1, drop=True) * 1.5  # measured 50 % deeper
+    >>> meas["wear_depth"].attrs = sim["wear_depth"].attrs
+    >>> meas.attrs = {"data_origin": "synthetic", "cycles": 2000}
+    >>> from jointwear.compare import compare
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from jointwear.reports import build_report
+    >>> page = build_report(compare(sim, meas), Path(tempfile.mkdtemp()) / "report.html")
+    >>> page.name, "maximum wear depth" in page.read_text(encoding="utf-8")
+    ('report.html', True)
     """
     html = render_html(
         comparison,
@@ -348,7 +370,7 @@ def report_from_files(
     period_s: float | None = None,
     variables: Sequence[str] | None = None,
     ensemble: Sequence[str | Path] = (),
-    axes: Sequence[str] | None = ("x", "y"),
+    axes: Sequence[str] | None = DEFAULT_AXES,
     warn: Callable[[str], None] | None = None,
 ) -> tuple[Path, Comparison]:
     """Build a report from files: simulation, metrology and DIC netCDF, or a saved comparison.

@@ -90,10 +90,16 @@ def _available(module: str, *names: str) -> bool:
 
 def _simulate(folder: Path, size: DemoSize) -> tuple[Path, Path, Any, Path | None, float]:
     from jointwear.params import replace_nested
-    from jointwear.sim import PARAMETER_SETS, WearSettings, run_cycles, simulate_wear
+    from jointwear.sim import (
+        DEFAULT_PARAMETER_SET,
+        PARAMETER_SETS,
+        WearSettings,
+        run_cycles,
+        simulate_wear,
+    )
 
     params = replace_nested(
-        PARAMETER_SETS["zhang2023"],
+        PARAMETER_SETS[DEFAULT_PARAMETER_SET],
         **{"joint.n_layers": size.n_layers, "joint.n_points": size.n_points},
     )
     t0 = time.perf_counter()

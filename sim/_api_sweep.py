@@ -1,8 +1,8 @@
 """Public names of the sweep part of jointwear.sim (ensembles, sensitivity, dask execution)."""
 
-from jointwear.sim._sweep_models import analytic_sobol
-from jointwear.sim._sweep_spec import SweepSpec, make_design, read_spec
-from jointwear.sim.sweep import STATUS, run_sweep, to_grid
+from jointwear.sim.sweep._driver import STATUS, run_sweep, to_grid
+from jointwear.sim.sweep._models import analytic_sobol
+from jointwear.sim.sweep._spec import SweepSpec, make_design, read_spec
 
 __all__ = [
     "run_sweep",

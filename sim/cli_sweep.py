@@ -63,7 +63,7 @@ def register(app: typer.Typer) -> None:
 
         from jointwear.errors import BadInputError, SimulationError
         from jointwear.progress import progress_bar
-        from jointwear.sim.sweep import run_sweep
+        from jointwear.sim.sweep._driver import run_sweep
 
         if scheduler is not None and workers is not None:
             raise BadInputError("give --workers or --scheduler, not both")
@@ -89,7 +89,7 @@ def register(app: typer.Typer) -> None:
                     on_progress=on_progress,
                 )
             except KeyboardInterrupt:
-                from jointwear.sim._sweep_store import parts_dir
+                from jointwear.sim.sweep._store import parts_dir
 
                 n = len(list(parts_dir(out).glob("run-*.npz")))
                 typer.echo(

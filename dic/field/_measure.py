@@ -373,6 +373,20 @@ def measure_field(
         (``camera``); ``zncc`` (lowest of the point's matches), ``flag``; ``strain`` and
         ``strain_engineering`` [1] (``component`` xx, yy, xy) with ``strain_u``; coordinates
         ``x``, ``y`` [pixel] (left reference image) and the grid ``row``/``col``.
+
+    Examples
+    --------
+    2D (one camera): the second image's displacement of every subset, image-plane pixels:
+
+    >>> from jointwear.datasets.speckle import RigidField, speckle_pair
+    >>> pair = speckle_pair((128, 128), RigidField(translation=(1.3, -0.7)))  # exact shift [pixel]
+    >>> from jointwear.dic import measure_field
+    >>> ds = measure_field(
+    ...     [pair.reference, pair.deformed], subset_size=31, step=16, data_origin="synthetic"
+    ... )
+    >>> d = ds["displacement"].isel(time=1).mean("point")
+    >>> print(f"{float(d.sel(axis='x')):.3f}, {float(d.sel(axis='y')):.3f} pixel")
+    1.300, -0.700 pixel
     """
     from jointwear.dic.field._roi import grid_points, read_roi
     from jointwear.dic.field._stereo import stereo_geometry

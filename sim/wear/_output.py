@@ -8,7 +8,7 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from jointwear.sim._wear_control import COVERAGE
+from jointwear.sim.wear._control import COVERAGE
 from jointwear.sim.wearmap import BearingGrid, wear_map_dataset
 
 __all__ = ["build_dataset"]

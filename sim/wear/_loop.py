@@ -26,7 +26,7 @@ local error of an update, relative to its depth increment, is ``eta / 2``. Impac
 dynamics non-periodic, so every rate measurement averages several single cycles and their scatter
 re-estimates the cycle-to-cycle variability on the current profile; the noise part of ``eta`` is
 removed in quadrature, the controller aims at ``max(tol, detection limit)`` and averages more
-cycles when the noise hides changes of ``tol`` (details in :mod:`jointwear.sim._wear_control`).
+cycles when the noise hides changes of ``tol`` (details in :mod:`jointwear.sim.wear._control`).
 The next interval is ``dN * 0.9 tol_eff / eta`` (at most doubled, at least 0.2x); an update whose
 ``eta`` exceeds ``reject_factor * tol_eff`` is rejected and redone with a smaller interval. The
 run always finishes; its accuracy (expanded, k = 2) is reported per point (``wear_depth_u``), for
@@ -57,11 +57,12 @@ import xarray as xr
 from jointwear.errors import BadInputError, ParameterError
 from jointwear.io import check_writable
 from jointwear.params import to_jsonable
-from jointwear.sim import _wear_control as ctl
-from jointwear.sim._wear_checkpoint import read_checkpoint, write_checkpoint
-from jointwear.sim._wear_contact import CycleWear, describe_any
-from jointwear.sim._wear_output import build_dataset
-from jointwear.sim._wear_settings import (
+from jointwear.sim.wear import _control as ctl
+from jointwear.sim.wear._checkpoint import read_checkpoint, write_checkpoint
+from jointwear.sim.wear._contact import CycleWear, describe_any
+from jointwear.sim.wear._output import build_dataset
+from jointwear.sim.wear._settings import (
+    DEFAULT_CYCLES,
     DEFAULT_KW,
     KW_RANGE,
     WearSettings,
@@ -117,7 +118,7 @@ class WearRun:
         :func:`default_snapshots`.
     checkpoint : path, optional
         File written atomically after every accepted update (safe versioned format, see
-        :mod:`jointwear.sim._wear_checkpoint`).
+        :mod:`jointwear.sim.wear._checkpoint`).
     initial_wear : ndarray (Nl, Nd), optional
         Initial wear profile [m] (default unworn).
     on_update : callable, optional
@@ -230,6 +231,36 @@ class WearRun:
         if path is None:
             raise BadInputError("no checkpoint path given")
         return write_checkpoint(path, self.fingerprint(), self._s)
+
+    @classmethod
+    def start(
+        cls,
+        contact: Any,
+        settings: WearSettings | None = None,
+        *,
+        cycles: float,
+        snapshots: Sequence[float] | None = None,
+        checkpoint: str | Path | None = None,
+        resume: bool = False,
+        initial_wear: np.ndarray | None = None,
+        on_update: Callable[[dict[str, Any]], None] | None = None,
+    ) -> WearRun:
+        """A new run, or with ``resume`` the run of ``checkpoint`` continued (:meth:`resume`)."""
+        if not resume:
+            return cls(
+                contact,
+                settings,
+                cycles=cycles,
+                snapshots=snapshots,
+                checkpoint=checkpoint,
+                initial_wear=initial_wear,
+                on_update=on_update,
+            )
+        if checkpoint is None:
+            raise BadInputError("resume=True needs the checkpoint path")
+        return cls.resume(
+            checkpoint, contact, settings, cycles=cycles, snapshots=snapshots, on_update=on_update
+        )
 
     @classmethod
     def resume(
@@ -543,7 +574,7 @@ def halved_schedule(ds: xr.Dataset) -> tuple[int, ...]:
 def simulate_wear(
     params: Any = None,
     *,
-    cycles: float = 1e6,
+    cycles: float = DEFAULT_CYCLES,
     kw: float | None = None,
     settings: WearSettings | None = None,
     contact: Any = None,
@@ -560,7 +591,7 @@ def simulate_wear(
     Parameters
     ----------
     params : SimParameters, optional
-        Mechanism and joint parameters (default ``PARAMETER_SETS["zhang2023"]``); ignored when
+        Mechanism and joint parameters (default ``PARAMETER_SETS[DEFAULT_PARAMETER_SET]``, the reference study); ignored when
         ``contact`` is given.
     cycles : float
         Target number of cycles.
@@ -594,37 +625,51 @@ def simulate_wear(
         ``cylindricity``, ``normal_work``, their expanded uncertainties ``wear_depth_u``,
         ``max_wear_depth_u``, ``worn_volume_u`` (adaptive scheme; NaN = not assessed), and the
         update history ``update_*``.
+
+    Examples
+    --------
+    A prescribed 20 N load sliding 0.02 m per cycle on a Winkler lining (no multibody
+    dynamics, so it runs in a second); the worn volume follows Archard's law, kw F s N:
+
+    >>> from jointwear.sim import BearingGrid, WearSettings, WinklerContact, simulate_wear
+    >>> sim = simulate_wear(
+    ...     contact=WinklerContact(BearingGrid(4, 36), load=20.0, sliding=0.02),
+    ...     cycles=2000,
+    ...     snapshots=[1000, 2000],
+    ...     settings=WearSettings(scheme="fixed", dn=500),
+    ... )
+    >>> from jointwear.sim import DEFAULT_KW
+    >>> print(
+    ...     f"{float(sim['worn_volume'][-1]):.3g} m³, Archard {DEFAULT_KW * 20.0 * 0.02 * 2000:.3g} m³"
+    ... )
+    7.2e-13 m³, Archard 7.2e-13 m³
+    >>> sim["wear_depth"].dims
+    ('cycles', 'z', 'theta')
     """
     settings = settings or WearSettings()
     if kw is not None:
         settings = dataclasses.replace(settings, kw=kw)
     if contact is None:
-        from jointwear.sim._wear_contact import DynamicContact
+        from jointwear.sim.wear._contact import DynamicContact
 
         if params is None:
-            from jointwear.sim import PARAMETER_SETS
+            from jointwear.sim.parameters import DEFAULT_PARAMETER_SET, PARAMETER_SETS
 
-            params = PARAMETER_SETS["zhang2023"]
+            params = PARAMETER_SETS[DEFAULT_PARAMETER_SET]
         params, settings = apply_overrides(params, settings, overrides)
         contact = DynamicContact(params, cycle_function)
     elif overrides:
         _, settings = apply_overrides(None, settings, overrides)
-    if resume:
-        if checkpoint is None:
-            raise BadInputError("resume=True needs the checkpoint path")
-        run = WearRun.resume(
-            checkpoint, contact, settings, cycles=cycles, snapshots=snapshots, on_update=on_update
-        )
-    else:
-        run = WearRun(
-            contact,
-            settings,
-            cycles=cycles,
-            snapshots=snapshots,
-            checkpoint=checkpoint,
-            initial_wear=initial_wear,
-            on_update=on_update,
-        )
+    run = WearRun.start(
+        contact,
+        settings,
+        cycles=cycles,
+        snapshots=snapshots,
+        checkpoint=checkpoint,
+        resume=resume,
+        initial_wear=initial_wear,
+        on_update=on_update,
+    )
     ds = run.run()
     if overrides:
         ds.attrs["parameter_overrides"] = json.dumps(

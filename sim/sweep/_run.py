@@ -55,15 +55,15 @@ def _record_cycles(params: Any, h: np.ndarray | None, settle: float, cycles: flo
 
 def _wear(task: RunTask) -> tuple[dict[str, float], dict[str, np.ndarray]]:
     from jointwear.errors import SimulationError
-    from jointwear.sim._sweep_outputs import (
+    from jointwear.sim.sweep._outputs import (
         MOTION_OUTPUTS,
         force_history,
         motion_outputs,
         wear_outputs,
     )
-    from jointwear.sim._sweep_params import apply_values
-    from jointwear.sim._wear_contact import DynamicContact
-    from jointwear.sim.wear import WearRun
+    from jointwear.sim.sweep._params import apply_values
+    from jointwear.sim.wear._contact import DynamicContact
+    from jointwear.sim.wear._loop import WearRun
 
     spec = task.spec
     params, settings = apply_values(task.sim_params, task.wear_settings, task.values)
@@ -102,8 +102,8 @@ def _wear(task: RunTask) -> tuple[dict[str, float], dict[str, np.ndarray]]:
 
 
 def _cycle(task: RunTask) -> tuple[dict[str, float], dict[str, np.ndarray]]:
-    from jointwear.sim._sweep_outputs import force_history, motion_outputs
-    from jointwear.sim._sweep_params import apply_values
+    from jointwear.sim.sweep._outputs import force_history, motion_outputs
+    from jointwear.sim.sweep._params import apply_values
 
     spec = task.spec
     params, _ = apply_values(task.sim_params, task.wear_settings, task.values)
@@ -115,7 +115,7 @@ def _cycle(task: RunTask) -> tuple[dict[str, float], dict[str, np.ndarray]]:
 
 
 def _function(task: RunTask) -> tuple[dict[str, float], dict[str, np.ndarray]]:
-    from jointwear.sim._sweep_models import evaluate, get_model
+    from jointwear.sim.sweep._models import evaluate, get_model
 
     spec = task.spec
     out = evaluate(

@@ -2,17 +2,27 @@
 
 from __future__ import annotations
 
+import math
+import numbers
 from dataclasses import dataclass
 from typing import Literal
 
-import numpy as np
-
 from jointwear.errors import ParameterError
 
-__all__ = ["DEFAULT_KW", "KW_RANGE", "WearSettings", "check_kw", "default_snapshots"]
+__all__ = [
+    "DEFAULT_KW",
+    "DEFAULT_CYCLES",
+    "KW_RANGE",
+    "WearSettings",
+    "check_kw",
+    "default_snapshots",
+]
 
 #: Default Archard wear coefficient [m²/N = m³/(N m)]; derivation in docs/sim-wear.md.
 DEFAULT_KW: float = 9.0e-16
+
+#: Default target of a wear run [cycles].
+DEFAULT_CYCLES: float = 1e6
 
 #: Accepted range of kw [m²/N]. Above 1e-11 (1e-2 mm³/(N m), beyond severe dry wear) the bore of
 #: the study would wear through in hours; below 1e-20 nothing measurable wears in any lifetime.
@@ -25,7 +35,7 @@ def check_kw(kw: float, *, name: str = "kw") -> float:
         kw = float(kw)
     except (TypeError, ValueError):
         raise ParameterError(f"{name} must be a number [m²/N], got {kw!r}") from None
-    if not np.isfinite(kw) or kw <= 0:
+    if not math.isfinite(kw) or kw <= 0:
         raise ParameterError(
             f"{name} = {kw!r}: the wear coefficient must be a positive number [m²/N = m³/(N m)]"
         )
@@ -56,7 +66,7 @@ def default_snapshots(target: float) -> list[float]:
 def _whole(name: str, v: object) -> int:
     if isinstance(v, float) and v.is_integer():
         v = int(v)
-    if not isinstance(v, (int, np.integer)) or isinstance(v, bool) or v < 1:
+    if not isinstance(v, numbers.Integral) or isinstance(v, bool) or v < 1:
         raise ParameterError(f"wear.{name} must be an integer >= 1 [cycles], got {v!r}")
     return int(v)
 
@@ -141,14 +151,14 @@ class WearSettings:
         if not (0 < self.tol < 1):
             raise ParameterError(f"wear.tol must be in (0, 1), got {self.tol!r}")
         if self.max_increment is not None and not (
-            np.isfinite(self.max_increment) and self.max_increment > 0
+            math.isfinite(self.max_increment) and self.max_increment > 0
         ):
             raise ParameterError(
                 f"wear.max_increment must be a positive depth [m] or None, got {self.max_increment!r}"
             )
         for name in ("settle_cycles", "initial_settle_cycles"):
             v = getattr(self, name)
-            if not (np.isfinite(v) and v >= 0):
+            if not (math.isfinite(v) and v >= 0):
                 raise ParameterError(f"wear.{name} must be >= 0 cycles, got {v!r}")
         if not self.reject_factor > 1:
             raise ParameterError(f"wear.reject_factor must be > 1, got {self.reject_factor!r}")

@@ -1,6 +1,6 @@
 """Executors of sweep runs: in-process, a local dask cluster, or an existing one by address.
 
-Each run is one dask task (:func:`jointwear.sim._sweep_run.evaluate_run`); results are handed
+Each run is one dask task (:func:`jointwear.sim.sweep._run.evaluate_run`); results are handed
 to ``on_result`` in the order they finish, so the caller writes each at once. A run whose
 worker died too often (dask's ``KilledWorker``) or that dask could not deliver is reported to
 ``on_lost`` and stays missing (a later ``--resume`` recomputes it).
@@ -15,7 +15,7 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 from jointwear.errors import BadInputError
-from jointwear.sim._sweep_run import RunResult, RunTask, evaluate_run
+from jointwear.sim.sweep._run import RunResult, RunTask, evaluate_run
 
 __all__ = ["execute", "WORKER_ENV"]
 

@@ -37,8 +37,8 @@ from typing import Any
 import numpy as np
 
 from jointwear.errors import ParameterError
-from jointwear.sim._sweep_outputs import FIELDS, available_outputs
-from jointwear.sim._sweep_params import ParameterSpec, parse_parameter
+from jointwear.sim.sweep._outputs import FIELDS, available_outputs
+from jointwear.sim.sweep._params import ParameterSpec, parse_parameter
 
 __all__ = ["SweepSpec", "Design", "read_spec", "make_design", "METHODS", "RUNS"]
 
@@ -250,7 +250,7 @@ def read_spec(spec: str | Path | Mapping[str, Any]) -> SweepSpec:
     model = None
     function_args: dict[str, Any] = {}
     if run == "function":
-        from jointwear.sim._sweep_models import check_function_args, get_model
+        from jointwear.sim.sweep._models import check_function_args, get_model
 
         if "function" not in sw:
             raise ParameterError('[sweep] run = "function" needs function = "<name>"')

@@ -17,7 +17,7 @@ import numpy as np
 
 from jointwear.errors import BadInputError
 from jointwear.io import atomic_path
-from jointwear.sim._sweep_run import RunResult
+from jointwear.sim.sweep._run import RunResult
 
 __all__ = ["PartStore", "parts_dir"]
 

@@ -255,7 +255,7 @@ class DynamicContact:
     def cycle_function(self) -> Any:
         if self._fn is None:
             try:
-                from jointwear.sim import run_cycles
+                from jointwear.sim.dynamics import run_cycles
             except ImportError:
                 raise SimulationError(
                     "the multibody dynamics (jointwear.sim.run_cycles) are not available in this "
@@ -303,7 +303,7 @@ def contact_from_description(desc: dict[str, Any]) -> Any:
 
     model = desc.get("model")
     if model == "dynamics":
-        from jointwear.sim import SimParameters
+        from jointwear.sim.parameters import SimParameters
 
         return DynamicContact(from_mapping(SimParameters, desc["parameters"], where="parameters"))
     if model in ("winkler", "constant"):

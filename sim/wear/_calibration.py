@@ -23,9 +23,9 @@ import xarray as xr
 
 from jointwear import conventions
 from jointwear.errors import BadInputError
-from jointwear.sim._wear_settings import WearSettings
-from jointwear.sim._wear_settings import check_kw as _check_kw
-from jointwear.sim.wear import simulate_wear
+from jointwear.sim.wear._loop import simulate_wear
+from jointwear.sim.wear._settings import WearSettings
+from jointwear.sim.wear._settings import check_kw as _check_kw
 
 __all__ = [
     "KwCalibration",
@@ -50,7 +50,7 @@ def resimulator(ds: xr.Dataset, parameter: str | None = None) -> Callable[..., x
     """
     from jointwear.io import parse_provenance
     from jointwear.params import from_mapping
-    from jointwear.sim._wear_contact import contact_from_description
+    from jointwear.sim.wear._contact import contact_from_description
 
     params = parse_provenance(ds).get("parameters") or {}
     if "contact" not in params or "wear" not in params:
@@ -79,7 +79,7 @@ def resimulator(ds: xr.Dataset, parameter: str | None = None) -> Callable[..., x
             "which has no simulator parameters to vary"
         )
     from jointwear.params import replace_nested
-    from jointwear.sim._wear_contact import DynamicContact
+    from jointwear.sim.wear._contact import DynamicContact
 
     replace_nested(contact.params, **{parameter: _get(contact.params, parameter)})  # name check
 
@@ -597,3 +597,92 @@ def calibrate_kw_and_parameter(
     s_best = _values(simulate(kw_best, best), meas)
     n_sim[0] += 1
     return _result(kw_best, meas, s_best, beta, n_sim[0], n_free=2, parameter=parameter, value=best)
+
+
+def calibration_report(
+    sim: xr.Dataset,
+    measurements: list[Measurement],
+    *,
+    measured_map: xr.Dataset | None = None,
+    single: bool = False,
+    cycles: float | None = None,
+    vary: tuple[str, tuple[float, float]] | None = None,
+    resimulate: bool = True,
+    rtol: float = 0.02,
+) -> list[str]:
+    """Calibrate kw against measurements and describe the result, line by line.
+
+    What ``jointwear sim calibrate-kw`` does. One measurement (``measured_map``, or the only
+    scalar one with ``single``) goes through :func:`calibrate_kw` (tolerance ``rtol``);
+    several snapshots through :func:`calibrate_kw_multi` and, with ``vary`` (a parameter name
+    and its bounds), also :func:`calibrate_kw_and_parameter`, compared with kw alone.
+
+    Parameters
+    ----------
+    sim : Dataset
+        Simulated wear map (written by :func:`simulate_wear`).
+    measurements : list of Measurement
+        Scalar measurements.
+    measured_map : Dataset, optional
+        A measured wear map instead of ``measurements``.
+    single : bool
+        Calibrate the only measurement at ``cycles`` (default: the last snapshot).
+    cycles : float, optional
+        Cycle count of a single measurement.
+    vary : (str, (float, float)), optional
+        Also fit this simulator parameter within these bounds (SI).
+    resimulate : bool
+        Check the linear estimate by re-simulating.
+    rtol : float
+        Relative tolerance of the re-simulated match.
+
+    Returns
+    -------
+    list of str
+        The lines to print; the last one gives the calibrated kw.
+    """
+    resim = resimulator(sim) if resimulate else None
+    if vary is None and (measured_map is not None or (single and len(measurements) == 1)):
+        if measured_map is not None:
+            quantity, measured, what = "map", measured_map, "measured map"
+        else:
+            m = measurements[0]
+            quantity, measured, what = m.quantity, m.value, m.describe()
+        cal = calibrate_kw(
+            sim, measured, quantity=quantity, cycles=cycles, resimulate=resim, rtol=rtol
+        )
+        lines = [
+            f"data used: {what} (at {cal.cycles:.6g} cycles)",
+            f"kw (linear estimate): {cal.kw_linear:.4g} m²/N",
+        ]
+        if cal.linearity_error is not None:
+            state = "converged" if cal.converged else "NOT converged"
+            lines += [
+                f"re-simulated with it: {100 * cal.linearity_error:+.1f} % off the measurement "
+                "(wear is not exactly linear in kw)",
+                f"kw (calibrated, {state} after {len(cal.iterations) - 1} re-simulations): "
+                f"{cal.kw:.4g} m²/N",
+                "residual of the last re-simulation: "
+                f"{100 * (cal.iterations[-1][1] / cal.measured - 1):+.1f} %",
+            ]
+        return lines
+    if vary is not None and not resimulate:
+        raise BadInputError("--vary needs re-simulation; drop --linear")
+    if vary is not None and len(measurements) < 2:
+        raise BadInputError("--vary needs at least two measured snapshots")
+    one = calibrate_kw_multi(sim, measurements, resimulate=resim, rtol=rtol / 4)
+    lines = ["kw alone:", *(f"  {line}" for line in one.report())]
+    if vary is not None:
+        name, bounds = vary
+        two = calibrate_kw_and_parameter(
+            resimulator(sim, name), measurements, parameter=name, bounds=bounds, kw0=one.kw
+        )
+        better = two.rms_log_misfit < 0.5 * one.rms_log_misfit
+        lines += [
+            f"kw and {name}:",
+            *(f"  {line}" for line in two.report()),
+            f"two parameters {'fit clearly better than' if better else 'do not fit clearly better than'} "
+            f"kw alone (RMS log misfit {100 * two.rms_log_misfit:.1f} % vs "
+            f"{100 * one.rms_log_misfit:.1f} %)",
+        ]
+    return [*lines, f"kw (calibrated): {one.kw:.4g} m²/N"]

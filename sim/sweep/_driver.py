@@ -1,6 +1,6 @@
 """Parameter sweeps, ensembles and sensitivity analysis of the simulator, executed on dask.
 
-:func:`run_sweep` reads a sweep spec (:mod:`jointwear.sim._sweep_spec`, docs/sweeps.md), draws
+:func:`run_sweep` reads a sweep spec (:mod:`jointwear.sim.sweep._spec`, docs/sweeps.md), draws
 the design, runs every member as one dask task (in-process, on a local cluster of worker
 processes, or on an existing cluster by address), writes each finished run at once to
 ``<out>.parts/`` (so an interrupted sweep resumes with only the missing runs), and returns one
@@ -21,9 +21,9 @@ import numpy as np
 import xarray as xr
 
 from jointwear.errors import BadInputError, ParameterError
-from jointwear.sim._sweep_outputs import FIELDS, available_outputs, phase_grid
-from jointwear.sim._sweep_run import RunResult, RunTask
-from jointwear.sim._sweep_spec import (
+from jointwear.sim.sweep._outputs import FIELDS, available_outputs, phase_grid
+from jointwear.sim.sweep._run import RunResult, RunTask
+from jointwear.sim.sweep._spec import (
     Design,
     SweepSpec,
     check_stackable_maps,
@@ -41,18 +41,23 @@ STATUS = {"ok": 0, "failed": 1, "not_run": 2}
 def _base(spec: SweepSpec, params: Any, wear: Any) -> tuple[Any, Any, dict[str, Any], list]:
     """(SimParameters, WearSettings, JSON record, input files) of the base of every run."""
     from jointwear.params import from_mapping, read_toml, to_jsonable
-    from jointwear.sim.wear import WearSettings
+    from jointwear.sim.wear._settings import WearSettings
 
     if spec.run == "function":
         if params is not None:
             raise BadInputError('--params does not apply to run = "function" sweeps')
         return None, None, {}, []
-    from jointwear.sim.parameters import PARAMETER_SETS, SimParameters, load_parameters
+    from jointwear.sim.parameters import (
+        DEFAULT_PARAMETER_SET,
+        PARAMETER_SETS,
+        SimParameters,
+        load_parameters,
+    )
 
     inputs = []
     table: dict[str, Any] = {}
     if params is None:
-        sim = PARAMETER_SETS["zhang2023"]
+        sim = PARAMETER_SETS[DEFAULT_PARAMETER_SET]
     elif isinstance(params, SimParameters):
         sim = params
     else:
@@ -72,7 +77,7 @@ def _base(spec: SweepSpec, params: Any, wear: Any) -> tuple[Any, Any, dict[str, 
 
 def _check_feasible(spec: SweepSpec, sim: Any, wear: Any) -> None:
     """Each swept value at its extremes must be a valid parameter (impossible bounds -> error)."""
-    from jointwear.sim._sweep_params import apply_values, check_simulator_names
+    from jointwear.sim.sweep._params import apply_values, check_simulator_names
 
     check_simulator_names(spec.parameters, sim, wear, run=spec.run)
     for p in spec.parameters:
@@ -95,7 +100,7 @@ def _check_feasible(spec: SweepSpec, sim: Any, wear: Any) -> None:
 
 
 def _param_coord(spec: SweepSpec, p: Any, values: np.ndarray) -> xr.Variable:
-    from jointwear.sim._sweep_params import DERIVED, parameter_units
+    from jointwear.sim.sweep._params import DERIVED, parameter_units
 
     units = "1" if spec.run == "function" else parameter_units(p.name)
     attrs = {"units": units, "long_name": f"swept parameter {p.name}"}
@@ -134,7 +139,7 @@ def assemble(
     sim: Any = None,
 ) -> xr.Dataset:
     """The sweep's Dataset along ``run`` from the runs' results (missing runs: ``not_run``)."""
-    from jointwear.sim._sweep_models import get_model
+    from jointwear.sim.sweep._models import get_model
 
     n = design.n_runs
     model = get_model(spec.function) if spec.run == "function" else None
@@ -421,7 +426,7 @@ def run_sweep(
         once ``out`` is written); without ``out`` nothing is written and nothing can resume.
     params : path or SimParameters, optional
         Base parameters of every run (a ``--params`` TOML, possibly with a ``[wear]`` table);
-        default the ``"zhang2023"`` set.
+        default the :data:`~jointwear.sim.DEFAULT_PARAMETER_SET`.
     wear : WearSettings, optional
         Base wear settings (default: the ``[wear]`` table of ``params``, else the defaults).
     workers : int, optional
@@ -438,8 +443,8 @@ def run_sweep(
     Returns
     -------
     Dataset
-        Along ``run``: parameter values (coordinates), outputs, ``status``
-        (ok/failed/not_run), ``error``; Sobol/Morris indices for those methods.
+        Along ``run``: parameter values (coordinates), outputs, ``status`` (ok/failed/not_run),
+        ``error``; Sobol/Morris indices for those methods.
 
     Raises
     ------
@@ -447,9 +452,17 @@ def run_sweep(
         A bad spec (named entry), impossible bounds, unknown parameter names.
     BadInputError
         Unreachable scheduler, resume of another sweep, unwritable ``out``.
+
+    Examples
+    --------
+    >>> from jointwear.sim import run_sweep  # below: y = x1 + 2 x2 on a grid, in-process
+    >>> sweep = {"run": "function", "function": "linear", "method": "grid"}
+    >>> grid = {"x1": {"values": [0.0, 1.0]}, "x2": {"values": [0.0, 0.5]}}
+    >>> run_sweep({"sweep": sweep, "parameters": grid}, workers=0)["y"].values.tolist()
+    [0.0, 1.0, 1.0, 2.0]
     """
     from jointwear import io
-    from jointwear._version import __version__
+    from jointwear._version import source_attribute
 
     if resume and out is None:
         raise BadInputError("resume needs the sweep's result file (out=/--out)")
@@ -476,7 +489,7 @@ def run_sweep(
     store = None
     results: dict[int, RunResult] = {}
     if out is not None:
-        from jointwear.sim._sweep_store import PartStore
+        from jointwear.sim.sweep._store import PartStore
 
         io.check_writable(out, what="--out")
         store = PartStore(out, digest, record, resume=resume)
@@ -534,7 +547,7 @@ def run_sweep(
                 out,
                 inputs=[*spec_file, *inputs],
                 parameters=record,
-                source=f"jointwear {__version__} (sim.sweep)",
+                source=source_attribute("sim.sweep"),
             )
             finished = not lost
     finally:
@@ -546,7 +559,7 @@ def run_sweep(
 def _already_complete(out: str | Path | None, digest: str) -> bool:
     """True if ``out`` is the finished result of this very sweep (nothing left to resume)."""
     from jointwear import io
-    from jointwear.sim._sweep_store import parts_dir
+    from jointwear.sim.sweep._store import parts_dir
 
     if out is None or not Path(out).exists() or parts_dir(out).exists():
         return False
@@ -559,6 +572,6 @@ def _already_complete(out: str | Path | None, digest: str) -> bool:
 
 def execute_runs(tasks: list[RunTask], **kwargs: Any) -> None:
     """Indirection so that tests can count what an executor is given."""
-    from jointwear.sim._sweep_exec import execute
+    from jointwear.sim.sweep._exec import execute
 
     execute(tasks, **kwargs)
