@@ -2,6 +2,7 @@
 ``jointwear._lazy.stub_text``; do not edit)."""
 
 from jointwear.sim._api_dynamics import CONTACT_MODES as CONTACT_MODES
+from jointwear.sim._api_dynamics import DEFAULT_PARAMETER_SET as DEFAULT_PARAMETER_SET
 from jointwear.sim._api_dynamics import PARAMETER_SETS as PARAMETER_SETS
 from jointwear.sim._api_dynamics import ContactParameters as ContactParameters
 from jointwear.sim._api_dynamics import CycleResult as CycleResult
@@ -65,6 +66,7 @@ __all__ = [
     "FrictionParameters",
     "SolverParameters",
     "PARAMETER_SETS",
+    "DEFAULT_PARAMETER_SET",
     "load_parameters",
     "run_cycles",
     "CycleResult",
