@@ -27,10 +27,16 @@ def test_inner_corners_given_as_squares_are_named(rig_boards):
     rig, boards = rig_boards
     sx, sy = rig.config.board_squares  # 10 x 8 squares: 9 x 7 inner corners
     wrong = CalibrationBoard("chessboard", sx - 1, sy - 1, rig.config.board_square_size)
+    views = boards[:3]  # fewer than the 6 needed: the count is checked on the failed views
     with pytest.raises(CalibrationError, match=rf"--squares {sx} {sy}") as info:
-        calibrate_stereo([b[0] for b in boards], [b[1] for b in boards], wrong)
+        calibrate_stereo([b[0] for b in views], [b[1] for b in views], wrong)
     assert "inner corners" in str(info.value)
     assert "record more views" not in str(info.value)
+    # the right count with too few views: no hint about the squares, the views are the problem
+    right = CalibrationBoard("chessboard", sx, sy, rig.config.board_square_size)
+    with pytest.raises(CalibrationError, match="record more views") as info:
+        calibrate_stereo([b[0] for b in views], [b[1] for b in views], right)
+    assert "--squares" not in str(info.value)
 
 
 def test_baseline_is_stored_in_the_calibration_length_unit(rig_boards):
