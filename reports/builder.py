@@ -311,23 +311,19 @@ def build_report(
 
     Examples
     --------
-    The self-contained HTML report of a comparison (see :func:`jointwear.compare.compare`):
+    The self-contained HTML report of a simulated wear map compared with itself, labelled as
+    synthetic measurement data:
 
-    >>> from jointwear.sim import BearingGrid, WearSettings, WinklerContact, simulate_wear
-    >>> sim = simulate_wear(
-    ...     contact=WinklerContact(BearingGrid(4, 36), load=20.0, sliding=0.02),
-    ...     cycles=2000,
-    ...     snapshots=[1000, 2000],
-    ...     settings=WearSettings(scheme="fixed", dn=500),
-    ... )
-    >>> meas = sim[["wear_depth"]].isel(cycles=-1, drop=True) * 1.5  # measured 50 % deeper
-    >>> meas["wear_depth"].attrs = sim["wear_depth"].attrs
-    >>> meas.attrs = {"data_origin": "synthetic", "cycles": 2000}
-    >>> from jointwear.compare import compare
     >>> import tempfile
     >>> from pathlib import Path
+    >>> from jointwear.compare import compare
     >>> from jointwear.reports import build_report
-    >>> page = build_report(compare(sim, meas), Path(tempfile.mkdtemp()) / "report.html")
+    >>> from jointwear.sim import BearingGrid, WearSettings, WinklerContact, simulate_wear
+    >>> run = {"contact": WinklerContact(BearingGrid(4, 36)), "snapshots": [1000, 2000]}
+    >>> sim = simulate_wear(cycles=2000, settings=WearSettings(scheme="fixed", dn=500), **run)
+    >>> meas = sim.isel(cycles=-1, drop=True)[["wear_depth"]]
+    >>> comparison = compare(sim, meas.assign_attrs(data_origin="synthetic", cycles=2000))
+    >>> page = build_report(comparison, Path(tempfile.mkdtemp()) / "report.html")
     >>> page.name, "maximum wear depth" in page.read_text(encoding="utf-8")
     ('report.html', True)
     """

@@ -486,6 +486,52 @@ def run_sweep(
         ds.attrs.update(runs_computed_now=0, runs_resumed=design.n_runs)
         ds.attrs["executor"] = "none (all runs resumed)"
         return ds
+
+    def build(results: dict[int, RunResult], lost: dict[int, str]) -> xr.Dataset:
+        return sensitivity(assemble(spec, design, results, lost, sim=sim), spec, design)
+
+    return run_and_save(
+        tasks,
+        design.values,
+        build,
+        out=out,
+        digest=digest,
+        record=record,
+        resume=resume,
+        workers=workers,
+        scheduler=scheduler,
+        on_progress=on_progress,
+        inputs=[*spec_file, *inputs],
+        source=source_attribute("sim.sweep"),
+    )
+
+
+def run_and_save(
+    tasks: list[RunTask],
+    values: np.ndarray,
+    build: Callable[[dict[int, RunResult], dict[int, str]], xr.Dataset],
+    *,
+    out: str | Path | None,
+    digest: str,
+    record: dict[str, Any],
+    resume: bool,
+    workers: int | None,
+    scheduler: str | None,
+    on_progress: Callable[[dict[str, Any]], None] | None,
+    inputs: list[Path],
+    source: str,
+) -> xr.Dataset:
+    """Run ``tasks`` through the part store and an executor, build the result and write it.
+
+    Each finished run goes at once to ``<out>.parts/`` (checked against ``digest`` and its row
+    of ``values`` on resume), the runs are executed in the order given, ``build(results, lost)``
+    makes the Dataset, which gets ``sweep_digest``, ``runs_computed_now``, ``runs_resumed`` and
+    ``executor`` and is written atomically to ``out``; the part files are removed once it is
+    written and no run was lost. Shared by :func:`run_sweep` and
+    :func:`jointwear.sim.verify_wear`.
+    """
+    from jointwear import io
+
     store = None
     results: dict[int, RunResult] = {}
     if out is not None:
@@ -497,12 +543,12 @@ def run_sweep(
     finished = False
     try:
         if store is not None:
-            results = store.load(design.values)
+            results = store.load(values)
         todo = [t for t in tasks if t.index not in results]
         state = {
             "done": len(results),
             "failed": sum(r.status == "failed" for r in results.values()),
-            "total": design.n_runs,
+            "total": len(tasks),
             "computed": 0,
             "resumed": len(results),
             "executor": "",
@@ -516,7 +562,7 @@ def run_sweep(
 
         def got(res: RunResult) -> None:
             if store is not None:
-                store.write(res, design.values[res.index])
+                store.write(res, values[res.index])
             results[res.index] = res
             state["done"] += 1
             state["computed"] += 1
@@ -535,20 +581,13 @@ def run_sweep(
             on_lost=gone,
             on_start=started,
         )
-        ds = assemble(spec, design, results, lost, sim=sim)
-        ds = sensitivity(ds, spec, design)
+        ds = build(results, lost)
         ds.attrs["sweep_digest"] = digest
         ds.attrs["runs_computed_now"] = state["computed"]
         ds.attrs["runs_resumed"] = state["resumed"]
         ds.attrs["executor"] = state["executor"] or "none (all runs resumed)"
         if out is not None:
-            io.save(
-                ds,
-                out,
-                inputs=[*spec_file, *inputs],
-                parameters=record,
-                source=source_attribute("sim.sweep"),
-            )
+            io.save(ds, out, inputs=inputs, parameters=record, source=source)
             finished = not lost
     finally:
         if store is not None:
