@@ -25,11 +25,14 @@ from jointwear.sim._api_dynamics import run_cycles as run_cycles
 from jointwear.sim._api_dynamics import wear_depth_on_grid as wear_depth_on_grid
 from jointwear.sim._api_sweep import STATUS as STATUS
 from jointwear.sim._api_sweep import SweepSpec as SweepSpec
+from jointwear.sim._api_sweep import VerifySpec as VerifySpec
 from jointwear.sim._api_sweep import analytic_sobol as analytic_sobol
 from jointwear.sim._api_sweep import make_design as make_design
 from jointwear.sim._api_sweep import read_spec as read_spec
+from jointwear.sim._api_sweep import read_verify_spec as read_verify_spec
 from jointwear.sim._api_sweep import run_sweep as run_sweep
 from jointwear.sim._api_sweep import to_grid as to_grid
+from jointwear.sim._api_sweep import verify_wear as verify_wear
 from jointwear.sim._api_wear import DEFAULT_KW as DEFAULT_KW
 from jointwear.sim._api_wear import KW_RANGE as KW_RANGE
 from jointwear.sim._api_wear import BearingGrid as BearingGrid
@@ -115,4 +118,7 @@ __all__ = [
     "to_grid",
     "analytic_sobol",
     "STATUS",
+    "verify_wear",
+    "VerifySpec",
+    "read_verify_spec",
 ]

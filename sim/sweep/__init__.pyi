@@ -7,6 +7,12 @@ from jointwear.sim.sweep._driver import make_design as make_design
 from jointwear.sim.sweep._driver import read_spec as read_spec
 from jointwear.sim.sweep._driver import run_sweep as run_sweep
 from jointwear.sim.sweep._driver import to_grid as to_grid
+from jointwear.sim.sweep._verify import QUANTITIES as QUANTITIES
+from jointwear.sim.sweep._verify import VerifySpec as VerifySpec
+from jointwear.sim.sweep._verify import band_quantities as band_quantities
+from jointwear.sim.sweep._verify import read_verify_spec as read_verify_spec
+from jointwear.sim.sweep._verify import study_dataset as study_dataset
+from jointwear.sim.sweep._verify import verify_wear as verify_wear
 
 __all__ = [
     "run_sweep",
@@ -15,4 +21,10 @@ __all__ = [
     "make_design",
     "to_grid",
     "STATUS",
+    "VerifySpec",
+    "read_verify_spec",
+    "verify_wear",
+    "study_dataset",
+    "band_quantities",
+    "QUANTITIES",
 ]
