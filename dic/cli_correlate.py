@@ -83,7 +83,12 @@ def register(app: typer.Typer) -> None:
             ),
         ],
         deformed: Annotated[
-            Path | None, typer.Argument(help="Deformed image (omit for a sequence).")
+            Path | None,
+            typer.Argument(
+                help="Deformed image; or a folder / quoted pattern of the later frames of a "
+                "sequence whose reference is REFERENCE (named unlike them); omit for a "
+                "sequence in REFERENCE."
+            ),
         ] = None,
         out: Annotated[Path, typer.Option("--out", help="Output netCDF file.")] = Path("field.nc"),
         overwrite: Overwrite = False,
@@ -141,13 +146,14 @@ def register(app: typer.Typer) -> None:
             ),
         ] = None,
         reference_mode: Annotated[
-            Literal["absolute", "incremental"],
+            Literal["absolute", "incremental"] | None,
             typer.Option(
                 "--sequence-mode",
-                help="Sequences: absolute (every frame against the first) or incremental "
-                "(against the previous one).",
+                help="Sequences: absolute (every frame against the first; default) or "
+                "incremental (the reference moves forward to a later frame when the matches "
+                "against it degrade, or every --update-every frames).",
             ),
-        ] = "absolute",
+        ] = None,
         frame_rate: Annotated[
             float | None,
             typer.Option("--fps", "--frame-rate", help="Sequences: frame rate (1/s)."),
@@ -158,11 +164,19 @@ def register(app: typer.Typer) -> None:
         threads: Annotated[
             int, typer.Option("--threads", min=0, help="numba threads (0: auto).")
         ] = 0,
+        allow_empty: Annotated[
+            bool,
+            typer.Option(
+                "--allow-empty",
+                help="Exit 0 even when an image has no valid point (otherwise exit 1).",
+            ),
+        ] = False,
     ) -> None:
         """Subset DIC (ZNSSD, IC-GN): displacement u, v (pixels) on a grid, written to netCDF."""
         import time as _time
 
         from jointwear._version import __version__
+        from jointwear.dic._flag_report import check_flags
         from jointwear.dic.subset._correlator import CorrelationParams, SubsetCorrelator
         from jointwear.dic.subset._quicklook import save_quicklook
         from jointwear.dic.subset._sequence import correlate_sequence, read_frames, read_image
@@ -188,20 +202,37 @@ def register(app: typer.Typer) -> None:
         if points is not None and roi_vals is not None:
             raise typer.BadParameter("give either --points or --roi, not both")
         pts = read_points_file(points) if points is not None else None
+        from jointwear.dic.footage._video import is_image_sequence
+
+        sequence = deformed is None or (not deformed.is_file() and is_image_sequence(str(deformed)))
+        if not sequence:
+            for given, flag in ((reference_mode, "--sequence-mode"), (frame_rate, "--fps")):
+                if given is not None:
+                    raise typer.BadParameter(
+                        f"{flag} applies to a sequence (a folder, pattern or video), not to "
+                        "a pair of images"
+                    )
         if reference_mode != "incremental" and (update_every is not None or update_zncc != 0.9):
             raise typer.BadParameter(
-                "--update-zncc/--update-every apply to --reference incremental only"
+                "--update-zncc/--update-every apply to --sequence-mode incremental only"
             )
         t0 = _time.perf_counter()
-        if deformed is None:
-            from jointwear.dic.footage._video import is_image_sequence
+        if sequence:
+            if deformed is not None:  # a reference named unlike the frames, then the frames
+                from jointwear.dic.footage._video import list_image_sequence
 
-            if not reference.exists() and not is_image_sequence(reference):
-                raise BadInputError(f"'{reference}' does not exist")
-            frames, fps = read_frames(reference)
+                if not reference.is_file():
+                    raise BadInputError(f"reference image '{reference}' does not exist")
+                files = list_image_sequence(str(deformed), what="frames")[0]
+                frames = [read_image(reference)] + [read_image(f) for f in files]
+                fps = None
+            else:
+                if not reference.exists() and not is_image_sequence(reference):
+                    raise BadInputError(f"'{reference}' does not exist")
+                frames, fps = read_frames(reference)
             ds = correlate_sequence(
                 (frames, fps),
-                reference=reference_mode,
+                reference=reference_mode or "absolute",
                 roi=roi_vals,
                 points=pts,
                 frame_rate=frame_rate,
@@ -212,6 +243,8 @@ def register(app: typer.Typer) -> None:
                 params=params,
             )
             inputs = [reference] if reference.is_file() else []
+            if deformed is not None:
+                inputs += files
         else:
             ref_img = read_image(reference)
             def_img = read_image(deformed)
@@ -238,4 +271,14 @@ def register(app: typer.Typer) -> None:
         if plot is not None:
             save_quicklook(ds, plot, title=reference.name)
             msg += f"; figure {plot}"
+        if reference_mode == "incremental":
+            moves = int(ds.attrs.get("dic_reference_updates", 0))
+            msg += (
+                f"; reference moved {moves} time(s)"
+                if moves
+                else "; the reference never moved (every frame matched frame 0 with a median "
+                f"ZNCC above --update-zncc {update_zncc}: the result is the absolute one; "
+                "--update-every N moves it every N frames)"
+            )
         typer.echo(msg)
+        check_flags(ds, allow_empty=allow_empty)

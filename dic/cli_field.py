@@ -13,20 +13,28 @@ from jointwear.errors import BadInputError
 
 
 def _images(values: list[str] | None, what: str):
-    """One folder/pattern, or several image files (first = reference)."""
+    """One folder/pattern, several image files, or a reference file followed by a folder or
+    pattern of the later images (the first image is the reference)."""
     if not values:
         return None
-    if len(values) == 1:
-        from jointwear.dic.footage._video import is_image_sequence
+    from jointwear.dic.footage._video import is_image_sequence, list_image_sequence
 
-        if is_image_sequence(values[0]):
-            return values[0]
-        if not Path(values[0]).is_file():
-            raise BadInputError(f"{what} '{values[0]}' does not exist")
-    for v in values:
-        if not Path(v).is_file():
+    if len(values) == 1 and is_image_sequence(values[0]):
+        return values[0]
+    out: list[Path] = []
+    for k, v in enumerate(values):
+        if Path(v).is_file():
+            out.append(Path(v))
+        elif k > 0 and is_image_sequence(v):
+            out += list_image_sequence(v, what=f"{what} images")[0]
+        elif is_image_sequence(v):
+            raise BadInputError(
+                f"{what}: '{v}' is a folder or pattern of images, which can only follow the "
+                "reference image (or stand alone)"
+            )
+        else:
             raise BadInputError(f"{what} image '{v}' does not exist")
-    return [Path(v) for v in values]
+    return out
 
 
 def _inputs(values: list[str] | None) -> list[Path]:
@@ -74,12 +82,26 @@ def register(app: typer.Typer) -> None:
         subset: Annotated[int, typer.Option("--subset", help="Subset size (pixels), odd.")] = 31,
         step: Annotated[int, typer.Option("--step", help="Grid step (pixels).")] = 10,
         strain_window: Annotated[
-            int,
-            typer.Option("--strain-window", help="Strain fit window (grid points, odd; 0: none)."),
-        ] = 5,
+            int | None,
+            typer.Option(
+                "--strain-window",
+                help="Strain fit window (grid points, odd; 0: none). Default 5 (0 with --points).",
+            ),
+        ] = None,
+        points: Annotated[
+            Path | None,
+            typer.Option(
+                "--points",
+                help="Text file of subset centres 'x, y' (pixels, left reference image, one "
+                "per line) instead of a grid over --roi; no strain.",
+            ),
+        ] = None,
         frame: Annotated[
-            str, typer.Option("--frame", help="Stereo output frame: world or plane (best fit).")
-        ] = "world",
+            str | None,
+            typer.Option(
+                "--frame", help="Stereo output frame: world or plane (best fit). Default world."
+            ),
+        ] = None,
         fps: Annotated[
             float | None,
             typer.Option("--fps", help="Frames per second (omit for still images)."),
@@ -88,9 +110,13 @@ def register(app: typer.Typer) -> None:
             float, typer.Option("--zncc-min", help="Flag matches below this ZNCC.")
         ] = 0.8,
         epipolar_max: Annotated[
-            float,
-            typer.Option("--epipolar-max", help="Flag pairs whose rays miss by more (pixels)."),
-        ] = 1.0,
+            float | None,
+            typer.Option(
+                "--epipolar-max",
+                help="Stereo: flag pairs whose rays miss by more (pixels, RMS reprojection). "
+                "Default 1.",
+            ),
+        ] = None,
         search_radius: Annotated[
             int, typer.Option("--search-radius", help="Seed search half-width (pixels).")
         ] = 48,
@@ -106,6 +132,13 @@ def register(app: typer.Typer) -> None:
             Path | None, typer.Option("--plot", help="Contour figure of the last image (png).")
         ] = None,
         threads: Annotated[int, typer.Option("--threads", help="numba threads (0: auto).")] = 0,
+        allow_empty: Annotated[
+            bool,
+            typer.Option(
+                "--allow-empty",
+                help="Exit 0 even when an image has no valid point (otherwise exit 1).",
+            ),
+        ] = False,
         overwrite: Overwrite = False,
     ) -> None:
         """Displacement, shape and strain of a surface over a ROI (2D, or stereo with
@@ -113,6 +146,7 @@ def register(app: typer.Typer) -> None:
         import time as _time
 
         from jointwear._version import __version__
+        from jointwear.dic._flag_report import check_flags
         from jointwear.dic.field._io import save_field_plot, write_field_csv
         from jointwear.dic.field._measure import FieldParams, measure_field
         from jointwear.io import check_writable, save
@@ -128,6 +162,20 @@ def register(app: typer.Typer) -> None:
             raise typer.BadParameter("stereo needs --calibration")
         if not stereo and calibration is not None:
             raise typer.BadParameter("--calibration needs --left/--right images (stereo)")
+        if not stereo:
+            for given, flag in ((frame, "--frame"), (epipolar_max, "--epipolar-max")):
+                if given is not None:
+                    raise typer.BadParameter(
+                        f"{flag} applies to a stereo field (--left/--right/--calibration); "
+                        "a 2D field is in image pixels"
+                    )
+        if points is not None and roi is not None:
+            raise typer.BadParameter("give either --points or --roi, not both")
+        if points is not None and strain_window:
+            raise typer.BadParameter(
+                "--strain-window: scattered --points have no grid to fit strain over; drop "
+                "--strain-window, or use --roi for a grid with strain"
+            )
         check_writable(out)
         for p, what in ((plot, "figure"), (csv, "CSV")):
             if p is not None:
@@ -136,13 +184,20 @@ def register(app: typer.Typer) -> None:
         params = FieldParams(
             subset_size=subset,
             step=step,
-            strain_window=strain_window,
-            frame=frame,  # type: ignore[arg-type]
+            strain_window=(0 if points is not None else 5)
+            if strain_window is None
+            else strain_window,
+            frame=frame or "world",  # type: ignore[arg-type]
             zncc_min=zncc_min,
-            epipolar_max_px=epipolar_max,
+            epipolar_max_px=1.0 if epipolar_max is None else epipolar_max,
             search_radius=search_radius,
             threads=threads,
         )
+        pts = None
+        if points is not None:
+            from jointwear.dic.cli_correlate import read_points_file
+
+            pts = read_points_file(points)
         t0 = _time.perf_counter()
         if stereo:
             from jointwear.dic.calibration._importers import read_calibration
@@ -153,6 +208,7 @@ def register(app: typer.Typer) -> None:
                 _images(right, "--right"),
                 calibration=cal,
                 roi=roi_spec,
+                points=pts,
                 frame_rate=fps,
                 data_origin=origin,
                 params=params,
@@ -162,13 +218,15 @@ def register(app: typer.Typer) -> None:
             ds = measure_field(
                 _images(images, "IMAGES"),
                 roi=roi_spec,
+                points=pts,
                 frame_rate=fps,
                 data_origin=origin,
                 params=params,
             )
             inputs = _inputs(images)
-        if roi is not None and Path(roi).is_file():
-            inputs.append(Path(roi))
+        for extra in (roi, points):
+            if extra is not None and Path(extra).is_file():
+                inputs.append(Path(extra))
         elapsed = _time.perf_counter() - t0
         save(
             ds,
@@ -186,6 +244,7 @@ def register(app: typer.Typer) -> None:
             save_field_plot(ds, plot)
             msg += f"; figure {plot}"
         typer.echo(msg)
+        check_flags(ds, allow_empty=allow_empty, names=list(ds.image_left.values))
 
 
 def register_import(app: typer.Typer) -> None:

@@ -128,6 +128,12 @@ def register(app: typer.Typer) -> None:
                 f"{unit!r}: expected one of {', '.join(_LENGTH_UNITS)} or square",
                 param_hint="--unit",
             )
+        if board == "chessboard":
+            for given, flag in ((marker, "--marker"), (marker_mm, "--marker-mm")):
+                if given is not None:
+                    raise typer.BadParameter(
+                        f"{flag} applies to a ChArUco board (--board charuco), not a chessboard"
+                    )
         io.check_writable(out)
         b = CalibrationBoard(
             board,
@@ -253,6 +259,11 @@ def register(app: typer.Typer) -> None:
                 )
             cal = read_opencv_calibration(inputs, length_unit=length_unit, image_size=image_size)
         elif fmt == "vic3d":
+            if length_unit is not None:
+                raise typer.BadParameter(
+                    "--length-unit applies to OpenCV files; a VIC-3D calibration states its "
+                    "own unit (millimetres)"
+                )
             if len(inputs) != 1:
                 raise BadInputError(
                     f"--format vic3d takes one file (cal.xml, project XML or .z3d), got "
@@ -340,6 +351,16 @@ def register(app: typer.Typer) -> None:
         from jointwear.dic.calibration._importers import read_calibration
         from jointwear.dic.footage._track import read_bodies, track_footage
 
+        if right is None:
+            for given, flag in (
+                (calibration, "--calibration"),
+                (max_epipolar_px, "--max-epipolar-px"),
+            ):
+                if given is not None:
+                    raise typer.BadParameter(
+                        f"{flag} applies to two cameras (--right); one camera tracks in pixels "
+                        "of the left image"
+                    )
         io.check_writable(out)
         cfg, specs = read_bodies(bodies)
         overrides = {

@@ -35,6 +35,7 @@ __all__ = [
     "Overwrite",
     "OUTPUT_PARAMS",
     "speak_flags",
+    "lazy_groups",
 ]
 
 Overwrite = Annotated[
@@ -327,3 +328,66 @@ def discover_commands(app: typer.Typer, package: str) -> None:
     for name in names:
         module = importlib.import_module(f"{package}.{name}")
         module.register(app)
+
+
+# --- lazy groups: import a command group only when it is used ---------------------------------
+class _LazyCommands(dict):
+    """A group's ``commands``: entries that are ``_Pending`` are built on first access.
+
+    Names (``keys``, ``in``, order) need no import; ``get``/``[]`` build one group,
+    ``items``/``values`` (the help listing) build all.
+    """
+
+    def _build(self, name: str) -> Any:
+        value = dict.get(self, name)
+        if isinstance(value, _Pending):
+            value = value.build(name)
+            dict.__setitem__(self, name, value)
+        return value
+
+    def __getitem__(self, name: str) -> Any:
+        if not dict.__contains__(self, name):
+            raise KeyError(name)
+        return self._build(name)
+
+    def get(self, name: str, default: Any = None) -> Any:
+        return self._build(name) if dict.__contains__(self, name) else default
+
+    def values(self) -> Any:
+        return [self._build(name) for name in list(self)]
+
+    def items(self) -> Any:
+        return [(name, self._build(name)) for name in list(self)]
+
+
+class _Pending:
+    """A command group not imported yet: ``module`` defines the ``typer.Typer`` named ``app``."""
+
+    def __init__(self, module: str) -> None:
+        self.module = module
+
+    def build(self, name: str) -> Any:
+        sub = importlib.import_module(self.module).app
+        sub.info.cls = CommandGroup
+        apply_classes(sub)
+        group = typer.main.get_group(sub)
+        group.name = name
+        return group
+
+
+def lazy_groups(groups: dict[str, str]) -> type:
+    """A root group class whose sub-command groups ``{name: module}`` are imported when used.
+
+    ``jointwear dic correlate`` then imports and builds only the ``dic`` group; ``--help``
+    (which lists every group's help line) builds them all.
+    """
+
+    class LazyGroups(CommandGroup):
+        def __init__(self, *args: Any, **kwargs: Any) -> None:
+            super().__init__(*args, **kwargs)
+            commands = _LazyCommands(self.commands)
+            for name, module in groups.items():
+                commands.setdefault(name, _Pending(module))
+            self.commands = commands
+
+    return LazyGroups

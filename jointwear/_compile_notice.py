@@ -9,12 +9,12 @@ start fast): it waits until something else imports numba and then listens to num
 
 from __future__ import annotations
 
-import importlib.abc
-import importlib.machinery
 import sys
 import time
 from collections.abc import Callable
 from typing import Any, TextIO
+
+from jointwear._lazy import after_import
 
 __all__ = ["announce_compilation", "NOTICE"]
 
@@ -76,31 +76,6 @@ def _install(stream: TextIO | None) -> _Listener:
     return listener
 
 
-class _AfterNumbaImport(importlib.abc.MetaPathFinder):
-    """Runs a callback right after ``numba`` itself has been imported, then removes itself."""
-
-    def __init__(self, callback: Callable[[], None]) -> None:
-        self.callback = callback
-
-    def find_spec(self, name: str, path: Any, target: Any = None) -> Any:
-        if name != "numba":
-            return None
-        sys.meta_path.remove(self)
-        spec = importlib.machinery.PathFinder.find_spec(name, path)
-        if spec is None or spec.loader is None:
-            return spec
-        loader = spec.loader
-        exec_module = loader.exec_module
-        callback = self.callback
-
-        def exec_then_notify(module: Any) -> None:
-            exec_module(module)
-            callback()
-
-        loader.exec_module = exec_then_notify  # type: ignore[method-assign]
-        return spec
-
-
 _STATE: dict[str, Any] = {}
 
 
@@ -129,9 +104,6 @@ def announce_compilation(stream: TextIO | None = None) -> Callable[[], str | Non
         listener.active = False
         return listener.summary()
 
-    if "numba" in sys.modules:
-        start()
-    else:
-        sys.meta_path.insert(0, _AfterNumbaImport(start))
+    after_import("numba", start)
     _STATE["summary"] = summary
     return summary

@@ -17,7 +17,7 @@ from typing import Annotated
 
 import typer
 
-from jointwear._cli import CommandGroup, Overwrite, apply_classes
+from jointwear._cli import CommandGroup, Overwrite, apply_classes, lazy_groups
 from jointwear._compile_notice import announce_compilation
 from jointwear._version import __version__
 from jointwear.errors import EXIT_BAD_INPUT, EXIT_USAGE, JointwearError
@@ -56,22 +56,20 @@ def _root(
     _STATE["debug"] = debug
 
 
-def _register_groups() -> None:
-    from jointwear.cli_import import app as import_app
-    from jointwear.compare.cli import app as compare_app
-    from jointwear.datasets.cli import app as datasets_app
-    from jointwear.dic.cli import app as dic_app
-    from jointwear.metrology.cli import app as metrology_app
-    from jointwear.reports.cli import app as report_app
-    from jointwear.sim.cli import app as sim_app
+#: command groups, imported only when used (``jointwear dic ...`` imports ``dic`` alone)
+GROUPS = {
+    "sim": "jointwear.sim.cli",
+    "dic": "jointwear.dic.cli",
+    "metrology": "jointwear.metrology.cli",
+    "compare": "jointwear.compare.cli",
+    "report": "jointwear.reports.cli",
+    "datasets": "jointwear.datasets.cli",
+    "import": "jointwear.cli_import",
+}
 
-    app.add_typer(sim_app, name="sim")
-    app.add_typer(dic_app, name="dic")
-    app.add_typer(metrology_app, name="metrology")
-    app.add_typer(compare_app, name="compare")
-    app.add_typer(report_app, name="report")
-    app.add_typer(datasets_app, name="datasets")
-    app.add_typer(import_app, name="import")
+
+def _register_groups() -> None:
+    app.info.cls = lazy_groups(GROUPS)
 
 
 @app.command()

@@ -147,6 +147,23 @@ def detect_board(image: np.ndarray, board: CalibrationBoard, *, with_detector: b
     return None
 
 
+def _check_square_count(board: CalibrationBoard, missed: list[np.ndarray]) -> None:
+    """Too few views found the chessboard: if the images show a board with one more square each
+    way, the count given was the inner corners' (``--squares 9 6`` for a 10 x 7 board): say so."""
+    if board.kind != "chessboard" or not missed:
+        return
+    bigger = (board.squares_x + 1, board.squares_y + 1)
+    pattern = (bigger[0] - 1, bigger[1] - 1)
+    if any(_find_chessboard(img, pattern) is not None for img in missed):
+        raise CalibrationError(
+            f"the board was not found as {board.squares_x} x {board.squares_y} squares "
+            f"({board.squares_x - 1} x {board.squares_y - 1} inner corners), but these images "
+            f"show one of {bigger[0]} x {bigger[1]} squares ({board.squares_x} x "
+            f"{board.squares_y} inner corners): --squares counts squares, not inner corners; "
+            f"give --squares {bigger[0]} {bigger[1]}"
+        )
+
+
 def _find_chessboard(img: np.ndarray, pattern: tuple[int, int]):
     """Inner corners (N, 2) [pixel] and the detector that found them, or None.
 
@@ -346,6 +363,7 @@ def calibrate_stereo(
     obj_all = board.object_points() if board.kind == "chessboard" else _charuco_obj(board)
     views = []  # (index, obj, left_pts, right_pts)
     reasons: list[str] = []
+    missed: list[np.ndarray] = []  # a few images where the board was not found
     size = None
     for i, (li, ri) in enumerate(zip(left_images, right_images, strict=True)):
         L = _read_gray(li, "left calibration")
@@ -365,6 +383,8 @@ def calibrate_stereo(
                 "both cameras" if fl is None and fr is None else ("left" if fl is None else "right")
             )
             reasons.append(f"{names[i]}: board not found ({which}) by either detector")
+            if len(missed) < 3:
+                missed.append(L if fl is None else Rimg)
             continue
         common = np.intersect1d(fl[0], fr[0])
         if len(common) < 6:
@@ -373,6 +393,8 @@ def calibrate_stereo(
         li_idx = np.searchsorted(fl[0], common)
         ri_idx = np.searchsorted(fr[0], common)
         views.append((i, obj_all[common], fl[1][li_idx], fr[1][ri_idx]))
+    if len(views) < min_views:
+        _check_square_count(board, missed)
     _check_enough_views(len(views), n_total, min_views, reasons)
 
     flags = cv2.CALIB_FIX_K3 if fix_k3 else 0

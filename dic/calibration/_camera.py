@@ -332,7 +332,8 @@ class StereoCalibration:
         ds.attrs.update(
             {
                 "title": "jointwear stereo calibration",
-                "baseline_m": self.baseline,
+                # named by its unit: metres, or board squares (--unit square)
+                f"baseline_{self.length_unit}": self.baseline,
                 "reprojection_rms_px": float(self.rms) if self.rms is not None else -1.0,
                 "views_used": int(self.views_used),
                 "views_rejected": int(self.views_rejected),

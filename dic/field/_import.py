@@ -173,6 +173,13 @@ def read_field(
     if not stereo and not all(c in first for c in disp2_c):
         want = ", ".join(disp_c + disp2_c)
         raise BadInputError(f"{format} file '{paths[0]}' has neither of the columns {want}")
+    if not stereo and length_unit is not None:
+        raise BadInputError(
+            f"{format} file '{paths[0]}' is a 2D solution ({', '.join(disp2_c)}, no "
+            f"{', '.join(pos_c)}): its coordinates and displacements are in pixels, which "
+            f"length_unit={length_unit!r} cannot convert (no pixel size is known); drop the "
+            "length unit (the field is kept in pixel)"
+        )
     scale = _scale(length_unit) if stereo else 1.0
     x, y = first[cx], first[cy]
     n = len(x)

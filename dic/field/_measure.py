@@ -220,18 +220,21 @@ def left_right_deviation(corr_params, right_img, left_img, centres, rx, ry, subs
     return dev, sig
 
 
-def _match_images(corr, L, Rr, calibration, centres):
+def _match_images(corr, L, Rr, calibration, centres, epipolar_max_px=1.0):
     """Match the left reference subsets in every left image and (stereo) every right image.
 
     Returns shape parameters ``PL``, ``PR`` (T, N, 12), their (u, v) uncertainties ``SL``,
-    ``SR`` (T, N, 2) [pixel] (NaN where the match failed), ZNCC ``Z`` and flags ``F``
-    (T, cameras, N).
+    ``SR`` (T, N, 2) [pixel] (NaN where the match failed), ZNCC ``Z``, flags ``F``
+    (T, cameras, N) and (stereo) the reference pair's fit to the calibration
+    (:func:`~jointwear.dic.field._stereo.check_calibration_fits`: refused before the later
+    images are matched when it does not fit).
     """
-    from jointwear.dic.field._stereo import plane_guess
+    from jointwear.dic.field._stereo import check_calibration_fits, plane_guess
 
     stereo = len(Rr) > 0
     n_t, n = len(L), corr.n_points
     cams = 2 if stereo else 1
+    fit: dict = {}
     PL = np.full((n_t, n, 12), np.nan)
     PR = np.full((n_t, n, 12), np.nan)
     SL = np.full((n_t, n, 2), np.nan)
@@ -252,6 +255,10 @@ def _match_images(corr, L, Rr, calibration, centres):
                 G = plane_guess(calibration, centres)
                 centre = (float(np.median(G[:, 0])), float(np.median(G[:, 3])))
                 res = _track(corr, Rr[0], G, centre)
+                fit = check_calibration_fits(
+                    calibration, centres, centres + res.params[:, [0, 6]],
+                    (F[0, 0] == _flags.FLAG_OK) & res.ok, epipolar_max_px,
+                )  # fmt: skip
             else:
                 g = np.where(np.isfinite(PR[k - 1]).all(axis=1)[:, None], PR[k - 1], np.nan)
                 centre = (
@@ -266,7 +273,7 @@ def _match_images(corr, L, Rr, calibration, centres):
     if stereo:
         PR[~ok_img[:, 1]] = np.nan
         SR[~ok_img[:, 1]] = np.nan
-    return PL, PR, SL, SR, Z, F
+    return PL, PR, SL, SR, Z, F, fit
 
 
 def _relative_sigma(L, Rr, PL, PR, centres, cp, kappa):
@@ -295,12 +302,36 @@ def _relative_sigma(L, Rr, PL, PR, centres, cp, kappa):
     return DL * kappa[None, :, None], DR * kappa[None, :, None]
 
 
+def _point_grid(points, roi, prm: FieldParams):
+    """The given subset centres as a :class:`RoiGrid` (no grid index: no strain)."""
+    from jointwear.dic.field._roi import RoiGrid
+
+    if roi is not None:
+        raise ParameterError("give either points= or roi=, not both (points are the subsets)")
+    if prm.strain_window:
+        raise ParameterError(
+            f"strain_window={prm.strain_window}: scattered points= have no grid to fit strain "
+            "over; give strain_window=0, or a roi= grid for strain"
+        )
+    pts = np.asarray(points, float)
+    if pts.ndim != 2 or pts.shape[1] != 2 or len(pts) == 0 or not np.isfinite(pts).all():
+        raise BadInputError(
+            f"points: expected an (N, 2) array of finite x, y [pixel], got {pts.shape}"
+        )
+    n = len(pts)
+    return (
+        RoiGrid(pts, np.full((n, 2), -1, np.int64), np.ones(n, bool), f"{n} points given"),
+        f"{n} points given",
+    )
+
+
 def measure_field(
     left,
     right=None,
     *,
     calibration=None,
     roi=None,
+    points=None,
     times=None,
     frame_rate: float | None = None,
     data_origin: str = "measured",
@@ -321,6 +352,10 @@ def measure_field(
     roi : optional
         Rectangle ``(x0, y0, x1, y1)`` [pixel], polygon TOML, mask image or array (see
         :func:`jointwear.dic.field._roi.read_roi`); default the whole image.
+    points : array (N, 2), optional
+        Subset centres ``(x, y)`` [pixel, left reference image] instead of a grid over
+        ``roi`` (not both). Scattered points have no strain window: with points,
+        ``strain_window`` must be 0.
     times : sequence of float, optional
         Time of every image [s]; or ``frame_rate`` [1/s]. Without either (still images), the
         ``time`` dimension has no time coordinate, only the image index.
@@ -415,13 +450,18 @@ def measure_field(
             raise ParameterError(f"frame_rate={frame_rate!r}: expected > 0 frames per second")
         t = np.arange(n_t) / float(frame_rate)
 
-    mask, roi_text = read_roi(roi, L[0].shape)
     cp = prm.correlation()
-    grid = grid_points(mask, cp.subset_size, cp.step, cp.border)
+    if points is not None:
+        grid, roi_text = _point_grid(points, roi, prm)
+    else:
+        mask, roi_text = read_roi(roi, L[0].shape)
+        grid = grid_points(mask, cp.subset_size, cp.step, cp.border)
     corr = SubsetCorrelator(L[0], points=grid.centres, params=cp)
     n = corr.n_points
     cams = ["left", "right"] if stereo else ["left"]
-    PL, PR, SL, SR, Z, F = _match_images(corr, L, Rr, calibration, grid.centres)
+    PL, PR, SL, SR, Z, F, fit = _match_images(
+        corr, L, Rr, calibration, grid.centres, prm.epipolar_max_px
+    )
     DL, DR = _relative_sigma(L, Rr, PL, PR, grid.centres, cp, corr._sigma_scale())
     c = grid.centres
     sub_x = np.stack([c[:, 0] + PL[..., 0]] + ([c[:, 0] + PR[..., 0]] if stereo else []), axis=1)
@@ -462,14 +502,15 @@ def measure_field(
             c[:, 1],
             {"units": "pixel", "long_name": "subset centre row, left reference image"},
         ),
-        "row": ("point", grid.index[:, 0], {"long_name": "grid row of the point"}),
-        "col": ("point", grid.index[:, 1], {"long_name": "grid column of the point"}),
         "camera": ("camera", cams, {"long_name": "camera"}),
         "image": ("time", np.arange(n_t), {"long_name": "image index (0 = reference)"}),
         "image_left": ("time", lnames, {"long_name": "left (or only) camera image"}),
     }
     if stereo:
         coords["image_right"] = ("time", rnames, {"long_name": "right camera image"})
+    if points is None:
+        coords["row"] = ("point", grid.index[:, 0], {"long_name": "grid row of the point"})
+        coords["col"] = ("point", grid.index[:, 1], {"long_name": "grid column of the point"})
     if t is not None:
         coords["time"] = ("time", t, {"units": "s", "long_name": "time of the image"})
     data: dict[str, xr.DataArray] = {}
@@ -565,7 +606,8 @@ def measure_field(
             "data_origin": data_origin,
             "dic_roi": roi_text,
             "dic_subset_size_pixel": int(cp.subset_size),
-            "dic_step_pixel": int(cp.step),
+            "dic_step_pixel": int(cp.step) if points is None else "points given",
+            "dic_zncc_min": float(cp.zncc_min),
             "dic_shape_function": "affine",
             "dic_interpolation": f"{cp.interpolation} B-spline (prefiltered)",
             "dic_criterion": "ZNSSD (IC-GN), image gradients by central differences",
@@ -578,4 +620,5 @@ def measure_field(
     if stereo:
         ds.attrs["calibration_source"] = calibration.source
         ds.attrs["dic_epipolar_max_pixel"] = float(prm.epipolar_max_px)
+        ds.attrs.update(fit)
     return ds

@@ -75,6 +75,44 @@ def _point_cov(calibration, X, sl, sr):
     return out
 
 
+#: a calibration whose reference pair misses by more than this many times the epipolar gate
+#: (median RMS reprojection residual) is refused before the sequence is matched
+MISFIT_FACTOR = 2.0
+
+
+def check_calibration_fits(calibration, uv_left, uv_right, ok, epipolar_max_px) -> dict:
+    """Measure how well the calibration fits the reference pair's matches, once, up front.
+
+    ``uv_left``, ``uv_right`` (N, 2) [pixel] the matched subset centres, ``ok`` the points
+    matched in both images. Returns the medians as dataset attributes
+    (``dic_median_epipolar_error_pixel``: distance of the right match from the left point's
+    epipolar line; ``dic_median_reprojection_pixel``: RMS reprojection residual of the
+    triangulated pair, what ``epipolar_max_px`` gates). Raises :class:`BadInputError` when
+    the median reprojection residual exceeds ``MISFIT_FACTOR`` times the gate: most points
+    would be flagged ``epipolar_mismatch`` and the positions of the rest carry the misfit.
+    """
+    from jointwear.dic.calibration._stereo import epipolar_distance, triangulate
+
+    if not ok.any():
+        return {}
+    epi = epipolar_distance(calibration, uv_left[ok], uv_right[ok])
+    _, _, rep = triangulate(calibration, uv_left[ok], uv_right[ok])
+    med_epi, med_rep = float(np.nanmedian(np.abs(epi))), float(np.nanmedian(rep))
+    if med_rep > MISFIT_FACTOR * epipolar_max_px:
+        share = float(np.mean(rep > epipolar_max_px))
+        raise BadInputError(
+            f"the calibration ({calibration.source}) does not fit these images: over the "
+            f"{int(ok.sum())} points matched in the reference pair, median epipolar error "
+            f"{med_epi:.2f} pixel (median RMS reprojection residual {med_rep:.2f} pixel), "
+            f"against epipolar_max_px={epipolar_max_px:g} (CLI --epipolar-max, pixel, RMS "
+            f"reprojection): {share:.0%} of the points would be flagged epipolar_mismatch. "
+            "Use the calibration of these cameras and check which images are the left and "
+            "which the right camera's; only for a calibration known to be coarse raise the "
+            f"gate above {med_rep:.2f} pixel (the positions then carry that misfit)"
+        )
+    return {"dic_median_epipolar_error_pixel": med_epi, "dic_median_reprojection_pixel": med_rep}
+
+
 def best_fit_plane(P: np.ndarray, towards: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Rotation (3, 3) (rows: plane x, y, z in world coordinates) and origin (3,) [m] of the
     least-squares plane of the points P (N, 3); z points to the side of ``towards``."""

@@ -26,7 +26,17 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-__all__ = ["window_neighbours", "tangent_frames", "surface_strain", "strain_variables"]
+__all__ = [
+    "window_neighbours",
+    "tangent_frames",
+    "surface_strain",
+    "strain_variables",
+    "STRAIN_FLAG_MEANINGS",
+]
+
+#: ``strain_flag`` values: why a point has no strain (NaN) at an image
+STRAIN_FLAG_MEANINGS = "ok point_not_measured window_incomplete window_degenerate"
+_S_OK, _S_POINT, _S_WINDOW, _S_DEGENERATE = 0, 1, 2, 3
 
 
 def window_neighbours(index: np.ndarray, window: int) -> tuple[np.ndarray, np.ndarray]:
@@ -73,11 +83,19 @@ def tangent_frames(ref: np.ndarray, ptr: np.ndarray, idx: np.ndarray) -> np.ndar
 
 
 @njit(cache=True)
-def _strain_kernel(ref, cur, sig, pix, subset, ptr, idx, frames, min_count, E, U):
-    """E (T, N, 3): Green-Lagrange E11, E22, E12; U (T, N, 3) their standard uncertainty."""
+def _strain_kernel(ref, cur, sig, pix, subset, ptr, idx, frames, min_count, E, U, S):
+    """E (T, N, 3): Green-Lagrange E11, E22, E12; U (T, N, 3) their standard uncertainty;
+    S (T, N) why a point has none (``STRAIN_FLAG_MEANINGS``; preset to window_incomplete)."""
     T, N, d = cur.shape
     for k in range(N):
-        if not np.isfinite(frames[k, 0, 0]):
+        own = True
+        for c in range(d):
+            own = own and np.isfinite(ref[k, c])
+        if not own:  # the point itself has no reference position: no origin for the fit
+            for t in range(T):
+                S[t, k] = 1
+            continue
+        if not np.isfinite(frames[k, 0, 0]):  # too few neighbours for a tangent plane
             continue
         cnt = ptr[k + 1] - ptr[k]
         sv = np.empty(cnt)  # local coordinates of the neighbours in the point's frame
@@ -95,6 +113,12 @@ def _strain_kernel(ref, cur, sig, pix, subset, ptr, idx, frames, min_count, E, U
         w1 = np.zeros(cnt)
         w2 = np.zeros(cnt)
         for t in range(T):
+            here = np.isfinite(sig[t, k])
+            for c in range(d):
+                here = here and np.isfinite(cur[t, k, c])
+            if not here:
+                S[t, k] = 1
+                continue
             # normal equations of x_j = a + F (s_j, t_j), weights equal
             ata = np.zeros((3, 3))
             atx = np.zeros((3, d))
@@ -116,7 +140,9 @@ def _strain_kernel(ref, cur, sig, pix, subset, ptr, idx, frames, min_count, E, U
                 m += 1
             if m < min_count:
                 continue
-            if abs(np.linalg.det(ata)) < 1e-12 * (ata[1, 1] * ata[2, 2] + 1e-300) * m:
+            det = np.linalg.det(ata)
+            if not np.isfinite(det) or abs(det) < 1e-12 * (ata[1, 1] * ata[2, 2] + 1e-300) * m:
+                S[t, k] = 3  # the window's points are (nearly) on a line
                 continue
             inv = np.linalg.inv(ata)
             B = inv @ atx  # (3, d): rows a, dF/ds, dF/dt
@@ -157,6 +183,14 @@ def _strain_kernel(ref, cur, sig, pix, subset, ptr, idx, frames, min_count, E, U
             U[t, k, 0] = np.sqrt(v1)
             U[t, k, 1] = np.sqrt(v2)
             U[t, k, 2] = np.sqrt(v12)
+            S[t, k] = 0
+            for i in range(3):
+                if not (np.isfinite(E[t, k, i]) and np.isfinite(U[t, k, i])):
+                    S[t, k] = 3
+            if S[t, k] != 0:
+                for i in range(3):
+                    E[t, k, i] = np.nan
+                    U[t, k, i] = np.nan
 
 
 def surface_strain(
@@ -167,7 +201,9 @@ def surface_strain(
     window: int,
     pixels: np.ndarray,
     subset_size: int,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    *,
+    with_flag: bool = False,
+) -> tuple[np.ndarray, ...]:
     """Green-Lagrange surface strain by local fits (see module docstring).
 
     Parameters
@@ -191,15 +227,21 @@ def surface_strain(
     -------
     E, E_u : ndarray (T, N, 3)
         ``E11, E22, E12`` (tensor shear) [1] and their standard uncertainties; NaN where
-        fewer than 60 % of the window's points (and at least 4) were measured.
+        the point itself was not measured, where fewer than 60 % of the window's points (and
+        at least 4) were (the specimen's edge, a hole, the image border), or where they lie
+        on a line.
     frames : ndarray (N, 2, d)
         The tangent bases used.
+    flag : ndarray (T, N) int8
+        With ``with_flag``: why a point has no strain (:data:`STRAIN_FLAG_MEANINGS`), 0 where
+        it has.
     """
     ptr, idx = window_neighbours(index, window)
     frames = tangent_frames(ref, ptr, idx)
     T, N = cur.shape[:2]
     E = np.full((T, N, 3), np.nan)
     U = np.full((T, N, 3), np.nan)
+    S = np.full((T, N), _S_WINDOW, np.int8)
     min_count = max(4, int(np.ceil(0.6 * window * window)))
     _strain_kernel(
         np.ascontiguousarray(ref, float),
@@ -213,8 +255,9 @@ def surface_strain(
         min_count,
         E,
         U,
+        S,
     )
-    return E, U, frames
+    return (E, U, frames, S) if with_flag else (E, U, frames)
 
 
 def engineering_strain(E: np.ndarray) -> np.ndarray:
@@ -236,7 +279,9 @@ def strain_variables(ref, cur, disp_u, index, pixels, window, step, subset_size)
 
     data = {}
     inplane = np.sqrt(np.mean(disp_u[..., :2] ** 2, axis=-1))
-    E, Eu, _ = surface_strain(ref, cur, inplane, index, window, pixels, subset_size)
+    E, Eu, _, S = surface_strain(
+        ref, cur, inplane, index, window, pixels, subset_size, with_flag=True
+    )
     coords = {"component": ("component", ["xx", "yy", "xy"], {"long_name": "tensor component"})}
     span = (window - 1) * step
     note = (
@@ -251,7 +296,7 @@ def strain_variables(ref, cur, disp_u, index, pixels, window, step, subset_size)
             "units": "1",
             "long_name": "Green-Lagrange surface strain (xy: tensor shear)",
             "strain_window": note,
-            "ancillary_variables": "strain_u",
+            "ancillary_variables": "strain_u strain_flag",
         },
     )
     data["strain_u"] = xr.DataArray(
@@ -260,6 +305,18 @@ def strain_variables(ref, cur, disp_u, index, pixels, window, step, subset_size)
         attrs={
             "units": "1",
             "long_name": "standard uncertainty of strain (displacement noise through the fit)",
+        },
+    )
+    data["strain_flag"] = xr.DataArray(
+        S,
+        dims=("time", "point"),
+        attrs={
+            "units": "1",
+            "long_name": "why a point has no strain (NaN): its own match failed, too few "
+            "measured neighbours in the window (specimen edge, hole, image border), or they "
+            "lie on a line",
+            "flag_values": np.arange(4, dtype=np.int8),
+            "flag_meanings": STRAIN_FLAG_MEANINGS,
         },
     )
     data["strain_engineering"] = xr.DataArray(

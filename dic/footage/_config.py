@@ -35,12 +35,14 @@ class BodySpec:
         ``centroid`` is the bearing centre) the journal's offset in the bearing frame is given.
     polygon : list of [x, y]
         Region of interest in the left reference image [pixel] (3 or more vertices).
-    centroid : [x, y, z] or None
+    centroid : [x, y, z] or [x, y] or None
         Body-fixed point whose motion is reported, in the world frame at the reference frame
-        [m] (the follower's centre of mass). Default: the centroid of the tracked points.
+        [m] (the follower's centre of mass); with one camera ``[x, y]`` in pixels of the left
+        reference image. Default: the centroid of the tracked points.
     centroid_mechanism : [x, y, z] or None
         The same in the mechanism frame, used when the calibration's world frame is a board on
         the mechanism plane (the point is shifted by the board origin given in ``world_origin``).
+        Stereo only (refused with one camera).
     reference_angle_deg : float
         Crank angle at the reference frame [degree] (crank bodies).
     """

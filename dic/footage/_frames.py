@@ -49,9 +49,32 @@ class _BodyState:
 
 
 def _body_point(spec: BodySpec, ref: np.ndarray, cfg: TrackConfig) -> np.ndarray:
+    """The body's point of interest in the frame of ``ref`` (world [m] in stereo, left-image
+    pixels with one camera); refuses a point given in the other frame."""
+    d = ref.shape[1]
+    where = f"bodies.{spec.name}"
+    if d == 2 and spec.centroid_mechanism is not None:
+        raise BadInputError(
+            f"{where}.centroid_mechanism is a point of the mechanism frame [m], which one "
+            "camera does not measure (positions are in pixels of the left image): give "
+            f"{where}.centroid = [x, y] in pixels of the left reference image, or track with "
+            "two cameras (--right and --calibration)"
+        )
     if spec.centroid is not None:
-        return np.asarray(spec.centroid, dtype=float)
-    if spec.centroid_mechanism is not None and ref.shape[1] == 3:
+        point = np.asarray(spec.centroid, dtype=float)
+        if point.shape != (d,) or not np.isfinite(point).all():
+            raise BadInputError(
+                f"{where}.centroid = {list(spec.centroid)}: "
+                + (
+                    "with one camera positions are in pixels of the left reference image: "
+                    "give centroid = [x, y] in pixels (a world point [x, y, z] in metres needs "
+                    "two cameras and a calibration)"
+                    if d == 2
+                    else "expected [x, y, z] in metres of the calibration's world frame"
+                )
+            )
+        return point
+    if spec.centroid_mechanism is not None:
         return np.asarray(spec.centroid_mechanism, dtype=float) - np.asarray(cfg.world_origin)
     return np.nanmean(ref, axis=0)
 

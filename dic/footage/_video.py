@@ -310,6 +310,53 @@ def _frame_numbers(files: list[Path]) -> tuple[np.ndarray | None, str]:
     return np.array([int(g[-1]) for g in groups]), ""
 
 
+def _name_template(p: Path) -> str:
+    """A file name with its digit groups replaced by ``#`` (``frame_0012.png`` -> ``frame_#.png``)."""
+    return re.sub(r"\d+", "#", p.stem) + p.suffix.lower()
+
+
+def _pattern_of(files: list[Path]) -> str:
+    """A glob pattern selecting ``files`` (named alike): digit groups that vary become ``*``."""
+    groups = [re.findall(r"\d+", f.stem) for f in files]
+    parts = re.split(r"\d+", files[0].stem)
+    out = parts[0]
+    for j, rest in enumerate(parts[1:]):
+        values = {g[j] for g in groups if len(g) > j}
+        out += (values.pop() if len(values) == 1 else "*") + rest
+    return str(files[0].parent / (out + files[0].suffix))
+
+
+def check_frame_names(files: list[Path], where: str) -> None:
+    """Refuse images that are not all named alike (one name with a frame number).
+
+    A mask (``roi.tif``) or a stray image left in a folder of frames would otherwise be
+    correlated as one more frame, every point failing, the command still exiting 0; a
+    reference named unlike its frames (``Sample3 Reference.tif`` beside ``Sample3-1.tif``)
+    would be ordered by the digits of its name, among the frames.
+    """
+    groups: dict[str, list[Path]] = {}
+    for f in files:
+        groups.setdefault(_name_template(f), []).append(f)
+    if len(groups) <= 1:
+        return
+    ranked = sorted(groups.items(), key=lambda kv: -len(kv[1]))
+    main_t, main_files = ranked[0]
+    odd = [f.name for _, fs in ranked[1:] for f in fs]
+    shown = ", ".join(f"'{n}'" for n in odd[:5]) + (" ..." if len(odd) > 5 else "")
+    pattern = _pattern_of(main_files)
+    hint = (
+        f"; if '{odd[0]}' is the reference image, give it first and the frames after it: "
+        f"'{ranked[1][1][0]}' '{pattern}'"
+        if len(odd) == 1
+        else ""
+    )
+    raise BadInputError(
+        f"{where} holds {len(main_files)} images named like '{main_t}' (# = frame number) and "
+        f"{len(odd)} other image(s): {shown}. Which are the frames is ambiguous: give a pattern "
+        f"that selects them, e.g. '{pattern}', or move the other files out of the folder{hint}"
+    )
+
+
 def list_image_sequence(
     path: str | Path, *, what: str = "footage"
 ) -> tuple[list[Path], np.ndarray]:
@@ -350,6 +397,7 @@ def list_image_sequence(
         raise BadInputError(f"{what} '{path_str}' does not exist")
     if not files:
         raise BadInputError(f"{what} {where} holds no images ({', '.join(IMAGE_SUFFIXES)})")
+    check_frame_names(files, f"{what} {where}")
     files.sort(key=_natural_key)
     numbers, note = _frame_numbers(files)
     if numbers is None:

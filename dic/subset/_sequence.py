@@ -19,13 +19,13 @@ frame_rate=None, update_zncc=0.9, update_every=None, progress=False, params=None
 
 from __future__ import annotations
 
-import re
 from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
 import xarray as xr
 
+from jointwear.dic.footage._video import check_frame_names  # noqa: F401 (re-exported)
 from jointwear.errors import BadInputError, ParameterError
 
 __all__ = ["read_frames", "correlate_sequence"]
@@ -91,8 +91,6 @@ def read_frames(
         if is_image_sequence(source):
             # sorted by the frame number in the names (frame_9 before frame_10)
             files, _ = list_image_sequence(source, what="frames source")
-            if path.is_dir():
-                check_frame_names(files, f"folder '{path}'")
             return [read_image(p) for p in files[sel]], None
         if not path.exists():
             raise BadInputError(f"frames source '{path}' does not exist")
@@ -112,34 +110,6 @@ def read_frames(
         return frames, None
     raise BadInputError(
         f"frames: expected an array, a list of images, a folder or a video, got {type(source).__name__}"
-    )
-
-
-def _name_template(p: Path) -> str:
-    """A file name with its digit groups replaced by ``#`` (``frame_0012.png`` -> ``frame_#.png``)."""
-    return re.sub(r"\d+", "#", p.stem) + p.suffix.lower()
-
-
-def check_frame_names(files: Sequence[Path], where: str) -> None:
-    """Refuse a folder whose images are not all named alike (one name with a frame number).
-
-    A mask (``roi.tif``) or a stray image left in a folder of frames would otherwise be
-    correlated as one more frame, every point failing, the command still exiting 0.
-    """
-    groups: dict[str, list[Path]] = {}
-    for f in files:
-        groups.setdefault(_name_template(f), []).append(f)
-    if len(groups) <= 1:
-        return
-    ranked = sorted(groups.items(), key=lambda kv: -len(kv[1]))
-    main_t, main_files = ranked[0]
-    odd = [f.name for _, fs in ranked[1:] for f in fs]
-    shown = ", ".join(f"'{n}'" for n in odd[:5]) + (" ..." if len(odd) > 5 else "")
-    pattern = str(main_files[0].parent / main_t.replace("#", "*"))
-    raise BadInputError(
-        f"{where} holds {len(main_files)} images named like '{main_t}' (# = frame number) and "
-        f"{len(odd)} other image(s): {shown}. Which are the frames is ambiguous: give a pattern "
-        f"that selects them, e.g. '{pattern}', or move the other files out of the folder"
     )
 
 
@@ -382,4 +352,5 @@ def correlate_sequence(
     )
     ds.attrs["title"] = "2D subset DIC displacement over an image sequence"
     ds.attrs["dic_reference_strategy"] = reference
+    ds.attrs["dic_reference_updates"] = int(np.count_nonzero(np.diff(ref_frame)))
     return ds

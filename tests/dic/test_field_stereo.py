@@ -150,11 +150,16 @@ def test_a_calibration_that_does_not_fit_flags_epipolar_mismatch(scene):
         R.matrix, R.distortion, R.rotation, R.translation + [0, 0.006, 0], R.image_size
     )
     bad = StereoCalibration(sc.calibration.left, shifted, source="shifted")
-    ds = measure_field(
-        [pairs[0][0]], [pairs[0][1]], calibration=bad, roi=sc.roi_left(), subset_size=25, step=24
-    )
+    kw = dict(calibration=bad, roi=sc.roi_left(), subset_size=25, step=24)
+    # refused up front, with the measured misfit
+    with pytest.raises(BadInputError, match="median epipolar error") as info:
+        measure_field([pairs[0][0]], [pairs[0][1]], **kw)
+    rep = float(str(info.value).split("median RMS reprojection residual ")[1].split(" ")[0])
+    assert rep > 3
+    # a gate that lets it run (above half the misfit) still flags the pairs beyond it
+    ds = measure_field([pairs[0][0]], [pairs[0][1]], epipolar_max_px=0.6 * rep, **kw)
     assert (ds.flag.values[0] == 8).mean() > 0.9
-    assert np.nanmedian(ds.reprojection.values) > 3
+    assert np.nanmedian(ds.reprojection.values) == pytest.approx(rep, abs=0.006)  # 2 decimals
 
 
 def test_cli_stereo_field_with_patterns_csv_and_figure(scene, tmp_path):

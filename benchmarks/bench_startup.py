@@ -1,0 +1,160 @@
+"""Start-up cost of the command line, in CPU seconds (``python benchmarks/bench_startup.py``).
+
+Each command runs in a fresh process (as a user runs it) with a warm numba cache; the figure is
+its CPU time, user + system (``RUSAGE_CHILDREN``), which other users of a shared machine
+disturb less than the wall time: the minimum and the median of ``--repeat`` runs. Targets
+(issue 23): ``jointwear --help`` <= 0.3 s, ``jointwear info FILE`` <= 0.6 s, ``dic correlate``
+on a 256x256 pair <= 1.0 s. Also the modules each command imported that it should not need
+(dask, distributed, pint, matplotlib; numba for ``info``).
+
+Throughput through the command line (item 5): a 1024x1024 pair, 33-pixel subsets, step 4
+(60,025 points), two numba threads: points per wall second of the whole ``jointwear dic
+correlate`` process (start, reading, correlation, writing netCDF) against the library's
+``correlate`` call in a warm process, medians of ``--repeat-mp`` runs each.
+
+``--quick``: 3 runs, no 1-MP pair, written to ``results/startup_quick.json`` (the docs quote
+``results/startup.json``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import resource
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+from _common import write_results  # noqa: E402
+
+PROBE = (
+    "import runpy, sys\n"
+    "sys.argv = ['jointwear', *sys.argv[1:]]\n"
+    "try:\n"
+    "    from jointwear.cli import main\n"
+    "    code = main(sys.argv[1:])\n"
+    "finally:\n"
+    "    heavy = ('dask', 'distributed', 'pint', 'matplotlib', 'numba', 'pandas')\n"
+    "    sys.stderr.write('LOADED ' + ' '.join(m for m in heavy if m in sys.modules) + '\\n')\n"
+    "raise SystemExit(code)\n"
+)
+
+
+def _run(args: list[str], cwd: Path, env: dict) -> tuple[float, float, list[str]]:
+    """CPU seconds (user + sys) and wall seconds of one ``jointwear`` process, and the heavy
+    modules it imported."""
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    t0 = time.perf_counter()
+    out = subprocess.run(
+        [sys.executable, "-c", PROBE, *args], cwd=cwd, env=env, capture_output=True, text=True
+    )
+    wall = time.perf_counter() - t0
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    if out.returncode != 0:
+        raise RuntimeError(f"jointwear {' '.join(args)} failed:\n{out.stderr}")
+    line = [x for x in out.stderr.splitlines() if x.startswith("LOADED")][-1]
+    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    return cpu, wall, line.split()[1:]
+
+
+def _measure(args: list[str], cwd: Path, env: dict, repeat: int) -> dict:
+    _run(args, cwd, env)  # warm: numba cache, file system cache
+    runs = [_run(args, cwd, env) for _ in range(repeat)]
+    cpu = [r[0] for r in runs]
+    wall = [r[1] for r in runs]
+    return {
+        "cpu_s_min": round(min(cpu), 3),
+        "cpu_s_median": round(statistics.median(cpu), 3),
+        "wall_s_median": round(statistics.median(wall), 3),
+        "imported": runs[-1][2],
+    }
+
+
+def _images(folder: Path, size: int, name: str) -> Path:
+    from jointwear.cli import main
+
+    out = folder / name
+    assert main(["datasets", "speckle", str(out), "--size", f"{size}x{size}", "--field", "rigid",
+                 "--u", "3.3", "--v", "-2.7", "--overwrite"]) == 0  # fmt: skip
+    return out
+
+
+def _library_poi_per_s(pair: Path, repeat: int) -> float:
+    import cv2
+
+    from jointwear.dic import correlate
+
+    ref = cv2.imread(str(pair / "reference.png"), cv2.IMREAD_UNCHANGED)
+    dfm = cv2.imread(str(pair / "deformed.png"), cv2.IMREAD_UNCHANGED)
+    correlate(ref[:300, :300], dfm[:300, :300], subset_size=33, step=4, threads=2)  # warm
+    rates = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        ds = correlate(ref, dfm, subset_size=33, step=4, threads=2)
+        rates.append(ds.u.size / (time.perf_counter() - t0))
+    return statistics.median(rates)
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--repeat", type=int, default=7)
+    ap.add_argument("--repeat-mp", type=int, default=3)
+    ap.add_argument("--quick", action="store_true")
+    a = ap.parse_args()
+    repeat = 3 if a.quick else a.repeat
+    env = {**os.environ, "NUMBA_NUM_THREADS": "2"}
+    figures: dict = {"repeat": repeat, "numba_threads": 2}
+    with tempfile.TemporaryDirectory() as tmp:
+        work = Path(tmp)
+        _images(work, 256, "small")
+        corr = ["dic", "correlate", "small/reference.png", "small/deformed.png", "--subset", "31"]
+        corr += ["--step", "8", "--out", "small/field.nc", "--overwrite"]
+        field = ["dic", "field", "small/reference.png", "small/deformed.png", "--subset", "31"]
+        field += ["--step", "16", "--out", "small/f.nc", "--overwrite"]
+        commands = {
+            "jointwear --help": ["--help"],
+            "jointwear dic --help": ["dic", "--help"],
+            "jointwear dic correlate (256x256, step 8)": corr,
+            "jointwear info FILE": ["info", "small/field.nc"],
+            "jointwear dic field (256x256, step 16)": field,
+        }
+        targets = {
+            "jointwear --help": 0.3,
+            "jointwear dic correlate (256x256, step 8)": 1.0,
+            "jointwear info FILE": 0.6,
+        }
+        _run(corr, work, env)  # the file `info` reads
+        rows = {}
+        for label, args in commands.items():
+            rows[label] = _measure(args, work, env, repeat)
+            if label in targets:
+                rows[label]["target_cpu_s"] = targets[label]
+            print(label, rows[label], flush=True)
+        figures["commands"] = rows
+        if not a.quick:
+            mp = _images(work, 1024, "mp")
+            args = ["dic", "correlate", "mp/reference.png", "mp/deformed.png", "--subset", "33"]
+            args += ["--step", "4", "--threads", "2", "--out", "mp/field.nc", "--overwrite"]
+            _run(args, work, env)
+            walls = [_run(args, work, env)[1] for _ in range(a.repeat_mp)]
+            n = 60025
+            cli = n / statistics.median(walls)
+            lib = _library_poi_per_s(mp, a.repeat_mp)
+            figures["one_megapixel_step4"] = {
+                "points": n,
+                "cli_poi_per_s_whole_process": round(cli),
+                "library_poi_per_s_correlate_call": round(lib),
+                "ratio": round(cli / lib, 3),
+                "target_ratio": 0.7,
+            }
+            print(figures["one_megapixel_step4"], flush=True)
+    write_results("startup_quick" if a.quick else "startup", figures)
+
+
+if __name__ == "__main__":
+    main()

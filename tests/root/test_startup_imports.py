@@ -1,0 +1,69 @@
+"""A command imports what it uses: no dask/distributed/pint under xarray for NumPy data, one
+command group per call; and xarray still recognises dask arrays and pint quantities."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+HEAVY = ("dask", "distributed", "pint", "matplotlib", "numba")
+
+
+def _modules_after(code: str, tmp_path) -> set[str]:
+    script = (
+        f"{code}\nimport sys\n"
+        f"print('LOADED', *(m for m in {HEAVY!r} + ('jointwear.sim.cli', 'jointwear.metrology.cli') "
+        "if m in sys.modules))"
+    )
+    out = subprocess.run(
+        [sys.executable, "-c", script], capture_output=True, text=True, cwd=tmp_path, check=True
+    )
+    return set(out.stdout.splitlines()[-1].split()[1:])
+
+
+def test_saving_and_summarising_numpy_data_imports_no_dask_pint_or_numba(tmp_path):
+    code = (
+        "import numpy as np, xarray as xr\n"
+        "from jointwear import io\n"
+        "from jointwear.cli import main\n"
+        "ds = xr.Dataset({'a': ('x', np.arange(3.0), {'units': 'm'})}, "
+        "coords={'x': ('x', np.arange(3.0), {'units': 'm'})})\n"
+        "io.save(ds, 'a.nc', validate=False)\n"
+        "assert main(['info', 'a.nc', '--no-validate']) == 0"
+    )
+    assert _modules_after(code, tmp_path) == set()
+
+
+def test_a_command_builds_only_its_group(tmp_path):
+    loaded = _modules_after(
+        "from jointwear.cli import main\nassert main(['dic', '--help']) == 0", tmp_path
+    )
+    assert loaded == set()  # neither the numerical stack nor the other groups
+
+
+def test_xarray_still_sees_dask_arrays_and_pint_quantities(tmp_path):
+    import xarray as xr
+
+    import jointwear  # noqa: F401  (installs the import shortcuts)
+
+    da = pytest.importorskip("dask.array")
+    pint = pytest.importorskip("pint")
+    lazy = xr.DataArray(da.zeros(6, chunks=3), dims="x")
+    assert lazy.chunks == ((3, 3),)
+    assert isinstance(lazy.data, da.Array)
+    q = pint.UnitRegistry().Quantity(np.arange(3.0), "mm")
+    wrapped = xr.DataArray(q, dims="x")
+    assert isinstance(wrapped.data, pint.Quantity)
+    # a chunked dataset is written through dask (the scheduler is asked again once dask is in)
+    lazy.to_dataset(name="z").to_netcdf(tmp_path / "z.nc")
+    with xr.open_dataset(tmp_path / "z.nc") as back:
+        np.testing.assert_array_equal(back["z"].values, np.zeros(6))
+
+
+def test_unknown_group_is_a_usage_error():
+    from jointwear.cli import main
+
+    assert main(["no-such-group"]) == 2
