@@ -28,7 +28,7 @@ from jointwear.datasets import speckle as sp  # noqa: E402
 from jointwear.datasets.rig import RigConfig  # noqa: E402
 from jointwear.datasets.surface import SurfaceScene  # noqa: E402
 from jointwear.dic import SubsetCorrelator, measure_field  # noqa: E402
-from jointwear.dic._interp import prefilter  # noqa: E402
+from jointwear.dic.icgn._interp import prefilter  # noqa: E402
 
 
 def s_curve(size: float, gradient: str) -> list[float]:

@@ -19,11 +19,11 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _common import median_time, write_results  # noqa: E402
 
 from jointwear.params import replace_nested  # noqa: E402
-from jointwear.sim import PARAMETER_SETS, run_cycles  # noqa: E402
+from jointwear.sim import DEFAULT_PARAMETER_SET, PARAMETER_SETS, run_cycles  # noqa: E402
 
 
 def main() -> None:
-    base = PARAMETER_SETS["zhang2023"]
+    base = PARAMETER_SETS[DEFAULT_PARAMETER_SET]
     t0 = time.perf_counter()
     run_cycles(base, cycles=0.02)
     first_call = time.perf_counter() - t0

@@ -31,7 +31,13 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _common import write_results  # noqa: E402
 
 from jointwear.params import replace_nested  # noqa: E402
-from jointwear.sim import PARAMETER_SETS, WearSettings, run_cycles, simulate_wear  # noqa: E402
+from jointwear.sim import (  # noqa: E402
+    DEFAULT_PARAMETER_SET,
+    PARAMETER_SETS,
+    WearSettings,
+    run_cycles,
+    simulate_wear,
+)
 
 CYCLES = 4e5
 DN = 10_000
@@ -169,7 +175,7 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--replicates", type=int, default=REPLICATES, help="4e5-cycle runs per grid")
     ap.add_argument("--no-floor", action="store_true", help="skip the impact-velocity floor study")
     args = ap.parse_args(argv)
-    base = PARAMETER_SETS["zhang2023"]
+    base = PARAMETER_SETS[DEFAULT_PARAMETER_SET]
     overrides = dict(kv.split("=", 1) for kv in args.set)
     base = replace_nested(base, **{k: _value(v) for k, v in overrides.items()})
     grids = [tuple(int(v) for v in g.split("x")) for g in args.grids.split(",")]

@@ -19,6 +19,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _common import write_results  # noqa: E402
 
 from jointwear.sim import (  # noqa: E402
+    DEFAULT_PARAMETER_SET,
     PARAMETER_SETS,
     WearSettings,
     halved_schedule,
@@ -27,7 +28,7 @@ from jointwear.sim import (  # noqa: E402
 
 
 def main() -> None:
-    params = PARAMETER_SETS["zhang2023"]
+    params = PARAMETER_SETS[DEFAULT_PARAMETER_SET]
     settings = WearSettings()
     cycles = 1e6
     runs = []

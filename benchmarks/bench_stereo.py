@@ -67,7 +67,7 @@ def main() -> None:
     )
     args = ap.parse_args()
 
-    from jointwear.dic._footage import read_bodies, track_footage
+    from jointwear.dic.footage._track import read_bodies, track_footage
 
     with tempfile.TemporaryDirectory() as tmp:
         folder = Path(tmp)

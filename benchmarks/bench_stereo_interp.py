@@ -56,7 +56,7 @@ def speckle_errors(speckle: float, interpolation: str) -> dict:
 def rig_errors(interpolation: str, seconds: float) -> dict:
     from jointwear import io
     from jointwear.datasets.rig import RigConfig, VirtualRig, generate_rig
-    from jointwear.dic._footage import read_bodies, track_footage
+    from jointwear.dic.footage._track import read_bodies, track_footage
 
     cfg = RigConfig(duration=seconds)
     with tempfile.TemporaryDirectory() as tmp:

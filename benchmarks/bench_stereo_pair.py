@@ -35,13 +35,13 @@ def main() -> None:
     import cv2
 
     from jointwear.datasets.rig import RigConfig, VirtualRig, _write_bodies_toml
-    from jointwear.dic._footage import read_bodies, track_footage
-    from jointwear.dic._footage_features import (
+    from jointwear.dic.footage._features import (
         MatchReport,
         _sift_features,
         _sift_homography,
         epipolar_band,
     )
+    from jointwear.dic.footage._track import read_bodies, track_footage
 
     cfg = RigConfig(width=1920, height=1200)
     rig = VirtualRig(cfg)

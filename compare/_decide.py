@@ -131,8 +131,9 @@ def scalar_decision(
 
     The V&V 20 criterion is always on the card: *not comparable* when ``not_comparable``
     states why the data do not cover the quantity, *not assessed* when one of its
-    uncertainties is unknown (then the relative-error threshold is decided as well, marked as
-    the fallback), else pass/fail.
+    uncertainties is unknown (the relative error against the screening threshold
+    ``relative_error_max`` is then shown in its value, labelled *screening only*: it is never
+    counted as a pass or a fail), else pass/fail.
     """
     rows.add(quantity, "value_sim", s, units)
     rows.add(quantity, "value_meas", d, units)
@@ -160,26 +161,23 @@ def scalar_decision(
         return
     missing = [name for name, u in parts if not u.known]
     if missing:
+        # V&V 20 cannot be decided; the relative error against the screening threshold is shown
+        # for orientation only and is never a pass (nor a fail) of the criterion
         reason = "; ".join(f"{name} not assessed ({u.basis})" for name, u in parts if not u.known)
+        screen = (
+            f"; screening only, not a verdict: |S - D| / |D| = {abs(rel):.3g} "
+            f"{'<=' if abs(rel) <= relative_error_max else '>'} {relative_error_max:g}"
+            if np.isfinite(rel)
+            else ""
+        )
         decisions.append(
             decision(
                 label,
                 criterion,
-                f"E = {fmt(s - d, units)} (S = {fmt(s, units)}, D = {fmt(d, units)})",
+                f"E = {fmt(s - d, units)} (S = {fmt(s, units)}, D = {fmt(d, units)}){screen}",
                 vd.NOT_ASSESSED,
                 "V&V 20",
                 reason,
-                key=quantity,
-            )
-        )
-        ok = bool(np.isfinite(rel) and abs(rel) <= relative_error_max)
-        decisions.append(
-            decision(
-                label,
-                f"|S - D| / |D| <= {relative_error_max:g} (threshold; V&V 20 not assessed)",
-                f"{rel:+.3g} (S = {fmt(s, units)}, D = {fmt(d, units)})",
-                threshold_state(ok, bool(np.isfinite(rel))),
-                "threshold",
                 key=quantity,
             )
         )

@@ -53,15 +53,139 @@ def coverage(al: xr.Dataset, max_outside: float) -> tuple[str, str]:
     return peak, whole
 
 
-def wear_metrics(al: xr.Dataset, rows: Rows, decisions: list[dict[str, Any]], src: Sources) -> None:
-    """Metric rows and decisions of the aligned wear maps ``al``."""
+def band_label(al: xr.Dataset) -> str:
+    """``"within z = -6…+6 mm"`` (and the measured share of the circumference, if partial)."""
+    lo, hi = (float(v) for v in np.ravel(al.attrs["z_overlap_m"]))
+    text = f"within z = {lo * 1e3:+.3g}…{hi * 1e3:+.3g} mm"
+    arc = float(al.attrs.get("theta_fraction_measured", 1.0))
+    if arc < 1.0:
+        text += f", {arc:.0%} of the circumference"
+    return text.replace("-", "−")
+
+
+def validation_domain(al: xr.Dataset, rows: Rows) -> str:
+    """What of the simulation lies outside the measured band: an extrapolation statement.
+
+    Adds ``validation_domain`` rows (global simulated maximum, its location, the share of the
+    simulated worn volume outside the band) and returns the sentence for the card ('' when the
+    band holds the whole simulated map).
+    """
+    a = al.attrs
+    frac = float(a.get("volume_fraction_compared", np.nan))
+    gmax, gz, gth = (
+        float(a.get(k, np.nan)) for k in ("sim_max_value_m", "sim_max_z_m", "sim_max_theta_deg")
+    )
+    q = "validation_domain"
+    rows.add(q, "sim_global_max", gmax, "m", "whole simulated map")
+    rows.add(q, "sim_global_max_z", gz, "m", "whole simulated map")
+    rows.add(q, "sim_global_max_theta", gth, "m", "whole simulated map")
+    rows.add(q, "volume_fraction_outside", 1.0 - frac, "m", "share of the simulated worn volume")
+    outside = 1.0 - frac if np.isfinite(frac) else 0.0
+    if int(a.get("sim_max_inside", 1)) and outside <= 1e-3:
+        return ""
+    where = "outside" if not int(a.get("sim_max_inside", 1)) else "inside"
+    return (
+        f"validation domain: the wear criteria are decided {band_label(al)} only. Outside it "
+        f"the simulation is an extrapolation, not validated: its global maximum "
+        f"({gmax * 1e6:.3g} µm at z = {gz * 1e3:+.2f} mm, theta {gth:.0f} degree) lies {where} "
+        f"the band and {outside:.0%} of the simulated worn volume lies outside it"
+    )
+
+
+def _u_field(al: xr.Dataset, name: str) -> tuple[np.ndarray | None, str]:
+    # an all-NaN uncertainty (e.g. a fixed-interval wear run: accuracy not assessed) is not
+    # stated, the same as an absent one
+    if name not in al:
+        return None, ""
+    u = np.asarray(al[name].values, dtype=float)
+    return (u, str(al[name].attrs.get("basis", ""))) if np.isfinite(u).any() else (None, "")
+
+
+def _edge_max(f: np.ndarray) -> int:
+    """-1 / +1 when the maximum of ``f`` lies on the first / last layer of the band, else 0."""
+    i = int(np.unravel_index(np.nanargmax(f), f.shape)[0])
+    return -1 if i == 0 else (1 if i == f.shape[0] - 1 else 0)
+
+
+def _stated_volume_u(al: xr.Dataset, d_volume: float) -> tuple[float, str] | None:
+    """The measurement's own worn_volume_u (converted by k) when it is of the compared band.
+
+    It is, when the band is the map's whole width and circumference and the map's own
+    ``worn_volume`` agrees with the volume of the compared map ``d_volume`` within 5 % (a map
+    cut after the volume was computed keeps a stale value: then the per-point u is used).
+    """
+    value = al.attrs.get("worn_volume_u_meas")
+    own = float(al.attrs.get("worn_volume_meas_stated", np.nan))
+    if value is None or not np.isfinite(float(value)):
+        return None
+    if not (np.isfinite(d_volume) and abs(own - d_volume) <= 0.05 * abs(d_volume)):
+        return None
+    lo, hi = (float(v) for v in np.ravel(al.attrs["z_overlap_m"]))
+    zlo, zhi = (float(v) for v in np.ravel(al.attrs["z_range_meas_m"]))
+    whole = abs(lo - zlo) < 1e-9 and abs(hi - zhi) < 1e-9
+    if not whole or float(al.attrs.get("theta_fraction_measured", 1.0)) < 1.0:
+        return None
+    return float(value), str(al.attrs.get("worn_volume_u_meas_basis", ""))
+
+
+def _stated(al: xr.Dataset, s: np.ndarray, d: np.ndarray) -> dict[str, tuple]:
+    """Per quantity: ((u_sim, note), (u_meas, note)) from the per-point and derived ``_u``."""
+    z = np.asarray(al["z"].values)
+    th = np.asarray(al["theta"].values)
+    radius = al.attrs.get("bearing_radius_m")
+    out: dict[str, tuple] = {}
+    sides = {
+        "sim": (_u_field(al, "wear_depth_sim_u"), s),
+        "meas": (_u_field(al, "wear_depth_meas_u"), d),
+    }
+    for side, ((u, basis), f) in sides.items():
+        if u is None:
+            for name in ("max_wear_depth", "worn_volume", "cylindricity"):
+                out.setdefault(name, {})[side] = (None, "")
+            continue
+        i, j = np.unravel_index(np.nanargmax(f), f.shape)
+        out.setdefault("max_wear_depth", {})[side] = (
+            float(u[i, j]),
+            f"per-point u at the maximum ({basis})",
+        )
+        vol = mt.worn_volume(u, z, th, float(radius)) if radius else None
+        out.setdefault("worn_volume", {})[side] = (
+            vol,
+            f"per-point u integrated over the band as fully correlated (an upper bound; {basis})",
+        )
+        out.setdefault("cylindricity", {})[side] = (
+            math.sqrt(2) * float(np.sqrt(np.nanmean(u**2))),
+            f"√2 · rms of the per-point u (peak-to-valley of two independent points; {basis})",
+        )
+    vol_meas = _stated_volume_u(al, mt.worn_volume(d, z, th, float(radius)) if radius else np.nan)
+    if vol_meas is not None:
+        out["worn_volume"]["meas"] = (
+            vol_meas[0],
+            f"the measurement's worn_volume_u over its whole band ({vol_meas[1]})",
+        )
+    return out
+
+
+def wear_metrics(al: xr.Dataset, rows: Rows, decisions: list[dict[str, Any]], src: Sources) -> str:
+    """Metric rows and decisions of the aligned wear maps ``al``; returns the domain statement.
+
+    Every criterion is decided on the band the measurement covers and labelled so; what lies
+    outside is the validation-domain statement (returned), never a verdict. With
+    ``criteria.strict_coverage`` the old rule applies: a simulated maximum outside the band, or
+    more than ``max_volume_outside`` of the volume, makes the criteria *not comparable*.
+    """
     criteria = src.criteria
     s = np.asarray(al["wear_depth_sim"].values)
     d = np.asarray(al["wear_depth_meas"].values)
     z = np.asarray(al["z"].values)
     th = np.asarray(al["theta"].values)
     q = "wear_depth"
-    peak_nc, whole_nc = coverage(al, criteria.max_volume_outside)
+    band = band_label(al)
+    if criteria.strict_coverage:
+        peak_nc, whole_nc = coverage(al, criteria.max_volume_outside)
+    else:
+        peak_nc = whole_nc = ""
+    domain = validation_domain(al, rows)
     frac = float(al.attrs.get("volume_fraction_compared", np.nan))
     rows.add(q, "volume_fraction_compared", frac, "m")
     rows.add(q, "rmse", mt.rmse(s, d), "m")
@@ -77,10 +201,18 @@ def wear_metrics(al: xr.Dataset, rows: Rows, decisions: list[dict[str, Any]], sr
     ang = float(mt.wrap_angle_deg(ts - td))
     rows.add(q, "max_angle_error", ang, "m")
     rows.add(q, "max_z_error", zs - zd, "m")
+    z_nc = peak_nc
+    edge_s, edge_d = _edge_max(s), _edge_max(d)
+    if not z_nc and z.size > 1 and edge_s != 0 and edge_s == edge_d:
+        z_nc = (
+            f"both maxima {band} lie on its edge layer z = {z[0 if edge_s < 0 else -1] * 1e3:+.2f} "
+            "mm: the wear grows towards the edge on both sides and the band cannot show where "
+            "either maximum is"
+        )
     ok_shape = bool(nr <= criteria.wear_nrmse_max and r >= criteria.wear_r_min)
     decisions.append(
         decision(
-            "wear map shape",
+            f"wear map shape {band}",
             f"NRMSE <= {criteria.wear_nrmse_max:g} and r >= {criteria.wear_r_min:g}",
             f"NRMSE = {nr:.3g}, r = {r:.3g}",
             vd.NOT_COMPARABLE
@@ -88,11 +220,12 @@ def wear_metrics(al: xr.Dataset, rows: Rows, decisions: list[dict[str, Any]], sr
             else threshold_state(ok_shape, bool(np.isfinite(nr) and np.isfinite(r))),
             "threshold",
             whole_nc,
+            key="wear_depth",
         )
     )
     decisions.append(
         decision(
-            "angle of maximum wear",
+            f"angle of maximum wear {band}",
             f"|error| <= {criteria.max_angle_error_deg:g} degree",
             f"{ang:+.1f} degree (sim {ts:.1f}, meas {td:.1f})",
             vd.NOT_COMPARABLE
@@ -100,56 +233,29 @@ def wear_metrics(al: xr.Dataset, rows: Rows, decisions: list[dict[str, Any]], sr
             else threshold_state(abs(ang) <= criteria.max_angle_error_deg),
             "threshold",
             peak_nc,
+            key="wear_depth",
         )
     )
     decisions.append(
         decision(
-            "axial position of maximum wear",
+            f"axial position of maximum wear {band}",
             f"|error| <= {criteria.max_z_error_m * 1e3:g} mm",
             f"{(zs - zd) * 1e3:+.2f} mm (sim {zs * 1e3:+.2f}, meas {zd * 1e3:+.2f})",
             vd.NOT_COMPARABLE
-            if peak_nc
+            if z_nc
             else threshold_state(abs(zs - zd) <= criteria.max_z_error_m + 1e-12),
             "threshold",
-            peak_nc,
+            z_nc,
+            key="wear_depth",
         )
     )
-
-    def stated_u(name: str) -> np.ndarray | None:
-        # an all-NaN uncertainty (e.g. a fixed-interval wear run: accuracy not assessed) is
-        # not stated, the same as an absent one
-        if name not in al:
-            return None
-        u = np.asarray(al[name].values, dtype=float)
-        return u if np.isfinite(u).any() else None
-
-    us = stated_u("wear_depth_sim_u")
-    ud = stated_u("wear_depth_meas_u")
-
-    def at_max(u: np.ndarray | None, f: np.ndarray) -> float | None:
-        if u is None:
-            return None
-        i, j = np.unravel_index(np.nanargmax(f), f.shape)
-        return float(u[i, j])
-
+    stated = _stated(al, s, d)
     sim_q = sim_quantities(al)
     meas_q = sim_quantities(al, "wear_depth_meas")
-    radius = al.attrs.get("bearing_radius_m")
-    rms_u = (  # noqa: E731
-        lambda u: math.sqrt(2) * float(np.sqrt(np.nanmean(u**2))) if u is not None else None
-    )
-    stated = {
-        "max_wear_depth": (at_max(us, s), at_max(ud, d)),
-        "worn_volume": (
-            mt.worn_volume(us, z, th, float(radius)) if us is not None and radius else None,
-            mt.worn_volume(ud, z, th, float(radius)) if ud is not None and radius else None,
-        ),
-        "cylindricity": (rms_u(us), rms_u(ud)),
-    }
     labels = {
         "max_wear_depth": "maximum wear depth",
-        "worn_volume": "worn volume (compared width)",
-        "cylindricity": "cylindricity of the wear (LSCY, common grid)",
+        "worn_volume": "worn volume",
+        "cylindricity": "cylindricity of the wear (LSCY)",
     }
     units = {"max_wear_depth": "m", "worn_volume": "m3", "cylindricity": "m"}
     for name in ("max_wear_depth", "worn_volume", "cylindricity"):
@@ -157,17 +263,18 @@ def wear_metrics(al: xr.Dataset, rows: Rows, decisions: list[dict[str, Any]], sr
             continue
         value = sim_q[name] if name != "max_wear_depth" else vs
         meas = meas_q[name] if name != "max_wear_depth" else vd_
+        (us, us_note), (ud, ud_note) = stated[name]["sim"], stated[name]["meas"]
         scalar_decision(
             rows,
             decisions,
             name,
-            labels[name],
+            f"{labels[name]} {band}",
             value,
             meas,
             units[name],
-            u_num=src.u_num(name, value, stated[name][0], "wear"),
+            u_num=src.u_num(name, value, us, "wear", us_note),
             u_input=src.u_input(name, value, "wear"),
-            u_d=src.u_d(stated[name][1]),
+            u_d=src.u_d(ud, f"stated by the measurement: {ud_note}" if ud_note else ""),
             k=criteria.k,
             relative_error_max=criteria.relative_error_max,
             not_comparable=peak_nc if name == "max_wear_depth" else whole_nc,
@@ -177,3 +284,4 @@ def wear_metrics(al: xr.Dataset, rows: Rows, decisions: list[dict[str, Any]], sr
         rows.add("cylindricity_stated", "value_sim", float(cs), "m")
         rows.add("cylindricity_stated", "value_meas", float(cd), "m")
         rows.add("cylindricity_stated", "E", float(cs) - float(cd), "m")
+    return domain

@@ -31,6 +31,7 @@ from jointwear import conventions
 from jointwear.compare._coverage import theta_covered as _theta_covered
 from jointwear.compare._coverage import with_coverage as _with_coverage
 from jointwear.compare.align_motion import MOTION_VARIABLES, align_time_series
+from jointwear.compare.budget import to_standard
 from jointwear.errors import BadInputError, ConventionError
 
 __all__ = ["align_wear_maps", "align_time_series", "MOTION_VARIABLES", "to_metres"]
@@ -167,10 +168,13 @@ def _prepare_map(
     unc = None
     uname = f"{name}_u"
     if uname in ds:
-        unc = to_metres(ds[uname], what)
+        # converted to a standard uncertainty by its declared coverage factor (sim wear: k = 2)
+        std, u_note = to_standard(ds[uname].values, ds[uname].attrs, f"{what}: {uname}")
+        unc = to_metres(ds[uname].copy(data=std), what)
     da, n_cycles, how = _pick_cycles(da, ds, cycles, what)
     if unc is not None:
         unc, _, _ = _pick_cycles(unc, ds, n_cycles if "cycles" in unc.dims else None, what)
+        unc.attrs = {"units": "m", "basis": f"{uname}: {u_note}"}
     zattrs = da["z"].attrs
     if str(zattrs.get("z_direction", "+z")).strip() == "-z":
         da = da.assign_coords(z=-da["z"])
@@ -188,9 +192,11 @@ def _prepare_map(
         )
     da = conventions.to_canonical(da.transpose("z", "theta")).sortby("z")
     if unc is not None:
+        basis = unc.attrs["basis"]
         unc = conventions.convert_theta(
             unc.transpose("z", "theta"), source=conventions.angle_convention_of(ds[name])
         ).sortby("z")
+        unc.attrs["basis"] = basis
     return da, unc, n_cycles, how, ds
 
 
@@ -329,7 +335,12 @@ def align_wear_maps(
         out[uname] = (
             dims,
             vals,
-            {"units": "m", "long_name": f"standard uncertainty of {variable}_{side}"},
+            {
+                "units": "m",
+                "long_name": f"standard uncertainty of {variable}_{side}",
+                "coverage_factor": 1.0,
+                "basis": unc.attrs.get("basis", ""),
+            },
         )
         out[f"{variable}_{side}"].attrs["ancillary_variables"] = uname
         anc.append(uname)
@@ -363,6 +374,14 @@ def align_wear_maps(
     )
     if radius is not None:
         out.attrs["bearing_radius_m"] = radius
+    have = all(v in m_ds.data_vars and m_ds[v].ndim == 0 for v in ("worn_volume", "worn_volume_u"))
+    if have:
+        var = m_ds["worn_volume_u"]
+        if str(var.attrs.get("units", "m3")) == "m3":
+            out.attrs["worn_volume_meas_stated"] = float(m_ds["worn_volume"].values)
+            value, note = to_standard(var.values, var.attrs, "measured worn_volume_u")
+            out.attrs["worn_volume_u_meas"] = float(value)
+            out.attrs["worn_volume_u_meas_basis"] = f"worn_volume_u: {note}"
     for side, ds in (("sim", s_ds), ("meas", m_ds)):
         if "cylindricity" in ds.data_vars or "cylindricity" in ds.attrs:
             value = _stated_scalar(ds, "cylindricity", s_cycles if side == "sim" else m_cycles)

@@ -12,6 +12,7 @@ import numpy as np
 import xarray as xr
 
 from jointwear import conventions
+from jointwear.compare.budget import to_standard
 from jointwear.errors import BadInputError, ConventionError
 
 __all__ = ["align_time_series", "MOTION_VARIABLES"]
@@ -292,10 +293,16 @@ def align_time_series(
             if uname not in src:
                 continue
             uv = columns(src[uname], comps, None if side == "meas" else t_sim)
+            uv, note = to_standard(uv, src[uname].attrs, f"{uname} of the {side} record")
             out[f"{name}_{side}_u"] = (
                 dims,
                 uv,
-                {"units": units, "long_name": f"standard uncertainty of {name}_{side}"},
+                {
+                    "units": units,
+                    "long_name": f"standard uncertainty of {name}_{side}",
+                    "coverage_factor": 1.0,
+                    "basis": f"{uname}: {note}",
+                },
             )
             out[f"{name}_{side}"].attrs["ancillary_variables"] = f"{name}_{side}_u"
     out["sim_time"] = (

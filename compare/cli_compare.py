@@ -88,8 +88,9 @@ def register(app: typer.Typer) -> None:
             list[Path] | None,
             typer.Option(
                 "--verification",
-                help="Verification study (.nc: quantities over a refinement parameter); its "
-                "GCI is the numerical uncertainty when it converges monotonically.",
+                help="Verification study: a 'jointwear sim verify' study.nc (u_num of each wear "
+                "criterion on the measured band, Eça-Hoekstra), or older 1-D refinement data "
+                "(GCI, order capped at the formal order).",
             ),
         ] = None,
         strict: Annotated[

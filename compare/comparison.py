@@ -27,9 +27,11 @@ from jointwear.compare._motion import motion_metrics, rms_quantities
 from jointwear.compare._wear import sim_quantities, wear_metrics
 from jointwear.compare.align import MOTION_VARIABLES, align_time_series, align_wear_maps
 from jointwear.compare.criteria import Criteria, load_criteria
-from jointwear.compare.ensemble import Ensemble, as_ensemble
+from jointwear.compare.ensemble import WEAR_QUANTITIES, Ensemble, as_ensemble
 from jointwear.compare.origin import side_origin
+from jointwear.compare.reported import reported_metrics, split_reported
 from jointwear.compare.sources import Sources
+from jointwear.compare.study import band_study_uncertainty, is_study
 from jointwear.compare.verification import GCI, numerical_uncertainty
 from jointwear.errors import BadInputError
 
@@ -131,8 +133,14 @@ class Comparison:
         return float(rows["value"].iloc[0])
 
     def state(self, quantity: str, basis: str | None = None) -> str:
-        """State of the (first) decision on ``quantity`` (optionally of one ``basis``)."""
-        d = self.decisions[self.decisions.quantity == quantity]
+        """State of the (first) decision on ``quantity`` (optionally of one ``basis``).
+
+        ``quantity`` is the card's label, with or without its band (``"maximum wear depth"``
+        finds ``"maximum wear depth within z = −6…+6 mm"``).
+        """
+        label = self.decisions.quantity.astype(str)
+        # a wear criterion is labelled with its band ("maximum wear depth within z = ...")
+        d = self.decisions[(label == quantity) | label.str.startswith(quantity + " within ")]
         if basis is not None:
             d = d[d.basis == basis]
         if d.empty:
@@ -375,8 +383,10 @@ def compare(
         Ensembles of simulations over uncertain inputs (``run`` dimension); their spread is
         the u_input of each compared quantity (:mod:`jointwear.compare.ensemble`).
     verification : Dataset(s) or mapping of GCI, optional
-        Verification studies (quantities over a refinement parameter) for u_num
-        (:mod:`jointwear.compare.verification`).
+        Verification studies for u_num: a ``jointwear sim verify`` study (its stored wear maps
+        give u_num of every band quantity, :mod:`jointwear.compare.study`), or older 1-D
+        refinement datasets (quantities over a refinement parameter, GCI,
+        :mod:`jointwear.compare.verification`).
 
     Returns
     -------
@@ -389,19 +399,48 @@ def compare(
         Nothing to compare, inputs that cannot be aligned, or a malformed ensemble.
     ConventionError
         A wear map does not state its angle convention.
+
+    Examples
+    --------
+    A simulated wear map (prescribed contact) against itself as the "measurement", with stated
+    uncertainties: every decided criterion passes (the maximum lies on the edge layer, so its
+    axial position is not comparable); a bearing that wore 50 % more fails the depth and the
+    cylindricity:
+
+    >>> from jointwear.compare import Criteria, compare
+    >>> from jointwear.sim import BearingGrid, WearSettings, WinklerContact, simulate_wear
+    >>> fixed, contact = WearSettings(scheme="fixed", dn=500), WinklerContact(BearingGrid(4, 36))
+    >>> sim = simulate_wear(contact=contact, cycles=2000, snapshots=[1000, 2000], settings=fixed)
+    >>> meas = sim.isel(cycles=-1, drop=True)[["wear_depth"]].copy(deep=True)
+    >>> meas = meas.assign_attrs(data_origin="synthetic", cycles=2000)
+    >>> u_d = 0.02 * float(meas["wear_depth"].max())  # the measurement's u_D [m]
+    >>> meas["wear_depth_u"] = meas["wear_depth"].copy(data=0 * meas["wear_depth"].values + u_d)
+    >>> stated = Criteria(wear_u_num_rel=0.05, wear_u_input_rel=0.1)  # u_num 5 %, u_input 10 %
+    >>> compare(sim, meas, criteria=stated).summary()
+    '6 criteria: 5 pass, 1 not comparable'
+    >>> meas["wear_depth"].values *= 1.5  # a bearing that wore 50 % more
+    >>> compare(sim, meas, criteria=stated).failed()
+    ['maximum wear depth within z = −7.5…+7.5 mm', 'cylindricity of the wear (LSCY) within z = −7.5…+7.5 mm']
     """
     criteria = criteria or Criteria()
     ens = as_ensemble(ensemble)
+    studies: list[xr.Dataset] = []
     if verification is None:
         gci: Mapping[str, GCI] = {}
     elif isinstance(verification, xr.Dataset) or not isinstance(verification, Mapping):
-        gci = numerical_uncertainty(verification)  # a Dataset is a Mapping too: test it first
+        # a Dataset is a Mapping too: test it first. sim verify studies (contract) apart from
+        # the older 1-D refinement datasets (GCI)
+        items = [verification] if isinstance(verification, xr.Dataset) else list(verification)
+        studies = [ds for ds in items if is_study(ds)]
+        older = [ds for ds in items if not is_study(ds)]
+        gci = numerical_uncertainty(older) if older else {}
     else:
         gci = verification
     sims = [sim] if isinstance(sim, (xr.Dataset, xr.DataArray)) else list(sim)
     meass = [meas] if isinstance(meas, (xr.Dataset, xr.DataArray)) else list(meas)
     s_wear, s_motion = _split(sims)
-    m_wear, m_motion = _split(meass)
+    reported, meass_maps = split_reported(meass)
+    m_wear, m_motion = _split(meass_maps)
     rows = Rows()
     decisions: list[dict[str, Any]] = []
     notes: list[str] = []
@@ -420,15 +459,30 @@ def compare(
             field_values.update(values)
             if band is not None:
                 wear["wear_depth_sim_ensemble"] = band
-        src = Sources(criteria, ens, gci, float(wear.attrs["cycles_sim"]), field_values)
-        wear_metrics(wear, rows, decisions, src)
+        band_u = (
+            band_study_uncertainty(
+                studies,
+                m_wear,
+                WEAR_QUANTITIES,
+                theta_step_deg=theta_step_deg,
+                radius=wear.attrs.get("bearing_radius_m"),
+            )
+            if studies
+            else {}
+        )
+        src = Sources(
+            criteria, ens, gci, float(wear.attrs["cycles_sim"]), field_values, studies=band_u
+        )
+        domain = wear_metrics(wear, rows, decisions, src)
+        if domain:
+            notes.append(domain)
         if cycles is None and not np.isfinite(float(wear.attrs.get("cycles_meas", np.nan))):
             notes.append(
                 "wear cycles: the measured map does not state after how many crank cycles it was "
                 f"taken; it was compared with the simulation after {wear.attrs['cycles_sim']:g} "
                 "cycles (its last snapshot) - give cycles= / --cycles, or a 'cycles' attribute"
             )
-    elif s_wear is not None or m_wear is not None:
+    elif (s_wear is not None and not reported) or m_wear is not None:
         side = "measurement" if s_wear is not None else "simulation"
         partial.append(f"wear maps not compared: the {side} has no wear map (wear_depth)")
     if s_motion is not None and m_motion is not None:
@@ -457,7 +511,13 @@ def compare(
     elif s_motion is not None or m_motion is not None:
         side = "measurement" if s_motion is not None else "simulation"
         partial.append(f"motion not compared: the {side} has no motion record over time")
-    if wear is None and motion is None:
+    for rep in reported:  # reported measurements (a lab sheet's or a paper's numbers)
+        reported_metrics(
+            s_wear, rep, rows, decisions, notes, criteria=criteria, ensemble=ens,
+            verification=verification if isinstance(verification, Sequence) else
+            [verification] if isinstance(verification, xr.Dataset) else [],
+        )  # fmt: skip
+    if wear is None and motion is None and not reported:
         raise BadInputError(
             "nothing to compare: give a wear map (wear_depth over z, theta) and/or a motion "
             "record (follower_velocity, journal_offset, ... over time) on both sides"

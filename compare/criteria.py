@@ -35,15 +35,20 @@ class Criteria:
     max_z_error_m : float
         Largest acceptable error of the axial position of maximum wear [m].
     relative_error_max : float
-        Largest acceptable ``|S - D| / |D|`` of a scalar quantity, the engineering threshold
-        decided when V&V 20 cannot be assessed (max wear depth, worn volume, cylindricity, RMS
-        motion) [1].
+        Screening threshold of ``|S - D| / |D|`` of a scalar quantity, shown (labelled
+        *screening only*) when V&V 20 cannot be assessed; never decided as a pass or a fail
+        [1].
     motion_sg_c_max : float
         Largest acceptable Sprague-Geers comprehensive error of a motion component [1].
     max_volume_outside : float
-        Largest fraction of the simulated worn volume that may lie outside the axial range the
-        measurement covers for the whole-map criteria (shape, worn volume, cylindricity) to be
-        judged; above it they are *not comparable* [1].
+        With ``strict_coverage``: largest fraction of the simulated worn volume that may lie
+        outside the axial range the measurement covers for the whole-map criteria (shape, worn
+        volume, cylindricity) to be judged; above it they are *not comparable* [1].
+    strict_coverage : bool
+        False (default): every wear criterion is decided on the band the measurement covers
+        and named so; what lies outside is stated as extrapolation. True: the old strict rule,
+        a simulated maximum outside the band (or more than ``max_volume_outside`` of the
+        volume) makes the criteria *not comparable*.
     wear_u_input_rel, motion_u_input_rel : float or None
         User-stated relative standard uncertainty of the simulated quantities from their inputs
         (e.g. the wear coefficient), ``u_input = rel * |S|`` [1]. None (default) = not stated:
@@ -63,6 +68,7 @@ class Criteria:
     relative_error_max: float = 0.30
     motion_sg_c_max: float = 0.30
     max_volume_outside: float = 0.10
+    strict_coverage: bool = False
     wear_u_input_rel: float | None = None
     motion_u_input_rel: float | None = None
     wear_u_num_rel: float | None = None
@@ -73,8 +79,20 @@ class Criteria:
             value = getattr(self, f)
             if value is None and f in _STATED:
                 continue
+            if f == "strict_coverage":
+                if not isinstance(value, bool):
+                    raise ParameterError(
+                        f"criteria.strict_coverage must be true or false, got {value!r}"
+                    )
+                continue
             if not (isinstance(value, (int, float)) and np.isfinite(value) and value >= 0):
                 raise ParameterError(f"criteria.{f} must be a finite number >= 0, got {value!r}")
+        for f in _STATED:
+            if getattr(self, f) == 0:
+                raise ParameterError(
+                    f"criteria.{f} = 0 states that the uncertainty is exactly zero, which no "
+                    "simulation has; leave it out (not assessed) or state the real fraction"
+                )
         if self.k == 0:
             raise ParameterError("criteria.k (coverage factor) must be > 0")
         if self.max_volume_outside >= 1:

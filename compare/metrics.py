@@ -98,6 +98,23 @@ DEFINITIONS: dict[str, tuple[str, str, str]] = {
         "integral over the whole simulated width",
         "1",
     ),
+    "volume_fraction_outside": (
+        "share of the simulated worn volume outside the measured band",
+        "1 - volume_fraction_compared: the part of the simulation the comparison does not "
+        "validate (extrapolation)",
+        "1",
+    ),
+    "sim_global_max": (
+        "global maximum of the simulated wear",
+        "largest wear depth of the whole simulated map, inside or outside the measured band",
+        "m",
+    ),
+    "sim_global_max_z": ("axial position of the simulated global maximum", "z of it", "m"),
+    "sim_global_max_theta": (
+        "angle of the simulated global maximum",
+        "theta of it, canonical convention",
+        "degree",
+    ),
     "value_sim": ("simulated value", "value of the quantity from the simulation", "same"),
     "value_meas": ("measured value", "value of the quantity from the measurement", "same"),
     "relative_error": ("relative error", "(S - D) / |D|", "1"),

@@ -1,8 +1,9 @@
 """Where each standard uncertainty of the V&V 20 budget comes from, in order of precedence.
 
-``u_num`` (numerical): the simulation's own ``<name>_u`` > a verification study
-(``--verification``, GCI when it converges monotonically) > a fraction the user states in the
-criteria (labelled *user-stated*) > not assessed.
+``u_num`` (numerical): the quadrature sum of a verification study (``--verification``) and the
+simulation's own ``<name>_u`` (converted by its coverage factor), each source counted once
+(:func:`jointwear.compare.budget.combine`); without either, a fraction the user states in the
+criteria (labelled *user-stated*); else not assessed.
 
 ``u_input`` (model inputs): the spread of an ensemble (``--ensemble``) > a fraction the user
 states > not assessed.
@@ -20,11 +21,16 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from jointwear.compare._decide import Uncertainty, unknown
+from jointwear.compare.budget import Component, combine
 from jointwear.compare.criteria import Criteria
 from jointwear.compare.ensemble import Ensemble, spread
+from jointwear.compare.study import StudyResult, study_component
 from jointwear.compare.verification import GCI
 
-__all__ = ["Sources"]
+__all__ = ["Sources", "SIM_U_COVERS"]
+
+#: what the ``<name>_u`` of a ``jointwear sim wear`` run accounts for (its ``accuracy_note``)
+SIM_U_COVERS = frozenset({"wear-update interval", "cycle-to-cycle variability"})
 
 
 @dataclass(frozen=True)
@@ -44,6 +50,9 @@ class Sources:
     field_values : mapping
         Quantity -> per-ensemble per-run values computed from ensemble fields (preferred over
         the ensemble's scalar outputs).
+    studies : mapping
+        Quantity -> u_num of a ``jointwear sim verify`` study on the measured band
+        (:mod:`jointwear.compare.study`).
     """
 
     criteria: Criteria
@@ -51,21 +60,50 @@ class Sources:
     gci: Mapping[str, GCI] = field(default_factory=dict)
     compared_cycles: float | None = None
     field_values: Mapping[str, Sequence[tuple[int, np.ndarray]]] = field(default_factory=dict)
+    studies: Mapping[str, StudyResult] = field(default_factory=dict)
 
-    def u_num(self, quantity: str, s: float, stated: float | None, family: str) -> Uncertainty:
-        """Numerical standard uncertainty of a simulated value ``s`` (``family``: wear/motion)."""
-        if stated is not None and np.isfinite(stated):
-            return Uncertainty(float(stated), "stated by the simulation file (<name>_u)")
+    def u_num(
+        self,
+        quantity: str,
+        s: float,
+        stated: float | None,
+        family: str,
+        stated_note: str = "",
+    ) -> Uncertainty:
+        """Numerical standard uncertainty of a simulated value ``s`` (``family``: wear/motion).
+
+        ``stated`` is the simulation file's own standard uncertainty of the quantity (already
+        converted by its coverage factor, ``stated_note`` says how); it covers the wear-update
+        interval and the cycle-to-cycle variability only. A verification study adds what it
+        covers; a source counted by both is counted once (the study's estimate, by refinement,
+        is taken first). A user-stated fraction is used only when no file gives u_num.
+        """
+        comps: list[Component] = []
+        if quantity in self.studies:
+            cyc = self.compared_cycles if family == "wear" else None
+            comps.append(study_component(self.studies[quantity], s, cyc))
         g = self.gci.get(quantity)
-        if g is not None and g.assessed:
-            return Uncertainty(g.u_num_rel * abs(s), "verification: " + g.describe())
+        if g is not None:
+            comps.append(self._verification_component(g, s))
+        if stated is not None and np.isfinite(stated):
+            note = f" ({stated_note})" if stated_note else ""
+            what, covers = (
+                (": update interval and cycle-to-cycle variability of the wear rate", SIM_U_COVERS)
+                if family == "wear"
+                else ("", frozenset({"the simulation's own statement"}))
+            )
+            comps.append(
+                Component(float(stated), f"the simulation file's <name>_u{note}{what}", covers)
+            )
+        if any(c.known for c in comps):
+            return combine("u_num", comps)
         rel = getattr(self.criteria, f"{family}_u_num_rel")
         if rel is not None:
             return Uncertainty(
                 rel * abs(s), f"user-stated {rel:.3g}·|S| (criteria {family}_u_num_rel)"
             )
-        if g is not None:
-            return unknown(f"verification study: {g.reason}")
+        if comps:
+            return combine("u_num", comps)
         if self.gci:
             return unknown(
                 f"the verification study has no '{quantity}', the simulation states none "
@@ -75,6 +113,13 @@ class Sources:
             "the simulation states none (<name>_u), no verification study was given "
             f"(--verification) and the criteria state no {family}_u_num_rel"
         )
+
+    @staticmethod
+    def _verification_component(g: GCI, s: float) -> Component:
+        covers = frozenset({f"refinement of {g.refined}"} | g.covers)
+        if not g.assessed:
+            return Component(None, f"verification study: {g.reason}", covers)
+        return Component(g.u_num_rel * abs(s), "verification: " + g.describe(), covers)
 
     def u_input(self, quantity: str, s: float, family: str) -> Uncertainty:
         """Input standard uncertainty of a simulated value ``s``."""
@@ -115,8 +160,8 @@ class Sources:
         )
 
     @staticmethod
-    def u_d(stated: float | None) -> Uncertainty:
-        """Measurement standard uncertainty, from the measurement file only."""
+    def u_d(stated: float | None, note: str = "") -> Uncertainty:
+        """Measurement standard uncertainty, from the measurement file only (``note``: how)."""
         if stated is not None and np.isfinite(stated):
-            return Uncertainty(float(stated), "stated by the measurement file (<name>_u)")
+            return Uncertainty(float(stated), note or "stated by the measurement file (<name>_u)")
         return unknown("the measurement states no uncertainty (<name>_u)")

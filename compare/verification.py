@@ -11,9 +11,18 @@ interest. From the three finest solutions ``f1`` (finest), ``f2``, ``f3`` with r
 * the observed order ``p`` solves ``p = |ln|e32 / e21| + q(p)| / ln r21`` with
   ``q(p) = ln((r21^p - s) / (r32^p - s))``, ``s = sign(e32 / e21)`` (fixed-point iteration;
   ``q = 0`` for a constant ratio);
-* the extrapolated value ``f_ext = (r21^p f1 - f2) / (r21^p - 1)``, the relative error
-  ``e_a = |(f1 - f2) / f1|`` and ``GCI_fine = Fs e_a / (r21^p - 1)`` with the factor of safety
-  ``Fs = 1.25`` (Roache, three or more solutions).
+* the order used is capped at the formal order of the scheme, ``p_u = min(p, p_formal)``: an
+  observed order above it (three solutions changing by 1 % with ``p = 6``) would claim an
+  accuracy the scheme does not have;
+* the factor of safety is ``Fs = 1.25`` only when the observed order is credible,
+  ``0.5 <= p < p_formal + 0.1`` (Eça & Hoekstra 2014's range, scaled to the formal order);
+  otherwise ``Fs = 3`` (Roache's value for an unconfirmed order);
+* the extrapolated value ``f_ext = (r21^p_u f1 - f2) / (r21^p_u - 1)``, the relative error
+  ``e_a = |(f1 - f2) / f1|`` and ``GCI_fine = Fs e_a / (r21^p_u - 1)``.
+
+The formal order comes from the refinement coordinate's (or the dataset's) ``formal_order``
+attribute; without one it is taken as 1 (the explicit update of the wear in cycles is first
+order; a lower cap only makes the uncertainty larger) and the description says so.
 
 The GCI is an expanded (about 95 %) uncertainty; ASME V&V 20 (section 2-4) takes the standard
 numerical uncertainty as ``u_num = GCI / 1.15``. Two solutions cannot show that the sequence
@@ -28,6 +37,8 @@ References
   Procedure for estimation and reporting of uncertainty due to discretization in CFD
   applications. *J. Fluids Eng.* 130, 078001.
 - ASME V&V 20-2009 (R2021), section 2-4.
+- Eça, L., Hoekstra, M. (2014). A procedure for the estimation of the numerical uncertainty of
+  CFD calculations based on grid refinement studies. *J. Comput. Phys.* 262, 104-130.
 """
 
 from __future__ import annotations
@@ -67,6 +78,12 @@ class GCI:
         ``R = (f2 - f1) / (f3 - f2)`` (NaN when undefined).
     order : float
         Observed order of convergence ``p`` [1] (NaN when not assessed).
+    order_used : float
+        ``min(p, formal_order)``, the order the GCI is computed with [1].
+    formal_order : float
+        Formal order of the refined scheme [1].
+    formal_order_note : str
+        Where the formal order came from.
     extrapolated : float
         Richardson-extrapolated value ``f_ext`` (NaN when not assessed).
     relative_error : float
@@ -91,15 +108,34 @@ class GCI:
     gci_fine: float
     u_num_rel: float
     safety_factor: float
+    order_used: float = float("nan")
+    formal_order: float = 1.0
+    formal_order_note: str = "stated"
+    refined: str = "h"
+
+    @property
+    def covers(self) -> frozenset[str]:
+        """Error sources the study accounts for (beyond the refinement of ``refined`` itself)."""
+        name = self.refined.lower()
+        if any(key in name for key in UPDATE_INTERVAL_NAMES):
+            return frozenset({"wear-update interval"})
+        return frozenset()
 
     def describe(self) -> str:
         """One line for the report: the method and its figures, or why it was not assessed."""
         seq = " → ".join(f"{v:.4g}" for v in self.values[::-1])
         if not self.assessed:
             return f"{self.quantity}: not assessed - {self.reason} (coarse to fine: {seq})"
+        cap = (
+            f", capped at the formal order {self.formal_order:g} ({self.formal_order_note})"
+            if self.order > self.formal_order
+            else f" (formal order {self.formal_order:g}, {self.formal_order_note})"
+        )
+        credible = "p credible" if self.safety_factor == 1.25 else "p not credible"
         return (
-            f"{self.quantity}: GCI (Roache; Celik et al. 2008), Fs = {self.safety_factor:g}, "
-            f"observed order p = {self.order:.2f}, R = {self.convergence_ratio:.3g}, "
+            f"{self.quantity}: GCI (Roache; Celik et al. 2008), observed order p = "
+            f"{self.order:.2f}{cap}, {credible}: Fs = {self.safety_factor:g}, "
+            f"R = {self.convergence_ratio:.3g}, "
             f"GCI_fine = {self.gci_fine:.3g} -> u_num = GCI/{GCI_TO_STANDARD:g} = "
             f"{self.u_num_rel:.3g}·|S| (coarse to fine: {seq})"
         )
@@ -123,12 +159,24 @@ def _order(r21: float, r32: float, e21: float, e32: float) -> float:
     return float("nan")
 
 
+#: refinement coordinates that refine the wear-update interval (what sim wear's _u also covers)
+UPDATE_INTERVAL_NAMES = ("update_tolerance", "update_dn", "update_interval", "delta_n", "dn")
+
+#: Eça & Hoekstra's credible range of the observed order, as a fraction/offset of the formal one
+CREDIBLE_MIN_ORDER = 0.5
+CREDIBLE_ABOVE_FORMAL = 0.1
+FS_CREDIBLE = 1.25
+FS_NOT_CREDIBLE = 3.0
+
+
 def gci(
     h: Sequence[float],
     values: Sequence[float],
     *,
     quantity: str = "quantity",
-    safety_factor: float = 1.25,
+    formal_order: float = 1.0,
+    formal_order_note: str = "stated",
+    refined: str = "h",
 ) -> GCI:
     """Grid Convergence Index of a quantity from a refinement sequence (three finest solutions).
 
@@ -141,8 +189,12 @@ def gci(
         The quantity computed with each ``h`` [any unit].
     quantity : str
         Name used in messages.
-    safety_factor : float
-        ``Fs`` (1.25 for three or more solutions, Roache).
+    formal_order : float
+        Formal order of accuracy of the refined scheme [1], > 0: the cap of the order used.
+    formal_order_note : str
+        Where ``formal_order`` comes from (for the description).
+    refined : str
+        Name of the refinement parameter (what the study covers).
 
     Returns
     -------
@@ -150,6 +202,11 @@ def gci(
         ``assessed`` False (with the reason) unless the three finest solutions converge
         monotonically with refinement ratios > 1.
     """
+    if not (math.isfinite(formal_order) and formal_order > 0):
+        raise BadInputError(
+            f"verification of {quantity}: formal_order must be a number > 0, got {formal_order!r}"
+        )
+    safety_factor = FS_NOT_CREDIBLE
     h_arr = np.asarray(h, dtype=float)
     f_arr = np.asarray(values, dtype=float)
     if h_arr.shape != f_arr.shape or h_arr.ndim != 1:
@@ -222,7 +279,10 @@ def gci(
             e_a,
             safety_factor,
         )
-    rp = r21**p
+    credible = CREDIBLE_MIN_ORDER <= p < formal_order + CREDIBLE_ABOVE_FORMAL * formal_order
+    safety_factor = FS_CREDIBLE if credible else FS_NOT_CREDIBLE
+    p_used = min(p, formal_order)
+    rp = r21**p_used
     f_ext = (rp * f1 - f2) / (rp - 1)
     g = safety_factor * e_a / (rp - 1)
     return GCI(
@@ -238,7 +298,24 @@ def gci(
         g,
         g / GCI_TO_STANDARD,
         safety_factor,
+        p_used,
+        float(formal_order),
+        formal_order_note,
+        refined,
     )
+
+
+def _formal_order(ds: xr.Dataset, dim: str) -> tuple[float, str]:
+    for where, attrs in ((f"attribute of '{dim}'", ds[dim].attrs), ("dataset attribute", ds.attrs)):
+        if "formal_order" in attrs:
+            try:
+                return float(attrs["formal_order"]), f"formal_order {where}"
+            except (TypeError, ValueError):
+                raise BadInputError(
+                    f"verification data: formal_order {attrs['formal_order']!r} ({where}) is "
+                    "not a number"
+                ) from None
+    return 1.0, "not stated: taken as 1, the first-order wear update"
 
 
 def numerical_uncertainty(
@@ -270,9 +347,13 @@ def numerical_uncertainty(
                     f"verification data: '{name}' varies over '{dim}', which has no coordinate "
                     "values (the refinement parameter h of each solution)"
                 )
+            order, note = _formal_order(ds, str(dim))
             out[str(name)] = gci(
                 np.asarray(ds[dim].values, dtype=float),
                 np.asarray(var.values, dtype=float),
                 quantity=str(name),
+                formal_order=order,
+                formal_order_note=note,
+                refined=str(dim),
             )
     return out

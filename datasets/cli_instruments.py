@@ -8,6 +8,7 @@ from typing import Annotated, Literal
 import typer
 
 from jointwear._cli import Overwrite
+from jointwear._version import source_attribute
 
 
 def register(app: typer.Typer) -> None:
@@ -144,7 +145,7 @@ def register(app: typer.Typer) -> None:
             io.save(
                 t,
                 truth,
-                source="jointwear 0.1 (datasets.instruments)",
+                source=source_attribute("datasets.instruments"),
                 parameters={
                     "layers": layers,
                     "points": points,

@@ -41,9 +41,9 @@ from collections.abc import Sequence
 import numpy as np
 import xarray as xr
 
-from jointwear.dic._quicklook import plot_displacement, save_quicklook
-from jointwear.dic._sequence import correlate_sequence, read_frames
-from jointwear.dic._subset import CorrelationParams, MatchResult, SubsetCorrelator
+from jointwear.dic.subset._correlator import CorrelationParams, MatchResult, SubsetCorrelator
+from jointwear.dic.subset._quicklook import plot_displacement, save_quicklook
+from jointwear.dic.subset._sequence import correlate_sequence, read_frames
 
 __all__ = [
     "correlate",
@@ -128,6 +128,19 @@ def correlate(
         Images of different sizes or dtypes, not 2D, malformed points or guesses.
     ParameterError
         Even or too small subset size, unknown shape/interpolation, bad roi.
+
+    Examples
+    --------
+    Speckle images moved by an exact sub-pixel shift:
+
+    >>> from jointwear.datasets.speckle import RigidField, speckle_pair
+    >>> pair = speckle_pair((128, 128), RigidField(translation=(1.3, -0.7)))  # exact shift [pixel]
+    >>> from jointwear.dic import correlate
+    >>> ds = correlate(pair.reference, pair.deformed, subset_size=31, step=16)
+    >>> dict(ds.sizes)
+    {'x': 6, 'y': 6}
+    >>> print(f"u = {float(ds['u'].mean()):.3f}, v = {float(ds['v'].mean()):.3f} pixel")
+    u = 1.300, v = -0.700 pixel
     """
     params = CorrelationParams(
         subset_size=subset_size,

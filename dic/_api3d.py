@@ -10,20 +10,22 @@ Stereo geometry: :func:`triangulate` (with covariance), :func:`epipolar_distance
 :func:`plot_body_motion`.
 """
 
-from jointwear.dic._calib import (
+from jointwear.dic.calibration._board import CalibrationBoard, board_world_frame, calibrate_stereo
+from jointwear.dic.calibration._camera import (
     Camera,
     StereoCalibration,
     cardan_to_matrix,
+)
+from jointwear.dic.calibration._importers import (
     read_calibration,
     read_opencv_calibration,
     read_vic3d_calibration,
 )
-from jointwear.dic._calib_board import CalibrationBoard, board_world_frame, calibrate_stereo
-from jointwear.dic._footage import BodySpec, TrackConfig, read_bodies, track_footage
-from jointwear.dic._footage_plot import plot_body_motion
-from jointwear.dic._rigid import fit_rigid, fit_rigid_robust, time_derivative
-from jointwear.dic._stereo import epipolar_distance, stereo_noise_floor, triangulate
-from jointwear.dic._video import FrameSource, open_frames
+from jointwear.dic.calibration._stereo import epipolar_distance, stereo_noise_floor, triangulate
+from jointwear.dic.footage._plot import plot_body_motion
+from jointwear.dic.footage._rigid import fit_rigid, fit_rigid_robust, time_derivative
+from jointwear.dic.footage._track import BodySpec, TrackConfig, read_bodies, track_footage
+from jointwear.dic.footage._video import FrameSource, open_frames
 
 __all__ = [
     "Camera",

@@ -163,9 +163,9 @@ def register(app: typer.Typer) -> None:
         import time as _time
 
         from jointwear._version import __version__
-        from jointwear.dic._quicklook import save_quicklook
-        from jointwear.dic._sequence import correlate_sequence, read_frames, read_image
-        from jointwear.dic._subset import CorrelationParams, SubsetCorrelator
+        from jointwear.dic.subset._correlator import CorrelationParams, SubsetCorrelator
+        from jointwear.dic.subset._quicklook import save_quicklook
+        from jointwear.dic.subset._sequence import correlate_sequence, read_frames, read_image
         from jointwear.io import check_writable, save
         from jointwear.progress import progress_bar
 
@@ -194,7 +194,7 @@ def register(app: typer.Typer) -> None:
             )
         t0 = _time.perf_counter()
         if deformed is None:
-            from jointwear.dic._video import is_image_sequence
+            from jointwear.dic.footage._video import is_image_sequence
 
             if not reference.exists() and not is_image_sequence(reference):
                 raise BadInputError(f"'{reference}' does not exist")

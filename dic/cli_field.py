@@ -17,7 +17,7 @@ def _images(values: list[str] | None, what: str):
     if not values:
         return None
     if len(values) == 1:
-        from jointwear.dic._video import is_image_sequence
+        from jointwear.dic.footage._video import is_image_sequence
 
         if is_image_sequence(values[0]):
             return values[0]
@@ -30,7 +30,7 @@ def _images(values: list[str] | None, what: str):
 
 
 def _inputs(values: list[str] | None) -> list[Path]:
-    from jointwear.dic._video import is_image_sequence, list_image_sequence
+    from jointwear.dic.footage._video import is_image_sequence, list_image_sequence
 
     out: list[Path] = []
     for v in values or []:
@@ -113,8 +113,8 @@ def register(app: typer.Typer) -> None:
         import time as _time
 
         from jointwear._version import __version__
-        from jointwear.dic._field import FieldParams, measure_field
-        from jointwear.dic._field_io import save_field_plot, write_field_csv
+        from jointwear.dic.field._io import save_field_plot, write_field_csv
+        from jointwear.dic.field._measure import FieldParams, measure_field
         from jointwear.io import check_writable, save
 
         stereo = bool(left or right)
@@ -145,7 +145,7 @@ def register(app: typer.Typer) -> None:
         )
         t0 = _time.perf_counter()
         if stereo:
-            from jointwear.dic._calib import read_calibration
+            from jointwear.dic.calibration._importers import read_calibration
 
             cal = read_calibration(calibration)
             ds = measure_field(
@@ -217,7 +217,7 @@ def register_import(app: typer.Typer) -> None:
         import numpy as np
 
         from jointwear._version import __version__
-        from jointwear.dic._field_import import _files, read_field
+        from jointwear.dic.field._import import _files, read_field
         from jointwear.io import check_writable, save
 
         check_writable(out)

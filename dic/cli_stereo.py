@@ -12,13 +12,13 @@ from jointwear._cli import Overwrite
 
 def _image_list(path: Path, what: str) -> list[Path]:
     """Board images of one camera: a folder, or a pattern such as 'cal/*_0.tif'."""
-    from jointwear.dic._video import list_image_sequence
+    from jointwear.dic.footage._video import list_image_sequence
 
     return list_image_sequence(path, what=what)[0]
 
 
 def _video_frames(path: Path, every: int, what: str) -> list:
-    from jointwear.dic._video import open_frames
+    from jointwear.dic.footage._video import open_frames
 
     src = open_frames(path, what=what)
     return [img for i, _, img in src.frames() if i % every == 0]
@@ -104,10 +104,10 @@ def register(app: typer.Typer) -> None:
         writes it to --out instead).
         """
         from jointwear import io
-        from jointwear.dic._calib import _LENGTH_UNITS
-        from jointwear.dic._calib_board import CalibrationBoard, calibrate_stereo
-        from jointwear.dic._calib_gate import PoorCalibration, view_table
-        from jointwear.dic._video import is_image_sequence
+        from jointwear.dic.calibration._board import CalibrationBoard, calibrate_stereo
+        from jointwear.dic.calibration._gate import PoorCalibration, view_table
+        from jointwear.dic.calibration._importers import _LENGTH_UNITS
+        from jointwear.dic.footage._video import is_image_sequence
 
         if square_mm is not None:
             if square is not None:
@@ -238,7 +238,10 @@ def register(app: typer.Typer) -> None:
         ] = None,
     ) -> None:
         """Import a calibration made elsewhere (OpenCV FileStorage, VIC-3D) as a jointwear file."""
-        from jointwear.dic._calib import read_opencv_calibration, read_vic3d_calibration
+        from jointwear.dic.calibration._importers import (
+            read_opencv_calibration,
+            read_vic3d_calibration,
+        )
         from jointwear.errors import BadInputError
 
         inputs = [*paths, *([extrinsics] if extrinsics is not None else [])]
@@ -334,8 +337,8 @@ def register(app: typer.Typer) -> None:
         computed (attribute 'status').
         """
         from jointwear import io
-        from jointwear.dic._calib import read_calibration
-        from jointwear.dic._footage import read_bodies, track_footage
+        from jointwear.dic.calibration._importers import read_calibration
+        from jointwear.dic.footage._track import read_bodies, track_footage
 
         io.check_writable(out)
         cfg, specs = read_bodies(bodies)
@@ -396,7 +399,7 @@ def register(app: typer.Typer) -> None:
                     err=True,
                 )
         if plot is not None:
-            from jointwear.dic._footage_plot import plot_body_motion
+            from jointwear.dic.footage._plot import plot_body_motion
 
             plot_body_motion(ds, path=plot)
             typer.echo(f"plot -> {plot}")
@@ -415,7 +418,7 @@ def register(app: typer.Typer) -> None:
     ) -> None:
         """Plot the follower velocity and the journal's out-of-plane displacement."""
         from jointwear import io
-        from jointwear.dic._footage_plot import plot_body_motion
+        from jointwear.dic.footage._plot import plot_body_motion
 
         ds = io.load(motion)
         ref = io.load(reference) if reference is not None else None

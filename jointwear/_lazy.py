@@ -45,7 +45,7 @@ def lazy_api(
     loading = False
 
     def __getattr__(name: str) -> Any:
-        # Private names are submodules (``from jointwear.dic import _flags``): answering
+        # Private names are submodules (``from jointwear.dic import _api2d``): answering
         # AttributeError lets the import system load them without pulling in the whole API,
         # and so does any lookup made while the API modules themselves are being imported.
         nonlocal loading
@@ -79,7 +79,9 @@ class _ShadowingModule(types.ModuleType):
             isinstance(value, types.ModuleType)
             and not name.startswith("_")
             and value.__name__ == f"{self.__name__}.{name}"
-            and name in getattr(value, "__all__", ())
+            # the module's own __all__ only: a lazy subpackage computes its __all__ on first
+            # use, and binding it must not load it
+            and name in vars(value).get("__all__", ())
         ):
             value = getattr(value, name)
         super().__setattr__(name, value)

@@ -188,3 +188,20 @@ def wearmap(
             tool=tool,
         )
     _save(ds, out, file)
+
+
+@app.command("reported")
+def reported(
+    file: Annotated[Path, typer.Argument(help="Reported-measurement TOML file (schema in docs).")],
+    out: Annotated[Path, _OUT],
+    overwrite: Overwrite = False,
+) -> None:
+    """Import reported measurements (a lab sheet's or a paper's numbers) from a TOML file."""
+    from jointwear import io
+    from jointwear.params import read_toml
+    from jointwear.reported import reported_dataset
+
+    data = read_toml(file)
+    ds = reported_dataset(data, file)
+    io.save(ds, out, inputs=[file], parameters={"reported": data})
+    typer.echo(f"wrote {out} ({ds.attrs['data_origin']}, {len(ds.data_vars) // 2} quantities)")

@@ -20,7 +20,7 @@ import numpy as np
 import xarray as xr
 
 from jointwear import conventions, outputs
-from jointwear._version import __version__
+from jointwear._version import source_attribute
 from jointwear.errors import BadInputError
 from jointwear.provenance import build_provenance, dumps, history_line
 
@@ -171,7 +171,7 @@ def save(
     command : str, optional
         Command line; defaults to ``sys.argv``.
     source : str, optional
-        CF ``source`` attribute, e.g. ``"jointwear 0.1 (sim.wear)"``; kept from ``ds`` if set.
+        CF ``source`` attribute, e.g. ``source_attribute("sim.wear")``; kept from ``ds`` if set.
     title : str, optional
         CF ``title``; kept from ``ds`` if set.
     parents : iterable of Dataset
@@ -190,7 +190,7 @@ def save(
         conventions.validate(out, what=f"dataset to be written to '{path}'")
     out.attrs["Conventions"] = "CF-1.11"
     out.attrs["title"] = title or out.attrs.get("title") or "jointwear dataset"
-    out.attrs["source"] = source or out.attrs.get("source") or f"jointwear {__version__}"
+    out.attrs["source"] = source or out.attrs.get("source") or source_attribute()
     line = history_line(command)
     previous = out.attrs.get("history")
     out.attrs["history"] = f"{previous}\n{line}" if previous else line

@@ -3,14 +3,14 @@
 from __future__ import annotations
 
 import dataclasses
+import math
+import numbers
 import tomllib
 import types
 import typing
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any, TypeVar
-
-import numpy as np
 
 from jointwear.errors import BadInputError, ParameterError
 
@@ -88,19 +88,21 @@ def _coerce(value: Any, tp: Any, where: str) -> Any:
         out = [_coerce(v, inner, f"{where}[{i}]") for i, v in enumerate(value)]
         return tuple(out) if origin is tuple else out
     if tp is float:
-        if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+        if isinstance(value, bool) or not isinstance(value, numbers.Real):
             raise ParameterError(f"{where}: expected a number, got {value!r}")
         value = float(value)
-        if not np.isfinite(value):
+        if not math.isfinite(value):
             raise ParameterError(f"{where}: expected a finite number, got {value!r}")
         return value
     if tp is int:
-        if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+        if isinstance(value, bool) or not isinstance(value, numbers.Integral):
             if isinstance(value, float) and value.is_integer():
                 return int(value)
             raise ParameterError(f"{where}: expected an integer, got {value!r}")
         return int(value)
     if tp is bool:
+        import numpy as np  # not at import time: the CLI reads parameter defaults at start-up
+
         if not isinstance(value, (bool, np.bool_)):
             raise ParameterError(f"{where}: expected true or false, got {value!r}")
         return bool(value)
@@ -168,6 +170,8 @@ def replace_nested(obj: T, **changes: Any) -> T:
 
 def to_jsonable(obj: Any) -> Any:
     """Convert dataclasses, numpy scalars/arrays, paths and tuples into JSON-ready values."""
+    import numpy as np
+
     if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
         return {f.name: to_jsonable(getattr(obj, f.name)) for f in dataclasses.fields(obj)}
     if isinstance(obj, Mapping):
@@ -180,6 +184,6 @@ def to_jsonable(obj: Any) -> Any:
         return obj.item()
     if isinstance(obj, Path):
         return str(obj)
-    if isinstance(obj, float) and not np.isfinite(obj):
+    if isinstance(obj, float) and not math.isfinite(obj):
         return str(obj)
     return obj

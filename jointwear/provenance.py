@@ -13,7 +13,7 @@ from importlib import metadata
 from pathlib import Path
 from typing import Any
 
-from jointwear._version import __version__
+from jointwear._version import __version__, source_attribute
 from jointwear.params import to_jsonable
 
 __all__ = [
@@ -23,6 +23,7 @@ __all__ = [
     "history_line",
     "command_line",
     "utc_now",
+    "source_attribute",
 ]
 
 _PACKAGES = (

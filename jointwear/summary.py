@@ -47,6 +47,10 @@ def summarise(path: str | Path, *, validate: bool = True) -> str:
         lines.append(
             f"  {name}({dims}) [{v.attrs.get('units', '?')}]: {v.attrs.get('long_name', '')}"
         )
+    if ds.attrs.get("jointwear_file") == "verification_study":
+        from jointwear.refinement import describe_study
+
+        lines.append(describe_study(ds))
     if "history" in ds.attrs:
         lines.append("history:")
         lines.extend("  " + h for h in str(ds.attrs["history"]).splitlines())

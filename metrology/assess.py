@@ -58,7 +58,7 @@ def _scan_var(scan: xr.Dataset | xr.DataArray) -> tuple[xr.DataArray, str]:
 def assess(
     scan: xr.Dataset | xr.DataArray,
     *,
-    references: tuple[str, ...] = ("LS", "MZ", "MI", "MC"),
+    references: tuple[str, ...] = tuple(REFERENCES),
     filter_upr: float | None = None,
     filter_kind: str = "gaussian",
     outliers: float | None = None,

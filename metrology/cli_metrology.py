@@ -9,6 +9,7 @@ from typing import Annotated
 import typer
 
 from jointwear._cli import Overwrite
+from jointwear._version import source_attribute
 
 
 class AngleUnit(StrEnum):
@@ -85,7 +86,7 @@ class ValueKind(StrEnum):
     deviation = "deviation"
 
 
-_SOURCE = "jointwear 0.1 (metrology)"
+_SOURCE = source_attribute("metrology")
 
 
 def _length_unit(value: str | None) -> str | None:

@@ -176,6 +176,11 @@ def _verdict(c: Comparison, counts: dict[str, int]) -> tuple[str, str]:
     )
     if n == 0:
         return "NO DECISION: nothing was compared", "undecided"
+    if c.wear is not None and any(str(t).startswith("validation domain") for t in c.notes):
+        from jointwear.compare._wear import band_label
+
+        # the wear is judged on the measured band only; the rest of the simulation is not
+        synthetic += f"; wear judged {band_label(c.wear)}, outside it extrapolated"
     if counts[vd.FAIL]:
         return f"NOT VALIDATED: {counts[vd.FAIL]} of {n} criteria failed{synthetic}", "fail"
     undecided = counts[vd.NOT_ASSESSED] + counts[vd.NOT_COMPARABLE]
@@ -212,12 +217,14 @@ def _coverage(c: Comparison) -> list[str]:
     out += [
         f"Compared axial range z = {lo * 1e3:+.2f} to {hi * 1e3:+.2f} mm of the simulated "
         f"{zs[0] * 1e3:+.2f} to {zs[1] * 1e3:+.2f} mm: {frac:.0%} of the simulated worn volume "
-        "is compared (uncompared region hatched on the wear maps)."
+        "is compared (uncompared region hatched on the wear maps); every wear criterion is "
+        "decided within this range."
     ]
     if not int(a.get("sim_max_inside", 1)):
         out.append(
             f"The simulated maximum ({float(a['sim_max_value_m']) * 1e6:.3g} µm at z = "
-            f"{float(a['sim_max_z_m']) * 1e3:+.2f} mm) lies outside the measured range."
+            f"{float(a['sim_max_z_m']) * 1e3:+.2f} mm) lies outside the measured range: there "
+            "the simulation is an extrapolation, not validated (validation domain)."
         )
     return out
 

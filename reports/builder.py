@@ -21,7 +21,7 @@ import xarray as xr
 
 from jointwear import io
 from jointwear._version import __version__
-from jointwear.compare import Comparison, Criteria, compare
+from jointwear.compare import DEFAULT_AXES, Comparison, Criteria, compare
 from jointwear.errors import BadInputError
 from jointwear.params import to_jsonable
 from jointwear.provenance import command_line, sha256_file, software_versions
@@ -308,6 +308,24 @@ def build_report(
     -------
     Path
         The HTML file.
+
+    Examples
+    --------
+    The self-contained HTML report of a simulated wear map compared with itself, labelled as
+    synthetic measurement data:
+
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from jointwear.compare import compare
+    >>> from jointwear.reports import build_report
+    >>> from jointwear.sim import BearingGrid, WearSettings, WinklerContact, simulate_wear
+    >>> run = {"contact": WinklerContact(BearingGrid(4, 36)), "snapshots": [1000, 2000]}
+    >>> sim = simulate_wear(cycles=2000, settings=WearSettings(scheme="fixed", dn=500), **run)
+    >>> meas = sim.isel(cycles=-1, drop=True)[["wear_depth"]]
+    >>> comparison = compare(sim, meas.assign_attrs(data_origin="synthetic", cycles=2000))
+    >>> page = build_report(comparison, Path(tempfile.mkdtemp()) / "report.html")
+    >>> page.name, "maximum wear depth" in page.read_text(encoding="utf-8")
+    ('report.html', True)
     """
     html = render_html(
         comparison,
@@ -348,8 +366,9 @@ def report_from_files(
     period_s: float | None = None,
     variables: Sequence[str] | None = None,
     ensemble: Sequence[str | Path] = (),
-    axes: Sequence[str] | None = ("x", "y"),
+    axes: Sequence[str] | None = DEFAULT_AXES,
     warn: Callable[[str], None] | None = None,
+    reported: Sequence[str | Path] = (),
 ) -> tuple[Path, Comparison]:
     """Build a report from files: simulation, metrology and DIC netCDF, or a saved comparison.
 
@@ -369,6 +388,9 @@ def report_from_files(
         Ensembles of simulations (``run`` dimension) whose spread is the input uncertainty.
     axes : sequence of str or None
         Motion components to compare (default in-plane x, y).
+    reported : sequence of path
+        Reported measurements (``jointwear import reported``), judged beside or instead of the
+        metrology and DIC files (:mod:`jointwear.compare.reported`).
     warn : callable, optional
         Receives the warning text for a file from another tool (the CLI prints it on stderr);
         by default it is a :class:`UserWarning` (see
@@ -393,9 +415,10 @@ def report_from_files(
     vers = [io.load(p, validate=False) for p in verification]
     ens_ds = [io.load(p) for p in ensemble]
     if comparison is not None:
-        if sim or metrology or dic or ensemble:
+        if sim or metrology or dic or ensemble or reported:
             raise BadInputError(
-                "give either --comparison or --sim/--metrology/--dic/--ensemble, not both"
+                "give either --comparison or --sim/--metrology/--dic/--reported/--ensemble, "
+                "not both"
             )
         ds = io.load(comparison)
         result = load_comparison(ds)
@@ -403,27 +426,30 @@ def report_from_files(
     else:
         if not sim:
             raise BadInputError("no simulation given: pass --sim FILE.nc (wear map and/or motion)")
-        if not metrology and not dic:
+        if not metrology and not dic and not reported:
             raise BadInputError(
-                "no measurement given: pass --metrology FILE.nc (wear map) and/or --dic FILE.nc"
+                "no measurement given: pass --metrology FILE.nc (wear map), --dic FILE.nc "
+                "and/or --reported FILE.nc (reported values)"
             )
         from jointwear.external import load_for_comparison
 
         sims = [load_for_comparison(p, role="simulated", warn=warn) for p in sim]
         metros = [load_for_comparison(p, role="measured", warn=warn) for p in metrology]
         dics = [load_for_comparison(p, role="measured", warn=warn) for p in dic]
+        reps = [io.load(p) for p in reported]
         inputs += [ReportInput("simulation", Path(p), d) for p, d in zip(sim, sims, strict=True)]
         inputs += [
             ReportInput("metrology", Path(p), d) for p, d in zip(metrology, metros, strict=True)
         ]
         inputs += [ReportInput("DIC", Path(p), d) for p, d in zip(dic, dics, strict=True)]
+        inputs += [ReportInput("reported", Path(p), d) for p, d in zip(reported, reps, strict=True)]
         if not metrology:
             missing.append("wear maps: no metrology file was given (--metrology)")
         if not dic:
             missing.append("motion: no DIC file was given (--dic)")
         result = compare(
             sims,
-            [*metros, *dics],
+            [*metros, *dics, *reps],
             criteria=criteria,
             cycles=cycles,
             period_s=period_s,

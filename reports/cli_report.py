@@ -33,6 +33,13 @@ def register(app: typer.Typer) -> None:
             list[Path] | None,
             typer.Option("--dic", help="Measured motion (.nc from jointwear dic)."),
         ] = None,
+        reported: Annotated[
+            list[Path] | None,
+            typer.Option(
+                "--reported",
+                help="Reported measurements (.nc from jointwear import reported); repeatable.",
+            ),
+        ] = None,
         comparison: Annotated[
             Path | None,
             typer.Option("--comparison", help="A metrics.nc from jointwear compare instead."),
@@ -115,6 +122,7 @@ def register(app: typer.Typer) -> None:
             ensemble=ensemble or [],
             axes=axes or ("x", "y"),
             warn=echo_warning,
+            reported=reported or [],
         )
         typer.echo(origin_line(result))
         for row in result.decisions.itertuples():

@@ -35,6 +35,7 @@ from jointwear import io
 from jointwear.errors import JointwearError, ValidationFailed
 from jointwear.reports.demo_studies import (
     ENSEMBLE_INPUTS,
+    main_wear_settings,
     motion_verification,
     run_ensemble,
     wear_verification,
@@ -64,14 +65,14 @@ class DemoSize:
     motion_cycles: float
     rig_size: tuple[int, int] | None  # stereo footage (width, height) [px]; None = no footage
     rig_duration: float  # recorded time [s]
-    verification_tols: tuple[float, ...]  # coarser wear-update tolerances for the study
+    verification_replicates: int  # runs per dN level of the verification study (0: none)
     ensemble_runs: int = 0  # members of the input-uncertainty ensemble (0: none)
     ensemble_cycles: float = 0.0  # wear cycles of each member (reduced)
     ensemble_updates: int = 4  # fixed wear updates per member
 
 
-FULL = DemoSize(2e5, (2e5,), 10, 90, 18000, 1.5, (640, 512), 0.6, (0.4, 0.2), 8, 5e4, 4)
-QUICK = DemoSize(5e4, (5e4,), 8, 72, 3600, 1.2, None, 0.0, ())
+FULL = DemoSize(2e5, (2e5,), 10, 90, 18000, 1.5, (640, 512), 0.6, 3, 8, 5e4, 4)
+QUICK = DemoSize(5e4, (5e4,), 8, 72, 3600, 1.2, None, 0.0, 0)
 
 
 def _say(msg: str) -> None:
@@ -88,16 +89,21 @@ def _available(module: str, *names: str) -> bool:
     return all(hasattr(mod, n) for n in names)
 
 
-def _simulate(folder: Path, size: DemoSize) -> tuple[Path, Path, Any, Path | None, float]:
+def _simulate(folder: Path, size: DemoSize) -> tuple[Path, Path, Any, list[Path], float]:
     from jointwear.params import replace_nested
-    from jointwear.sim import PARAMETER_SETS, WearSettings, run_cycles, simulate_wear
+    from jointwear.sim import DEFAULT_PARAMETER_SET, PARAMETER_SETS, run_cycles, simulate_wear
 
     params = replace_nested(
-        PARAMETER_SETS["zhang2023"],
+        PARAMETER_SETS[DEFAULT_PARAMETER_SET],
         **{"joint.n_layers": size.n_layers, "joint.n_points": size.n_points},
     )
     t0 = time.perf_counter()
-    wear = simulate_wear(params, cycles=size.cycles, snapshots=list(size.snapshots))
+    wear = simulate_wear(
+        params,
+        cycles=size.cycles,
+        snapshots=list(size.snapshots),
+        settings=main_wear_settings(size),
+    )
     wear.attrs["data_origin"] = "simulated"
     sim_wear = io.save(
         wear,
@@ -134,27 +140,26 @@ def _simulate(folder: Path, size: DemoSize) -> tuple[Path, Path, Any, Path | Non
     _say(
         f"  simulated motion: {size.motion_cycles:g} crank cycles ({time.perf_counter() - t0:.0f} s)"
     )
-    verification_path, u_num_rel = None, 0.0
-    if size.verification_tols:
+    verification_paths: list[Path] = []
+    if size.verification_replicates:
         from jointwear.compare import numerical_uncertainty
+        from jointwear.refinement import describe_study
 
         t0 = time.perf_counter()
-        ver, u_num_rel = wear_verification(params, size, wear, WearSettings().tol)
-        ver = xr.merge([ver, motion_verification(params, size, motion)], combine_attrs="override")
-        verification_path = io.save(
+        study_path, study = wear_verification(params, size, folder)
+        ver = motion_verification(params, size, motion)
+        motion_path = io.save(
             ver,
-            folder / "sim_verification.nc",
-            parameters={
-                "simulation": params,
-                "update_tolerances": list(ver["update_tolerance"].values),
-                "solver_rtols": list(ver["solver_rtol"].values),
-            },
-            source="jointwear (sim.wear, sim.dynamics) via jointwear demo",
+            folder / "sim_verification_motion.nc",
+            parameters={"simulation": params, "solver_rtols": list(ver["solver_rtol"].values)},
+            source="jointwear (sim.dynamics) via jointwear demo",
         )
+        verification_paths = [study_path, motion_path]
         _say(f"  verification studies ({time.perf_counter() - t0:.0f} s):")
+        _say("      " + describe_study(study).replace("\n", "\n      "))
         for g in numerical_uncertainty(ver).values():
             _say(f"      {g.describe()}")
-    return sim_wear, sim_motion, params, verification_path, u_num_rel
+    return sim_wear, sim_motion, params, verification_paths, 0.0
 
 
 def measured_wear_function(sim_wear: xr.Dataset) -> Any:
@@ -378,16 +383,18 @@ def run_demo(out: Path, *, quick: bool = False) -> Path:
     ]
     sims: list[Path] = []
     meas: list[tuple[str, Path]] = []
-    sim_wear_path = sim_motion_path = verification_path = ensemble_path = None
+    sim_wear_path = sim_motion_path = ensemble_path = None
+    verification_paths: list[Path] = []
     params = None
     _phase(1, "simulating the reference mechanism: wear and motion")
     if _available("jointwear.sim", "simulate_wear", "run_cycles", "PARAMETER_SETS"):
-        sim_wear_path, sim_motion_path, params, verification_path, _ = _simulate(out, size)
+        sim_wear_path, sim_motion_path, params, verification_paths, _ = _simulate(out, size)
         sims += [sim_wear_path, sim_motion_path]
-        if verification_path is None:
+        if not verification_paths:
             missing.append(
-                "verification: the convergence study of the wear update is skipped with --quick, "
-                "so u_num is not assessed"
+                "verification: the sim verify study is skipped with --quick; u_num of the wear is "
+                "the simulation's own wear_depth_u (update interval and cycle-to-cycle "
+                "variability; the wear grid is not assessed)"
             )
     else:
         missing.append("simulation: jointwear.sim is not available, nothing was simulated")
@@ -464,7 +471,7 @@ def run_demo(out: Path, *, quick: bool = False) -> Path:
             "calibration's world frame (the board), not the mechanism frame, and are not compared."
         )
     ens_ds = [io.load(ensemble_path)] if ensemble_path is not None else []
-    ver_ds = [io.load(verification_path)] if verification_path is not None else []
+    ver_ds = [io.load(p) for p in verification_paths]
     result = compare(
         sim_ds,
         [_in_plane(d) if role == "DIC" else d for (role, _), d in zip(meas, meas_ds, strict=True)],
@@ -482,8 +489,9 @@ def run_demo(out: Path, *, quick: bool = False) -> Path:
     inputs += [ReportInput(role, p, d) for (role, p), d in zip(meas, meas_ds, strict=True)]
     if ensemble_path is not None:
         inputs.append(ReportInput("ensemble", ensemble_path, ens_ds[0]))
-    if verification_path is not None:
-        inputs.append(ReportInput("verification", verification_path, ver_ds[0]))
+    inputs += [
+        ReportInput("verification", p, d) for p, d in zip(verification_paths, ver_ds, strict=True)
+    ]
     report = build_report(
         result,
         out / "report.html",

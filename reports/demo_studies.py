@@ -13,9 +13,12 @@ if TYPE_CHECKING:
     from jointwear.reports.demo import DemoSize
 
 __all__ = [
+    "DEMO_STUDY_UPDATES",
     "ENSEMBLE_INPUTS",
     "MOTION_RTOLS",
+    "demo_study",
     "ensemble_spec",
+    "main_wear_settings",
     "motion_verification",
     "run_ensemble",
     "wear_verification",
@@ -28,77 +31,65 @@ def _say(msg: str) -> None:
     typer.echo(msg, err=True)
 
 
-def wear_verification(
-    params: Any, size: DemoSize, main: xr.Dataset, main_tol: float
-) -> tuple[xr.Dataset, float]:
-    """Convergence of the simulated wear with the cycle-update tolerance (verification).
+#: The demo's verification study: ΔN levels as a fraction of the demo's cycles, replicates per
+#: level and runs on the grid refined 2x (a reduced :meth:`jointwear.sim.VerifySpec.default`).
+DEMO_STUDY_UPDATES = 40  # updates of the finest level
+DEMO_STUDY_GRID_REPLICATES = 2
 
-    The wear run is repeated with coarser tolerances of the adaptive update interval
-    (``WearSettings.tol``). :func:`jointwear.compare.compare` turns the study into ``u_num`` by
-    the GCI (:mod:`jointwear.compare.verification`) only where the three solutions converge
-    monotonically; otherwise u_num is reported as not assessed, with the reason. The returned
-    relative change between the two finest runs is for the console only.
+
+def demo_study(size: DemoSize) -> Any:
+    """The demo's verification study (``jointwear sim verify`` spec) at demo size.
+
+    ΔN = cycles/40 x (1, 2, 4, 8), ``size.verification_replicates`` runs per level starting at
+    different phases of the motion, and 2 runs on the grid refined 2x at the finest ΔN.
+    """
+    from jointwear.sim import VerifySpec
+
+    finest = max(1, round(size.cycles / DEMO_STUDY_UPDATES))
+    return VerifySpec(
+        cycles=size.cycles,
+        levels=tuple(finest * 2**k for k in range(4)),
+        replicates=size.verification_replicates,
+        grid_replicates=DEMO_STUDY_GRID_REPLICATES,
+    )
+
+
+def main_wear_settings(size: DemoSize) -> Any:
+    """Wear settings of the demo's compared wear run.
+
+    With a verification study the compared run is the verified configuration: the fixed update
+    scheme at the study's finest ΔN (replicate 0 of its finest level), so the study's
+    ``u_num_run`` is its numerical uncertainty. Without one (``--quick``): the default adaptive
+    scheme.
+    """
+    from jointwear.sim import WearSettings
+
+    if not size.verification_replicates:
+        return WearSettings()
+    return WearSettings(scheme="fixed", dn=demo_study(size).levels[0])
+
+
+def wear_verification(params: Any, size: DemoSize, folder: Any) -> tuple[Any, xr.Dataset]:
+    """The demo's verification study of the simulated wear (:func:`jointwear.sim.verify_wear`).
+
+    Replicates at four wear-update intervals ΔN and runs on the next grid (:func:`demo_study`),
+    in this process; :func:`jointwear.refinement.study_uncertainty` turns the study into u_num of
+    any wear quantity (Eça & Hoekstra 2014 on the replicate means, plus the grid term), so max
+    depth, volume and cylindricity are assessed with a value (the earlier refinement of the
+    adaptive update's ``tol`` was inert: the noise floor, not ``tol``, set the interval).
 
     Returns
     -------
-    (Dataset, float)
-        ``max_wear_depth`` [m] and ``worn_volume`` [m³] over ``update_tolerance`` [1], and the
-        relative numerical uncertainty [1].
+    (Path, Dataset)
+        The study file ``sim_verification.nc`` in ``folder`` and the study.
     """
-    from jointwear.sim import WearSettings, simulate_wear
+    from pathlib import Path
 
-    tols = [*size.verification_tols, main_tol]
-    depth, volume, cyl = [], [], []
-    for tol in size.verification_tols:
-        run = simulate_wear(
-            params,
-            cycles=size.cycles,
-            snapshots=list(size.snapshots),
-            settings=WearSettings(tol=tol),
-        )
-        depth.append(float(run["max_wear_depth"][-1]))
-        volume.append(float(run["worn_volume"][-1]))
-        cyl.append(float(run["cylindricity"][-1]))
-    depth.append(float(main["max_wear_depth"][-1]))
-    volume.append(float(main["worn_volume"][-1]))
-    cyl.append(float(main["cylindricity"][-1]))
-    rel = max(abs(depth[-1] - depth[-2]) / depth[-1], abs(volume[-1] - volume[-2]) / volume[-1])
-    ds = xr.Dataset(
-        {
-            "max_wear_depth": (
-                "update_tolerance",
-                depth,
-                {"units": "m", "long_name": "largest simulated wear depth"},
-            ),
-            "worn_volume": (
-                "update_tolerance",
-                volume,
-                {"units": "m3", "long_name": "simulated worn volume"},
-            ),
-            "cylindricity": (
-                "update_tolerance",
-                cyl,
-                {"units": "m", "long_name": "cylindricity of the simulated worn bore"},
-            ),
-        },
-        coords={
-            "update_tolerance": (
-                "update_tolerance",
-                tols,
-                {
-                    "units": "1",
-                    "long_name": "tolerance of the adaptive wear-update interval (WearSettings.tol)",
-                },
-            )
-        },
-        attrs={
-            "title": "verification: simulated wear versus the cycle-update tolerance",
-            "data_origin": "simulated",
-            "u_num_rel": rel,
-            "cycles": size.cycles,
-        },
-    )
-    return ds, rel
+    from jointwear.sim import verify_wear
+
+    path = Path(folder) / "sim_verification.nc"
+    study = verify_wear(params, spec=demo_study(size), workers=0, out=path)
+    return path, study
 
 
 #: solver tolerances of the motion verification study (the default 1e-6 is the finest)
@@ -165,14 +156,24 @@ ENSEMBLE_INPUTS: dict[str, tuple[float, str]] = {
 }
 
 
-def ensemble_spec(params: Any, size: DemoSize) -> dict[str, Any]:
-    """The demo's sweep spec (``jointwear sim sweep`` format): LHS over :data:`ENSEMBLE_INPUTS`."""
+def ensemble_spec(params: Any, size: Any, *, kw: float | None = None) -> dict[str, Any]:
+    """The demo's sweep spec (``jointwear sim sweep`` format): LHS over :data:`ENSEMBLE_INPUTS`.
+
+    ``size`` gives ``ensemble_cycles`` and ``ensemble_runs``; ``kw`` the nominal wear
+    coefficient (default :data:`jointwear.sim.DEFAULT_KW`). An input whose nominal value is 0
+    (e.g. a frictionless model) is not varied: a relative spread of 0 is no distribution.
+    """
     from jointwear.sim import DEFAULT_KW
 
     parameters: dict[str, Any] = {}
     for name, (rel, _) in ENSEMBLE_INPUTS.items():
         section, field = name.split(".")
-        mean = DEFAULT_KW if name == "wear.kw" else float(getattr(getattr(params, section), field))
+        if name == "wear.kw":
+            mean = DEFAULT_KW if kw is None else float(kw)
+        else:
+            mean = float(getattr(getattr(params, section), field))
+        if mean == 0:
+            continue
         spec = {"distribution": "truncnormal", "mean": mean, "std": rel * mean}
         spec["bounds"] = [mean * (1 - 4 * rel), mean * (1 + 4 * rel)]
         parameters[name] = spec

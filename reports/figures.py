@@ -267,9 +267,37 @@ def motion_figure(motion: xr.Dataset, *, k: float = 2.0) -> Any:
 _DISPLAY = {"m": (1e6, "µm"), "m3": (1e9, "mm³")}
 
 
+#: Quantities of a verification study shown in the report (when present).
+STUDY_PLOTTED = ("max_wear_depth", "worn_volume", "cylindricity")
+
+
+def _study_series(ds: xr.Dataset) -> list[tuple]:
+    """Series of a ``jointwear sim verify`` study: level means over ΔN with their standard
+    errors and the band value ± u_num (k = 1) of the finest level."""
+    out = []
+    names = [str(q) for q in ds["quantity"].values]
+    for q in [*STUDY_PLOTTED, *(n for n in names if n.endswith("_in_band"))]:
+        if q not in names:
+            continue
+        row = ds.sel(quantity=q)
+        assessed = int(row["assessed"]) == 1
+        attrs = {
+            "units": str(row["quantity_units"].values),
+            "long_name": f"{q}, band: value ± u_num" if assessed else f"{q}: u_num not assessed",
+            "sem": np.asarray(row["level_sem"].values, dtype=float),
+            "value": float(row["value"]),
+            "u_num": float(row["u_num"]) if assessed else float("nan"),
+        }
+        x = np.asarray(ds["h"].values, dtype=float)
+        out.append((q, "h", x, np.asarray(row["level_mean"].values, dtype=float), attrs, ds))
+    return out
+
+
 def verification_figure(datasets: Sequence[xr.Dataset]) -> Any | None:
     """Convergence plots of verification data: every 1-D variable against its dimension.
 
+    A ``jointwear sim verify`` study shows the replicate means ± standard error of its wear
+    quantities over ΔN and the finest level's value ± u_num (k = 1) as a band.
     Logarithmic x axis when the refinement parameter is positive (tolerances, grid steps), and
     a logarithmic y axis too when the values are positive and span more than a decade (then the
     slope is the observed order of convergence). Lengths in µm, volumes in mm³. Returns None
@@ -280,6 +308,9 @@ def verification_figure(datasets: Sequence[xr.Dataset]) -> Any | None:
 
     series = []
     for ds in datasets:
+        if ds.attrs.get("jointwear_file") == "verification_study":
+            series += _study_series(ds)
+            continue
         for name, var in ds.data_vars.items():
             if var.ndim != 1 or var.size < 2 or var.dtype.kind not in "fiu":
                 continue
@@ -296,6 +327,13 @@ def verification_figure(datasets: Sequence[xr.Dataset]) -> Any | None:
             ax = fig.add_subplot(nrow, ncol, k + 1)
             factor, units = _DISPLAY.get(str(attrs.get("units", "")), (1.0, attrs.get("units", "")))
             ax.plot(x, y * factor, marker="o", color=SIM_COLOUR, lw=1.0, ms=3)
+            if "sem" in attrs:  # a verification study: replicate means ± standard error, u_num
+                ax.errorbar(
+                    x, y * factor, yerr=attrs["sem"] * factor, fmt="none", ecolor=SIM_COLOUR
+                )
+                v, u = attrs["value"] * factor, attrs["u_num"] * factor
+                if np.isfinite(u):
+                    ax.axhspan(v - u, v + u, color=SIM_COLOUR, alpha=0.12, lw=0)
             if np.all(x > 0):
                 ax.set_xscale("log")
                 ax.xaxis.set_major_formatter(ScalarFormatter())

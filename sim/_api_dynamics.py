@@ -13,6 +13,7 @@ from jointwear.sim.dynamics import (
 from jointwear.sim.friction import friction_coefficient
 from jointwear.sim.mechanism import loop_closure
 from jointwear.sim.parameters import (
+    DEFAULT_PARAMETER_SET,
     PARAMETER_SETS,
     ContactParameters,
     FrictionParameters,
@@ -32,6 +33,7 @@ __all__ = [
     "FrictionParameters",
     "SolverParameters",
     "PARAMETER_SETS",
+    "DEFAULT_PARAMETER_SET",
     "load_parameters",
     "run_cycles",
     "CycleResult",

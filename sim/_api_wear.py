@@ -1,6 +1,6 @@
 """Public names of the wear part of jointwear.sim (Archard wear, cycle updates, wear maps)."""
 
-from jointwear.sim._kw_calibration import (
+from jointwear.sim.wear._calibration import (
     KwCalibration,
     Measurement,
     MultiCalibration,
@@ -9,14 +9,14 @@ from jointwear.sim._kw_calibration import (
     calibrate_kw_multi,
     resimulator,
 )
-from jointwear.sim._wear_contact import (
+from jointwear.sim.wear._contact import (
     ConstantContact,
     ContactModel,
     CycleWear,
     DynamicContact,
     WinklerContact,
 )
-from jointwear.sim.wear import (
+from jointwear.sim.wear._loop import (
     DEFAULT_KW,
     KW_RANGE,
     WearRun,

@@ -8,6 +8,7 @@ from typing import Annotated
 import typer
 
 from jointwear._cli import Overwrite
+from jointwear.sim.parameters import DEFAULT_PARAMETER_SET
 
 __all__ = ["register"]
 
@@ -28,7 +29,7 @@ def register(app: typer.Typer) -> None:
         ] = None,
         base: Annotated[
             str, typer.Option("--base", help="Named parameter set the overrides apply to.")
-        ] = "zhang2023",
+        ] = DEFAULT_PARAMETER_SET,
         wear: Annotated[
             Path | None,
             typer.Option(
@@ -52,7 +53,7 @@ def register(app: typer.Typer) -> None:
         <name>.partial.nc.
         """
         from jointwear import io
-        from jointwear._version import __version__
+        from jointwear._version import source_attribute
         from jointwear.errors import BadInputError, ParameterError, SimulationError
         from jointwear.progress import progress_bar
         from jointwear.sim.dynamics import run_cycles
@@ -67,7 +68,7 @@ def register(app: typer.Typer) -> None:
                 raise
             raise BadInputError(f"--base: {exc.args[0]}") from None
         io.check_writable(out)
-        source = f"jointwear {__version__} (sim.dynamics)"
+        source = source_attribute("sim.dynamics")
         inputs = [params] if params is not None else []
         depth = None
         if wear is not None:

@@ -9,7 +9,29 @@ import typer
 
 from jointwear._cli import Overwrite
 
-__all__ = ["register"]
+__all__ = ["register", "Workers", "Scheduler", "Resume", "Progress"]
+
+#: Options shared by the commands that run sweeps of dask tasks (sim sweep, sim verify).
+Workers = Annotated[
+    int | None,
+    typer.Option(
+        "--workers",
+        help="Local dask worker processes, one thread each (default: one per core; "
+        "0 = in this process, no dask).",
+    ),
+]
+Scheduler = Annotated[
+    str | None,
+    typer.Option("--scheduler", help="Address of a running dask scheduler, e.g. tcp://host:8786."),
+]
+Resume = Annotated[
+    bool,
+    typer.Option("--resume", help="Continue an interrupted run: compute only the missing runs."),
+]
+Progress = Annotated[
+    bool | None,
+    typer.Option("--progress/--no-progress", help="Progress bar (default: on a terminal)."),
+]
 
 
 def register(app: typer.Typer) -> None:
@@ -19,26 +41,9 @@ def register(app: typer.Typer) -> None:
     def sweep(
         spec: Annotated[Path, typer.Argument(help="Sweep spec (TOML; see docs/sweeps.md).")],
         out: Annotated[Path, typer.Option("--out", help="Result file (netCDF).")],
-        workers: Annotated[
-            int | None,
-            typer.Option(
-                "--workers",
-                help="Local dask worker processes, one thread each (default: one per core; "
-                "0 = in this process, no dask).",
-            ),
-        ] = None,
-        scheduler: Annotated[
-            str | None,
-            typer.Option(
-                "--scheduler", help="Address of a running dask scheduler, e.g. tcp://host:8786."
-            ),
-        ] = None,
-        resume: Annotated[
-            bool,
-            typer.Option(
-                "--resume", help="Continue an interrupted sweep: compute only the missing runs."
-            ),
-        ] = False,
+        workers: Workers = None,
+        scheduler: Scheduler = None,
+        resume: Resume = False,
         params: Annotated[
             Path | None,
             typer.Option(
@@ -47,10 +52,7 @@ def register(app: typer.Typer) -> None:
                 "\\[wear] table).",
             ),
         ] = None,
-        progress: Annotated[
-            bool | None,
-            typer.Option("--progress/--no-progress", help="Progress bar (default: on a terminal)."),
-        ] = None,
+        progress: Progress = None,
         overwrite: Overwrite = False,
     ) -> None:
         """Run a parameter sweep or ensemble of simulations; each run is one dask task.
@@ -63,7 +65,7 @@ def register(app: typer.Typer) -> None:
 
         from jointwear.errors import BadInputError, SimulationError
         from jointwear.progress import progress_bar
-        from jointwear.sim.sweep import run_sweep
+        from jointwear.sim.sweep._driver import run_sweep
 
         if scheduler is not None and workers is not None:
             raise BadInputError("give --workers or --scheduler, not both")
@@ -89,7 +91,7 @@ def register(app: typer.Typer) -> None:
                     on_progress=on_progress,
                 )
             except KeyboardInterrupt:
-                from jointwear.sim._sweep_store import parts_dir
+                from jointwear.sim.sweep._store import parts_dir
 
                 n = len(list(parts_dir(out).glob("run-*.npz")))
                 typer.echo(

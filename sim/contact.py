@@ -1,7 +1,7 @@
 """Contact law of joint C: Lankarani-Nikravesh force with constant or time-varying stiffness.
 
 Eqs. 6-10 of the reference study. The per-step contact search and force assembly run in numba
-(:mod:`jointwear.sim._kernels`); the functions here give the same laws for single values, for
+(:mod:`jointwear.sim.kernels`); the functions here give the same laws for single values, for
 analysis and tests.
 """
 

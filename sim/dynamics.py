@@ -1,7 +1,7 @@
 """Running the four-bar simulator: initial state, integration in chunks, results as xarray.
 
 The equations of motion (minimal coordinates, see ``docs/sim.md``) and the contact model run
-in numba (:mod:`jointwear.sim._kernels`); this module packs parameters, drives the integrator
+in numba (:mod:`jointwear.sim.kernels`); this module packs parameters, drives the integrator
 chunk by chunk (progress, errors with the partial record) and builds the Dataset.
 """
 
@@ -15,11 +15,12 @@ from collections.abc import Callable
 import numpy as np
 import xarray as xr
 
-import jointwear.sim._kernels as kn
 from jointwear import conventions
 from jointwear.errors import BadInputError, ParameterError, SimulationError
 from jointwear.params import to_jsonable
 from jointwear.sim.contact import contact_constant
+from jointwear.sim.kernels import _layout as kn
+from jointwear.sim.kernels._integrator import integrate
 from jointwear.sim.mechanism import loop_closure, quaternion_to_matrix, rotation_xzy_angles
 from jointwear.sim.parameters import SimParameters
 from jointwear.sim.wearmap import layer_positions
@@ -54,7 +55,7 @@ class SimState:
     time : float
         Simulated time since the documented initial configuration [s].
     y : ndarray
-        State vector (see :mod:`jointwear.sim._kernels`).
+        State vector (see :mod:`jointwear.sim.kernels`).
     step : float
         Last step size [s].
     impact_velocity : ndarray
@@ -387,7 +388,7 @@ def run_cycles(
     nacc_total = 0
     for k in range(n_chunks):
         t_chunk = t0 + duration * (k + 1) / n_chunks if k < n_chunks - 1 else t_end
-        status, t, hstep, i_out, nacc, _nrej = kn.integrate(
+        status, t, hstep, i_out, nacc, _nrej = integrate(
             t,
             y,
             hstep,

@@ -24,7 +24,9 @@ __all__ = [
     "SolverParameters",
     "SimParameters",
     "PARAMETER_SETS",
+    "DEFAULT_PARAMETER_SET",
     "load_parameters",
+    "parameters_from_tables",
 ]
 
 
@@ -312,11 +314,15 @@ class SolverParameters:
             raise ParameterError("solver.min_step must be smaller than solver.max_step")
 
 
+#: Name of the default parameter set (Tables 1-2 of the reference study).
+DEFAULT_PARAMETER_SET = "zhang2023"
+
+
 @dataclasses.dataclass(frozen=True)
 class SimParameters:
     """All parameters of a simulation (nested: mechanism, joint, contact, friction, solver)."""
 
-    name: str = "zhang2023"
+    name: str = DEFAULT_PARAMETER_SET
     mechanism: MechanismParameters = MechanismParameters()
     joint: JointParameters = JointParameters()
     contact: ContactParameters = ContactParameters()
@@ -331,15 +337,16 @@ class _ParameterSets(dict):
         )
 
 
-#: Named parameter sets. ``"zhang2023"``: Tables 1-2 of the reference study.
-PARAMETER_SETS: dict[str, SimParameters] = _ParameterSets(zhang2023=SimParameters())
+#: Named parameter sets. :data:`DEFAULT_PARAMETER_SET` (``"zhang2023"``): Tables 1-2 of the
+#: reference study.
+PARAMETER_SETS: dict[str, SimParameters] = _ParameterSets({DEFAULT_PARAMETER_SET: SimParameters()})
 
 
 #: Top-level TOML tables read by other parts of jointwear (ignored here).
 _OTHER_TABLES = ("wear",)
 
 
-def load_parameters(toml_path: str | Path, base: str = "zhang2023") -> SimParameters:
+def load_parameters(toml_path: str | Path, base: str = DEFAULT_PARAMETER_SET) -> SimParameters:
     """Read parameters from a TOML file, on top of a named parameter set.
 
     The file holds tables ``[mechanism]``, ``[joint]``, ``[contact]``, ``[friction]``,
@@ -367,26 +374,34 @@ def load_parameters(toml_path: str | Path, base: str = "zhang2023") -> SimParame
     ParameterError
         Unknown names (listed with the known ones), wrong types or inconsistent values.
     """
+    return parameters_from_tables(read_toml(toml_path), base, where=f"parameter file '{toml_path}'")
+
+
+def parameters_from_tables(
+    data: dict, base: str = DEFAULT_PARAMETER_SET, *, where: str = "parameters"
+) -> SimParameters:
+    """:class:`SimParameters` from TOML tables already read, on top of a named parameter set.
+
+    What :func:`load_parameters` does after reading the file; for a caller that has read it
+    for other tables too (``[wear]``), so that the file is parsed once. ``where`` names the
+    source in error messages.
+    """
     base_params = PARAMETER_SETS[base]
-    data = read_toml(toml_path)
     merged = dataclasses.asdict(base_params)
     data = {k: v for k, v in data.items() if k not in _OTHER_TABLES}
     unknown = [k for k in data if k not in merged]
     if unknown:
         raise ParameterError(
-            f"parameter file '{toml_path}': unknown table(s)/name(s) {', '.join(unknown)}; "
-            f"known: {', '.join(merged)}"
+            f"{where}: unknown table(s)/name(s) {', '.join(unknown)}; known: {', '.join(merged)}"
         )
     for key, value in data.items():
         if isinstance(merged[key], dict):
             if not isinstance(value, dict):
-                raise ParameterError(
-                    f"parameter file '{toml_path}': [{key}] must be a table, got {value!r}"
-                )
+                raise ParameterError(f"{where}: [{key}] must be a table, got {value!r}")
             merged[key] = {**merged[key], **value}
         else:
             merged[key] = value
     try:
         return from_mapping(SimParameters, merged)
     except ParameterError as exc:
-        raise ParameterError(f"parameter file '{toml_path}': {exc}") from None
+        raise ParameterError(f"{where}: {exc}") from None

@@ -175,6 +175,19 @@ def read_scan(
         ``radius`` or ``radial_deviation`` [m] over (``z`` [m], ``theta`` [degree, canonical]);
         attrs record the instrument convention, files, every guess of the reader and the header
         metadata.
+
+    Examples
+    --------
+    A folder of per-layer text exports written by the Talyrond-style generator:
+
+    >>> import tempfile
+    >>> from jointwear.datasets.instruments import generate, write
+    >>> from jointwear.metrology import read_scan
+    >>> folder = tempfile.mkdtemp()
+    >>> files = write(generate(n_layers=3, n_points=360, wear=None, seed=1), folder)
+    >>> scan = read_scan(folder, convention=("+y", "counterclockwise"))
+    >>> dict(scan.sizes), scan["radial_deviation"].attrs["units"], scan.attrs["data_origin"]
+    ({'z': 3, 'theta': 360}, 'm', 'synthetic')
     """
     conv = _as_convention(convention)
     if value not in ("auto", "radius", "deviation"):

@@ -19,7 +19,8 @@ def files(tmp_path):
         "meas_wear": syn.meas_wear(u=1e-6),
         "meas_wear_full": syn.meas_wear(u=1e-6, n_layers=16),  # covers the simulated width
         "meas_wear_turned": syn.meas_wear(u=1e-6, n_layers=16, rotate_deg=180.0),
-        "meas_wear_bad": syn.meas_wear(scale=2.0),
+        "meas_wear_turned_narrow": syn.meas_wear(u=1e-6, rotate_deg=180.0),  # +-6 mm scan
+        "meas_wear_bad": syn.meas_wear(scale=2.0, u=1e-6),
         "meas_motion": syn.meas_motion(u=0.002),
         "meas_unstated": syn.meas_wear(state_convention=False),
     }.items():
@@ -31,8 +32,8 @@ def files(tmp_path):
 def _stated_zero(tmp_path):
     crit = tmp_path / "criteria.toml"
     crit.write_text(
-        "[criteria]\nwear_u_num_rel = 0.0\nwear_u_input_rel = 0.0\n"
-        "motion_u_num_rel = 0.0\nmotion_u_input_rel = 0.0\n"
+        "[criteria]\nwear_u_num_rel = 1e-9\nwear_u_input_rel = 1e-9\n"
+        "motion_u_num_rel = 1e-9\nmotion_u_input_rel = 1e-9\n"
     )
     return crit
 
@@ -81,12 +82,17 @@ def test_compare_cli_exit_codes(files, tmp_path, capsys):
         str(out),
         "--overwrite",
     ]
+    # without u_num and u_input the depth that is 2x off is not assessed: the screening
+    # threshold it exceeds is shown, never counted as a fail (nor, elsewhere, as a pass)
+    assert main(bad) == 0
+    assert "screening only, not a verdict: |S - D| / |D| = 0.497 > 0.3" in capsys.readouterr().out
+    bad += ["--criteria", str(_stated_zero(tmp_path))]
     assert main(bad) == 1  # a failed criterion exits 1 (no --strict needed)
     captured = capsys.readouterr()
     assert "FAIL            maximum wear depth" in captured.out
     assert "validation failed for: maximum wear depth" in captured.err
-    # nothing fails, but V&V 20 is not assessed and the narrow scan leaves criteria not
-    # comparable: exit 0 with a summary saying so; --strict makes it exit 1
+    # nothing fails, but V&V 20 is not assessed and the narrow scan leaves part of the
+    # simulation unvalidated: exit 0 with a summary saying so; --strict makes it exit 1
     undecided = [
         "compare",
         str(files["sim_wear"]),
@@ -98,7 +104,15 @@ def test_compare_cli_exit_codes(files, tmp_path, capsys):
     assert main(undecided) == 0
     text = capsys.readouterr().out
     assert "not assessed (an uncertainty is unknown" in text
-    assert "not comparable (the data do not cover it): wear map shape" in text
+    assert "validation domain: the wear criteria are decided within z = −6…+6 mm only" in text
+    # the criteria file's switch restores the strict rule: the narrow scan is not comparable
+    strict = tmp_path / "strict.toml"
+    strict.write_text("[criteria]\nstrict_coverage = true\n")
+    assert main([*undecided, "--criteria", str(strict)]) == 0
+    assert "not comparable (the data do not cover it): wear map shape" in capsys.readouterr().out
+    strict.write_text("[criteria]\nwear_u_num_rel = 0\n")  # a stated 0 is refused: exit 3
+    assert main([*undecided, "--criteria", str(strict)]) == 3
+    assert "exactly zero" in capsys.readouterr().err
     assert main([*undecided, "--strict"]) == 1
     assert "--strict: not every criterion was decided" in capsys.readouterr().err
     unstated = ["compare", str(files["sim_wear"]), str(files["meas_unstated"]), "-o", str(out)]
@@ -113,8 +127,14 @@ def test_compare_cli_map_turned_180_degree_fails(files, tmp_path, capsys):
     argv = ["compare", str(files["sim_wear"]), str(files["meas_wear_turned"]), "-o", str(out)]
     assert main(argv) == 1
     text = capsys.readouterr().out
-    assert "FAIL            angle of maximum wear: +180.0 degree" in text
+    assert "FAIL            angle of maximum wear within z = −7.5…+7.5 mm: +180.0 degree" in text
     assert "FAIL            wear map shape" in text
+    # the same on the reference study's layout (13 layers, +-6 mm of a 15 mm bearing): the
+    # simulated maximum outside the band no longer lets the turned map escape as not comparable
+    argv = ["compare", str(files["sim_wear"]), str(files["meas_wear_turned_narrow"]), "-o"]
+    assert main([*argv, str(out), "--overwrite"]) == 1
+    text = capsys.readouterr().out
+    assert "FAIL            angle of maximum wear within z = −6…+6 mm: +180.0 degree" in text
 
 
 def test_compare_cli_motion_variables(files, tmp_path, capsys):

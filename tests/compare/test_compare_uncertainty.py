@@ -23,7 +23,7 @@ from jointwear.errors import BadInputError
 def test_gci_recovers_order_and_extrapolated_value():
     # f(h) = 10 + 0.3 h^2 on h = 1, 2, 4: p = 2, f_ext = 10, e_a = 0.9/10.3
     h = np.array([4.0, 2.0, 1.0])
-    g = gci(h, 10 + 0.3 * h**2, quantity="f")
+    g = gci(h, 10 + 0.3 * h**2, quantity="f", formal_order=2.0)
     assert g.assessed and g.order == pytest.approx(2.0, rel=1e-9)
     assert g.extrapolated == pytest.approx(10.0, rel=1e-12)
     e_a = 0.9 / 10.3
@@ -34,7 +34,7 @@ def test_gci_recovers_order_and_extrapolated_value():
 def test_gci_non_constant_ratio():
     # unequal refinement ratios (Celik's iteration): f = 2 - 0.5 h^1.5, h = 0.1, 0.25, 0.4
     h = np.array([0.1, 0.25, 0.4])
-    g = gci(h, 2 - 0.5 * h**1.5)
+    g = gci(h, 2 - 0.5 * h**1.5, formal_order=2.0)
     assert g.assessed and g.order == pytest.approx(1.5, rel=1e-6)
     assert g.extrapolated == pytest.approx(2.0, rel=1e-9)
 
@@ -71,7 +71,7 @@ def test_verification_study_sets_u_num_only_when_monotone():
     assert "GCI" in basis
     osc = compare(sim, meas, verification=study(s * np.array([1.02, 0.99, 1.05])))
     assert np.isnan(osc.value("max_wear_depth", "u_num"))
-    row = osc.decisions[(osc.decisions.quantity == "maximum wear depth")]
+    row = osc.decisions[(osc.decisions.key == "max_wear_depth")]
     assert row.state.iloc[0] == "not_assessed" and "oscillate" in row.reason.iloc[0]
 
 
@@ -93,33 +93,33 @@ def test_ensemble_spread_is_u_input():
     rng = np.random.default_rng(3)
     depth = 32e-6 + 2e-6 * rng.standard_normal(12)
     ens = _ensemble({"max_wear_depth": depth}, kw=rng.uniform(1, 2, 12))
-    c = compare(sim, meas, ensemble=ens, criteria=Criteria(wear_u_num_rel=0.0))
+    c = compare(sim, meas, ensemble=ens, criteria=Criteria(wear_u_num_rel=1e-9))
     assert c.value("max_wear_depth", "u_input") == pytest.approx(np.std(depth, ddof=1))
     basis = c.metrics.set_index(["quantity", "metric"]).loc[("max_wear_depth", "u_input"), "basis"]
     assert "standard deviation over 12 runs" in basis
     # an ensemble that does not say after how many cycles: its spread could be of any wear time
     undated = ens.copy()
     del undated.attrs["cycles"]
-    c_undated = compare(sim, meas, ensemble=undated, criteria=Criteria(wear_u_num_rel=0.0))
+    c_undated = compare(sim, meas, ensemble=undated, criteria=Criteria(wear_u_num_rel=1e-9))
     assert np.isnan(c_undated.value("max_wear_depth", "u_input"))
     # a failed run (NaN) biases the spread of the others: not assessed, never left out silently
     broken = ens.copy(deep=True)
     broken["max_wear_depth"][4] = np.nan
-    c_broken = compare(sim, meas, ensemble=broken, criteria=Criteria(wear_u_num_rel=0.0))
+    c_broken = compare(sim, meas, ensemble=broken, criteria=Criteria(wear_u_num_rel=1e-9))
     assert np.isnan(c_broken.value("max_wear_depth", "u_input"))
     assert c_broken.state("maximum wear depth", "V&V 20") == "not_assessed"
     # a grid sweep's spread is not an input distribution
     grid = ens.assign_attrs(probabilistic_sample="false", sweep_method="grid")
-    c_grid = compare(sim, meas, ensemble=grid, criteria=Criteria(wear_u_num_rel=0.0))
+    c_grid = compare(sim, meas, ensemble=grid, criteria=Criteria(wear_u_num_rel=1e-9))
     assert np.isnan(c_grid.value("max_wear_depth", "u_input"))
-    reason = c_grid.decisions.set_index("key").loc["max_wear_depth", "reason"].iloc[0]
+    reason = c_grid.decisions[c_grid.decisions.key == "max_wear_depth"].reason.iloc[0]
     assert "not a sample of the input distribution" in reason
     assert c.state("maximum wear depth", "V&V 20") in ("pass", "fail")
     # a quantity the ensemble does not have stays not assessed
     assert np.isnan(c.value("worn_volume", "u_input"))
     # two ensembles over independent inputs: variances add; over the same input: refused
     other = _ensemble({"max_wear_depth": 32e-6 + np.array([-1e-6, 1e-6])}, mu=[0.1, 0.2])
-    both = compare(sim, meas, ensemble=[ens, other], criteria=Criteria(wear_u_num_rel=0.0))
+    both = compare(sim, meas, ensemble=[ens, other], criteria=Criteria(wear_u_num_rel=1e-9))
     expected = np.hypot(np.std(depth, ddof=1), np.std([-1e-6, 1e-6], ddof=1))
     assert both.value("max_wear_depth", "u_input") == pytest.approx(expected)
     with pytest.raises(BadInputError, match="both vary 'kw'"):
@@ -165,7 +165,7 @@ def test_states_are_cf_flags_in_the_file(tmp_path):
     sim.attrs["data_origin"] = "simulated"
     meas = syn.meas_wear(u=1e-6)  # +-6 mm: narrower than the simulated worn zone
     meas.attrs["data_origin"] = "synthetic"
-    c = compare(sim, meas)
+    c = compare(sim, meas, criteria=Criteria(strict_coverage=True))
     assert c.data_origin == {"simulation": "simulated", "measurement": "synthetic"}
     path = save_comparison(c, tmp_path / "m.nc")
     ds = xr.open_dataset(path)
@@ -181,19 +181,43 @@ def test_states_are_cf_flags_in_the_file(tmp_path):
     back = load_comparison(path)
     assert list(back.decisions.state) == list(c.decisions.state)
     assert back.data_origin == c.data_origin
+    # the validation-domain statement (extrapolation) is in the metrics file
+    assert any(n.startswith("validation domain") for n in back.notes)
+    assert back.value("validation_domain", "volume_fraction_outside") > 0.1
     # a measurement without data_origin is "not stated", never assumed measured
     assert compare(sim, syn.meas_wear()).data_origin["measurement"] == "not stated"
 
 
-def test_uncovered_maximum_is_not_comparable_not_pass():
-    """Both maxima clipped to the scan edge agree - a believable wrong PASS without the check."""
+def _edge_case():
     sim = syn.sim_wear(width=15e-3)
     # move the simulated wear to the bearing edge: its maximum lies at z = -7.5 mm
     z = sim["z"].values
     edge = np.exp(-0.5 * ((z + 7.5e-3) / 2e-3) ** 2)[None, :, None]
-    sim["wear_depth"] = sim["wear_depth"] * 0 + edge * 20e-6
-    meas = syn.meas_wear(n_layers=13)  # +-6 mm
-    c = compare(sim, meas, criteria=Criteria(max_z_error_m=10.0))
+    ring = 1 + 0.3 * np.cos(np.radians(sim["theta"].values))[None, None, :]
+    sim["wear_depth"] = sim["wear_depth"] * 0 + edge * 20e-6 * ring
+    meas = syn.meas_wear(n_layers=13, u=0.2e-6)  # +-6 mm
+    zm = meas["z"].values
+    # the measured bearing wears the same way: scanned on +-6 mm only
+    th = np.radians(meas["theta"].values)
+    from jointwear.conventions import CANONICAL, AngleConvention
+
+    canon = CANONICAL.from_physical(
+        AngleConvention("+y", "counterclockwise").to_physical(np.degrees(th))
+    )
+    meas["wear_depth"] = (
+        ("z", "theta"),
+        np.exp(-0.5 * ((zm + 7.5e-3) / 2e-3) ** 2)[:, None]
+        * 20e-6
+        * (1 + 0.3 * np.cos(np.radians(canon)))[None, :],
+        meas["wear_depth"].attrs,
+    )
+    return sim, meas
+
+
+def test_uncovered_maximum_strict_is_not_comparable_not_pass():
+    """strict_coverage (the old rule): both maxima clipped to the scan edge are not comparable."""
+    sim, meas = _edge_case()
+    c = compare(sim, meas, criteria=Criteria(max_z_error_m=10.0, strict_coverage=True))
     assert c.wear.attrs["sim_max_inside"] == 0
     assert c.state("axial position of maximum wear") == "not_comparable"
     assert c.state("maximum wear depth") == "not_comparable"
@@ -205,6 +229,37 @@ def test_uncovered_maximum_is_not_comparable_not_pass():
     inside = norm.cdf(13.5 / 2) - norm.cdf(1.5 / 2)
     total = norm.cdf(15 / 2) - norm.cdf(0)
     assert frac == pytest.approx(inside / total, abs=0.02)
+
+
+def test_edge_maximum_is_decided_within_the_band_and_stated_as_extrapolation():
+    sim, meas = _edge_case()
+    crit = Criteria(wear_u_num_rel=0.02, wear_u_input_rel=0.05)
+    c = compare(sim, meas, criteria=crit)
+    # decided on the band, named so
+    label = c.decisions.quantity[c.decisions.key == "max_wear_depth"].iloc[0]
+    assert label == "maximum wear depth within z = −6…+6 mm"
+    assert c.state("maximum wear depth") == "pass"
+    assert c.state("worn volume") == "pass" and c.state("wear map shape") == "pass"
+    assert c.state("angle of maximum wear") == "pass"
+    # only the axial position cannot be answered: both maxima sit on the band's edge
+    assert c.state("axial position of maximum wear") == "not_comparable"
+    reason = c.decisions.reason[c.decisions.quantity.str.startswith("axial")].iloc[0]
+    assert "lie on its edge layer z = -5.92 mm" in reason  # the first common layer
+    # the validation domain: the global maximum outside, stated as extrapolation
+    dom = [n for n in c.notes if n.startswith("validation domain")]
+    assert dom and "extrapolation" in dom[0] and "z = -7.50 mm" in dom[0]
+    assert c.value("validation_domain", "sim_global_max_z") == pytest.approx(-7.5e-3)
+    outside = c.value("validation_domain", "volume_fraction_outside")
+    assert outside == pytest.approx(1 - c.value("wear_depth", "volume_fraction_compared"))
+    # a wrong model on the same band fails: 1.5x deeper
+    deep = sim.assign(wear_depth=sim["wear_depth"] * 1.5)
+    bad = compare(deep, meas, criteria=crit)
+    assert bad.state("maximum wear depth") == "fail" and bad.state("worn volume") == "fail"
+    # ... and so does the map turned by 180 degree (angle and shape)
+    turned = sim.assign_coords(theta=(sim["theta"] + 180.0) % 360.0).sortby("theta")
+    turned["theta"].attrs = sim["theta"].attrs
+    t = compare(turned, meas, criteria=crit)
+    assert t.state("angle of maximum wear") == "fail" and t.any_failed
 
 
 def test_sweep_style_ensemble_sobol_indices_reach_the_comparison():
@@ -306,10 +361,16 @@ def test_partial_arc_is_not_interpolated_across_its_gap():
     assert np.isnan(meas).any() and np.isfinite(meas).any()
     # the simulated map is blanked where the measurement is missing: nothing is compared there
     np.testing.assert_array_equal(np.isnan(c.wear["wear_depth_sim"].values), np.isnan(meas))
-    assert c.state("maximum wear depth") == "not_comparable"
-    assert "of the circumference" in c.decisions[c.decisions.key == "max_wear_depth"].reason.iloc[0]
-    assert c.state("wear map shape") == "not_comparable"
+    # decided on the measured arc only, and named so; the rest is extrapolation
+    label = c.decisions.quantity[c.decisions.key == "max_wear_depth"].iloc[0]
+    assert label.endswith("of the circumference") and "within z" in label
+    assert any("global maximum" in n and "outside the band" in n for n in c.notes)
     assert c.value("wear_depth", "volume_fraction_compared") < 0.5
+    strict = compare(syn.sim_wear(), arc, criteria=Criteria(strict_coverage=True))
+    assert strict.state("maximum wear depth") == "not_comparable"
+    reason = strict.decisions[strict.decisions.key == "max_wear_depth"].reason.iloc[0]
+    assert "of the circumference" in reason
+    assert strict.state("wear map shape") == "not_comparable"
 
 
 def test_an_interrupted_simulation_is_flagged_partial_and_never_complete(tmp_path):
@@ -322,3 +383,26 @@ def test_an_interrupted_simulation_is_flagged_partial_and_never_complete(tmp_pat
     assert not c.complete  # --strict exits 1
     save_comparison(c, tmp_path / "m.nc")
     assert any("stopped after 30000" in p for p in load_comparison(tmp_path / "m.nc").partial)
+
+
+def test_each_wear_criterion_fails_on_a_wrong_model():
+    """Within the band, every wear criterion can fail: a model wrong in what it judges."""
+    meas = syn.meas_wear(u=0.2e-6)  # +-6 mm
+    crit = Criteria(wear_u_num_rel=0.02, wear_u_input_rel=0.05)
+    right = compare(syn.sim_wear(), meas, criteria=crit)
+    assert not right.any_failed
+    # mirrored axially: the maximum at the other end of the band (axial position), wrong shape
+    sim = syn.sim_wear()
+    mirrored = sim.assign_coords(z=-sim["z"]).sortby("z")
+    mirrored["z"].attrs = sim["z"].attrs
+    c = compare(mirrored, meas, criteria=crit)
+    assert c.state("axial position of maximum wear") == "fail"
+    assert c.state("wear map shape") == "fail"
+    # twice as deep: maximum depth, volume and cylindricity of the wear
+    deep = sim.assign(wear_depth=sim["wear_depth"] * 2.0)
+    c = compare(deep, meas, criteria=crit)
+    for name in ("maximum wear depth", "worn volume", "cylindricity of the wear (LSCY)"):
+        assert c.state(name) == "fail", name
+    # turned: the angle of the maximum
+    c = compare(syn.sim_wear(rotate_deg=90.0), meas, criteria=crit)
+    assert c.state("angle of maximum wear") == "fail"

@@ -16,8 +16,8 @@ from jointwear.datasets.rig import (
     fourbar_pose,
     generate_rig,
 )
-from jointwear.dic._footage import read_bodies
-from jointwear.dic._video import open_frames
+from jointwear.dic.footage._track import read_bodies
+from jointwear.dic.footage._video import open_frames
 from jointwear.errors import BadInputError
 
 

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from scipy import ndimage
 
-from jointwear.dic import _interp
+from jointwear.dic.icgn import _interp
 
 
 @pytest.mark.parametrize(("interpolation", "order"), [("cubic", 3), ("quintic", 5)])

@@ -6,16 +6,18 @@ import numpy as np
 import pytest
 
 from jointwear.datasets.rig import RigConfig, VirtualRig
-from jointwear.dic._calib import (
+from jointwear.dic.calibration._board import CalibrationBoard, board_world_frame, calibrate_stereo
+from jointwear.dic.calibration._camera import (
     Camera,
     StereoCalibration,
     cardan_to_matrix,
     matrix_to_cardan,
+)
+from jointwear.dic.calibration._importers import (
     read_calibration,
     read_opencv_calibration,
     read_vic3d_calibration,
 )
-from jointwear.dic._calib_board import CalibrationBoard, board_world_frame, calibrate_stereo
 from jointwear.errors import BadInputError, CalibrationError
 
 
@@ -319,7 +321,7 @@ def _vic_file(cameras, size=None, root="project") -> str:
 
 
 def _reprojection_rms(cal, uv0, uv1):
-    from jointwear.dic._stereo import triangulate
+    from jointwear.dic.calibration._stereo import triangulate
 
     X, _, rep = triangulate(cal, uv0, uv1)
     return float(np.sqrt(np.mean(rep**2))), X

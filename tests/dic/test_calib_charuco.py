@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from jointwear.datasets.rig import RigConfig, VirtualRig
-from jointwear.dic._calib_board import CalibrationBoard, calibrate_stereo, detect_board
+from jointwear.dic.calibration._board import CalibrationBoard, calibrate_stereo, detect_board
 from jointwear.errors import BadInputError
 
 

@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 
 from jointwear.datasets.rig import RigConfig, VirtualRig
-from jointwear.dic._calib import read_calibration
-from jointwear.dic._calib_board import CalibrationBoard, calibrate_stereo
-from jointwear.dic._calib_gate import PoorCalibration
+from jointwear.dic.calibration._board import CalibrationBoard, calibrate_stereo
+from jointwear.dic.calibration._gate import PoorCalibration
+from jointwear.dic.calibration._importers import read_calibration
 from jointwear.errors import BadInputError, CalibrationError
 
 
@@ -82,7 +82,7 @@ def test_camera_mounted_upside_down(rig, board, rotated_boards, monkeypatch):
     cx, cy = rig.calibration.right.matrix[:2, 2]
     assert np.allclose(cal.right.matrix[:2, 2], [w - 1 - cx, h - 1 - cy], atol=3.0)
     # without the geometric ordering the same images give a calibration that the gate refuses
-    import jointwear.dic._calib_order as order
+    import jointwear.dic.calibration._order as order
 
     monkeypatch.setattr(order, "consistent_order", lambda cands: ([0] * len(cands), cands[0][0]))
     with pytest.raises(PoorCalibration, match="reprojection RMS"):

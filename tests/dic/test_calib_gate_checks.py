@@ -6,8 +6,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from jointwear.dic._calib import Camera, StereoCalibration
-from jointwear.dic._calib_gate import check_calibration, view_table
+from jointwear.dic.calibration._camera import Camera, StereoCalibration
+from jointwear.dic.calibration._gate import check_calibration, view_table
 
 
 def _cal(f_left=800.0, f_right=805.0, baseline=3.34, rms=0.3, cx=320.0, aspect=1.0, side=1.0):

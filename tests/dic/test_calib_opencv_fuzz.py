@@ -12,7 +12,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from jointwear.dic._calib import read_opencv_calibration
+from jointwear.dic.calibration._importers import read_opencv_calibration
 from jointwear.errors import BadInputError
 
 K1 = np.array([[1523.5, 0.0, 321.25], [0.0, 1524.25, 253.5], [0.0, 0.0, 1.0]])

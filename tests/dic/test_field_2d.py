@@ -135,7 +135,7 @@ def test_cli_2d_field_with_a_frame_rate_and_a_mask(affine, tmp_path):
 def test_strain_needs_the_stated_share_of_the_window():
     """A point whose window holds fewer valid neighbours than min_count gets no strain
     (min_count counts points; it once counted three per point)."""
-    from jointwear.dic._strain import surface_strain
+    from jointwear.dic.field._strain import surface_strain
 
     ys, xs = np.mgrid[0:7, 0:7]
     ref = np.column_stack([xs.ravel(), ys.ravel()]).astype(float) * 10.0

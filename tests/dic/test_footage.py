@@ -15,11 +15,17 @@ import pytest
 
 from jointwear import io
 from jointwear.datasets.rig import RigConfig, VirtualRig, generate_rig
-from jointwear.dic._footage import FRAME_FLAGS, BodySpec, TrackConfig, read_bodies, track_footage
-from jointwear.dic._video import check_stereo_pair, open_frames
+from jointwear.dic.footage._track import (
+    FRAME_FLAGS,
+    BodySpec,
+    TrackConfig,
+    read_bodies,
+    track_footage,
+)
+from jointwear.dic.footage._video import check_stereo_pair, open_frames
 from jointwear.errors import BadInputError, ParameterError
 
-pytest.importorskip("jointwear.dic._subset")  # the 2D engine (DIC part 1)
+pytest.importorskip("jointwear.dic.subset._correlator")  # the 2D engine (DIC part 1)
 
 
 @pytest.fixture(scope="module")
@@ -98,7 +104,7 @@ def test_follower_velocity_uncertainty_covers_the_error(study):
     )
     assert cover >= 0.9
     assert np.all(rms_u[:2] <= 4 * rms_err[:2])
-    from jointwear.dic._rigid import time_derivative
+    from jointwear.dic.footage._rigid import time_derivative
 
     _, gain = time_derivative(ds["time"].values, ds["follower_position"].values)
     propagated = np.nanmedian(gain) * np.median(ds["follower_position_u"].values, axis=0)
@@ -477,7 +483,7 @@ def test_a_blank_frame_is_flagged_and_tracking_resumes_after_it(small, tmp_path)
 
     import cv2
 
-    from jointwear.dic._footage import FRAME_FLAGS
+    from jointwear.dic.footage._track import FRAME_FLAGS
 
     cfg, written, out = small
     for cam in ("left", "right"):
@@ -503,7 +509,7 @@ def test_lost_tracking_is_reinitialised_and_the_speculative_next_frame_redone(sm
     # the pose of frame 1 "fails" once (as when tracking is lost): the body is found again
     # from SIFT features, the next frame (tracked meanwhile from frame 1's matches) is
     # discarded and tracked again, and every pose equals the undisturbed run's
-    import jointwear.dic._footage_frames as footage
+    import jointwear.dic.footage._frames as footage
 
     def run():
         return _track_small(small, max_frames=7)
@@ -654,7 +660,7 @@ def test_position_uncertainty_holds_the_lever_arm_of_the_point_of_interest(small
 
 
 def test_rigid_fit_keeps_ordinary_points_and_its_point_uncertainty_covers_a_lever_arm():
-    from jointwear.dic._rigid import fit_rigid_robust, pose_point_uncertainty
+    from jointwear.dic.footage._rigid import fit_rigid_robust, pose_point_uncertainty
 
     rng = np.random.default_rng(3)
     # a thin plate (40 x 4 mm), z 10x noisier than x and y, as a stereo rig measures it
@@ -767,7 +773,7 @@ def test_chunks_inside_a_daemon_process_and_on_a_dask_cluster(small, monkeypatch
 
 
 def _shifted_calibration(cfg, dy_px):
-    from jointwear.dic._calib import Camera
+    from jointwear.dic.calibration._camera import Camera
 
     cal = VirtualRig(cfg).calibration
     r = cal.right
@@ -808,7 +814,7 @@ def test_a_calibration_off_its_images_is_measured_and_the_gate_configurable(smal
 
 
 def test_reinitialisations_are_counted_and_limited(small, monkeypatch):
-    import jointwear.dic._footage_frames as frames
+    import jointwear.dic.footage._frames as frames
 
     real_pose = frames._body_pose
     calls = []

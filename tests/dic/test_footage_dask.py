@@ -74,7 +74,7 @@ def test_track_on_a_real_cluster_and_inside_a_worker(cluster, footage, tmp_path)
     from distributed import Client
 
     from jointwear.cli import main
-    from jointwear.dic._footage import read_bodies, track_footage
+    from jointwear.dic.footage._track import read_bodies, track_footage
 
     cfg, written = footage
     cal = tmp_path / "cal.nc"

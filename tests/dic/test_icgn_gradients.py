@@ -8,7 +8,9 @@ import dataclasses
 import numpy as np
 
 from jointwear.datasets import speckle as sp
-from jointwear.dic import SubsetCorrelator, _icgn, _interp
+from jointwear.dic import SubsetCorrelator
+from jointwear.dic.icgn import _interp
+from jointwear.dic.icgn import _match as _icgn
 
 
 def test_off_grid_reference_gradients_are_central_differences_of_the_interpolant():

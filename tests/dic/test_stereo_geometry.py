@@ -6,8 +6,13 @@ import numpy as np
 import pytest
 
 from jointwear.datasets.rig import RigConfig, VirtualRig
-from jointwear.dic._rigid import fit_rigid, fit_rigid_robust, rotation_angle_z, time_derivative
-from jointwear.dic._stereo import epipolar_distance, stereo_noise_floor, triangulate
+from jointwear.dic.calibration._stereo import epipolar_distance, stereo_noise_floor, triangulate
+from jointwear.dic.footage._rigid import (
+    fit_rigid,
+    fit_rigid_robust,
+    rotation_angle_z,
+    time_derivative,
+)
 from jointwear.errors import BadInputError
 
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from jointwear.dic._rigid import derivative_truncation, position_noise, time_derivative
+from jointwear.dic.footage._rigid import derivative_truncation, position_noise, time_derivative
 
 
 def test_truncation_estimate_covers_the_true_truncation_error():

@@ -11,7 +11,7 @@ from jointwear import io
 from jointwear.cli import main
 from jointwear.datasets import speckle as sp
 from jointwear.dic import SubsetCorrelator, correlate, correlate_sequence, read_frames
-from jointwear.dic._subset import _GRID_SLACK
+from jointwear.dic.subset._correlator import _GRID_SLACK
 from jointwear.errors import BadInputError
 
 

@@ -1,5 +1,5 @@
 """``dic track`` refuses a folder of frames holding a stray image, naming it, as ``dic correlate``
-and ``dic field`` do (one check, :func:`jointwear.dic._sequence.check_frame_names`)."""
+and ``dic field`` do (one check, :func:`jointwear.dic.subset._sequence.check_frame_names`)."""
 
 from __future__ import annotations
 
@@ -12,7 +12,7 @@ from jointwear.cli import main
 from jointwear.datasets.rig import RigConfig, VirtualRig, generate_rig
 
 cv2 = pytest.importorskip("cv2")
-pytest.importorskip("jointwear.dic._subset")  # the 2D engine (DIC part 1)
+pytest.importorskip("jointwear.dic.subset._correlator")  # the 2D engine (DIC part 1)
 
 
 @pytest.fixture(scope="module")

@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 from scipy import ndimage
 
-from jointwear.dic import _interp
 from jointwear.dic._api2d import CorrelationParams, SubsetCorrelator
-from jointwear.dic._video import open_frames, prefetch
+from jointwear.dic.footage._video import open_frames, prefetch
+from jointwear.dic.icgn import _interp
 
 
 def _speckle(shape, seed=0):
@@ -131,7 +131,7 @@ def test_native_grey_frames_equal_the_float_frames(tmp_path):
 
 
 def test_features_of_deep_images_are_scaled_not_clipped():
-    from jointwear.dic._footage import _as_uint8
+    from jointwear.dic.footage._track import _as_uint8
 
     img16 = (_speckle((64, 64)) * 40).clip(0, 65535).astype(np.uint16)  # ~12-bit range
     u8 = _as_uint8(img16)
@@ -145,7 +145,7 @@ def test_stereo_prediction_is_exact_for_points_moving_linearly_in_depth():
     # the right camera's start: left matches carried to the right image at depths
     # extrapolated from the two previous frames; exact when the depth changes linearly
     from jointwear.datasets.rig import RigConfig, VirtualRig
-    from jointwear.dic._footage import _stereo_prediction
+    from jointwear.dic.footage._track import _stereo_prediction
 
     cal = VirtualRig(RigConfig(width=640, height=512)).calibration
     rng = np.random.default_rng(4)

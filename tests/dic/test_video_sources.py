@@ -6,8 +6,8 @@ import cv2
 import numpy as np
 import pytest
 
-from jointwear.dic._sequence import read_frames
-from jointwear.dic._video import check_stereo_pair, list_image_sequence, open_frames
+from jointwear.dic.footage._video import check_stereo_pair, list_image_sequence, open_frames
+from jointwear.dic.subset._sequence import read_frames
 from jointwear.errors import BadInputError
 
 

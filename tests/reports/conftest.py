@@ -16,12 +16,12 @@ from jointwear import io  # noqa: E402
 
 @pytest.fixture(scope="session")
 def report_files(tmp_path_factory):
-    """Simulated wear + motion, measured wear (rotated 10 degree) + motion, saved as netCDF."""
+    """Simulated wear + motion, measured wear (rotated 40 degree) + motion, saved as netCDF."""
     folder = tmp_path_factory.mktemp("report-inputs")
     data = {
         "sim_wear": syn.sim_wear(),
         "sim_motion": syn.sim_motion(),
-        "metrology": syn.meas_wear(u=1e-6, rotate_deg=10.0, scale=1.5),
+        "metrology": syn.meas_wear(u=1e-6, rotate_deg=40.0, scale=1.5),
         "dic": syn.meas_motion(u=0.01, scale=1.05),
     }
     paths = {}

@@ -36,11 +36,17 @@ def test_demo_quick_runs_end_to_end(demo_run):
     assert "INCOMPLETE: no criterion failed" in html and "VALIDATED:" not in html
     # the generated scans stay synthetic through the importer into the decision card
     assert 'measurement: <strong class="origin-synthetic">synthetic</strong>' in html
-    # the virtual scans cover +-6 mm, the simulated bearing wears most at its edge (-7.5 mm)
+    # the virtual scans cover +-6 mm, the simulated bearing wears most at its edge (-7.5 mm):
+    # the wear criteria are decided within the band (u_input is not assessed with --quick) and
+    # what lies outside is stated as extrapolation
     c = load_comparison(out / "metrics.nc")
-    assert c.state("maximum wear depth") == "not_comparable"
-    assert c.state("axial position of maximum wear") == "not_comparable"
+    label = c.decisions.quantity[c.decisions.key == "max_wear_depth"].iloc[0]
+    assert label == "maximum wear depth within z = −6…+6 mm"
+    assert c.state("maximum wear depth") == "not_assessed"
+    assert c.state("angle of maximum wear") in ("pass", "fail")
     assert c.value("wear_depth", "volume_fraction_compared") < 0.9
+    assert c.value("validation_domain", "sim_global_max_z") < -6e-3
+    assert any(n.startswith("validation domain") and "extrapolation" in n for n in c.notes)
     # every stage wrote a contract file with provenance
     for name in ("sim_wear.nc", "sim_motion.nc", "metrology_wear.nc", "metrics.nc"):
         ds = io.load(out / name)

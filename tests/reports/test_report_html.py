@@ -8,7 +8,11 @@ import _jw_synth as syn
 import pytest
 
 from jointwear.cli import main
+from jointwear.compare import Criteria
 from jointwear.reports import report_from_files
+
+#: the old strict coverage rule, so that a narrow scan leaves criteria not comparable
+STRICT = Criteria(strict_coverage=True)
 
 EXPECTED_SECTIONS = [
     "Decision",
@@ -76,6 +80,7 @@ def built(report_files, tmp_path_factory):
         metrology=[f["metrology"]],
         dic=[f["dic"]],
         command="jointwear report (test)",
+        criteria=STRICT,
     )
     return path, result
 
@@ -94,10 +99,11 @@ def test_report_structure(built):
     ]
     assert verdicts[: len(result.decisions)] == [LABELS[s] for s in result.decisions.state]
     # all four states occur in this comparison (no uncertainty stated for the model, a scan
-    # narrower than the simulated worn zone, a rotated and a scaled measurement)
+    # narrower than the simulated worn zone with the strict coverage rule, a rotated and a
+    # scaled measurement)
     assert set(result.decisions.state) == {"pass", "fail", "not_assessed", "not_comparable"}
-    # the rotated measurement: angle error of the maximum is -10 degree, shown in the card
-    assert any("-10.0 degree" in text for _, text in page.cells)
+    # the rotated measurement: angle error of the maximum is -40 degree, shown in the card
+    assert any("-40.0 degree" in text for _, text in page.cells)
     # figures inline: the wear maps as PNG, polar plots and motion as SVG
     assert page.tags.get("svg", 0) >= 2 and page.tags.get("img", 0) == 1
     assert page.tags.get("script", 0) == 0
@@ -125,6 +131,7 @@ def test_report_is_byte_identical(report_files, built, tmp_path):
         metrology=[f["metrology"]],
         dic=[f["dic"]],
         command="jointwear report (test)",
+        criteria=STRICT,
     )
     assert again.read_bytes() == built[0].read_bytes()
 
@@ -230,3 +237,15 @@ def test_generated_scan_stays_synthetic_into_the_decision_card(tmp_path):
     plain = tmp_path / "plain"
     instruments.write(instruments.generate(**kw), plain, layout="folder", header=False)
     assert read_talyrond(plain, convention=conv).attrs["data_origin"] == "measured"
+
+
+def test_a_sim_verify_study_is_plotted(built):
+    from test_compare_study import study
+
+    from jointwear.reports import render_html
+
+    _, result = built
+    page = _Page()
+    page.feed(render_html(result, verification=[study()], command="t"))
+    # polar plots, motion and the study's level means against ΔN
+    assert page.tags.get("svg", 0) == 3

@@ -11,6 +11,8 @@ import pytest
 
 PACKAGES = [
     "jointwear.sim",
+    "jointwear.sim.wear",
+    "jointwear.sim.sweep",
     "jointwear.dic",
     "jointwear.metrology",
     "jointwear.compare",

@@ -13,10 +13,11 @@ import math
 import numpy as np
 import pytest
 
-import jointwear.sim._kernels as kn
 from jointwear.params import replace_nested
 from jointwear.sim import PARAMETER_SETS, run_cycles
 from jointwear.sim.dynamics import _layers, _pack, point_area
+from jointwear.sim.kernels._contact import _contact, _latch_impacts, _stiffness
+from jointwear.sim.kernels._layout import NINFO
 
 BASE = PARAMETER_SETS["zhang2023"]
 EDGE_PEN = 1.0e-6  # penetration at the bearing edge z = +wb/2 [m]
@@ -56,12 +57,12 @@ def _press(params, length=CONTACT_LENGTH):
         np.zeros(nl + 2),
         np.zeros(nl + 2),
         np.zeros(nl + 2, dtype=np.int64),
-        np.zeros(kn.NINFO),
+        np.zeros(NINFO),
         ww,
         acc,
     )
     wrench = np.zeros(12)
-    kn._contact(J0, u, V0, W, ctx, wrench, True, 1.0)
+    _contact(J0, u, V0, W, ctx, wrench, True, 1.0)
     return ww[0], area, float(np.linalg.norm(wrench[6:9])), J0, u, float(acc[0])
 
 
@@ -87,7 +88,7 @@ def test_edge_contact_force_and_line_load_match_the_closed_form(grid, grading):
     p = _grid(*grid, **{"joint.axial_grading": grading})
     j = p.joint
     work, area, fn, J0, u, _ = _press(p)
-    K = kn._stiffness(*_pack(p), 0.0)  # eq. 9 on the new bore
+    K = _stiffness(*_pack(p), 0.0)  # eq. 9 on the new bore
     n = BASE.contact.exponent
     # penetration along the bore from the exact geometry: linear in z to 1e-4 relative
     z = np.linspace(0.5 * j.bearing_width - 2 * CONTACT_LENGTH, 0.5 * j.bearing_width, 201)
@@ -168,7 +169,7 @@ def test_one_cycle_edge_wear_work_converges_with_the_grid():
 def _latch(son, srate, vimp, floor=0.01, per_layer=0):
     son = np.asarray(son, dtype=np.int64)
     vimp = np.asarray(vimp, dtype=float).copy()
-    kn._latch_impacts(vimp, np.asarray(srate, dtype=float), son, son.size - 2, floor, per_layer)
+    _latch_impacts(vimp, np.asarray(srate, dtype=float), son, son.size - 2, floor, per_layer)
     return vimp
 
 

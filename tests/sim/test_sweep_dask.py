@@ -21,7 +21,7 @@ import pytest
 
 from jointwear import io
 from jointwear.sim import run_sweep
-from jointwear.sim._sweep_store import parts_dir
+from jointwear.sim.sweep._store import parts_dir
 
 pytestmark = pytest.mark.slow
 
@@ -181,8 +181,8 @@ def _warm_up(address: str) -> None:
     from distributed import Client
 
     def imports() -> None:
-        import jointwear.sim._sweep_models  # noqa: F401
-        import jointwear.sim._sweep_run  # noqa: F401
+        import jointwear.sim.sweep._models  # noqa: F401
+        import jointwear.sim.sweep._run  # noqa: F401
 
     with Client(address, timeout="20s", set_as_default=False) as c:
         c.run(imports)

@@ -13,8 +13,8 @@ from jointwear import io
 from jointwear.cli import main
 from jointwear.errors import BadInputError
 from jointwear.sim import analytic_sobol, run_sweep, to_grid
-from jointwear.sim import sweep as sweep_mod
-from jointwear.sim._sweep_store import parts_dir
+from jointwear.sim.sweep import _driver as sweep_mod
+from jointwear.sim.sweep._store import parts_dir
 
 PI = math.pi
 

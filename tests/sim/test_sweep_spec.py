@@ -10,10 +10,10 @@ import pytest
 from scipy import stats
 
 from jointwear.errors import ParameterError
-from jointwear.sim._sweep_params import apply_values, numeric_fields, parameter_units
-from jointwear.sim._sweep_spec import make_design, read_spec
 from jointwear.sim.parameters import PARAMETER_SETS
-from jointwear.sim.sweep import _check_feasible
+from jointwear.sim.sweep._driver import _check_feasible
+from jointwear.sim.sweep._params import apply_values, numeric_fields, parameter_units
+from jointwear.sim.sweep._spec import make_design, read_spec
 from jointwear.sim.wear import WearSettings
 
 BASE = PARAMETER_SETS["zhang2023"]
@@ -248,7 +248,7 @@ def test_function_runs_check_their_inputs():
 
 
 def test_an_unworn_bore_has_no_location_of_maximum_wear():
-    from jointwear.sim._sweep_outputs import wear_outputs
+    from jointwear.sim.sweep._outputs import wear_outputs
     from jointwear.sim.wearmap import BearingGrid, wear_map_dataset
 
     grid = BearingGrid(4, 24)

@@ -11,8 +11,8 @@ import pytest
 
 from jointwear.errors import BadInputError
 from jointwear.sim import BearingGrid, ConstantContact, WearRun, WearSettings
-from jointwear.sim._wear_checkpoint import FORMAT_VERSION, read_checkpoint, write_checkpoint
 from jointwear.sim.dynamics import SimState
+from jointwear.sim.wear._checkpoint import FORMAT_VERSION, read_checkpoint, write_checkpoint
 
 
 def test_round_trip_is_exact_for_every_type_the_state_holds(tmp_path):

@@ -172,7 +172,7 @@ def test_calibrate_kw_command_recovers_the_kw_of_a_run(tmp_path, capsys):
 
 def test_a_failing_simulation_leaves_partial_output_and_checkpoint(tmp_path, monkeypatch, capsys):
     from jointwear.errors import SimulationError
-    from jointwear.sim import cli_wear
+    from jointwear.sim.wear import _files as cli_wear  # the CLI's library side
 
     real = cli_wear.demo_winkler_contact
 

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from jointwear.sim import BearingGrid, CycleWear, WearRun, WearSettings, simulate_wear
-from jointwear.sim import _wear_control as ctl
+from jointwear.sim.wear import _control as ctl
 
 GRID = BearingGrid(6, 48)
 A_RATE = 1e-9  # m per cycle on the unworn bore (mean)

@@ -1,0 +1,277 @@
+"""Full-field results of other DIC codes as jointwear field datasets (for ``compare``).
+
+``read_field(files, *, format, length_unit=None, data_origin)`` reads one file per image (first =
+reference), in the given order or a glob pattern's frame-number order:
+
+``"vic3d-csv"``
+    VIC-3D's CSV export: a header row of quoted column names, one row per point. Used columns:
+    ``x``, ``y`` [pixel] (subset centre, reference image); ``X``, ``Y``, ``Z`` (reference
+    position) and ``U``, ``V``, ``W`` (displacement) in the calibration's length unit, or ``u``,
+    ``v`` [pixel] in a 2D export; ``sigma`` (VIC-3D's matching confidence [pixel]; -1 or empty
+    marks a point without data).
+``"dice"``
+    DICe's solution text files (``DICe_solution_*.txt``): ``***`` comment lines, then a
+    comma-separated header row. Used columns: ``COORDINATE_X``, ``COORDINATE_Y`` [pixel];
+    ``MODEL_COORDINATES_X/Y/Z`` and ``MODEL_DISPLACEMENT_X/Y/Z`` (stereo, length unit of the
+    calibration) or ``DISPLACEMENT_X/Y`` [pixel] (2D); ``SIGMA`` (-1: failed) and ``GAMMA``.
+
+Nothing is guessed: a stereo file's length unit must be stated (``length_unit``: ``"mm"``,
+``"m"``, ``"um"``, ``"in"`` or metres per unit); the points must be the same in every file (same
+``x``, ``y``); the foreign tools' ``sigma`` is a matching confidence in pixels, not a
+displacement uncertainty, so ``displacement_u`` is NaN ("not assessed") and the foreign value
+is kept as ``foreign_sigma``. Points without data are flagged (``flag`` 6, ``not_reached``).
+"""
+
+from __future__ import annotations
+
+import csv
+import re
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+
+from jointwear.errors import BadInputError, ParameterError
+
+__all__ = ["read_field", "FIELD_FORMATS"]
+
+FIELD_FORMATS = ("vic3d-csv", "dice")
+_UNITS = {"m": 1.0, "mm": 1e-3, "um": 1e-6, "µm": 1e-6, "cm": 1e-2, "in": 0.0254}
+
+#: format -> (x, y, position XYZ, displacement XYZ, 2D displacement, sigma, quality)
+_COLUMNS = {
+    "vic3d-csv": (
+        "x",
+        "y",
+        ("X", "Y", "Z"),
+        ("U", "V", "W"),
+        ("u", "v"),
+        "sigma",
+        None,
+    ),
+    "dice": (
+        "COORDINATE_X",
+        "COORDINATE_Y",
+        ("MODEL_COORDINATES_X", "MODEL_COORDINATES_Y", "MODEL_COORDINATES_Z"),
+        ("MODEL_DISPLACEMENT_X", "MODEL_DISPLACEMENT_Y", "MODEL_DISPLACEMENT_Z"),
+        ("DISPLACEMENT_X", "DISPLACEMENT_Y"),
+        "SIGMA",
+        "GAMMA",
+    ),
+}
+
+
+def _scale(length_unit) -> float:
+    if isinstance(length_unit, str) and length_unit.strip() in _UNITS:
+        return _UNITS[length_unit.strip()]
+    try:
+        s = float(length_unit)
+    except (TypeError, ValueError):
+        s = float("nan")
+    if not (np.isfinite(s) and s > 0):
+        raise ParameterError(
+            f"length_unit={length_unit!r}: say what unit the file's lengths are in, one of "
+            f"{', '.join(_UNITS)} or the number of metres per unit (--length-unit)"
+        )
+    return s
+
+
+def _table(path: Path, fmt: str) -> dict[str, np.ndarray]:
+    try:
+        text = path.read_text(errors="replace")
+    except OSError as exc:
+        raise BadInputError(f"{fmt} file '{path}': {exc}") from None
+    lines = [ln for ln in text.splitlines() if ln.strip() and not ln.lstrip().startswith("***")]
+    if fmt == "dice":
+        lines = [ln for ln in lines if not ln.lstrip().startswith("#")]
+    if len(lines) < 2:
+        raise BadInputError(f"{fmt} file '{path}': no header and data rows found")
+    dialect = csv.excel if "," in lines[0] else csv.excel_tab
+    rows = list(csv.reader(lines, dialect))
+    head = [re.sub(r"\s*\[.*\]$", "", h.strip().strip('"')) for h in rows[0]]
+    cols: dict[str, np.ndarray] = {}
+    body = rows[1:]
+    for j, name in enumerate(head):
+        vals = []
+        for k, r in enumerate(body):
+            v = r[j].strip() if j < len(r) else ""
+            try:
+                vals.append(float(v) if v else np.nan)
+            except ValueError:
+                if name in ("flag",):
+                    vals.append(np.nan)
+                    continue
+                raise BadInputError(
+                    f"{fmt} file '{path}' row {k + 2}, column '{name}': {v!r} is not a number"
+                ) from None
+        cols[name] = np.array(vals)
+    return cols
+
+
+def _files(files) -> list[Path]:
+    if isinstance(files, (str, Path)):
+        from jointwear.dic.footage._video import _GLOB_CHARS, _natural_key
+
+        p = Path(files)
+        if p.is_file():
+            return [p]
+        if _GLOB_CHARS.search(p.name) and p.parent.is_dir():
+            found = sorted((q for q in p.parent.glob(p.name) if q.is_file()), key=_natural_key)
+            if not found:
+                raise BadInputError(f"pattern '{files}' matches no file")
+            return found
+        raise BadInputError(f"'{files}' does not exist")
+    out = [Path(f) for f in files]
+    if not out:
+        raise BadInputError("read_field: no files given")
+    for f in out:
+        if not f.is_file():
+            raise BadInputError(f"'{f}' does not exist")
+    return out
+
+
+def read_field(
+    files,
+    *,
+    format: str,
+    length_unit=None,
+    data_origin: str,
+    times=None,
+) -> xr.Dataset:
+    """Another DIC code's field results as a field dataset (see module docstring).
+
+    Parameters
+    ----------
+    files : path, pattern or list of paths
+        One file per image, the reference first.
+    format : {"vic3d-csv", "dice"}
+        The tool that wrote them.
+    length_unit : str or float
+        Unit of the stereo lengths (``"mm"``...; or metres per unit). Not needed for 2D files.
+    data_origin : {"measured", "synthetic"}
+        What the images were.
+    times : sequence of float, optional
+        Time of every image [s] (default: no time base, the image index).
+    """
+    if format not in FIELD_FORMATS:
+        raise ParameterError(f"format={format!r}: expected one of {', '.join(FIELD_FORMATS)}")
+    if data_origin not in ("measured", "synthetic"):
+        raise ParameterError(
+            f"data_origin={data_origin!r}: say what the images were, 'measured' or 'synthetic'"
+        )
+    paths = _files(files)
+    cx, cy, pos_c, disp_c, disp2_c, sig_c, q_c = _COLUMNS[format]
+    tables = [_table(p, format) for p in paths]
+    first = tables[0]
+    for c in (cx, cy):
+        if c not in first:
+            raise BadInputError(
+                f"{format} file '{paths[0]}' has no column '{c}' (columns: {', '.join(first)}); "
+                "is it the right --format?"
+            )
+    stereo = all(c in first for c in pos_c + disp_c)
+    if not stereo and not all(c in first for c in disp2_c):
+        want = ", ".join(disp_c + disp2_c)
+        raise BadInputError(f"{format} file '{paths[0]}' has neither of the columns {want}")
+    scale = _scale(length_unit) if stereo else 1.0
+    x, y = first[cx], first[cy]
+    n = len(x)
+    n_t = len(paths)
+    names = disp_c if stereo else disp2_c
+    disp = np.full((n_t, n, len(names)), np.nan)
+    sig = np.full((n_t, n), np.nan)
+    qual = np.full((n_t, n), np.nan)
+    for k, (p, tab) in enumerate(zip(paths, tables, strict=True)):
+        if len(tab.get(cx, [])) != n or not (
+            np.allclose(tab[cx], x, equal_nan=True) and np.allclose(tab[cy], y, equal_nan=True)
+        ):
+            raise BadInputError(
+                f"{format} file '{p}': its points (x, y) differ from those of '{paths[0]}'; "
+                "export every image with the same points (same AOI and step)"
+            )
+        for i, c in enumerate(names):
+            if c not in tab:
+                raise BadInputError(f"{format} file '{p}' has no column '{c}'")
+            disp[k, :, i] = tab[c] * scale
+        if sig_c in tab:
+            sig[k] = tab[sig_c]
+        if q_c and q_c in tab:
+            qual[k] = tab[q_c]
+    missing = ~np.isfinite(disp).all(axis=-1)
+    if sig_c in first:
+        missing |= ~(sig >= 0)
+    flag = np.where(missing, 6, 0).astype(np.int8)
+    disp[missing] = np.nan
+    axes = ["x", "y", "z"] if stereo else ["x", "y"]
+    unit = "m" if stereo else "pixel"
+    data = {
+        "displacement": xr.DataArray(
+            disp,
+            dims=("time", "point", "axis"),
+            attrs={
+                "units": unit,
+                "long_name": f"displacement from the reference image ({format})",
+                "ancillary_variables": "displacement_u flag",
+            },
+        ),
+        "displacement_u": xr.DataArray(
+            np.full_like(disp, np.nan),
+            dims=("time", "point", "axis"),
+            attrs={
+                "units": unit,
+                "long_name": "standard uncertainty of displacement: not assessed (the foreign "
+                "sigma is a matching confidence in pixels, see foreign_sigma)",
+            },
+        ),
+        "foreign_sigma": xr.DataArray(
+            np.where(sig >= 0, sig, np.nan),
+            dims=("time", "point"),
+            attrs={"units": "pixel", "long_name": f"{sig_c} column of the {format} files"},
+        ),
+        "flag": xr.DataArray(
+            flag,
+            dims=("time", "point"),
+            attrs={
+                "units": "1",
+                "long_name": "field quality flag (imported: ok or not_reached = no data)",
+                "flag_values": np.array([0, 6], np.int8),
+                "flag_meanings": "ok not_reached",
+            },
+        ),
+    }
+    if q_c and np.isfinite(qual).any():
+        data["foreign_quality"] = xr.DataArray(
+            qual, dims=("time", "point"), attrs={"units": "1", "long_name": f"{q_c} column"}
+        )
+    if stereo:
+        P = np.column_stack([first[c] for c in pos_c]) * scale
+        data["position"] = xr.DataArray(
+            np.where(missing[0][:, None], np.nan, P),
+            dims=("point", "axis"),
+            attrs={"units": "m", "long_name": f"reference position of the point ({format})"},
+        )
+    coords = {
+        "point": ("point", np.arange(n), {"long_name": "measurement point"}),
+        "x": ("point", x, {"units": "pixel", "long_name": "subset centre column, reference"}),
+        "y": ("point", y, {"units": "pixel", "long_name": "subset centre row, reference"}),
+        "axis": ("axis", axes, {"long_name": "vector component"}),
+        "image": ("time", np.arange(n_t), {"long_name": "image index (0 = reference)"}),
+        "source_file": ("time", [p.name for p in paths], {"long_name": "imported file"}),
+    }
+    if times is not None:
+        t = np.asarray(times, float)
+        if t.shape != (n_t,) or np.any(np.diff(t) <= 0):
+            raise BadInputError(f"times: expected {n_t} increasing values [s]")
+        coords["time"] = ("time", t, {"units": "s", "long_name": "time of the image"})
+    ds = xr.Dataset(data, coords=coords)
+    ds.attrs.update(
+        {
+            "title": f"{'stereo' if stereo else '2D'} DIC field imported from {format}",
+            "data_origin": data_origin,
+            "external_tool": format,
+            "field_frame": "the foreign tool's frame (as exported)",
+        }
+    )
+    if stereo:
+        ds.attrs["length_unit_of_the_files_m"] = scale
+    return ds

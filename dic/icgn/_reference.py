@@ -1,0 +1,189 @@
+"""Reference subsets of the IC-GN (numba): loading values and gradients, invalid-pixel boxes,
+texture, and the Gauss-Newton standard uncertainty."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from jointwear.dic.icgn._flags import FLAG_INVALID_PIXELS, FLAG_NO_TEXTURE, FLAG_OK, FLAG_OUTSIDE
+from jointwear.dic.icgn._interp import PAD, interp_value, node_filters
+
+
+@njit(cache=True)
+def _box_has_invalid(integral, x0, y0, x1, y1):
+    """True if any invalid pixel in [x0, x1] x [y0, y1] (integral image of invalid counts;
+    a (1, 1) table means that every pixel is valid)."""
+    if integral.shape[0] == 1:
+        return False
+    h = integral.shape[0] - 1
+    w = integral.shape[1] - 1
+    if x0 < 0:
+        x0 = 0
+    if y0 < 0:
+        y0 = 0
+    if x1 > w - 1:
+        x1 = w - 1
+    if y1 > h - 1:
+        y1 = h - 1
+    s = integral[y1 + 1, x1 + 1] - integral[y0, x1 + 1] - integral[y1 + 1, x0] + integral[y0, x0]
+    return s > 0
+
+
+@njit(cache=True)
+def _load_reference(
+    ref_img,
+    ref_gx,
+    ref_gy,
+    ref_coef,
+    ref_invalid,
+    order,
+    xc,
+    yc,
+    half,
+    min_std,
+    border,
+    f,
+    gx,
+    gy,
+    w,
+):
+    """Reference subset values (zero-mean, into ``f``) and gradients. Returns (flag, fn)."""
+    H, W = ref_img.shape
+    size = 2 * half + 1
+    n = size * size
+    if not math.isfinite(xc) or not math.isfinite(yc):
+        return FLAG_INVALID_PIXELS, 0.0
+    if (
+        xc - half < border
+        or yc - half < border
+        or xc + half > W - 1 - border
+        or yc + half > H - 1 - border
+    ):
+        return FLAG_OUTSIDE, 0.0
+    x0 = int(math.floor(xc)) - half - 1
+    y0 = int(math.floor(yc)) - half - 1
+    if _box_has_invalid(ref_invalid, x0, y0, x0 + size + 2, y0 + size + 2):
+        return FLAG_INVALID_PIXELS, 0.0
+    k = 0
+    if xc == math.floor(xc) and yc == math.floor(yc):
+        ic = int(xc)
+        jc = int(yc)
+        for r in range(-half, half + 1):
+            for c in range(-half, half + 1):
+                f[k] = ref_img[jc + r, ic + c]
+                gx[k] = ref_gx[jc + r, ic + c]
+                gy[k] = ref_gy[jc + r, ic + c]
+                k += 1
+    else:
+        # off the pixel grid: the values and the central differences of the interpolant (the
+        # node gradients are central differences of the pixels, see jointwear.dic.icgn._interp)
+        for r in range(-half, half + 1):
+            for c in range(-half, half + 1):
+                x = xc + c
+                y = yc + r
+                f[k] = interp_value(ref_coef, order, x, y, w[0], w[1])
+                gx[k] = 0.5 * (
+                    interp_value(ref_coef, order, x + 1.0, y, w[0], w[1])
+                    - interp_value(ref_coef, order, x - 1.0, y, w[0], w[1])
+                )
+                gy[k] = 0.5 * (
+                    interp_value(ref_coef, order, x, y + 1.0, w[0], w[1])
+                    - interp_value(ref_coef, order, x, y - 1.0, w[0], w[1])
+                )
+                k += 1
+    fm = 0.0
+    for k in range(n):
+        fm += f[k]
+    fm /= n
+    fn = 0.0
+    for k in range(n):
+        f[k] -= fm
+        fn += f[k] * f[k]
+    fn = math.sqrt(fn)
+    if fn <= min_std * math.sqrt(n):
+        return FLAG_NO_TEXTURE, fn
+    return FLAG_OK, fn
+
+
+@njit(cache=True)
+def _store_sigma(w, fn, zncc, n, n_params, hinv_u, hinv_v):
+    """Standard uncertainty of u and v from the residual (Gauss-Newton covariance
+    ``s2 H^-1``, ``s2 = fn^2 ZNSSD / (n - n_params)`` in reference grey levels), kept in the
+    scratch ``w[3, 4:6]``."""
+    znssd = max(2.0 * (1.0 - zncc), 0.0)
+    s2 = fn * fn * znssd / max(n - n_params, 1)
+    w[3, 4] = math.sqrt(s2 * hinv_u)
+    w[3, 5] = math.sqrt(s2 * hinv_v)
+
+
+@njit(cache=True)
+def subset_std(img, invalid, centres, half, border):
+    """Standard deviation of the reference subset at every centre (NaN: unusable centre)."""
+    H, W = img.shape
+    n = centres.shape[0]
+    out = np.full(n, np.nan)
+    size = 2 * half + 1
+    for i in range(n):
+        xc = centres[i, 0]
+        yc = centres[i, 1]
+        if not (math.isfinite(xc) and math.isfinite(yc)):
+            continue
+        if xc - half < border or yc - half < border:
+            continue
+        if xc + half > W - 1 - border or yc + half > H - 1 - border:
+            continue
+        x0 = int(round(xc)) - half
+        y0 = int(round(yc)) - half
+        if _box_has_invalid(invalid, x0, y0, x0 + size - 1, y0 + size - 1):
+            continue
+        s = 0.0
+        s2 = 0.0
+        for r in range(size):
+            for c in range(size):
+                v = img[y0 + r, x0 + c]
+                s += v
+                s2 += v * v
+        m = s / (size * size)
+        out[i] = math.sqrt(max(s2 / (size * size) - m * m, 0.0))
+    return out
+
+
+@njit(cache=True)
+def subset_kappa(coef, order, gx, gy, centres, half, out):
+    """Per subset, ``kappa = sum |g_c|^2 / sum g_c . g_s``: central-difference node gradients
+    ``gx``, ``gy`` against the interpolant's exact node derivative ``g_s`` (from the padded
+    coefficients), over the subset square around each centre (1 where undefined)."""
+    val, der = node_filters(order)
+    r = val.shape[0] // 2
+    h, w = gx.shape
+    for i in range(centres.shape[0]):
+        out[i] = 1.0
+        xc = centres[i, 0]
+        yc = centres[i, 1]
+        if not (math.isfinite(xc) and math.isfinite(yc)):
+            continue
+        ic = int(round(xc))
+        jc = int(round(yc))
+        a = 0.0
+        b = 0.0
+        for y in range(max(jc - half, 0), min(jc + half + 1, h)):
+            for x in range(max(ic - half, 0), min(ic + half + 1, w)):
+                sx = 0.0
+                sy = 0.0
+                for p in range(2 * r + 1):
+                    row = coef[y + PAD - r + p]
+                    vd = 0.0
+                    vv = 0.0
+                    for q in range(2 * r + 1):
+                        c = row[x + PAD - r + q]
+                        vd += der[q] * c
+                        vv += val[q] * c
+                    sx += val[p] * vd
+                    sy += der[p] * vv
+                a += gx[y, x] * gx[y, x] + gy[y, x] * gy[y, x]
+                b += gx[y, x] * sx + gy[y, x] * sy
+        if b > 0.0 and math.isfinite(a / b):
+            out[i] = a / b

@@ -1,0 +1,115 @@
+"""Sampling the deformed image for the IC-GN (numba): B-spline weights written once, the value
+at one point, and one pass over a warped subset with the sums the Gauss-Newton step needs.
+
+The cubic and quintic kernels are one source: ``order`` is a loop invariant, so the compiler
+hoists the branch out of the pixel loop and each order runs its own straight-line code.
+"""
+
+from __future__ import annotations
+
+from numba import njit
+
+from jointwear.dic.icgn._interp import PAD
+
+_FM = {"nsz", "arcp", "contract", "reassoc"}  # fastmath without no-NaN/no-inf assumptions
+
+
+@njit(cache=True, inline="always")
+def bspline3(t):
+    """Cubic B-spline weights (x 6) of the 4 nodes around a point at fraction ``t``."""
+    s = 1.0 - t
+    t2 = t * t
+    t3 = t2 * t
+    return s * s * s, 4.0 - 6.0 * t2 + 3.0 * t3, 1.0 + 3.0 * (t + t2 - t3), t3
+
+
+@njit(cache=True, inline="always")
+def bspline5(t):
+    """Quintic B-spline weights (x 120) of the 6 nodes around a point at fraction ``t``
+    (Horner form)."""
+    s = 1.0 - t
+    s2 = s * s
+    t2 = t * t
+    return (
+        s2 * s2 * s,
+        26.0 + t * (-50.0 + t * (20.0 + t * (20.0 + t * (-20.0 + 5.0 * t)))),
+        66.0 + t2 * (-60.0 + t2 * (30.0 - 10.0 * t)),
+        26.0 + t * (50.0 + t * (20.0 + t * (-20.0 + t * (-20.0 + 10.0 * t)))),
+        1.0 + t * (5.0 + t * (10.0 + t * (10.0 + t * (5.0 - 5.0 * t)))),
+        t2 * t2 * t,
+    )
+
+
+@njit(cache=True, inline="always")
+def interp_point(coef, order, xw, yw):
+    """B-spline value at (xw, yw) >= 0 [pixel] on padded prefiltered coefficients."""
+    ix = int(xw)
+    iy = int(yw)
+    if order == 3:
+        w0, w1, w2, w3 = bspline3(xw - ix)
+        v0, v1, v2, v3 = bspline3(yw - iy)
+        bx = ix + PAD - 1
+        by = iy + PAD - 1
+        r0 = coef[by]
+        r1 = coef[by + 1]
+        r2 = coef[by + 2]
+        r3 = coef[by + 3]
+        return (
+            v0 * (w0 * r0[bx] + w1 * r0[bx + 1] + w2 * r0[bx + 2] + w3 * r0[bx + 3])
+            + v1 * (w0 * r1[bx] + w1 * r1[bx + 1] + w2 * r1[bx + 2] + w3 * r1[bx + 3])
+            + v2 * (w0 * r2[bx] + w1 * r2[bx + 1] + w2 * r2[bx + 2] + w3 * r2[bx + 3])
+            + v3 * (w0 * r3[bx] + w1 * r3[bx + 1] + w2 * r3[bx + 2] + w3 * r3[bx + 3])
+        ) * (1.0 / 36.0)
+    w0, w1, w2, w3, w4, w5 = bspline5(xw - ix)
+    v0, v1, v2, v3, v4, v5 = bspline5(yw - iy)
+    bx = ix + PAD - 2
+    by = iy + PAD - 2
+    r0 = coef[by]
+    r1 = coef[by + 1]
+    r2 = coef[by + 2]
+    r3 = coef[by + 3]
+    r4 = coef[by + 4]
+    r5 = coef[by + 5]
+    acc = 0.0
+    for q, wq in enumerate((w0, w1, w2, w3, w4, w5)):
+        b = bx + q
+        acc += wq * (v0 * r0[b] + v1 * r1[b] + v2 * r2[b] + v3 * r3[b] + v4 * r4[b] + v5 * r5[b])
+    return acc * (1.0 / 14400.0)
+
+
+@njit(cache=True, fastmath=_FM)
+def sample_affine(coef, order, x_start, y_start, a11, a12, a21, a22, half, f, gx, gy, acc):
+    """Sample the affinely warped subset and accumulate into ``acc`` (9,): sum g, sum g^2,
+    sum g f and the six sums J g (J = gradient times (1, column, row))."""
+    for i in range(9):
+        acc[i] = 0.0
+    k = 0
+    for r in range(-half, half + 1):
+        rr = float(r)
+        xw = x_start + a12 * rr
+        yw = y_start + a22 * rr
+        ga = gac = gb = gbc = 0.0
+        sg = sgg = sgf = 0.0
+        for c in range(-half, half + 1):
+            gv = interp_point(coef, order, xw, yw)
+            sg += gv
+            sgg += gv * gv
+            sgf += gv * f[k]
+            q = gx[k] * gv
+            ga += q
+            gac += q * c
+            q = gy[k] * gv
+            gb += q
+            gbc += q * c
+            xw += a11
+            yw += a21
+            k += 1
+        acc[0] += sg
+        acc[1] += sgg
+        acc[2] += sgf
+        acc[3] += ga
+        acc[4] += gac
+        acc[5] += ga * rr
+        acc[6] += gb
+        acc[7] += gbc
+        acc[8] += gb * rr

@@ -1,0 +1,411 @@
+"""One IC-GN subset match (numba): Gauss-Newton systems and iterations, affine and second
+order, from one reference loading (:func:`solve_point`).
+
+Criterion: zero-normalised sum of squared differences (ZNSSD), minimised by the
+inverse-compositional Gauss-Newton (Baker & Matthews 2004; Pan, Li & Tong 2013): the Hessian is
+built once per subset from the reference gradients (central differences, see
+:mod:`jointwear.dic.icgn._interp`), each iteration samples the deformed image once at the warped
+subset and updates ``W(p) <- W(p) o W(dp)^-1``. Kernel arguments come packed: ``ref`` =
+``(image, gx, gy, coef, invalid)`` of the reference, ``dfm`` = ``(coef, invalid)`` of the
+deformed image, ``opts`` = ``(half, quadratic, max_iter, tol, min_std, max_shift, border,
+zncc_min, order)``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from jointwear.dic.icgn._flags import (
+    AFFINE_INDEX,
+    FLAG_DIVERGED,
+    FLAG_INVALID_PIXELS,
+    FLAG_NO_TEXTURE,
+    FLAG_NOT_CONVERGED,
+    FLAG_OK,
+    FLAG_OUTSIDE,
+)
+from jointwear.dic.icgn._interp import PAD
+from jointwear.dic.icgn._reference import _box_has_invalid, _load_reference, _store_sigma
+from jointwear.dic.icgn._sample import interp_point, sample_affine
+from jointwear.dic.icgn._warp import _compose_affine, _compose_quadratic, _solve_spd
+
+# a subset still below this ZNCC after this many iterations is not going to match
+_HOPELESS_AFTER = 10
+_HOPELESS_ZNCC = 0.5
+
+_FM = {"nsz", "arcp", "contract", "reassoc"}  # fastmath without no-NaN/no-inf assumptions
+
+
+@njit(cache=True, fastmath=_FM)
+def _hessian_affine(f, gx, gy, half, Hm, jf, js):
+    """Affine Gauss-Newton Hessian ``sum J J^T``, ``sum J f`` and ``sum J`` (row-wise sums)."""
+    m = np.zeros(18)  # aa, ab, bb moments: 1, c, r, cc, cr, rr
+    k = 0
+    for r in range(-half, half + 1):
+        rr = float(r)
+        raa = raac = raacc = rab = rabc = rabcc = rbb = rbbc = rbbcc = 0.0
+        rfa = rfac = rfb = rfbc = rsa = rsac = rsb = rsbc = 0.0
+        for c in range(-half, half + 1):
+            a = gx[k]
+            b = gy[k]
+            fk = f[k]
+            q = a * a
+            raa += q
+            raac += q * c
+            raacc += q * c * c
+            q = a * b
+            rab += q
+            rabc += q * c
+            rabcc += q * c * c
+            q = b * b
+            rbb += q
+            rbbc += q * c
+            rbbcc += q * c * c
+            rfa += a * fk
+            rfac += a * fk * c
+            rfb += b * fk
+            rfbc += b * fk * c
+            rsa += a
+            rsac += a * c
+            rsb += b
+            rsbc += b * c
+            k += 1
+        for o, s1, sc, scc in (
+            (0, raa, raac, raacc),
+            (6, rab, rabc, rabcc),
+            (12, rbb, rbbc, rbbcc),
+        ):
+            m[o] += s1
+            m[o + 1] += sc
+            m[o + 2] += s1 * rr
+            m[o + 3] += scc
+            m[o + 4] += sc * rr
+            m[o + 5] += s1 * rr * rr
+        jf[0] += rfa
+        jf[1] += rfac
+        jf[2] += rfa * rr
+        jf[3] += rfb
+        jf[4] += rfbc
+        jf[5] += rfb * rr
+        js[0] += rsa
+        js[1] += rsac
+        js[2] += rsa * rr
+        js[3] += rsb
+        js[4] += rsbc
+        js[5] += rsb * rr
+    # J = [a, a c, a r, b, b c, b r]: block (i, j) of sum J J^T from the moments
+    for blk_i in range(2):
+        for blk_j in range(blk_i, 2):
+            o = 0 if (blk_i == 0 and blk_j == 0) else (6 if blk_i != blk_j else 12)
+            M3 = np.empty((3, 3))
+            M3[0, 0] = m[o]
+            M3[0, 1] = m[o + 1]
+            M3[0, 2] = m[o + 2]
+            M3[1, 0] = m[o + 1]
+            M3[1, 1] = m[o + 3]
+            M3[1, 2] = m[o + 4]
+            M3[2, 0] = m[o + 2]
+            M3[2, 1] = m[o + 4]
+            M3[2, 2] = m[o + 5]
+            for i in range(3):
+                for j in range(3):
+                    Hm[3 * blk_i + i, 3 * blk_j + j] = M3[i, j]
+                    Hm[3 * blk_j + j, 3 * blk_i + i] = M3[i, j]
+
+
+@njit(cache=True, nogil=True)
+def _affine_system(f, gx, gy, half, Hinv, jf, js):
+    """Inverse Gauss-Newton Hessian (into ``Hinv``, which must hold the identity), ``sum J f``
+    and ``sum J``; False when the Hessian is singular (no texture)."""
+    Hm = np.empty((6, 6))
+    _hessian_affine(f, gx, gy, half, Hm, jf, js)
+    return _solve_spd(Hm, Hinv, 6)
+
+
+@njit(cache=True, nogil=True)
+def _quadratic_system(f, gx, gy, half, Hinv, jf, js):
+    """As :func:`_affine_system` with the 12-parameter second-order Jacobian."""
+    Hm = np.zeros((12, 12))
+    J = np.empty(12)
+    k = 0
+    for r in range(-half, half + 1):
+        for c in range(-half, half + 1):
+            a = gx[k]
+            b = gy[k]
+            J[0] = a
+            J[1] = a * c
+            J[2] = a * r
+            J[3] = 0.5 * a * c * c
+            J[4] = a * c * r
+            J[5] = 0.5 * a * r * r
+            J[6] = b
+            J[7] = b * c
+            J[8] = b * r
+            J[9] = 0.5 * b * c * c
+            J[10] = b * c * r
+            J[11] = 0.5 * b * r * r
+            fk = f[k]
+            for i in range(12):
+                ji = J[i]
+                jf[i] += ji * fk
+                js[i] += ji
+                for j in range(i + 1):
+                    Hm[i, j] += ji * J[j]
+            k += 1
+    for i in range(12):
+        for j in range(i + 1, 12):
+            Hm[i, j] = Hm[j, i]
+    return _solve_spd(Hm, Hinv, 12)
+
+
+@njit(cache=True, nogil=True)
+def _iterate_affine(
+    f, gx, gy, fn, Hinv, jf, js, def_coef, def_invalid, order, xc, yc, half, p, max_iter, tol,
+    max_shift, border, w,
+):  # fmt: skip
+    """Gauss-Newton iterations of the affine IC-GN from the loaded reference subset.
+
+    Uses ``sum J (f - fm - fn/gn (g - gm)) = Jf - fn/gn (Jg - gm Js)`` with ``Jf``, ``Js``
+    fixed per subset, so each iteration samples the deformed subset once and accumulates.
+    """
+    Hd = def_coef.shape[0] - 2 * PAD
+    Wd = def_coef.shape[1] - 2 * PAD
+    n = (2 * half + 1) ** 2
+    acc = np.empty(9)
+    e = np.empty(6)
+    dp = np.zeros(12)
+    p_start_u = p[0]
+    p_start_v = p[6]
+    zncc = np.nan
+    it = 0
+    hh2 = float(half) * float(half)
+    while it < max_iter:
+        it += 1
+        a11 = 1.0 + p[1]
+        a12 = p[2]
+        a21 = p[7]
+        a22 = 1.0 + p[8]
+        # the warped subset is a parallelogram: its corners bound it
+        xmin = 1e300
+        xmax = -1e300
+        ymin = 1e300
+        ymax = -1e300
+        for corner in range(4):
+            c = -half if corner % 2 == 0 else half
+            r = -half if corner < 2 else half
+            xw = xc + p[0] + a11 * c + a12 * r
+            yw = yc + p[6] + a21 * c + a22 * r
+            xmin = min(xmin, xw)
+            xmax = max(xmax, xw)
+            ymin = min(ymin, yw)
+            ymax = max(ymax, yw)
+        if not (
+            xmin >= border
+            and ymin >= border
+            and xmax <= Wd - 1 - border
+            and ymax <= Hd - 1 - border
+        ):
+            return np.nan, it, FLAG_OUTSIDE
+        if def_invalid.shape[0] > 1 and _box_has_invalid(
+            def_invalid,
+            int(math.floor(xmin)) - 3,
+            int(math.floor(ymin)) - 3,
+            int(math.ceil(xmax)) + 3,
+            int(math.ceil(ymax)) + 3,
+        ):
+            return np.nan, it, FLAG_INVALID_PIXELS
+        x_start = xc + p[0] - a11 * half
+        y_start = yc + p[6] - a21 * half
+        sample_affine(def_coef, order, x_start, y_start, a11, a12, a21, a22, half, f, gx, gy, acc)
+        gm = acc[0] / n
+        gn2 = acc[1] - n * gm * gm
+        if not gn2 > 1e-300:
+            return np.nan, it, FLAG_NO_TEXTURE
+        gn = math.sqrt(gn2)
+        zncc = acc[2] / (fn * gn)
+        if it >= _HOPELESS_AFTER and not (zncc >= _HOPELESS_ZNCC):
+            return zncc, it, FLAG_NOT_CONVERGED  # far from any match: stop early
+        ratio = fn / gn
+        for j in range(6):
+            e[j] = jf[j] - ratio * (acc[3 + j] - gm * js[j])
+        for i in range(6):
+            s = 0.0
+            for j in range(6):
+                s += Hinv[i, j] * e[j]
+            dp[AFFINE_INDEX[i]] = -s
+        if not _compose_affine(p, dp):
+            return zncc, it, FLAG_DIVERGED
+        ok = True
+        for i in range(12):
+            if not math.isfinite(p[i]):
+                ok = False
+        if not ok or abs(p[0] - p_start_u) > max_shift or abs(p[6] - p_start_v) > max_shift:
+            return np.nan, it, FLAG_DIVERGED
+        norm = dp[0] * dp[0] + dp[6] * dp[6]
+        norm += hh2 * (dp[1] * dp[1] + dp[2] * dp[2] + dp[7] * dp[7] + dp[8] * dp[8])
+        if math.sqrt(norm) < tol:
+            _store_sigma(w, fn, zncc, n, 6, Hinv[0, 0], Hinv[3, 3])
+            return zncc, it, FLAG_OK
+    return zncc, it, FLAG_NOT_CONVERGED
+
+
+@njit(cache=True, fastmath=_FM)
+def _iterate_quadratic(
+    f, gx, gy, fn, Hinv, jf, js, def_coef, def_invalid, order, xc, yc, half, p, max_iter, tol,
+    max_shift, border, w,
+):  # fmt: skip
+    """Gauss-Newton iterations of the second-order IC-GN (as :func:`_iterate_affine`, with the
+    12-parameter Jacobian, every warped pixel bounds-checked and 6x6 warp composition)."""
+    Hd = def_coef.shape[0] - 2 * PAD
+    Wd = def_coef.shape[1] - 2 * PAD
+    n = (2 * half + 1) ** 2
+    jg = np.empty(12)
+    e = np.empty(12)
+    dp = np.zeros(12)
+    p_start_u = p[0]
+    p_start_v = p[6]
+    zncc = np.nan
+    it = 0
+    hh = float(half)
+    lo = float(border)
+    hix = Wd - 1.0 - border
+    hiy = Hd - 1.0 - border
+    while it < max_iter:
+        it += 1
+        for i in range(12):
+            jg[i] = 0.0
+        sg = sgg = sgf = 0.0
+        xmin = 1e300
+        xmax = -1e300
+        ymin = 1e300
+        ymax = -1e300
+        k = 0
+        for r in range(-half, half + 1):
+            rr = float(r)
+            ra = rb = rac = rbc = racc = rbcc = 0.0
+            for c in range(-half, half + 1):
+                cc = float(c)
+                xw = xc + cc + p[0] + p[1] * cc + p[2] * rr
+                xw += 0.5 * p[3] * cc * cc + p[4] * cc * rr + 0.5 * p[5] * rr * rr
+                yw = yc + rr + p[6] + p[7] * cc + p[8] * rr
+                yw += 0.5 * p[9] * cc * cc + p[10] * cc * rr + 0.5 * p[11] * rr * rr
+                if not (xw >= lo and yw >= lo and xw <= hix and yw <= hiy):
+                    return np.nan, it, FLAG_OUTSIDE
+                xmin = min(xmin, xw)
+                xmax = max(xmax, xw)
+                ymin = min(ymin, yw)
+                ymax = max(ymax, yw)
+                gv = interp_point(def_coef, order, xw, yw)
+                sg += gv
+                sgg += gv * gv
+                sgf += gv * f[k]
+                qa = gx[k] * gv
+                qb = gy[k] * gv
+                ra += qa
+                rac += qa * cc
+                racc += qa * cc * cc
+                rb += qb
+                rbc += qb * cc
+                rbcc += qb * cc * cc
+                k += 1
+            jg[0] += ra
+            jg[1] += rac
+            jg[2] += ra * rr
+            jg[3] += 0.5 * racc
+            jg[4] += rac * rr
+            jg[5] += 0.5 * ra * rr * rr
+            jg[6] += rb
+            jg[7] += rbc
+            jg[8] += rb * rr
+            jg[9] += 0.5 * rbcc
+            jg[10] += rbc * rr
+            jg[11] += 0.5 * rb * rr * rr
+        if def_invalid.shape[0] > 1 and _box_has_invalid(
+            def_invalid,
+            int(math.floor(xmin)) - 3,
+            int(math.floor(ymin)) - 3,
+            int(math.ceil(xmax)) + 3,
+            int(math.ceil(ymax)) + 3,
+        ):
+            return np.nan, it, FLAG_INVALID_PIXELS
+        gm = sg / n
+        gn2 = sgg - n * gm * gm
+        if not gn2 > 1e-300:
+            return np.nan, it, FLAG_NO_TEXTURE
+        gn = math.sqrt(gn2)
+        zncc = sgf / (fn * gn)
+        if it >= _HOPELESS_AFTER and not (zncc >= _HOPELESS_ZNCC):
+            return zncc, it, FLAG_NOT_CONVERGED  # far from any match: stop early
+        ratio = fn / gn
+        for j in range(12):
+            e[j] = jf[j] - ratio * (jg[j] - gm * js[j])
+        for i in range(12):
+            s = 0.0
+            for j in range(12):
+                s += Hinv[i, j] * e[j]
+            dp[i] = -s
+        if not _compose_quadratic(p, dp):
+            return zncc, it, FLAG_DIVERGED
+        ok = True
+        for i in range(12):
+            if not math.isfinite(p[i]):
+                ok = False
+        if not ok or abs(p[0] - p_start_u) > max_shift or abs(p[6] - p_start_v) > max_shift:
+            return np.nan, it, FLAG_DIVERGED
+        norm = dp[0] * dp[0] + dp[6] * dp[6]
+        norm += hh * hh * (dp[1] * dp[1] + dp[2] * dp[2] + dp[7] * dp[7] + dp[8] * dp[8])
+        q = 0.5 * hh * hh
+        norm += q * q * (dp[3] ** 2 + dp[5] ** 2 + dp[9] ** 2 + dp[11] ** 2)
+        norm += hh**4 * (dp[4] ** 2 + dp[10] ** 2)
+        if math.sqrt(norm) < tol:
+            _store_sigma(w, fn, zncc, n, 12, Hinv[0, 0], Hinv[6, 6])
+            return zncc, it, FLAG_OK
+    return zncc, it, FLAG_NOT_CONVERGED
+
+
+@njit(cache=True)
+def make_work(half):
+    """Scratch arrays for :func:`solve_point` (one set per thread/chunk)."""
+    n = (2 * half + 1) ** 2
+    return np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty((4, 6))
+
+
+@njit(cache=True)
+def solve_point(ref, dfm, opts, xc, yc, p, work):
+    """Match one subset centred at (xc, yc) of the reference; refines ``p`` (12,) in place.
+
+    ``work`` comes from :func:`make_work`. Returns ``(zncc, iterations, flag)``; the standard
+    uncertainty of (u, v) is left in ``work[4][3, 4:6]`` (NaN unless ok).
+    """
+    ref_img, ref_gx, ref_gy, ref_coef, ref_invalid = ref
+    def_coef, def_invalid = dfm
+    half, quadratic, max_iter, tol, min_std, max_shift, border, _, order = opts
+    f, gx, gy, _g, w = work
+    w[3, 4] = np.nan
+    w[3, 5] = np.nan
+    flag0, fn = _load_reference(
+        ref_img, ref_gx, ref_gy, ref_coef, ref_invalid, order, xc, yc, half, min_std, border,
+        f, gx, gy, w,
+    )  # fmt: skip
+    if flag0 != FLAG_OK:
+        return np.nan, 0, flag0
+    m = 12 if quadratic else 6
+    Hinv = np.eye(m)
+    jf = np.zeros(m)
+    js = np.zeros(m)
+    if quadratic:
+        if not _quadratic_system(f, gx, gy, half, Hinv, jf, js):
+            return np.nan, 0, FLAG_NO_TEXTURE
+        return _iterate_quadratic(
+            f, gx, gy, fn, Hinv, jf, js, def_coef, def_invalid, order, xc, yc, half, p,
+            max_iter, tol, max_shift, border, w,
+        )  # fmt: skip
+    if not _affine_system(f, gx, gy, half, Hinv, jf, js):
+        return np.nan, 0, FLAG_NO_TEXTURE
+    return _iterate_affine(
+        f, gx, gy, fn, Hinv, jf, js, def_coef, def_invalid, order, xc, yc, half, p, max_iter,
+        tol, max_shift, border, w,
+    )  # fmt: skip

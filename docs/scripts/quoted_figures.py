@@ -1,0 +1,138 @@
+"""Check the figures quoted in README.md and docs/*.md against ``benchmarks/results/*.json``.
+
+A figure that a benchmark measures carries a marker right after it (units may stand between)::
+
+    0.10 s CPU per cycle <!-- fig: sim_cycle.json:figures/cpu_seconds_per_cycle_20x200 -->
+
+The marker names the results file and the path of the value in it (keys joined by ``/``, list
+items by their index; keys may contain dots and spaces). An optional factor converts the JSON
+value to the quoted unit, e.g. ``<!-- fig: sim_cycle.json:figures/x_s *1e3 -->`` for a figure
+quoted in milliseconds. The figure is the last number before the marker; it agrees when it
+equals the JSON value rounded to the digits the figure shows (half a unit of its last digit).
+
+Usage: ``python docs/scripts/quoted_figures.py`` prints every marked figure with its JSON value
+and exits 1 when one disagrees or its marker names no value.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+import sys
+from collections.abc import Iterable
+from dataclasses import dataclass
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[2]
+RESULTS = ROOT / "benchmarks" / "results"
+
+MARKER = re.compile(
+    r"<!--\s*fig:\s*(?P<file>[\w.-]+\.json):(?P<path>[^*>]+?)\s*(?:\*\s*(?P<factor>[-+0-9.eE]+)\s*)?-->"
+)
+# a number as docs write it: 1.71, 0.10, 2,909, 1e-16, −0.5 (unicode minus)
+NUMBER = re.compile(r"[-−]?(?:\d{1,3}(?:,\d{3})+|\d+)(?:\.\d+)?(?:[eE][-−+]?\d+)?")
+
+
+@dataclass(frozen=True)
+class Figure:
+    """One marked figure: where it is, what it says, and what its JSON value is."""
+
+    doc: str
+    line: int
+    quoted: str
+    source: str
+    value: float | None
+    problem: str | None
+
+    @property
+    def ok(self) -> bool:
+        return self.problem is None
+
+
+def documents(root: Path = ROOT) -> list[Path]:
+    """README.md and docs/*.md."""
+    return [root / "README.md", *sorted((root / "docs").glob("*.md"))]
+
+
+def lookup(data: object, path: str) -> object:
+    """The value at ``path`` (keys joined by ``/``, list indices as integers)."""
+    for key in path.split("/"):
+        if isinstance(data, list):
+            data = data[int(key)]
+        elif isinstance(data, dict):
+            data = data[key]
+        else:
+            raise KeyError(key)
+    return data
+
+
+def _as_float(text: str) -> float:
+    return float(text.replace(",", "").replace("−", "-"))
+
+
+def _decimals_unit(text: str) -> float:
+    """Half a unit of the last digit shown: the rounding a quoted figure may carry."""
+    mantissa, _, exponent = text.replace("−", "-").lower().partition("e")
+    decimals = len(mantissa.partition(".")[2])
+    return 0.5 * 10.0 ** (-decimals + (int(exponent) if exponent else 0))
+
+
+def agrees(quoted: str, value: float) -> bool:
+    """``quoted`` equals ``value`` rounded to the digits ``quoted`` shows."""
+    q = _as_float(quoted)
+    return abs(q - value) <= _decimals_unit(quoted) * (1 + 1e-9) + 1e-12 * abs(value)
+
+
+def check_text(text: str, doc: str, results: Path = RESULTS) -> list[Figure]:
+    """Every marked figure of ``text`` with its JSON value and the problem, if any."""
+    cache: dict[str, object] = {}
+    figures = []
+    for m in MARKER.finditer(text):
+        line = text.count("\n", 0, m.start()) + 1
+        source = f"{m['file']}:{m['path'].strip()}"
+        before = text[: m.start()]
+        start = max(before.rfind("-->"), before.rfind("\n\n"))
+        numbers = list(NUMBER.finditer(before, max(start, 0)))
+        if not numbers:
+            figures.append(Figure(doc, line, "", source, None, "no number before the marker"))
+            continue
+        quoted = numbers[-1].group()
+        try:
+            if m["file"] not in cache:
+                cache[m["file"]] = json.loads((results / m["file"]).read_text(encoding="utf-8"))
+            raw = lookup(cache[m["file"]], m["path"].strip())
+            value = float(raw) * (float(m["factor"]) if m["factor"] else 1.0)
+        except FileNotFoundError:
+            figures.append(
+                Figure(doc, line, quoted, source, None, f"no file benchmarks/results/{m['file']}")
+            )
+            continue
+        except (KeyError, IndexError, ValueError, TypeError):
+            figures.append(Figure(doc, line, quoted, source, None, "no numeric value at that path"))
+            continue
+        problem = None if agrees(quoted, value) else f"quoted {quoted}, the results say {value:.6g}"
+        figures.append(Figure(doc, line, quoted, source, value, problem))
+    return figures
+
+
+def check(paths: Iterable[Path] | None = None, results: Path = RESULTS) -> list[Figure]:
+    """Every marked figure of README.md and docs/*.md (or ``paths``)."""
+    out = []
+    for path in paths if paths is not None else documents():
+        name = str(path.relative_to(ROOT)) if path.is_relative_to(ROOT) else str(path)
+        out += check_text(path.read_text(encoding="utf-8"), name, results)
+    return out
+
+
+def main() -> int:
+    figures = check()
+    for f in figures:
+        state = "ok" if f.ok else f"DISAGREES: {f.problem}"
+        print(f"{f.doc}:{f.line}: {f.quoted} <- {f.source}: {state}")
+    bad = [f for f in figures if not f.ok]
+    print(f"{len(figures)} marked figures, {len(bad)} disagree")
+    return 1 if bad else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,113 @@
+"""Array layout of the kernels: indices into the float (P) and integer (IP) parameter
+vectors, the diagnostics row, the per-evaluation info and the contact modes.
+"""
+
+from __future__ import annotations
+
+# ---- float parameters (P) ---------------------------------------------------------------------
+L1, L2, L3, L4 = 0, 1, 2, 3
+
+
+M1, M2, M3 = 4, 5, 6
+
+
+I1, I2, I3X, I3Y, I3Z = 7, 8, 9, 10, 11
+
+
+GRAV, OMEGA, JOFF = 12, 13, 14
+
+
+RJ, LJ, RB, WB, CA, RHO = 15, 16, 17, 18, 19, 20
+
+
+KFAC, K0, NEXP, CE, VFLOOR, KAX = 21, 22, 23, 24, 25, 26
+
+
+MUS, MUD, VS, VD, MUON = 27, 28, 29, 30, 31
+
+
+BAUM, DPHI = 32, 33
+
+
+NP = 34
+
+
+# ---- integer parameters (IP) ------------------------------------------------------------------
+DRIVER, ON_COUPLER, IDEAL, PER_POINT, KVARY, KDEN_WORN, NL, ND = 0, 1, 2, 3, 4, 5, 6, 7
+
+
+WPROJ = 8  # wear projection of the slice formulation: 0 local, 1 lumped, 2 local_conserving
+
+
+LATCH = 9  # impact velocity latched 0 once per impact and contact region, 1 per layer
+
+
+GRADED = 10  # 0: layers equally spaced (eq. 2), 1: spacing from ZL (joint.axial_grading)
+
+
+NIP = 11
+
+
+WPROJ_LOCAL, WPROJ_LUMPED, WPROJ_CONSERVING = 0, 1, 2
+
+
+# ---- diagnostics row (recorded at output times) ----------------------------------------------
+D_TH1 = 0
+
+
+D_CRANK_POS, D_CRANK_VEL = 1, 4
+
+
+D_COUP_POS, D_COUP_VEL = 7, 10
+
+
+D_FOLL_POS, D_FOLL_VEL = 13, 16
+
+
+D_FOLL_OMEGA = 19
+
+
+D_TH2, D_TH3 = 22, 23
+
+
+D_OFFSET, D_AXIS, D_TILT = 24, 27, 30
+
+
+D_FORCE = 31
+
+
+D_FN, D_FT, D_FMAG = 34, 35, 36
+
+
+D_MODE, D_PEN, D_PENAX, D_K, D_ENERGY, D_NSLICE, D_TH2DOT = 37, 38, 39, 40, 41, 42, 43
+
+
+D_QUAT = 44
+
+
+D_FAX = 48
+
+
+D_BEAR_POS, D_JOUR_POS = 49, 52
+
+
+ND_DIAG = 55
+
+
+# ---- info (per evaluation) -------------------------------------------------------------------
+I_PEN, I_CONTACT, I_BAD = 0, 1, 2
+
+
+NINFO = 4
+
+
+# contact modes
+MODE_FREE, MODE_POINT, MODE_LINE, MODE_TWO, MODE_AXIAL, MODE_AXIAL_RADIAL, MODE_IDEAL = (
+    0,
+    1,
+    2,
+    3,
+    4,
+    5,
+    6,
+)

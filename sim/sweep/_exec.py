@@ -1,0 +1,119 @@
+"""Executors of sweep runs: in-process, a local dask cluster, or an existing one by address.
+
+Each run is one dask task (:func:`jointwear.sim.sweep._run.evaluate_run`); results are handed
+to ``on_result`` in the order they finish, so the caller writes each at once. A run whose
+worker died too often (dask's ``KilledWorker``) or that dask could not deliver is reported to
+``on_lost`` and stays missing (a later ``--resume`` recomputes it).
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import uuid
+from collections.abc import Callable, Sequence
+from typing import Any
+
+from jointwear.errors import BadInputError
+from jointwear.sim.sweep._run import RunResult, RunTask, evaluate_run
+
+__all__ = ["execute", "WORKER_ENV"]
+
+#: Environment of local workers: one thread each for numba and BLAS (one run per core).
+WORKER_ENV = {
+    "NUMBA_NUM_THREADS": "1",
+    "OMP_NUM_THREADS": "1",
+    "OPENBLAS_NUM_THREADS": "1",
+    "MKL_NUM_THREADS": "1",
+}
+
+
+def _serial(tasks: Sequence[RunTask], on_result: Callable[[RunResult], None]) -> str:
+    for task in tasks:
+        on_result(evaluate_run(task))
+    return "in-process"
+
+
+def _client(workers: int | None, scheduler: str | None) -> tuple[Any, Any, str]:
+    """(client, cluster or None, description)."""
+    from distributed import Client, LocalCluster
+
+    if scheduler is not None:
+        try:
+            client = Client(scheduler, timeout="15s", set_as_default=False)
+        except (OSError, TimeoutError) as exc:
+            raise BadInputError(
+                f"--scheduler {scheduler}: cannot connect to a dask scheduler there ({exc}); "
+                "check the address (tcp://host:port) and that the scheduler is running"
+            ) from None
+        n = len(client.scheduler_info().get("workers", {}))
+        return client, None, f"dask scheduler {scheduler} ({n} worker(s) now)"
+    n = workers if workers is not None else (os.cpu_count() or 1)
+    cluster = LocalCluster(
+        n_workers=n,
+        threads_per_worker=1,
+        processes=True,
+        # no dashboard; the scheduler's HTTP endpoints (health, metrics) take a free port
+        # instead of 8787, which another cluster on the machine may hold (a warning)
+        dashboard_address=":0",
+        scheduler_kwargs={"dashboard": False},
+        env=dict(WORKER_ENV),
+        silence_logs=logging.ERROR,
+    )
+    client = Client(cluster, set_as_default=False)
+    return client, cluster, f"local dask cluster ({n} worker process(es), 1 thread each)"
+
+
+def execute(
+    tasks: Sequence[RunTask],
+    *,
+    workers: int | None,
+    scheduler: str | None,
+    on_result: Callable[[RunResult], None],
+    on_lost: Callable[[int, str], None],
+    on_start: Callable[[str], None] | None = None,
+) -> None:
+    """Run ``tasks``; call ``on_result`` for each finished run as it comes.
+
+    Parameters
+    ----------
+    tasks : sequence of RunTask
+    workers : int or None
+        0: in this process, no dask; N: a local cluster of N worker processes (default: one per
+        core). Ignored with ``scheduler``.
+    scheduler : str or None
+        Address of a running dask scheduler (``tcp://host:8786``).
+    on_result, on_lost : callable
+        Called with each :class:`RunResult`, or with ``(index, reason)`` for a run dask lost.
+    on_start : callable, optional
+        Called with a description of the executor once it is up.
+    """
+    if not tasks:
+        return
+    if scheduler is None and workers == 0:
+        if on_start:
+            on_start("in-process (no dask)")
+        _serial(tasks, on_result)
+        return
+    from distributed import as_completed
+
+    client, cluster, what = _client(workers, scheduler)
+    try:
+        if on_start:
+            on_start(what)
+        token = uuid.uuid4().hex[:8]
+        keys = [f"jointwear-sweep-run-{t.index}-{token}" for t in tasks]
+        futures = client.map(evaluate_run, tasks, key=keys, pure=False)
+        index_of = {f.key: t.index for f, t in zip(futures, tasks, strict=True)}
+        for fut in as_completed(futures, loop=client.loop):
+            try:
+                res = fut.result()
+            except Exception as exc:  # KilledWorker, CancelledError, communication failures
+                on_lost(index_of[fut.key], f"{type(exc).__name__}: {exc}")
+            else:
+                on_result(res)
+            fut.release()
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()

@@ -1,0 +1,79 @@
+"""Figures quoted in README.md and docs/*.md agree with benchmarks/results/*.json."""
+
+from __future__ import annotations
+
+import importlib.util
+import json
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def _script():
+    path = ROOT / "docs" / "scripts" / "quoted_figures.py"
+    spec = importlib.util.spec_from_file_location("quoted_figures", path)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module  # dataclasses look their module up there
+    spec.loader.exec_module(module)
+    return module
+
+
+qf = _script()
+
+
+def test_every_marked_figure_agrees_with_its_benchmark():
+    figures = qf.check()
+    bad = [f"{f.doc}:{f.line}: {f.source}: {f.problem}" for f in figures if not f.ok]
+    assert not bad, "\n".join(bad)
+    sources = {(f.doc, f.source) for f in figures}
+    # the figures issue 24 found wrong stay tied to their results
+    assert ("README.md", "compare_report.json:figures/demo_full/wall_s") in sources
+    assert ("docs/sim.md", "sim_cycle.json:figures/cpu_per_step_ratio_40x400_to_20x200") in sources
+    assert ("docs/compare-report.md", "compare_report.json:figures/demo_full/exit_code") in sources
+    assert len(figures) >= 30
+
+
+@pytest.fixture
+def results(tmp_path):
+    (tmp_path / "bench.json").write_text(
+        json.dumps({"figures": {"ratio": 1.7067, "runs": [0.1, 0.25], "a.b c": 2.0}})
+    )
+    return tmp_path
+
+
+@pytest.mark.parametrize(
+    ("quoted", "ok"),
+    [("1.71", True), ("1.7", True), ("2", True), ("1.72", False), ("1.70", False), ("1.42", False)],
+)
+def test_a_figure_agrees_only_within_its_rounding(results, quoted, ok):
+    text = f"grows {quoted}× <!-- fig: bench.json:figures/ratio --> per step"
+    (fig,) = qf.check_text(text, "doc.md", results)
+    assert fig.ok is ok, fig.problem
+
+
+def test_paths_indices_factors_and_keys_with_dots(results):
+    text = (
+        "250 ms <!-- fig: bench.json:figures/runs/1 *1e3 -->; "
+        "2.0 <!-- fig: bench.json:figures/a.b c -->; 0.1 s <!-- fig: bench.json:figures/runs/0 -->"
+    )
+    assert [f.ok for f in qf.check_text(text, "doc.md", results)] == [True, True, True]
+
+
+@pytest.mark.parametrize(
+    ("text", "problem"),
+    [
+        ("1.71 <!-- fig: bench.json:figures/ratioo -->", "no numeric value"),
+        ("1.71 <!-- fig: other.json:figures/ratio -->", "no file"),
+        ("fast <!-- fig: bench.json:figures/ratio -->", "no number"),
+        (
+            "1.5 <!-- fig: bench.json:figures/ratio --> and 1.71 <!-- fig: bench.json:figures/ratio -->",
+            "quoted 1.5",
+        ),
+    ],
+)
+def test_a_broken_marker_is_reported(results, text, problem):
+    figures = qf.check_text(text, "doc.md", results)
+    assert any(f.problem and problem in f.problem for f in figures), figures
