@@ -609,6 +609,14 @@ def wear_map(
             except BadInputError:
                 pass
     noise = noise_sigma(wear)  # successive differences of the residual: the probe noise
+    if rbz is not None and np.sqrt(s2) > max(1.5 * noise, 1e-9) and tau > 20.0:
+        raise BadInputError(
+            f"wear_map: the difference of the scans leaves {np.sqrt(s2) * 1e9:.3g} nm RMS of "
+            f"smooth structure (correlation length {tau:.0f} samples) on the points taken as "
+            f"unworn, against {noise * 1e9:.3g} nm of noise: wear spread around most of the "
+            "bore (or a change of form between the scans) cannot be separated from the change "
+            "of set-up; pass an explicit unworn mask (unworn=...) of points known to be unworn"
+        )
     if rbz is None:
         lobing = _lobing_rms((d - resid).reshape(rw.shape)) if isinstance(X, FormBasis) else 0.0
         _separable(q, s2, noise, mask2, threshold, lobing)
