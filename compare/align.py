@@ -11,7 +11,8 @@ Wear maps
     points per layer) is thereby box-averaged (no aliasing) and a coarse simulated map is
     averaged over the same cells, not sampled at its nodes: sampling one side and averaging
     the other read a sharp peak (and the cylindricity) low on the averaged side, by about
-    slope x step / 4 (3-5 % on the reference layout). In z both are point values (thin measured
+    slope x step / 4 (3-5 % on the reference layout). Only when both maps are sampled at the
+    grid's angles are their own values compared (the identity, again for both). In z both are point values (thin measured
     layers, simulated nodes), linear between layers, never extrapolated. The method used for
     each side is stated in the ``interpolation`` attribute.
 
@@ -221,18 +222,29 @@ def _bearing_radius(*datasets: xr.Dataset) -> float | None:
     return None
 
 
+def _on_grid(da: xr.DataArray, theta_tgt: np.ndarray) -> bool:
+    """True when the map's own angles are the grid's angles."""
+    theta = np.sort(np.asarray(da["theta"].values, dtype=float))
+    return theta.size == theta_tgt.size and bool(np.allclose(theta, theta_tgt, atol=1e-9))
+
+
 def _resample(
-    da: xr.DataArray, z_tgt: np.ndarray, theta_tgt: np.ndarray, step: float
+    da: xr.DataArray, z_tgt: np.ndarray, theta_tgt: np.ndarray, step: float, native: bool
 ) -> tuple[np.ndarray, str]:
+    """The map on the common grid: its own values (``native``, both maps on the grid) or, for
+    both maps alike, the cell mean of its interpolant in theta; linear between layers in z."""
     theta = np.asarray(da["theta"].values, dtype=float)
     z = np.asarray(da["z"].values, dtype=float)
     values = np.asarray(da.values, dtype=float)
-    own = _theta_step(theta)
-    at_theta = _cell_mean(theta, values, theta_tgt, step)
-    how_theta = (
-        f"mean over each grid cell ({step:.4g} degree) of the periodic linear interpolant of its "
-        f"{int(round(360.0 / own))} samples per layer in theta"
-    )
+    if native:
+        at_theta = values[:, np.argsort(theta)]
+        how_theta = "native theta grid (both maps on it)"
+    else:
+        at_theta = _cell_mean(theta, values, theta_tgt, step)
+        how_theta = (
+            f"mean over each grid cell ({step:.4g} degree) of the periodic linear interpolant "
+            f"of its {int(round(360.0 / _theta_step(theta)))} samples per layer in theta"
+        )
     if z.size == z_tgt.size and np.allclose(z, z_tgt, atol=1e-12):
         return at_theta, how_theta + ", native z layers"
     if z.size == 1:
@@ -306,8 +318,10 @@ def align_wear_maps(
     n = max(4, int(round(360.0 / step)))
     step = 360.0 / n
     theta_tgt = np.arange(n) * step
-    s_vals, s_interp = _resample(s_da, z_tgt, theta_tgt, step)
-    m_vals, m_interp = _resample(m_da, z_tgt, theta_tgt, step)
+    # one operator for both maps: their own values when both are on the grid, else the cell mean
+    native = _on_grid(s_da, theta_tgt) and _on_grid(m_da, theta_tgt)
+    s_vals, s_interp = _resample(s_da, z_tgt, theta_tgt, step, native)
+    m_vals, m_interp = _resample(m_da, z_tgt, theta_tgt, step, native)
     # a measurement with an angular gap (a partial arc) is not interpolated across it: both
     # sides are compared only where the measurement has samples
     covered = _theta_covered(np.asarray(m_da["theta"].values, dtype=float), theta_tgt)
@@ -333,7 +347,7 @@ def align_wear_maps(
     for unc, side in ((s_u, "sim"), (m_u, "meas")):
         if unc is None:
             continue
-        vals, _ = _resample(unc, z_tgt, theta_tgt, step)
+        vals, _ = _resample(unc, z_tgt, theta_tgt, step, native and _on_grid(unc, theta_tgt))
         uname = f"{variable}_{side}_u"
         out[uname] = (
             dims,

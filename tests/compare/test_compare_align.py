@@ -348,3 +348,18 @@ def test_cell_mean_is_one_operator_for_nodes_and_dense_traces():
     np.testing.assert_allclose(
         _cell_mean(dense, trace[None, :], grid, step)[0], at_nodes, atol=1e-9
     )
+
+
+def test_one_operator_both_sides_native_or_cell_mean():
+    """Both maps on the grid's angles: both keep their own values; else both are cell means."""
+    sim = syn.sim_wear(n_points=72)
+    meas = sim.isel(cycles=[-1]).copy()
+    meas["wear_depth"] = meas["wear_depth"] * 1.1
+    meas["wear_depth"].attrs = sim["wear_depth"].attrs
+    al = align_wear_maps(sim, meas)
+    raw = sim["wear_depth"].isel(cycles=-1).values
+    np.testing.assert_allclose(al["wear_depth_sim"].values, raw, rtol=1e-12)
+    np.testing.assert_allclose(al["wear_depth_meas"].values, 1.1 * raw, rtol=1e-12)
+    assert al.attrs["interpolation"].count("native theta grid (both maps on it)") == 2
+    dense = align_wear_maps(sim, syn.meas_wear(n_points=3600, cycles=4e5))
+    assert dense.attrs["interpolation"].count("mean over each grid cell (5 degree)") == 2
