@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+
 import _jw_synth as syn
 import pandas as pd
 import pytest
@@ -127,14 +129,17 @@ def test_compare_cli_map_turned_180_degree_fails(files, tmp_path, capsys):
     argv = ["compare", str(files["sim_wear"]), str(files["meas_wear_turned"]), "-o", str(out)]
     assert main(argv) == 1
     text = capsys.readouterr().out
-    assert "FAIL            angle of maximum wear within z = −7.5…+7.5 mm: +180.0 degree" in text
+    # exactly half a turn: +180 or -180 by round-off in the located maxima
+    assert re.search(
+        r"FAIL +angle of maximum wear within z = −7\.5…\+7\.5 mm: [+-]180\.0 degree", text
+    )
     assert "FAIL            wear map shape" in text
     # the same on the reference study's layout (13 layers, +-6 mm of a 15 mm bearing): the
     # simulated maximum outside the band no longer lets the turned map escape as not comparable
     argv = ["compare", str(files["sim_wear"]), str(files["meas_wear_turned_narrow"]), "-o"]
     assert main([*argv, str(out), "--overwrite"]) == 1
     text = capsys.readouterr().out
-    assert "FAIL            angle of maximum wear within z = −6…+6 mm: +180.0 degree" in text
+    assert re.search(r"FAIL +angle of maximum wear within z = −6…\+6 mm: [+-]180\.0 degree", text)
 
 
 def test_compare_cli_motion_variables(files, tmp_path, capsys):
