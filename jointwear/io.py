@@ -28,6 +28,8 @@ __all__ = [
     "save",
     "load",
     "atomic_path",
+    "save_figure",
+    "figure_format",
     "check_writable",
     "encode_attrs",
     "decode_attrs",
@@ -142,6 +144,56 @@ def parse_provenance(ds: xr.Dataset) -> dict[str, Any]:
         return json.loads(text)
     except (TypeError, ValueError):
         return {}
+
+
+def save_figure(fig: Any, path: str | Path, *, dpi: float = 110, what: str = "--out") -> Path:
+    """Write a matplotlib figure atomically in the format its file name says.
+
+    The suffix must be one the figure's canvas can write (png, pdf, svg, ...; a name without a
+    suffix is written as PNG): anything else (``o.nc``) is refused naming ``what`` and the
+    supported formats, before any file is touched.
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+        The figure.
+    path : path
+        Output file.
+    dpi : float
+        Resolution of a raster format [dots per inch].
+    what : str
+        How the user named the path (an option, a parameter), for the message.
+
+    Returns
+    -------
+    Path
+        ``path``.
+    """
+    path = Path(path)
+    fmt = figure_format(path, what=what)
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, dpi=dpi, format=fmt)
+    return path
+
+
+def figure_format(path: str | Path, *, what: str = "--out") -> str:
+    """The figure format a file name asks for (its suffix; none: png), or a refusal.
+
+    Call it before a long computation whose figure goes to ``path``, so that a name matplotlib
+    cannot write (``map.nc``) is refused at once, naming ``what`` and the supported formats.
+    """
+    from matplotlib.backend_bases import FigureCanvasBase
+
+    path = Path(path)
+    fmt = path.suffix.lstrip(".").lower() or "png"
+    supported = FigureCanvasBase.get_supported_filetypes()
+    if fmt not in supported:
+        raise BadInputError(
+            f"{what} '{path}': a figure cannot be written as '.{fmt}'; use one of "
+            + ", ".join(f".{k}" for k in sorted(supported))
+            + " (e.g. .png)"
+        )
+    return fmt
 
 
 def save(

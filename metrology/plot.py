@@ -107,9 +107,7 @@ def plot_wear_map(
     if title:
         fig.suptitle(title)
     if path is not None:
-        from jointwear.io import atomic_path
+        from jointwear.io import save_figure
 
-        path = Path(path)
-        with atomic_path(path) as tmp:
-            fig.savefig(tmp, dpi=dpi, format=path.suffix.lstrip(".") or "png")
+        save_figure(fig, path, dpi=dpi)
     return fig

@@ -92,16 +92,14 @@ def _progress_text(info: dict[str, Any]) -> str:
 
 
 def _write_figure(ds: Any, figure: Path) -> None:
-    """PNG of the final wear map (depth map and profile)."""
+    """The final wear map (depth map and profile), in the format the file name says."""
     import matplotlib
 
     matplotlib.use("Agg")
     from jointwear import io
     from jointwear.sim.wearmap import plot_wear_map
 
-    fig = plot_wear_map(ds, kind="both")
-    with io.atomic_path(figure) as tmp:
-        fig.savefig(tmp, dpi=110, format="png")
+    io.save_figure(plot_wear_map(ds, kind="both"), figure, dpi=110, what="--figure")
 
 
 def _summary(out: Path, ds: Any, run: Any) -> str:
@@ -179,9 +177,10 @@ def calibrate(
     """
     from jointwear import io
     from jointwear.errors import BadInputError
-    from jointwear.sim.wear._calibration import calibration_report
+    from jointwear.sim.wear._calibration import calibration_report, check_wear_run
 
     sim = io.load(simulated)
+    check_wear_run(sim, f"SIMULATED '{simulated}'")
     last = float(sim["cycles"].values[-1])
     meas = _measurements(
         {"max_depth": max_depth_um, "volume": volume_mm3, "cylindricity": cylindricity_um},
@@ -304,7 +303,11 @@ def wear(
         ),
     ] = "dynamics",
     figure: Annotated[
-        Path | None, typer.Option("--figure", help="Also write a PNG of the final wear map.")
+        Path | None,
+        typer.Option(
+            "--figure",
+            help="Also write a figure of the final wear map (PNG, PDF, SVG by its suffix).",
+        ),
     ] = None,
     progress: Annotated[
         bool | None,
@@ -333,6 +336,7 @@ def wear(
     io.check_writable(out, what="--out")
     if figure is not None:
         io.check_writable(figure, what="--figure")
+        io.figure_format(figure, what="--figure")
     snaps = _parse_snapshots(snapshots)
     kinds = _check_kinds(check)
     overrides = {"kw": kw, "scheme": scheme, "dn": dn, "tol": tol, "settle_cycles": settle}

@@ -90,11 +90,9 @@ def plot_cycle(ds: xr.Dataset, path: str | Path | None = None, *, clearance: flo
     ax.set_title(body_name)
     ax.legend(fontsize=8)
     if path is not None:
-        from jointwear.io import atomic_path
+        from jointwear.io import save_figure
 
-        path = Path(path)
-        with atomic_path(path) as tmp:
-            fig.savefig(tmp, dpi=110, format=path.suffix.lstrip(".") or "png")
+        save_figure(fig, path, dpi=110)
     return fig
 
 

@@ -136,10 +136,9 @@ def plot_field(ds: xr.Dataset, *, time: int = -1, title: str | None = None):
 
 def save_field_plot(ds: xr.Dataset, path: str | Path, **kwargs) -> Path:
     """Write :func:`plot_field` to ``path`` (png/pdf/svg), atomically."""
-    from jointwear.io import atomic_path
+    from jointwear.io import save_figure
 
     path = Path(path)
     fig = plot_field(ds, **kwargs)
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, dpi=90, format=path.suffix.lstrip(".") or "png")
+    save_figure(fig, path, dpi=90)
     return path

@@ -94,9 +94,7 @@ def plot_body_motion(
     )
     fig.tight_layout()
     if path is not None:
-        from jointwear.io import atomic_path
+        from jointwear.io import save_figure
 
-        path = Path(path)
-        with atomic_path(path) as tmp:
-            fig.savefig(tmp, dpi=110, format=path.suffix.lstrip(".") or "png")
+        save_figure(fig, path, dpi=110)
     return fig

@@ -94,10 +94,9 @@ def plot_displacement(
 
 def save_quicklook(ds: xr.Dataset, path: str | Path, **kwargs) -> Path:
     """Write :func:`plot_displacement` to ``path`` (png/pdf/svg), atomically."""
-    from jointwear.io import atomic_path
+    from jointwear.io import save_figure
 
     path = Path(path)
     fig = plot_displacement(ds, **kwargs)
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, dpi=90, format=path.suffix.lstrip(".") or "png")
+    save_figure(fig, path, dpi=90)
     return path

@@ -599,6 +599,22 @@ def calibrate_kw_and_parameter(
     return _result(kw_best, meas, s_best, beta, n_sim[0], n_free=2, parameter=parameter, value=best)
 
 
+def check_wear_run(sim: xr.Dataset, what: str = "the simulated file") -> None:
+    """Refuse a dataset that is not a wear run of :func:`simulate_wear` (``sim wear --out``).
+
+    Calibration reads the run's cycles and wear maps; a measured map or a file of
+    another kind given in its place is named with what it lacks.
+    """
+    missing = [n for n in ("cycles", "wear_depth") if n not in sim.variables]
+    if missing:
+        raise BadInputError(
+            f"{what} is not a wear run written by 'jointwear sim wear' (no "
+            + ", ".join(missing)
+            + "); give the file 'jointwear sim wear --out' wrote as SIMULATED and the measured "
+            "map with --map"
+        )
+
+
 def calibration_report(
     sim: xr.Dataset,
     measurements: list[Measurement],
@@ -641,6 +657,7 @@ def calibration_report(
     list of str
         The lines to print; the last one gives the calibrated kw.
     """
+    check_wear_run(sim)
     resim = resimulator(sim) if resimulate else None
     if vary is None and (measured_map is not None or (single and len(measurements) == 1)):
         if measured_map is not None:
