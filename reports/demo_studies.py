@@ -35,9 +35,9 @@ def _say(msg: str) -> None:
 #: level and runs on the grid refined 2x (a reduced :meth:`jointwear.sim.VerifySpec.default`).
 #: A fixed-scheme run costs its number of updates (each simulates 1 + settle cycles), whatever
 #: its cycles: the finest level and the grid runs dominate the study, which dominated the demo
-#: (about 2/3 of its time with 40 updates, benchmarks/results/compare_report.json); 16 updates
-#: (16, 8, 4, 2 per level) cost 0.4x. The compared run is the finest level's replicate 0, so
-#: its coarser update shows in the study's u_num, not hidden.
+#: (phase 1 took 109 s of 147 s with 40 updates, 51 s of 82 s with 16 = 16, 8, 4, 2 per level;
+#: benchmarks/results/compare_report.json, docs/compare-report.md). The compared run is the
+#: finest level's replicate 0, so its coarser update shows in the study's u_num, not hidden.
 DEMO_STUDY_UPDATES = 16  # updates of the finest level
 DEMO_STUDY_GRID_REPLICATES = 2
 
