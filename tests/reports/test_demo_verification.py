@@ -19,6 +19,9 @@ def test_demo_study_size_and_the_compared_run_is_its_replicate_zero():
     assert main.scheme == "fixed" and main.dn == spec.levels[0]
     assert main.initial_settle_cycles == WearSettings().initial_settle_cycles
     assert math.isclose(FULL.cycles % main.dn, 0.0)
+    # every level updates the profile at least twice (one update of all cycles would be the
+    # initial rate extrapolated, not a refinement level), and all divide the cycles
+    assert all(FULL.cycles / dn >= 2 and math.isclose(FULL.cycles % dn, 0.0) for dn in spec.levels)
     # --quick has no study and keeps the default adaptive run
     assert QUICK.verification_replicates == 0
     assert main_wear_settings(QUICK) == WearSettings()
