@@ -13,6 +13,8 @@ from jointwear.dic.subset._params import MIN_STEP, MIN_SUBSET, CorrelationParams
 __all__ = [
     "AllowEmptyOpt",
     "DEFAULTS",
+    "FpsOpt",
+    "OriginOpt",
     "OutOpt",
     "PointsOpt",
     "SearchRadiusOpt",
@@ -51,4 +53,10 @@ AllowEmptyOpt = Annotated[
         "--allow-empty",
         help="Exit 0 even when an image has no valid point (otherwise exit 1).",
     ),
+]
+OriginOpt = Annotated[
+    str, typer.Option("--origin", help="What the images are: measured or synthetic.")
+]
+FpsOpt = Annotated[
+    float | None, typer.Option("--fps", help="Frames per second (omit for still images).")
 ]

@@ -81,10 +81,7 @@ def field_cmd(
             "--frame", help="Stereo output frame: world or plane (best fit). Default world."
         ),
     ] = None,
-    fps: Annotated[
-        float | None,
-        typer.Option("--fps", help="Frames per second (omit for still images)."),
-    ] = None,
+    fps: opt.FpsOpt = None,
     zncc_min: opt.ZnccMinOpt = opt.DEFAULTS.zncc_min,
     epipolar_max: Annotated[
         float | None,
@@ -95,9 +92,7 @@ def field_cmd(
         ),
     ] = None,
     search_radius: opt.SearchRadiusOpt = opt.DEFAULTS.search_radius,
-    origin: Annotated[
-        str, typer.Option("--origin", help="What the images are: measured or synthetic.")
-    ] = "measured",
+    origin: opt.OriginOpt = "measured",
     out: opt.OutOpt = Path("field.nc"),
     csv: Annotated[
         Path | None,
@@ -164,16 +159,12 @@ def import_field_cmd(
         typer.Argument(help="One file per image (reference first), or a quoted pattern."),
     ],
     format: Annotated[str, typer.Option("--format", help="vic3d-csv (VIC-3D CSV export) or dice.")],
-    origin: Annotated[
-        str, typer.Option("--origin", help="What the images were: measured or synthetic.")
-    ],
+    origin: opt.OriginOpt,
     length_unit: Annotated[
         str | None,
         typer.Option("--length-unit", help="Unit of the files' lengths (mm, m, ...; stereo)."),
     ] = None,
-    fps: Annotated[
-        float | None, typer.Option("--fps", help="Frames per second (omit: still images).")
-    ] = None,
+    fps: opt.FpsOpt = None,
     out: opt.OutOpt = Path("field.nc"),
     overwrite: Overwrite = False,
 ) -> None:
