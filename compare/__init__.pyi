@@ -18,6 +18,7 @@ from jointwear.compare._api import align_wear_maps as align_wear_maps
 from jointwear.compare._api import area_validation_metric as area_validation_metric
 from jointwear.compare._api import as_ensemble as as_ensemble
 from jointwear.compare._api import compare as compare
+from jointwear.compare._api import compare_files as compare_files
 from jointwear.compare._api import gci as gci
 from jointwear.compare._api import load_comparison as load_comparison
 from jointwear.compare._api import load_criteria as load_criteria
@@ -56,6 +57,7 @@ __all__ = [
     "gci",
     "numerical_uncertainty",
     "compare",
+    "compare_files",
     "load_comparison",
     "load_criteria",
     "metrics_table",

@@ -20,7 +20,12 @@ from jointwear.compare.metrics import (
     wrap_angle_deg,
 )
 from jointwear.compare.origin import origin_of, side_origin
-from jointwear.compare.storage import load_comparison, metrics_table, save_comparison
+from jointwear.compare.storage import (
+    compare_files,
+    load_comparison,
+    metrics_table,
+    save_comparison,
+)
 from jointwear.compare.verdicts import FLAG_MEANINGS, FLAG_VALUES, STATES, summary_line
 from jointwear.compare.verification import GCI, gci, numerical_uncertainty
 
@@ -43,6 +48,7 @@ __all__ = [
     "gci",
     "numerical_uncertainty",
     "compare",
+    "compare_files",
     "load_comparison",
     "load_criteria",
     "metrics_table",

@@ -342,6 +342,83 @@ def _sensitivity(
     return pd.DataFrame(rows, columns=SENSITIVITY_COLUMNS)
 
 
+def _verification(verification) -> tuple[Mapping[str, GCI], list[xr.Dataset]]:
+    """(GCI per quantity of older 1-D refinement data, sim verify studies) of ``verification``."""
+    studies: list[xr.Dataset] = []
+    if verification is None:
+        gci: Mapping[str, GCI] = {}
+    elif isinstance(verification, xr.Dataset) or not isinstance(verification, Mapping):
+        # a Dataset is a Mapping too: test it first. sim verify studies (contract) apart from
+        # the older 1-D refinement datasets (GCI)
+        items = [verification] if isinstance(verification, xr.Dataset) else list(verification)
+        studies = [ds for ds in items if is_study(ds)]
+        older = [ds for ds in items if not is_study(ds)]
+        gci = numerical_uncertainty(older) if older else {}
+    else:
+        gci = verification
+    return gci, studies
+
+
+def _compare_wear(
+    s_wear, m_wear, cycles, theta_step_deg, ens, studies, criteria, gci, rows, decisions, notes,
+    field_values,
+) -> xr.Dataset:  # fmt: skip
+    """Align the wear maps and add their metrics and decisions (``rows``, ``decisions``,
+    ``notes`` and ``field_values`` are filled in)."""
+    wear = align_wear_maps(s_wear, m_wear, cycles=cycles, theta_step_deg=theta_step_deg)
+    if ens is not None:
+        values, band = _ensemble_wear(ens, m_wear, wear, float(wear.attrs["cycles_sim"]))
+        field_values.update(values)
+        if band is not None:
+            wear["wear_depth_sim_ensemble"] = band
+    band_u = (
+        band_study_uncertainty(
+            studies,
+            m_wear,
+            WEAR_QUANTITIES,
+            theta_step_deg=theta_step_deg,
+            radius=wear.attrs.get("bearing_radius_m"),
+        )
+        if studies
+        else {}
+    )
+    src = Sources(criteria, ens, gci, float(wear.attrs["cycles_sim"]), field_values, studies=band_u)
+    domain = wear_metrics(wear, rows, decisions, src)
+    if domain:
+        notes.append(domain)
+    if cycles is None and not np.isfinite(float(wear.attrs.get("cycles_meas", np.nan))):
+        notes.append(
+            "wear cycles: the measured map does not state after how many crank cycles it was "
+            f"taken; it was compared with the simulation after {wear.attrs['cycles_sim']:g} "
+            "cycles (its last snapshot) - give cycles= / --cycles, or a 'cycles' attribute"
+        )
+    return wear
+
+
+def _partial_inputs(sims, meass) -> list[str]:
+    """A line for every input that is the partial result of an interrupted run (never judged
+    as if it had finished)."""
+    partial: list[str] = []
+    for side, group in (("simulation", sims), ("measurement", meass)):
+        for ds in group:
+            status = conventions.describe_status(ds) if isinstance(ds, xr.Dataset) else None
+            if status:
+                partial.append(f"{side} input {ds.attrs.get('title', '')!r}: {status}")
+    return partial
+
+
+def _add_motion_ensemble(ens, axes, m_sel, motion, kwargs, field_values) -> None:
+    """The ensemble's motion values (into ``field_values``) and bands (into ``motion``)."""
+    ens_sel = Ensemble(
+        tuple(_select_axes(d, axes)[0] if "axis" in d.dims else d for d in ens.datasets),
+        ens.names,
+    )
+    values, bands = _ensemble_motion(ens_sel, m_sel, motion, kwargs)
+    field_values.update(values)
+    for n, band in bands.items():
+        motion[f"{n}_sim_ensemble"] = band
+
+
 def compare(
     sim: xr.Dataset | Sequence[xr.Dataset],
     meas: xr.Dataset | Sequence[xr.Dataset],
@@ -424,18 +501,7 @@ def compare(
     """
     criteria = criteria or Criteria()
     ens = as_ensemble(ensemble)
-    studies: list[xr.Dataset] = []
-    if verification is None:
-        gci: Mapping[str, GCI] = {}
-    elif isinstance(verification, xr.Dataset) or not isinstance(verification, Mapping):
-        # a Dataset is a Mapping too: test it first. sim verify studies (contract) apart from
-        # the older 1-D refinement datasets (GCI)
-        items = [verification] if isinstance(verification, xr.Dataset) else list(verification)
-        studies = [ds for ds in items if is_study(ds)]
-        older = [ds for ds in items if not is_study(ds)]
-        gci = numerical_uncertainty(older) if older else {}
-    else:
-        gci = verification
+    gci, studies = _verification(verification)
     sims = [sim] if isinstance(sim, (xr.Dataset, xr.DataArray)) else list(sim)
     meass = [meas] if isinstance(meas, (xr.Dataset, xr.DataArray)) else list(meas)
     s_wear, s_motion = _split(sims)
@@ -444,44 +510,14 @@ def compare(
     rows = Rows()
     decisions: list[dict[str, Any]] = []
     notes: list[str] = []
-    partial: list[str] = []
-    for side, group in (("simulation", sims), ("measurement", meass)):
-        for ds in group:  # an interrupted run is never judged as if it had finished
-            status = conventions.describe_status(ds) if isinstance(ds, xr.Dataset) else None
-            if status:
-                partial.append(f"{side} input {ds.attrs.get('title', '')!r}: {status}")
+    partial = _partial_inputs(sims, meass)
     wear = motion = None
     field_values: dict[str, list[tuple[int, np.ndarray]]] = {}
     if s_wear is not None and m_wear is not None:
-        wear = align_wear_maps(s_wear, m_wear, cycles=cycles, theta_step_deg=theta_step_deg)
-        if ens is not None:
-            values, band = _ensemble_wear(ens, m_wear, wear, float(wear.attrs["cycles_sim"]))
-            field_values.update(values)
-            if band is not None:
-                wear["wear_depth_sim_ensemble"] = band
-        band_u = (
-            band_study_uncertainty(
-                studies,
-                m_wear,
-                WEAR_QUANTITIES,
-                theta_step_deg=theta_step_deg,
-                radius=wear.attrs.get("bearing_radius_m"),
-            )
-            if studies
-            else {}
-        )
-        src = Sources(
-            criteria, ens, gci, float(wear.attrs["cycles_sim"]), field_values, studies=band_u
-        )
-        domain = wear_metrics(wear, rows, decisions, src)
-        if domain:
-            notes.append(domain)
-        if cycles is None and not np.isfinite(float(wear.attrs.get("cycles_meas", np.nan))):
-            notes.append(
-                "wear cycles: the measured map does not state after how many crank cycles it was "
-                f"taken; it was compared with the simulation after {wear.attrs['cycles_sim']:g} "
-                "cycles (its last snapshot) - give cycles= / --cycles, or a 'cycles' attribute"
-            )
+        wear = _compare_wear(
+            s_wear, m_wear, cycles, theta_step_deg, ens, studies, criteria, gci,
+            rows, decisions, notes, field_values,
+        )  # fmt: skip
     elif (s_wear is not None and not reported) or m_wear is not None:
         side = "measurement" if s_wear is not None else "simulation"
         partial.append(f"wear maps not compared: the {side} has no wear map (wear_depth)")
@@ -498,14 +534,7 @@ def compare(
                 "motion is not a prediction of it) - ask for them with axes= / --axis"
             )
         if ens is not None:
-            ens_sel = Ensemble(
-                tuple(_select_axes(d, axes)[0] if "axis" in d.dims else d for d in ens.datasets),
-                ens.names,
-            )
-            values, bands = _ensemble_motion(ens_sel, m_sel, motion, kwargs)
-            field_values.update(values)
-            for n, band in bands.items():
-                motion[f"{n}_sim_ensemble"] = band
+            _add_motion_ensemble(ens, axes, m_sel, motion, kwargs, field_values)
         src = Sources(criteria, ens, gci, None, field_values)
         motion_metrics(motion, rows, decisions, src)
     elif s_motion is not None or m_motion is not None:

@@ -11,7 +11,14 @@ import jointwear.compare.verdicts as vd
 from jointwear.compare.comparison import Comparison
 from jointwear.errors import ValidationFailed
 
-__all__ = ["card_lines", "echo_warning", "origin_line", "outcome_lines", "raise_for_outcome"]
+__all__ = [
+    "alignment_lines",
+    "card_lines",
+    "echo_warning",
+    "origin_line",
+    "outcome_lines",
+    "raise_for_outcome",
+]
 
 
 def echo_warning(text: str) -> None:
@@ -45,6 +52,21 @@ def card_lines(c: Comparison) -> list[str]:
         if row.reason:
             out.append(f"{'':<{width}}    why: {row.reason}")
     return out
+
+
+def alignment_lines(c: Comparison) -> list[str]:
+    """How the wear maps were interpolated and the motion aligned, and the notes: one line each."""
+    lines = []
+    if c.wear is not None:
+        lines.append(f"wear maps: {c.wear.attrs['interpolation']}")
+    if c.motion is not None:
+        a = c.motion.attrs
+        lines.append(
+            f"motion aligned by {a['alignment_method'].replace('_', ' ')}: shift "
+            f"{a['time_shift_s'] * 1e3:+.2f} ms ({a['time_shift_deg']:+.1f} degree of crank "
+            f"angle) over {a['n_cycles']:g} cycle(s)"
+        )
+    return lines + [f"note: {note}" for note in c.notes]
 
 
 def outcome_lines(c: Comparison) -> list[str]:

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import json
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -15,12 +15,12 @@ import jointwear.compare.metrics as mt
 import jointwear.compare.verdicts as vd
 from jointwear import io
 from jointwear.compare._decide import DECISION_COLUMNS, METRIC_COLUMNS
-from jointwear.compare.comparison import Comparison
+from jointwear.compare.comparison import DEFAULT_AXES, Comparison
 from jointwear.compare.criteria import Criteria
 from jointwear.errors import ParameterError
 from jointwear.params import from_mapping, to_jsonable
 
-__all__ = ["to_dataset", "load_comparison", "save_comparison", "metrics_table"]
+__all__ = ["to_dataset", "load_comparison", "save_comparison", "metrics_table", "compare_files"]
 
 
 def metrics_table(comparison: Comparison | xr.Dataset) -> pd.DataFrame:
@@ -200,3 +200,81 @@ def save_comparison(
         command=command,
         source="jointwear compare",
     )
+
+
+def compare_files(
+    sim: Sequence[str | Path],
+    meas: Sequence[str | Path],
+    out: str | Path,
+    *,
+    table: str | Path | None = None,
+    criteria: Criteria | str | Path | None = None,
+    cycles: float | None = None,
+    period_s: float | None = None,
+    motion_method: str = "auto",
+    variables: Sequence[str] | None = None,
+    axes: Sequence[str] | None = DEFAULT_AXES,
+    ensemble: Sequence[str | Path] = (),
+    verification: Sequence[str | Path] = (),
+    warn: Callable[[str], None] | None = None,
+) -> Comparison:
+    """Compare files: load simulation and measurement, :func:`compare` them, save the result.
+
+    Parameters
+    ----------
+    sim, meas : sequence of path
+        Simulated and measured netCDF files (wear maps and/or motion records); a foreign CF
+        file is read by :func:`jointwear.external.load_for_comparison`.
+    out : path
+        netCDF to write: aligned fields, differences, metrics and decisions.
+    table : path, optional
+        Also write the metrics table as CSV.
+    criteria : Criteria or path, optional
+        Validation criteria, or a TOML file of them (:func:`load_criteria`).
+    cycles, period_s, motion_method, variables, axes
+        Passed to :func:`jointwear.compare.compare`.
+    ensemble : sequence of path
+        Ensembles of simulations (``run`` dimension): their spread is the input uncertainty.
+    verification : sequence of path
+        Verification studies or refinement data (numerical uncertainty).
+    warn : callable, optional
+        Receives the warning text for a file from another tool (the CLI prints it on stderr).
+
+    Returns
+    -------
+    Comparison
+    """
+    from jointwear.compare.comparison import compare
+    from jointwear.compare.criteria import load_criteria
+    from jointwear.compare.ensemble import as_ensemble
+    from jointwear.external import load_for_comparison
+
+    io.check_writable(out)
+    if not isinstance(criteria, Criteria):
+        criteria = load_criteria(criteria)
+    sims = [load_for_comparison(p, role="simulated", warn=warn) for p in sim]
+    meass = [load_for_comparison(p, role="measured", warn=warn) for p in meas]
+    ens = [io.load(p) for p in ensemble]
+    vers = [io.load(p, validate=False) for p in verification]
+    result = compare(
+        sims,
+        meass,
+        criteria=criteria,
+        cycles=cycles,
+        period_s=period_s,
+        motion_method=motion_method,
+        variables=variables or None,
+        axes=axes,
+        ensemble=as_ensemble(ens, [Path(p).name for p in ensemble]) if ens else None,
+        verification=vers or None,
+    )
+    save_comparison(
+        result,
+        out,
+        inputs=[*sim, *meas, *ensemble, *verification],
+        parents=[*sims, *meass],
+    )
+    if table is not None:
+        with io.atomic_path(table) as tmp:
+            result.metrics.to_csv(tmp, index=False, float_format="%.6g")
+    return result

@@ -107,6 +107,35 @@ class InstrumentScan:
     metadata: dict = field(default_factory=dict)
 
 
+def _imposed_wear(wear, theta_can: np.ndarray, zz: np.ndarray, shape, *, depth: float, z):
+    """The imposed wear depth [m] at each instrument sample (``wear`` as in :func:`generate`)."""
+    if wear is None:
+        w = np.zeros(shape)
+    elif isinstance(wear, str):
+        if wear != "default":
+            raise BadInputError(f"wear {wear!r}: use 'default', an array, a callable or None")
+        w = default_wear(
+            np.broadcast_to(theta_can, shape),
+            np.broadcast_to(zz, shape),
+            depth=depth,
+            width_mm=max(np.ptp(z) * 1e3, 1.0),
+        )
+    elif callable(wear):
+        w = np.asarray(
+            wear(np.broadcast_to(theta_can, shape), np.broadcast_to(zz, shape)),
+            dtype=float,
+        )
+    else:
+        arr = np.asarray(wear, dtype=float)
+        if arr.shape != shape:
+            raise BadInputError(f"wear array has shape {arr.shape}, expected {shape}")
+        # given on the canonical sorted grid -> reorder to instrument samples
+        order = np.argsort(theta_can)
+        w = np.empty_like(arr)
+        w[:, order] = arr
+    return w
+
+
 def generate(
     *,
     n_layers: int = 13,
@@ -183,30 +212,7 @@ def generate(
         phase = rng.uniform(0, 2 * np.pi)
         drift = rng.uniform(-1, 1) * 50.0  # rad/m
         form += amp * np.cos(k * tc + phase + drift * zz)
-    if wear is None:
-        w = np.zeros_like(form)
-    elif isinstance(wear, str):
-        if wear != "default":
-            raise BadInputError(f"wear {wear!r}: use 'default', an array, a callable or None")
-        w = default_wear(
-            np.broadcast_to(theta_can, form.shape),
-            np.broadcast_to(zz, form.shape),
-            depth=wear_depth,
-            width_mm=max(np.ptp(z) * 1e3, 1.0),
-        )
-    elif callable(wear):
-        w = np.asarray(
-            wear(np.broadcast_to(theta_can, form.shape), np.broadcast_to(zz, form.shape)),
-            dtype=float,
-        )
-    else:
-        arr = np.asarray(wear, dtype=float)
-        if arr.shape != form.shape:
-            raise BadInputError(f"wear array has shape {arr.shape}, expected {form.shape}")
-        # given on the canonical sorted grid -> reorder to instrument samples
-        order = np.argsort(theta_can)
-        w = np.empty_like(arr)
-        w[:, order] = arr
+    w = _imposed_wear(wear, theta_can, zz, form.shape, depth=wear_depth, z=z)
     rho = radius + form + w  # part radius profile at each sample's direction
     # exact set-up: part axis at (ex + tx z, ey + ty z) in the instrument frame
     phi = np.radians(theta_inst)[None, :]

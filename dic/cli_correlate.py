@@ -8,6 +8,8 @@ from typing import Annotated, Literal
 import typer
 
 from jointwear._cli import Overwrite
+from jointwear.dic import _cli_options as opt
+from jointwear.dic.subset._params import UPDATE_ZNCC, CorrelationParams
 from jointwear.errors import BadInputError
 
 
@@ -40,245 +42,158 @@ def _parse_points(texts: list[str] | None):
     return np.array(out)
 
 
-def read_points_file(path: Path):
-    """Points of interest from a text file: one ``x, y`` [pixel] per line (comma or blank
-    separated; ``#`` comments and a non-numeric header line are skipped)."""
-    import numpy as np
+def _refuse_misapplied(ctx_params: dict, sequence: bool) -> None:
+    """Usage errors (exit 2): sequence options on a pair, incremental options without it."""
+    if ctx_params["points"] is not None and ctx_params["roi"] is not None:
+        raise typer.BadParameter("give either --points or --roi, not both")
+    if not sequence:
+        for name, flag in (("reference_mode", "--sequence-mode"), ("frame_rate", "--fps")):
+            if ctx_params[name] is not None:
+                raise typer.BadParameter(
+                    f"{flag} applies to a sequence (a folder, pattern or video), not to "
+                    "a pair of images"
+                )
+    if ctx_params["reference_mode"] != "incremental" and (
+        ctx_params["update_every"] is not None or ctx_params["update_zncc"] != UPDATE_ZNCC
+    ):
+        raise typer.BadParameter(
+            "--update-zncc/--update-every apply to --sequence-mode incremental only"
+        )
 
-    if not path.is_file():
-        raise BadInputError(f"--points '{path}' does not exist")
-    rows = []
-    for k, line in enumerate(path.read_text(errors="replace").splitlines(), start=1):
-        text = line.split("#", 1)[0].replace(",", " ").replace(";", " ").split()
-        if not text:
-            continue
-        try:
-            vals = [float(v) for v in text]
-        except ValueError:
-            if not rows and k == 1:
-                continue  # a header line
-            raise BadInputError(
-                f"--points '{path}' line {k}: {line.strip()!r} is not two numbers x, y (pixels)"
-            ) from None
-        if len(vals) != 2:
-            raise BadInputError(
-                f"--points '{path}' line {k}: expected two numbers x, y (pixels), got {len(vals)}"
-            )
-        rows.append(vals)
-    if not rows:
-        raise BadInputError(f"--points '{path}' holds no points (expected lines 'x, y' in pixels)")
-    return np.array(rows)
+
+def _summary(ds, out: Path, elapsed: float, plot: Path | None, mode, update_zncc) -> str:
+    ok = ds["flag"].values == 0
+    msg = (
+        f"{out}: {ok.sum()}/{ok.size} points ok, median ZNCC "
+        f"{float(ds['zncc'].where(ds['flag'] == 0).median()):.4f}, {elapsed:.2f} s"
+    )
+    if plot is not None:
+        msg += f"; figure {plot}"
+    if mode == "incremental":
+        moves = int(ds.attrs.get("dic_reference_updates", 0))
+        msg += (
+            f"; reference moved {moves} time(s)"
+            if moves
+            else "; the reference never moved (every frame matched frame 0 with a median "
+            f"ZNCC above --update-zncc {update_zncc}: the result is the absolute one; "
+            "--update-every N moves it every N frames)"
+        )
+    return msg
+
+
+def correlate_cmd(
+    ctx: typer.Context,
+    reference: Annotated[
+        Path,
+        typer.Argument(
+            help="Reference image, or a folder of frames, a quoted pattern ('f/*_0.tif') "
+            "or a video (sequence)."
+        ),
+    ],
+    deformed: Annotated[
+        Path | None,
+        typer.Argument(
+            help="Deformed image; or a folder / quoted pattern of the later frames of a "
+            "sequence whose reference is REFERENCE (named unlike them); omit for a "
+            "sequence in REFERENCE."
+        ),
+    ] = None,
+    out: opt.OutOpt = Path("field.nc"),
+    overwrite: Overwrite = False,
+    roi: Annotated[
+        str | None, typer.Option("--roi", help="Region x_min,y_min,x_max,y_max (pixels).")
+    ] = None,
+    subset: opt.SubsetOpt = opt.DEFAULTS.subset_size,
+    step: opt.StepOpt = opt.DEFAULTS.step,
+    shape: Annotated[
+        Literal["affine", "quadratic"],
+        typer.Option("--shape", help="Shape function: affine or quadratic."),
+    ] = opt.DEFAULTS.shape,
+    interpolation: Annotated[
+        Literal["quintic", "cubic"],
+        typer.Option("--interpolation", help="B-spline: quintic or cubic."),
+    ] = opt.DEFAULTS.interpolation,
+    search_radius: opt.SearchRadiusOpt = opt.DEFAULTS.search_radius,
+    seed: Annotated[
+        list[str] | None,
+        typer.Option("--seed", help="Seed point x,y (pixels) (repeatable)."),
+    ] = None,
+    zncc_min: opt.ZnccMinOpt = opt.DEFAULTS.zncc_min,
+    points: opt.PointsOpt = None,
+    tolerance: Annotated[
+        float,
+        typer.Option("--tolerance", help="IC-GN convergence: last update norm (pixels)."),
+    ] = opt.DEFAULTS.tolerance,
+    max_iterations: Annotated[
+        int, typer.Option("--max-iterations", help="IC-GN iteration limit per point.")
+    ] = opt.DEFAULTS.max_iterations,
+    update_zncc: Annotated[
+        float,
+        typer.Option(
+            "--update-zncc",
+            help="Incremental: move the reference forward when the median ZNCC drops below.",
+        ),
+    ] = UPDATE_ZNCC,
+    update_every: Annotated[
+        int | None,
+        typer.Option(
+            "--update-every",
+            help="Incremental: also move the reference after this many frames (1: always).",
+        ),
+    ] = None,
+    reference_mode: Annotated[
+        Literal["absolute", "incremental"] | None,
+        typer.Option(
+            "--sequence-mode",
+            help="Sequences: absolute (every frame against the first; default) or "
+            "incremental (the reference moves forward to a later frame when the matches "
+            "against it degrade, or every --update-every frames).",
+        ),
+    ] = None,
+    frame_rate: Annotated[
+        float | None,
+        typer.Option("--fps", "--frame-rate", help="Sequences: frame rate (1/s)."),
+    ] = None,
+    plot: Annotated[
+        Path | None, typer.Option("--plot", help="Write a quick-look figure (png).")
+    ] = None,
+    threads: opt.ThreadsOpt = opt.DEFAULTS.threads,
+    allow_empty: opt.AllowEmptyOpt = False,
+) -> None:
+    """Subset DIC (ZNSSD, IC-GN): displacement u, v (pixels) on a grid, written to netCDF."""
+    from jointwear.dic._flag_report import check_flags
+    from jointwear.dic.subset._files import correlate_files, is_sequence_input
+
+    _refuse_misapplied(ctx.params, is_sequence_input(deformed))
+    params = CorrelationParams(
+        subset_size=subset,
+        step=step,
+        shape=shape,
+        interpolation=interpolation,
+        search_radius=search_radius,
+        zncc_min=zncc_min,
+        tolerance=tolerance,
+        max_iterations=max_iterations,
+        threads=threads,
+    )
+    ds, elapsed = correlate_files(
+        reference,
+        deformed,
+        out,
+        params=params,
+        roi=_parse_roi(roi),
+        points=points,
+        seed_points=_parse_points(seed),
+        reference_mode=reference_mode,
+        frame_rate=frame_rate,
+        update_zncc=update_zncc,
+        update_every=update_every,
+        plot=plot,
+    )
+    typer.echo(_summary(ds, out, elapsed, plot, reference_mode, update_zncc))
+    check_flags(ds, allow_empty=allow_empty)
 
 
 def register(app: typer.Typer) -> None:
     """Add ``correlate`` to the ``jointwear dic`` group."""
-
-    @app.command("correlate")
-    def correlate_cmd(
-        reference: Annotated[
-            Path,
-            typer.Argument(
-                help="Reference image, or a folder of frames, a quoted pattern ('f/*_0.tif') "
-                "or a video (sequence)."
-            ),
-        ],
-        deformed: Annotated[
-            Path | None,
-            typer.Argument(
-                help="Deformed image; or a folder / quoted pattern of the later frames of a "
-                "sequence whose reference is REFERENCE (named unlike them); omit for a "
-                "sequence in REFERENCE."
-            ),
-        ] = None,
-        out: Annotated[Path, typer.Option("--out", help="Output netCDF file.")] = Path("field.nc"),
-        overwrite: Overwrite = False,
-        roi: Annotated[
-            str | None, typer.Option("--roi", help="Region x_min,y_min,x_max,y_max (pixels).")
-        ] = None,
-        subset: Annotated[
-            int, typer.Option("--subset", min=3, help="Subset size (pixels), odd.")
-        ] = 31,
-        step: Annotated[int, typer.Option("--step", min=1, help="Grid step (pixels).")] = 10,
-        shape: Annotated[
-            Literal["affine", "quadratic"],
-            typer.Option("--shape", help="Shape function: affine or quadratic."),
-        ] = "affine",
-        interpolation: Annotated[
-            Literal["quintic", "cubic"],
-            typer.Option("--interpolation", help="B-spline: quintic or cubic."),
-        ] = "quintic",
-        search_radius: Annotated[
-            int, typer.Option("--search-radius", help="Seed search half-width (pixels).")
-        ] = 48,
-        seed: Annotated[
-            list[str] | None,
-            typer.Option("--seed", help="Seed point x,y (pixels) (repeatable)."),
-        ] = None,
-        zncc_min: Annotated[
-            float, typer.Option("--zncc-min", help="Flag matches below this ZNCC.")
-        ] = 0.8,
-        points: Annotated[
-            Path | None,
-            typer.Option(
-                "--points",
-                help="Text file of subset centres 'x, y' (pixels, one per line) instead of a grid.",
-            ),
-        ] = None,
-        tolerance: Annotated[
-            float,
-            typer.Option("--tolerance", help="IC-GN convergence: last update norm (pixels)."),
-        ] = 1e-3,
-        max_iterations: Annotated[
-            int, typer.Option("--max-iterations", help="IC-GN iteration limit per point.")
-        ] = 40,
-        update_zncc: Annotated[
-            float,
-            typer.Option(
-                "--update-zncc",
-                help="Incremental: move the reference forward when the median ZNCC drops below.",
-            ),
-        ] = 0.9,
-        update_every: Annotated[
-            int | None,
-            typer.Option(
-                "--update-every",
-                help="Incremental: also move the reference after this many frames (1: always).",
-            ),
-        ] = None,
-        reference_mode: Annotated[
-            Literal["absolute", "incremental"] | None,
-            typer.Option(
-                "--sequence-mode",
-                help="Sequences: absolute (every frame against the first; default) or "
-                "incremental (the reference moves forward to a later frame when the matches "
-                "against it degrade, or every --update-every frames).",
-            ),
-        ] = None,
-        frame_rate: Annotated[
-            float | None,
-            typer.Option("--fps", "--frame-rate", help="Sequences: frame rate (1/s)."),
-        ] = None,
-        plot: Annotated[
-            Path | None, typer.Option("--plot", help="Write a quick-look figure (png).")
-        ] = None,
-        threads: Annotated[
-            int, typer.Option("--threads", min=0, help="numba threads (0: auto).")
-        ] = 0,
-        allow_empty: Annotated[
-            bool,
-            typer.Option(
-                "--allow-empty",
-                help="Exit 0 even when an image has no valid point (otherwise exit 1).",
-            ),
-        ] = False,
-    ) -> None:
-        """Subset DIC (ZNSSD, IC-GN): displacement u, v (pixels) on a grid, written to netCDF."""
-        import time as _time
-
-        from jointwear._version import __version__
-        from jointwear.dic._flag_report import check_flags
-        from jointwear.dic.subset._correlator import CorrelationParams, SubsetCorrelator
-        from jointwear.dic.subset._quicklook import save_quicklook
-        from jointwear.dic.subset._sequence import correlate_sequence, read_frames, read_image
-        from jointwear.io import check_writable, save
-        from jointwear.progress import progress_bar
-
-        check_writable(out)
-        if plot is not None:
-            check_writable(plot, what="figure")
-        params = CorrelationParams(
-            subset_size=subset,
-            step=step,
-            shape=shape,  # type: ignore[arg-type]
-            interpolation=interpolation,  # type: ignore[arg-type]
-            search_radius=search_radius,
-            zncc_min=zncc_min,
-            tolerance=tolerance,
-            max_iterations=max_iterations,
-            threads=threads,
-        )
-        roi_vals = _parse_roi(roi)
-        seeds = _parse_points(seed)
-        if points is not None and roi_vals is not None:
-            raise typer.BadParameter("give either --points or --roi, not both")
-        pts = read_points_file(points) if points is not None else None
-        from jointwear.dic.footage._video import is_image_sequence
-
-        sequence = deformed is None or (not deformed.is_file() and is_image_sequence(str(deformed)))
-        if not sequence:
-            for given, flag in ((reference_mode, "--sequence-mode"), (frame_rate, "--fps")):
-                if given is not None:
-                    raise typer.BadParameter(
-                        f"{flag} applies to a sequence (a folder, pattern or video), not to "
-                        "a pair of images"
-                    )
-        if reference_mode != "incremental" and (update_every is not None or update_zncc != 0.9):
-            raise typer.BadParameter(
-                "--update-zncc/--update-every apply to --sequence-mode incremental only"
-            )
-        t0 = _time.perf_counter()
-        if sequence:
-            if deformed is not None:  # a reference named unlike the frames, then the frames
-                from jointwear.dic.footage._video import list_image_sequence
-
-                if not reference.is_file():
-                    raise BadInputError(f"reference image '{reference}' does not exist")
-                files = list_image_sequence(str(deformed), what="frames")[0]
-                frames = [read_image(reference)] + [read_image(f) for f in files]
-                fps = None
-            else:
-                if not reference.exists() and not is_image_sequence(reference):
-                    raise BadInputError(f"'{reference}' does not exist")
-                frames, fps = read_frames(reference)
-            ds = correlate_sequence(
-                (frames, fps),
-                reference=reference_mode or "absolute",
-                roi=roi_vals,
-                points=pts,
-                frame_rate=frame_rate,
-                update_zncc=update_zncc,
-                update_every=update_every,
-                seed_points=seeds,
-                progress=None,
-                params=params,
-            )
-            inputs = [reference] if reference.is_file() else []
-            if deformed is not None:
-                inputs += files
-        else:
-            ref_img = read_image(reference)
-            def_img = read_image(deformed)
-            with progress_bar("correlating", total=2, enabled=None) as bar:
-                task = bar.tasks[0].id
-                corr = SubsetCorrelator(ref_img, roi=roi_vals, points=pts, params=params)
-                bar.update(task, advance=1, description=f"correlating {corr.n_points} points")
-                ds = corr.correlate(def_img, seed_points=seeds)
-                bar.update(task, advance=1)
-            inputs = [reference, deformed]
-        elapsed = _time.perf_counter() - t0
-        save(
-            ds,
-            out,
-            inputs=inputs,
-            parameters=params,
-            source=f"jointwear {__version__} (dic.correlate)",
-        )
-        ok = ds["flag"].values == 0
-        msg = (
-            f"{out}: {ok.sum()}/{ok.size} points ok, median ZNCC "
-            f"{float(ds['zncc'].where(ds['flag'] == 0).median()):.4f}, {elapsed:.2f} s"
-        )
-        if plot is not None:
-            save_quicklook(ds, plot, title=reference.name)
-            msg += f"; figure {plot}"
-        if reference_mode == "incremental":
-            moves = int(ds.attrs.get("dic_reference_updates", 0))
-            msg += (
-                f"; reference moved {moves} time(s)"
-                if moves
-                else "; the reference never moved (every frame matched frame 0 with a median "
-                f"ZNCC above --update-zncc {update_zncc}: the result is the absolute one; "
-                "--update-every N moves it every N frames)"
-            )
-        typer.echo(msg)
-        check_flags(ds, allow_empty=allow_empty)
+    app.command("correlate")(correlate_cmd)

@@ -8,440 +8,430 @@ from typing import Annotated, Literal
 import typer
 
 from jointwear._cli import Overwrite
+from jointwear.dic.calibration._defaults import (
+    MAX_RMS_PX,
+    MAX_VIEW_RMS_PX,
+    MIN_VIEWS,
+    VIDEO_EVERY,
+)
 
 
-def _image_list(path: Path, what: str) -> list[Path]:
-    """Board images of one camera: a folder, or a pattern such as 'cal/*_0.tif'."""
-    from jointwear.dic.footage._video import list_image_sequence
+def _board(board, squares, square, unit, square_u, square_mm, marker, marker_mm, dictionary):
+    """The calibration board of the options, and the square side and unit as given; usage
+    errors (exit 2) for a missing square size, an unknown unit or marker options on a
+    chessboard."""
+    from jointwear.dic.calibration._board import CalibrationBoard
+    from jointwear.dic.calibration._importers import _LENGTH_UNITS
 
-    return list_image_sequence(path, what=what)[0]
+    if square_mm is not None:
+        if square is not None:
+            raise typer.BadParameter("give --square (with --unit), not also --square-mm")
+        square, unit = square_mm, "mm"
+    if square is None:
+        raise typer.BadParameter(
+            "the board's square size is required: --square 25 --unit mm (or --square 1 "
+            "--unit square for lengths in squares)",
+            param_hint="--square",
+        )
+    if unit == "square":
+        scale, length_unit = 1.0, "square"
+    elif unit in _LENGTH_UNITS:
+        scale, length_unit = _LENGTH_UNITS[unit], "m"
+    else:
+        raise typer.BadParameter(
+            f"{unit!r}: expected one of {', '.join(_LENGTH_UNITS)} or square",
+            param_hint="--unit",
+        )
+    if board == "chessboard":
+        for given, flag in ((marker, "--marker"), (marker_mm, "--marker-mm")):
+            if given is not None:
+                raise typer.BadParameter(
+                    f"{flag} applies to a ChArUco board (--board charuco), not a chessboard"
+                )
+    if marker is not None:
+        marker_m = marker * scale
+    else:
+        marker_m = marker_mm * 1e-3 if marker_mm is not None else 0.75 * square * scale
+    b = CalibrationBoard(
+        board,
+        squares[0],
+        squares[1],
+        square * scale,
+        marker_m,
+        dictionary,
+        length_unit=length_unit,
+        square_size_u=None if square_u is None else square_u * scale,
+    )
+    return b, square, unit
 
 
-def _video_frames(path: Path, every: int, what: str) -> list:
-    from jointwear.dic.footage._video import open_frames
+def _calibration_lines(cal, out: Path) -> list[str]:
+    from jointwear.dic.calibration._gate import view_table
 
-    src = open_frames(path, what=what)
-    return [img for i, _, img in src.frames() if i % every == 0]
+    lu = "mm" if cal.length_unit == "m" else cal.length_unit + "s"
+    ls = 1e3 if cal.length_unit == "m" else 1.0
+    u = (
+        f" (relative length uncertainty {cal.length_scale_u_rel:.1e})"
+        if cal.length_scale_u_rel is not None
+        else ""
+    )
+    head = (
+        f"calibrated from {cal.views_used} views ({cal.views_rejected} rejected): RMS "
+        f"{cal.rms:.3f} px, baseline {cal.baseline * ls:.2f} {lu}{u}, focal "
+        f"{cal.left.focal[0]:.1f}/{cal.right.focal[0]:.1f} px -> {out}"
+    )
+    return [head, *view_table(cal)]
+
+
+def calibrate_cmd(
+    left: Annotated[
+        Path,
+        typer.Option(
+            "--left",
+            help="Left board images (folder or quoted pattern 'cal/*_0.tif') or video.",
+        ),
+    ],
+    right: Annotated[
+        Path,
+        typer.Option(
+            "--right",
+            help="Right board images (folder or quoted pattern 'cal/*_1.tif') or video.",
+        ),
+    ],
+    out: Annotated[Path, typer.Option("--out", "-o", help="Calibration file (.nc).")] = Path(
+        "calibration.nc"
+    ),
+    overwrite: Overwrite = False,
+    board: Annotated[
+        Literal["chessboard", "charuco"], typer.Option(help="chessboard or charuco.")
+    ] = "chessboard",
+    squares: Annotated[
+        tuple[int, int], typer.Option(help="Squares along x and y (not inner corners).")
+    ] = (10, 7),
+    square: Annotated[
+        float | None,
+        typer.Option(help="Side of one board square, in --unit (required)."),
+    ] = None,
+    unit: Annotated[
+        str,
+        typer.Option(
+            help="Unit of --square/--marker/--square-u: m, mm, cm, um, in, or 'square' "
+            "(lengths in board squares; such a calibration cannot measure)."
+        ),
+    ] = "mm",
+    square_u: Annotated[
+        float | None,
+        typer.Option(help="Standard uncertainty of the square side, in --unit."),
+    ] = None,
+    square_mm: Annotated[
+        float | None, typer.Option(hidden=True, help="Deprecated: --square N --unit mm.")
+    ] = None,
+    marker: Annotated[float | None, typer.Option(help="ChArUco marker side, in --unit.")] = None,
+    marker_mm: Annotated[float | None, typer.Option(hidden=True)] = None,
+    dictionary: Annotated[str, typer.Option(help="ChArUco ArUco dictionary.")] = "DICT_5X5_100",
+    world_view: Annotated[
+        int | None,
+        typer.Option(help="Index of the view whose board pose becomes the world frame."),
+    ] = None,
+    min_views: Annotated[int, typer.Option(min=1, help="Fewest usable views.")] = MIN_VIEWS,
+    every: Annotated[int, typer.Option(min=1, help="Videos: use every N-th frame.")] = VIDEO_EVERY,
+    max_rms: Annotated[
+        float, typer.Option(help="Largest acceptable stereo reprojection RMS (px).")
+    ] = MAX_RMS_PX,
+    max_view_rms: Annotated[
+        float,
+        typer.Option(help="Views above this per-camera reprojection RMS (px) are dropped."),
+    ] = MAX_VIEW_RMS_PX,
+    accept_poor: Annotated[
+        bool,
+        typer.Option(
+            help="Write a calibration that fails the sanity checks instead of refusing it."
+        ),
+    ] = False,
+) -> None:
+    """Calibrate a stereo pair from simultaneous views of a chessboard or ChArUco board.
+
+    The result passes a sanity gate (reprojection RMS, field of view, pixel aspect,
+    principal point, baseline, camera order); a calibration that fails it is written to
+    <out>.rejected.nc for inspection and the command exits with code 1 (--accept-poor
+    writes it to --out instead).
+    """
+    from jointwear.dic.calibration._files import calibrate_files, rejected_path
+    from jointwear.dic.calibration._gate import PoorCalibration, view_table
+
+    b, square, unit = _board(
+        board, squares, square, unit, square_u, square_mm, marker, marker_mm, dictionary
+    )
+    params = {
+        "board": b.__dict__,
+        "world_view": world_view,
+        "square": square,
+        "unit": unit,
+        "max_rms_px": max_rms,
+        "accept_poor": accept_poor,
+    }
+    try:
+        cal = calibrate_files(
+            left,
+            right,
+            out,
+            b,
+            every=every,
+            parameters=params,
+            min_views=min_views,
+            world_view=world_view,
+            max_rms=max_rms,
+            max_view_rms=max_view_rms,
+            accept_poor=accept_poor,
+        )
+    except PoorCalibration as exc:
+        for line in view_table(exc.calibration):
+            typer.echo(line, err=True)
+        typer.echo(f"rejected calibration kept for inspection -> {rejected_path(out)}", err=True)
+        raise
+    for line in _calibration_lines(cal, out):
+        typer.echo(line)
+    if cal.status != "accepted":
+        typer.echo(f"WARNING: {cal.status}", err=True)
+
+
+def import_calibration_cmd(
+    paths: Annotated[
+        list[Path],
+        typer.Argument(
+            help="OpenCV YAML/XML file(s) (stereo_calib: intrinsics.yml extrinsics.yml) or "
+            "one VIC-3D cal.xml / project XML / .z3d.",
+            show_default=False,
+        ),
+    ],
+    fmt: Annotated[Literal["opencv", "vic3d"], typer.Option("--format", help="opencv or vic3d.")],
+    out: Annotated[Path, typer.Option("--out", "-o", help="Calibration file (.nc).")] = Path(
+        "calibration.nc"
+    ),
+    overwrite: Overwrite = False,
+    length_unit: Annotated[
+        str | None,
+        typer.Option(help="OpenCV: unit of T (m, mm, cm, um, in, or metres per unit)."),
+    ] = None,
+    image_size: Annotated[
+        tuple[int, int] | None, typer.Option(help="Image width and height (px) if absent.")
+    ] = None,
+    extrinsics: Annotated[
+        Path | None,
+        typer.Option("--extrinsics", help="OpenCV: a second file with R and T (extrinsics.yml)."),
+    ] = None,
+) -> None:
+    """Import a calibration made elsewhere (OpenCV FileStorage, VIC-3D) as a jointwear file."""
+    from jointwear.dic.calibration._importers import (
+        read_opencv_calibration,
+        read_vic3d_calibration,
+    )
+    from jointwear.errors import BadInputError
+
+    inputs = [*paths, *([extrinsics] if extrinsics is not None else [])]
+    if fmt == "opencv":
+        if length_unit is None:
+            raise BadInputError(
+                "--length-unit is required for OpenCV files (the unit of T, i.e. of the board "
+                "square size used when calibrating: m, mm, cm, um or in, or metres per unit)"
+            )
+        cal = read_opencv_calibration(inputs, length_unit=length_unit, image_size=image_size)
+    elif fmt == "vic3d":
+        if length_unit is not None:
+            raise typer.BadParameter(
+                "--length-unit applies to OpenCV files; a VIC-3D calibration states its "
+                "own unit (millimetres)"
+            )
+        if len(inputs) != 1:
+            raise BadInputError(
+                f"--format vic3d takes one file (cal.xml, project XML or .z3d), got "
+                f"{len(inputs)}: {', '.join(str(p) for p in inputs)}"
+            )
+        cal = read_vic3d_calibration(inputs[0], image_size=image_size)
+    else:
+        raise BadInputError(f"--format {fmt!r}: expected 'opencv' or 'vic3d'")
+    cal.save(out, inputs=inputs, parameters={"format": fmt, "length_unit": length_unit})
+    typer.echo(
+        f"imported {fmt} calibration ({cal.left.image_size[0]}x{cal.left.image_size[1]} px, "
+        f"baseline {cal.baseline * 1e3:.2f} mm) -> {out}"
+    )
+
+
+def _track_config(bodies: Path, **overrides):
+    """Options and bodies of the TOML file with the command's overrides; a bad override is a
+    usage error (exit 2) naming its flag."""
+    from jointwear.dic.footage._config import read_bodies
+    from jointwear.dic.footage._files import with_overrides
+    from jointwear.errors import ParameterError
+
+    cfg, specs = read_bodies(bodies)
+    try:
+        return with_overrides(cfg, **overrides), specs
+    except ParameterError as exc:
+        flag = "--" + str(exc).split("=")[0].removeprefix("track.").replace("_", "-")
+        raise typer.BadParameter(str(exc), param_hint=flag) from None
+
+
+def _track_lines(ds, cfg, out: Path) -> tuple[list[str], list[str]]:
+    """(stdout lines, stderr lines) that summarise a tracking run."""
+    import json
+
+    dup = ds.attrs.get("duplicated_frames", "[]")
+    lines = [
+        f"tracked {ds.attrs['frames_processed']} frames in {ds.attrs.get('wall_time_s', 0):.1f} s; "
+        f"duplicated frames: {dup}; dropped frames (time gaps): "
+        f"{ds.attrs.get('dropped_frames_estimated', 0)} -> {out}"
+    ]
+    counts = json.loads(ds.attrs.get("sift_reinitialisations", "{}"))
+    errs = []
+    if any(counts.values()):
+        lines.append(
+            "tracking lost and found again from SIFT features (re-initialisations): "
+            + ", ".join(f"{k} {v}" for k, v in counts.items())
+            + f" (limit {cfg.max_reinit} per body, --max-reinit; frames in "
+            "<body>_reinitialised)"
+        )
+        full = [k for k, v in counts.items() if v >= cfg.max_reinit]
+        if full:
+            errs.append(
+                f"WARNING: {', '.join(full)} reached the re-initialisation limit; later "
+                "lost frames are flagged tracking_failed"
+            )
+    return lines, errs
+
+
+def track_cmd(
+    left: Annotated[
+        Path,
+        typer.Option(
+            "--left",
+            help="Left video, image folder, quoted pattern ('images/*_0.tif') or multi-page TIFF.",
+        ),
+    ],
+    bodies: Annotated[
+        Path, typer.Option("--bodies", help="TOML file with the regions of interest.")
+    ],
+    right: Annotated[
+        Path | None,
+        typer.Option("--right", help="Right footage, as --left (omit for one camera)."),
+    ] = None,
+    calibration: Annotated[
+        Path | None, typer.Option("--calibration", "-c", help="Stereo calibration (.nc).")
+    ] = None,
+    out: Annotated[Path, typer.Option("--out", "-o", help="Body motion (.nc).")] = Path(
+        "motion.nc"
+    ),
+    overwrite: Overwrite = False,
+    fps: Annotated[float | None, typer.Option(help="Frame rate (1/s) (image sequences).")] = None,
+    max_frames: Annotated[int | None, typer.Option(help="Process only the first N frames.")] = None,
+    plot: Annotated[
+        Path | None, typer.Option(help="Also write the velocity/displacement plot.")
+    ] = None,
+    workers: Annotated[
+        int | None, typer.Option(help="Worker processes for chunks (overrides the TOML).")
+    ] = None,
+    chunk_size: Annotated[
+        int | None, typer.Option(help="Frames per chunk (overrides the TOML).")
+    ] = None,
+    resume: Annotated[
+        bool,
+        typer.Option(
+            help="Continue the partial result in --out of a run that stopped (same footage, "
+            "bodies and options)."
+        ),
+    ] = False,
+    max_epipolar_px: Annotated[
+        float | None,
+        typer.Option(
+            help="Epipolar gate of the stereo matches (px; overrides the TOML's "
+            "max_epipolar_px). Raise only for a calibration known to be that far off."
+        ),
+    ] = None,
+    max_reinit: Annotated[
+        int | None,
+        typer.Option(
+            help="Most SIFT re-initialisations per body after lost tracking (0: none; "
+            "overrides the TOML)."
+        ),
+    ] = None,
+    scheduler: Annotated[
+        str | None,
+        typer.Option(help="Run the chunks on this dask.distributed cluster (tcp://host:8786)."),
+    ] = None,
+) -> None:
+    """Track the bodies of rig footage: poses, follower velocity, journal out-of-plane motion.
+
+    The result is written after every chunk of frames, so an interrupted run keeps what was
+    computed (attribute 'status').
+    """
+    from jointwear import io
+    from jointwear.dic.footage._files import track_files
+
+    if right is None:
+        for given, flag in (
+            (calibration, "--calibration"),
+            (max_epipolar_px, "--max-epipolar-px"),
+        ):
+            if given is not None:
+                raise typer.BadParameter(
+                    f"{flag} applies to two cameras (--right); one camera tracks in pixels "
+                    "of the left image"
+                )
+    io.check_writable(out)
+    cfg, specs = _track_config(
+        bodies,
+        workers=workers,
+        chunk_size=chunk_size,
+        max_epipolar_px=max_epipolar_px,
+        max_reinit=max_reinit,
+    )
+    ds = track_files(
+        left,
+        right,
+        out,
+        bodies=bodies,
+        config=cfg,
+        specs=specs,
+        calibration=calibration,
+        plot=plot,
+        fps=fps,
+        max_frames=max_frames,
+        resume=resume,
+        scheduler=scheduler,
+    )
+    lines, errs = _track_lines(ds, cfg, out)
+    for line in lines:
+        typer.echo(line)
+    for line in errs:
+        typer.echo(line, err=True)
+    if plot is not None:
+        typer.echo(f"plot -> {plot}")
+
+
+def plot_track_cmd(
+    motion: Annotated[Path, typer.Argument(help="Output of `jointwear dic track` (.nc).")],
+    out: Annotated[Path, typer.Option("--out", "-o", help="Figure (.png/.svg/.pdf).")] = Path(
+        "motion.png"
+    ),
+    overwrite: Overwrite = False,
+    reference: Annotated[
+        Path | None,
+        typer.Option("--overlay", help="File to overlay (ground truth, simulation) (.nc)."),
+    ] = None,
+) -> None:
+    """Plot the follower velocity and the journal's out-of-plane displacement."""
+    from jointwear import io
+    from jointwear.dic.footage._plot import plot_body_motion
+
+    ds = io.load(motion)
+    ref = io.load(reference) if reference is not None else None
+    plot_body_motion(ds, reference=ref, path=out)
+    typer.echo(f"plot -> {out}")
 
 
 def register(app: typer.Typer) -> None:
     """Add the stereo commands to ``jointwear dic``."""
-
-    @app.command("calibrate")
-    def calibrate(
-        left: Annotated[
-            Path,
-            typer.Option(
-                "--left",
-                help="Left board images (folder or quoted pattern 'cal/*_0.tif') or video.",
-            ),
-        ],
-        right: Annotated[
-            Path,
-            typer.Option(
-                "--right",
-                help="Right board images (folder or quoted pattern 'cal/*_1.tif') or video.",
-            ),
-        ],
-        out: Annotated[Path, typer.Option("--out", "-o", help="Calibration file (.nc).")] = Path(
-            "calibration.nc"
-        ),
-        overwrite: Overwrite = False,
-        board: Annotated[
-            Literal["chessboard", "charuco"], typer.Option(help="chessboard or charuco.")
-        ] = "chessboard",
-        squares: Annotated[
-            tuple[int, int], typer.Option(help="Squares along x and y (not inner corners).")
-        ] = (10, 7),
-        square: Annotated[
-            float | None,
-            typer.Option(help="Side of one board square, in --unit (required)."),
-        ] = None,
-        unit: Annotated[
-            str,
-            typer.Option(
-                help="Unit of --square/--marker/--square-u: m, mm, cm, um, in, or 'square' "
-                "(lengths in board squares; such a calibration cannot measure)."
-            ),
-        ] = "mm",
-        square_u: Annotated[
-            float | None,
-            typer.Option(help="Standard uncertainty of the square side, in --unit."),
-        ] = None,
-        square_mm: Annotated[
-            float | None, typer.Option(hidden=True, help="Deprecated: --square N --unit mm.")
-        ] = None,
-        marker: Annotated[
-            float | None, typer.Option(help="ChArUco marker side, in --unit.")
-        ] = None,
-        marker_mm: Annotated[float | None, typer.Option(hidden=True)] = None,
-        dictionary: Annotated[str, typer.Option(help="ChArUco ArUco dictionary.")] = "DICT_5X5_100",
-        world_view: Annotated[
-            int | None,
-            typer.Option(help="Index of the view whose board pose becomes the world frame."),
-        ] = None,
-        min_views: Annotated[int, typer.Option(min=1, help="Fewest usable views.")] = 6,
-        every: Annotated[int, typer.Option(min=1, help="Videos: use every N-th frame.")] = 10,
-        max_rms: Annotated[
-            float, typer.Option(help="Largest acceptable stereo reprojection RMS (px).")
-        ] = 1.0,
-        max_view_rms: Annotated[
-            float,
-            typer.Option(help="Views above this per-camera reprojection RMS (px) are dropped."),
-        ] = 1.0,
-        accept_poor: Annotated[
-            bool,
-            typer.Option(
-                help="Write a calibration that fails the sanity checks instead of refusing it."
-            ),
-        ] = False,
-    ) -> None:
-        """Calibrate a stereo pair from simultaneous views of a chessboard or ChArUco board.
-
-        The result passes a sanity gate (reprojection RMS, field of view, pixel aspect,
-        principal point, baseline, camera order); a calibration that fails it is written to
-        <out>.rejected.nc for inspection and the command exits with code 1 (--accept-poor
-        writes it to --out instead).
-        """
-        from jointwear import io
-        from jointwear.dic.calibration._board import CalibrationBoard, calibrate_stereo
-        from jointwear.dic.calibration._gate import PoorCalibration, view_table
-        from jointwear.dic.calibration._importers import _LENGTH_UNITS
-        from jointwear.dic.footage._video import is_image_sequence
-
-        if square_mm is not None:
-            if square is not None:
-                raise typer.BadParameter("give --square (with --unit), not also --square-mm")
-            square, unit = square_mm, "mm"
-        if square is None:
-            raise typer.BadParameter(
-                "the board's square size is required: --square 25 --unit mm (or --square 1 "
-                "--unit square for lengths in squares)",
-                param_hint="--square",
-            )
-        if unit == "square":
-            scale, length_unit = 1.0, "square"
-        elif unit in _LENGTH_UNITS:
-            scale, length_unit = _LENGTH_UNITS[unit], "m"
-        else:
-            raise typer.BadParameter(
-                f"{unit!r}: expected one of {', '.join(_LENGTH_UNITS)} or square",
-                param_hint="--unit",
-            )
-        if board == "chessboard":
-            for given, flag in ((marker, "--marker"), (marker_mm, "--marker-mm")):
-                if given is not None:
-                    raise typer.BadParameter(
-                        f"{flag} applies to a ChArUco board (--board charuco), not a chessboard"
-                    )
-        io.check_writable(out)
-        b = CalibrationBoard(
-            board,
-            squares[0],
-            squares[1],
-            square * scale,
-            marker * scale
-            if marker is not None
-            else (marker_mm * 1e-3 if marker_mm is not None else 0.75 * square * scale),
-            dictionary,
-            length_unit=length_unit,
-            square_size_u=None if square_u is None else square_u * scale,
-        )
-        if is_image_sequence(left):  # a folder, or a pattern like 'cal/*_0.tif'
-            lefts, rights = (
-                _image_list(left, "left calibration"),
-                _image_list(right, "right calibration"),
-            )
-        else:
-            lefts = _video_frames(left, every, "left calibration video")
-            rights = _video_frames(right, every, "right calibration video")
-            lefts = [(f"{left.name}#{i * every}", img) for i, img in enumerate(lefts)]
-            rights = [(f"{right.name}#{i * every}", img) for i, img in enumerate(rights)]
-        names = None
-        if lefts and isinstance(lefts[0], tuple):
-            names = [f"{a[0]} / {c[0]}" for a, c in zip(lefts, rights, strict=False)]
-            lefts, rights = [a[1] for a in lefts], [c[1] for c in rights]
-            names = names if len(names) == len(lefts) == len(rights) else None
-        params = {
-            "board": b.__dict__,
-            "world_view": world_view,
-            "square": square,
-            "unit": unit,
-            "max_rms_px": max_rms,
-            "accept_poor": accept_poor,
-        }
-        from jointwear.progress import progress_bar
-
-        try:
-            with progress_bar("finding the board", total=min(len(lefts), len(rights))) as bar:
-                task = bar.tasks[0].id
-                cal = calibrate_stereo(
-                    lefts,
-                    rights,
-                    b,
-                    min_views=min_views,
-                    world_view=world_view,
-                    max_rms=max_rms,
-                    max_view_rms=max_view_rms,
-                    accept_poor=accept_poor,
-                    view_names=names,
-                    progress=lambda done, total: bar.update(task, completed=done),
-                )
-        except PoorCalibration as exc:
-            rejected = out.with_name(out.stem + ".rejected" + (out.suffix or ".nc"))
-            exc.calibration.save(rejected, inputs=[left, right], parameters=params)
-            for line in view_table(exc.calibration):
-                typer.echo(line, err=True)
-            typer.echo(f"rejected calibration kept for inspection -> {rejected}", err=True)
-            raise
-        cal.save(out, inputs=[left, right], parameters=params)
-        lu = "mm" if cal.length_unit == "m" else cal.length_unit + "s"
-        ls = 1e3 if cal.length_unit == "m" else 1.0
-        u = (
-            f" (relative length uncertainty {cal.length_scale_u_rel:.1e})"
-            if cal.length_scale_u_rel is not None
-            else ""
-        )
-        typer.echo(
-            f"calibrated from {cal.views_used} views ({cal.views_rejected} rejected): RMS "
-            f"{cal.rms:.3f} px, baseline {cal.baseline * ls:.2f} {lu}{u}, focal "
-            f"{cal.left.focal[0]:.1f}/{cal.right.focal[0]:.1f} px -> {out}"
-        )
-        for line in view_table(cal):
-            typer.echo(line)
-        if cal.status != "accepted":
-            typer.echo(f"WARNING: {cal.status}", err=True)
-
-    @app.command("import-calibration")
-    def import_calibration(
-        paths: Annotated[
-            list[Path],
-            typer.Argument(
-                help="OpenCV YAML/XML file(s) (stereo_calib: intrinsics.yml extrinsics.yml) or "
-                "one VIC-3D cal.xml / project XML / .z3d.",
-                show_default=False,
-            ),
-        ],
-        fmt: Annotated[
-            Literal["opencv", "vic3d"], typer.Option("--format", help="opencv or vic3d.")
-        ],
-        out: Annotated[Path, typer.Option("--out", "-o", help="Calibration file (.nc).")] = Path(
-            "calibration.nc"
-        ),
-        overwrite: Overwrite = False,
-        length_unit: Annotated[
-            str | None,
-            typer.Option(help="OpenCV: unit of T (m, mm, cm, um, in, or metres per unit)."),
-        ] = None,
-        image_size: Annotated[
-            tuple[int, int] | None, typer.Option(help="Image width and height (px) if absent.")
-        ] = None,
-        extrinsics: Annotated[
-            Path | None,
-            typer.Option(
-                "--extrinsics", help="OpenCV: a second file with R and T (extrinsics.yml)."
-            ),
-        ] = None,
-    ) -> None:
-        """Import a calibration made elsewhere (OpenCV FileStorage, VIC-3D) as a jointwear file."""
-        from jointwear.dic.calibration._importers import (
-            read_opencv_calibration,
-            read_vic3d_calibration,
-        )
-        from jointwear.errors import BadInputError
-
-        inputs = [*paths, *([extrinsics] if extrinsics is not None else [])]
-        if fmt == "opencv":
-            if length_unit is None:
-                raise BadInputError(
-                    "--length-unit is required for OpenCV files (the unit of T, i.e. of the board "
-                    "square size used when calibrating: m, mm, cm, um or in, or metres per unit)"
-                )
-            cal = read_opencv_calibration(inputs, length_unit=length_unit, image_size=image_size)
-        elif fmt == "vic3d":
-            if length_unit is not None:
-                raise typer.BadParameter(
-                    "--length-unit applies to OpenCV files; a VIC-3D calibration states its "
-                    "own unit (millimetres)"
-                )
-            if len(inputs) != 1:
-                raise BadInputError(
-                    f"--format vic3d takes one file (cal.xml, project XML or .z3d), got "
-                    f"{len(inputs)}: {', '.join(str(p) for p in inputs)}"
-                )
-            cal = read_vic3d_calibration(inputs[0], image_size=image_size)
-        else:
-            raise BadInputError(f"--format {fmt!r}: expected 'opencv' or 'vic3d'")
-        cal.save(out, inputs=inputs, parameters={"format": fmt, "length_unit": length_unit})
-        typer.echo(
-            f"imported {fmt} calibration ({cal.left.image_size[0]}x{cal.left.image_size[1]} px, "
-            f"baseline {cal.baseline * 1e3:.2f} mm) -> {out}"
-        )
-
-    @app.command("track")
-    def track(
-        left: Annotated[
-            Path,
-            typer.Option(
-                "--left",
-                help="Left video, image folder, quoted pattern ('images/*_0.tif') or multi-page TIFF.",
-            ),
-        ],
-        bodies: Annotated[
-            Path, typer.Option("--bodies", help="TOML file with the regions of interest.")
-        ],
-        right: Annotated[
-            Path | None,
-            typer.Option("--right", help="Right footage, as --left (omit for one camera)."),
-        ] = None,
-        calibration: Annotated[
-            Path | None, typer.Option("--calibration", "-c", help="Stereo calibration (.nc).")
-        ] = None,
-        out: Annotated[Path, typer.Option("--out", "-o", help="Body motion (.nc).")] = Path(
-            "motion.nc"
-        ),
-        overwrite: Overwrite = False,
-        fps: Annotated[
-            float | None, typer.Option(help="Frame rate (1/s) (image sequences).")
-        ] = None,
-        max_frames: Annotated[
-            int | None, typer.Option(help="Process only the first N frames.")
-        ] = None,
-        plot: Annotated[
-            Path | None, typer.Option(help="Also write the velocity/displacement plot.")
-        ] = None,
-        workers: Annotated[
-            int | None, typer.Option(help="Worker processes for chunks (overrides the TOML).")
-        ] = None,
-        chunk_size: Annotated[
-            int | None, typer.Option(help="Frames per chunk (overrides the TOML).")
-        ] = None,
-        resume: Annotated[
-            bool,
-            typer.Option(
-                help="Continue the partial result in --out of a run that stopped (same footage, "
-                "bodies and options)."
-            ),
-        ] = False,
-        max_epipolar_px: Annotated[
-            float | None,
-            typer.Option(
-                help="Epipolar gate of the stereo matches (px; overrides the TOML's "
-                "max_epipolar_px). Raise only for a calibration known to be that far off."
-            ),
-        ] = None,
-        max_reinit: Annotated[
-            int | None,
-            typer.Option(
-                help="Most SIFT re-initialisations per body after lost tracking (0: none; "
-                "overrides the TOML)."
-            ),
-        ] = None,
-        scheduler: Annotated[
-            str | None,
-            typer.Option(help="Run the chunks on this dask.distributed cluster (tcp://host:8786)."),
-        ] = None,
-    ) -> None:
-        """Track the bodies of rig footage: poses, follower velocity, journal out-of-plane motion.
-
-        The result is written after every chunk of frames, so an interrupted run keeps what was
-        computed (attribute 'status').
-        """
-        from jointwear import io
-        from jointwear.dic.calibration._importers import read_calibration
-        from jointwear.dic.footage._track import read_bodies, track_footage
-
-        if right is None:
-            for given, flag in (
-                (calibration, "--calibration"),
-                (max_epipolar_px, "--max-epipolar-px"),
-            ):
-                if given is not None:
-                    raise typer.BadParameter(
-                        f"{flag} applies to two cameras (--right); one camera tracks in pixels "
-                        "of the left image"
-                    )
-        io.check_writable(out)
-        cfg, specs = read_bodies(bodies)
-        overrides = {
-            "workers": workers,
-            "chunk_size": chunk_size,
-            "max_epipolar_px": max_epipolar_px,
-            "max_reinit": max_reinit,
-        }
-        overrides = {k: v for k, v in overrides.items() if v is not None}
-        if overrides:
-            import dataclasses
-
-            from jointwear.errors import ParameterError
-
-            try:
-                cfg = dataclasses.replace(cfg, **overrides)
-            except ParameterError as exc:
-                flag = "--" + str(exc).split("=")[0].removeprefix("track.").replace("_", "-")
-                raise typer.BadParameter(str(exc), param_hint=flag) from None
-        cal = read_calibration(calibration) if calibration is not None else None
-        inputs = [p for p in (left, right, bodies, calibration) if p is not None]
-        ds = track_footage(
-            left,
-            right,
-            bodies=specs,
-            calibration=cal,
-            config=cfg,
-            fps=fps,
-            max_frames=max_frames,
-            out=out,
-            progress=True,
-            inputs=tuple(inputs),
-            resume=resume,
-            scheduler=scheduler,
-        )
-        dup = ds.attrs.get("duplicated_frames", "[]")
-        typer.echo(
-            f"tracked {ds.attrs['frames_processed']} frames in {ds.attrs.get('wall_time_s', 0):.1f} s; "
-            f"duplicated frames: {dup}; dropped frames (time gaps): "
-            f"{ds.attrs.get('dropped_frames_estimated', 0)} -> {out}"
-        )
-        import json
-
-        counts = json.loads(ds.attrs.get("sift_reinitialisations", "{}"))
-        if any(counts.values()):
-            typer.echo(
-                "tracking lost and found again from SIFT features (re-initialisations): "
-                + ", ".join(f"{k} {v}" for k, v in counts.items())
-                + f" (limit {cfg.max_reinit} per body, --max-reinit; frames in "
-                "<body>_reinitialised)"
-            )
-            full = [k for k, v in counts.items() if v >= cfg.max_reinit]
-            if full:
-                typer.echo(
-                    f"WARNING: {', '.join(full)} reached the re-initialisation limit; later "
-                    "lost frames are flagged tracking_failed",
-                    err=True,
-                )
-        if plot is not None:
-            from jointwear.dic.footage._plot import plot_body_motion
-
-            plot_body_motion(ds, path=plot)
-            typer.echo(f"plot -> {plot}")
-
-    @app.command("plot-track")
-    def plot_track(
-        motion: Annotated[Path, typer.Argument(help="Output of `jointwear dic track` (.nc).")],
-        out: Annotated[Path, typer.Option("--out", "-o", help="Figure (.png/.svg/.pdf).")] = Path(
-            "motion.png"
-        ),
-        overwrite: Overwrite = False,
-        reference: Annotated[
-            Path | None,
-            typer.Option("--overlay", help="File to overlay (ground truth, simulation) (.nc)."),
-        ] = None,
-    ) -> None:
-        """Plot the follower velocity and the journal's out-of-plane displacement."""
-        from jointwear import io
-        from jointwear.dic.footage._plot import plot_body_motion
-
-        ds = io.load(motion)
-        ref = io.load(reference) if reference is not None else None
-        plot_body_motion(ds, reference=ref, path=out)
-        typer.echo(f"plot -> {out}")
+    app.command("calibrate")(calibrate_cmd)
+    app.command("import-calibration")(import_calibration_cmd)
+    app.command("track")(track_cmd)
+    app.command("plot-track")(plot_track_cmd)

@@ -339,6 +339,47 @@ def _check(h, means, sems, quantity):
     return h_arr[order], m_arr[order], s_arr[order]
 
 
+def _error_estimate(h_arr, m_arr, s_fit, formal_order: float):
+    """Eça-Hoekstra fit and error estimate: (fit, order p, its sd, Fs, u_refinement, branch)."""
+    x = h_arr / h_arr[0]
+    weightings = _weightings(x, s_fit)
+    power = _best([_fit_power(x, m_arr, w, name) for name, w in weightings])
+    p = power.order
+    p_sd = _order_sd(power, x, m_arr, s_fit)
+    p_high = P_HIGH_FACTOR * formal_order
+    if P_LOW <= p < p_high:
+        fit, fs = power, FS_CREDIBLE
+        branch = f"p credible ({P_LOW:g} <= p < {p_high:.3g})"
+    else:
+        if p >= p_high:
+            models = [str(k) for k in (1, 2) if k <= max(1.0, formal_order)]
+            why = f"p >= {p_high:.3g}"
+        else:
+            models = ["1", "2", "12"]
+            why = f"p < {P_LOW:g}"
+        fit = _best([_fit_fixed(m, x, m_arr, w, n) for m in models for n, w in weightings])
+        fs = FS_OTHER
+        label = {"1": "order 1", "2": "order 2", "12": "orders 1 and 2"}[fit.model]
+        branch = f"{why}: fit with fixed {label}"
+    eps = abs(float(fit.fitted[0]) - fit.phi0)
+    resid1 = abs(float(m_arr[0] - fit.fitted[0]))
+    data_range = float(np.ptp(m_arr)) / (m_arr.size - 1)
+    if fit.std < data_range:
+        big_u = fs * eps + fit.std + resid1
+        branch += f": Fs = {fs:g}"
+    else:
+        fs = FS_OTHER
+        ratio = fit.std / data_range
+        big_u = fs * ratio * (eps + fit.std + resid1)
+        branch = (
+            f"scattered (U_s >= data range parameter): data range x 3 "
+            f"(U = 3 U_s/Δφ (ε + U_s + |φ1 - fit|), U_s/Δφ = {ratio:.3g}; fit: {branch})"
+        )
+    u_ref = big_u / COVERAGE_K
+    branch += f" [{fit.weighting}]"
+    return fit, p, p_sd, fs, u_ref, branch
+
+
 def eca_hoekstra(
     h: Sequence[float],
     means: Sequence[float],
@@ -459,49 +500,10 @@ def eca_hoekstra(
             m_arr,
             s_arr,
         )
-    if deterministic:
-        s_fit = None
-        u_stat = 0.0
-    else:
-        # a level whose replicates agree exactly carries no weight information: no weighting
-        s_fit = s_arr if np.all(s_arr > 0) else None
-        u_stat = float(s_arr[0])
-    x = h_arr / h_arr[0]
-    weightings = _weightings(x, s_fit)
-    power = _best([_fit_power(x, m_arr, w, name) for name, w in weightings])
-    p = power.order
-    p_sd = _order_sd(power, x, m_arr, s_fit)
-    p_high = P_HIGH_FACTOR * formal_order
-    if P_LOW <= p < p_high:
-        fit, fs = power, FS_CREDIBLE
-        branch = f"p credible ({P_LOW:g} <= p < {p_high:.3g})"
-    else:
-        if p >= p_high:
-            models = [str(k) for k in (1, 2) if k <= max(1.0, formal_order)]
-            why = f"p >= {p_high:.3g}"
-        else:
-            models = ["1", "2", "12"]
-            why = f"p < {P_LOW:g}"
-        fit = _best([_fit_fixed(m, x, m_arr, w, n) for m in models for n, w in weightings])
-        fs = FS_OTHER
-        label = {"1": "order 1", "2": "order 2", "12": "orders 1 and 2"}[fit.model]
-        branch = f"{why}: fit with fixed {label}"
-    eps = abs(float(fit.fitted[0]) - fit.phi0)
-    resid1 = abs(float(m_arr[0] - fit.fitted[0]))
-    data_range = float(np.ptp(m_arr)) / (m_arr.size - 1)
-    if fit.std < data_range:
-        big_u = fs * eps + fit.std + resid1
-        branch += f": Fs = {fs:g}"
-    else:
-        fs = FS_OTHER
-        ratio = fit.std / data_range
-        big_u = fs * ratio * (eps + fit.std + resid1)
-        branch = (
-            f"scattered (U_s >= data range parameter): data range x 3 "
-            f"(U = 3 U_s/Δφ (ε + U_s + |φ1 - fit|), U_s/Δφ = {ratio:.3g}; fit: {branch})"
-        )
-    u_ref = big_u / COVERAGE_K
-    branch += f" [{fit.weighting}]"
+    # a level whose replicates agree exactly carries no weight information: no weighting
+    s_fit = None if deterministic or not np.all(s_arr > 0) else s_arr
+    u_stat = 0.0 if deterministic else float(s_arr[0])
+    fit, p, p_sd, fs, u_ref, branch = _error_estimate(h_arr, m_arr, s_fit, formal_order)
     notes = [note] if note else []
     if deterministic:
         notes.append("deterministic solutions (no standard errors): u_stat = 0")

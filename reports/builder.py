@@ -358,8 +358,8 @@ def report_from_files(
     dic: Sequence[str | Path] = (),
     comparison: str | Path | None = None,
     verification: Sequence[str | Path] = (),
-    criteria: Criteria | None = None,
-    title: str = DEFAULT_TITLE,
+    criteria: Criteria | str | Path | None = None,
+    title: str | None = DEFAULT_TITLE,
     pdf: str | Path | None = None,
     command: str | None = None,
     cycles: float | None = None,
@@ -395,10 +395,10 @@ def report_from_files(
         Receives the warning text for a file from another tool (the CLI prints it on stderr);
         by default it is a :class:`UserWarning` (see
         :func:`jointwear.external.load_for_comparison`).
-    criteria : Criteria, optional
-        Validation criteria.
+    criteria : Criteria or path, optional
+        Validation criteria, or a TOML file of them (:func:`jointwear.compare.load_criteria`).
     title, pdf, command
-        See :func:`build_report`.
+        See :func:`build_report` (``title=None``: the default title).
     cycles, period_s : float, optional
         Passed to :func:`jointwear.compare.compare`.
     variables : sequence of str, optional
@@ -408,8 +408,12 @@ def report_from_files(
     -------
     (Path, Comparison)
     """
-    from jointwear.compare import as_ensemble, load_comparison
+    from jointwear.compare import as_ensemble, load_comparison, load_criteria
 
+    io.check_writable(out, what="report")
+    if not isinstance(criteria, Criteria):
+        criteria = load_criteria(criteria)
+    title = title or DEFAULT_TITLE
     inputs: list[ReportInput] = []
     missing: list[str] = []
     vers = [io.load(p, validate=False) for p in verification]

@@ -325,6 +325,40 @@ _STATUS = {
 }
 
 
+def _span(params: SimParameters, cycles: float, duration: float | None) -> tuple[float, float]:
+    """(cycles, duration [s]) of a run given in cycles or, with ``duration``, in seconds."""
+    period = params.mechanism.period
+    if duration is not None:
+        if not (duration > 0 and math.isfinite(duration)):
+            raise ParameterError(f"duration must be a positive number of seconds, got {duration!r}")
+        cycles = duration / period if math.isfinite(period) else 0.0
+    else:
+        if not (cycles > 0 and math.isfinite(cycles)):
+            raise ParameterError(f"cycles must be a positive number, got {cycles!r}")
+        if not math.isfinite(period):
+            raise ParameterError(
+                "mechanism.crank_speed_rpm is 0: a crank cycle has no duration; pass duration="
+            )
+        duration = cycles * period
+    return cycles, duration
+
+
+def _check_state(st: SimState, params: SimParameters) -> None:
+    """Refuse a state from another mechanism, contact model or number of layers."""
+    model = params.joint.model
+    if st.mechanism != _mechanism(params):
+        raise BadInputError(
+            f"state comes from a {st.mechanism} run; these parameters are a "
+            f"{_mechanism(params)}'s - pass state=None to start from the initial configuration"
+        )
+    if st.model != model or st.impact_velocity.shape != (params.joint.n_layers + 2,):
+        raise BadInputError(
+            f"state comes from a '{st.model}' run with {st.impact_velocity.shape[0] - 2} layers; "
+            f"these parameters need a '{model}' state with {params.joint.n_layers} layers - pass "
+            "state=None to start from the initial configuration"
+        )
+
+
 def run_cycles(
     params: SimParameters,
     *,
@@ -372,34 +406,12 @@ def run_cycles(
         Excessive penetration, step-size collapse or a non-finite state; the message names the
         time and crank angle, ``.partial`` holds the Dataset recorded so far.
     """
-    period = params.mechanism.period
-    if duration is not None:
-        if not (duration > 0 and math.isfinite(duration)):
-            raise ParameterError(f"duration must be a positive number of seconds, got {duration!r}")
-        cycles = duration / period if math.isfinite(period) else 0.0
-    else:
-        if not (cycles > 0 and math.isfinite(cycles)):
-            raise ParameterError(f"cycles must be a positive number, got {cycles!r}")
-        if not math.isfinite(period):
-            raise ParameterError(
-                "mechanism.crank_speed_rpm is 0: a crank cycle has no duration; pass duration="
-            )
-        duration = cycles * period
+    cycles, duration = _span(params, cycles, duration)
     h = _check_wear(params, wear_depth)
     P, IP = _pack(params)
     st = state if state is not None else initial_state(params)
     model = params.joint.model
-    if st.mechanism != _mechanism(params):
-        raise BadInputError(
-            f"state comes from a {st.mechanism} run; these parameters are a "
-            f"{_mechanism(params)}'s - pass state=None to start from the initial configuration"
-        )
-    if st.model != model or st.impact_velocity.shape != (params.joint.n_layers + 2,):
-        raise BadInputError(
-            f"state comes from a '{st.model}' run with {st.impact_velocity.shape[0] - 2} layers; "
-            f"these parameters need a '{model}' state with {params.joint.n_layers} layers - pass "
-            "state=None to start from the initial configuration"
-        )
+    _check_state(st, params)
     s = params.solver
     t0 = st.time
     t_end = t0 + duration

@@ -10,6 +10,7 @@ from typing import Literal
 import numpy as np
 
 from jointwear.dic.calibration._camera import Camera, StereoCalibration, _check_enough_views
+from jointwear.dic.calibration._defaults import MAX_RMS_PX, MAX_VIEW_RMS_PX, MIN_VIEWS
 from jointwear.errors import BadInputError, CalibrationError
 
 __all__ = ["CalibrationBoard", "calibrate_stereo", "detect_board", "board_world_frame"]
@@ -273,12 +274,12 @@ def calibrate_stereo(
     right_images: Sequence | Iterable,
     board: CalibrationBoard,
     *,
-    min_views: int = 6,
-    max_view_rms: float = 1.0,
+    min_views: int = MIN_VIEWS,
+    max_view_rms: float = MAX_VIEW_RMS_PX,
     fix_k3: bool = False,
     rational: bool = False,
     world_view: int | None = None,
-    max_rms: float = 1.0,
+    max_rms: float = MAX_RMS_PX,
     accept_poor: bool = False,
     view_names: Sequence[str] | None = None,
     progress: Callable[[int, int], None] | None = None,

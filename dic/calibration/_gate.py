@@ -12,6 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from jointwear.dic.calibration._camera import StereoCalibration
+from jointwear.dic.calibration._defaults import MAX_RMS_PX
 from jointwear.errors import EXIT_VALIDATION_FAILED, CalibrationError
 
 __all__ = ["PoorCalibration", "check_calibration", "view_table"]
@@ -46,7 +47,7 @@ class PoorCalibration(CalibrationError):
 def check_calibration(
     cal: StereoCalibration,
     *,
-    max_rms: float = 1.0,
+    max_rms: float = MAX_RMS_PX,
     board_distance: float | None = None,
 ) -> list[str]:
     """What is implausible about a stereo calibration (empty list: nothing found).

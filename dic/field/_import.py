@@ -130,6 +130,46 @@ def _files(files) -> list[Path]:
     return out
 
 
+def _field_variables(disp, sig, flag, unit: str, format: str, sig_c: str) -> dict:
+    """Displacement (uncertainty not assessed), the foreign sigma and the flag of an import."""
+    data = {
+        "displacement": xr.DataArray(
+            disp,
+            dims=("time", "point", "axis"),
+            attrs={
+                "units": unit,
+                "long_name": f"displacement from the reference image ({format})",
+                "ancillary_variables": "displacement_u flag",
+            },
+        ),
+        "displacement_u": xr.DataArray(
+            np.full_like(disp, np.nan),
+            dims=("time", "point", "axis"),
+            attrs={
+                "units": unit,
+                "long_name": "standard uncertainty of displacement: not assessed (the foreign "
+                "sigma is a matching confidence in pixels, see foreign_sigma)",
+            },
+        ),
+        "foreign_sigma": xr.DataArray(
+            np.where(sig >= 0, sig, np.nan),
+            dims=("time", "point"),
+            attrs={"units": "pixel", "long_name": f"{sig_c} column of the {format} files"},
+        ),
+        "flag": xr.DataArray(
+            flag,
+            dims=("time", "point"),
+            attrs={
+                "units": "1",
+                "long_name": "field quality flag (imported: ok or not_reached = no data)",
+                "flag_values": np.array([0, 6], np.int8),
+                "flag_meanings": "ok not_reached",
+            },
+        ),
+    }
+    return data
+
+
 def read_field(
     files,
     *,
@@ -211,41 +251,7 @@ def read_field(
     disp[missing] = np.nan
     axes = ["x", "y", "z"] if stereo else ["x", "y"]
     unit = "m" if stereo else "pixel"
-    data = {
-        "displacement": xr.DataArray(
-            disp,
-            dims=("time", "point", "axis"),
-            attrs={
-                "units": unit,
-                "long_name": f"displacement from the reference image ({format})",
-                "ancillary_variables": "displacement_u flag",
-            },
-        ),
-        "displacement_u": xr.DataArray(
-            np.full_like(disp, np.nan),
-            dims=("time", "point", "axis"),
-            attrs={
-                "units": unit,
-                "long_name": "standard uncertainty of displacement: not assessed (the foreign "
-                "sigma is a matching confidence in pixels, see foreign_sigma)",
-            },
-        ),
-        "foreign_sigma": xr.DataArray(
-            np.where(sig >= 0, sig, np.nan),
-            dims=("time", "point"),
-            attrs={"units": "pixel", "long_name": f"{sig_c} column of the {format} files"},
-        ),
-        "flag": xr.DataArray(
-            flag,
-            dims=("time", "point"),
-            attrs={
-                "units": "1",
-                "long_name": "field quality flag (imported: ok or not_reached = no data)",
-                "flag_values": np.array([0, 6], np.int8),
-                "flag_meanings": "ok not_reached",
-            },
-        ),
-    }
+    data = _field_variables(disp, sig, flag, unit, format, sig_c)
     if q_c and np.isfinite(qual).any():
         data["foreign_quality"] = xr.DataArray(
             qual, dims=("time", "point"), attrs={"units": "1", "long_name": f"{q_c} column"}

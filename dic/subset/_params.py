@@ -10,7 +10,22 @@ import numpy as np
 
 from jointwear.errors import BadInputError, ParameterError
 
-__all__ = ["CorrelationParams", "set_threads", "check_image", "check_pair"]
+__all__ = [
+    "CorrelationParams",
+    "MIN_STEP",
+    "MIN_SUBSET",
+    "UPDATE_ZNCC",
+    "set_threads",
+    "check_image",
+    "check_pair",
+]
+
+#: smallest subset side [pixel] (odd) and grid step [pixel] the correlation accepts
+MIN_SUBSET = 7
+MIN_STEP = 1
+
+#: default median ZNCC below which an incremental sequence moves its reference forward
+UPDATE_ZNCC = 0.9
 
 _SHAPES = {"affine": False, "first": False, "quadratic": True, "second": True}
 
@@ -64,13 +79,14 @@ class CorrelationParams:
 
     def __post_init__(self) -> None:
         s = self.subset_size
-        if isinstance(s, bool) or not isinstance(s, (int, np.integer)) or s < 7 or s % 2 == 0:
+        is_int = isinstance(s, (int, np.integer)) and not isinstance(s, bool)
+        if not is_int or s < MIN_SUBSET or s % 2 == 0:
             raise ParameterError(
-                f"subset_size={s!r}: expected an odd integer >= 7 (the subset is centred on "
-                f"its point); use {s + 1 if isinstance(s, (int, np.integer)) and s >= 6 else 31}"
+                f"subset_size={s!r}: expected an odd integer >= {MIN_SUBSET} (the subset is "
+                f"centred on its point); use {s + 1 if is_int and s >= MIN_SUBSET - 1 else 31}"
             )
-        if not isinstance(self.step, (int, np.integer)) or self.step < 1:
-            raise ParameterError(f"step={self.step!r}: expected an integer >= 1 pixel")
+        if not isinstance(self.step, (int, np.integer)) or self.step < MIN_STEP:
+            raise ParameterError(f"step={self.step!r}: expected an integer >= {MIN_STEP} pixel")
         if self.shape not in _SHAPES:
             raise ParameterError(
                 f"shape={self.shape!r}: expected 'affine' (first order) or 'quadratic' (second order)"

@@ -26,6 +26,7 @@ import numpy as np
 import xarray as xr
 
 from jointwear.dic.footage._video import check_frame_names  # noqa: F401 (re-exported)
+from jointwear.dic.subset._params import UPDATE_ZNCC
 from jointwear.errors import BadInputError, ParameterError
 
 __all__ = ["read_frames", "correlate_sequence"]
@@ -163,7 +164,7 @@ def correlate_sequence(
     roi: Sequence[float] | None = None,
     times: Sequence[float] | None = None,
     frame_rate: float | None = None,
-    update_zncc: float = 0.9,
+    update_zncc: float = UPDATE_ZNCC,
     update_every: int | None = None,
     progress: bool | None = False,
     seed_points: np.ndarray | None = None,

@@ -138,6 +138,47 @@ def _xy_about_origin(x: np.ndarray, y: np.ndarray, where: str) -> None:
         )
 
 
+def _check_layers(
+    out: list[_Layer],
+    pf: ParsedFile,
+    where: str,
+    pts,
+    *,
+    layered: bool,
+    full_turn: bool,
+    arc: str | None,
+    notes: dict[str, str],
+    limits: dict[str, float],
+    expected_points: int | None,
+) -> None:
+    """Check the layers cut from a file against its header claims and ``expected_points``
+    (points per layer, stated filter), noting what was checked in ``notes``."""
+    for k, lay in enumerate(out):
+        if lay.value.size < 4:
+            raise BadInputError(
+                f"{where}: layer {k + 1} has only {lay.value.size} point(s); a roundness trace "
+                "needs at least 4 (the file looks truncated - re-export it)"
+            )
+    if pts is not None and layered:
+        for lay in out:
+            check_points(pts, lay.value.size, {"deg": lay.theta_deg}, arc, True, where, limits)
+    filt = stated_filter(pf.metadata)
+    if filt is not None:
+        for lay in out:
+            if full_turn:
+                notes["filter"] = check_filter(lay.value, filt, where, limits)
+            else:
+                notes["filter"] = f"header {filt[0]} = {filt[1]!r} (partial arc: not checked)"
+    if expected_points is not None:
+        for k, lay in enumerate(out):
+            if lay.value.size != expected_points:
+                raise BadInputError(
+                    f"{where}: expected {expected_points} points in layer {k + 1}, found "
+                    f"{lay.value.size} - the file looks truncated or the layer is incomplete; "
+                    "re-export it or pass expected_points=None / allow_partial=True"
+                )
+
+
 def _layers_from_file(
     pf: ParsedFile,
     expected_points: int | None,
@@ -265,31 +306,18 @@ def _layers_from_file(
             out.append(make(np.arange(n), vc, None))
     else:
         out.append(make(np.arange(n), value_cols[0] if value_cols else None, None))
-    for k, lay in enumerate(out):
-        if lay.value.size < 4:
-            raise BadInputError(
-                f"{where}: layer {k + 1} has only {lay.value.size} point(s); a roundness trace "
-                "needs at least 4 (the file looks truncated - re-export it)"
-            )
-    if pts is not None and (zcols or layer_cols):
-        for lay in out:
-            check_points(pts, lay.value.size, {"deg": lay.theta_deg}, arc, True, where, limits)
-    filt = stated_filter(pf.metadata)
-    if filt is not None:
-        full = angle_cols == [] or notes.get("angle", "").endswith("full turn")
-        for lay in out:
-            if full:
-                notes["filter"] = check_filter(lay.value, filt, where, limits)
-            else:
-                notes["filter"] = f"header {filt[0]} = {filt[1]!r} (partial arc: not checked)"
-    if expected_points is not None:
-        for k, lay in enumerate(out):
-            if lay.value.size != expected_points:
-                raise BadInputError(
-                    f"{where}: expected {expected_points} points in layer {k + 1}, found "
-                    f"{lay.value.size} - the file looks truncated or the layer is incomplete; "
-                    "re-export it or pass expected_points=None / allow_partial=True"
-                )
+    _check_layers(
+        out,
+        pf,
+        where,
+        pts,
+        layered=bool(zcols or layer_cols),
+        full_turn=angle_cols == [] or notes.get("angle", "").endswith("full turn"),
+        arc=arc,
+        notes=notes,
+        limits=limits,
+        expected_points=expected_points,
+    )
     return out
 
 

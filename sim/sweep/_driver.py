@@ -304,6 +304,125 @@ def _quietly(fn: Callable[[], Any]) -> tuple[Any, list[str]]:
     return out, sorted({str(w.message).strip() for w in caught})
 
 
+def _sobol_indices(ds, spec: SweepSpec, problem, not_assessed: dict, notes: list) -> None:
+    """Add the Sobol indices of every output to ``ds`` (NaN, and named in ``not_assessed``,
+    for an output with failed runs or in degrees)."""
+    names = problem["names"]
+    from SALib.analyze import sobol
+
+    keys = ("S1", "S1_conf", "ST", "ST_conf")
+    table = {k: np.full((len(spec.outputs), len(names)), np.nan) for k in keys}
+    keys2 = ("S2", "S2_conf") if spec.second_order else ()
+    table.update({k: np.full((len(spec.outputs), len(names), len(names)), np.nan) for k in keys2})
+    for i, out in enumerate(spec.outputs):
+        y = np.asarray(ds[out].values, dtype=float)
+        if ds[out].attrs.get("units") == ANGLE_UNITS:
+            not_assessed[out] = _ANGLE_REFUSED
+            continue
+        if not np.all(np.isfinite(y)):
+            not_assessed[out] = f"{int(np.sum(~np.isfinite(y)))} run(s) failed or not run"
+            continue
+        res, caught = _quietly(
+            lambda y=y: sobol.analyze(
+                problem,
+                y,
+                calc_second_order=spec.second_order,
+                num_resamples=spec.resamples,
+                conf_level=spec.confidence,
+                seed=spec.seed,
+            )
+        )
+        notes += [f"{out}: {c}" for c in caught]
+        for k in keys + keys2:
+            table[k][i] = np.asarray(res[k], dtype=float)
+    long = {
+        "S1": "first-order Sobol index",
+        "ST": "total-effect Sobol index",
+        "S2": "second-order Sobol index of the pair (parameter, parameter_2)",
+    }
+    for k in keys2:
+        attrs = {"units": "1", "long_name": long["S2"]}
+        if k.endswith("_conf"):
+            attrs["long_name"] = (
+                f"half-width of the {100 * spec.confidence:g} % bootstrap confidence interval "
+                "of the second-order Sobol index"
+            )
+        ds[f"sobol_{k}"] = xr.Variable(("output", "parameter", "parameter_2"), table[k], attrs)
+    for k in keys:
+        base = k.split("_")[0]
+        attrs = {"units": "1", "long_name": long[base]}
+        if k.endswith("_conf"):
+            attrs["long_name"] = (
+                f"half-width of the {100 * spec.confidence:g} % bootstrap confidence interval "
+                f"of the {long[base]}"
+            )
+        else:
+            attrs["ancillary_variables"] = f"sobol_{k}_conf"
+        ds[f"sobol_{k}"] = xr.Variable(("output", "parameter"), table[k], attrs)
+    ds.attrs["sensitivity_method"] = (
+        f"SALib sobol.analyze (Saltelli 2002 / Jansen estimators), N = {spec.samples}, "
+        f"{spec.resamples} bootstrap resamples"
+    )
+
+
+def _morris_measures(
+    ds, spec: SweepSpec, design: Design, problem, not_assessed: dict, notes: list
+) -> None:
+    """Add the Morris measures of every output to ``ds`` (as :func:`_sobol_indices`)."""
+    names = problem["names"]
+    from SALib.analyze import morris
+
+    for out in spec.outputs:
+        y = np.asarray(ds[out].values, dtype=float)
+        units = ds[out].attrs["units"]
+        angle = units == ANGLE_UNITS
+        if angle or not np.all(np.isfinite(y)):
+            not_assessed[out] = (
+                _ANGLE_REFUSED
+                if angle
+                else f"{int(np.sum(~np.isfinite(y)))} run(s) failed or not run"
+            )
+            res = {
+                k: np.full(len(names), np.nan) for k in ("mu", "mu_star", "sigma", "mu_star_conf")
+            }
+        else:
+            res, caught = _quietly(
+                lambda y=y: morris.analyze(
+                    problem,
+                    design.unit,
+                    y,
+                    num_resamples=spec.resamples,
+                    conf_level=spec.confidence,
+                    num_levels=spec.levels,
+                    seed=spec.seed,
+                )
+            )
+            notes += [f"{out}: {c}" for c in caught]
+        for k, long in (
+            ("mu_star", "Morris mu*: mean absolute elementary effect"),
+            (
+                "mu_star_conf",
+                f"half-width of the {100 * spec.confidence:g} % bootstrap "
+                "confidence interval of Morris mu*",
+            ),
+            ("sigma", "Morris sigma: standard deviation of the elementary effects"),
+            ("mu", "Morris mu: mean elementary effect"),
+        ):
+            ds[f"{out}_morris_{k}"] = xr.Variable(
+                "parameter",
+                np.asarray(res[k], dtype=float),
+                {
+                    "units": units,
+                    "long_name": f"{long} of {out}",
+                    "comment": "elementary effects per unit of the parameter's range "
+                    "(unit hypercube)",
+                },
+            )
+    ds.attrs["sensitivity_method"] = (
+        f"SALib morris.analyze, {spec.samples} trajectories, {spec.levels} levels"
+    )
+
+
 def sensitivity(ds: xr.Dataset, spec: SweepSpec, design: Design) -> xr.Dataset:
     """Add SALib's Sobol indices (``method = "sobol"``) or Morris measures (``"morris"``).
 
@@ -321,116 +440,9 @@ def sensitivity(ds: xr.Dataset, spec: SweepSpec, design: Design) -> xr.Dataset:
     not_assessed: dict[str, str] = {}
     notes: list[str] = []
     if spec.method == "sobol":
-        from SALib.analyze import sobol
-
-        keys = ("S1", "S1_conf", "ST", "ST_conf")
-        table = {k: np.full((len(spec.outputs), len(names)), np.nan) for k in keys}
-        keys2 = ("S2", "S2_conf") if spec.second_order else ()
-        table.update(
-            {k: np.full((len(spec.outputs), len(names), len(names)), np.nan) for k in keys2}
-        )
-        for i, out in enumerate(spec.outputs):
-            y = np.asarray(ds[out].values, dtype=float)
-            if ds[out].attrs.get("units") == ANGLE_UNITS:
-                not_assessed[out] = _ANGLE_REFUSED
-                continue
-            if not np.all(np.isfinite(y)):
-                not_assessed[out] = f"{int(np.sum(~np.isfinite(y)))} run(s) failed or not run"
-                continue
-            res, caught = _quietly(
-                lambda y=y: sobol.analyze(
-                    problem,
-                    y,
-                    calc_second_order=spec.second_order,
-                    num_resamples=spec.resamples,
-                    conf_level=spec.confidence,
-                    seed=spec.seed,
-                )
-            )
-            notes += [f"{out}: {c}" for c in caught]
-            for k in keys + keys2:
-                table[k][i] = np.asarray(res[k], dtype=float)
-        long = {
-            "S1": "first-order Sobol index",
-            "ST": "total-effect Sobol index",
-            "S2": "second-order Sobol index of the pair (parameter, parameter_2)",
-        }
-        for k in keys2:
-            attrs = {"units": "1", "long_name": long["S2"]}
-            if k.endswith("_conf"):
-                attrs["long_name"] = (
-                    f"half-width of the {100 * spec.confidence:g} % bootstrap confidence interval "
-                    "of the second-order Sobol index"
-                )
-            ds[f"sobol_{k}"] = xr.Variable(("output", "parameter", "parameter_2"), table[k], attrs)
-        for k in keys:
-            base = k.split("_")[0]
-            attrs = {"units": "1", "long_name": long[base]}
-            if k.endswith("_conf"):
-                attrs["long_name"] = (
-                    f"half-width of the {100 * spec.confidence:g} % bootstrap confidence interval "
-                    f"of the {long[base]}"
-                )
-            else:
-                attrs["ancillary_variables"] = f"sobol_{k}_conf"
-            ds[f"sobol_{k}"] = xr.Variable(("output", "parameter"), table[k], attrs)
-        ds.attrs["sensitivity_method"] = (
-            f"SALib sobol.analyze (Saltelli 2002 / Jansen estimators), N = {spec.samples}, "
-            f"{spec.resamples} bootstrap resamples"
-        )
+        _sobol_indices(ds, spec, problem, not_assessed, notes)
     else:
-        from SALib.analyze import morris
-
-        for out in spec.outputs:
-            y = np.asarray(ds[out].values, dtype=float)
-            units = ds[out].attrs["units"]
-            angle = units == ANGLE_UNITS
-            if angle or not np.all(np.isfinite(y)):
-                not_assessed[out] = (
-                    _ANGLE_REFUSED
-                    if angle
-                    else f"{int(np.sum(~np.isfinite(y)))} run(s) failed or not run"
-                )
-                res = {
-                    k: np.full(len(names), np.nan)
-                    for k in ("mu", "mu_star", "sigma", "mu_star_conf")
-                }
-            else:
-                res, caught = _quietly(
-                    lambda y=y: morris.analyze(
-                        problem,
-                        design.unit,
-                        y,
-                        num_resamples=spec.resamples,
-                        conf_level=spec.confidence,
-                        num_levels=spec.levels,
-                        seed=spec.seed,
-                    )
-                )
-                notes += [f"{out}: {c}" for c in caught]
-            for k, long in (
-                ("mu_star", "Morris mu*: mean absolute elementary effect"),
-                (
-                    "mu_star_conf",
-                    f"half-width of the {100 * spec.confidence:g} % bootstrap "
-                    "confidence interval of Morris mu*",
-                ),
-                ("sigma", "Morris sigma: standard deviation of the elementary effects"),
-                ("mu", "Morris mu: mean elementary effect"),
-            ):
-                ds[f"{out}_morris_{k}"] = xr.Variable(
-                    "parameter",
-                    np.asarray(res[k], dtype=float),
-                    {
-                        "units": units,
-                        "long_name": f"{long} of {out}",
-                        "comment": "elementary effects per unit of the parameter's range "
-                        "(unit hypercube)",
-                    },
-                )
-        ds.attrs["sensitivity_method"] = (
-            f"SALib morris.analyze, {spec.samples} trajectories, {spec.levels} levels"
-        )
+        _morris_measures(ds, spec, design, problem, not_assessed, notes)
     ds = ds.assign_coords(
         parameter=xr.Variable("parameter", np.array(names), {"long_name": "swept parameter"})
     )

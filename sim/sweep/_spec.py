@@ -187,30 +187,8 @@ def check_stackable_maps(keep: Sequence[str], names: Sequence[str]) -> None:
         )
 
 
-def read_spec(spec: str | Path | Mapping[str, Any]) -> SweepSpec:
-    """Parse a sweep spec from a TOML file or an already-read mapping.
-
-    Checks everything that does not need the simulator's parameters: keys, run kind, method,
-    sample sizes, outputs, fields, and that grid axes and distributions fit the method.
-    :func:`jointwear.sim.sweep.run_sweep` then checks the parameter names against the simulator.
-
-    Raises
-    ------
-    ParameterError
-        The message names the table/key and says what fixes it.
-    """
-    if not isinstance(spec, Mapping):
-        from jointwear.params import read_toml
-
-        where_file = f"sweep spec '{spec}': "
-        try:
-            data = read_toml(spec)
-        except ParameterError:
-            raise
-        try:
-            return read_spec(data)
-        except ParameterError as exc:
-            raise ParameterError(where_file + str(exc)) from None
+def _check_tables(spec: Mapping[str, Any]):
+    """The [sweep] table, run kind, method and [parameters] table of a spec mapping."""
     data = dict(spec)
     unknown = sorted(set(data) - {"sweep", "parameters"})
     if unknown:
@@ -245,8 +223,11 @@ def read_spec(spec: str | Path | Mapping[str, Any]) -> SweepSpec:
             'the spec sweeps no parameter: add [parameters."<dotted name>"] tables, e.g. '
             '[parameters."wear.kw"] with distribution = "lognormal", mean = 9e-16, std = 3e-16'
         )
-    parameters = tuple(parse_parameter(str(k), v) for k, v in params_tbl.items())
+    return sw, run, method, params_tbl
 
+
+def _function_model(sw, run: str, parameters, params_tbl):
+    """The model and its arguments of a ``run = "function"`` sweep (None, {} otherwise)."""
     model = None
     function_args: dict[str, Any] = {}
     if run == "function":
@@ -275,7 +256,11 @@ def read_spec(spec: str | Path | Mapping[str, Any]) -> SweepSpec:
         raise ParameterError(
             f'[sweep] function/function_args only apply to run = "function", not {run!r}'
         )
+    return model, function_args
 
+
+def _cycles(sw, run: str) -> tuple[Any, Any, Any]:
+    """cycles, settle_cycles and max_cycles_simulated of [sweep], checked."""
     cycles = sw.get("cycles", 1.0 if run != "function" else 0.0)
     if run != "function":
         if (
@@ -297,7 +282,11 @@ def read_spec(spec: str | Path | Mapping[str, Any]) -> SweepSpec:
         raise ParameterError(f"[sweep] max_cycles_simulated must be > 0, got {budget!r}")
     if "max_cycles_simulated" in sw and run != "wear":
         raise ParameterError('[sweep] max_cycles_simulated applies to run = "wear" only')
+    return cycles, settle, budget
 
+
+def _outputs_and_fields(sw, run: str, model, parameters):
+    """The outputs and the kept fields of [sweep], checked against the run kind."""
     avail = available_outputs(run, model)
     outputs = (
         _names(sw["outputs"], "[sweep] outputs")
@@ -326,7 +315,11 @@ def read_spec(spec: str | Path | Mapping[str, Any]) -> SweepSpec:
                 f"{', '.join(allowed) or 'none'}"
             )
     check_stackable_maps(keep, [p.name for p in parameters])
+    return outputs, keep
 
+
+def _sampling_options(sw):
+    """seed, levels, resamples, confidence and second_order of [sweep], checked."""
     seed = _int(sw.get("seed", 0), "[sweep] seed", 0)
     levels = _int(sw.get("levels", 4), "[sweep] levels", 2)
     resamples = _int(sw.get("resamples", 100), "[sweep] resamples", 10)
@@ -336,7 +329,11 @@ def read_spec(spec: str | Path | Mapping[str, Any]) -> SweepSpec:
     second = sw.get("second_order", False)
     if not isinstance(second, bool):
         raise ParameterError(f"[sweep] second_order must be true or false, got {second!r}")
+    return seed, levels, resamples, confidence, second
 
+
+def _samples(sw, method: str, parameters) -> int | None:
+    """The base sample size (None for a grid), checked against the method and parameters."""
     grid = [p for p in parameters if p.is_grid]
     rand = [p for p in parameters if not p.is_grid]
     samples = None
@@ -380,6 +377,40 @@ def read_spec(spec: str | Path | Mapping[str, Any]) -> SweepSpec:
                     f"range; a {unbounded[0].distribution} distribution has none (use uniform or "
                     "truncnormal with bounds)"
                 )
+    return samples
+
+
+def read_spec(spec: str | Path | Mapping[str, Any]) -> SweepSpec:
+    """Parse a sweep spec from a TOML file or an already-read mapping.
+
+    Checks everything that does not need the simulator's parameters: keys, run kind, method,
+    sample sizes, outputs, fields, and that grid axes and distributions fit the method.
+    :func:`jointwear.sim.sweep.run_sweep` then checks the parameter names against the simulator.
+
+    Raises
+    ------
+    ParameterError
+        The message names the table/key and says what fixes it.
+    """
+    if not isinstance(spec, Mapping):
+        from jointwear.params import read_toml
+
+        where_file = f"sweep spec '{spec}': "
+        try:
+            data = read_toml(spec)
+        except ParameterError:
+            raise
+        try:
+            return read_spec(data)
+        except ParameterError as exc:
+            raise ParameterError(where_file + str(exc)) from None
+    sw, run, method, params_tbl = _check_tables(spec)
+    parameters = tuple(parse_parameter(str(k), v) for k, v in params_tbl.items())
+    model, function_args = _function_model(sw, run, parameters, params_tbl)
+    cycles, settle, budget = _cycles(sw, run)
+    outputs, keep = _outputs_and_fields(sw, run, model, parameters)
+    seed, levels, resamples, confidence, second = _sampling_options(sw)
+    samples = _samples(sw, method, parameters)
     return SweepSpec(
         run=run,
         method=method,

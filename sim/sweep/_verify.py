@@ -405,6 +405,71 @@ def _grid_coords(sim: Any, suffix: str = "") -> dict[str, xr.DataArray]:
     }
 
 
+def _study_coords(spec, qnames: list[str], values: np.ndarray) -> dict[str, xr.Variable]:
+    """Coordinates of a study: ΔN levels (h), replicates, grid replicates, quantities."""
+    nlev, nrep, ng = len(spec.levels), spec.replicates, spec.grid_replicates
+    return {
+        "level": xr.Variable("level", np.arange(nlev), {"units": "1", "long_name": "ΔN level"}),
+        "h": xr.Variable(
+            "level",
+            np.asarray(spec.levels, dtype=float),
+            {
+                "units": "1",
+                "long_name": "refinement parameter h: wear-update interval ΔN [crank cycles] "
+                "(wear.dn, fixed update scheme)",
+                "refinement_parameter": "wear.dn",
+            },
+        ),
+        "replicate": xr.Variable(
+            "replicate",
+            np.arange(nrep),
+            {
+                "units": "1",
+                "long_name": "replicate: run started at another phase of the motion",
+            },
+        ),
+        "grid_replicate": xr.Variable(
+            "grid_replicate",
+            np.arange(ng),
+            {"units": "1", "long_name": "replicate on the next grid (finest ΔN)"},
+        ),
+        "quantity": xr.Variable(
+            "quantity", np.array(qnames), {"units": "1", "long_name": "studied quantity"}
+        ),
+        "initial_settle_cycles": xr.Variable(
+            "replicate",
+            values[:nrep, 1],
+            {"units": "1", "long_name": "cycles discarded before the first measurement"},
+        ),
+    }
+
+
+def _add_quantity_info(ds: xr.Dataset, qnames: list[str], units: dict, coords: dict) -> None:
+    """Units, meaning, period and resolution of each studied quantity (in place)."""
+    ds["quantity_units"] = ("quantity", np.array([units[q][0] for q in qnames], dtype=object))
+    ds["quantity_units"].attrs = {"units": "1", "long_name": "units of each quantity"}
+    ds["quantity_long_name"] = ("quantity", np.array([units[q][1] for q in qnames], dtype=object))
+    ds["quantity_long_name"].attrs = {"units": "1", "long_name": "meaning of each quantity"}
+    ds["quantity_period"] = (
+        "quantity",
+        np.array([QUANTITIES.get(q) or np.nan for q in qnames]),
+        {"units": "1", "long_name": "period of a circular quantity (NaN: not circular)"},
+    )
+    step = {
+        "max_wear_theta": 360.0 / coords["theta"].size,
+        "max_wear_z": float(np.max(np.diff(coords["z"].values))) if coords["z"].size > 1 else 0.0,
+    }
+    ds["quantity_resolution"] = (
+        "quantity",
+        np.array([step.get(q, np.nan) for q in qnames]),
+        {
+            "units": "1",
+            "long_name": "step of a quantised quantity (a location on the wear grid; NaN: "
+            "continuous), units: quantity_units",
+        },
+    )
+
+
 def study_dataset(
     spec: VerifySpec,
     sim: Any,
@@ -486,42 +551,7 @@ def study_dataset(
             gv[:, rep] = out
             if depth is not None:
                 gmaps[rep] = depth
-    coords.update(
-        {
-            "level": xr.Variable("level", np.arange(nlev), {"units": "1", "long_name": "ΔN level"}),
-            "h": xr.Variable(
-                "level",
-                np.asarray(spec.levels, dtype=float),
-                {
-                    "units": "1",
-                    "long_name": "refinement parameter h: wear-update interval ΔN [crank cycles] "
-                    "(wear.dn, fixed update scheme)",
-                    "refinement_parameter": "wear.dn",
-                },
-            ),
-            "replicate": xr.Variable(
-                "replicate",
-                np.arange(nrep),
-                {
-                    "units": "1",
-                    "long_name": "replicate: run started at another phase of the motion",
-                },
-            ),
-            "grid_replicate": xr.Variable(
-                "grid_replicate",
-                np.arange(ng),
-                {"units": "1", "long_name": "replicate on the next grid (finest ΔN)"},
-            ),
-            "quantity": xr.Variable(
-                "quantity", np.array(qnames), {"units": "1", "long_name": "studied quantity"}
-            ),
-            "initial_settle_cycles": xr.Variable(
-                "replicate",
-                values[:nrep, 1],
-                {"units": "1", "long_name": "cycles discarded before the first measurement"},
-            ),
-        }
-    )
+    coords.update(_study_coords(spec, qnames, values))
     ds = xr.Dataset(coords=coords)
     ds["replicate_value"] = (
         ("quantity", "level", "replicate"),
@@ -533,28 +563,7 @@ def study_dataset(
         gv,
         {"units": "1", "long_name": "value of each run on the next grid (units: quantity_units)"},
     )
-    ds["quantity_units"] = ("quantity", np.array([units[q][0] for q in qnames], dtype=object))
-    ds["quantity_units"].attrs = {"units": "1", "long_name": "units of each quantity"}
-    ds["quantity_long_name"] = ("quantity", np.array([units[q][1] for q in qnames], dtype=object))
-    ds["quantity_long_name"].attrs = {"units": "1", "long_name": "meaning of each quantity"}
-    ds["quantity_period"] = (
-        "quantity",
-        np.array([QUANTITIES.get(q) or np.nan for q in qnames]),
-        {"units": "1", "long_name": "period of a circular quantity (NaN: not circular)"},
-    )
-    step = {
-        "max_wear_theta": 360.0 / coords["theta"].size,
-        "max_wear_z": float(np.max(np.diff(coords["z"].values))) if coords["z"].size > 1 else 0.0,
-    }
-    ds["quantity_resolution"] = (
-        "quantity",
-        np.array([step.get(q, np.nan) for q in qnames]),
-        {
-            "units": "1",
-            "long_name": "step of a quantised quantity (a location on the wear grid; NaN: "
-            "continuous), units: quantity_units",
-        },
-    )
+    _add_quantity_info(ds, qnames, units, coords)
     ds["wear_depth_run"] = (
         ("level", "replicate", "z", "theta"),
         maps,

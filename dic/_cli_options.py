@@ -1,0 +1,62 @@
+"""Options shared by the ``jointwear dic`` commands, declared once; their defaults are the
+library's (:class:`jointwear.dic.CorrelationParams`), so the CLI and the library agree."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from jointwear.dic.subset._params import MIN_STEP, MIN_SUBSET, CorrelationParams
+
+__all__ = [
+    "AllowEmptyOpt",
+    "DEFAULTS",
+    "FpsOpt",
+    "OriginOpt",
+    "OutOpt",
+    "PointsOpt",
+    "SearchRadiusOpt",
+    "StepOpt",
+    "SubsetOpt",
+    "ThreadsOpt",
+    "ZnccMinOpt",
+]
+
+#: the library's correlation defaults (the options below show them)
+DEFAULTS = CorrelationParams()
+
+# the limits are the library's (a value below them is a usage error naming the flag; an even
+# subset is refused by CorrelationParams with the odd size to use)
+SubsetOpt = Annotated[
+    int, typer.Option("--subset", min=MIN_SUBSET, help="Subset size (pixels), odd.")
+]
+StepOpt = Annotated[int, typer.Option("--step", min=MIN_STEP, help="Grid step (pixels).")]
+ZnccMinOpt = Annotated[float, typer.Option("--zncc-min", help="Flag matches below this ZNCC.")]
+SearchRadiusOpt = Annotated[
+    int, typer.Option("--search-radius", help="Seed search half-width (pixels).")
+]
+ThreadsOpt = Annotated[int, typer.Option("--threads", min=0, help="numba threads (0: auto).")]
+OutOpt = Annotated[Path, typer.Option("--out", help="Output netCDF file.")]
+PointsOpt = Annotated[
+    Path | None,
+    typer.Option(
+        "--points",
+        help="Text file of subset centres 'x, y' (pixels, reference image, one per line) "
+        "instead of a grid over --roi.",
+    ),
+]
+AllowEmptyOpt = Annotated[
+    bool,
+    typer.Option(
+        "--allow-empty",
+        help="Exit 0 even when an image has no valid point (otherwise exit 1).",
+    ),
+]
+OriginOpt = Annotated[
+    str, typer.Option("--origin", help="What the images are: measured or synthetic.")
+]
+FpsOpt = Annotated[
+    float | None, typer.Option("--fps", help="Frames per second (omit for still images).")
+]
