@@ -642,6 +642,7 @@ def wear_map(
                 )
                 other = sel.reshape(rw.shape)
                 _model_order_term(q, other, wts, z, th, "unworn selection")
+                _tail_correction(q, float(np.sum(wts * np.nan_to_num(other))))
                 u = np.hypot(u, wear - other)
             except BadInputError:
                 pass
@@ -942,6 +943,23 @@ def _model_order_term(q: dict, other: np.ndarray, wts: np.ndarray, z, th, what: 
         dv = abs(alt[name][0] - v)
         if np.isfinite(dv):
             q[name] = (v, float(np.hypot(u, dv)), comment + f"; {what} ({dv:.3g})")
+
+
+def _tail_correction(q: dict, v_narrow: float) -> None:
+    """Correct the worn volume for wear below the noise left among the unworn points.
+
+    Faint tails of the worn region pull the reference up, so the volume reads low. Refitting
+    without a further 10 degree band next to the worn region raises it by dv (> 0 for a tail;
+    wear only removes material, so dv < 0 is noise and left alone). The tail beyond that band,
+    for a decay (Gaussian, exponential) whose length is about the band, holds about as much
+    again: the volume is raised by 2 dv, and dv (the part beyond, 100 %) stays in its u.
+    Measured over 23 mapped Gaussian grooves 8-45 degree wide (``wearmap_form.json``,
+    ``before_*``) and the power study's simulated map (``validation_power.json``).
+    """
+    v, u, comment = q["worn_volume"]
+    dv = v_narrow - v
+    if np.isfinite(dv) and dv > 0:
+        q["worn_volume"] = (v + 2.0 * dv, u, comment + f"; faint-tail correction +{2 * dv:.3g}")
 
 
 def _lower_quantile_start(X, d: np.ndarray, finite: np.ndarray, threshold: float, tau=0.25):
