@@ -642,8 +642,13 @@ def wear_map(
                 )
                 other = sel.reshape(rw.shape)
                 _model_order_term(q, other, wts, z, th, "unworn selection")
-                _tail_correction(q, float(np.sum(wts * np.nan_to_num(other))))
                 u = np.hypot(u, wear - other)
+                added = _tail_correction(q, float(np.sum(wts * np.nan_to_num(other))))
+                if added > 0:  # the map too, as a uniform depth: its volume is the corrected one
+                    c = added / float(np.sum(wts[np.isfinite(wear)]))
+                    wear = wear + c
+                    v, uu, cm = q["max_wear_depth"]
+                    q["max_wear_depth"] = (v + c, uu, cm)
             except BadInputError:
                 pass
     noise = noise_sigma(wear)  # successive differences of the residual: the probe noise
@@ -945,7 +950,7 @@ def _model_order_term(q: dict, other: np.ndarray, wts: np.ndarray, z, th, what: 
             q[name] = (v, float(np.hypot(u, dv)), comment + f"; {what} ({dv:.3g})")
 
 
-def _tail_correction(q: dict, v_narrow: float) -> None:
+def _tail_correction(q: dict, v_narrow: float) -> float:
     """Correct the worn volume for wear below the noise left among the unworn points.
 
     Faint tails of the worn region pull the reference up, so the volume reads low. Refitting
@@ -954,12 +959,15 @@ def _tail_correction(q: dict, v_narrow: float) -> None:
     for a decay (Gaussian, exponential) whose length is about the band, holds about as much
     again: the volume is raised by 2 dv, and dv (the part beyond, 100 %) stays in its u.
     Measured over 23 mapped Gaussian grooves 8-45 degree wide (``wearmap_form.json``,
-    ``before_*``) and the power study's simulated map (``validation_power.json``).
+    ``before_*``) and the power study's simulated map (``validation_power.json``). Returns the
+    volume added [m^3] (0: none).
     """
     v, u, comment = q["worn_volume"]
     dv = v_narrow - v
     if np.isfinite(dv) and dv > 0:
         q["worn_volume"] = (v + 2.0 * dv, u, comment + f"; faint-tail correction +{2 * dv:.3g}")
+        return 2.0 * dv
+    return 0.0
 
 
 def _lower_quantile_start(X, d: np.ndarray, finite: np.ndarray, threshold: float, tau=0.25):
