@@ -216,7 +216,6 @@ def _robust_reference(
     smooth_deg: float = 2.0,
     start: np.ndarray | None = None,
     one_sided: bool = True,
-    symmetric_noise: bool = False,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, float, int]:
     """Fit X b ~ d on the unworn points (found iteratively unless given).
 
@@ -224,16 +223,6 @@ def _robust_reference(
     the median, and it is not within ``margin_deg`` of a worn region (where the residual
     smoothed over ``smooth_deg`` exceeds ``threshold`` robust deviations of the smoothed
     residual) -- so the faint tails of a worn patch do not bias the reference.
-
-    ``one_sided``: wear only removes material, so only a high residual is taken as wear (low
-    ones down to twice the threshold are kept); without ``unworn`` and for a limaçon basis the
-    first unworn set comes from a lower-quantile fit, which a broad groove hardly pulls.
-    ``symmetric_noise`` (the lower-quantile start is kept): the iteration rejects points and
-    smoothed regions symmetrically about the noise centre. A one-sided cut drops only the high
-    tail of the noise, so the points kept read low on average and every depth, hence the
-    volume, reads high (0.0044 sigma per point at 3 sigma, plus the high smoothed windows:
-    0.25 nm over the whole bore, 2-4 % of the volume and 1-3.5 u of it, on the power study's
-    13 x 18000 scans with a before-scan).
     """
     finite = np.isfinite(d)
     mask = finite.copy() if unworn is None else (finite & unworn)
@@ -267,7 +256,7 @@ def _robust_reference(
         med = np.median(rm)
         # floor: 10 pm, far below any instrument's resolution (noise-free synthetic data)
         scale = max(1.4826 * np.median(np.abs(rm - med)), _SCALE_FLOOR)
-        if one_sided and not symmetric_noise:  # only a high residual can be wear
+        if one_sided:  # wear removes material: only a high residual can be wear
             new = finite & (resid - med <= threshold * scale)
             new &= resid - med >= -2.0 * threshold * scale  # dents and spikes
         else:
@@ -277,7 +266,7 @@ def _robust_reference(
             smm = sm.ravel()[mask]
             smed = np.nanmedian(smm)
             sscale = max(1.4826 * np.nanmedian(np.abs(smm - smed)), _SCALE_FLOOR)
-            high = (sm - smed) if one_sided and not symmetric_noise else np.abs(sm - smed)
+            high = (sm - smed) if one_sided else np.abs(sm - smed)
             region = ~(high > threshold * sscale)
             region = _dilate(region, theta_deg, margin_deg)
             new &= region.ravel()
@@ -527,7 +516,6 @@ def wear_map(
                     rw.shape,
                     th,
                     margin_deg,
-                    symmetric_noise=True,
                 )
                 done = abs(new_off - offset) < 1e-3
                 offset = new_off
@@ -557,17 +545,7 @@ def wear_map(
             "scan (no before-wear scan)"
         )
     X, fit, alt = _reference(
-        d,
-        X,
-        shape,
-        z,
-        th,
-        harmonics,
-        threshold,
-        mask_in,
-        max_iter,
-        margin_deg,
-        rbz is not None,
+        d, X, shape, z, th, harmonics, threshold, mask_in, max_iter, margin_deg
     )
     resid, mask, var_fit, s2, n_iter = fit
     # exact centring: the limaçon leaves each scan's e^2/(4R) second harmonic, which differs
@@ -582,33 +560,21 @@ def wear_map(
             "form model: its second harmonic, quadratic in z, holds the limaçon's e^2/(4R) term"
         )
     elif r0_w is not None and not isinstance(X, FormBasis):
+        rw_c = _recentre(rw + r0_w, z, th, mask)
         if rbz is not None:
             r0_b = 0.0 if bname == "radius" else (radius or _attr_radius(before, b) or r0_w)
-            rb_abs = _rotate(th, thb, rbz, offset) + r0_b
-            ok = np.isfinite(d)
-            # the before scan's axis from the whole circle (the form is orthogonal to it); the
-            # worn scan's = that plus the change of set-up fitted to the difference on the
-            # unworn points, where the form cancels. Fitted to the worn scan's unworn arc alone,
-            # the form shifts the axis by delta, and delta x eccentricity / R reads as a
-            # constant over the bore (0.1-0.6 nm: 1-6 u of the volume on 13 x 18000 points)
-            axis_b = _axis(rb_abs, z, th, ok)
-            axis_w = axis_b + _axis(rw + r0_w - rb_abs, z, th, mask & ok)
-            rw_c = _recentre(rw + r0_w, z, th, axis_w)
-            d = sign * (rw_c - _recentre(rb_abs, z, th, axis_b)).ravel()
+            rb_c = _recentre(_rotate(th, thb, rbz, offset) + r0_b, z, th, np.isfinite(d))
+            d = sign * (rw_c - rb_c).ravel()
         else:
-            rw_c = _recentre(rw + r0_w, z, th, _axis(rw + r0_w, z, th, mask))
             d = sign * (rw_c - r0_w).ravel()
         X, fit, alt = _reference(
-            d, X, shape, z, th, harmonics, threshold, mask_in, max_iter, margin_deg, rbz is not None
+            d, X, shape, z, th, harmonics, threshold, mask_in, max_iter, margin_deg
         )
         resid, mask, var_fit, s2, n_iter = fit
         centring = (
-            "exact: the before scan re-centred on its least-squares axis (all points), the "
-            "worn scan on that axis plus the change of set-up (difference on the unworn "
-            "points)"
-            if rbz is not None
-            else "exact: the scan re-centred on its least-squares axis (unworn points)"
-        ) + ", then the limaçon reference fitted to the unworn points"
+            "exact: each scan re-centred on its own least-squares axis (unworn points), then the "
+            "limaçon reference fitted to the unworn points"
+        )
     wear = resid.reshape(rw.shape)
     u = np.sqrt(s2 + var_fit).reshape(rw.shape)
     mask2 = mask.reshape(rw.shape)
@@ -630,11 +596,8 @@ def wear_map(
         u = np.hypot(u, wear - other)  # each depth's dependence on the model order
     if rbz is not None and mask_in is None and not mask2.all():
         # faint wear tails next to the worn region bias the reference: refit without the
-        # points within a further 10 degree of it and count the change. The worn region: where
-        # most of a 2-degree window is not unworn (not every isolated noise outlier)
-        win = max(1, int(round(2.0 * th.size / 360.0)))
-        region = _smooth_theta((~mask2).astype(float), win) <= 0.5
-        narrower = (mask2 & _dilate(region, th, 10.0)).ravel()
+        # points within a further 10 degree of it and count the change
+        narrower = _dilate(mask2, th, 10.0).ravel()
         if narrower.sum() > 0.1 * narrower.size:
             try:
                 sel, *_ = _robust_reference(
@@ -643,12 +606,6 @@ def wear_map(
                 other = sel.reshape(rw.shape)
                 _model_order_term(q, other, wts, z, th, "unworn selection")
                 u = np.hypot(u, wear - other)
-                added = _tail_correction(q, float(np.sum(wts * np.nan_to_num(other))))
-                if added > 0:  # the map too, as a uniform depth: its volume is the corrected one
-                    c = added / float(np.sum(wts[np.isfinite(wear)]))
-                    wear = wear + c
-                    v, uu, cm = q["max_wear_depth"]
-                    q["max_wear_depth"] = (v + c, uu, cm)
             except BadInputError:
                 pass
     noise = noise_sigma(wear)  # successive differences of the residual: the probe noise
@@ -737,15 +694,13 @@ def wear_map(
     return out
 
 
-def _axis(r_abs: np.ndarray, z: np.ndarray, theta_deg: np.ndarray, mask: np.ndarray):
-    """Least-squares limaçon cylinder of ``r_abs`` on ``mask``: coefficients (5,) [m]."""
+def _recentre(
+    r_abs: np.ndarray, z: np.ndarray, theta_deg: np.ndarray, mask: np.ndarray
+) -> np.ndarray:
+    """Exact distance of each point from the scan's own LS axis (fitted on ``mask``) [m]."""
     X = _basis(z, theta_deg, "cylinder")
     m = np.asarray(mask, dtype=bool).ravel() & np.isfinite(r_abs.ravel())
-    return np.linalg.lstsq(X[m], r_abs.ravel()[m], rcond=None)[0]
-
-
-def _recentre(r_abs: np.ndarray, z: np.ndarray, theta_deg: np.ndarray, b: np.ndarray):
-    """Exact distance of each point from the axis ``b`` (see :func:`_axis`) [m]."""
+    b = np.linalg.lstsq(X[m], r_abs.ravel()[m], rcond=None)[0]
     zc = z - 0.5 * (z.min() + z.max())
     zz = zc / max(np.ptp(zc), 1e-12)
     xc = (b[1] + b[3] * zz)[:, None]
@@ -904,14 +859,8 @@ def _scalars(q: dict, cyl_before, cyl_after, note: str, noise: float) -> dict:
     return out
 
 
-def _reference(
-    d, X, shape, z, th, harmonics, threshold, mask_in, max_iter, margin_deg, difference=False
-):
+def _reference(d, X, shape, z, th, harmonics, threshold, mask_in, max_iter, margin_deg):
     """(basis used, robust fit, fit at the neighbouring lobing order or None).
-
-    ``difference``: ``d`` is the difference to a before-scan, whose unworn points hold noise
-    only: the iteration rejects them symmetrically about the noise centre (an unbiased volume;
-    see :func:`_robust_reference`).
 
     For the form model the lobing order starts at 2 (which also holds the limaçon's
     e^2/(4R) second harmonic) and grows one harmonic at a time, up to ``harmonics``, while the
@@ -923,7 +872,7 @@ def _reference(
     shape2d = (z.size, th.size)
     args = (threshold, mask_in, max_iter, "wear_map", shape2d, th, margin_deg)
     if not isinstance(X, FormBasis):
-        return X, _robust_reference(d, X, *args, symmetric_noise=difference), None
+        return X, _robust_reference(d, X, *args), None
     k = min(2, X.harmonics)
     basis = FormBasis(z, th, k, X.deg)
     fit = _robust_reference(d, basis, *args, one_sided=True)
@@ -948,26 +897,6 @@ def _model_order_term(q: dict, other: np.ndarray, wts: np.ndarray, z, th, what: 
         dv = abs(alt[name][0] - v)
         if np.isfinite(dv):
             q[name] = (v, float(np.hypot(u, dv)), comment + f"; {what} ({dv:.3g})")
-
-
-def _tail_correction(q: dict, v_narrow: float) -> float:
-    """Correct the worn volume for wear below the noise left among the unworn points.
-
-    Faint tails of the worn region pull the reference up, so the volume reads low. Refitting
-    without a further 10 degree band next to the worn region raises it by dv (> 0 for a tail;
-    wear only removes material, so dv < 0 is noise and left alone). The tail beyond that band,
-    for a decay (Gaussian, exponential) whose length is about the band, holds about as much
-    again: the volume is raised by 2 dv, and dv (the part beyond, 100 %) stays in its u.
-    Measured over 23 mapped Gaussian grooves 8-45 degree wide (``wearmap_form.json``,
-    ``before_*``) and the power study's simulated map (``validation_power.json``). Returns the
-    volume added [m^3] (0: none).
-    """
-    v, u, comment = q["worn_volume"]
-    dv = v_narrow - v
-    if np.isfinite(dv) and dv > 0:
-        q["worn_volume"] = (v + 2.0 * dv, u, comment + f"; faint-tail correction +{2 * dv:.3g}")
-        return 2.0 * dv
-    return 0.0
 
 
 def _lower_quantile_start(X, d: np.ndarray, finite: np.ndarray, threshold: float, tau=0.25):
