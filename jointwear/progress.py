@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import sys
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator, Mapping
 from contextlib import contextmanager
 
 from rich.console import Console
@@ -16,7 +16,7 @@ from rich.progress import (
     TimeRemainingColumn,
 )
 
-__all__ = ["progress_bar", "stderr_console"]
+__all__ = ["progress_bar", "run_counter", "stderr_console"]
 
 
 def stderr_console() -> Console:
@@ -53,3 +53,21 @@ def progress_bar(
     with progress:
         progress.add_task(description, total=total)
         yield progress
+
+
+def run_counter(bar: Progress, label: str) -> Callable[[Mapping[str, int]], None]:
+    """An ``on_progress`` callback of a sweep (``{"total", "done", "failed"}`` runs) for ``bar``.
+
+    Shows ``"<label>: N ok, M failed"`` on the bar's first task.
+    """
+    task = bar.tasks[0].id
+
+    def on_progress(s: Mapping[str, int]) -> None:
+        bar.update(
+            task,
+            total=s["total"],
+            completed=s["done"],
+            description=f"{label}: {s['done'] - s['failed']} ok, {s['failed']} failed",
+        )
+
+    return on_progress

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated, Any
+from typing import Annotated
 
 import typer
 
@@ -75,7 +75,7 @@ def register(app: typer.Typer) -> None:
         import numpy as np
 
         from jointwear.errors import BadInputError, SimulationError
-        from jointwear.progress import progress_bar
+        from jointwear.progress import progress_bar, run_counter
         from jointwear.sim.sweep._driver import run_sweep
 
         # printed below, once (the runs keep their warnings in the record)
@@ -83,15 +83,7 @@ def register(app: typer.Typer) -> None:
         if scheduler is not None and workers is not None:
             raise BadInputError("give --workers or --scheduler, not both")
         with progress_bar("sweep", total=None, enabled=progress) as bar:
-            task = bar.tasks[0].id
-
-            def on_progress(s: dict[str, Any]) -> None:
-                bar.update(
-                    task,
-                    total=s["total"],
-                    completed=s["done"],
-                    description=f"sweep: {s['done'] - s['failed']} ok, {s['failed']} failed",
-                )
+            on_progress = run_counter(bar, "sweep")
 
             try:
                 ds = run_sweep(

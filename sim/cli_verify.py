@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated, Any
+from typing import Annotated
 
 import typer
 
@@ -60,7 +60,7 @@ def register(app: typer.Typer) -> None:
         u_num = sqrt(u_stat^2 + u_refinement^2 + u_grid^2) as a standard uncertainty (k = 1).
         """
         from jointwear.errors import BadInputError, SimulationError
-        from jointwear.progress import progress_bar
+        from jointwear.progress import progress_bar, run_counter
         from jointwear.refinement import describe_study
         from jointwear.sim.sweep._verify import verify_wear
 
@@ -78,15 +78,7 @@ def register(app: typer.Typer) -> None:
         if spec is None and cycles is None:
             raise BadInputError("the default study needs --cycles N (or give a SPEC.toml)")
         with progress_bar("verify", total=None, enabled=progress) as bar:
-            task = bar.tasks[0].id
-
-            def on_progress(s: dict[str, Any]) -> None:
-                bar.update(
-                    task,
-                    total=s["total"],
-                    completed=s["done"],
-                    description=f"verify: {s['done'] - s['failed']} ok, {s['failed']} failed",
-                )
+            on_progress = run_counter(bar, "verify")
 
             ds = verify_wear(
                 params,
