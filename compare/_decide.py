@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -140,41 +141,82 @@ def scalar_decision(
     rel = (s - d) / abs(d) if d != 0 else float("nan")
     rows.add(quantity, "relative_error", rel, units)
     finite = bool(np.isfinite(s) and np.isfinite(d))
-    rows.add(quantity, "E", (s - d) if finite else float("nan"), units)
+    screen = (
+        f"; screening only, not a verdict: |S - D| / |D| = {abs(rel):.3g} "
+        f"{'<=' if abs(rel) <= relative_error_max else '>'} {relative_error_max:g}"
+        if np.isfinite(rel)
+        else ""
+    )
+    vv20_decision(
+        rows,
+        decisions,
+        quantity,
+        label,
+        s,
+        d,
+        (s - d) if finite else float("nan"),
+        units,
+        u_num=u_num,
+        u_input=u_input,
+        u_d=u_d,
+        k=k,
+        criterion=f"|E| <= U_val = {k:g} u_val (ASME V&V 20)",
+        shown=f"S = {fmt(s, units)}, D = {fmt(d, units)}",
+        not_assessed_text=f"E = {fmt(s - d, units)} (S = {fmt(s, units)}, D = {fmt(d, units)}){screen}",
+        result_text=lambda res: f"|E| = {fmt(abs(res.E), units)}, U_val = {fmt(res.U_val, units)}",
+        not_comparable=not_comparable,
+    )
+
+
+def vv20_decision(
+    rows: Rows,
+    decisions: list[dict[str, Any]],
+    quantity: str,
+    label: str,
+    s: float,
+    d: float,
+    e: float,
+    units: str,
+    *,
+    u_num: Uncertainty,
+    u_input: Uncertainty,
+    u_d: Uncertainty,
+    k: float,
+    criterion: str,
+    shown: str,
+    not_assessed_text: str,
+    result_text: Callable[[Any], str],
+    not_comparable: str = "",
+) -> None:
+    """The four states of one V&V 20 criterion of ``s`` against ``d`` with the error ``e``.
+
+    ``e`` is ``s - d`` for a scalar and the wrapped difference for an angle (then ``s`` is
+    ``d + e``, so that V&V 20 sees the same error).
+
+    Adds the ``E`` and uncertainty rows, then one decision: *not comparable* (``not_comparable``
+    or a non-finite ``e``; value ``shown``), *not assessed* when an uncertainty is unknown (value
+    ``not_assessed_text``, which may carry a screening figure: never a pass or a fail), else pass
+    or fail with ``result_text(vv20 result)``. Shared by :func:`scalar_decision` and the
+    circular (angle) decision of reported measurements.
+    """
+    rows.add(quantity, "E", e, units)
     parts = (("u_num", u_num), ("u_input", u_input), ("u_D", u_d))
     for name, u in parts:
         rows.add(quantity, name, u.value if u.known else float("nan"), units, u.basis)
-    criterion = f"|E| <= U_val = {k:g} u_val (ASME V&V 20)"
-    if not_comparable or not finite:
+    if not_comparable or not np.isfinite(e):
         reason = not_comparable or "the simulated or measured value is undefined"
         decisions.append(
-            decision(
-                label,
-                criterion,
-                f"S = {fmt(s, units)}, D = {fmt(d, units)}",
-                vd.NOT_COMPARABLE,
-                "V&V 20",
-                reason,
-                key=quantity,
-            )
+            decision(label, criterion, shown, vd.NOT_COMPARABLE, "V&V 20", reason, key=quantity)
         )
         return
-    missing = [name for name, u in parts if not u.known]
-    if missing:
-        # V&V 20 cannot be decided; the relative error against the screening threshold is shown
-        # for orientation only and is never a pass (nor a fail) of the criterion
+    if not all(u.known for _, u in parts):
+        # V&V 20 cannot be decided; a screening figure in the text is for orientation only
         reason = "; ".join(f"{name} not assessed ({u.basis})" for name, u in parts if not u.known)
-        screen = (
-            f"; screening only, not a verdict: |S - D| / |D| = {abs(rel):.3g} "
-            f"{'<=' if abs(rel) <= relative_error_max else '>'} {relative_error_max:g}"
-            if np.isfinite(rel)
-            else ""
-        )
         decisions.append(
             decision(
                 label,
                 criterion,
-                f"E = {fmt(s - d, units)} (S = {fmt(s, units)}, D = {fmt(d, units)}){screen}",
+                not_assessed_text,
                 vd.NOT_ASSESSED,
                 "V&V 20",
                 reason,
@@ -191,7 +233,7 @@ def scalar_decision(
         decision(
             label,
             criterion,
-            f"|E| = {fmt(abs(res.E), units)}, U_val = {fmt(res.U_val, units)}",
+            result_text(res),
             vd.PASS if res.passed else vd.FAIL,
             "V&V 20",
             key=quantity,

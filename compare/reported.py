@@ -51,7 +51,15 @@ import xarray as xr
 
 import jointwear.compare.metrics as mt
 import jointwear.compare.verdicts as vd
-from jointwear.compare._decide import Rows, Uncertainty, decision, fmt, scalar_decision, unknown
+from jointwear.compare._decide import (
+    Rows,
+    Uncertainty,
+    decision,
+    fmt,
+    scalar_decision,
+    unknown,
+    vv20_decision,
+)
 from jointwear.compare._reported_quantities import (
     SEPARATION,
     Reading,
@@ -102,51 +110,31 @@ def circular_decision(
     units = "degree"
     rows.add(quantity, "value_sim", s, units)
     rows.add(quantity, "value_meas", d, units)
-    rows.add(quantity, "E", e, units)
-    parts = (("u_num", u_num), ("u_input", u_input), ("u_D", u_d))
-    for name, u in parts:
-        rows.add(quantity, name, u.value if u.known else float("nan"), units, u.basis)
-    criterion = f"|E| <= U_val = {k:g} u_val (ASME V&V 20, E wrapped to (-180, 180] degree)"
     shown = f"S = {s:.1f} degree, D = {d:.1f} degree"
-    if not_comparable or not finite:
-        reason = not_comparable or "the simulated or measured value is undefined"
-        decisions.append(
-            decision(label, criterion, shown, vd.NOT_COMPARABLE, "V&V 20", reason, key=quantity)
-        )
-        return
-    missing = [name for name, u in parts if not u.known]
-    if missing:  # screening against max_error_deg is shown, never counted as a verdict
-        reason = "; ".join(f"{name} not assessed ({u.basis})" for name, u in parts if not u.known)
-        screen = (
-            f"; screening only, not a verdict: |E| {'<=' if abs(e) <= max_error_deg else '>'} "
-            f"{max_error_deg:g} degree"
-        )
-        decisions.append(
-            decision(
-                label,
-                criterion,
-                f"E = {e:+.1f} degree ({shown}){screen}",
-                vd.NOT_ASSESSED,
-                "V&V 20",
-                reason,
-                key=quantity,
-            )
-        )
-        return
-    res = mt.vv20(
-        d + e, d, u_num=float(u_num.value), u_input=float(u_input.value), u_d=float(u_d.value), k=k
+    screen = (
+        f"; screening only, not a verdict: |E| {'<=' if abs(e) <= max_error_deg else '>'} "
+        f"{max_error_deg:g} degree"
     )
-    rows.add(quantity, "u_val", res.u_val, units)
-    rows.add(quantity, "U_val", res.U_val, units)
-    decisions.append(
-        decision(
-            label,
-            criterion,
-            f"|E| = {abs(e):.1f} degree, U_val = {res.U_val:.1f} degree ({shown})",
-            vd.PASS if res.passed else vd.FAIL,
-            "V&V 20",
-            key=quantity,
-        )
+    vv20_decision(
+        rows,
+        decisions,
+        quantity,
+        label,
+        d + e,
+        d,
+        e,
+        units,
+        u_num=u_num,
+        u_input=u_input,
+        u_d=u_d,
+        k=k,
+        criterion=f"|E| <= U_val = {k:g} u_val (ASME V&V 20, E wrapped to (-180, 180] degree)",
+        shown=shown,
+        not_assessed_text=f"E = {e:+.1f} degree ({shown}){screen}",
+        result_text=lambda res: (
+            f"|E| = {abs(e):.1f} degree, U_val = {res.U_val:.1f} degree ({shown})"
+        ),
+        not_comparable=not_comparable,
     )
 
 
