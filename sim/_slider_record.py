@@ -1,8 +1,9 @@
 """The slider-crank's side of the simulator: packing its parameters, initial state, record.
 
-:mod:`jointwear.sim.dynamics` drives the integrator and builds the clearance joint's part of
-the record for every mechanism; this module adds what is particular to the slider-crank (its
-kernel is :mod:`jointwear.sim.kernels._slider_crank`).
+:mod:`jointwear.sim.dynamics` drives the integrator; :mod:`jointwear.sim._record` builds the
+clearance joint's part of the record for every mechanism. This module adds what is particular
+to the slider-crank (its kernel is :mod:`jointwear.sim.kernels._slider_crank`; the four-bar's
+counterpart: :mod:`jointwear.sim._four_bar_record`).
 """
 
 from __future__ import annotations
@@ -12,23 +13,18 @@ import math
 import numpy as np
 
 import jointwear.sim.kernels._slider_crank as ks
-from jointwear import conventions
+from jointwear.sim._record import AXIS, body_motion, crank_angle, variable, vector
 from jointwear.sim.kernels import _layout as kn
 from jointwear.sim.parameters import SimParameters
 from jointwear.sim.slider_crank import SliderCrankParameters, slider_crank_kinematics
 
-__all__ = ["is_slider_crank", "pack_mechanism", "initial_vector", "ANGLE_FLAGS", "variables"]
+__all__ = ["pack_mechanism", "initial_vector", "ANGLE_FLAGS", "variables"]
 
 #: State components integrated with absolute tolerance only (positions and angles).
 ANGLE_FLAGS = {
     "clearance": np.array([1, 1, 0, 0, 1, 1, 1, 1, 0, 0, 0], dtype=np.int64),
     "ideal": np.array([1, 0], dtype=np.int64),
 }
-
-
-def is_slider_crank(params: SimParameters) -> bool:
-    """Whether ``params`` describe the slider-crank (``mechanism.kind``)."""
-    return isinstance(params.mechanism, SliderCrankParameters)
 
 
 def pack_mechanism(params: SimParameters, P: np.ndarray, IP: np.ndarray) -> None:
@@ -70,10 +66,6 @@ def initial_vector(params: SimParameters) -> np.ndarray:
     return np.array([th1, x, m.crank_speed, v, *q, 0.0, 0.0, w])
 
 
-def _vec(diag: np.ndarray, k: int) -> np.ndarray:
-    return diag[:, k : k + 3]
-
-
 def _along_x(values: np.ndarray) -> np.ndarray:
     out = np.zeros((values.shape[0], 3))
     out[:, 0] = values
@@ -83,7 +75,6 @@ def _along_x(values: np.ndarray) -> np.ndarray:
 def variables(params: SimParameters, diag: np.ndarray) -> dict:
     """The slider-crank's record variables (name -> (dims, values, attrs))."""
     m: SliderCrankParameters = params.mechanism  # type: ignore[assignment]
-    axis = ("time", "axis")
     th1 = diag[:, kn.D_TH1]
     rod = diag[:, ks.D_ROD_ANGLE]
     if m.clearance_at == "crank_rod" and params.joint.model != "ideal":
@@ -94,62 +85,36 @@ def variables(params: SimParameters, diag: np.ndarray) -> dict:
     w1 = m.crank_speed
     crank_vel = np.column_stack([-w1 * crank_pos[:, 1], w1 * crank_pos[:, 0], np.zeros_like(th1)])
     return {
-        "crank_angle": (
-            "time",
-            np.mod(th1, 2 * math.pi),
-            conventions.variable_attrs("crank_angle", note="wrapped to [0, 2 pi)"),
+        "crank_angle": crank_angle(th1),
+        "rod_angle": variable(
+            "time", rod, "rad", "connecting rod angle (B to C) from +x, counter-clockwise"
         ),
-        "rod_angle": (
-            "time",
-            rod,
-            {
-                "units": "rad",
-                "long_name": "connecting rod angle (B to C) from +x, counter-clockwise",
-            },
-        ),
-        "slider_position": (
-            axis,
+        "slider_position": variable(
+            AXIS,
             _along_x(diag[:, ks.D_SLIDER_POS]),
-            {"units": "m", "long_name": "position of the slider pin C (guide along x)"},
+            "m",
+            "position of the slider pin C (guide along x)",
         ),
-        "slider_velocity": (
-            axis,
-            _along_x(diag[:, ks.D_SLIDER_VEL]),
-            {"units": "m s-1", "long_name": "velocity of the slider"},
+        "slider_velocity": variable(
+            AXIS, _along_x(diag[:, ks.D_SLIDER_VEL]), "m s-1", "velocity of the slider"
         ),
-        "slider_acceleration": (
-            axis,
-            _along_x(diag[:, ks.D_SLIDER_ACC]),
-            {"units": "m s-2", "long_name": "acceleration of the slider"},
+        "slider_acceleration": variable(
+            AXIS, _along_x(diag[:, ks.D_SLIDER_ACC]), "m s-2", "acceleration of the slider"
         ),
-        "crank_position": (
-            axis,
-            crank_pos,
-            {"units": "m", "long_name": "position of the crank centre of mass"},
+        **body_motion("crank", "crank", crank_pos, crank_vel),
+        **body_motion(
+            "rod", "connecting rod", vector(diag, ks.D_ROD_POS), vector(diag, ks.D_ROD_VEL)
         ),
-        "crank_velocity": (
-            axis,
-            crank_vel,
-            {"units": "m s-1", "long_name": "velocity of the crank centre of mass"},
+        "rod_angular_velocity": variable(
+            AXIS,
+            vector(diag, ks.D_ROD_OMEGA),
+            "rad s-1",
+            "angular velocity of the connecting rod, global",
         ),
-        "rod_position": (
-            axis,
-            _vec(diag, ks.D_ROD_POS),
-            {"units": "m", "long_name": "position of the connecting rod centre of mass"},
-        ),
-        "rod_velocity": (
-            axis,
-            _vec(diag, ks.D_ROD_VEL),
-            {"units": "m s-1", "long_name": "velocity of the connecting rod centre of mass"},
-        ),
-        "rod_angular_velocity": (
-            axis,
-            _vec(diag, ks.D_ROD_OMEGA),
-            {"units": "rad s-1", "long_name": "angular velocity of the connecting rod, global"},
-        ),
-        "driver_torque": (
+        "driver_torque": variable(
             "time",
             diag[:, ks.D_DRIVER_TORQUE],
-            {"units": "N m", "long_name": "torque that keeps the crank at constant speed"},
+            "N m",
+            "torque that keeps the crank at constant speed",
         ),
     }

@@ -9,7 +9,6 @@ chunk by chunk (progress, errors with the partial record) and builds the Dataset
 from __future__ import annotations
 
 import dataclasses
-import json
 import math
 from collections.abc import Callable
 
@@ -18,19 +17,16 @@ import xarray as xr
 
 from jointwear import conventions
 from jointwear.errors import BadInputError, ParameterError, SimulationError
-from jointwear.params import to_jsonable
-from jointwear.sim._slider_record import ANGLE_FLAGS as SLIDER_ANGLE_FLAGS
+from jointwear.sim import _four_bar_record, _slider_record
+from jointwear.sim._record import CONTACT_MODES, add_maps, dataset, is_slider_crank
+from jointwear.sim._record import layers as _layers
 from jointwear.sim._slider_record import initial_vector as slider_crank_state
-from jointwear.sim._slider_record import is_slider_crank
-from jointwear.sim._slider_record import pack_mechanism as pack_slider_crank
-from jointwear.sim._slider_record import variables as slider_variables
 from jointwear.sim.contact import contact_constant
 from jointwear.sim.kernels import _layout as kn
 from jointwear.sim.kernels._integrator import integrate
-from jointwear.sim.mechanism import loop_closure, quaternion_to_matrix, rotation_xzy_angles
+from jointwear.sim.mechanism import loop_closure
 from jointwear.sim.parameters import SimParameters
 from jointwear.sim.validity import contact_validity
-from jointwear.sim.wearmap import layer_positions
 
 __all__ = [
     "SimState",
@@ -40,17 +36,6 @@ __all__ = [
     "CONTACT_MODES",
     "wear_depth_on_grid",
 ]
-
-#: Contact modes recorded in ``contact_mode`` (flag value -> meaning).
-CONTACT_MODES: dict[int, str] = {
-    kn.MODE_FREE: "free_flight",
-    kn.MODE_POINT: "single_point",
-    kn.MODE_LINE: "line",
-    kn.MODE_TWO: "two_point",
-    kn.MODE_AXIAL: "axial",
-    kn.MODE_AXIAL_RADIAL: "axial_and_radial",
-    kn.MODE_IDEAL: "ideal_joint",
-}
 
 
 @dataclasses.dataclass(frozen=True)
@@ -128,28 +113,9 @@ class CycleResult:
     max_penetration: float = math.nan
 
 
-def _layers(params: SimParameters) -> tuple[np.ndarray, np.ndarray]:
-    j = params.joint
-    return layer_positions(j.n_layers, j.bearing_width, j.axial_grading)
-
-
-def _pack_four_bar(params: SimParameters, P: np.ndarray, IP: np.ndarray) -> None:
-    """Write the four-bar's slots of the kernel parameter arrays."""
-    m = params.mechanism
-    P[kn.L1], P[kn.L2], P[kn.L3], P[kn.L4] = (
-        m.crank_length,
-        m.coupler_length,
-        m.follower_length,
-        m.ground_length,
-    )
-    P[kn.M1], P[kn.M2], P[kn.M3] = m.crank_mass, m.coupler_mass, m.follower_mass
-    P[kn.I1], P[kn.I2] = m.crank_inertia, m.coupler_inertia
-    P[kn.I3X], P[kn.I3Y], P[kn.I3Z] = m.follower_inertia
-    P[kn.GRAV] = m.gravity
-    P[kn.JOFF] = m.joint_offset
-    P[kn.OMEGA] = m.crank_speed
-    IP[kn.DRIVER] = 1 if m.driver else 0
-    IP[kn.ON_COUPLER] = 1 if m.bearing_on == "coupler" else 0
+def _side(params: SimParameters):
+    """The module with the mechanism's own packing, angle flags and record variables."""
+    return _slider_record if is_slider_crank(params) else _four_bar_record
 
 
 def _pack(params: SimParameters) -> tuple[np.ndarray, np.ndarray]:
@@ -157,10 +123,7 @@ def _pack(params: SimParameters) -> tuple[np.ndarray, np.ndarray]:
     j, c, f, s = params.joint, params.contact, params.friction, params.solver
     P = np.zeros(kn.NP)
     IP = np.zeros(kn.NIP, dtype=np.int64)
-    if is_slider_crank(params):
-        pack_slider_crank(params, P, IP)
-    else:
-        _pack_four_bar(params, P, IP)
+    _side(params).pack_mechanism(params, P, IP)
     P[kn.RJ], P[kn.LJ], P[kn.RB], P[kn.WB] = (
         j.journal_radius,
         j.journal_length,
@@ -314,9 +277,6 @@ def wear_depth_on_grid(
     return out
 
 
-_ANG = {"clearance": np.array([1, 1, 0, 0, 1, 1, 1, 1, 0, 0, 0], dtype=np.int64)}
-_ANG["ideal"] = np.array([1, 1, 1, 0, 0, 0], dtype=np.int64)
-
 _STATUS = {
     1: "the step size collapsed below solver.min_step (the contact became too stiff to resolve)",
     2: "the penetration exceeded contact.max_penetration_fraction of the radial clearance",
@@ -453,7 +413,7 @@ def run_cycles(
             vimp,
             ww,
             acc,
-            (SLIDER_ANGLE_FLAGS if is_slider_crank(params) else _ANG)[model],
+            _side(params).ANGLE_FLAGS[model],
             s.rtol,
             s.atol,
             s.max_step,
@@ -463,7 +423,7 @@ def run_cycles(
         )
         nacc_total += nacc
         if status != 0:
-            partial = _dataset(params, t_rel[:i_out], diag[:i_out], t0) if record else None
+            partial = _record(params, t_rel[:i_out], diag[:i_out], t0) if record else None
             theta = math.degrees(y[0]) % 360.0
             raise SimulationError(
                 f"simulation stopped at t = {t:.6g} s (crank angle {theta:.2f} deg): "
@@ -475,9 +435,9 @@ def run_cycles(
         if progress is not None:
             progress((k + 1) / n_chunks)
     new_state = SimState(t, y.copy(), hstep, vimp.copy(), model, _mechanism(params))
-    ds = _dataset(params, t_rel, diag, t0) if record else None
+    ds = _record(params, t_rel, diag, t0) if record else None
     if ds is not None:
-        ds = _add_maps(ds, params, ww, area)
+        ds = add_maps(ds, params, ww, area)
         if model == "clearance":
             ds.attrs.update(contact_validity(params, float(acc[3]))["attrs"])
     return CycleResult(
@@ -495,267 +455,6 @@ def run_cycles(
     )
 
 
-def _add_maps(
-    ds: xr.Dataset, params: SimParameters, ww: np.ndarray, area: np.ndarray
-) -> xr.Dataset:
-    """Add the accumulated per-point maps over (z, theta) in the canonical angle convention."""
-    z, _ = _layers(params)
-    nd = params.joint.n_points
-    coords = {
-        "z": conventions.z_coord(z, note="layer n = 0 at z = +wb/2 (eq. 2)"),
-        "theta": conventions.theta_coord(np.arange(nd) * 360.0 / nd),
-    }
-    maps = xr.Dataset(
-        {
-            "wear_work": (
-                ("z", "theta"),
-                ww[0],
-                {
-                    "units": "Pa m",
-                    "long_name": "integral of contact pressure times sliding distance over the run",
-                },
-            ),
-            "sliding_distance": (
-                ("z", "theta"),
-                ww[1],
-                {"units": "m", "long_name": "sliding distance while in contact over the run"},
-            ),
-            "point_area": (
-                ("z", "theta"),
-                area,
-                {"units": "m2", "long_name": "bearing surface area represented by each point"},
-            ),
-        },
-        coords=coords,
-    )
-    return xr.merge([ds, maps], combine_attrs="override")
-
-
-def _vec(diag: np.ndarray, k: int) -> np.ndarray:
-    return diag[:, k : k + 3]
-
-
-def _four_bar_variables(diag: np.ndarray) -> dict:
-    """The four-bar's record variables (name -> (dims, values, attrs))."""
-    axis = ("time", "axis")
-    v = conventions.variable_attrs
-    quat = diag[:, kn.D_QUAT : kn.D_QUAT + 4]
-    ok = np.all(np.isfinite(quat), axis=1) & (np.linalg.norm(quat, axis=1) > 0)
-    rot = np.full((len(diag), 3), np.nan)
-    if ok.any():
-        rot[ok] = rotation_xzy_angles(quaternion_to_matrix(quat[ok]))
-    return {
-        "crank_angle": (
-            "time",
-            np.mod(diag[:, kn.D_TH1], 2 * math.pi),
-            v("crank_angle", note="wrapped to [0, 2 pi)"),
-        ),
-        "coupler_angle": (
-            "time",
-            diag[:, kn.D_TH2],
-            {"units": "rad", "long_name": "coupler angle from +x, counter-clockwise"},
-        ),
-        "follower_angle": (
-            "time",
-            diag[:, kn.D_TH3],
-            {
-                "units": "rad",
-                "long_name": "angle of the follower (D to C) projected on the x-y plane, from +x",
-            },
-        ),
-        "follower_rotation": (
-            axis,
-            rot,
-            {
-                "units": "rad",
-                "long_name": "follower rotations about x, y, z from the vertical reference, "
-                "R = Rx Rz Ry (eq. 4 order)",
-            },
-        ),
-        "crank_position": (
-            axis,
-            _vec(diag, kn.D_CRANK_POS),
-            {"units": "m", "long_name": "position of the crank centre of mass"},
-        ),
-        "crank_velocity": (
-            axis,
-            _vec(diag, kn.D_CRANK_VEL),
-            {"units": "m s-1", "long_name": "velocity of the crank centre of mass"},
-        ),
-        "coupler_position": (
-            axis,
-            _vec(diag, kn.D_COUP_POS),
-            {"units": "m", "long_name": "position of the coupler centre of mass"},
-        ),
-        "coupler_velocity": (
-            axis,
-            _vec(diag, kn.D_COUP_VEL),
-            {"units": "m s-1", "long_name": "velocity of the coupler centre of mass"},
-        ),
-        "follower_position": (axis, _vec(diag, kn.D_FOLL_POS), v("follower_position")),
-        "follower_velocity": (axis, _vec(diag, kn.D_FOLL_VEL), v("follower_velocity")),
-        "follower_angular_velocity": (
-            axis,
-            _vec(diag, kn.D_FOLL_OMEGA),
-            {"units": "rad s-1", "long_name": "angular velocity of the follower, global frame"},
-        ),
-    }
-
-
-def _joint_variables(diag: np.ndarray, joint: str = "C") -> dict:
-    """The clearance joint's record variables, the same for every mechanism (``joint``: its
-    name in the long names)."""
-    axis = ("time", "axis")
-    v = conventions.variable_attrs
-    fmag = diag[:, kn.D_FMAG]
-    fn = diag[:, kn.D_FN]
-    mode = np.where(np.isfinite(diag[:, kn.D_MODE]), diag[:, kn.D_MODE], 0).astype(np.int8)
-    pen = np.maximum(np.maximum(diag[:, kn.D_PEN], diag[:, kn.D_PENAX]), 0.0)
-    return {
-        "journal_offset": (
-            axis,
-            _vec(diag, kn.D_OFFSET),
-            v(
-                "journal_offset",
-                frame="bearing frame: z along the bearing axis, -x = theta 0 direction",
-            ),
-        ),
-        "bearing_centre_position": (
-            axis,
-            _vec(diag, kn.D_BEAR_POS),
-            {
-                "units": "m",
-                "long_name": f"position of the bearing centre of joint {joint}, global frame",
-            },
-        ),
-        "journal_centre_position": (
-            axis,
-            _vec(diag, kn.D_JOUR_POS),
-            {
-                "units": "m",
-                "long_name": f"position of the journal centre of joint {joint}, global frame",
-            },
-        ),
-        "eccentricity": (
-            "time",
-            np.hypot(diag[:, kn.D_OFFSET], diag[:, kn.D_OFFSET + 1]),
-            {
-                "units": "m",
-                "long_name": "radial eccentricity of the journal centre in the bearing "
-                "(|journal_offset| in the bearing's x-y plane)",
-            },
-        ),
-        "journal_axis": (
-            axis,
-            _vec(diag, kn.D_AXIS),
-            {"units": "1", "long_name": "unit vector of the journal axis, bearing frame"},
-        ),
-        "journal_tilt": (
-            "time",
-            diag[:, kn.D_TILT],
-            {"units": "rad", "long_name": "angle between the journal and bearing axes"},
-        ),
-        "bearing_force": (
-            axis,
-            _vec(diag, kn.D_FORCE),
-            {
-                "units": "N",
-                "long_name": "resultant contact force on the bearing, global frame",
-            },
-        ),
-        "contact_force": ("time", fmag, v("contact_force")),
-        "contact_force_normal": (
-            "time",
-            fn,
-            {"units": "N", "long_name": "magnitude of the resultant normal contact force"},
-        ),
-        "contact_force_tangential": (
-            "time",
-            diag[:, kn.D_FT],
-            {"units": "N", "long_name": "magnitude of the resultant friction force"},
-        ),
-        "axial_force": (
-            "time",
-            diag[:, kn.D_FAX],
-            {"units": "N", "long_name": "normal force of the end-face (thrust) contacts"},
-        ),
-        "contact_mode": (
-            "time",
-            mode,
-            {
-                "units": "1",
-                "long_name": f"contact mode of joint {joint}",
-                "flag_values": np.array(sorted(CONTACT_MODES), dtype=np.int8),
-                "flag_meanings": " ".join(CONTACT_MODES[k] for k in sorted(CONTACT_MODES)),
-            },
-        ),
-        "penetration": (
-            "time",
-            pen,
-            {
-                "units": "m",
-                "long_name": f"largest penetration in joint {joint} (bore or end faces)",
-            },
-        ),
-        "contact_stiffness": (
-            "time",
-            diag[:, kn.D_K],
-            {
-                "units": "N m-1.5",
-                "long_name": "contact stiffness K(t) at the deepest contacting slice (0 if none)",
-            },
-        ),
-        "mechanical_energy": (
-            "time",
-            diag[:, kn.D_ENERGY],
-            {
-                "units": "J",
-                "long_name": "kinetic + gravitational + elastic contact energy",
-            },
-        ),
-    }
-
-
-def _dataset(params: SimParameters, t_rel: np.ndarray, diag: np.ndarray, t0: float) -> xr.Dataset:
-    """Build the contract Dataset from the recorded diagnostics."""
-    data = (
-        _four_bar_variables(diag) if not is_slider_crank(params) else slider_variables(params, diag)
-    )
-    joint = "B" if getattr(params.mechanism, "clearance_at", "") == "crank_rod" else "C"
-    data.update(_joint_variables(diag, joint))
-    time = xr.DataArray(
-        t_rel,
-        dims="time",
-        attrs={
-            "units": "s",
-            "long_name": conventions.COORDINATES["time"][1],
-            "simulation_time_at_start": float(t0),
-        },
-    )
-    axis_c = xr.DataArray(
-        np.array(["x", "y", "z"]), dims="axis", attrs={"long_name": "vector component"}
-    )
-    ds = xr.Dataset(
-        {k: xr.Variable(d, np.asarray(val), attrs=a) for k, (d, val, a) in data.items()},
-        coords={"time": time, "axis": axis_c},
-    )
-    mech = "slider-crank" if is_slider_crank(params) else "four-bar"
-    ds.attrs["title"] = f"jointwear {mech} simulation with a 3D revolute clearance joint"
-    ds.attrs["data_origin"] = "simulated"
-    ds.attrs["source"] = "jointwear (sim.dynamics)"
-    ds.attrs["parameter_set"] = params.name
-    ds.attrs["joint_model"] = params.joint.model
-    ds.attrs["contact_formulation"] = params.contact.formulation
-    if params.contact.formulation == "per_point":
-        ds.attrs["contact_formulation_note"] = (
-            "the study's literal per-point sum: forces and wear work depend on the grid"
-        )
-    ds.attrs["wear_projection"] = params.contact.wear_projection
-    ds.attrs["impact_latch"] = params.contact.impact_latch
-    ds.attrs["contact_stiffness_model"] = params.contact.stiffness
-    ds.attrs["bearing_on"] = params.mechanism.bearing_on
-    if is_slider_crank(params):
-        ds.attrs["clearance_at"] = params.mechanism.clearance_at
-        ds.attrs["planar"] = int(params.mechanism.planar)
-    ds.attrs["parameters_json"] = json.dumps(to_jsonable(params))
-    return ds
+def _record(params: SimParameters, t_rel: np.ndarray, diag: np.ndarray, t0: float) -> xr.Dataset:
+    """The record over time: the mechanism's variables, then the clearance joint's."""
+    return dataset(params, _side(params).variables(params, diag), diag, t_rel, t0)

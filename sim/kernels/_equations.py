@@ -10,37 +10,26 @@ import numpy as np
 from numba import njit
 
 from jointwear.sim.kernels._geometry import body_rotation
-from jointwear.sim.kernels._joint import clearance_joint
+from jointwear.sim.kernels._joint import (
+    clearance_joint,
+    ideal_joint_info,
+    record_ideal_joint,
+    record_joint,
+)
 from jointwear.sim.kernels._layout import (
     BAUM,
-    D_AXIS,
-    D_BEAR_POS,
     D_COUP_POS,
     D_COUP_VEL,
     D_CRANK_POS,
     D_CRANK_VEL,
     D_ENERGY,
-    D_FAX,
-    D_FMAG,
-    D_FN,
     D_FOLL_OMEGA,
     D_FOLL_POS,
     D_FOLL_VEL,
-    D_FORCE,
-    D_FT,
-    D_JOUR_POS,
-    D_K,
-    D_MODE,
-    D_NSLICE,
-    D_OFFSET,
-    D_PEN,
-    D_PENAX,
-    D_QUAT,
     D_TH1,
     D_TH2,
     D_TH2DOT,
     D_TH3,
-    D_TILT,
     DRIVER,
     GRAV,
     I1,
@@ -48,9 +37,6 @@ from jointwear.sim.kernels._layout import (
     I3X,
     I3Y,
     I3Z,
-    I_BAD,
-    I_CONTACT,
-    I_PEN,
     IDEAL,
     JOFF,
     L1,
@@ -62,7 +48,6 @@ from jointwear.sim.kernels._layout import (
     M3,
     MECH,
     MECH_SLIDER_CRANK,
-    MODE_IDEAL,
     ND_DIAG,
     ON_COUPLER,
 )
@@ -198,35 +183,12 @@ def _eval_clearance(t, y, ctx, dy, acc, hstep, diag):
         diag[D_FOLL_OMEGA], diag[D_FOLL_OMEGA + 1], diag[D_FOLL_OMEGA + 2] = wgx, wgy, wgz
         diag[D_TH2] = th2
         diag[D_TH3] = math.atan2(R[1, 1], R[0, 1])
-        for i in range(3):
-            diag[D_OFFSET + i] = J0[i]
-            diag[D_AXIS + i] = u[i]
-        diag[D_TILT] = math.acos(min(1.0, u[2]))
-        diag[D_FORCE], diag[D_FORCE + 1], diag[D_FORCE + 2] = Fx, Fy, Fz
-        diag[D_FN] = math.sqrt(wrench[6] ** 2 + wrench[7] ** 2 + wrench[8] ** 2)
-        diag[D_FMAG] = math.sqrt(Fx * Fx + Fy * Fy + Fz * Fz)
-        diag[D_FT] = math.sqrt(wrench[9] ** 2 + wrench[10] ** 2 + wrench[11] ** 2)
-        diag[D_MODE] = mode
-        diag[D_PEN] = pen_rad
-        diag[D_PENAX] = pen_ax
-        diag[D_K] = kdeep
+        record_joint(diag, y, Og, Cj, FM, J0, u, wrench, pen_rad, pen_ax, mode, kdeep, nslice, fax)
         T = 0.5 * (M11 * w1 * w1 + 2 * M12 * w1 * w2 + M22 * w2 * w2)
         T += 0.5 * (Ix * ob0 * ob0 + Iy * ob1 * ob1 + Iz * ob2 * ob2)
         V = g * (0.5 * m1 * l1 * s1 + m2 * (l1 * s1 + hb * s2) + m3 * gy)
         diag[D_ENERGY] = T + V + energy
-        diag[D_NSLICE] = nslice
         diag[D_TH2DOT] = w2
-        n = math.sqrt(q0 * q0 + q1 * q1 + q2 * q2 + q3 * q3)
-        diag[D_QUAT], diag[D_QUAT + 1], diag[D_QUAT + 2], diag[D_QUAT + 3] = (
-            q0 / n,
-            q1 / n,
-            q2 / n,
-            q3 / n,
-        )
-        diag[D_FAX] = fax
-        for i in range(3):
-            diag[D_BEAR_POS + i] = Og[i]
-            diag[D_JOUR_POS + i] = Cj[i]
 
 
 @njit(cache=True)
@@ -274,11 +236,6 @@ def _eval_ideal(t, y, P, IP, dy, diag):
         diag[D_FOLL_OMEGA + 2] = w3
         diag[D_TH2] = th2
         diag[D_TH3] = th3
-        diag[D_BEAR_POS], diag[D_BEAR_POS + 1] = l4 + l3 * c3, l3 * s3
-        diag[D_JOUR_POS], diag[D_JOUR_POS + 1] = Bx + l2 * c2, By + l2 * s2
-        diag[D_BEAR_POS + 2] = P[JOFF]
-        diag[D_JOUR_POS + 2] = P[JOFF]
-        diag[D_AXIS + 2] = 1.0
         # joint reaction at C (force on the follower) from the two rotational equations
         Ia = P[I3Z] + 0.25 * m3 * l3 * l3
         rhs_f = Ia * dd3 + m3 * g * 0.5 * l3 * c3  # = ((C-D) x F)_z
@@ -291,19 +248,14 @@ def _eval_ideal(t, y, P, IP, dy, diag):
         det2 = rdx * rby - rdy * rbx
         Fx = (rhs_f * rbx - rdx * rhs_c) / det2
         Fy = (rhs_f * rby - rdy * rhs_c) / det2
-        diag[D_FORCE], diag[D_FORCE + 1] = Fx, Fy
-        diag[D_FN] = math.sqrt(Fx * Fx + Fy * Fy)
-        diag[D_FMAG] = diag[D_FN]
-        diag[D_MODE] = MODE_IDEAL
-        diag[D_PEN] = 0.0
+        bx, by = l4 + l3 * c3, l3 * s3
+        record_ideal_joint(diag, bx, by, Bx + l2 * c2, By + l2 * s2, P[JOFF], Fx, Fy, th3)
         M11 = P[I1] + m1 * 0.25 * l1 * l1 + m2 * l1 * l1
         M12 = m2 * l1 * hb * math.cos(th2 - th1)
         T = 0.5 * (M11 * w1 * w1 + 2 * M12 * w1 * w2 + IB * w2 * w2) + 0.5 * Ia * w3 * w3
         V = g * (0.5 * m1 * l1 * s1 + m2 * (l1 * s1 + hb * s2) + m3 * 0.5 * l3 * s3)
         diag[D_ENERGY] = T + V
         diag[D_TH2DOT] = w2
-        a = 0.5 * (th3 - 0.5 * math.pi)
-        diag[D_QUAT], diag[D_QUAT + 3] = math.cos(a), math.sin(a)
 
 
 @njit(cache=True)
@@ -319,9 +271,6 @@ def _eval(t, y, ctx, dy, acc, hstep, diag):
         eval_slider_crank(t, y, ctx, dy, acc, hstep, diag)
     elif ctx[1][IDEAL] == 1:
         _eval_ideal(t, y, ctx[0], ctx[1], dy, diag)
-        info = ctx[10]
-        info[I_PEN] = -1.0
-        info[I_CONTACT] = 0.0
-        info[I_BAD] = 0.0
+        ideal_joint_info(ctx[10])
     else:
         _eval_clearance(t, y, ctx, dy, acc, hstep, diag)

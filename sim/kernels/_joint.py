@@ -8,14 +8,39 @@ forces, friction and wear work behind it (:mod:`._contact`) know nothing of the 
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numba import njit
 
 from jointwear.sim.kernels._contact import _contact
-from jointwear.sim.kernels._layout import CTILT, I_BAD, KTILT
+from jointwear.sim.kernels._layout import (
+    CTILT,
+    D_AXIS,
+    D_BEAR_POS,
+    D_FAX,
+    D_FMAG,
+    D_FN,
+    D_FORCE,
+    D_FT,
+    D_JOUR_POS,
+    D_K,
+    D_MODE,
+    D_NSLICE,
+    D_OFFSET,
+    D_PEN,
+    D_PENAX,
+    D_QUAT,
+    D_TILT,
+    I_BAD,
+    I_CONTACT,
+    I_PEN,
+    KTILT,
+    MODE_IDEAL,
+)
 from jointwear.sim.kernels._tilt import _tilt_spring
 
-__all__ = ["clearance_joint"]
+__all__ = ["clearance_joint", "record_joint", "ideal_joint_info", "record_ideal_joint"]
 
 
 @njit(cache=True)
@@ -57,3 +82,62 @@ def clearance_joint(Rb, Og, Cj, ug, V0g, Wg, ctx, acc, hstep, FM, J0, u):
     FM[4] = Rb[1, 0] * wrench[3] + Rb[1, 1] * wrench[4] + Rb[1, 2] * wrench[5]
     FM[5] = Rb[2, 0] * wrench[3] + Rb[2, 1] * wrench[4] + Rb[2, 2] * wrench[5]
     return energy, fnsum, pen_rad, pen_ax, mode, kdeep, nslice, fax, wrench
+
+
+@njit(cache=True)
+def record_joint(diag, y, Og, Cj, FM, J0, u, wrench, pen_rad, pen_ax, mode, kdeep, nslice, fax):
+    """Write the clearance joint's slots of the diagnostics row, the same for every mechanism.
+
+    ``Og``, ``Cj``, ``FM``, ``J0``, ``u`` and the scalars as given to and returned by
+    :func:`clearance_joint`; ``y`` the clearance state, whose components 4-7 are the orientation
+    quaternion of the journal's body (recorded normalised).
+    """
+    for i in range(3):
+        diag[D_OFFSET + i] = J0[i]
+        diag[D_AXIS + i] = u[i]
+        diag[D_BEAR_POS + i] = Og[i]
+        diag[D_JOUR_POS + i] = Cj[i]
+        diag[D_FORCE + i] = FM[i]
+    diag[D_TILT] = math.acos(min(1.0, u[2]))
+    diag[D_FN] = math.sqrt(wrench[6] * wrench[6] + wrench[7] * wrench[7] + wrench[8] * wrench[8])
+    diag[D_FMAG] = math.sqrt(FM[0] * FM[0] + FM[1] * FM[1] + FM[2] * FM[2])
+    diag[D_FT] = math.sqrt(
+        wrench[9] * wrench[9] + wrench[10] * wrench[10] + wrench[11] * wrench[11]
+    )
+    diag[D_MODE] = mode
+    diag[D_PEN] = pen_rad
+    diag[D_PENAX] = pen_ax
+    diag[D_K] = kdeep
+    diag[D_NSLICE] = nslice
+    diag[D_FAX] = fax
+    n = math.sqrt(y[4] * y[4] + y[5] * y[5] + y[6] * y[6] + y[7] * y[7])
+    for i in range(4):
+        diag[D_QUAT + i] = y[4 + i] / n
+
+
+@njit(cache=True)
+def record_ideal_joint(diag, bx, by, jx, jy, joff, Fx, Fy, angle):
+    """Write the joint's slots of the diagnostics row for the ideal (planar) joint.
+
+    Bearing centre (``bx``, ``by``, ``joff``), journal centre (``jx``, ``jy``, ``joff``), axis
+    +z, reaction force (``Fx``, ``Fy``, 0) on the bearing, mode ideal, no penetration; the
+    journal's body turned by ``angle`` about z (its y axis from +x) as its quaternion.
+    """
+    diag[D_BEAR_POS], diag[D_BEAR_POS + 1], diag[D_BEAR_POS + 2] = bx, by, joff
+    diag[D_JOUR_POS], diag[D_JOUR_POS + 1], diag[D_JOUR_POS + 2] = jx, jy, joff
+    diag[D_AXIS + 2] = 1.0
+    diag[D_FORCE], diag[D_FORCE + 1] = Fx, Fy
+    diag[D_FN] = math.sqrt(Fx * Fx + Fy * Fy)
+    diag[D_FMAG] = diag[D_FN]
+    diag[D_MODE] = MODE_IDEAL
+    diag[D_PEN] = 0.0
+    a = 0.5 * (angle - 0.5 * math.pi)
+    diag[D_QUAT], diag[D_QUAT + 3] = math.cos(a), math.sin(a)
+
+
+@njit(cache=True)
+def ideal_joint_info(info):
+    """Set the per-evaluation ``info`` of the ideal joint: no contact, no penetration, valid."""
+    info[I_PEN] = -1.0
+    info[I_CONTACT] = 0.0
+    info[I_BAD] = 0.0

@@ -30,44 +30,13 @@ import math
 import numpy as np
 from numba import njit
 
+from jointwear.sim.kernels import _layout as kn
 from jointwear.sim.kernels._geometry import body_rotation
-from jointwear.sim.kernels._joint import clearance_joint
-from jointwear.sim.kernels._layout import (
-    D_AXIS,
-    D_BEAR_POS,
-    D_ENERGY,
-    D_FAX,
-    D_FMAG,
-    D_FN,
-    D_FORCE,
-    D_FT,
-    D_JOUR_POS,
-    D_K,
-    D_MODE,
-    D_NSLICE,
-    D_OFFSET,
-    D_PEN,
-    D_PENAX,
-    D_QUAT,
-    D_TH1,
-    D_TILT,
-    GRAV,
-    I1,
-    I3X,
-    I3Y,
-    I3Z,
-    I_BAD,
-    I_CONTACT,
-    I_PEN,
-    IDEAL,
-    JOFF,
-    L1,
-    L2,
-    M1,
-    M2,
-    M3,
-    MODE_IDEAL,
-    ND_DIAG,
+from jointwear.sim.kernels._joint import (
+    clearance_joint,
+    ideal_joint_info,
+    record_ideal_joint,
+    record_joint,
 )
 from jointwear.sim.kernels._slider_kinematics import closed_form
 
@@ -93,8 +62,8 @@ def _eval_slider_clearance(t, y, ctx, dy, acc, hstep, diag):
     """Right-hand side of the slider-crank with the clearance joint; fills ``diag`` if sized."""
     P, IP = ctx[0], ctx[1]
     th1, xs, w1, vs = y[0], y[1], y[2], y[3]
-    l1, l2, joff = P[L1], P[L2], P[JOFF]
-    m1, mr, ms, g = P[M1], P[M2], P[M3], P[GRAV]
+    l1, l2, joff = P[kn.L1], P[kn.L2], P[kn.JOFF]
+    m1, mr, ms, g = P[kn.M1], P[kn.M2], P[kn.M3], P[kn.GRAV]
     case_b = IP[SC_CASE] == 1
     on_rod = IP[SC_BEARING_ROD] == 1
     c1, s1 = math.cos(th1), math.sin(th1)
@@ -176,9 +145,9 @@ def _eval_slider_clearance(t, y, ctx, dy, acc, hstep, diag):
     ex0, ex2 = R[0, 0], R[0, 2]  # R^T e_x (its y component does not enter rho x .)
     a0 = R[0, 0] * aP0x + R[1, 0] * aP0y
     a2 = R[0, 2] * aP0x + R[1, 2] * aP0y
-    Dx = P[I3X] + mr * c * c
-    Dy = P[I3Y]
-    Dz = P[I3Z] + mr * c * c
+    Dx = P[kn.I3X] + mr * c * c
+    Dy = P[kn.I3Y]
+    Dz = P[kn.I3Z] + mr * c * c
     # rho x v = (c v2, 0, -c v0)
     gb0 = (mb0 - (Dz - Dy) * ob1 * ob2 - mr * c * a2) / Dx
     gb1 = (mb1 - (Dx - Dz) * ob2 * ob0) / Dy
@@ -212,7 +181,7 @@ def _eval_slider_clearance(t, y, ctx, dy, acc, hstep, diag):
     dy[10] = al2
     if diag.shape[0] == 0:
         return
-    for i in range(ND_DIAG):
+    for i in range(kn.ND_DIAG):
         diag[i] = 0.0
     # rod centre of mass: velocity and acceleration
     vgx = vPx + wgy * gz - wgz * gy
@@ -234,7 +203,7 @@ def _eval_slider_clearance(t, y, ctx, dy, acc, hstep, diag):
         Fcy = -(mr * acy - Fry + mr * g)
         Mcz = Bx * Fcy - By * Fcx
     tau = -(Mcz - m1 * g * 0.5 * l1 * c1)
-    diag[D_TH1] = th1
+    diag[kn.D_TH1] = th1
     diag[D_SLIDER_POS] = xs
     diag[D_SLIDER_VEL] = vs
     diag[D_SLIDER_ACC] = xdd
@@ -244,30 +213,12 @@ def _eval_slider_clearance(t, y, ctx, dy, acc, hstep, diag):
     diag[D_ROD_OMEGA], diag[D_ROD_OMEGA + 1], diag[D_ROD_OMEGA + 2] = wgx, wgy, wgz
     diag[D_ROD_ANGLE] = math.atan2(R[1, 1], R[0, 1])
     diag[D_DRIVER_TORQUE] = tau
-    for i in range(3):
-        diag[D_OFFSET + i] = J0[i]
-        diag[D_AXIS + i] = u[i]
-        diag[D_BEAR_POS + i] = Og[i]
-        diag[D_JOUR_POS + i] = Cj[i]
-    diag[D_TILT] = math.acos(min(1.0, u[2]))
-    diag[D_FORCE], diag[D_FORCE + 1], diag[D_FORCE + 2] = FM[0], FM[1], FM[2]
-    diag[D_FN] = math.sqrt(wrench[6] ** 2 + wrench[7] ** 2 + wrench[8] ** 2)
-    diag[D_FMAG] = math.sqrt(FM[0] ** 2 + FM[1] ** 2 + FM[2] ** 2)
-    diag[D_FT] = math.sqrt(wrench[9] ** 2 + wrench[10] ** 2 + wrench[11] ** 2)
-    diag[D_MODE] = mode
-    diag[D_PEN] = pen_rad
-    diag[D_PENAX] = pen_ax
-    diag[D_K] = kdeep
-    diag[D_NSLICE] = nslice
-    diag[D_FAX] = fax
-    T = 0.5 * (P[I1] + 0.25 * m1 * l1 * l1) * w1 * w1 + 0.5 * ms * vs * vs
+    record_joint(diag, y, Og, Cj, FM, J0, u, wrench, pen_rad, pen_ax, mode, kdeep, nslice, fax)
+    T = 0.5 * (P[kn.I1] + 0.25 * m1 * l1 * l1) * w1 * w1 + 0.5 * ms * vs * vs
     T += 0.5 * mr * (vgx * vgx + vgy * vgy + vgz * vgz)
-    T += 0.5 * (P[I3X] * ob0 * ob0 + P[I3Y] * ob1 * ob1 + P[I3Z] * ob2 * ob2)
+    T += 0.5 * (P[kn.I3X] * ob0 * ob0 + P[kn.I3Y] * ob1 * ob1 + P[kn.I3Z] * ob2 * ob2)
     V = g * (0.5 * m1 * By + mr * (Py + gy))
-    diag[D_ENERGY] = T + V + energy
-    n = math.sqrt(q0 * q0 + q1 * q1 + q2 * q2 + q3 * q3)
-    for i in range(4):
-        diag[D_QUAT + i] = y[4 + i] / n
+    diag[kn.D_ENERGY] = T + V + energy
 
 
 @njit(cache=True)
@@ -282,14 +233,11 @@ def _eval_slider_ideal(t, y, ctx, dy, diag):
     th1, w1 = y[0], y[1]
     dy[0] = w1
     dy[1] = 0.0
-    info = ctx[10]
-    info[I_PEN] = -1.0
-    info[I_CONTACT] = 0.0
-    info[I_BAD] = 0.0
+    ideal_joint_info(ctx[10])
     if diag.shape[0] == 0:
         return
-    l1, l2, joff = P[L1], P[L2], P[JOFF]
-    m1, mr, ms, g = P[M1], P[M2], P[M3], P[GRAV]
+    l1, l2, joff = P[kn.L1], P[kn.L2], P[kn.JOFF]
+    m1, mr, ms, g = P[kn.M1], P[kn.M2], P[kn.M3], P[kn.GRAV]
     s1, c1 = math.sin(th1), math.cos(th1)
     x, dx, ddx, phi, dphi, ddphi = closed_form(th1, l1, l2)
     cp, sp = math.cos(phi), math.sin(phi)
@@ -303,11 +251,11 @@ def _eval_slider_ideal(t, y, ctx, dy, diag):
     FCx = -ms * ddx * w1 * w1
     FBx = Qx - FCx
     dCx, dCy = h * cp, h * sp  # C - G = -(B - G)
-    FCy = (P[I3Z] * aphi + dCx * Qy - dCy * FBx + dCy * FCx) / (2.0 * dCx)
+    FCy = (P[kn.I3Z] * aphi + dCx * Qy - dCy * FBx + dCy * FCx) / (2.0 * dCx)
     FBy = Qy - FCy
     Bxf, Byf = l1 * c1, l1 * s1
     tau = Bxf * FBy - Byf * FBx + m1 * g * 0.5 * l1 * c1
-    for i in range(ND_DIAG):
+    for i in range(kn.ND_DIAG):
         diag[i] = 0.0
     # force on the bearing at the clearance-joint location
     on_rod = IP[SC_BEARING_ROD] == 1
@@ -317,7 +265,7 @@ def _eval_slider_ideal(t, y, ctx, dy, diag):
     else:  # joint C: on the rod F_C, on the slider -F_C
         Fx, Fy = (FCx, FCy) if on_rod else (-FCx, -FCy)
         bx, by = x, 0.0
-    diag[D_TH1] = th1
+    diag[kn.D_TH1] = th1
     diag[D_SLIDER_POS] = x
     diag[D_SLIDER_VEL] = dx * w1
     diag[D_SLIDER_ACC] = ddx * w1 * w1
@@ -328,25 +276,17 @@ def _eval_slider_ideal(t, y, ctx, dy, diag):
     diag[D_ROD_OMEGA + 2] = wphi
     diag[D_ROD_ANGLE] = phi
     diag[D_DRIVER_TORQUE] = tau
-    diag[D_BEAR_POS], diag[D_BEAR_POS + 1], diag[D_BEAR_POS + 2] = bx, by, joff
-    diag[D_JOUR_POS], diag[D_JOUR_POS + 1], diag[D_JOUR_POS + 2] = bx, by, joff
-    diag[D_AXIS + 2] = 1.0
-    diag[D_FORCE], diag[D_FORCE + 1] = Fx, Fy
-    diag[D_FN] = math.sqrt(Fx * Fx + Fy * Fy)
-    diag[D_FMAG] = diag[D_FN]
-    diag[D_MODE] = MODE_IDEAL
+    record_ideal_joint(diag, bx, by, bx, by, joff, Fx, Fy, phi)
     vGx, vGy = diag[D_ROD_VEL], diag[D_ROD_VEL + 1]
-    T = 0.5 * (P[I1] + 0.25 * m1 * l1 * l1) * w1 * w1 + 0.5 * ms * (dx * w1) ** 2
-    T += 0.5 * mr * (vGx * vGx + vGy * vGy) + 0.5 * P[I3Z] * wphi * wphi
-    diag[D_ENERGY] = T + g * (0.5 * m1 * Byf + mr * (Byf + h * sp))
-    a = 0.5 * (phi - 0.5 * math.pi)
-    diag[D_QUAT], diag[D_QUAT + 3] = math.cos(a), math.sin(a)
+    T = 0.5 * (P[kn.I1] + 0.25 * m1 * l1 * l1) * w1 * w1 + 0.5 * ms * (dx * w1) ** 2
+    T += 0.5 * mr * (vGx * vGx + vGy * vGy) + 0.5 * P[kn.I3Z] * wphi * wphi
+    diag[kn.D_ENERGY] = T + g * (0.5 * m1 * Byf + mr * (Byf + h * sp))
 
 
 @njit(cache=True)
 def eval_slider_crank(t, y, ctx, dy, acc, hstep, diag):
     """Right-hand side of the slider-crank (clearance or ideal model, ``IP[IDEAL]``)."""
-    if ctx[1][IDEAL] == 1:
+    if ctx[1][kn.IDEAL] == 1:
         _eval_slider_ideal(t, y, ctx, dy, diag)
     else:
         _eval_slider_clearance(t, y, ctx, dy, acc, hstep, diag)
