@@ -279,6 +279,118 @@ def _table(cols: list[list[str]], delim: str) -> str:
     return "\n".join(delim.join(row) for row in zip(*cols, strict=True)) + "\n"
 
 
+@dataclass(frozen=True)
+class _TextFormat:
+    """How :func:`write` spells a scan: value, units, angle column, separators, header."""
+
+    scan: InstrumentScan
+    layout: str
+    value: str
+    units: str
+    angle: str
+    sep: str
+    decimal: str
+    header: bool
+    column_names: bool
+    decimals: int
+
+    def header_lines(self, extra: dict[str, str] | None = None) -> str:
+        """Keyword/value metadata lines (none without ``header``)."""
+        if not self.header:
+            return ""
+        scan, angle = self.scan, self.angle
+        meta = {
+            "Instrument": scan.metadata.get("instrument", "Talyrond"),
+            "Operator": scan.metadata.get("operator", ""),
+            "Units": self.units,
+            # the angle unit and the span are stated, never left to the reader's judgement
+            "Angle unit": {"deg": "deg", "rad": "rad", "index": "index"}.get(angle, ""),
+            "Arc": "full" if angle != "xy" else "",
+            "Z unit": "mm" if self.layout in ("long", "folder-header") else "",
+            "Points": str(scan.radius.shape[1]),
+            "Nominal radius": f"{scan.nominal_radius * 1e3:.6f} mm",
+            # generated with a known truth: the importer keeps this (data contract: data_origin)
+            "Data origin": "synthetic",
+            **(extra or {}),
+        }
+        return "".join(f"{k}: {v}\n" for k, v in meta.items() if v != "")
+
+    def layer_columns(self, i: int) -> tuple[list[str], list[list[str]]]:
+        """Column names and formatted columns of layer ``i``."""
+        scan, units, f = self.scan, self.units, _UNITS[self.units]
+        th, n = scan.theta_deg, scan.radius.shape[1]
+        fmt = self.numbers
+        if self.angle == "xy":
+            t = np.radians(th)
+            x = scan.radius[i] * np.cos(t) / f
+            y = scan.radius[i] * np.sin(t) / f
+            return [f"X [{units}]", f"Y [{units}]"], [fmt(x), fmt(y)]
+        deviation = self.value == "deviation"
+        vname = ("Deviation" if deviation else "Radius") + f" [{units}]"
+        v = fmt((scan.radius[i] - (scan.nominal_radius if deviation else 0.0)) / f)
+        if self.angle == "deg":
+            return ["Angle (deg)", vname], [_fmt(th, 6, self.decimal), v]
+        if self.angle == "rad":
+            return ["Angle (rad)", vname], [_fmt(np.radians(th), 9, self.decimal), v]
+        if self.angle == "index":
+            return ["Index", vname], [[str(j) for j in range(n)], v]
+        return [vname], [v]
+
+    def numbers(self, values: np.ndarray) -> list[str]:
+        """Values in the file's length unit, with its decimals and decimal separator."""
+        return _fmt(values, self.decimals, self.decimal)
+
+    def text(self, names: list[str], cols: list[list[str]], extra: dict | None = None) -> str:
+        """A whole file: header, column names, table."""
+        line = self.sep.join(names) + "\n" if self.column_names else ""
+        return self.header_lines(extra) + line + _table(cols, self.sep)
+
+
+def _folder_files(fmt: _TextFormat, path: Path) -> list[tuple[Path, str]]:
+    """Per-layer files (and the manifest of the ``folder`` layout)."""
+    scan, layout = fmt.scan, fmt.layout
+    files, names = [], []
+    for i in range(scan.radius.shape[0]):
+        hz = scan.heights[i] * 1e3
+        name = f"trace_z{hz:+.3f}mm.txt" if layout == "folder-names" else f"layer{i + 1:02d}.txt"
+        extra = {"Height": f"{hz:.4f} mm"} if layout == "folder-header" else {}
+        files.append((path / name, fmt.text(*fmt.layer_columns(i), extra)))
+        names.append(name)
+    if layout == "folder":
+        man = "file,z_mm\n" + "".join(
+            f"{nm},{scan.heights[i] * 1e3:.4f}\n" for i, nm in enumerate(names)
+        )
+        files.append((path / "manifest.csv", man))
+    return files
+
+
+def _long_text(fmt: _TextFormat) -> str:
+    """All layers one below the other, with a height column first."""
+    scan = fmt.scan
+    nz, n = scan.radius.shape
+    zcol: list[str] = []
+    rest: list[list[str]] | None = None
+    cn: list[str] = []
+    for i in range(nz):
+        cn, cols = fmt.layer_columns(i)
+        zcol += _fmt(np.full(n, scan.heights[i] * 1e3), 4, fmt.decimal)
+        rest = cols if rest is None else [a + b for a, b in zip(rest, cols, strict=True)]
+    assert rest is not None
+    return fmt.text(["Height [mm]"] + cn, [zcol] + rest)
+
+
+def _wide_text(fmt: _TextFormat) -> str:
+    """One angle column, then one value column per layer."""
+    if fmt.angle == "xy":
+        raise BadInputError("the wide layout holds one value column per layer; use angle='deg'")
+    scan = fmt.scan
+    nz = scan.radius.shape[0]
+    cn0, cols0 = fmt.layer_columns(0)
+    vcols = [fmt.layer_columns(i)[1][-1] for i in range(nz)]
+    names = cn0[:-1] + [f"z={scan.heights[i] * 1e3:.3f}mm" for i in range(nz)]
+    return fmt.text(names, cols0[:-1] + vcols)
+
+
 def write(
     scan: InstrumentScan,
     path: str | Path,
@@ -341,114 +453,23 @@ def write(
         raise BadInputError("decimal separator and delimiter must differ")
     if angle == "xy" and value == "deviation":
         value = "radius"  # Cartesian points are absolute positions
-    f = _UNITS[units]
     if decimals is None:
-        decimals = max(0, int(np.ceil(-np.log10(1e-10 / f))))
-    nz, n = scan.radius.shape
-    vals = scan.radius - (scan.nominal_radius if value == "deviation" else 0.0)
-    th = scan.theta_deg
-    path = Path(path)
+        decimals = max(0, int(np.ceil(-np.log10(1e-10 / _UNITS[units]))))
     sep = "  " if delimiter == " " else delimiter
-    vname = ("Deviation" if value == "deviation" else "Radius") + f" [{units}]"
-
-    def header_lines(extra: dict[str, str]) -> str:
-        if not header:
-            return ""
-        meta = {
-            "Instrument": scan.metadata.get("instrument", "Talyrond"),
-            "Operator": scan.metadata.get("operator", ""),
-            "Units": units,
-            # the angle unit and the span are stated, never left to the reader's judgement
-            "Angle unit": {"deg": "deg", "rad": "rad", "index": "index"}.get(angle, ""),
-            "Arc": "full" if angle != "xy" else "",
-            "Z unit": "mm" if layout in ("long", "folder-header") else "",
-            "Points": str(n),
-            "Nominal radius": f"{scan.nominal_radius * 1e3:.6f} mm",
-            # generated with a known truth: the importer keeps this (data contract: data_origin)
-            "Data origin": "synthetic",
-            **extra,
-        }
-        return "".join(f"{k}: {v}\n" for k, v in meta.items() if v != "")
-
-    def layer_cols(i: int) -> tuple[list[str], list[list[str]]]:
-        if angle == "xy":
-            t = np.radians(th)
-            x = scan.radius[i] * np.cos(t) / f
-            y = scan.radius[i] * np.sin(t) / f
-            return [f"X [{units}]", f"Y [{units}]"], [
-                _fmt(x, decimals, decimal),
-                _fmt(y, decimals, decimal),
-            ]
-        v = _fmt(vals[i] / f, decimals, decimal)
-        if angle == "deg":
-            return ["Angle (deg)", vname], [_fmt(th, 6, decimal), v]
-        if angle == "rad":
-            return ["Angle (rad)", vname], [_fmt(np.radians(th), 9, decimal), v]
-        if angle == "index":
-            return ["Index", vname], [[str(j) for j in range(n)], v]
-        return [vname], [v]
-
-    written: list[Path] = []
-
-    def put(p: Path, text: str) -> None:
-        with atomic_path(p) as tmp:
-            Path(tmp).write_text(text, encoding="utf-8")
-        written.append(p)
-
+    fmt = _TextFormat(
+        scan, layout, value, units, angle, sep, decimal, header, column_names, decimals
+    )
+    path = Path(path)
     if layout.startswith("folder"):
         path.mkdir(parents=True, exist_ok=True)
-        names = []
-        for i in range(nz):
-            hz = scan.heights[i] * 1e3
-            if layout == "folder-names":
-                name = f"trace_z{hz:+.3f}mm.txt"
-            else:
-                name = f"layer{i + 1:02d}.txt"
-            extra = {"Height": f"{hz:.4f} mm"} if layout == "folder-header" else {}
-            cn, cols = layer_cols(i)
-            text = header_lines(extra) + (sep.join(cn) + "\n" if column_names else "")
-            put(path / name, text + _table(cols, sep))
-            names.append(name)
-        if layout == "folder":
-            man = "file,z_mm\n" + "".join(
-                f"{nm},{scan.heights[i] * 1e3:.4f}\n" for i, nm in enumerate(names)
-            )
-            put(path / "manifest.csv", man)
-        return written
-    if layout == "single":
-        cn, cols = layer_cols(0)
-        put(
-            path,
-            header_lines({}) + (sep.join(cn) + "\n" if column_names else "") + _table(cols, sep),
-        )
-        return written
-    if layout == "long":
-        zcol: list[str] = []
-        rest: list[list[str]] | None = None
-        cn: list[str] = []
-        for i in range(nz):
-            cn, cols = layer_cols(i)
-            zcol += _fmt(np.full(n, scan.heights[i] * 1e3), 4, decimal)
-            rest = cols if rest is None else [a + b for a, b in zip(rest, cols, strict=True)]
-        assert rest is not None
-        hdr = header_lines({})
-        names = ["Height [mm]"] + cn
-        put(
-            path,
-            hdr + (sep.join(names) + "\n" if column_names else "") + _table([zcol] + rest, sep),
-        )
-        return written
-    # wide
-    if angle == "xy":
-        raise BadInputError("the wide layout holds one value column per layer; use angle='deg'")
-    cn0, cols0 = layer_cols(0)
-    angle_col = cols0[:-1]
-    vcols = [layer_cols(i)[1][-1] for i in range(nz)]
-    names = cn0[:-1] + [f"z={scan.heights[i] * 1e3:.3f}mm" for i in range(nz)]
-    put(
-        path,
-        header_lines({})
-        + (sep.join(names) + "\n" if column_names else "")
-        + _table(angle_col + vcols, sep),
-    )
-    return written
+        files = _folder_files(fmt, path)
+    elif layout == "single":
+        files = [(path, fmt.text(*fmt.layer_columns(0)))]
+    elif layout == "long":
+        files = [(path, _long_text(fmt))]
+    else:
+        files = [(path, _wide_text(fmt))]
+    for p, text in files:
+        with atomic_path(p) as tmp:
+            Path(tmp).write_text(text, encoding="utf-8")
+    return [p for p, _ in files]

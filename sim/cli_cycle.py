@@ -8,6 +8,7 @@ from typing import Annotated
 import typer
 
 from jointwear._cli import Overwrite
+from jointwear.sim._cli_options import Base, Progress
 from jointwear.sim.parameters import DEFAULT_PARAMETER_SET
 
 __all__ = ["register"]
@@ -27,9 +28,7 @@ def register(app: typer.Typer) -> None:
             Path | None,
             typer.Option("--params", help="TOML file overriding the parameter set (SI units)."),
         ] = None,
-        base: Annotated[
-            str, typer.Option("--base", help="Named parameter set the overrides apply to.")
-        ] = DEFAULT_PARAMETER_SET,
+        base: Base = DEFAULT_PARAMETER_SET,
         wear: Annotated[
             Path | None,
             typer.Option(
@@ -41,9 +40,7 @@ def register(app: typer.Typer) -> None:
             float | None,
             typer.Option("--wear-cycles", help="Snapshot of the wear map (default: the last)."),
         ] = None,
-        progress: Annotated[
-            bool, typer.Option("--progress/--no-progress", help="Progress bar on stderr.")
-        ] = True,
+        progress: Progress = None,
     ) -> None:
         """Simulate the four-bar with the 3D clearance joint C and write the time record.
 
@@ -82,9 +79,7 @@ def register(app: typer.Typer) -> None:
             except BadInputError as exc:
                 raise BadInputError(f"--wear '{wear}': {exc}") from None
             inputs.append(wear)
-        with progress_bar(
-            f"crank cycles ({p.name})", total=cycles, enabled=None if progress else False
-        ) as bar:
+        with progress_bar(f"crank cycles ({p.name})", total=cycles, enabled=progress) as bar:
             task = bar.tasks[0].id
 
             def report(fraction: float) -> None:

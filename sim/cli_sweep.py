@@ -8,31 +8,10 @@ from typing import Annotated
 import typer
 
 from jointwear._cli import Overwrite
+from jointwear.sim._cli_options import Base, Progress, Resume, Scheduler, WearParams, Workers
 from jointwear.sim.parameters import DEFAULT_PARAMETER_SET
 
-__all__ = ["register", "Workers", "Scheduler", "Resume", "Progress"]
-
-#: Options shared by the commands that run sweeps of dask tasks (sim sweep, sim verify).
-Workers = Annotated[
-    int | None,
-    typer.Option(
-        "--workers",
-        help="Local dask worker processes, one thread each (default: one per core; "
-        "0 = in this process, no dask).",
-    ),
-]
-Scheduler = Annotated[
-    str | None,
-    typer.Option("--scheduler", help="Address of a running dask scheduler, e.g. tcp://host:8786."),
-]
-Resume = Annotated[
-    bool,
-    typer.Option("--resume", help="Continue an interrupted run: compute only the missing runs."),
-]
-Progress = Annotated[
-    bool | None,
-    typer.Option("--progress/--no-progress", help="Progress bar (default: on a terminal)."),
-]
+__all__ = ["register"]
 
 
 def register(app: typer.Typer) -> None:
@@ -45,22 +24,8 @@ def register(app: typer.Typer) -> None:
         workers: Workers = None,
         scheduler: Scheduler = None,
         resume: Resume = False,
-        params: Annotated[
-            Path | None,
-            typer.Option(
-                "--params",
-                help="Base parameters of every run (TOML, as for 'sim wear', with an optional "
-                "\\[wear] table).",
-            ),
-        ] = None,
-        base: Annotated[
-            str,
-            typer.Option(
-                "--base",
-                help=f"Named parameter set of the base: the four-bar's {DEFAULT_PARAMETER_SET} "
-                "or slider_crank.",
-            ),
-        ] = DEFAULT_PARAMETER_SET,
+        params: WearParams = None,
+        base: Base = DEFAULT_PARAMETER_SET,
         progress: Progress = None,
         overwrite: Overwrite = False,
     ) -> None:

@@ -8,7 +8,7 @@ from typing import Annotated
 import typer
 
 from jointwear._cli import Overwrite
-from jointwear.sim.cli_sweep import Progress, Resume, Scheduler, Workers
+from jointwear.sim._cli_options import Progress, Resume, Scheduler, Workers
 
 __all__ = ["register"]
 

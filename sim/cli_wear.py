@@ -8,6 +8,7 @@ from typing import Annotated, Any, Literal
 import typer
 
 from jointwear._cli import Overwrite
+from jointwear.sim._cli_options import Base, Progress, WearParams
 from jointwear.sim.parameters import DEFAULT_PARAMETER_SET, JointParameters
 from jointwear.sim.wear._settings import DEFAULT_CYCLES, DEFAULT_KW, WearSettings
 
@@ -209,119 +210,112 @@ def calibrate(
         typer.echo(line)
 
 
+# options of ``sim wear`` (the update settings show the library's defaults)
+_Cycles = Annotated[float, typer.Option("--cycles", help="Target number of cycles.")]
+_Kw = Annotated[
+    float | None,
+    typer.Option(
+        "--kw", help=f"Archard wear coefficient \\[m²/N = m³/(N m)]; default {DEFAULT_KW:g}."
+    ),
+]
+_Resume = Annotated[
+    bool, typer.Option("--resume", help="Continue from the checkpoint of an earlier run.")
+]
+_Checkpoint = Annotated[
+    Path | None, typer.Option("--checkpoint", help="Checkpoint file (default: <out>.ckpt).")
+]
+_Snapshots = Annotated[
+    str | None,
+    typer.Option(
+        "--snapshots",
+        help="Cycle counts to store, comma-separated (default 1-2-5 steps and the target).",
+    ),
+]
+_Scheme = Annotated[
+    Literal["adaptive", "fixed", "schedule"] | None,
+    typer.Option(
+        "--scheme",
+        help="Update interval: adaptive, fixed, or schedule (intervals from the \\[wear] "
+        f"table); default {WearSettings.scheme}.",
+    ),
+]
+_Dn = Annotated[
+    int | None,
+    typer.Option(
+        "--dn",
+        help=f"Cycles per update (fixed) or first interval (adaptive); default {WearSettings.dn}.",
+    ),
+]
+_Tol = Annotated[
+    float | None,
+    typer.Option(
+        "--tol",
+        help="Adaptive: allowed relative change of the wear-rate field; "
+        f"default {WearSettings.tol:g}.",
+    ),
+]
+_Settle = Annotated[
+    float | None,
+    typer.Option(
+        "--settle",
+        help="Cycles discarded after each update before accumulating; "
+        f"default {WearSettings.settle_cycles:g}.",
+    ),
+]
+_Layers = Annotated[
+    int | None,
+    typer.Option(
+        "--layers", help=f"Layers over the bearing width (Nl); default {JointParameters.n_layers}."
+    ),
+]
+_Points = Annotated[
+    int | None,
+    typer.Option("--points", help=f"Points per layer (Nd); default {JointParameters.n_points}."),
+]
+_Contact = Annotated[
+    Literal["dynamics", "winkler"],
+    typer.Option(
+        "--contact",
+        help="dynamics (the multibody simulation) or winkler (prescribed load, for tests).",
+    ),
+]
+_Figure = Annotated[
+    Path | None,
+    typer.Option(
+        "--figure", help="Also write a figure of the final wear map (PNG, PDF, SVG by its suffix)."
+    ),
+]
+_Check = Annotated[
+    list[str] | None,
+    typer.Option(
+        "--check",
+        help="After the run, repeat it with 'interval' (every update interval halved) or "
+        "'grid' (spacing halved) and compare with the stated accuracy; repeatable. Exit 1 "
+        "if a change exceeds it.",
+    ),
+]
+
+
 def wear(
     out: Annotated[Path, typer.Option("--out", help="Output wear map (netCDF).")],
     overwrite: Overwrite = False,
-    cycles: Annotated[
-        float, typer.Option("--cycles", help="Target number of cycles.")
-    ] = DEFAULT_CYCLES,
-    kw: Annotated[
-        float | None,
-        typer.Option(
-            "--kw", help=f"Archard wear coefficient \\[m²/N = m³/(N m)]; default {DEFAULT_KW:g}."
-        ),
-    ] = None,
-    params: Annotated[
-        Path | None,
-        typer.Option(
-            "--params",
-            help="TOML file: simulator parameters, and a \\[wear] table (kw, scheme, dn, tol, ...).",
-        ),
-    ] = None,
-    base: Annotated[
-        str,
-        typer.Option(
-            "--base",
-            help="Named parameter set the --params overrides apply to: the four-bar's "
-            f"{DEFAULT_PARAMETER_SET} or slider_crank.",
-        ),
-    ] = DEFAULT_PARAMETER_SET,
-    resume: Annotated[
-        bool, typer.Option("--resume", help="Continue from the checkpoint of an earlier run.")
-    ] = False,
-    checkpoint: Annotated[
-        Path | None,
-        typer.Option("--checkpoint", help="Checkpoint file (default: <out>.ckpt)."),
-    ] = None,
-    snapshots: Annotated[
-        str | None,
-        typer.Option(
-            "--snapshots",
-            help="Cycle counts to store, comma-separated (default 1-2-5 steps and the target).",
-        ),
-    ] = None,
-    scheme: Annotated[
-        Literal["adaptive", "fixed", "schedule"] | None,
-        typer.Option(
-            "--scheme",
-            help="Update interval: adaptive, fixed, or schedule (intervals from the \\[wear] "
-            f"table); default {WearSettings.scheme}.",
-        ),
-    ] = None,
-    dn: Annotated[
-        int | None,
-        typer.Option(
-            "--dn",
-            help="Cycles per update (fixed) or first interval (adaptive); "
-            f"default {WearSettings.dn}.",
-        ),
-    ] = None,
-    tol: Annotated[
-        float | None,
-        typer.Option(
-            "--tol",
-            help="Adaptive: allowed relative change of the wear-rate field; "
-            f"default {WearSettings.tol:g}.",
-        ),
-    ] = None,
-    settle: Annotated[
-        float | None,
-        typer.Option(
-            "--settle",
-            help="Cycles discarded after each update before accumulating; "
-            f"default {WearSettings.settle_cycles:g}.",
-        ),
-    ] = None,
-    layers: Annotated[
-        int | None,
-        typer.Option(
-            "--layers",
-            help=f"Layers over the bearing width (Nl); default {JointParameters.n_layers}.",
-        ),
-    ] = None,
-    points: Annotated[
-        int | None,
-        typer.Option(
-            "--points", help=f"Points per layer (Nd); default {JointParameters.n_points}."
-        ),
-    ] = None,
-    contact: Annotated[
-        Literal["dynamics", "winkler"],
-        typer.Option(
-            "--contact",
-            help="dynamics (the multibody simulation) or winkler (prescribed load, for tests).",
-        ),
-    ] = "dynamics",
-    figure: Annotated[
-        Path | None,
-        typer.Option(
-            "--figure",
-            help="Also write a figure of the final wear map (PNG, PDF, SVG by its suffix).",
-        ),
-    ] = None,
-    progress: Annotated[
-        bool | None,
-        typer.Option("--progress/--no-progress", help="Progress bar (default: on a terminal)."),
-    ] = None,
-    check: Annotated[
-        list[str] | None,
-        typer.Option(
-            "--check",
-            help="After the run, repeat it with 'interval' (every update interval halved) or "
-            "'grid' (spacing halved) and compare with the stated accuracy; repeatable. Exit 1 "
-            "if a change exceeds it.",
-        ),
-    ] = None,
+    cycles: _Cycles = DEFAULT_CYCLES,
+    kw: _Kw = None,
+    params: WearParams = None,
+    base: Base = DEFAULT_PARAMETER_SET,
+    resume: _Resume = False,
+    checkpoint: _Checkpoint = None,
+    snapshots: _Snapshots = None,
+    scheme: _Scheme = None,
+    dn: _Dn = None,
+    tol: _Tol = None,
+    settle: _Settle = None,
+    layers: _Layers = None,
+    points: _Points = None,
+    contact: _Contact = "dynamics",
+    figure: _Figure = None,
+    progress: Progress = None,
+    check: _Check = None,
 ) -> None:
     """Simulate Archard wear of joint C over many cycles; checkpoint after every update."""
     import logging
