@@ -17,6 +17,7 @@ from jointwear.errors import ParameterError
 from jointwear.params import check_non_negative as _non_negative
 from jointwear.params import check_positive as _positive
 from jointwear.params import from_mapping, read_toml
+from jointwear.sim._crank import CrankDriven, check_finite, principal_inertias
 from jointwear.sim.slider_crank import BENCHMARK_TABLES, SliderCrankParameters
 
 __all__ = [
@@ -34,7 +35,7 @@ __all__ = [
 
 
 @dataclasses.dataclass(frozen=True)
-class MechanismParameters:
+class MechanismParameters(CrankDriven):
     """Links, masses and drive of the spatial four-bar (Table 1 of the study).
 
     Crank A-B, coupler B-C, follower D-C and ground A-D; A at the origin, D at
@@ -78,19 +79,10 @@ class MechanismParameters:
             crank_inertia=self.crank_inertia,
             coupler_inertia=self.coupler_inertia,
         )
-        if len(self.follower_inertia) != 3:
-            raise ParameterError(
-                f"{w}.follower_inertia must hold 3 values (I3x, I3y, I3z) [kg m2], got "
-                f"{len(self.follower_inertia)}"
-            )
-        object.__setattr__(self, "follower_inertia", tuple(float(v) for v in self.follower_inertia))
-        for i, v in enumerate(self.follower_inertia):
-            _positive(w, **{f"follower_inertia[{i}]": float(v)})
+        inertia = principal_inertias(w, "follower_inertia", self.follower_inertia, "I3x, I3y, I3z")
+        object.__setattr__(self, "follower_inertia", inertia)
         _non_negative(w, gravity=self.gravity)
-        if not math.isfinite(self.joint_offset):
-            raise ParameterError(f"{w}.joint_offset must be finite")
-        if not math.isfinite(self.crank_speed_rpm):
-            raise ParameterError(f"{w}.crank_speed_rpm must be finite")
+        check_finite(w, joint_offset=self.joint_offset, crank_speed_rpm=self.crank_speed_rpm)
         lengths = sorted(
             [self.crank_length, self.coupler_length, self.follower_length, self.ground_length]
         )
@@ -101,16 +93,6 @@ class MechanismParameters:
                 "Grashof crank-rocker (the crank must be the shortest link and "
                 "shortest + longest <= sum of the other two); the crank could not turn fully"
             )
-
-    @property
-    def crank_speed(self) -> float:
-        """Crank angular speed [rad/s] (counter-clockwise positive)."""
-        return self.crank_speed_rpm * 2.0 * math.pi / 60.0
-
-    @property
-    def period(self) -> float:
-        """Duration of one crank revolution at the nominal speed [s]."""
-        return 2.0 * math.pi / abs(self.crank_speed) if self.crank_speed else math.inf
 
 
 @dataclasses.dataclass(frozen=True)

@@ -31,13 +31,13 @@ checked against the tables in this work**: the searchable text available when th
 from __future__ import annotations
 
 import dataclasses
-import math
 from typing import Literal
 
 import numpy as np
 
 from jointwear.errors import ParameterError
 from jointwear.params import check_non_negative, check_positive
+from jointwear.sim._crank import CrankDriven, check_finite, principal_inertias
 
 __all__ = ["SliderCrankParameters", "BENCHMARK_TABLES", "slider_crank_kinematics"]
 
@@ -48,7 +48,7 @@ BEARING_BODIES = {"rod_slider": ("slider", "rod"), "crank_rod": ("crank", "rod")
 
 
 @dataclasses.dataclass(frozen=True)
-class SliderCrankParameters:
+class SliderCrankParameters(CrankDriven):
     """Links, masses and drive of the slider-crank (``[mechanism]`` of the ``slider_crank`` set).
 
     Each link's centre of mass is at mid-length (uniform links, jointwear choice: the benchmark
@@ -120,18 +120,15 @@ class SliderCrankParameters:
             slider_mass=self.slider_mass,
             crank_inertia=self.crank_inertia,
         )
-        if len(self.rod_inertia) != 3:
-            raise ParameterError(
-                "mechanism.rod_inertia must hold 3 values (Ix, Iy, Iz) [kg m2], got "
-                f"{len(self.rod_inertia)}"
-            )
-        object.__setattr__(self, "rod_inertia", tuple(float(v) for v in self.rod_inertia))
-        for i, v in enumerate(self.rod_inertia):
-            check_positive("mechanism", **{f"rod_inertia[{i}]": v})
+        inertia = principal_inertias("mechanism", "rod_inertia", self.rod_inertia, "Ix, Iy, Iz")
+        object.__setattr__(self, "rod_inertia", inertia)
         check_non_negative("mechanism", gravity=self.gravity)
-        for name in ("joint_offset", "crank_speed_rpm", "initial_crank_angle_deg"):
-            if not math.isfinite(getattr(self, name)):
-                raise ParameterError(f"mechanism.{name} must be finite")
+        check_finite(
+            "mechanism",
+            joint_offset=self.joint_offset,
+            crank_speed_rpm=self.crank_speed_rpm,
+            initial_crank_angle_deg=self.initial_crank_angle_deg,
+        )
         if self.rod_length <= self.crank_length:
             raise ParameterError(
                 f"mechanism.rod_length ({self.rod_length} m) must exceed mechanism.crank_length "
@@ -153,16 +150,6 @@ class SliderCrankParameters:
                 f"mechanism.bearing_on = {self.bearing_on!r} is not a body of the "
                 f"{self.clearance_at} joint; set it to {allowed[0]!r} or {allowed[1]!r}"
             )
-
-    @property
-    def crank_speed(self) -> float:
-        """Crank angular speed [rad/s] (counter-clockwise positive)."""
-        return self.crank_speed_rpm * 2.0 * math.pi / 60.0
-
-    @property
-    def period(self) -> float:
-        """Duration of one crank revolution [s]."""
-        return 2.0 * math.pi / abs(self.crank_speed) if self.crank_speed else math.inf
 
     @property
     def stroke(self) -> float:
