@@ -11,7 +11,8 @@ from numba import njit
 
 from jointwear.sim.kernels._friction import _apply_friction
 from jointwear.sim.kernels._geometry import (
-    _cross_acc,
+    W_NORMAL,
+    _add_force,
     _facing_node,
     _layer_axis,
     _node,
@@ -70,18 +71,6 @@ def _stiffness(P, IP, h):
     else:
         den = P[RB] - P[RJ]
     return P[KFAC] * math.sqrt(P[RJ] * rbt / den)
-
-
-@njit(cache=True, inline="always")
-def _add_normal(wrench, px, py, pz, nx, ny, nz, s):
-    """Add the normal force s (nx, ny, nz) at (px, py, pz) to the force, moment and normal slots."""
-    wrench[0] += s * nx
-    wrench[1] += s * ny
-    wrench[2] += s * nz
-    wrench[6] += s * nx
-    wrench[7] += s * ny
-    wrench[8] += s * nz
-    _cross_acc(px, py, pz, nx, ny, nz, wrench, 3, s)
 
 
 @njit(cache=True, inline="always")
@@ -206,7 +195,7 @@ def _slices(J0, u, V0, W, ctx, wrench, acc, hstep):
         for k in range(3):
             lk = lw0 if k == 0 else (lw1 if k == 1 else lw2)
             g = geo[n, k]
-            _add_normal(wrench, g[0], g[1], g[2], g[3], g[4], g[5], fn * lk)
+            _add_force(wrench, g[0], g[1], g[2], g[3], g[4], g[5], fn * lk, W_NORMAL)
         fnsum += fn
         tx = vx - rate * hx
         ty = vy - rate * hy
@@ -395,7 +384,7 @@ def _per_point(J0, u, V0, W, ctx, wrench, acc, hstep):
                 kdk = K
             fn = _damped(K * dk**nexp, rate, vimp[n], P[VFLOOR], P[CE])
             energy += K * dk ** (nexp + 1.0) / (nexp + 1.0)
-            _add_normal(wrench, nd[1], nd[2], nd[3], nd[4], nd[5], nd[6], fn)
+            _add_force(wrench, nd[1], nd[2], nd[3], nd[4], nd[5], nd[6], fn, W_NORMAL)
             fnsum += fn
             tx = vx - rate * nd[4]
             ty = vy - rate * nd[5]
@@ -462,7 +451,7 @@ def _end_faces(J0, u, V0, W, ctx, wrench, acc, hstep):
         rate = -sg * vn
         fn = _damped(kax * dlt**nexp, rate, vimp[k], P[VFLOOR], P[CE])
         energy += kax * dlt ** (nexp + 1.0) / (nexp + 1.0)
-        _add_normal(wrench, xx, xy, xz, u[0], u[1], u[2], -sg * fn)
+        _add_force(wrench, xx, xy, xz, u[0], u[1], u[2], -sg * fn, W_NORMAL)
         tx, ty, tz = vx - vn * u[0], vy - vn * u[1], vz - vn * u[2]
         vt = _apply_friction(wrench, xx, xy, xz, tx, ty, tz, fn, P[MUON], P)
         srate[k] = rate

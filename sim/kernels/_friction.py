@@ -8,7 +8,7 @@ import math
 
 from numba import njit
 
-from jointwear.sim.kernels._geometry import _cross_acc
+from jointwear.sim.kernels._geometry import W_FRICTION, _add_force
 from jointwear.sim.kernels._layout import MUD, MUS, VD, VS
 
 
@@ -34,11 +34,5 @@ def _apply_friction(wrench, px, py, pz, tx, ty, tz, fn, muon, P):
     if muon > 0.0 and vt > 0.0:
         mu = friction_coefficient(vt, P[MUS], P[MUD], P[VS], P[VD])
         s = mu * fn / vt
-        wrench[0] += s * tx
-        wrench[1] += s * ty
-        wrench[2] += s * tz
-        wrench[9] += s * tx
-        wrench[10] += s * ty
-        wrench[11] += s * tz
-        _cross_acc(px, py, pz, tx, ty, tz, wrench, 3, s)
+        _add_force(wrench, px, py, pz, tx, ty, tz, s, W_FRICTION)
     return vt

@@ -81,6 +81,24 @@ def _cross_acc(ax, ay, az, bx, by, bz, out, k, s):
     out[k + 2] += s * (ax * by - ay * bx)
 
 
+#: Slots of a contact wrench (12 values): resultant force 0-2, its moment 3-5, then the sums of
+#: the normal forces (6-8) and of the friction forces (9-11).
+W_NORMAL, W_FRICTION = 6, 9
+
+
+@njit(cache=True, inline="always")
+def _add_force(wrench, px, py, pz, dx, dy, dz, s, part):
+    """Add the force s (dx, dy, dz) acting at (px, py, pz) to a contact wrench: to the resultant,
+    to its ``part`` (:data:`W_NORMAL` or :data:`W_FRICTION`) and its moment to the moment slots."""
+    wrench[0] += s * dx
+    wrench[1] += s * dy
+    wrench[2] += s * dz
+    wrench[part] += s * dx
+    wrench[part + 1] += s * dy
+    wrench[part + 2] += s * dz
+    _cross_acc(px, py, pz, dx, dy, dz, wrench, 3, s)
+
+
 _GL_T = (0.5 - 0.5 * math.sqrt(0.6), 0.5, 0.5 + 0.5 * math.sqrt(0.6))
 
 
