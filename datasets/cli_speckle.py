@@ -9,8 +9,6 @@ import typer
 
 from jointwear._cli import Overwrite
 
-FIELDS = ("rigid", "affine", "rotation", "sinusoidal")
-
 
 def register(app: typer.Typer) -> None:
     """Add ``speckle`` to the ``jointwear datasets`` group."""
@@ -54,43 +52,15 @@ def register(app: typer.Typer) -> None:
         seed: Annotated[int, typer.Option("--seed", help="Random seed.")] = 0,
     ) -> None:
         """Write reference/deformed speckle PNGs and the exact displacement (truth.nc)."""
-        import cv2
-        import numpy as np
-        import xarray as xr
-
-        from jointwear._version import __version__
-        from jointwear.datasets import speckle as sp
-        from jointwear.errors import BadInputError, ParameterError
-        from jointwear.io import atomic_path, save
+        from jointwear.datasets.speckle import SpeckleParams
+        from jointwear.datasets.speckle_set import write_speckle_set
+        from jointwear.errors import BadInputError
 
         try:
             w, h = (int(s) for s in size.lower().split("x"))
         except ValueError:
             raise BadInputError(f"--size {size!r}: expected WIDTHxHEIGHT, e.g. 512x512") from None
-        if field not in FIELDS:
-            raise ParameterError(f"--field {field!r}: expected one of {', '.join(FIELDS)}")
-        if frames < 1:
-            raise ParameterError(f"--frames {frames}: expected >= 1")
-        if not 1 <= bit_depth <= 16:
-            raise ParameterError(f"--bit-depth {bit_depth}: expected 1..16 (PNG output)")
-        centre = ((w - 1) / 2, (h - 1) / 2)
-
-        def make(scale: float) -> sp.Field:
-            if field == "rigid":
-                return sp.RigidField((u * scale, v * scale), theta_deg * scale, centre)
-            if field == "rotation":
-                return sp.rotation(theta_deg * scale, centre)
-            if field == "affine":
-                return sp.AffineField.from_strain(
-                    exx=strain * scale,
-                    eyy=-0.5 * strain * scale,
-                    rotation_deg=theta_deg * scale,
-                    translation=(u * scale, v * scale),
-                    center=centre,
-                )
-            return sp.SinusoidalField((amplitude * scale, 0.0), wavelength)
-
-        params = sp.SpeckleParams(
+        params = SpeckleParams(
             speckle_size=speckle_size,
             density=density,
             contrast=contrast,
@@ -98,53 +68,18 @@ def register(app: typer.Typer) -> None:
             noise_std=noise,
             blur_std=blur,
         )
-        fields = [make((k + 1) / frames) for k in range(frames)]
-        images = sp.speckle_sequence((h, w), [None, *fields], params=params, seed=seed)
-        out.mkdir(parents=True, exist_ok=True)
-        names = (
-            ["reference.png", "deformed.png"]
-            if frames == 1
-            else [f"frame_{k:04d}.png" for k in range(frames + 1)]
-        )
-        for name, img in zip(names, images, strict=True):
-            with atomic_path(out / name) as tmp:
-                ok, buf = cv2.imencode(".png", img)
-                if not ok:
-                    raise BadInputError(f"could not encode {name} as PNG")
-                tmp.write_bytes(buf.tobytes())
-        truths = [sp.truth_dataset(f, (h, w)) for f in fields]
-        zero = xr.zeros_like(truths[0])
-        truth = xr.concat([zero, *truths], dim="time") if frames > 1 else truths[0]
-        if frames > 1:
-            truth = truth.assign_coords(
-                time=(
-                    "time",
-                    np.arange(frames + 1, dtype=float),
-                    {"units": "s", "long_name": "frame index (1 frame per second)"},
-                )
-            )
-        truth.attrs.update(
-            {
-                "title": "synthetic speckle ground truth (Lagrangian displacement of reference pixels)",
-                "field_kind": field,
-                "images": ", ".join(names),
-            }
-        )
-        save(
-            truth,
-            out / "truth.nc",
-            parameters={
-                "speckle": params,
-                "field": field,
-                "u": u,
-                "v": v,
-                "theta_deg": theta_deg,
-                "strain": strain,
-                "amplitude": amplitude,
-                "wavelength": wavelength,
-                "frames": frames,
-                "seed": seed,
-            },
-            source=f"jointwear {__version__} (datasets.speckle)",
+        names = write_speckle_set(
+            out,
+            (h, w),
+            field=field,
+            u=u,
+            v=v,
+            theta_deg=theta_deg,
+            strain=strain,
+            amplitude=amplitude,
+            wavelength=wavelength,
+            frames=frames,
+            params=params,
+            seed=seed,
         )
         typer.echo(f"{out}: {', '.join(names)} and truth.nc ({w}x{h} pixels, field {field})")
