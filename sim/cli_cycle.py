@@ -49,56 +49,26 @@ def register(app: typer.Typer) -> None:
         in its provenance. If the run fails, what was computed is written next to --out as
         <name>.partial.nc.
         """
-        from jointwear import io
-        from jointwear._version import source_attribute
-        from jointwear.errors import BadInputError, ParameterError, SimulationError
+        from jointwear.errors import ParameterError
         from jointwear.progress import progress_bar
-        from jointwear.sim.dynamics import run_cycles
-        from jointwear.sim.parameters import PARAMETER_SETS, load_parameters
+        from jointwear.sim._cycle_file import cycle_parameters, simulate_cycles_to_file
 
         if not cycles > 0:
             raise ParameterError(f"--cycles must be positive, got {cycles}")
-        try:
-            p = load_parameters(params, base=base) if params is not None else PARAMETER_SETS[base]
-        except KeyError as exc:
-            if isinstance(exc, ParameterError):
-                raise
-            raise BadInputError(f"--base: {exc.args[0]}") from None
-        io.check_writable(out)
-        source = source_attribute("sim.dynamics")
-        inputs = [params] if params is not None else []
-        depth = None
-        if wear is not None:
-            from jointwear.sim.dynamics import wear_depth_on_grid
-
-            worn = io.load(wear, validate=False)
-            if "wear_depth" not in worn:
-                raise BadInputError(f"--wear '{wear}' has no 'wear_depth' variable")
-            try:
-                depth = wear_depth_on_grid(worn["wear_depth"], p, cycles=wear_cycles)
-            except BadInputError as exc:
-                raise BadInputError(f"--wear '{wear}': {exc}") from None
-            inputs.append(wear)
+        p = cycle_parameters(params, base)
         with progress_bar(f"crank cycles ({p.name})", total=cycles, enabled=progress) as bar:
             task = bar.tasks[0].id
-
-            def report(fraction: float) -> None:
-                bar.update(task, completed=fraction * cycles)
-
-            try:
-                result = run_cycles(p, cycles=cycles, wear_depth=depth, progress=report)
-            except SimulationError as exc:
-                if exc.partial is not None:
-                    partial = out.with_name(out.stem + ".partial.nc")
-                    io.save(exc.partial, partial, inputs=inputs, parameters=p, source=source)
-                    raise SimulationError(
-                        f"{exc} (partial record written to '{partial}')", partial=exc.partial
-                    ) from None
-                raise
-        io.save(result.dataset, out, inputs=inputs, parameters=p, source=source)
-        if "contact_validity_warning" in result.dataset.attrs:
-            typer.echo(f"warning: {result.dataset.attrs['contact_validity_warning']}", err=True)
-        ds = result.dataset
+            ds = simulate_cycles_to_file(
+                out,
+                p,
+                cycles=cycles,
+                params_file=params,
+                wear=wear,
+                wear_cycles=wear_cycles,
+                progress=lambda fraction: bar.update(task, completed=fraction * cycles),
+            )
+        if "contact_validity_warning" in ds.attrs:
+            typer.echo(f"warning: {ds.attrs['contact_validity_warning']}", err=True)
         typer.echo(
             f"{out}: {cycles:g} cycle(s), {ds.sizes['time']} samples, "
             f"mean contact force {float(ds.contact_force.mean()):.1f} N, "

@@ -25,14 +25,15 @@ __all__ = ["simulate_wear_to_file", "wear_inputs", "run_wear_to_file", "demo_win
 SOURCE = source_attribute("sim.wear")
 
 
-def demo_winkler_contact(grid: Any) -> Any:
+def demo_winkler_contact(grid: Any, *, n_steps: int = 24) -> Any:
     """The prescribed contact of ``--contact winkler``: a 20 N load on a Winkler lining whose
-    direction swings sinusoidally between 45 and 135 degrees over the cycle, slightly tilted."""
+    direction swings sinusoidally between 45 and 135 degrees over the cycle (``n_steps`` load
+    steps), slightly tilted."""
     import numpy as np
 
     from jointwear.sim.wear._contact import WinklerContact
 
-    n = 24
+    n = n_steps
     t = (np.arange(n) + 0.5) / n
     return WinklerContact(
         grid,

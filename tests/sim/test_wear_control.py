@@ -145,17 +145,11 @@ def test_sample_rates_measures_the_scatter():
     assert np.isnan(one.rel_noise) and np.all(np.isnan(one.var))
 
 
-def test_resume_mid_run_is_bit_identical_with_the_noise_aware_controller(tmp_path):
+def test_resume_mid_run_is_bit_identical_with_the_noise_aware_controller(tmp_path, interrupt_after):
     settings = WearSettings(kw=KW, tol=0.05)
     full = WearRun(DecayingNoisyContact(), settings, cycles=50_000).run()
     ckpt = tmp_path / "run.ckpt"
-    seen = []
-
-    def stop(info):
-        seen.append(info)
-        if len(seen) == 4:
-            raise KeyboardInterrupt
-
+    stop = interrupt_after(4)
     run = WearRun(DecayingNoisyContact(), settings, cycles=50_000, checkpoint=ckpt, on_update=stop)
     with pytest.raises(KeyboardInterrupt):
         run.run()

@@ -7,6 +7,8 @@ stability limit dN = 2 / (kw s kf) of explicit updates on a Winkler foundation, 
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -24,24 +26,15 @@ from jointwear.sim import (
     simulate_wear,
     worn_volume,
 )
+from jointwear.sim.wear._files import demo_winkler_contact
 
 GRID = BearingGrid(10, 72)
 
 
-def swept_winkler(grid=GRID, **kw):
-    """Load swinging between 45 and 135 degrees over the cycle, tilted journal."""
-    n = 12
-    t = (np.arange(n) + 0.5) / n
-    args = dict(
-        load=20.0,
-        load_angle_deg=tuple(90 + 45 * np.sin(2 * np.pi * t)),
-        foundation_modulus=1e11,
-        sliding=0.02,
-        tilt=2e-3,
-        n_steps=n,
-    )
-    args.update(kw)
-    return WinklerContact(grid, **args)
+def swept_winkler(grid=GRID, **changes):
+    """Load swinging between 45 and 135 degrees over the cycle (12 steps), tilted journal;
+    ``changes``: other WinklerContact fields."""
+    return dataclasses.replace(demo_winkler_contact(grid, n_steps=12), **changes)
 
 
 def roughness(h):
@@ -209,21 +202,13 @@ class NoisyContact:
         return CycleWear(w, area, float(np.sum(w * area)), rng.bit_generator.state, cycles)
 
 
-def test_resume_after_interrupt_gives_identical_arrays(tmp_path):
+def test_resume_after_interrupt_gives_identical_arrays(tmp_path, interrupt_after):
     settings = WearSettings(kw=1e-14, tol=0.1)
     full = WearRun(NoisyContact(GRID), settings, cycles=30_000).run()
 
     ckpt = tmp_path / "run.ckpt"
-    count = {"n": 0}
-
-    def kill_after_5(info):
-        count["n"] += 1
-        if count["n"] == 5:
-            raise KeyboardInterrupt
-
-    run = WearRun(
-        NoisyContact(GRID), settings, cycles=30_000, checkpoint=ckpt, on_update=kill_after_5
-    )
+    stop = interrupt_after(5)
+    run = WearRun(NoisyContact(GRID), settings, cycles=30_000, checkpoint=ckpt, on_update=stop)
     with pytest.raises(KeyboardInterrupt):
         run.run()
     partial = run.to_dataset()

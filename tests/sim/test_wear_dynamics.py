@@ -94,25 +94,18 @@ def test_grid_invariance_20x200_to_40x400(base):
         assert abs(a / b - 1) < 0.05, name
 
 
-def test_resume_with_the_dynamics_is_identical(tmp_path):
+def test_resume_with_the_dynamics_is_identical(tmp_path, interrupt_after):
     params = replace_nested(PARAMS, **{"joint.n_layers": 6, "joint.n_points": 60})
     settings = WearSettings(kw=DEFAULT_KW * SCALE, scheme="fixed", dn=500, settle_cycles=0.5)
     full = WearRun(DynamicContact(params), settings, cycles=2000, snapshots=[]).run()
     ckpt = tmp_path / "d.ckpt"
-    seen = []
-
-    def stop_after_2(info):
-        seen.append(info)
-        if len(seen) == 2:
-            raise KeyboardInterrupt
-
     run = WearRun(
         DynamicContact(params),
         settings,
         cycles=2000,
         snapshots=[],
         checkpoint=ckpt,
-        on_update=stop_after_2,
+        on_update=interrupt_after(2),
     )
     with pytest.raises(KeyboardInterrupt):
         run.run()
