@@ -53,7 +53,7 @@ def register(app: typer.Typer) -> None:
     ) -> None:
         """Write reference/deformed speckle PNGs and the exact displacement (truth.nc)."""
         from jointwear.datasets.speckle import SpeckleParams
-        from jointwear.datasets.speckle_set import write_speckle_set
+        from jointwear.datasets.speckle_set import SpeckleMotion, write_speckle_set
         from jointwear.errors import BadInputError
 
         try:
@@ -68,18 +68,6 @@ def register(app: typer.Typer) -> None:
             noise_std=noise,
             blur_std=blur,
         )
-        names = write_speckle_set(
-            out,
-            (h, w),
-            field=field,
-            u=u,
-            v=v,
-            theta_deg=theta_deg,
-            strain=strain,
-            amplitude=amplitude,
-            wavelength=wavelength,
-            frames=frames,
-            params=params,
-            seed=seed,
-        )
+        motion = SpeckleMotion(field, u, v, theta_deg, strain, amplitude, wavelength)
+        names = write_speckle_set(out, (h, w), motion, frames=frames, params=params, seed=seed)
         typer.echo(f"{out}: {', '.join(names)} and truth.nc ({w}x{h} pixels, field {field})")

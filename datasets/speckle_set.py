@@ -1,12 +1,14 @@
 """A speckle data set on disk: reference and deformed PNGs with their exact displacement.
 
-:func:`write_speckle_set` renders the frames with :mod:`jointwear.datasets.speckle` for one of
-the :data:`FIELDS` (ramped up over the frames) and writes them with ``truth.nc``, the Lagrangian
+:func:`write_speckle_set` renders the frames with :mod:`jointwear.datasets.speckle` for a
+:class:`SpeckleMotion`, one of the :data:`FIELDS` (ramped up over the frames), and writes them with ``truth.nc``, the Lagrangian
 displacement of every reference pixel; ``jointwear datasets speckle`` is its command.
 """
 
 from __future__ import annotations
 
+import dataclasses
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -17,56 +19,60 @@ from jointwear.datasets import speckle as sp
 from jointwear.errors import BadInputError, ParameterError
 from jointwear.io import atomic_path, save
 
-__all__ = ["FIELDS", "speckle_field", "write_speckle_set"]
+__all__ = ["FIELDS", "SpeckleMotion", "write_speckle_set"]
 
 #: Displacement fields of a speckle data set.
 FIELDS = ("rigid", "affine", "rotation", "sinusoidal")
 
 
-def speckle_field(
-    kind: str,
-    shape: tuple[int, int],
-    *,
-    u: float = 1.5,
-    v: float = -0.7,
-    theta_deg: float = 0.0,
-    strain: float = 0.01,
-    amplitude: float = 2.0,
-    wavelength: float = 128.0,
-) -> sp.Field:
-    """A displacement field of the reference image of ``shape`` (height, width) [pixel].
+@dataclass(frozen=True)
+class SpeckleMotion:
+    """The displacement field of the last frame of a speckle data set (pixel units).
 
-    ``rigid``: translation (``u``, ``v``) [pixel] and rotation ``theta_deg`` about the image
-    centre (+x towards +y); ``rotation``: the rotation alone; ``affine``: normal strain
+    ``rigid``: translation (``u``, ``v``) [pixel] and rotation ``theta_deg`` [degree] about the
+    image centre (+x towards +y); ``rotation``: the rotation alone; ``affine``: normal strain
     exx = ``strain``, eyy = -strain/2 with that rotation and translation; ``sinusoidal``: u of
     ``amplitude`` [pixel] varying along x with ``wavelength`` [pixel].
     """
-    if kind not in FIELDS:
-        raise ParameterError(f"field {kind!r}: expected one of {', '.join(FIELDS)}")
-    h, w = shape
-    centre = ((w - 1) / 2, (h - 1) / 2)
-    if kind == "rigid":
-        return sp.RigidField((u, v), theta_deg, centre)
-    if kind == "rotation":
-        return sp.rotation(theta_deg, centre)
-    if kind == "affine":
-        return sp.AffineField.from_strain(
-            exx=strain, eyy=-0.5 * strain, rotation_deg=theta_deg, translation=(u, v), center=centre
-        )
-    return sp.SinusoidalField((amplitude, 0.0), wavelength)
+
+    field: str = "rigid"
+    u: float = 1.5
+    v: float = -0.7
+    theta_deg: float = 0.0
+    strain: float = 0.01
+    amplitude: float = 2.0
+    wavelength: float = 128.0
+
+    def __post_init__(self) -> None:
+        if self.field not in FIELDS:
+            raise ParameterError(f"field {self.field!r}: expected one of {', '.join(FIELDS)}")
+
+    def at(self, shape: tuple[int, int], scale: float = 1.0) -> sp.Field:
+        """The field on a reference image of ``shape`` (height, width), its amplitudes scaled
+        by ``scale`` (the sinusoid's wavelength is not)."""
+        h, w = shape
+        centre = ((w - 1) / 2, (h - 1) / 2)
+        u, v, theta = self.u * scale, self.v * scale, self.theta_deg * scale
+        if self.field == "rigid":
+            return sp.RigidField((u, v), theta, centre)
+        if self.field == "rotation":
+            return sp.rotation(theta, centre)
+        if self.field == "affine":
+            return sp.AffineField.from_strain(
+                exx=self.strain * scale,
+                eyy=-0.5 * self.strain * scale,
+                rotation_deg=theta,
+                translation=(u, v),
+                center=centre,
+            )
+        return sp.SinusoidalField((self.amplitude * scale, 0.0), self.wavelength)
 
 
 def write_speckle_set(
     out: str | Path,
     shape: tuple[int, int],
+    motion: SpeckleMotion | None = None,
     *,
-    field: str = "rigid",
-    u: float = 1.5,
-    v: float = -0.7,
-    theta_deg: float = 0.0,
-    strain: float = 0.01,
-    amplitude: float = 2.0,
-    wavelength: float = 128.0,
     frames: int = 1,
     params: sp.SpeckleParams | None = None,
     seed: int = 0,
@@ -80,9 +86,9 @@ def write_speckle_set(
         ``frame_0000.png`` ... (frame 0 the reference), and ``truth.nc``.
     shape : (int, int)
         Image height and width [pixel].
-    field, u, v, theta_deg, strain, amplitude, wavelength
-        The displacement of the last frame (:func:`speckle_field`); frame k of ``frames`` has
-        the field scaled by k / frames (the sinusoid's wavelength unscaled).
+    motion : SpeckleMotion, optional
+        The displacement of the last frame (default ``SpeckleMotion()``); frame k of ``frames``
+        has it scaled by k / frames.
     frames : int
         Number of deformed frames (>= 1); with more than one, ``truth.nc`` has a ``time``
         dimension (one frame per second, the reference at 0).
@@ -93,17 +99,12 @@ def write_speckle_set(
     """
     if frames < 1:
         raise ParameterError(f"frames={frames}: expected >= 1")
+    motion = SpeckleMotion() if motion is None else motion
     params = sp.SpeckleParams() if params is None else params
     if not 1 <= params.bit_depth <= 16:
         raise ParameterError(f"bit_depth={params.bit_depth}: expected 1..16 (PNG output)")
-    h, w = shape
-    motion = {"u": u, "v": v, "theta_deg": theta_deg, "strain": strain, "amplitude": amplitude}
-    scales = [(k + 1) / frames for k in range(frames)]
-    fields = [
-        speckle_field(field, shape, wavelength=wavelength, **{k: x * s for k, x in motion.items()})
-        for s in scales
-    ]
-    images = sp.speckle_sequence((h, w), [None, *fields], params=params, seed=seed)
+    fields = [motion.at(shape, (k + 1) / frames) for k in range(frames)]
+    images = sp.speckle_sequence(shape, [None, *fields], params=params, seed=seed)
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     names = (
@@ -114,13 +115,11 @@ def write_speckle_set(
     for name, img in zip(names, images, strict=True):
         _write_png(out / name, img)
     save(
-        _truth(fields, (h, w), field, names),
+        _truth(fields, shape, motion.field, names),
         out / "truth.nc",
         parameters={
             "speckle": params,
-            "field": field,
-            **{k: motion[k] for k in ("u", "v", "theta_deg", "strain", "amplitude")},
-            "wavelength": wavelength,
+            **dataclasses.asdict(motion),
             "frames": frames,
             "seed": seed,
         },
