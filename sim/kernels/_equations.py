@@ -13,6 +13,7 @@ from jointwear.sim.kernels._geometry import body_rotation
 from jointwear.sim.kernels._joint import (
     clearance_joint,
     ideal_joint_info,
+    joint_frames,
     record_ideal_joint,
     record_joint,
 )
@@ -76,20 +77,8 @@ def _eval_clearance(t, y, ctx, dy, acc, hstep, diag):
     Cj = np.empty(3)
     ug = np.empty(3)
     on_coupler = IP[ON_COUPLER] == 1
-    if on_coupler:
-        Rb[0, 0], Rb[1, 0], Rb[2, 0] = c2, s2, 0.0
-        Rb[0, 1], Rb[1, 1], Rb[2, 1] = -s2, c2, 0.0
-        Rb[0, 2], Rb[1, 2], Rb[2, 2] = 0.0, 0.0, 1.0
-        Og[0], Og[1], Og[2] = Ccx, Ccy, dz
-        Cj[0], Cj[1], Cj[2] = Cfx, Cfy, Cfz
-        ug[0], ug[1], ug[2] = R[0, 2], R[1, 2], R[2, 2]
-    else:
-        for i in range(3):
-            for j in range(3):
-                Rb[i, j] = R[i, j]
-        Og[0], Og[1], Og[2] = Cfx, Cfy, Cfz
-        Cj[0], Cj[1], Cj[2] = Ccx, Ccy, dz
-        ug[0], ug[1], ug[2] = 0.0, 0.0, 1.0
+    # the follower is the spatial body, the coupler the planar one
+    joint_frames(not on_coupler, R, Cfx, Cfy, Cfz, c2, s2, -s2, c2, Ccx, Ccy, dz, Rb, Og, Cj, ug)
     # velocities at Og of the coupler-fixed and follower-fixed points, and angular velocities
     vcx = vBx - w2 * (Og[1] - By)
     vcy = vBy + w2 * (Og[0] - Bx)

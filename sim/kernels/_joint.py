@@ -40,7 +40,40 @@ from jointwear.sim.kernels._layout import (
 )
 from jointwear.sim.kernels._tilt import _tilt_spring
 
-__all__ = ["clearance_joint", "record_joint", "ideal_joint_info", "record_ideal_joint"]
+__all__ = [
+    "joint_frames",
+    "clearance_joint",
+    "record_joint",
+    "ideal_joint_info",
+    "record_ideal_joint",
+]
+
+
+@njit(cache=True, inline="always")
+def joint_frames(on_spatial, R, sx, sy, sz, xx, xy, yx, yy, qx, qy, qz, Rb, Og, Cj, ug):
+    """Fill the bearing frame ``Rb``, bearing centre ``Og``, journal centre ``Cj`` and journal
+    axis ``ug`` (global) of a joint between a spatial body and a planar one.
+
+    The spatial body is turned by ``R`` (body -> global; its z axis is its joint axis) and has
+    its joint centre at (``sx``, ``sy``, ``sz``); the planar body turns about +z, its x and y
+    axes are (``xx``, ``xy``, 0) and (``yx``, ``yy``, 0), its joint centre is at (``qx``,
+    ``qy``, ``qz``).
+    The bearing is on the spatial body if ``on_spatial``, else on the planar body.
+    """
+    if on_spatial:
+        for i in range(3):
+            for j in range(3):
+                Rb[i, j] = R[i, j]
+        Og[0], Og[1], Og[2] = sx, sy, sz
+        Cj[0], Cj[1], Cj[2] = qx, qy, qz
+        ug[0], ug[1], ug[2] = 0.0, 0.0, 1.0
+    else:
+        Rb[0, 0], Rb[1, 0], Rb[2, 0] = xx, xy, 0.0
+        Rb[0, 1], Rb[1, 1], Rb[2, 1] = yx, yy, 0.0
+        Rb[0, 2], Rb[1, 2], Rb[2, 2] = 0.0, 0.0, 1.0
+        Og[0], Og[1], Og[2] = qx, qy, qz
+        Cj[0], Cj[1], Cj[2] = sx, sy, sz
+        ug[0], ug[1], ug[2] = R[0, 2], R[1, 2], R[2, 2]
 
 
 @njit(cache=True)

@@ -35,6 +35,7 @@ from jointwear.sim.kernels._geometry import body_rotation
 from jointwear.sim.kernels._joint import (
     clearance_joint,
     ideal_joint_info,
+    joint_frames,
     record_ideal_joint,
     record_joint,
 )
@@ -89,23 +90,9 @@ def _eval_slider_clearance(t, y, ctx, dy, acc, hstep, diag):
     Og = np.empty(3)
     Cj = np.empty(3)
     ug = np.empty(3)
-    if on_rod:
-        for i in range(3):
-            for j in range(3):
-                Rb[i, j] = R[i, j]
-        Og[0], Og[1], Og[2] = Jx, Jy, Jz
-        Cj[0], Cj[1], Cj[2] = Ox, Oy, joff
-        ug[0], ug[1], ug[2] = 0.0, 0.0, 1.0
-    else:
-        for i in range(3):
-            for j in range(3):
-                Rb[i, j] = 1.0 if i == j else 0.0
-        if case_b:  # bearing on the crank: x along the crank A -> B
-            Rb[0, 0], Rb[1, 0] = c1, s1
-            Rb[0, 1], Rb[1, 1] = -s1, c1
-        Og[0], Og[1], Og[2] = Ox, Oy, joff
-        Cj[0], Cj[1], Cj[2] = Jx, Jy, Jz
-        ug[0], ug[1], ug[2] = R[0, 2], R[1, 2], R[2, 2]
+    # the rod is the spatial body; the other is the crank (x along A -> B) or the slider
+    xx, xy, yx, yy = (c1, s1, -s1, c1) if case_b else (1.0, 0.0, 0.0, 1.0)
+    joint_frames(on_rod, R, Jx, Jy, Jz, xx, xy, yx, yy, Ox, Oy, joff, Rb, Og, Cj, ug)
     # velocities at Og of the rod-fixed point and of the other body's point
     rx, ry, rz = Og[0] - Px, Og[1] - Py, Og[2]
     vrx = vPx + wgy * rz - wgz * ry
