@@ -82,7 +82,12 @@ class MechanismParameters(CrankDriven):
         inertia = principal_inertias(w, "follower_inertia", self.follower_inertia, "I3x, I3y, I3z")
         object.__setattr__(self, "follower_inertia", inertia)
         _non_negative(w, gravity=self.gravity)
-        check_finite(w, joint_offset=self.joint_offset, crank_speed_rpm=self.crank_speed_rpm)
+        check_finite(
+            w,
+            joint_offset=self.joint_offset,
+            crank_speed_rpm=self.crank_speed_rpm,
+            initial_crank_angle_deg=self.initial_crank_angle_deg,
+        )
         lengths = sorted(
             [self.crank_length, self.coupler_length, self.follower_length, self.ground_length]
         )

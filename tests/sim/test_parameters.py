@@ -93,3 +93,25 @@ def test_toml_unknown_names(tmp_path):
 def test_bad_geometry_names_the_parameter(change, match):
     with pytest.raises(ParameterError, match=match):
         replace_nested(PARAMETER_SETS["zhang2023"], **change)
+
+
+@pytest.mark.parametrize("base", ["zhang2023", "slider_crank"])
+@pytest.mark.parametrize("name", ["joint_offset", "crank_speed_rpm", "initial_crank_angle_deg"])
+def test_non_finite_mechanism_values_are_refused_by_name(base, name):
+    # a NaN start angle or speed would integrate into a NaN record instead of an error
+    with pytest.raises(ParameterError, match=rf"mechanism\.{name} must be finite"):
+        replace_nested(PARAMETER_SETS[base], **{f"mechanism.{name}": float("nan")})
+
+
+@pytest.mark.parametrize(
+    ("base", "name", "axes"),
+    [
+        ("zhang2023", "follower_inertia", "I3x, I3y, I3z"),
+        ("slider_crank", "rod_inertia", "Ix, Iy, Iz"),
+    ],
+)
+def test_inertia_triples_are_checked_alike(base, name, axes):
+    with pytest.raises(ParameterError, match=rf"mechanism\.{name} must hold 3 values \({axes}\)"):
+        replace_nested(PARAMETER_SETS[base], **{f"mechanism.{name}": (1e-3, 1e-3)})
+    with pytest.raises(ParameterError, match=rf"mechanism\.{name}\[1\] must be a positive"):
+        replace_nested(PARAMETER_SETS[base], **{f"mechanism.{name}": (1e-3, -1e-3, 1e-3)})
