@@ -10,7 +10,7 @@ import typer
 from jointwear._cli import Overwrite
 from jointwear.sim._cli_options import Base, Progress, WearParams
 from jointwear.sim.parameters import DEFAULT_PARAMETER_SET, JointParameters
-from jointwear.sim.wear._settings import DEFAULT_CYCLES, DEFAULT_KW, WearSettings
+from jointwear.sim.wear._settings import DEFAULT_CYCLES, WearSettings
 
 __all__ = ["register"]
 
@@ -212,12 +212,6 @@ def calibrate(
 
 # options of ``sim wear`` (the update settings show the library's defaults)
 _Cycles = Annotated[float, typer.Option("--cycles", help="Target number of cycles.")]
-_Kw = Annotated[
-    float | None,
-    typer.Option(
-        "--kw", help=f"Archard wear coefficient \\[m²/N = m³/(N m)]; default {DEFAULT_KW:g}."
-    ),
-]
 _Resume = Annotated[
     bool, typer.Option("--resume", help="Continue from the checkpoint of an earlier run.")
 ]
@@ -231,37 +225,28 @@ _Snapshots = Annotated[
         help="Cycle counts to store, comma-separated (default 1-2-5 steps and the target).",
     ),
 ]
-_Scheme = Annotated[
-    Literal["adaptive", "fixed", "schedule"] | None,
-    typer.Option(
-        "--scheme",
-        help="Update interval: adaptive, fixed, or schedule (intervals from the \\[wear] "
-        f"table); default {WearSettings.scheme}.",
-    ),
-]
-_Dn = Annotated[
-    int | None,
-    typer.Option(
-        "--dn",
-        help=f"Cycles per update (fixed) or first interval (adaptive); default {WearSettings.dn}.",
-    ),
-]
-_Tol = Annotated[
-    float | None,
-    typer.Option(
-        "--tol",
-        help="Adaptive: allowed relative change of the wear-rate field; "
-        f"default {WearSettings.tol:g}.",
-    ),
-]
-_Settle = Annotated[
-    float | None,
-    typer.Option(
-        "--settle",
-        help="Cycles discarded after each update before accumulating; "
-        f"default {WearSettings.settle_cycles:g}.",
-    ),
-]
+
+
+def _setting(flag: str, field: str, kind: Any, text: str) -> Any:
+    """The option type of ``--<flag>``, which overrides ``WearSettings.<field>`` (None: the
+    ``[wear]`` table's or the library's value); its help shows the library's default."""
+    default = getattr(WearSettings, field)
+    shown = f"{default:g}" if isinstance(default, float) else default
+    return Annotated[kind | None, typer.Option(flag, help=f"{text}; default {shown}.")]
+
+
+_Kw = _setting("--kw", "kw", float, "Archard wear coefficient \\[m²/N = m³/(N m)]")
+_Scheme = _setting(
+    "--scheme",
+    "scheme",
+    Literal["adaptive", "fixed", "schedule"],
+    "Update interval: adaptive, fixed, or schedule (intervals from the \\[wear] table)",
+)
+_Dn = _setting("--dn", "dn", int, "Cycles per update (fixed) or first interval (adaptive)")
+_Tol = _setting("--tol", "tol", float, "Adaptive: allowed relative change of the wear-rate field")
+_Settle = _setting(
+    "--settle", "settle_cycles", float, "Cycles discarded after each update before accumulating"
+)
 _Layers = Annotated[
     int | None,
     typer.Option(
