@@ -11,149 +11,146 @@ from jointwear._cli import Overwrite
 from jointwear._version import source_attribute
 
 
+def instruments_cmd(
+    out: Annotated[Path, typer.Argument(help="Output folder (or file for long/wide/single).")],
+    overwrite: Overwrite = False,
+    layers: Annotated[int, typer.Option("--layers", help="Number of layers.")] = 13,
+    points: Annotated[int, typer.Option("--points", help="Points per layer.")] = 18000,
+    radius_mm: Annotated[
+        float | None,
+        typer.Option(
+            "--radius-mm",
+            help="Bore radius [mm] (default 8, or the simulated bore's with --wear-from).",
+        ),
+    ] = None,
+    spacing_mm: Annotated[float, typer.Option("--spacing-mm", help="Layer spacing [mm].")] = 1.0,
+    layout: Annotated[
+        Literal["folder", "folder-names", "folder-header", "long", "wide", "single"],
+        typer.Option("--layout", help="folder, folder-names, folder-header, long, wide or single."),
+    ] = "folder",
+    value: Annotated[
+        Literal["deviation", "radius"], typer.Option("--value", help="deviation or radius.")
+    ] = "deviation",
+    units: Annotated[str, typer.Option("--units", help="um, mm, m or inch.")] = "um",
+    angle: Annotated[
+        Literal["deg", "rad", "index", "none", "xy"],
+        typer.Option("--angle", help="Angle column: deg, rad, index, none or xy."),
+    ] = "deg",
+    delimiter: Annotated[
+        str, typer.Option("--delimiter", help="tab, semicolon, comma or space.")
+    ] = "tab",
+    decimal: Annotated[str, typer.Option("--decimal", help="'.' or ','.")] = ".",
+    eccentricity_um: Annotated[
+        tuple[float, float], typer.Option("--eccentricity-um", help="Set-up offset x y [µm].")
+    ] = (15.0, -8.0),
+    tilt: Annotated[
+        tuple[float, float], typer.Option("--tilt", help="Axis slopes dx/dz dy/dz [1].")
+    ] = (1.5e-3, -0.8e-3),
+    wear_um: Annotated[
+        float, typer.Option("--wear-um", help="Peak depth of the imposed wear [µm] (0: none).")
+    ] = 20.0,
+    wear_from: Annotated[
+        Path | None,
+        typer.Option(
+            "--wear-from",
+            help="Take the imposed wear from a 'jointwear sim wear' result (last snapshot) "
+            "instead of the built-in pattern; --wear-um is then not used.",
+        ),
+    ] = None,
+    wear_scale: Annotated[
+        float,
+        typer.Option("--wear-scale", help="Factor on the wear taken with --wear-from [1]."),
+    ] = 1.0,
+    wear_rotation_deg: Annotated[
+        float,
+        typer.Option(
+            "--wear-rotation-deg",
+            help="Turn of the wear taken with --wear-from, canonical sense [degree].",
+        ),
+    ] = 0.0,
+    noise_um: Annotated[float, typer.Option("--noise-um", help="Probe noise [µm].")] = 0.02,
+    quantisation_nm: Annotated[
+        float, typer.Option("--quantisation-nm", help="Reading resolution [nm].")
+    ] = 1.0,
+    angle_zero: Annotated[
+        str, typer.Option("--angle-zero", help="Instrument 0 degree in the bearing frame.")
+    ] = "+y",
+    angle_direction: Annotated[
+        str, typer.Option("--angle-direction", help="Instrument angle sense.")
+    ] = "counterclockwise",
+    seed: Annotated[int, typer.Option("--seed", help="Random seed (form and noise).")] = 0,
+    noise_seed: Annotated[
+        int | None,
+        typer.Option("--noise-seed", help="Separate noise seed (same bore, new measurement)."),
+    ] = None,
+    truth: Annotated[
+        Path | None,
+        typer.Option("--truth", help="Also save the truth (radius, wear) as netCDF."),
+    ] = None,
+) -> None:
+    """Generate a virtual roundness-instrument scan of a worn bore with known truth."""
+    from jointwear import io
+    from jointwear.datasets.instruments import generate, write
+
+    delims = {"tab": "\t", "semicolon": ";", "comma": ",", "space": " ", "whitespace": " "}
+    wear: object = "default" if wear_um > 0 else None
+    radius = 8e-3 if radius_mm is None else radius_mm * 1e-3
+    if wear_from is not None:
+        from jointwear.datasets.simulated_wear import wear_from_simulation
+
+        sim = io.load(wear_from)
+        wear = wear_from_simulation(sim, scale=wear_scale, rotation_deg=wear_rotation_deg)
+        if radius_mm is None:
+            radius = float(sim.attrs.get("bearing_radius_m", radius))
+    sc = generate(
+        n_layers=layers,
+        n_points=points,
+        radius=radius,
+        layer_spacing=spacing_mm * 1e-3,
+        eccentricity=(eccentricity_um[0] * 1e-6, eccentricity_um[1] * 1e-6),
+        tilt=tilt,
+        wear=wear,
+        wear_depth=wear_um * 1e-6,
+        noise=noise_um * 1e-6,
+        quantisation=quantisation_nm * 1e-9,
+        convention=(angle_zero, angle_direction),
+        seed=seed,
+        noise_seed=noise_seed,
+    )
+    files = write(
+        sc,
+        out,
+        layout=layout,
+        value=value,
+        units=units,
+        angle=angle,
+        delimiter=delims.get(delimiter, delimiter),
+        decimal=decimal,
+    )
+    typer.echo(f"wrote {len(files)} file(s) under {out}")
+    typer.echo(
+        f"import with: jointwear metrology import {out} --angle-zero {angle_zero} "
+        f"--angle-direction {angle_direction} --out scan.nc"
+    )
+    if truth is not None:
+        t = sc.truth
+        io.save(
+            t,
+            truth,
+            source=source_attribute("datasets.instruments"),
+            parameters={
+                "layers": layers,
+                "points": points,
+                "seed": seed,
+                "layout": layout,
+                "wear_from": None if wear_from is None else str(wear_from),
+                "wear_scale": wear_scale,
+                "wear_rotation_deg": wear_rotation_deg,
+            },
+        )
+        typer.echo(f"wrote {truth}")
+
+
 def register(app: typer.Typer) -> None:
     """Add ``jointwear datasets instruments``."""
-
-    @app.command("instruments")
-    def instruments_cmd(
-        out: Annotated[Path, typer.Argument(help="Output folder (or file for long/wide/single).")],
-        overwrite: Overwrite = False,
-        layers: Annotated[int, typer.Option("--layers", help="Number of layers.")] = 13,
-        points: Annotated[int, typer.Option("--points", help="Points per layer.")] = 18000,
-        radius_mm: Annotated[
-            float | None,
-            typer.Option(
-                "--radius-mm",
-                help="Bore radius [mm] (default 8, or the simulated bore's with --wear-from).",
-            ),
-        ] = None,
-        spacing_mm: Annotated[
-            float, typer.Option("--spacing-mm", help="Layer spacing [mm].")
-        ] = 1.0,
-        layout: Annotated[
-            Literal["folder", "folder-names", "folder-header", "long", "wide", "single"],
-            typer.Option(
-                "--layout", help="folder, folder-names, folder-header, long, wide or single."
-            ),
-        ] = "folder",
-        value: Annotated[
-            Literal["deviation", "radius"], typer.Option("--value", help="deviation or radius.")
-        ] = "deviation",
-        units: Annotated[str, typer.Option("--units", help="um, mm, m or inch.")] = "um",
-        angle: Annotated[
-            Literal["deg", "rad", "index", "none", "xy"],
-            typer.Option("--angle", help="Angle column: deg, rad, index, none or xy."),
-        ] = "deg",
-        delimiter: Annotated[
-            str, typer.Option("--delimiter", help="tab, semicolon, comma or space.")
-        ] = "tab",
-        decimal: Annotated[str, typer.Option("--decimal", help="'.' or ','.")] = ".",
-        eccentricity_um: Annotated[
-            tuple[float, float], typer.Option("--eccentricity-um", help="Set-up offset x y [µm].")
-        ] = (15.0, -8.0),
-        tilt: Annotated[
-            tuple[float, float], typer.Option("--tilt", help="Axis slopes dx/dz dy/dz [1].")
-        ] = (1.5e-3, -0.8e-3),
-        wear_um: Annotated[
-            float, typer.Option("--wear-um", help="Peak depth of the imposed wear [µm] (0: none).")
-        ] = 20.0,
-        wear_from: Annotated[
-            Path | None,
-            typer.Option(
-                "--wear-from",
-                help="Take the imposed wear from a 'jointwear sim wear' result (last snapshot) "
-                "instead of the built-in pattern; --wear-um is then not used.",
-            ),
-        ] = None,
-        wear_scale: Annotated[
-            float,
-            typer.Option("--wear-scale", help="Factor on the wear taken with --wear-from [1]."),
-        ] = 1.0,
-        wear_rotation_deg: Annotated[
-            float,
-            typer.Option(
-                "--wear-rotation-deg",
-                help="Turn of the wear taken with --wear-from, canonical sense [degree].",
-            ),
-        ] = 0.0,
-        noise_um: Annotated[float, typer.Option("--noise-um", help="Probe noise [µm].")] = 0.02,
-        quantisation_nm: Annotated[
-            float, typer.Option("--quantisation-nm", help="Reading resolution [nm].")
-        ] = 1.0,
-        angle_zero: Annotated[
-            str, typer.Option("--angle-zero", help="Instrument 0 degree in the bearing frame.")
-        ] = "+y",
-        angle_direction: Annotated[
-            str, typer.Option("--angle-direction", help="Instrument angle sense.")
-        ] = "counterclockwise",
-        seed: Annotated[int, typer.Option("--seed", help="Random seed (form and noise).")] = 0,
-        noise_seed: Annotated[
-            int | None,
-            typer.Option("--noise-seed", help="Separate noise seed (same bore, new measurement)."),
-        ] = None,
-        truth: Annotated[
-            Path | None,
-            typer.Option("--truth", help="Also save the truth (radius, wear) as netCDF."),
-        ] = None,
-    ) -> None:
-        """Generate a virtual roundness-instrument scan of a worn bore with known truth."""
-        from jointwear import io
-        from jointwear.datasets.instruments import generate, write
-
-        delims = {"tab": "\t", "semicolon": ";", "comma": ",", "space": " ", "whitespace": " "}
-        wear: object = "default" if wear_um > 0 else None
-        radius = 8e-3 if radius_mm is None else radius_mm * 1e-3
-        if wear_from is not None:
-            from jointwear.datasets.simulated_wear import wear_from_simulation
-
-            sim = io.load(wear_from)
-            wear = wear_from_simulation(sim, scale=wear_scale, rotation_deg=wear_rotation_deg)
-            if radius_mm is None:
-                radius = float(sim.attrs.get("bearing_radius_m", radius))
-        sc = generate(
-            n_layers=layers,
-            n_points=points,
-            radius=radius,
-            layer_spacing=spacing_mm * 1e-3,
-            eccentricity=(eccentricity_um[0] * 1e-6, eccentricity_um[1] * 1e-6),
-            tilt=tilt,
-            wear=wear,
-            wear_depth=wear_um * 1e-6,
-            noise=noise_um * 1e-6,
-            quantisation=quantisation_nm * 1e-9,
-            convention=(angle_zero, angle_direction),
-            seed=seed,
-            noise_seed=noise_seed,
-        )
-        files = write(
-            sc,
-            out,
-            layout=layout,
-            value=value,
-            units=units,
-            angle=angle,
-            delimiter=delims.get(delimiter, delimiter),
-            decimal=decimal,
-        )
-        typer.echo(f"wrote {len(files)} file(s) under {out}")
-        typer.echo(
-            f"import with: jointwear metrology import {out} --angle-zero {angle_zero} "
-            f"--angle-direction {angle_direction} --out scan.nc"
-        )
-        if truth is not None:
-            t = sc.truth
-            io.save(
-                t,
-                truth,
-                source=source_attribute("datasets.instruments"),
-                parameters={
-                    "layers": layers,
-                    "points": points,
-                    "seed": seed,
-                    "layout": layout,
-                    "wear_from": None if wear_from is None else str(wear_from),
-                    "wear_scale": wear_scale,
-                    "wear_rotation_deg": wear_rotation_deg,
-                },
-            )
-            typer.echo(f"wrote {truth}")
+    app.command("instruments")(instruments_cmd)

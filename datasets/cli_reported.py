@@ -10,45 +10,47 @@ import typer
 from jointwear._cli import Overwrite
 
 
+def reported_cmd(
+    out: Annotated[Path, typer.Argument(help="TOML file to write.")],
+    overwrite: Overwrite = False,
+) -> None:
+    """Write the reference study's reported values (Zhang et al. 2023) as a reported-measurement file."""
+    from jointwear import io
+    from jointwear.datasets.reference_study import reference_file
+
+    text = reference_file().read_text(encoding="utf-8")
+    with io.atomic_path(out) as tmp:
+        tmp.write_text(text, encoding="utf-8")
+    typer.echo(f"wrote {out}: edit it or pass it to 'jointwear import reported'")
+
+
+def reference_study_cmd(
+    out: Annotated[Path, typer.Argument(help="Output folder.")],
+    overwrite: Overwrite = False,
+    reduced: Annotated[
+        bool,
+        typer.Option("--reduced", help="Coarse grid, 3 ensemble members (about a minute)."),
+    ] = False,
+) -> None:
+    """Decide the reference study's reported values against the default rig (with u_num, u_input).
+
+    Writes reported.nc, sim_wear.nc, verification.nc, ensemble.nc and metrics.nc to OUT and
+    prints the verdict per reported quantity; exit code 1 when a criterion fails.
+    """
+    from jointwear.compare.outcome import card_lines, outcome_lines, raise_for_outcome
+    from jointwear.datasets.reference_study import FULL, REDUCED, run_reference_study
+
+    result = run_reference_study(
+        out, REDUCED if reduced else FULL, say=lambda s: typer.echo(s, err=True)
+    )
+    for line in [*card_lines(result), *(f"note: {n}" for n in result.notes)]:
+        typer.echo(line)
+    for line in outcome_lines(result):
+        typer.echo(line)
+    raise_for_outcome(result, where=str(Path(out) / "metrics.nc"))
+
+
 def register(app: typer.Typer) -> None:
     """Add ``reported`` to the ``jointwear datasets`` group."""
-
-    @app.command("reported")
-    def reported_cmd(
-        out: Annotated[Path, typer.Argument(help="TOML file to write.")],
-        overwrite: Overwrite = False,
-    ) -> None:
-        """Write the reference study's reported values (Zhang et al. 2023) as a reported-measurement file."""
-        from jointwear import io
-        from jointwear.datasets.reference_study import reference_file
-
-        text = reference_file().read_text(encoding="utf-8")
-        with io.atomic_path(out) as tmp:
-            tmp.write_text(text, encoding="utf-8")
-        typer.echo(f"wrote {out}: edit it or pass it to 'jointwear import reported'")
-
-    @app.command("reference-study")
-    def reference_study_cmd(
-        out: Annotated[Path, typer.Argument(help="Output folder.")],
-        overwrite: Overwrite = False,
-        reduced: Annotated[
-            bool,
-            typer.Option("--reduced", help="Coarse grid, 3 ensemble members (about a minute)."),
-        ] = False,
-    ) -> None:
-        """Decide the reference study's reported values against the default rig (with u_num, u_input).
-
-        Writes reported.nc, sim_wear.nc, verification.nc, ensemble.nc and metrics.nc to OUT and
-        prints the verdict per reported quantity; exit code 1 when a criterion fails.
-        """
-        from jointwear.compare.outcome import card_lines, outcome_lines, raise_for_outcome
-        from jointwear.datasets.reference_study import FULL, REDUCED, run_reference_study
-
-        result = run_reference_study(
-            out, REDUCED if reduced else FULL, say=lambda s: typer.echo(s, err=True)
-        )
-        for line in [*card_lines(result), *(f"note: {n}" for n in result.notes)]:
-            typer.echo(line)
-        for line in outcome_lines(result):
-            typer.echo(line)
-        raise_for_outcome(result, where=str(Path(out) / "metrics.nc"))
+    app.command("reported")(reported_cmd)
+    app.command("reference-study")(reference_study_cmd)

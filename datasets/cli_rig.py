@@ -10,101 +10,102 @@ import typer
 from jointwear._cli import Overwrite
 
 
+def rig(
+    out: Annotated[Path, typer.Option("--out", "-o", help="Output folder.")],
+    overwrite: Overwrite = False,
+    duration: Annotated[float, typer.Option(help="Recorded time (s).")] = 1.0,
+    fps: Annotated[float, typer.Option(help="Frame rate (1/s).")] = 50.0,
+    width: Annotated[int, typer.Option(help="Image width (px).")] = 1280,
+    height: Annotated[int, typer.Option(help="Image height (px).")] = 1024,
+    z_amplitude_mm: Annotated[
+        float, typer.Option(help="Out-of-plane amplitude of joint C (mm).")
+    ] = 2.5,
+    noise: Annotated[float, typer.Option(help="Sensor noise (grey levels).")] = 1.0,
+    blur: Annotated[float, typer.Option(help="Optical blur sigma (px).")] = 0.6,
+    exposure: Annotated[float, typer.Option(help="Brightness gain.")] = 1.0,
+    codec: Annotated[
+        Literal["ffv1", "png", "grey", "mjpg", "mp4v"],
+        typer.Option(help="ffv1, png or grey (lossless), mjpg or mp4v (lossy)."),
+    ] = "ffv1",
+    video: Annotated[bool, typer.Option(help="Write videos.")] = True,
+    images: Annotated[bool, typer.Option(help="Write image folders.")] = True,
+    drop: Annotated[
+        list[int] | None, typer.Option(help="Frame index to drop (repeatable).")
+    ] = None,
+    duplicate: Annotated[
+        list[int] | None, typer.Option(help="Frame index to duplicate (repeatable).")
+    ] = None,
+    seed: Annotated[int, typer.Option(help="Random seed.")] = 0,
+    board: Annotated[
+        Literal["chessboard", "charuco"],
+        typer.Option(
+            help="Calibration board: chessboard, or charuco (10 x 8 squares of 25 mm, "
+            "18.75 mm DICT_5X5_100 markers)."
+        ),
+    ] = "chessboard",
+    board_legacy: Annotated[
+        bool,
+        typer.Option(help="ChArUco in the layout of OpenCV < 4.6 (boards printed from it)."),
+    ] = False,
+    motion: Annotated[
+        Path | None,
+        typer.Option(
+            help="Motion from data (.nc, e.g. simulator output with crank_angle and "
+            "follower_position) instead of the analytic one."
+        ),
+    ] = None,
+) -> None:
+    """Render what the rig's two cameras would record, board images and the ground truth."""
+    from jointwear.datasets.rig import RigConfig, generate_rig
+
+    cfg = RigConfig(
+        width=width,
+        height=height,
+        fps=fps,
+        duration=duration,
+        z_amplitude=z_amplitude_mm * 1e-3,
+        noise_sigma=noise,
+        blur_sigma_px=blur,
+        exposure=exposure,
+        seed=seed,
+        drop_frames=tuple(drop or ()),
+        duplicate_frames=tuple(duplicate or ()),
+        board_kind=board,
+        board_legacy=board_legacy,
+    )
+    motion_ds = None
+    if motion is not None:
+        from jointwear import io
+
+        motion_ds = io.load(motion)
+    from jointwear.progress import progress_bar
+
+    # frames of both cameras; the calibration views join the total when they start
+    offsets = {"left": 0, "right": cfg.n_frames, "calibration": 2 * cfg.n_frames}
+    with progress_bar("rendering the rig", total=2 * cfg.n_frames) as bar:
+        task = bar.tasks[0].id
+
+        def advance(stage: str, done: int, of: int) -> None:
+            bar.update(
+                task,
+                completed=offsets[stage] + done,
+                total=offsets[stage] + of if stage == "calibration" else None,
+                description=f"rendering {stage}",
+            )
+
+        written = generate_rig(
+            out,
+            cfg,
+            video=video,
+            images=images,
+            codec=codec,
+            motion=motion_ds,
+            progress=advance,
+        )
+    for key, path in written.items():
+        typer.echo(f"{key}: {path}")
+
+
 def register(app: typer.Typer) -> None:
     """Add ``rig`` to ``jointwear datasets``."""
-
-    @app.command("rig")
-    def rig(
-        out: Annotated[Path, typer.Option("--out", "-o", help="Output folder.")],
-        overwrite: Overwrite = False,
-        duration: Annotated[float, typer.Option(help="Recorded time (s).")] = 1.0,
-        fps: Annotated[float, typer.Option(help="Frame rate (1/s).")] = 50.0,
-        width: Annotated[int, typer.Option(help="Image width (px).")] = 1280,
-        height: Annotated[int, typer.Option(help="Image height (px).")] = 1024,
-        z_amplitude_mm: Annotated[
-            float, typer.Option(help="Out-of-plane amplitude of joint C (mm).")
-        ] = 2.5,
-        noise: Annotated[float, typer.Option(help="Sensor noise (grey levels).")] = 1.0,
-        blur: Annotated[float, typer.Option(help="Optical blur sigma (px).")] = 0.6,
-        exposure: Annotated[float, typer.Option(help="Brightness gain.")] = 1.0,
-        codec: Annotated[
-            Literal["ffv1", "png", "grey", "mjpg", "mp4v"],
-            typer.Option(help="ffv1, png or grey (lossless), mjpg or mp4v (lossy)."),
-        ] = "ffv1",
-        video: Annotated[bool, typer.Option(help="Write videos.")] = True,
-        images: Annotated[bool, typer.Option(help="Write image folders.")] = True,
-        drop: Annotated[
-            list[int] | None, typer.Option(help="Frame index to drop (repeatable).")
-        ] = None,
-        duplicate: Annotated[
-            list[int] | None, typer.Option(help="Frame index to duplicate (repeatable).")
-        ] = None,
-        seed: Annotated[int, typer.Option(help="Random seed.")] = 0,
-        board: Annotated[
-            Literal["chessboard", "charuco"],
-            typer.Option(
-                help="Calibration board: chessboard, or charuco (10 x 8 squares of 25 mm, "
-                "18.75 mm DICT_5X5_100 markers)."
-            ),
-        ] = "chessboard",
-        board_legacy: Annotated[
-            bool,
-            typer.Option(help="ChArUco in the layout of OpenCV < 4.6 (boards printed from it)."),
-        ] = False,
-        motion: Annotated[
-            Path | None,
-            typer.Option(
-                help="Motion from data (.nc, e.g. simulator output with crank_angle and "
-                "follower_position) instead of the analytic one."
-            ),
-        ] = None,
-    ) -> None:
-        """Render what the rig's two cameras would record, board images and the ground truth."""
-        from jointwear.datasets.rig import RigConfig, generate_rig
-
-        cfg = RigConfig(
-            width=width,
-            height=height,
-            fps=fps,
-            duration=duration,
-            z_amplitude=z_amplitude_mm * 1e-3,
-            noise_sigma=noise,
-            blur_sigma_px=blur,
-            exposure=exposure,
-            seed=seed,
-            drop_frames=tuple(drop or ()),
-            duplicate_frames=tuple(duplicate or ()),
-            board_kind=board,
-            board_legacy=board_legacy,
-        )
-        motion_ds = None
-        if motion is not None:
-            from jointwear import io
-
-            motion_ds = io.load(motion)
-        from jointwear.progress import progress_bar
-
-        # frames of both cameras; the calibration views join the total when they start
-        offsets = {"left": 0, "right": cfg.n_frames, "calibration": 2 * cfg.n_frames}
-        with progress_bar("rendering the rig", total=2 * cfg.n_frames) as bar:
-            task = bar.tasks[0].id
-
-            def advance(stage: str, done: int, of: int) -> None:
-                bar.update(
-                    task,
-                    completed=offsets[stage] + done,
-                    total=offsets[stage] + of if stage == "calibration" else None,
-                    description=f"rendering {stage}",
-                )
-
-            written = generate_rig(
-                out,
-                cfg,
-                video=video,
-                images=images,
-                codec=codec,
-                motion=motion_ds,
-                progress=advance,
-            )
-        for key, path in written.items():
-            typer.echo(f"{key}: {path}")
+    app.command("rig")(rig)

@@ -13,91 +13,90 @@ from jointwear.sim._cli_options import Progress, Resume, Scheduler, Workers
 __all__ = ["register"]
 
 
+def verify(
+    out: Annotated[Path, typer.Option("--out", help="Study file (netCDF).")],
+    spec: Annotated[
+        Path | None,
+        typer.Argument(
+            help="Study spec (TOML with a \\[verify] table; see docs/sim-wear.md). Without "
+            "it: the default study (4 dN levels N/80 x 1, 2, 4, 8; 4 replicates each; 4 "
+            "runs on the grid refined 2x)."
+        ),
+    ] = None,
+    cycles: Annotated[
+        float | None,
+        typer.Option("--cycles", help="Wear cycles of every run (overrides the spec)."),
+    ] = None,
+    params: Annotated[
+        Path | None,
+        typer.Option(
+            "--params",
+            help="The rig (TOML, as for 'sim wear', with an optional \\[wear] table); "
+            "default the zhang2023 set.",
+        ),
+    ] = None,
+    workers: Workers = None,
+    scheduler: Scheduler = None,
+    resume: Resume = False,
+    band_mm: Annotated[
+        str | None,
+        typer.Option(
+            "--band-mm",
+            help="Axial band LO,HI [mm] (e.g. what the measurement covers): adds the "
+            "maximum depth, volume and cylindricity within it as quantities.",
+        ),
+    ] = None,
+    progress: Progress = None,
+    overwrite: Overwrite = False,
+) -> None:
+    """Estimate u_num of a wear run: replicates at >= 4 update intervals dN and a grid run.
+
+    The runs are one sweep of dask tasks (resumable with --resume); the study file holds
+    every run's values and final wear map and, per quantity, the Eça-Hoekstra fit and
+    u_num = sqrt(u_stat^2 + u_refinement^2 + u_grid^2) as a standard uncertainty (k = 1).
+    """
+    from jointwear.errors import BadInputError, SimulationError
+    from jointwear.progress import progress_bar, run_counter
+    from jointwear.refinement import describe_study
+    from jointwear.sim.sweep._verify import verify_wear
+
+    if scheduler is not None and workers is not None:
+        raise BadInputError("give --workers or --scheduler, not both")
+    band = None
+    if band_mm is not None:
+        try:
+            lo, hi = (1e-3 * float(v) for v in band_mm.split(","))
+        except ValueError:
+            raise BadInputError(f"--band-mm {band_mm!r}: expected LO,HI in mm, e.g. -6,6") from None
+        band = (lo, hi)
+    if spec is None and cycles is None:
+        raise BadInputError("the default study needs --cycles N (or give a SPEC.toml)")
+    with progress_bar("verify", total=None, enabled=progress) as bar:
+        on_progress = run_counter(bar, "verify")
+
+        ds = verify_wear(
+            params,
+            cycles=cycles,
+            spec=spec,
+            workers=workers,
+            scheduler=scheduler,
+            band=band,
+            out=out,
+            resume=resume,
+            on_progress=on_progress,
+        )
+    typer.echo(
+        f"{out}: {ds.attrs['n_runs']} runs on {ds.attrs['executor']}: {ds.attrs['n_ok']} ok, "
+        f"{ds.attrs['n_failed']} failed, {ds.attrs['n_not_run']} not run"
+    )
+    typer.echo(describe_study(ds))
+    if ds.attrs["n_not_run"]:
+        raise SimulationError(
+            f"{ds.attrs['n_not_run']} run(s) were lost by the cluster; their parts are kept: "
+            "run the same command with --resume to compute them"
+        )
+
+
 def register(app: typer.Typer) -> None:
     """Add ``jointwear sim verify`` to the ``sim`` group."""
-
-    @app.command("verify")
-    def verify(
-        out: Annotated[Path, typer.Option("--out", help="Study file (netCDF).")],
-        spec: Annotated[
-            Path | None,
-            typer.Argument(
-                help="Study spec (TOML with a \\[verify] table; see docs/sim-wear.md). Without "
-                "it: the default study (4 dN levels N/80 x 1, 2, 4, 8; 4 replicates each; 4 "
-                "runs on the grid refined 2x)."
-            ),
-        ] = None,
-        cycles: Annotated[
-            float | None,
-            typer.Option("--cycles", help="Wear cycles of every run (overrides the spec)."),
-        ] = None,
-        params: Annotated[
-            Path | None,
-            typer.Option(
-                "--params",
-                help="The rig (TOML, as for 'sim wear', with an optional \\[wear] table); "
-                "default the zhang2023 set.",
-            ),
-        ] = None,
-        workers: Workers = None,
-        scheduler: Scheduler = None,
-        resume: Resume = False,
-        band_mm: Annotated[
-            str | None,
-            typer.Option(
-                "--band-mm",
-                help="Axial band LO,HI [mm] (e.g. what the measurement covers): adds the "
-                "maximum depth, volume and cylindricity within it as quantities.",
-            ),
-        ] = None,
-        progress: Progress = None,
-        overwrite: Overwrite = False,
-    ) -> None:
-        """Estimate u_num of a wear run: replicates at >= 4 update intervals dN and a grid run.
-
-        The runs are one sweep of dask tasks (resumable with --resume); the study file holds
-        every run's values and final wear map and, per quantity, the Eça-Hoekstra fit and
-        u_num = sqrt(u_stat^2 + u_refinement^2 + u_grid^2) as a standard uncertainty (k = 1).
-        """
-        from jointwear.errors import BadInputError, SimulationError
-        from jointwear.progress import progress_bar, run_counter
-        from jointwear.refinement import describe_study
-        from jointwear.sim.sweep._verify import verify_wear
-
-        if scheduler is not None and workers is not None:
-            raise BadInputError("give --workers or --scheduler, not both")
-        band = None
-        if band_mm is not None:
-            try:
-                lo, hi = (1e-3 * float(v) for v in band_mm.split(","))
-            except ValueError:
-                raise BadInputError(
-                    f"--band-mm {band_mm!r}: expected LO,HI in mm, e.g. -6,6"
-                ) from None
-            band = (lo, hi)
-        if spec is None and cycles is None:
-            raise BadInputError("the default study needs --cycles N (or give a SPEC.toml)")
-        with progress_bar("verify", total=None, enabled=progress) as bar:
-            on_progress = run_counter(bar, "verify")
-
-            ds = verify_wear(
-                params,
-                cycles=cycles,
-                spec=spec,
-                workers=workers,
-                scheduler=scheduler,
-                band=band,
-                out=out,
-                resume=resume,
-                on_progress=on_progress,
-            )
-        typer.echo(
-            f"{out}: {ds.attrs['n_runs']} runs on {ds.attrs['executor']}: {ds.attrs['n_ok']} ok, "
-            f"{ds.attrs['n_failed']} failed, {ds.attrs['n_not_run']} not run"
-        )
-        typer.echo(describe_study(ds))
-        if ds.attrs["n_not_run"]:
-            raise SimulationError(
-                f"{ds.attrs['n_not_run']} run(s) were lost by the cluster; their parts are kept: "
-                "run the same command with --resume to compute them"
-            )
+    app.command("verify")(verify)
