@@ -1,15 +1,16 @@
-"""Option types shared by the ``jointwear sim`` commands (declared once, one help text each)."""
+"""Option types shared by the ``jointwear sim`` commands (declared once, one help text each),
+and the check that closes the commands that run sweeps of dask tasks."""
 
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Any
 
 import typer
 
 from jointwear.sim.parameters import DEFAULT_PARAMETER_SET
 
-__all__ = ["Base", "WearParams", "Progress", "Workers", "Scheduler", "Resume"]
+__all__ = ["Base", "WearParams", "Progress", "Workers", "Scheduler", "Resume", "check_lost_runs"]
 
 Base = Annotated[
     str,
@@ -54,3 +55,15 @@ Resume = Annotated[
     bool,
     typer.Option("--resume", help="Continue an interrupted run: compute only the missing runs."),
 ]
+
+
+def check_lost_runs(ds: Any, where: str = "") -> None:
+    """Raise a SimulationError when the cluster lost runs of ``ds`` (``n_not_run``): their
+    parts are kept, and ``--resume`` computes them; ``where`` tells where to read why."""
+    if ds.attrs["n_not_run"]:
+        from jointwear.errors import SimulationError
+
+        raise SimulationError(
+            f"{ds.attrs['n_not_run']} run(s) were lost by the cluster{where}; their parts are "
+            "kept: run the same command with --resume to compute them"
+        )

@@ -8,7 +8,15 @@ from typing import Annotated
 import typer
 
 from jointwear._cli import Overwrite
-from jointwear.sim._cli_options import Base, Progress, Resume, Scheduler, WearParams, Workers
+from jointwear.sim._cli_options import (
+    Base,
+    Progress,
+    Resume,
+    Scheduler,
+    WearParams,
+    Workers,
+    check_lost_runs,
+)
 from jointwear.sim.parameters import DEFAULT_PARAMETER_SET
 
 __all__ = ["register"]
@@ -35,7 +43,7 @@ def sweep(
 
     import numpy as np
 
-    from jointwear.errors import BadInputError, SimulationError
+    from jointwear.errors import BadInputError
     from jointwear.progress import progress_bar, run_counter
     from jointwear.sim.sweep._driver import run_sweep
 
@@ -86,11 +94,7 @@ def sweep(
         typer.echo(
             f"sensitivity not assessed for: {ds.attrs['sensitivity_not_assessed']}", err=True
         )
-    if ds.attrs["n_not_run"]:
-        raise SimulationError(
-            f"{ds.attrs['n_not_run']} run(s) were lost by the cluster (see 'error' in {out}); "
-            "their parts are kept: run the same command with --resume to compute them"
-        )
+    check_lost_runs(ds, f" (see 'error' in {out})")
 
 
 def register(app: typer.Typer) -> None:

@@ -8,7 +8,7 @@ from typing import Annotated
 import typer
 
 from jointwear._cli import Overwrite
-from jointwear.sim._cli_options import Progress, Resume, Scheduler, Workers
+from jointwear.sim._cli_options import Progress, Resume, Scheduler, Workers, check_lost_runs
 
 __all__ = ["register"]
 
@@ -55,7 +55,7 @@ def verify(
     every run's values and final wear map and, per quantity, the Eça-Hoekstra fit and
     u_num = sqrt(u_stat^2 + u_refinement^2 + u_grid^2) as a standard uncertainty (k = 1).
     """
-    from jointwear.errors import BadInputError, SimulationError
+    from jointwear.errors import BadInputError
     from jointwear.progress import progress_bar, run_counter
     from jointwear.refinement import describe_study
     from jointwear.sim.sweep._verify import verify_wear
@@ -90,11 +90,7 @@ def verify(
         f"{ds.attrs['n_failed']} failed, {ds.attrs['n_not_run']} not run"
     )
     typer.echo(describe_study(ds))
-    if ds.attrs["n_not_run"]:
-        raise SimulationError(
-            f"{ds.attrs['n_not_run']} run(s) were lost by the cluster; their parts are kept: "
-            "run the same command with --resume to compute them"
-        )
+    check_lost_runs(ds)
 
 
 def register(app: typer.Typer) -> None:
