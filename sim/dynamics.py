@@ -3,7 +3,9 @@ results as xarray.
 
 The equations of motion (minimal coordinates, see ``docs/sim.md``) and the contact model run
 in numba (:mod:`jointwear.sim.kernels`); this module packs parameters, drives the integrator
-chunk by chunk (progress, errors with the partial record) and builds the Dataset.
+chunk by chunk (progress, errors with the partial record) and has the record built: the
+mechanism's own part by :mod:`jointwear.sim._four_bar_record` or
+:mod:`jointwear.sim._slider_record`, the rest by :mod:`jointwear.sim._record`.
 """
 
 from __future__ import annotations
