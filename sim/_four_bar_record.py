@@ -1,4 +1,4 @@
-"""The four-bar's side of the simulator: packing its parameters and its record variables.
+"""The four-bar's side of the simulator: packing its parameters, initial state, record variables.
 
 :mod:`jointwear.sim.dynamics` drives the integrator; :mod:`jointwear.sim._record` builds the
 clearance joint's part of the record for every mechanism. This module adds what is particular
@@ -7,21 +7,51 @@ to the four-bar (the slider-crank's counterpart: :mod:`jointwear.sim._slider_rec
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from jointwear import conventions
+from jointwear.errors import ParameterError
 from jointwear.sim._record import AXIS, body_motion, crank_angle, variable, vector
 from jointwear.sim.kernels import _layout as kn
-from jointwear.sim.mechanism import quaternion_to_matrix, rotation_xzy_angles
+from jointwear.sim.mechanism import loop_closure, quaternion_to_matrix, rotation_xzy_angles
 from jointwear.sim.parameters import SimParameters
 
-__all__ = ["pack_mechanism", "ANGLE_FLAGS", "variables"]
+__all__ = ["pack_mechanism", "initial_vector", "INITIAL_STEP", "ANGLE_FLAGS", "variables"]
 
 #: State components integrated with absolute tolerance only (positions and angles).
 ANGLE_FLAGS = {
     "clearance": np.array([1, 1, 0, 0, 1, 1, 1, 1, 0, 0, 0], dtype=np.int64),
     "ideal": np.array([1, 1, 1, 0, 0, 0], dtype=np.int64),
 }
+
+
+#: First step size of the integrator from the initial state [s], per joint model.
+INITIAL_STEP = {"clearance": 1e-5, "ideal": 1e-4}
+
+
+def initial_vector(params: SimParameters) -> np.ndarray:
+    """State at the documented initial configuration.
+
+    Crank at ``initial_crank_angle_deg`` turning at the nominal speed; coupler and follower at
+    the ideal four-bar's loop-closure angles and rates (joint C above the ground line); the
+    journal centred in the bearing and aligned with it; follower not rotated out of plane.
+    """
+    m = params.mechanism
+    th1 = math.radians(m.initial_crank_angle_deg)
+    th2, th3, w2, w3 = (float(v) for v in loop_closure(th1, m))
+    if params.joint.model == "ideal":
+        if not m.driver:
+            raise ParameterError(
+                "joint.model = 'ideal' needs mechanism.driver = true (the ideal four-bar is "
+                "kinematically driven); use the clearance model for a free crank"
+            )
+        return np.array([th1, th2, th3, m.crank_speed, w2, w3])
+    # follower in the x-y plane at the ideal angle: bearing and journal centres coincide
+    a = th3 - math.pi / 2
+    q = np.array([math.cos(a / 2), 0.0, 0.0, math.sin(a / 2)])
+    return np.array([th1, th2, m.crank_speed, w2, *q, 0.0, 0.0, w3])
 
 
 def pack_mechanism(params: SimParameters, P: np.ndarray, IP: np.ndarray) -> None:

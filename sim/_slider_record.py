@@ -18,7 +18,7 @@ from jointwear.sim.kernels import _layout as kn
 from jointwear.sim.parameters import SimParameters
 from jointwear.sim.slider_crank import SliderCrankParameters, slider_crank_kinematics
 
-__all__ = ["pack_mechanism", "initial_vector", "ANGLE_FLAGS", "variables"]
+__all__ = ["pack_mechanism", "initial_vector", "INITIAL_STEP", "ANGLE_FLAGS", "variables"]
 
 #: State components integrated with absolute tolerance only (positions and angles).
 ANGLE_FLAGS = {
@@ -42,6 +42,10 @@ def pack_mechanism(params: SimParameters, P: np.ndarray, IP: np.ndarray) -> None
     IP[ks.SC_CASE] = 1 if m.clearance_at == "crank_rod" else 0
     IP[ks.SC_BEARING_ROD] = 1 if m.bearing_on == "rod" else 0
     IP[ks.SC_PLANAR] = 1 if m.planar else 0
+
+
+#: First step size of the integrator from the initial state [s], per joint model.
+INITIAL_STEP = {"clearance": 1e-6, "ideal": 1e-6}
 
 
 def initial_vector(params: SimParameters) -> np.ndarray:

@@ -22,11 +22,9 @@ from jointwear.errors import BadInputError, ParameterError, SimulationError
 from jointwear.sim import _four_bar_record, _slider_record
 from jointwear.sim._record import CONTACT_MODES, add_maps, dataset, is_slider_crank
 from jointwear.sim._record import layers as _layers
-from jointwear.sim._slider_record import initial_vector as slider_crank_state
 from jointwear.sim.contact import contact_constant
 from jointwear.sim.kernels import _layout as kn
 from jointwear.sim.kernels._integrator import integrate
-from jointwear.sim.mechanism import loop_closure
 from jointwear.sim.parameters import SimParameters
 from jointwear.sim.validity import contact_validity
 
@@ -165,31 +163,15 @@ def _mechanism(params: SimParameters) -> str:
 def initial_state(params: SimParameters) -> SimState:
     """The documented initial configuration.
 
-    Crank at ``initial_crank_angle_deg`` turning at the nominal speed; coupler and follower at
-    the ideal four-bar's loop-closure angles and rates (joint C above the ground line); the
-    journal centred in the bearing and aligned with it; follower not rotated out of plane. The
-    slider-crank: :func:`jointwear.sim._slider_record.initial_vector`.
+    Crank at ``initial_crank_angle_deg`` turning at the nominal speed, the other bodies at the
+    ideal mechanism's positions and rates, the journal centred in the bearing and aligned with
+    it (:func:`jointwear.sim._four_bar_record.initial_vector`,
+    :func:`jointwear.sim._slider_record.initial_vector`).
     """
-    m = params.mechanism
+    side, model = _side(params), params.joint.model
+    y = side.initial_vector(params)
     nl = params.joint.n_layers
-    if is_slider_crank(params):
-        y = slider_crank_state(params)
-        return SimState(0.0, y, 1e-6, np.zeros(nl + 2), params.joint.model, "slider_crank")
-    th1 = math.radians(m.initial_crank_angle_deg)
-    th2, th3, w2, w3 = (float(v) for v in loop_closure(th1, m))
-    if params.joint.model == "ideal":
-        if not m.driver:
-            raise ParameterError(
-                "joint.model = 'ideal' needs mechanism.driver = true (the ideal four-bar is "
-                "kinematically driven); use the clearance model for a free crank"
-            )
-        y = np.array([th1, th2, th3, m.crank_speed, w2, w3])
-        return SimState(0.0, y, 1e-4, np.zeros(nl + 2), "ideal")
-    # follower in the x-y plane at the ideal angle: bearing and journal centres coincide
-    a = th3 - math.pi / 2
-    q = np.array([math.cos(a / 2), 0.0, 0.0, math.sin(a / 2)])
-    y = np.array([th1, th2, m.crank_speed, w2, *q, 0.0, 0.0, w3])
-    return SimState(0.0, y, 1e-5, np.zeros(nl + 2), "clearance")
+    return SimState(0.0, y, side.INITIAL_STEP[model], np.zeros(nl + 2), model, _mechanism(params))
 
 
 def _check_wear(params: SimParameters, wear_depth: np.ndarray | None) -> np.ndarray:
