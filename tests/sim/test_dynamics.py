@@ -301,3 +301,35 @@ def test_bearing_carrier_does_not_change_planar_motion():
         out.append((r.normal_impulse, float(r.dataset.contact_force.mean()), ecc.mean()))
         assert np.abs(r.dataset.follower_position.sel(axis="z")).max() < 1e-9
     np.testing.assert_allclose(out[0], out[1], rtol=0.02)
+
+
+def test_ideal_four_bar_without_driver_is_refused():
+    # the ideal four-bar is kinematically driven: a free crank is not modelled, so it is refused
+    from jointwear.errors import ParameterError
+
+    p = replace_nested(BASE, **{"joint.model": "ideal", "mechanism.driver": False})
+    with pytest.raises(ParameterError, match=r"needs mechanism\.driver = true"):
+        run_cycles(p, cycles=0.01)
+
+
+@pytest.mark.parametrize(
+    ("base", "model", "step", "length"),
+    [
+        ("zhang2023", "clearance", 1e-5, 11),
+        ("zhang2023", "ideal", 1e-4, 6),
+        ("slider_crank", "clearance", 1e-6, 11),
+        ("slider_crank", "ideal", 1e-6, 2),
+    ],
+)
+def test_initial_state_of_each_mechanism_and_model(base, model, step, length):
+    from jointwear.sim import initial_state
+
+    p = replace_nested(PARAMETER_SETS[base], **{"joint.model": model})
+    st = initial_state(p)
+    assert (st.model, st.mechanism, st.step, st.y.shape) == (
+        model,
+        base.replace("zhang2023", "four_bar"),
+        step,
+        (length,),
+    )
+    assert st.y[0] == pytest.approx(math.radians(p.mechanism.initial_crank_angle_deg))
