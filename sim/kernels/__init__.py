@@ -1,11 +1,14 @@
 """numba kernels of the simulator (four-bar, slider-crank), one module per piece of physics.
 
 * ``_layout``: indices into the parameter vectors, the diagnostics row and the info array;
-* ``_geometry``: follower rotation, bore/journal nodes, contact search, layer axes;
+* ``_geometry``: follower rotation, bore/journal nodes, contact search, layer axes, a force
+  added to a contact wrench;
 * ``_friction``: smoothed Coulomb friction (eq. 12);
 * ``_contact``: Lankarani-Nikravesh contact forces (eqs. 6-10), wear work, impact latch;
 * ``_tilt``: the lumped tilt spring-damper of the clearance joint (``joint.tilt_stiffness``);
-* ``_joint``: the clearance joint's side of the mechanism interface (poses in, wrench out);
+* ``_joint``: the clearance joint's side of the mechanism interface (poses in, wrench out), the
+  joint's frames between a spatial and a planar body, and its slots of the diagnostics row
+  (clearance and ideal joint), written once for every mechanism;
 * ``_equations``: equations of motion of the four-bar's clearance and ideal models, and the
   dispatch to the mechanism (``IP[MECH]``);
 * ``_slider_crank``, ``_slider_kinematics``: the slider-crank's equations of motion and its

@@ -4,6 +4,10 @@ A mechanism's equations of motion give :func:`clearance_joint` the two bodies' p
 velocities at the joint (bearing frame and centre, journal centre and axis, relative velocity
 and angular velocity) and get back the contact wrench on the bearing; the contact search,
 forces, friction and wear work behind it (:mod:`._contact`) know nothing of the mechanism.
+:func:`joint_frames` builds those poses for a joint between a spatial and a planar body (both
+mechanisms have one); :func:`record_joint`, :func:`record_ideal_joint` and
+:func:`ideal_joint_info` write the joint's part of the diagnostics and info, the same for every
+mechanism.
 """
 
 from __future__ import annotations
