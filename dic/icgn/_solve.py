@@ -29,7 +29,7 @@ from jointwear.dic.icgn._flags import (
 )
 from jointwear.dic.icgn._interp import PAD
 from jointwear.dic.icgn._reference import _box_has_invalid, _load_reference, _store_sigma
-from jointwear.dic.icgn._sample import interp_point, sample_affine
+from jointwear.dic.icgn._sample import add_row_sums, interp_point, sample_affine
 from jointwear.dic.icgn._warp import _compose_affine, _compose_quadratic, _solve_spd
 
 # a subset still below this ZNCC after this many iterations is not going to match
@@ -84,18 +84,10 @@ def _hessian_affine(f, gx, gy, half, Hm, jf, js):
             m[o + 3] += scc
             m[o + 4] += sc * rr
             m[o + 5] += s1 * rr * rr
-        jf[0] += rfa
-        jf[1] += rfac
-        jf[2] += rfa * rr
-        jf[3] += rfb
-        jf[4] += rfbc
-        jf[5] += rfb * rr
-        js[0] += rsa
-        js[1] += rsac
-        js[2] += rsa * rr
-        js[3] += rsb
-        js[4] += rsbc
-        js[5] += rsb * rr
+        add_row_sums(jf, 0, rfa, rfac, rr)
+        add_row_sums(jf, 3, rfb, rfbc, rr)
+        add_row_sums(js, 0, rsa, rsac, rr)
+        add_row_sums(js, 3, rsb, rsbc, rr)
     # J = [a, a c, a r, b, b c, b r]: block (i, j) of sum J J^T from the moments
     for blk_i in range(2):
         for blk_j in range(blk_i, 2):
