@@ -419,18 +419,19 @@ def _prefilter_2d(img, order, out):
         _filter_columns(tmp, blk * 64, min(w, blk * 64 + 64), z1, z2, npoles)
     # mirrored padding (reflect without repeating the edge sample)
     for i in range(h + 2 * PAD):
-        si = i - PAD
-        if si < 0:
-            si = -si
-        elif si > h - 1:
-            si = 2 * (h - 1) - si
+        si = _reflect(i - PAD, h)
         for j in range(w + 2 * PAD):
-            sj = j - PAD
-            if sj < 0:
-                sj = -sj
-            elif sj > w - 1:
-                sj = 2 * (w - 1) - sj
-            out[i, j] = tmp[si, sj]
+            out[i, j] = tmp[si, _reflect(j - PAD, w)]
+
+
+@njit(cache=True, inline="always")
+def _reflect(i, n):
+    """Index ``i`` reflected into ``0 .. n - 1`` without repeating the edge sample."""
+    if i < 0:
+        return -i
+    if i > n - 1:
+        return 2 * (n - 1) - i
+    return i
 
 
 @njit(cache=True)
@@ -560,11 +561,12 @@ def interp_value(coef, order, x, y, wx, wy):
     tx = x - ix
     ty = y - iy
     acc = 0.0
+    lead = 1 if order == 3 else 2  # nodes before the point's own: 1 cubic, 2 quintic
+    bx = ix + PAD - lead
+    by = iy + PAD - lead
     if order == 3:
         _weights3(tx, wx)
         _weights3(ty, wy)
-        bx = ix + PAD - 1
-        by = iy + PAD - 1
         for r in range(4):
             row = coef[by + r]
             s = wx[0] * row[bx] + wx[1] * row[bx + 1] + wx[2] * row[bx + 2] + wx[3] * row[bx + 3]
@@ -572,8 +574,6 @@ def interp_value(coef, order, x, y, wx, wy):
     else:
         _weights5(tx, wx)
         _weights5(ty, wy)
-        bx = ix + PAD - 2
-        by = iy + PAD - 2
         for r in range(6):
             row = coef[by + r]
             s = 0.0
@@ -595,17 +595,15 @@ def interp_value_grad(coef, order, x, y, wx, wy, dx, dy):
         _weights3(ty, wy)
         _dweights3(tx, dx)
         _dweights3(ty, dy)
-        n = 4
-        bx = ix + PAD - 1
-        by = iy + PAD - 1
     else:
         _weights5(tx, wx)
         _weights5(ty, wy)
         _dweights5(tx, dx)
         _dweights5(ty, dy)
-        n = 6
-        bx = ix + PAD - 2
-        by = iy + PAD - 2
+    lead = 1 if order == 3 else 2  # nodes before the point's own: 1 cubic, 2 quintic
+    n = 2 * lead + 2
+    bx = ix + PAD - lead
+    by = iy + PAD - lead
     f = 0.0
     fx = 0.0
     fy = 0.0
