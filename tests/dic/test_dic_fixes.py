@@ -184,29 +184,20 @@ def pair(tmp_path_factory):
 
 
 @pytest.mark.parametrize(
-    "extra, named",
+    "command, extra, named",
     [
-        (["--sequence-mode", "incremental"], "--sequence-mode"),
-        (["--fps", "50"], "--fps"),
+        # sequence options on a pair of images
+        ("correlate", ["--sequence-mode", "incremental"], "--sequence-mode"),
+        ("correlate", ["--fps", "50"], "--fps"),
+        # stereo options on a 2D field
+        ("field", ["--frame", "plane"], "--frame"),
+        ("field", ["--epipolar-max", "2"], "--epipolar-max"),
     ],
 )
-def test_correlate_flags_that_cannot_apply_to_a_pair_are_errors(pair, extra, named, capsys):
+def test_flags_that_cannot_apply_to_the_input_are_usage_errors(pair, command, extra, named, capsys):
     tmp, names = pair
-    code = main(["dic", "correlate", *names, *extra, "--out", str(tmp / "c.nc"), "--overwrite"])
-    assert code == 2, capsys.readouterr()
-    assert named in capsys.readouterr().err
-
-
-@pytest.mark.parametrize(
-    "extra, named",
-    [
-        (["--frame", "plane"], "--frame"),
-        (["--epipolar-max", "2"], "--epipolar-max"),
-    ],
-)
-def test_field_stereo_flags_on_a_2d_field_are_errors(pair, extra, named, capsys):
-    tmp, names = pair
-    code = main(["dic", "field", *names, *extra, "--out", str(tmp / "f.nc"), "--overwrite"])
+    out = tmp / f"{command}.nc"
+    code = main(["dic", command, *names, *extra, "--out", str(out), "--overwrite"])
     assert code == 2
     assert named in capsys.readouterr().err
 
