@@ -8,6 +8,7 @@ from typing import Annotated, Literal
 import typer
 
 from jointwear._cli import Overwrite
+from jointwear.dic import _cli_options as opt
 from jointwear.dic.calibration._defaults import (
     MAX_RMS_PX,
     MAX_VIEW_RMS_PX,
@@ -43,11 +44,10 @@ def _board(board, squares, square, unit, square_u, square_mm, marker, marker_mm,
             param_hint="--unit",
         )
     if board == "chessboard":
-        for given, flag in ((marker, "--marker"), (marker_mm, "--marker-mm")):
-            if given is not None:
-                raise typer.BadParameter(
-                    f"{flag} applies to a ChArUco board (--board charuco), not a chessboard"
-                )
+        opt.refuse_given(
+            ((marker, "--marker"), (marker_mm, "--marker-mm")),
+            "a ChArUco board (--board charuco), not a chessboard",
+        )
     if marker is not None:
         marker_m = marker * scale
     else:
@@ -98,9 +98,7 @@ def calibrate_cmd(
             help="Right board images (folder or quoted pattern 'cal/*_1.tif') or video.",
         ),
     ],
-    out: Annotated[Path, typer.Option("--out", "-o", help="Calibration file (.nc).")] = Path(
-        "calibration.nc"
-    ),
+    out: opt.CalibrationOutOpt = Path("calibration.nc"),
     overwrite: Overwrite = False,
     board: Annotated[
         Literal["chessboard", "charuco"], typer.Option(help="chessboard or charuco.")
@@ -205,9 +203,7 @@ def import_calibration_cmd(
         ),
     ],
     fmt: Annotated[Literal["opencv", "vic3d"], typer.Option("--format", help="opencv or vic3d.")],
-    out: Annotated[Path, typer.Option("--out", "-o", help="Calibration file (.nc).")] = Path(
-        "calibration.nc"
-    ),
+    out: opt.CalibrationOutOpt = Path("calibration.nc"),
     overwrite: Overwrite = False,
     length_unit: Annotated[
         str | None,
