@@ -17,6 +17,7 @@ __all__ = [
     "FpsOpt",
     "OriginOpt",
     "OutOpt",
+    "PlotOpt",
     "PointsOpt",
     "SearchRadiusOpt",
     "StepOpt",
@@ -49,6 +50,10 @@ PointsOpt = Annotated[
         help="Text file of subset centres 'x, y' (pixels, reference image, one per line) "
         "instead of a grid over --roi.",
     ),
+]
+PlotOpt = Annotated[
+    Path | None,
+    typer.Option("--plot", help="Also write a quick-look figure of the last image (png)."),
 ]
 AllowEmptyOpt = Annotated[
     bool,

@@ -155,9 +155,7 @@ def correlate_cmd(
         float | None,
         typer.Option("--fps", "--frame-rate", help="Sequences: frame rate (1/s)."),
     ] = None,
-    plot: Annotated[
-        Path | None, typer.Option("--plot", help="Write a quick-look figure (png).")
-    ] = None,
+    plot: opt.PlotOpt = None,
     threads: opt.ThreadsOpt = opt.DEFAULTS.threads,
     allow_empty: opt.AllowEmptyOpt = False,
 ) -> None:

@@ -96,9 +96,7 @@ def field_cmd(
         Path | None,
         typer.Option("--csv", help="Also write CSV (one file per image, VIC-3D-like)."),
     ] = None,
-    plot: Annotated[
-        Path | None, typer.Option("--plot", help="Contour figure of the last image (png).")
-    ] = None,
+    plot: opt.PlotOpt = None,
     threads: opt.ThreadsOpt = opt.DEFAULTS.threads,
     allow_empty: opt.AllowEmptyOpt = False,
     overwrite: Overwrite = False,
