@@ -10,7 +10,12 @@ from typing import Literal
 import numpy as np
 
 from jointwear.dic.calibration._camera import Camera, StereoCalibration, _check_enough_views
-from jointwear.dic.calibration._defaults import MAX_RMS_PX, MAX_VIEW_RMS_PX, MIN_VIEWS
+from jointwear.dic.calibration._defaults import (
+    CHARUCO_DICTIONARY,
+    MAX_RMS_PX,
+    MAX_VIEW_RMS_PX,
+    MIN_VIEWS,
+)
 from jointwear.errors import BadInputError, CalibrationError
 
 __all__ = ["CalibrationBoard", "calibrate_stereo", "detect_board", "board_world_frame"]
@@ -46,7 +51,7 @@ class CalibrationBoard:
     squares_y: int = 7
     square_size: float = 0.01
     marker_size: float = 0.0075
-    dictionary: str = "DICT_5X5_100"
+    dictionary: str = CHARUCO_DICTIONARY
     length_unit: str = "m"
     square_size_u: float | None = None
 

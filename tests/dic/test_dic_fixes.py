@@ -234,9 +234,18 @@ def test_track_stereo_flags_with_one_camera_are_errors(mono, tmp_path, extra, na
     assert named in capsys.readouterr().err
 
 
-def test_calibrate_marker_on_a_chessboard_is_an_error(tmp_path, capsys):
+@pytest.mark.parametrize(
+    "extra, named",
+    [
+        (["--marker", "18"], "--marker"),  # a chessboard has no markers
+        (["--dictionary", "DICT_4X4_50"], "--dictionary"),  # nor an ArUco dictionary
+        (["--every", "5"], "--every"),  # a folder of images has no frames to skip
+    ],
+)
+def test_calibrate_options_that_cannot_apply_are_errors(tmp_path, extra, named, capsys):
     args = ["dic", "calibrate", "--left", str(tmp_path), "--right", str(tmp_path)]
-    args += ["--board", "chessboard"]
-    args += ["--square", "25", "--unit", "mm", "--marker", "18", "--out", str(tmp_path / "c.nc")]
-    assert main(args) == 2
-    assert "--marker" in capsys.readouterr().err
+    args += ["--board", "chessboard", "--square", "25", "--unit", "mm", *extra]
+    assert main([*args, "--out", str(tmp_path / "c.nc")]) == 2
+    err = capsys.readouterr().err
+    assert named in err and "applies to" in err
+    assert not (tmp_path / "c.nc").exists()
