@@ -36,19 +36,24 @@ def _errors(ds, pair):
     return eu, ev, ok
 
 
+def _correlate(pair, step, interp, threads):
+    """The benchmarked call: the whole ``correlate`` of the pair, 33-pixel subsets."""
+    return correlate(
+        pair.reference,
+        pair.deformed,
+        subset_size=33,
+        step=step,
+        interpolation=interp,
+        threads=threads,
+    )
+
+
 def _cpu_seconds(pair, step, interp, repeat=3) -> float:
     """Median CPU time of one call on one thread (insensitive to other users of the machine)."""
     times = []
     for _ in range(repeat + 1):
         t0 = time.process_time()
-        correlate(
-            pair.reference,
-            pair.deformed,
-            subset_size=33,
-            step=step,
-            interpolation=interp,
-            threads=1,
-        )
+        _correlate(pair, step, interp, threads=1)
         times.append(time.process_time() - t0)
     return float(np.median(times[1:]))
 
@@ -68,14 +73,7 @@ def main() -> None:
             for name, pair in pairs.items():
 
                 def run(pair=pair, step=step, interp=interp):
-                    return correlate(
-                        pair.reference,
-                        pair.deformed,
-                        subset_size=33,
-                        step=step,
-                        interpolation=interp,
-                        threads=2,
-                    )
+                    return _correlate(pair, step, interp, threads=2)
 
                 ds = run()
                 t, _ = median_time(run, repeat=5 if step == 16 else 3, warmup=1)

@@ -12,16 +12,19 @@ from jointwear.dic.subset._params import MIN_STEP, MIN_SUBSET, CorrelationParams
 
 __all__ = [
     "AllowEmptyOpt",
+    "CalibrationOutOpt",
     "DEFAULTS",
     "FpsOpt",
     "OriginOpt",
     "OutOpt",
+    "PlotOpt",
     "PointsOpt",
     "SearchRadiusOpt",
     "StepOpt",
     "SubsetOpt",
     "ThreadsOpt",
     "ZnccMinOpt",
+    "refuse_given",
 ]
 
 #: the library's correlation defaults (the options below show them)
@@ -39,6 +42,7 @@ SearchRadiusOpt = Annotated[
 ]
 ThreadsOpt = Annotated[int, typer.Option("--threads", min=0, help="numba threads (0: auto).")]
 OutOpt = Annotated[Path, typer.Option("--out", help="Output netCDF file.")]
+CalibrationOutOpt = Annotated[Path, typer.Option("--out", "-o", help="Calibration file (.nc).")]
 PointsOpt = Annotated[
     Path | None,
     typer.Option(
@@ -46,6 +50,10 @@ PointsOpt = Annotated[
         help="Text file of subset centres 'x, y' (pixels, reference image, one per line) "
         "instead of a grid over --roi.",
     ),
+]
+PlotOpt = Annotated[
+    Path | None,
+    typer.Option("--plot", help="Also write a quick-look figure of the last image (png)."),
 ]
 AllowEmptyOpt = Annotated[
     bool,
@@ -60,3 +68,11 @@ OriginOpt = Annotated[
 FpsOpt = Annotated[
     float | None, typer.Option("--fps", help="Frames per second (omit for still images).")
 ]
+
+
+def refuse_given(given, applies_to: str) -> None:
+    """Usage error (exit 2) naming the first option of ``given`` (``(value, flag)`` pairs)
+    that was given (not None): it applies to ``applies_to`` only."""
+    for value, flag in given:
+        if value is not None:
+            raise typer.BadParameter(f"{flag} applies to {applies_to}")

@@ -47,12 +47,13 @@ def _refuse_misapplied(ctx_params: dict, sequence: bool) -> None:
     if ctx_params["points"] is not None and ctx_params["roi"] is not None:
         raise typer.BadParameter("give either --points or --roi, not both")
     if not sequence:
-        for name, flag in (("reference_mode", "--sequence-mode"), ("frame_rate", "--fps")):
-            if ctx_params[name] is not None:
-                raise typer.BadParameter(
-                    f"{flag} applies to a sequence (a folder, pattern or video), not to "
-                    "a pair of images"
-                )
+        opt.refuse_given(
+            (
+                (ctx_params["reference_mode"], "--sequence-mode"),
+                (ctx_params["frame_rate"], "--fps"),
+            ),
+            "a sequence (a folder, pattern or video), not to a pair of images",
+        )
     if ctx_params["reference_mode"] != "incremental" and (
         ctx_params["update_every"] is not None or ctx_params["update_zncc"] != UPDATE_ZNCC
     ):
@@ -154,9 +155,7 @@ def correlate_cmd(
         float | None,
         typer.Option("--fps", "--frame-rate", help="Sequences: frame rate (1/s)."),
     ] = None,
-    plot: Annotated[
-        Path | None, typer.Option("--plot", help="Write a quick-look figure (png).")
-    ] = None,
+    plot: opt.PlotOpt = None,
     threads: opt.ThreadsOpt = opt.DEFAULTS.threads,
     allow_empty: opt.AllowEmptyOpt = False,
 ) -> None:

@@ -26,12 +26,10 @@ def _refuse_misapplied(p: dict) -> None:
     if not stereo and p["calibration"] is not None:
         raise typer.BadParameter("--calibration needs --left/--right images (stereo)")
     if not stereo:
-        for name, flag in (("frame", "--frame"), ("epipolar_max", "--epipolar-max")):
-            if p[name] is not None:
-                raise typer.BadParameter(
-                    f"{flag} applies to a stereo field (--left/--right/--calibration); "
-                    "a 2D field is in image pixels"
-                )
+        opt.refuse_given(
+            ((p["frame"], "--frame"), (p["epipolar_max"], "--epipolar-max")),
+            "a stereo field (--left/--right/--calibration); a 2D field is in image pixels",
+        )
     if p["points"] is not None and p["roi"] is not None:
         raise typer.BadParameter("give either --points or --roi, not both")
     if p["points"] is not None and p["strain_window"]:
@@ -98,9 +96,7 @@ def field_cmd(
         Path | None,
         typer.Option("--csv", help="Also write CSV (one file per image, VIC-3D-like)."),
     ] = None,
-    plot: Annotated[
-        Path | None, typer.Option("--plot", help="Contour figure of the last image (png).")
-    ] = None,
+    plot: opt.PlotOpt = None,
     threads: opt.ThreadsOpt = opt.DEFAULTS.threads,
     allow_empty: opt.AllowEmptyOpt = False,
     overwrite: Overwrite = False,

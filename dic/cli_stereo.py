@@ -8,7 +8,9 @@ from typing import Annotated, Literal
 import typer
 
 from jointwear._cli import Overwrite
+from jointwear.dic import _cli_options as opt
 from jointwear.dic.calibration._defaults import (
+    CHARUCO_DICTIONARY,
     MAX_RMS_PX,
     MAX_VIEW_RMS_PX,
     MIN_VIEWS,
@@ -43,11 +45,10 @@ def _board(board, squares, square, unit, square_u, square_mm, marker, marker_mm,
             param_hint="--unit",
         )
     if board == "chessboard":
-        for given, flag in ((marker, "--marker"), (marker_mm, "--marker-mm")):
-            if given is not None:
-                raise typer.BadParameter(
-                    f"{flag} applies to a ChArUco board (--board charuco), not a chessboard"
-                )
+        opt.refuse_given(
+            ((marker, "--marker"), (marker_mm, "--marker-mm"), (dictionary, "--dictionary")),
+            "a ChArUco board (--board charuco), not a chessboard",
+        )
     if marker is not None:
         marker_m = marker * scale
     else:
@@ -58,7 +59,7 @@ def _board(board, squares, square, unit, square_u, square_mm, marker, marker_mm,
         squares[1],
         square * scale,
         marker_m,
-        dictionary,
+        dictionary or CHARUCO_DICTIONARY,
         length_unit=length_unit,
         square_size_u=None if square_u is None else square_u * scale,
     )
@@ -98,9 +99,7 @@ def calibrate_cmd(
             help="Right board images (folder or quoted pattern 'cal/*_1.tif') or video.",
         ),
     ],
-    out: Annotated[Path, typer.Option("--out", "-o", help="Calibration file (.nc).")] = Path(
-        "calibration.nc"
-    ),
+    out: opt.CalibrationOutOpt = Path("calibration.nc"),
     overwrite: Overwrite = False,
     board: Annotated[
         Literal["chessboard", "charuco"], typer.Option(help="chessboard or charuco.")
@@ -128,13 +127,19 @@ def calibrate_cmd(
     ] = None,
     marker: Annotated[float | None, typer.Option(help="ChArUco marker side, in --unit.")] = None,
     marker_mm: Annotated[float | None, typer.Option(hidden=True)] = None,
-    dictionary: Annotated[str, typer.Option(help="ChArUco ArUco dictionary.")] = "DICT_5X5_100",
+    dictionary: Annotated[
+        str | None,
+        typer.Option(help=f"ChArUco ArUco dictionary (default {CHARUCO_DICTIONARY})."),
+    ] = None,
     world_view: Annotated[
         int | None,
         typer.Option(help="Index of the view whose board pose becomes the world frame."),
     ] = None,
     min_views: Annotated[int, typer.Option(min=1, help="Fewest usable views.")] = MIN_VIEWS,
-    every: Annotated[int, typer.Option(min=1, help="Videos: use every N-th frame.")] = VIDEO_EVERY,
+    every: Annotated[
+        int | None,
+        typer.Option(min=1, help=f"Videos: use every N-th frame (default {VIDEO_EVERY})."),
+    ] = None,
     max_rms: Annotated[
         float, typer.Option(help="Largest acceptable stereo reprojection RMS (px).")
     ] = MAX_RMS_PX,
@@ -158,10 +163,13 @@ def calibrate_cmd(
     """
     from jointwear.dic.calibration._files import calibrate_files, rejected_path
     from jointwear.dic.calibration._gate import PoorCalibration, view_table
+    from jointwear.dic.footage._video import is_image_sequence
 
     b, square, unit = _board(
         board, squares, square, unit, square_u, square_mm, marker, marker_mm, dictionary
     )
+    if every is not None and is_image_sequence(left):
+        opt.refuse_given(((every, "--every"),), "videos, not a folder or pattern of images")
     params = {
         "board": b.__dict__,
         "world_view": world_view,
@@ -176,7 +184,7 @@ def calibrate_cmd(
             right,
             out,
             b,
-            every=every,
+            every=VIDEO_EVERY if every is None else every,
             parameters=params,
             min_views=min_views,
             world_view=world_view,
@@ -205,9 +213,7 @@ def import_calibration_cmd(
         ),
     ],
     fmt: Annotated[Literal["opencv", "vic3d"], typer.Option("--format", help="opencv or vic3d.")],
-    out: Annotated[Path, typer.Option("--out", "-o", help="Calibration file (.nc).")] = Path(
-        "calibration.nc"
-    ),
+    out: opt.CalibrationOutOpt = Path("calibration.nc"),
     overwrite: Overwrite = False,
     length_unit: Annotated[
         str | None,

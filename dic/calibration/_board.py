@@ -10,7 +10,12 @@ from typing import Literal
 import numpy as np
 
 from jointwear.dic.calibration._camera import Camera, StereoCalibration, _check_enough_views
-from jointwear.dic.calibration._defaults import MAX_RMS_PX, MAX_VIEW_RMS_PX, MIN_VIEWS
+from jointwear.dic.calibration._defaults import (
+    CHARUCO_DICTIONARY,
+    MAX_RMS_PX,
+    MAX_VIEW_RMS_PX,
+    MIN_VIEWS,
+)
 from jointwear.errors import BadInputError, CalibrationError
 
 __all__ = ["CalibrationBoard", "calibrate_stereo", "detect_board", "board_world_frame"]
@@ -46,7 +51,7 @@ class CalibrationBoard:
     squares_y: int = 7
     square_size: float = 0.01
     marker_size: float = 0.0075
-    dictionary: str = "DICT_5X5_100"
+    dictionary: str = CHARUCO_DICTIONARY
     length_unit: str = "m"
     square_size_u: float | None = None
 
@@ -340,60 +345,15 @@ def calibrate_stereo(
     """
     import cv2
 
-    from jointwear.dic.calibration._gate import PoorCalibration, check_calibration
-    from jointwear.dic.calibration._order import consistent_order, grid_symmetries, pair_poses
-
     left_images = list(left_images)
     right_images = list(right_images)
-    if len(left_images) != len(right_images):
-        raise BadInputError(
-            f"calibration needs simultaneous left/right views: got {len(left_images)} left and "
-            f"{len(right_images)} right images; give the same number, in the same order"
-        )
-    n_total = len(left_images)
-    names = (
-        list(view_names)
-        if view_names is not None
-        else [
-            _view_name(li, ri, i)
-            for i, (li, ri) in enumerate(zip(left_images, right_images, strict=True))
-        ]
-    )
-    if len(names) != n_total:
-        raise BadInputError(f"view_names: {len(names)} names for {n_total} views")
+    names = _view_names(left_images, right_images, view_names)
+    n_total = len(names)
     obj_all = board.object_points() if board.kind == "chessboard" else _charuco_obj(board)
-    views = []  # (index, obj, left_pts, right_pts)
     reasons: list[str] = []
-    missed: list[np.ndarray] = []  # a few images where the board was not found
-    size = None
-    for i, (li, ri) in enumerate(zip(left_images, right_images, strict=True)):
-        L = _read_gray(li, "left calibration")
-        Rimg = _read_gray(ri, "right calibration")
-        if size is None:
-            size = (L.shape[1], L.shape[0])
-        if (L.shape[1], L.shape[0]) != size or (Rimg.shape[1], Rimg.shape[0]) != size:
-            raise BadInputError(
-                f"calibration view {names[i]}: image size {L.shape[1]}x{L.shape[0]} / "
-                f"{Rimg.shape[1]}x{Rimg.shape[0]} differs from the first view's {size[0]}x{size[1]}"
-            )
-        fl, fr = detect_board(L, board), detect_board(Rimg, board)
-        if progress is not None:
-            progress(i + 1, n_total)
-        if fl is None or fr is None:
-            which = (
-                "both cameras" if fl is None and fr is None else ("left" if fl is None else "right")
-            )
-            reasons.append(f"{names[i]}: board not found ({which}) by either detector")
-            if len(missed) < 3:
-                missed.append(L if fl is None else Rimg)
-            continue
-        common = np.intersect1d(fl[0], fr[0])
-        if len(common) < 6:
-            reasons.append(f"{names[i]}: only {len(common)} corners seen by both cameras")
-            continue
-        li_idx = np.searchsorted(fl[0], common)
-        ri_idx = np.searchsorted(fr[0], common)
-        views.append((i, obj_all[common], fl[1][li_idx], fr[1][ri_idx]))
+    views, missed, size = _detect_views(
+        left_images, right_images, board, obj_all, names, reasons, progress
+    )
     if len(views) < min_views:
         _check_square_count(board, missed)
     _check_enough_views(len(views), n_total, min_views, reasons)
@@ -401,74 +361,23 @@ def calibrate_stereo(
     flags = cv2.CALIB_FIX_K3 if fix_k3 else 0
     if rational:
         flags |= cv2.CALIB_RATIONAL_MODEL
-    crit = (cv2.TERM_CRITERIA_COUNT + cv2.TERM_CRITERIA_EPS, 200, 1e-12)
-
-    def mono(k: int, sel):
-        objp = [v[1].astype(np.float32) for v in sel]
-        imgp = [v[2 + k].astype(np.float32).reshape(-1, 1, 2) for v in sel]
-        rms, K, D, _, _, _, _, per_view = cv2.calibrateCameraExtended(
-            objp, imgp, size, None, None, flags=flags, criteria=crit
-        )
-        return K, D, per_view.ravel()
-
-    # one corner order for both cameras: the relabelling of the right corners whose
-    # left-to-right pose agrees with the other views
-    KL, DL, _ = mono(0, views)
-    KR, DR, _ = mono(1, views)
-    perms_full = grid_symmetries(*board.inner_corners) if board.kind == "chessboard" else None
-    cands = []
-    for v in views:
-        perms = perms_full if perms_full is not None and len(v[1]) == len(obj_all) else None
-        perms = perms or [np.arange(len(v[1]))]
-        cands.append(pair_poses(v[1], v[2], v[3], (KL, DL), (KR, DR), perms, v[0]))
-    relabel, _ = consistent_order(cands)
-    kept, pair_T, board_dist = [], [], []
-    for v, k, cs in zip(views, relabel, cands, strict=True):
-        if k is None:
-            reasons.append(
-                f"{names[v[0]]}: the left and right images do not show the board in the pose "
-                "the other views agree on (mismatched or swapped pair, or the board moved "
-                "between the two exposures)"
-            )
-            continue
-        perm = perms_full[k] if perms_full is not None and len(v[1]) == len(obj_all) else None
-        kept.append(v if perm is None else (v[0], v[1], v[2], v[3][perm]))
-        pair_T.append(np.linalg.norm(next(c.T for c in cs if c.relabel == k)))
-    n_disagree = len(views) - len(kept)
-    if len(kept) < min_views and n_disagree >= len(views) / 2:
-        raise CalibrationError(
-            f"in {n_disagree} of {len(views)} views the left and right images do not show the "
-            "board in one common pose: the two image lists are not simultaneous pairs in the "
-            "same order (check that both folders hold the same views sorted alike, and that "
-            f"--left/--right are not mixed up); e.g. {reasons[-1]}"
-        )
-    views = kept
+    mono = _MonoCalibration(size, flags)
+    views, pair_T = _consistent_views(views, board, obj_all, names, reasons, mono, min_views)
     _check_enough_views(len(views), n_total, min_views, reasons)
-
-    for _ in range(2):
-        KL, DL, pv_l = mono(0, views)
-        KR, DR, pv_r = mono(1, views)
-        bad = (pv_l > max_view_rms) | (pv_r > max_view_rms)
-        if not np.any(bad):
-            break
-        for j in np.flatnonzero(bad):
-            reasons.append(
-                f"{names[views[j][0]]}: reprojection RMS {pv_l[j]:.2f}/{pv_r[j]:.2f} px > "
-                f"{max_view_rms} (--max-view-rms)"
-            )
-        pair_T = [t for t, b in zip(pair_T, bad, strict=True) if not b]
-        views = [v for v, b in zip(views, bad, strict=True) if not b]
-        _check_enough_views(len(views), n_total, min_views, reasons)
+    views, pair_T, (KL, DL, KR, DR) = _reject_poor_views(
+        views, pair_T, mono, max_view_rms, names, reasons, n_total, min_views
+    )
 
     objp = [v[1].astype(np.float32) for v in views]
     lp = [v[2].astype(np.float32).reshape(-1, 1, 2) for v in views]
     rp = [v[3].astype(np.float32).reshape(-1, 1, 2) for v in views]
     sflags = flags | cv2.CALIB_USE_INTRINSIC_GUESS
     out = cv2.stereoCalibrateExtended(
-        objp, lp, rp, KL, DL, KR, DR, size, None, None, flags=sflags, criteria=crit
+        objp, lp, rp, KL, DL, KR, DR, size, None, None, flags=sflags, criteria=mono.criteria
     )
     rms, KL, DL, KR, DR, R, T = out[:7]
     per_view = np.asarray(out[-1]).reshape(len(views), 2)
+    board_dist = []
     for v in views:  # distance of the board from the left camera (baseline plausibility)
         ok, _, tvec = cv2.solvePnP(v[1].astype(np.float64), v[2].astype(np.float64), KL, DL)
         if ok:
@@ -493,25 +402,173 @@ def calibrate_stereo(
         if not 0 <= world_view < n_total:
             raise BadInputError(f"world_view {world_view} is outside the {n_total} views")
         cal = board_world_frame(cal, _read_gray(left_images[world_view], "left"), board)
+    return _sanity_gate(cal, max_rms, board_dist, accept_poor)
+
+
+def _view_names(left_images: list, right_images: list, view_names) -> list[str]:
+    """The views' names (given, or from the image files); checks the two lists pair up."""
+    if len(left_images) != len(right_images):
+        raise BadInputError(
+            f"calibration needs simultaneous left/right views: got {len(left_images)} left and "
+            f"{len(right_images)} right images; give the same number, in the same order"
+        )
+    n_total = len(left_images)
+    names = (
+        list(view_names)
+        if view_names is not None
+        else [
+            _view_name(li, ri, i)
+            for i, (li, ri) in enumerate(zip(left_images, right_images, strict=True))
+        ]
+    )
+    if len(names) != n_total:
+        raise BadInputError(f"view_names: {len(names)} names for {n_total} views")
+    return names
+
+
+def _detect_views(left_images, right_images, board, obj_all, names, reasons, progress):
+    """The board's corners seen by both cameras in every view pair: ``views`` (index, object
+    points, left points, right points), a few images where the board was not found, and the
+    image size; the views without the board are counted in ``reasons``."""
+    views = []  # (index, obj, left_pts, right_pts)
+    missed: list[np.ndarray] = []  # a few images where the board was not found
+    size = None
+    for i, (li, ri) in enumerate(zip(left_images, right_images, strict=True)):
+        L = _read_gray(li, "left calibration")
+        Rimg = _read_gray(ri, "right calibration")
+        if size is None:
+            size = (L.shape[1], L.shape[0])
+        if (L.shape[1], L.shape[0]) != size or (Rimg.shape[1], Rimg.shape[0]) != size:
+            raise BadInputError(
+                f"calibration view {names[i]}: image size {L.shape[1]}x{L.shape[0]} / "
+                f"{Rimg.shape[1]}x{Rimg.shape[0]} differs from the first view's {size[0]}x{size[1]}"
+            )
+        fl, fr = detect_board(L, board), detect_board(Rimg, board)
+        if progress is not None:
+            progress(i + 1, len(names))
+        if fl is None or fr is None:
+            which = (
+                "both cameras" if fl is None and fr is None else ("left" if fl is None else "right")
+            )
+            reasons.append(f"{names[i]}: board not found ({which}) by either detector")
+            if len(missed) < 3:
+                missed.append(L if fl is None else Rimg)
+            continue
+        common = np.intersect1d(fl[0], fr[0])
+        if len(common) < 6:
+            reasons.append(f"{names[i]}: only {len(common)} corners seen by both cameras")
+            continue
+        li_idx = np.searchsorted(fl[0], common)
+        ri_idx = np.searchsorted(fr[0], common)
+        views.append((i, obj_all[common], fl[1][li_idx], fr[1][ri_idx]))
+    return views, missed, size
+
+
+class _MonoCalibration:
+    """One camera calibrated on its own (``cv2.calibrateCameraExtended``) over given views."""
+
+    def __init__(self, size, flags: int):
+        import cv2
+
+        self.size, self.flags = size, flags
+        #: termination criteria, shared with the stereo calibration
+        self.criteria = (cv2.TERM_CRITERIA_COUNT + cv2.TERM_CRITERIA_EPS, 200, 1e-12)
+
+    def __call__(self, k: int, sel):
+        """Camera ``k`` (0 left, 1 right): matrix, distortion and per-view RMS [pixel]."""
+        import cv2
+
+        objp = [v[1].astype(np.float32) for v in sel]
+        imgp = [v[2 + k].astype(np.float32).reshape(-1, 1, 2) for v in sel]
+        rms, K, D, _, _, _, _, per_view = cv2.calibrateCameraExtended(
+            objp, imgp, self.size, None, None, flags=self.flags, criteria=self.criteria
+        )
+        return K, D, per_view.ravel()
+
+
+def _consistent_views(views, board, obj_all, names, reasons, mono, min_views):
+    """One corner order for both cameras: the relabelling of the right corners whose
+    left-to-right pose agrees with the other views. Returns the views kept (right corners
+    relabelled) and each one's baseline length from its own pose."""
+    from jointwear.dic.calibration._order import consistent_order, grid_symmetries, pair_poses
+
+    KL, DL, _ = mono(0, views)
+    KR, DR, _ = mono(1, views)
+    perms_full = grid_symmetries(*board.inner_corners) if board.kind == "chessboard" else None
+    cands = []
+    for v in views:
+        perms = perms_full if perms_full is not None and len(v[1]) == len(obj_all) else None
+        perms = perms or [np.arange(len(v[1]))]
+        cands.append(pair_poses(v[1], v[2], v[3], (KL, DL), (KR, DR), perms, v[0]))
+    relabel, _ = consistent_order(cands)
+    kept, pair_T = [], []
+    for v, k, cs in zip(views, relabel, cands, strict=True):
+        if k is None:
+            reasons.append(
+                f"{names[v[0]]}: the left and right images do not show the board in the pose "
+                "the other views agree on (mismatched or swapped pair, or the board moved "
+                "between the two exposures)"
+            )
+            continue
+        perm = perms_full[k] if perms_full is not None and len(v[1]) == len(obj_all) else None
+        kept.append(v if perm is None else (v[0], v[1], v[2], v[3][perm]))
+        pair_T.append(np.linalg.norm(next(c.T for c in cs if c.relabel == k)))
+    n_disagree = len(views) - len(kept)
+    if len(kept) < min_views and n_disagree >= len(views) / 2:
+        raise CalibrationError(
+            f"in {n_disagree} of {len(views)} views the left and right images do not show the "
+            "board in one common pose: the two image lists are not simultaneous pairs in the "
+            "same order (check that both folders hold the same views sorted alike, and that "
+            f"--left/--right are not mixed up); e.g. {reasons[-1]}"
+        )
+    return kept, pair_T
+
+
+def _reject_poor_views(views, pair_T, mono, max_view_rms, names, reasons, n_total, min_views):
+    """Calibrate each camera, reject the views whose reprojection RMS exceeds
+    ``max_view_rms`` and calibrate again (twice at most). Returns the views and baselines
+    kept and the cameras' matrices and distortions ``(KL, DL, KR, DR)``."""
+    for _ in range(2):
+        KL, DL, pv_l = mono(0, views)
+        KR, DR, pv_r = mono(1, views)
+        bad = (pv_l > max_view_rms) | (pv_r > max_view_rms)
+        if not np.any(bad):
+            break
+        for j in np.flatnonzero(bad):
+            reasons.append(
+                f"{names[views[j][0]]}: reprojection RMS {pv_l[j]:.2f}/{pv_r[j]:.2f} px > "
+                f"{max_view_rms} (--max-view-rms)"
+            )
+        pair_T = [t for t, b in zip(pair_T, bad, strict=True) if not b]
+        views = [v for v, b in zip(views, bad, strict=True) if not b]
+        _check_enough_views(len(views), n_total, min_views, reasons)
+    return views, pair_T, (KL, DL, KR, DR)
+
+
+def _sanity_gate(cal, max_rms, board_dist, accept_poor) -> StereoCalibration:
+    """``cal`` if it passes the sanity gate; else refused (:class:`PoorCalibration`), or with
+    ``accept_poor`` returned with a status that says so."""
+    import dataclasses
+
+    from jointwear.dic.calibration._gate import PoorCalibration, check_calibration
+
     problems = check_calibration(
         cal, max_rms=max_rms, board_distance=float(np.median(board_dist)) if board_dist else None
     )
-    if problems:
-        import dataclasses
-
-        if not accept_poor:
-            bad = dataclasses.replace(cal, status="rejected: " + "; ".join(problems))
-            raise PoorCalibration(
-                "the stereo calibration is not plausible: "
-                + "; ".join(problems)
-                + ". Check that --left and --right are the right cameras, that the views are "
-                "simultaneous pairs in the same order, and --squares; accept it anyway with "
-                "--accept-poor",
-                bad,
-                tuple(problems),
-            )
-        cal = dataclasses.replace(cal, status="accepted with --accept-poor: " + "; ".join(problems))
-    return cal
+    if not problems:
+        return cal
+    if not accept_poor:
+        bad = dataclasses.replace(cal, status="rejected: " + "; ".join(problems))
+        raise PoorCalibration(
+            "the stereo calibration is not plausible: "
+            + "; ".join(problems)
+            + ". Check that --left and --right are the right cameras, that the views are "
+            "simultaneous pairs in the same order, and --squares; accept it anyway with "
+            "--accept-poor",
+            bad,
+            tuple(problems),
+        )
+    return dataclasses.replace(cal, status="accepted with --accept-poor: " + "; ".join(problems))
 
 
 def _length_u_rel(pair_T: np.ndarray, board: CalibrationBoard) -> float | None:

@@ -9,3 +9,5 @@ MAX_RMS_PX = 1.0
 MAX_VIEW_RMS_PX = 1.0
 #: videos: use every N-th frame
 VIDEO_EVERY = 10
+#: ArUco dictionary of a ChArUco board
+CHARUCO_DICTIONARY = "DICT_5X5_100"

@@ -22,15 +22,22 @@ __all__ = ["read_opencv_calibration", "read_vic3d_calibration", "read_calibratio
 _LENGTH_UNITS = {"m": 1.0, "mm": 1e-3, "cm": 1e-2, "um": 1e-6, "in": 0.0254}
 
 
-def _length_scale(length_unit: str | float) -> float:
-    """Metres per unit of ``length_unit`` (a unit name, or a number of metres per unit)."""
-    if isinstance(length_unit, str) and length_unit.strip() in _LENGTH_UNITS:
-        return _LENGTH_UNITS[length_unit.strip()]
+def metres_per_unit(length_unit: str | float, units: dict = _LENGTH_UNITS) -> float | None:
+    """Metres per unit of ``length_unit``: a name in ``units``, or a positive number of
+    metres per unit; None if it is neither."""
+    if isinstance(length_unit, str) and length_unit.strip() in units:
+        return units[length_unit.strip()]
     try:
         scale = float(length_unit)
     except (TypeError, ValueError):
-        scale = float("nan")
-    if not (np.isfinite(scale) and scale > 0):
+        return None
+    return scale if np.isfinite(scale) and scale > 0 else None
+
+
+def _length_scale(length_unit: str | float) -> float:
+    """Metres per unit of ``length_unit`` (a unit name, or a number of metres per unit)."""
+    scale = metres_per_unit(length_unit)
+    if scale is None:
         raise BadInputError(
             f"length_unit {length_unit!r} is not known; use one of {', '.join(_LENGTH_UNITS)} "
             "(the unit the calibration board's square size was given in), or the number of "

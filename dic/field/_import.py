@@ -62,13 +62,10 @@ _COLUMNS = {
 
 
 def _scale(length_unit) -> float:
-    if isinstance(length_unit, str) and length_unit.strip() in _UNITS:
-        return _UNITS[length_unit.strip()]
-    try:
-        s = float(length_unit)
-    except (TypeError, ValueError):
-        s = float("nan")
-    if not (np.isfinite(s) and s > 0):
+    from jointwear.dic.calibration._importers import metres_per_unit
+
+    s = metres_per_unit(length_unit, _UNITS)
+    if s is None:
         raise ParameterError(
             f"length_unit={length_unit!r}: say what unit the file's lengths are in, one of "
             f"{', '.join(_UNITS)} or the number of metres per unit (--length-unit)"

@@ -138,7 +138,4 @@ def save_field_plot(ds: xr.Dataset, path: str | Path, **kwargs) -> Path:
     """Write :func:`plot_field` to ``path`` (png/pdf/svg), atomically."""
     from jointwear.io import save_figure
 
-    path = Path(path)
-    fig = plot_field(ds, **kwargs)
-    save_figure(fig, path, dpi=90)
-    return path
+    return save_figure(plot_field(ds, **kwargs), path, dpi=90)

@@ -389,9 +389,53 @@ def measure_field(
     1.300, -0.700 pixel
     """
     from jointwear.dic.field._roi import grid_points, read_roi
-    from jointwear.dic.field._stereo import stereo_geometry
-    from jointwear.dic.subset._correlator import SubsetCorrelator, check_pair
+    from jointwear.dic.subset._correlator import SubsetCorrelator
 
+    prm = _field_params(params, options)
+    if data_origin not in ("measured", "synthetic"):
+        raise ParameterError(f"data_origin={data_origin!r}: expected 'measured' or 'synthetic'")
+    calibration, L, lnames, Rr, rnames = _read_images(left, right, calibration)
+    t = _time_base(times, frame_rate, len(L))
+    cp = prm.correlation()
+    if points is not None:
+        grid, roi_text = _point_grid(points, roi, prm)
+    else:
+        mask, roi_text = read_roi(roi, L[0].shape)
+        grid = grid_points(mask, cp.subset_size, cp.step, cp.border)
+    corr = SubsetCorrelator(L[0], points=grid.centres, params=cp)
+    PL, PR, SL, SR, Z, F, fit = _match_images(
+        corr, L, Rr, calibration, grid.centres, prm.epipolar_max_px
+    )
+    DL, DR = _relative_sigma(L, Rr, PL, PR, grid.centres, cp, corr._sigma_scale())
+    m = _Matches(L, Rr, lnames, rnames, t, grid, PL, PR, SR, DL, DR, Z, F)
+    flag, lr = _point_flags(m, cp, prm)
+    ds = _field_dataset(m, flag, lr, calibration, prm, cp, with_grid=points is None)
+    ds.attrs.update(
+        {
+            "title": ("stereo" if m.stereo else "2D") + " DIC displacement field",
+            "data_origin": data_origin,
+            "dic_roi": roi_text,
+            "dic_subset_size_pixel": int(cp.subset_size),
+            "dic_step_pixel": int(cp.step) if points is None else "points given",
+            "dic_zncc_min": float(cp.zncc_min),
+            "dic_shape_function": "affine",
+            "dic_interpolation": f"{cp.interpolation} B-spline (prefiltered)",
+            "dic_criterion": "ZNSSD (IC-GN), image gradients by central differences",
+            "dic_reference": "absolute (image 0), guesses from the previous image",
+            "displacement_convention": "Lagrangian: the point at position moved by displacement",
+        }
+    )
+    if t is None:
+        ds.attrs["time_note"] = "still images: no time base; 'image' indexes the time dimension"
+    if m.stereo:
+        ds.attrs["calibration_source"] = calibration.source
+        ds.attrs["dic_epipolar_max_pixel"] = float(prm.epipolar_max_px)
+        ds.attrs.update(fit)
+    return ds
+
+
+def _field_params(params: FieldParams | None, options: dict) -> FieldParams:
+    """``params`` (default :class:`FieldParams`) with the keyword ``options`` applied."""
     base = params or FieldParams()
     if options:
         unknown = sorted(set(options) - set(asdict(base)))
@@ -401,9 +445,14 @@ def measure_field(
                 f"{', '.join(sorted(asdict(base)))}"
             )
         base = FieldParams(**{**asdict(base), **options})
-    prm = base
-    if data_origin not in ("measured", "synthetic"):
-        raise ParameterError(f"data_origin={data_origin!r}: expected 'measured' or 'synthetic'")
+    return base
+
+
+def _read_images(left, right, calibration):
+    """The calibration (read if a path) and the checked images of both cameras with their
+    names: ``calibration, L, lnames, Rr, rnames`` (``Rr`` empty in 2D)."""
+    from jointwear.dic.subset._correlator import check_pair
+
     stereo = right is not None
     if stereo and calibration is None:
         raise BadInputError(
@@ -440,58 +489,98 @@ def measure_field(
                 f"calibration: the left camera was calibrated for {w}x{h} images, the images "
                 f"are {L[0].shape[1]}x{L[0].shape[0]}; use the calibration of these cameras"
             )
-    t = None
+    return calibration, L, lnames, Rr, rnames
+
+
+def _time_base(times, frame_rate, n_t: int) -> np.ndarray | None:
+    """Time of every image [s] from ``times`` or ``frame_rate`` (None: still images)."""
     if times is not None:
         t = np.asarray(times, float)
         if t.shape != (n_t,) or not np.isfinite(t).all() or np.any(np.diff(t) <= 0):
             raise BadInputError(f"times: expected {n_t} finite, increasing values [s]")
-    elif frame_rate is not None:
+        return t
+    if frame_rate is not None:
         if not frame_rate > 0:
             raise ParameterError(f"frame_rate={frame_rate!r}: expected > 0 frames per second")
-        t = np.arange(n_t) / float(frame_rate)
+        return np.arange(n_t) / float(frame_rate)
+    return None
 
-    cp = prm.correlation()
-    if points is not None:
-        grid, roi_text = _point_grid(points, roi, prm)
-    else:
-        mask, roi_text = read_roi(roi, L[0].shape)
-        grid = grid_points(mask, cp.subset_size, cp.step, cp.border)
-    corr = SubsetCorrelator(L[0], points=grid.centres, params=cp)
-    n = corr.n_points
-    cams = ["left", "right"] if stereo else ["left"]
-    PL, PR, SL, SR, Z, F, fit = _match_images(
-        corr, L, Rr, calibration, grid.centres, prm.epipolar_max_px
-    )
-    DL, DR = _relative_sigma(L, Rr, PL, PR, grid.centres, cp, corr._sigma_scale())
-    c = grid.centres
-    sub_x = np.stack([c[:, 0] + PL[..., 0]] + ([c[:, 0] + PR[..., 0]] if stereo else []), axis=1)
-    sub_y = np.stack([c[:, 1] + PL[..., 6]] + ([c[:, 1] + PR[..., 6]] if stereo else []), axis=1)
-    # one flag per (time, point): the first failing match, else the field's own checks
+
+@dataclass(frozen=True)
+class _Matches:
+    """The images and their matches (:func:`_match_images`, :func:`_relative_sigma`)."""
+
+    L: list
+    Rr: list
+    lnames: list
+    rnames: list
+    t: np.ndarray | None
+    grid: object
+    PL: np.ndarray
+    PR: np.ndarray
+    SR: np.ndarray
+    DL: np.ndarray
+    DR: np.ndarray
+    Z: np.ndarray
+    F: np.ndarray
+
+    @property
+    def stereo(self) -> bool:
+        return len(self.Rr) > 0
+
+    def subset_centres(self) -> tuple[np.ndarray, np.ndarray]:
+        """Subset centres ``sub_x``, ``sub_y`` (T, cameras, N) [pixel] in every image."""
+        c, PL, PR = self.grid.centres, self.PL, self.PR
+        sub_x = np.stack(
+            [c[:, 0] + PL[..., 0]] + ([c[:, 0] + PR[..., 0]] if self.stereo else []), axis=1
+        )
+        sub_y = np.stack(
+            [c[:, 1] + PL[..., 6]] + ([c[:, 1] + PR[..., 6]] if self.stereo else []), axis=1
+        )
+        return sub_x, sub_y
+
+
+def _point_flags(m: _Matches, cp, prm: FieldParams):
+    """One flag per (time, point): the first failing match, else the field's own checks
+    (stereo left-right consistency, ROI edge); and (stereo) the left-right deviation
+    [pixel]."""
+    F = m.F
+    n_t, n = F.shape[0], F.shape[2]
     flag = np.full((n_t, n), _flags.FLAG_OK, np.int8)
-    for j in range(len(cams)):
+    for j in range(F.shape[1]):
         bad = (flag == _flags.FLAG_OK) & (F[:, j] != _flags.FLAG_OK)
         flag[bad] = F[:, j][bad]
-    if stereo:
+    lr = None
+    if m.stereo:
         bad0 = F[0, 1] != _flags.FLAG_OK  # no right reference match: no position
         flag[:, bad0 & (flag[0] == _flags.FLAG_OK)] = F[0, 1][bad0 & (flag[0] == _flags.FLAG_OK)]
-    if stereo:
+        sub_x, sub_y = m.subset_centres()
         lr, lr_sig = left_right_deviation(
-            cp, Rr[0], L[0], c, sub_x[0, 1], sub_y[0, 1], cp.subset_size
+            cp, m.Rr[0], m.L[0], m.grid.centres, sub_x[0, 1], sub_y[0, 1], cp.subset_size
         )
         # the forward and backward matches' typical noise (a median: a straddling subset's
         # own residual-based sigma is inflated by the very mismatch to be caught)
-        noise = np.sqrt(lr_sig**2 + np.sum(SR[0] ** 2, axis=1))
+        noise = np.sqrt(lr_sig**2 + np.sum(m.SR[0] ** 2, axis=1))
         typical = float(np.nanmedian(noise)) if np.isfinite(noise).any() else 0.0
         limit = max(prm.consistency_max_px, 5.0 * typical)
         bad = (lr > limit) & (flag[0] == _flags.FLAG_OK)
         flag[:, bad] = np.where(flag[:, bad] == _flags.FLAG_OK, FLAG_LEFT_RIGHT, flag[:, bad])
-    flag[:, ~grid.complete] = np.where(
-        flag[:, ~grid.complete] == _flags.FLAG_OK, FLAG_ROI_EDGE, flag[:, ~grid.complete]
-    )
-    zncc = np.nanmin(np.where(np.isfinite(Z), Z, np.nan), axis=1) if stereo else Z[:, 0]
+    edge = ~m.grid.complete
+    flag[:, edge] = np.where(flag[:, edge] == _flags.FLAG_OK, FLAG_ROI_EDGE, flag[:, edge])
+    return flag, lr
 
+
+def variable(values, dims, units: str, long_name: str, **attrs) -> xr.DataArray:
+    """A data variable with its ``units`` and ``long_name`` (and further ``attrs``)."""
+    return xr.DataArray(values, dims=dims, attrs={"units": units, "long_name": long_name, **attrs})
+
+
+def _coordinates(m: _Matches, with_grid: bool) -> dict:
+    """Coordinates of the field over point, camera and time."""
+    c = m.grid.centres
+    cams = ["left", "right"] if m.stereo else ["left"]
     coords = {
-        "point": ("point", np.arange(n), {"long_name": "measurement point (subset)"}),
+        "point": ("point", np.arange(len(c)), {"long_name": "measurement point (subset)"}),
         "x": (
             "point",
             c[:, 0],
@@ -503,29 +592,41 @@ def measure_field(
             {"units": "pixel", "long_name": "subset centre row, left reference image"},
         ),
         "camera": ("camera", cams, {"long_name": "camera"}),
-        "image": ("time", np.arange(n_t), {"long_name": "image index (0 = reference)"}),
-        "image_left": ("time", lnames, {"long_name": "left (or only) camera image"}),
+        "image": ("time", np.arange(len(m.L)), {"long_name": "image index (0 = reference)"}),
+        "image_left": ("time", m.lnames, {"long_name": "left (or only) camera image"}),
     }
-    if stereo:
-        coords["image_right"] = ("time", rnames, {"long_name": "right camera image"})
-    if points is None:
-        coords["row"] = ("point", grid.index[:, 0], {"long_name": "grid row of the point"})
-        coords["col"] = ("point", grid.index[:, 1], {"long_name": "grid column of the point"})
-    if t is not None:
-        coords["time"] = ("time", t, {"units": "s", "long_name": "time of the image"})
+    if m.stereo:
+        coords["image_right"] = ("time", m.rnames, {"long_name": "right camera image"})
+    if with_grid:
+        coords["row"] = ("point", m.grid.index[:, 0], {"long_name": "grid row of the point"})
+        coords["col"] = ("point", m.grid.index[:, 1], {"long_name": "grid column of the point"})
+    if m.t is not None:
+        coords["time"] = ("time", m.t, {"units": "s", "long_name": "time of the image"})
+    return coords
+
+
+def _field_dataset(m: _Matches, flag, lr, calibration, prm: FieldParams, cp, with_grid: bool):
+    """The field's Dataset (displacement, uncertainty, subset centres, ZNCC, flags, strain)."""
+    from jointwear.dic.field._stereo import stereo_geometry
+
+    c = m.grid.centres
+    sub_x, sub_y = m.subset_centres()
+    Z = m.Z
+    zncc = np.nanmin(np.where(np.isfinite(Z), Z, np.nan), axis=1) if m.stereo else Z[:, 0]
+    coords = _coordinates(m, with_grid)
     data: dict[str, xr.DataArray] = {}
     attrs: dict = {}
-    if not stereo:
+    if not m.stereo:
         axes = ["x", "y"]
-        disp = np.stack([PL[..., 0], PL[..., 6]], axis=-1)
-        disp_u = DL
+        disp = np.stack([m.PL[..., 0], m.PL[..., 6]], axis=-1)
+        disp_u = m.DL
         ref_pos = c.copy()
         unit = "pixel"
         attrs["field_frame"] = "left image: x to the right (columns), y down (rows), pixel"
     else:
         axes = ["x", "y", "z"]
         ref_pos, disp, disp_u, extra, extra_coords, extra_attrs = stereo_geometry(
-            calibration, sub_x, sub_y, DL, SR, DR, flag, prm
+            calibration, sub_x, sub_y, m.DL, m.SR, m.DR, flag, prm
         )
         unit = "m"
         data.update(extra)
@@ -535,90 +636,43 @@ def measure_field(
     disp = np.where(ok[..., None], disp, np.nan)
     disp_u = np.where(ok[..., None], disp_u, np.nan)
     coords["axis"] = ("axis", axes, {"long_name": "vector component"})
-    data["displacement"] = xr.DataArray(
-        disp,
-        dims=("time", "point", "axis"),
-        attrs={
-            "units": unit,
-            "long_name": "displacement of the point from the reference image",
-            "ancillary_variables": "displacement_u zncc flag",
-        },
+    tpa = ("time", "point", "axis")
+    data["displacement"] = variable(
+        disp, tpa, unit, "displacement of the point from the reference image",
+        ancillary_variables="displacement_u zncc flag",
+    )  # fmt: skip
+    data["displacement_u"] = variable(
+        disp_u, tpa, unit,
+        "standard uncertainty of displacement (image noise and sub-pixel pattern mismatch "
+        "through the matches and the triangulation; excludes calibration error)",
+    )  # fmt: skip
+    tcp = ("time", "camera", "point")
+    data["subset_x"] = variable(
+        np.where(ok[:, None, :], sub_x, np.nan), tcp, "pixel", "subset centre column in the image"
     )
-    data["displacement_u"] = xr.DataArray(
-        disp_u,
-        dims=("time", "point", "axis"),
-        attrs={
-            "units": unit,
-            "long_name": "standard uncertainty of displacement (image noise and sub-pixel "
-            "pattern mismatch through the matches and the triangulation; excludes "
-            "calibration error)",
-        },
+    data["subset_y"] = variable(
+        np.where(ok[:, None, :], sub_y, np.nan), tcp, "pixel", "subset centre row in the image"
     )
-    data["subset_x"] = xr.DataArray(
-        np.where(ok[:, None, :], sub_x, np.nan),
-        dims=("time", "camera", "point"),
-        attrs={"units": "pixel", "long_name": "subset centre column in the image"},
-    )
-    data["subset_y"] = xr.DataArray(
-        np.where(ok[:, None, :], sub_y, np.nan),
-        dims=("time", "camera", "point"),
-        attrs={"units": "pixel", "long_name": "subset centre row in the image"},
-    )
-    data["zncc"] = xr.DataArray(
-        zncc,
-        dims=("time", "point"),
-        attrs={"units": "1", "long_name": "lowest ZNCC of the point's matches"},
-    )
-    data["flag"] = xr.DataArray(
-        flag,
-        dims=("time", "point"),
-        attrs={
-            "units": "1",
-            "long_name": "field quality flag",
-            "flag_values": np.arange(11, dtype=np.int8),
-            "flag_meanings": FIELD_FLAG_MEANINGS,
-        },
-    )
-    if stereo:
-        data["left_right_deviation"] = xr.DataArray(
-            np.where(np.isfinite(lr), lr, np.nan),
-            dims="point",
-            attrs={
-                "units": "pixel",
-                "long_name": "distance from the left subset centre to where its right match "
-                "lands when matched back into the left reference image",
-            },
-        )
+    data["zncc"] = variable(zncc, ("time", "point"), "1", "lowest ZNCC of the point's matches")
+    data["flag"] = variable(
+        flag, ("time", "point"), "1", "field quality flag",
+        flag_values=np.arange(11, dtype=np.int8), flag_meanings=FIELD_FLAG_MEANINGS,
+    )  # fmt: skip
+    if m.stereo:
+        data["left_right_deviation"] = variable(
+            np.where(np.isfinite(lr), lr, np.nan), "point", "pixel",
+            "distance from the left subset centre to where its right match lands when matched "
+            "back into the left reference image",
+        )  # fmt: skip
     if prm.strain_window:
         from jointwear.dic.field._strain import strain_variables
 
         strain, comp = strain_variables(
             np.where(ok[0][:, None], ref_pos, np.nan), ref_pos[None] + disp, disp_u,
-            grid.index, c, prm.strain_window, cp.step, cp.subset_size,
+            m.grid.index, c, prm.strain_window, cp.step, cp.subset_size,
         )  # fmt: skip
         data.update(strain)
         coords.update(comp)
     ds = xr.Dataset(data, coords=coords)
     ds.attrs.update(attrs)
-    ds.attrs.update(
-        {
-            "title": ("stereo" if stereo else "2D") + " DIC displacement field",
-            "data_origin": data_origin,
-            "dic_roi": roi_text,
-            "dic_subset_size_pixel": int(cp.subset_size),
-            "dic_step_pixel": int(cp.step) if points is None else "points given",
-            "dic_zncc_min": float(cp.zncc_min),
-            "dic_shape_function": "affine",
-            "dic_interpolation": f"{cp.interpolation} B-spline (prefiltered)",
-            "dic_criterion": "ZNSSD (IC-GN), image gradients by central differences",
-            "dic_reference": "absolute (image 0), guesses from the previous image",
-            "displacement_convention": "Lagrangian: the point at position moved by displacement",
-        }
-    )
-    if t is None:
-        ds.attrs["time_note"] = "still images: no time base; 'image' indexes the time dimension"
-    if stereo:
-        ds.attrs["calibration_source"] = calibration.source
-        ds.attrs["dic_epipolar_max_pixel"] = float(prm.epipolar_max_px)
-        ds.attrs.update(fit)
     return ds

@@ -143,6 +143,7 @@ def stereo_geometry(calibration, sub_x, sub_y, DL, SR, DR, flag, prm):
     dataset's stereo variables, coordinates and attributes.
     """
     from jointwear.dic.calibration._stereo import triangulate
+    from jointwear.dic.field._measure import variable
 
     n_t, _, n = sub_x.shape
     data: dict[str, xr.DataArray] = {}
@@ -193,35 +194,20 @@ def stereo_geometry(calibration, sub_x, sub_y, DL, SR, DR, flag, prm):
     disp_u = np.sqrt(np.maximum(np.diagonal(cov_d, axis1=-2, axis2=-1), 0.0))
     pos_u = np.sqrt(np.maximum(np.diagonal(cov_pos, axis1=-2, axis2=-1), 0.0))
     okp = flag[0] == _flags.FLAG_OK
-    data["position"] = xr.DataArray(
-        np.where(okp[:, None], ref_pos, np.nan),
-        dims=("point", "axis"),
-        attrs={
-            "units": "m",
-            "long_name": "reference position of the point (surface shape)",
-            "ancillary_variables": "position_u",
-        },
+    data["position"] = variable(
+        np.where(okp[:, None], ref_pos, np.nan), ("point", "axis"), "m",
+        "reference position of the point (surface shape)", ancillary_variables="position_u",
+    )  # fmt: skip
+    data["position_u"] = variable(
+        np.where(okp[:, None], pos_u, np.nan), ("point", "axis"), "m",
+        "standard uncertainty of position (image noise)",
+    )  # fmt: skip
+    data["reprojection"] = variable(
+        rep, ("time", "point"), "pixel", "RMS reprojection residual of the triangulated pair"
     )
-    data["position_u"] = xr.DataArray(
-        np.where(okp[:, None], pos_u, np.nan),
-        dims=("point", "axis"),
-        attrs={"units": "m", "long_name": "standard uncertainty of position (image noise)"},
+    data["frame_rotation"] = variable(
+        Rf, ("axis", "axis_world"), "1", "rows: output frame axes in world coordinates"
     )
-    data["reprojection"] = xr.DataArray(
-        rep,
-        dims=("time", "point"),
-        attrs={
-            "units": "pixel",
-            "long_name": "RMS reprojection residual of the triangulated pair",
-        },
-    )
-    data["frame_rotation"] = xr.DataArray(
-        Rf,
-        dims=("axis", "axis_world"),
-        attrs={"units": "1", "long_name": "rows: output frame axes in world coordinates"},
-    )
-    data["frame_origin"] = xr.DataArray(
-        of, dims="axis_world", attrs={"units": "m", "long_name": "output frame origin (world)"}
-    )
+    data["frame_origin"] = variable(of, "axis_world", "m", "output frame origin (world)")
     coords["axis_world"] = ("axis_world", ["x", "y", "z"], {"long_name": "world axis"})
     return ref_pos, disp, disp_u, data, coords, attrs

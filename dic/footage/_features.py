@@ -231,13 +231,19 @@ def _homography_guess(H: np.ndarray, pts: np.ndarray) -> np.ndarray:
     q = hp[:, :2] / w[:, None]
     # Jacobian of the homography at each point
     J = (H[None, :2, :2] - q[:, :, None] * H[None, 2:3, :2]) / w[:, None, None]
+    return affine_guess(pts, q, J)
+
+
+def affine_guess(pts: np.ndarray, moved: np.ndarray, J: np.ndarray) -> np.ndarray:
+    """Affine subset parameters (u, du/dx, du/dy, v, dv/dx, dv/dy) of points ``pts`` (N, 2)
+    mapped to ``moved`` [pixel] with the map's Jacobian ``J`` (N, 2, 2) there."""
     return np.column_stack(
         [
-            q[:, 0] - pts[:, 0],
-            J[:, 0, 0] - 1,
+            moved[:, 0] - pts[:, 0],
+            J[:, 0, 0] - 1.0,
             J[:, 0, 1],
-            q[:, 1] - pts[:, 1],
+            moved[:, 1] - pts[:, 1],
             J[:, 1, 0],
-            J[:, 1, 1] - 1,
+            J[:, 1, 1] - 1.0,
         ]
     )

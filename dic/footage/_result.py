@@ -165,6 +165,243 @@ def _med(a) -> list[float]:
     return [float(v) for v in _nanmedian(a)]
 
 
+def _frame_gaps(t: np.ndarray, flag_arr: np.ndarray, fps: float) -> tuple[np.ndarray, int]:
+    """Gaps in the frame times (dropped frames): flags the frames after a gap in ``flag_arr``
+    and returns their indices and the estimated number of dropped frames."""
+    dt = np.diff(t)
+    nominal = 1.0 / fps
+    gaps = np.flatnonzero(dt > 1.5 * nominal) + 1
+    flag_arr[gaps] |= FRAME_FLAGS["after_gap"]
+    dropped = int(np.sum(np.rint(dt[dt > 1.5 * nominal] / nominal) - 1)) if len(dt) else 0
+    return gaps, dropped
+
+
+def _body_variables(st, t, poi, poi_u, vel, axes, unit, stereo) -> tuple[dict, dict]:
+    """A tracked body's variables (point of interest, rigid fit, subsets) and coordinates."""
+    rows, name = st.rows, st.spec.name
+    img = "" if stereo else "_image"  # one camera: pixels, not the contract's metres
+    tpa = ("time", f"{name}_point", f"{name}_point_axis")
+    pts = np.asarray(rows["points"], dtype=np.float32)
+    data = {
+        f"{name}{img}_position": (
+            ("time", "axis"),
+            poi,
+            {
+                "units": unit,
+                "long_name": f"position of the {name}'s point of interest (world frame)",
+                "ancillary_variables": f"{name}{img}_position_u",
+            },
+        ),
+        f"{name}{img}_position_u": (
+            ("time", "axis"),
+            poi_u,
+            {"units": unit, "long_name": f"standard uncertainty of {name}{img}_position"},
+        ),
+        f"{name}{img}_velocity": (
+            ("time", "axis"),
+            vel,
+            {"units": f"{unit} s-1", "long_name": f"velocity of the {name}'s point of interest"},
+        ),
+        f"{name}_n_points": (
+            "time",
+            np.asarray(rows["n"]),
+            {"units": "1", "long_name": f"subsets used in the {name}'s rigid fit"},
+        ),
+        f"{name}_fit_rms": (
+            "time",
+            np.asarray(rows["rms"], dtype=float),
+            {"units": unit, "long_name": f"RMS residual of the {name}'s rigid fit"},
+        ),
+        f"{name}_rotation": (
+            ("time", f"{name}_row", f"{name}_col"),
+            np.asarray(rows["R"], dtype=float),
+            {"units": "1", "long_name": f"rotation of the {name} since the reference frame"},
+        ),
+        f"{name}_points": (
+            tpa,
+            pts,
+            {
+                "units": unit,
+                "long_name": f"tracked subset centres of the {name} (world frame)",
+                "ancillary_variables": f"{name}_points_u",
+            },
+        ),
+        f"{name}_points_u": (
+            tpa,
+            np.asarray(rows["points_u"], dtype=np.float32),
+            {"units": unit, "long_name": f"standard uncertainty of {name}_points (propagated)"},
+        ),
+        f"{name}_zncc": (
+            ("time", f"{name}_point"),
+            np.asarray(rows["zncc"], dtype=np.float32),
+            {"units": "1", "long_name": f"ZNCC of the {name}'s subsets (lower of the two cameras)"},
+        ),
+        f"{name}_subset_displacement": (
+            tpa,
+            pts - pts[:1],
+            {
+                "units": unit,
+                "long_name": f"displacement of the {name}'s subsets since the reference frame",
+            },
+        ),
+        f"{name}_reinitialised": (
+            "time",
+            np.asarray(rows.get("reinit", np.zeros(len(t))), dtype=np.int8),
+            {
+                "units": "1",
+                "long_name": f"1 where the {name}'s tracking was lost and found again from SIFT "
+                "features of the reference images",
+            },
+        ),
+    }
+    d = st.ref3d.shape[1]
+    coords = {
+        f"{name}_row": (f"{name}_row", np.arange(d)),
+        f"{name}_col": (f"{name}_col", np.arange(d)),
+        f"{name}_point_axis": (f"{name}_point_axis", axes),
+    }
+    return data, coords
+
+
+def _noise_attrs(st, calibration) -> dict[str, float]:
+    """The body's median match uncertainty [pixel] and (stereo) its out-of-plane noise floor."""
+    name = st.spec.name
+    sig_med = float(np.median(st.sigma_px))
+    attrs = {f"{name}_match_sigma_px": sig_med}
+    if calibration is not None:
+        from jointwear.dic.calibration._stereo import stereo_noise_floor
+
+        floor = stereo_noise_floor(calibration, np.nanmean(st.ref3d, axis=0), sig_med)
+        attrs[f"{name}_noise_floor_z_per_point_m"] = floor
+        attrs[f"{name}_noise_floor_z_body_m"] = floor / np.sqrt(len(st.ref3d))
+    return attrs
+
+
+def _follower_variables(poi, poi_u, vel, budget, cfg, unit) -> dict:
+    """The contract's follower position and velocity with their uncertainties (stereo)."""
+    from jointwear import conventions as C
+
+    return {
+        "follower_position": (
+            ("time", "axis"),
+            poi,
+            C.variable_attrs("follower_position", ancillary_variables="follower_position_u"),
+        ),
+        "follower_position_u": (
+            ("time", "axis"),
+            poi_u,
+            {"units": unit, "long_name": "standard uncertainty of follower_position"},
+        ),
+        "follower_velocity": (
+            ("time", "axis"),
+            vel,
+            C.variable_attrs(
+                "follower_velocity",
+                ancillary_variables="follower_velocity_u",
+                method=f"Savitzky-Golay on frame times, window {cfg.velocity_window} "
+                f"samples, order {cfg.velocity_order}",
+            ),
+        ),
+        "follower_velocity_u": (
+            ("time", "axis"),
+            budget["total"],
+            {
+                "units": f"{unit} s-1",
+                "long_name": "standard uncertainty of follower_velocity: position noise "
+                "through the differentiator, its truncation error and the calibration's "
+                "length and orientation uncertainty, combined in quadrature",
+                "noise_median": _med(budget["noise"]),
+                "truncation_median": _med(budget["truncation"]),
+                "calibration_median": (
+                    _med(budget["calibration"])
+                    if budget["calibration"] is not None
+                    else "not assessed (the calibration carries no length_scale_u_rel)"
+                ),
+            },
+        ),
+    }
+
+
+def _journal_variables(poi, poi_u, unit, stereo) -> dict:
+    """The journal's displacement since the reference frame with its uncertainty."""
+    jname = "journal_displacement" if stereo else "journal_image_displacement"
+    return {
+        jname: (
+            ("time", "axis"),
+            poi - poi[:1],
+            {
+                "units": unit,
+                "long_name": "displacement of the journal since the reference frame (z = out of plane)",
+                "ancillary_variables": f"{jname}_u",
+            },
+        ),
+        f"{jname}_u": (
+            ("time", "axis"),
+            poi_u * np.sqrt(2),
+            {"units": unit, "long_name": "standard uncertainty of journal_displacement"},
+        ),
+    }
+
+
+def _crank_variables(st, flag_arr, stereo, attrs_extra) -> dict:
+    """The crank angle; flags the frames lost without a time gap that its steps reveal (in
+    ``flag_arr``, counted in ``attrs_extra``)."""
+    from jointwear import conventions as C
+
+    ang = np.unwrap(rotation_angle_z(np.asarray(st.rows["R"], dtype=float)))
+    if not stereo:  # image y points down: a counter-clockwise turn looks clockwise
+        ang = -ang
+    ang = ang + np.deg2rad(st.spec.reference_angle_deg)
+    # a crank turning at constant speed also reveals frames lost without a time gap
+    # (constant-rate video containers): a step of about k >= 2 median steps
+    step = np.diff(ang)
+    ok = np.isfinite(step)
+    if ok.sum() >= 3:
+        med = np.median(step[ok])
+        if abs(med) > 1e-6:
+            k = np.rint(step / med)
+            jumps = np.flatnonzero(ok & (k >= 2) & (np.abs(step / med - k) < 0.25)) + 1
+            jumps = [int(j) for j in jumps if not flag_arr[j] & FRAME_FLAGS["after_gap"]]
+            flag_arr[jumps] |= FRAME_FLAGS["crank_step_gap"]
+            attrs_extra["dropped_frames_from_crank"] = json.dumps(
+                {str(j): int(k[j - 1] - 1) for j in jumps}
+            )
+    return {
+        "crank_angle": (
+            "time",
+            ang,
+            C.variable_attrs(
+                "crank_angle",
+                note=f"rotation of the tracked crank about the world z axis plus reference_angle_deg = {st.spec.reference_angle_deg}",
+            ),
+        )
+    }
+
+
+def _journal_offset(states) -> dict:
+    """The journal's point of interest in the bearing's frame (stereo, both bodies tracked)."""
+    from jointwear import conventions as C
+
+    roles = {st.spec.role: st for st in states}
+    if "journal" not in roles or "bearing" not in roles:
+        return {}
+    rb = np.asarray(roles["bearing"].rows["R"], dtype=float)
+    pb = np.asarray(roles["bearing"].rows["poi"], dtype=float)
+    pj = np.asarray(roles["journal"].rows["poi"], dtype=float)
+    offset = np.einsum("nji,nj->ni", rb, pj - pb)  # R_b^T (p_j - p_b)
+    return {
+        "journal_offset": (
+            ("time", "axis"),
+            offset,
+            C.variable_attrs(
+                "journal_offset",
+                note="journal point of interest minus bearing centre, in the bearing frame "
+                "(world axes at the reference frame, turning with the bearing body)",
+            ),
+        )
+    }
+
+
 def _assemble(states, times, flags, duplicates, L, R, cfg, calibration, status) -> xr.Dataset:
     from jointwear import conventions as C
 
@@ -173,12 +410,7 @@ def _assemble(states, times, flags, duplicates, L, R, cfg, calibration, status) 
     unit = "m" if stereo else "pixel"
     axes = ["x", "y", "z"] if stereo else ["x", "y"]
     flag_arr = np.asarray(flags, dtype=np.int8)
-    # gaps in the frame times (dropped frames)
-    dt = np.diff(t)
-    nominal = 1.0 / L.fps
-    gaps = np.flatnonzero(dt > 1.5 * nominal) + 1
-    flag_arr[gaps] |= FRAME_FLAGS["after_gap"]
-    dropped = int(np.sum(np.rint(dt[dt > 1.5 * nominal] / nominal) - 1)) if len(dt) else 0
+    gaps, dropped = _frame_gaps(t, flag_arr, L.fps)
     data: dict[str, Any] = {}
     coords = {
         "time": ("time", t, {"units": "s", "long_name": C.COORDINATES["time"][1]}),
@@ -188,198 +420,25 @@ def _assemble(states, times, flags, duplicates, L, R, cfg, calibration, status) 
     attrs_extra: dict[str, float] = {}
     reinit_counts: dict[str, int] = {}
     for st in states:
-        rows = st.rows
-        name = st.spec.name
-        img = "" if stereo else "_image"  # one camera: pixels, not the contract's metres
-        poi = np.asarray(rows["poi"], dtype=float)
-        poi_u = np.asarray(rows["poi_u"], dtype=float)
+        poi = np.asarray(st.rows["poi"], dtype=float)
+        poi_u = np.asarray(st.rows["poi_u"], dtype=float)
         poi_v = np.where(valid_time[:, None], poi, np.nan)
         vel, gain = time_derivative(t, poi_v, window=cfg.velocity_window, order=cfg.velocity_order)
         budget = velocity_budget(t, poi_v, poi_u, vel, gain, cfg, calibration if stereo else None)
-        vel_u = budget["total"]
-        data[f"{name}{img}_position"] = (
-            ("time", "axis"),
-            poi,
-            {
-                "units": unit,
-                "long_name": f"position of the {name}'s point of interest (world frame)",
-                "ancillary_variables": f"{name}{img}_position_u",
-            },
-        )
-        data[f"{name}{img}_position_u"] = (
-            ("time", "axis"),
-            poi_u,
-            {"units": unit, "long_name": f"standard uncertainty of {name}{img}_position"},
-        )
-        data[f"{name}{img}_velocity"] = (
-            ("time", "axis"),
-            vel,
-            {"units": f"{unit} s-1", "long_name": f"velocity of the {name}'s point of interest"},
-        )
-        data[f"{name}_n_points"] = (
-            "time",
-            np.asarray(rows["n"]),
-            {"units": "1", "long_name": f"subsets used in the {name}'s rigid fit"},
-        )
-        data[f"{name}_fit_rms"] = (
-            "time",
-            np.asarray(rows["rms"], dtype=float),
-            {"units": unit, "long_name": f"RMS residual of the {name}'s rigid fit"},
-        )
-        d = st.ref3d.shape[1]
-        data[f"{name}_rotation"] = (
-            ("time", f"{name}_row", f"{name}_col"),
-            np.asarray(rows["R"], dtype=float),
-            {"units": "1", "long_name": f"rotation of the {name} since the reference frame"},
-        )
-        pts = np.asarray(rows["points"], dtype=np.float32)
-        data[f"{name}_points"] = (
-            ("time", f"{name}_point", f"{name}_point_axis"),
-            pts,
-            {
-                "units": unit,
-                "long_name": f"tracked subset centres of the {name} (world frame)",
-                "ancillary_variables": f"{name}_points_u",
-            },
-        )
-        data[f"{name}_points_u"] = (
-            ("time", f"{name}_point", f"{name}_point_axis"),
-            np.asarray(rows["points_u"], dtype=np.float32),
-            {"units": unit, "long_name": f"standard uncertainty of {name}_points (propagated)"},
-        )
-        data[f"{name}_zncc"] = (
-            ("time", f"{name}_point"),
-            np.asarray(rows["zncc"], dtype=np.float32),
-            {"units": "1", "long_name": f"ZNCC of the {name}'s subsets (lower of the two cameras)"},
-        )
-        data[f"{name}_subset_displacement"] = (
-            ("time", f"{name}_point", f"{name}_point_axis"),
-            pts - pts[:1],
-            {
-                "units": unit,
-                "long_name": f"displacement of the {name}'s subsets since the reference frame",
-            },
-        )
-        reinit = np.asarray(rows.get("reinit", np.zeros(len(t))), dtype=np.int8)
-        data[f"{name}_reinitialised"] = (
-            "time",
-            reinit,
-            {
-                "units": "1",
-                "long_name": f"1 where the {name}'s tracking was lost and found again from SIFT "
-                "features of the reference images",
-            },
-        )
-        reinit_counts[name] = int(reinit.sum())
-        coords[f"{name}_row"] = (f"{name}_row", np.arange(d))
-        coords[f"{name}_col"] = (f"{name}_col", np.arange(d))
-        coords[f"{name}_point_axis"] = (f"{name}_point_axis", axes)
-        sig_med = float(np.median(st.sigma_px))
-        attrs_extra[f"{name}_match_sigma_px"] = sig_med
-        if stereo:
-            from jointwear.dic.calibration._stereo import stereo_noise_floor
-
-            floor = stereo_noise_floor(calibration, np.nanmean(st.ref3d, axis=0), sig_med)
-            attrs_extra[f"{name}_noise_floor_z_per_point_m"] = floor
-            attrs_extra[f"{name}_noise_floor_z_body_m"] = floor / np.sqrt(len(st.ref3d))
+        body, body_coords = _body_variables(st, t, poi, poi_u, vel, axes, unit, stereo)
+        data.update(body)
+        coords.update(body_coords)
+        reinit_counts[st.spec.name] = int(body[f"{st.spec.name}_reinitialised"][1].sum())
+        attrs_extra.update(_noise_attrs(st, calibration if stereo else None))
         role = st.spec.role
         if role == "follower" and stereo:
-            data["follower_position"] = (
-                ("time", "axis"),
-                poi,
-                C.variable_attrs("follower_position", ancillary_variables="follower_position_u"),
-            )
-            data["follower_position_u"] = (
-                ("time", "axis"),
-                poi_u,
-                {"units": unit, "long_name": "standard uncertainty of follower_position"},
-            )
-            data["follower_velocity"] = (
-                ("time", "axis"),
-                vel,
-                C.variable_attrs(
-                    "follower_velocity",
-                    ancillary_variables="follower_velocity_u",
-                    method=f"Savitzky-Golay on frame times, window {cfg.velocity_window} "
-                    f"samples, order {cfg.velocity_order}",
-                ),
-            )
-            data["follower_velocity_u"] = (
-                ("time", "axis"),
-                vel_u,
-                {
-                    "units": f"{unit} s-1",
-                    "long_name": "standard uncertainty of follower_velocity: position noise "
-                    "through the differentiator, its truncation error and the calibration's "
-                    "length and orientation uncertainty, combined in quadrature",
-                    "noise_median": _med(budget["noise"]),
-                    "truncation_median": _med(budget["truncation"]),
-                    "calibration_median": (
-                        _med(budget["calibration"])
-                        if budget["calibration"] is not None
-                        else "not assessed (the calibration carries no length_scale_u_rel)"
-                    ),
-                },
-            )
+            data.update(_follower_variables(poi, poi_u, vel, budget, cfg, unit))
         elif role == "journal":
-            disp = poi - poi[:1]
-            jname = "journal_displacement" if stereo else "journal_image_displacement"
-            data[jname] = (
-                ("time", "axis"),
-                disp,
-                {
-                    "units": unit,
-                    "long_name": "displacement of the journal since the reference frame (z = out of plane)",
-                    "ancillary_variables": f"{jname}_u",
-                },
-            )
-            data[f"{jname}_u"] = (
-                ("time", "axis"),
-                poi_u * np.sqrt(2),
-                {"units": unit, "long_name": "standard uncertainty of journal_displacement"},
-            )
+            data.update(_journal_variables(poi, poi_u, unit, stereo))
         elif role == "crank":
-            ang = np.unwrap(rotation_angle_z(np.asarray(rows["R"], dtype=float)))
-            if not stereo:  # image y points down: a counter-clockwise turn looks clockwise
-                ang = -ang
-            ang = ang + np.deg2rad(st.spec.reference_angle_deg)
-            # a crank turning at constant speed also reveals frames lost without a time gap
-            # (constant-rate video containers): a step of about k >= 2 median steps
-            step = np.diff(ang)
-            ok = np.isfinite(step)
-            if ok.sum() >= 3:
-                med = np.median(step[ok])
-                if abs(med) > 1e-6:
-                    k = np.rint(step / med)
-                    jumps = np.flatnonzero(ok & (k >= 2) & (np.abs(step / med - k) < 0.25)) + 1
-                    jumps = [int(j) for j in jumps if not flag_arr[j] & FRAME_FLAGS["after_gap"]]
-                    flag_arr[jumps] |= FRAME_FLAGS["crank_step_gap"]
-                    attrs_extra["dropped_frames_from_crank"] = json.dumps(
-                        {str(j): int(k[j - 1] - 1) for j in jumps}
-                    )
-            data["crank_angle"] = (
-                "time",
-                ang,
-                C.variable_attrs(
-                    "crank_angle",
-                    note=f"rotation of the tracked crank about the world z axis plus reference_angle_deg = {st.spec.reference_angle_deg}",
-                ),
-            )
-    roles = {st.spec.role: st for st in states}
-    if stereo and "journal" in roles and "bearing" in roles:
-        rb = np.asarray(roles["bearing"].rows["R"], dtype=float)
-        pb = np.asarray(roles["bearing"].rows["poi"], dtype=float)
-        pj = np.asarray(roles["journal"].rows["poi"], dtype=float)
-        offset = np.einsum("nji,nj->ni", rb, pj - pb)  # R_b^T (p_j - p_b)
-        data["journal_offset"] = (
-            ("time", "axis"),
-            offset,
-            C.variable_attrs(
-                "journal_offset",
-                note="journal point of interest minus bearing centre, in the bearing frame "
-                "(world axes at the reference frame, turning with the bearing body)",
-            ),
-        )
+            data.update(_crank_variables(st, flag_arr, stereo, attrs_extra))
+    if stereo:
+        data.update(_journal_offset(states))
     data["frame_flag"] = (
         "time",
         flag_arr,

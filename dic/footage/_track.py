@@ -172,23 +172,7 @@ def track_footage(
         dropped frames found.
     """
     cfg = config or TrackConfig()
-    L = _open_footage(left, fps, "left footage")
-    R = None
-    if right is not None:
-        R = _open_footage(right, fps, "right footage")
-        check_stereo_pair(L, R)
-        if calibration is None:
-            raise BadInputError(
-                "two cameras need a stereo calibration (calibration=..., CLI --calibration)"
-            )
-        for name, src in (("left", L), ("right", R)):
-            cam_size = calibration.cameras[name].image_size
-            if tuple(src.size) != tuple(cam_size):
-                raise BadInputError(
-                    f"{name} footage '{src.path}' has {src.size[0]}x{src.size[1]} pixel frames but "
-                    f"the calibration's {name} camera is {cam_size[0]}x{cam_size[1]}; use the "
-                    "calibration made for these cameras at this resolution"
-                )
+    L, R = _open_cameras(left, right, fps, calibration)
     n_total = L.n_frames if max_frames is None else min(L.n_frames, max_frames)
     t_start = _time.perf_counter()
     (_, t0, ref_l), ref_r = _reference_frames(L, R)
@@ -208,22 +192,9 @@ def track_footage(
         )
     from jointwear.progress import progress_bar
 
-    # partial results are rewritten whole after a chunk, so on a long recording each write
-    # costs more; a chunk's write is skipped while the previous write took more than
-    # 1/_CHECKPOINT_OVERHEAD of the time since, keeping the writes' share of the run bounded
-    last_write = {"end": _time.perf_counter(), "cost": 0.0}
-
-    def save(status: str, *, force: bool = False) -> None:
-        if out is None or not times:
-            return
-        now = _time.perf_counter()
-        if not force and (now - last_write["end"]) * _CHECKPOINT_OVERHEAD < last_write["cost"]:
-            return
-        ds = _assemble(states, times, flags, duplicates, L, R, cfg, calibration, status)
-        _write(ds, out, inputs, cfg, bodies)
-        last_write["end"] = _time.perf_counter()
-        last_write["cost"] = last_write["end"] - now
-
+    save = _Checkpoint(
+        out, inputs, bodies, (states, times, flags, duplicates, L, R, cfg, calibration)
+    )
     # one process: the cameras' and bodies' trackers of a frame run in threads (their
     # kernels release the GIL); several processes: one thread each
     n_threads = min(2, os.cpu_count() or 1) if cfg.workers <= 1 and scheduler is None else 1
@@ -235,40 +206,27 @@ def track_footage(
             if cfg.workers <= 1 and scheduler is None:
                 # decoding overlaps; a resumed run starts one frame early for the duplicate check
                 frames = prefetch(_paired_frames(L, R, max(start - 1, 0), n_total))
-                for i, t, flag, dup in _run_frames(
+                tracked = _run_frames(
                     states, frames, cfg, calibration, pool, first=start, reinit_first=start > 0
-                ):
-                    flags.append(flag)
-                    times.append(t)
-                    if dup:
-                        duplicates.append(i)
+                )
+                for _ in _recorded(tracked, times, flags, duplicates):
                     bar.update(task, advance=1)
                     if len(times) % cfg.chunk_size == 0:
                         save("partial")
             else:
-                ranges = [
-                    (a, min(a + cfg.chunk_size, n_total))
-                    for a in range(start, n_total, cfg.chunk_size)
-                ]
-                with _chunk_executor(cfg.workers, scheduler) as chunks:
-                    futures = [
-                        chunks.submit(_run_chunk, L, R, bodies, calibration, cfg, a, b)
-                        for a, b in ranges
-                    ]
-                    for fut in futures:
-                        part = fut.result()
-                        for st in states:
-                            for key, vals in part["rows"][st.spec.name].items():
-                                st.rows.setdefault(key, []).extend(vals)
-                        times.extend(part["times"])
-                        flags.extend(part["flags"])
-                        duplicates.extend(part["duplicates"])
-                        bar.update(task, advance=len(part["times"]))
-                        if part["error"]:
-                            for other in futures:
-                                other.cancel()  # chunks not started yet
-                            raise BadInputError(part["error"])
-                        save("partial")
+                for part in _chunk_results(
+                    L, R, bodies, calibration, cfg, scheduler, start, n_total
+                ):
+                    for st in states:
+                        for key, vals in part["rows"][st.spec.name].items():
+                            st.rows.setdefault(key, []).extend(vals)
+                    times.extend(part["times"])
+                    flags.extend(part["flags"])
+                    duplicates.extend(part["duplicates"])
+                    bar.update(task, advance=len(part["times"]))
+                    if part["error"]:
+                        raise BadInputError(part["error"])
+                    save("partial")
     except (BadInputError, KeyboardInterrupt) as exc:
         if isinstance(pool, ThreadPoolExecutor):
             pool.shutdown(cancel_futures=True)
@@ -288,6 +246,81 @@ def track_footage(
     )
 
 
+def _open_cameras(left, right, fps, calibration) -> tuple[FrameSource, FrameSource | None]:
+    """Both cameras' footage (``R`` None: one camera), checked against each other and the
+    calibration's image sizes."""
+    L = _open_footage(left, fps, "left footage")
+    if right is None:
+        return L, None
+    R = _open_footage(right, fps, "right footage")
+    check_stereo_pair(L, R)
+    if calibration is None:
+        raise BadInputError(
+            "two cameras need a stereo calibration (calibration=..., CLI --calibration)"
+        )
+    for name, src in (("left", L), ("right", R)):
+        cam_size = calibration.cameras[name].image_size
+        if tuple(src.size) != tuple(cam_size):
+            raise BadInputError(
+                f"{name} footage '{src.path}' has {src.size[0]}x{src.size[1]} pixel frames but "
+                f"the calibration's {name} camera is {cam_size[0]}x{cam_size[1]}; use the "
+                "calibration made for these cameras at this resolution"
+            )
+    return L, R
+
+
+def _recorded(tracked, times: list, flags: list, duplicates: list):
+    """Record every tracked frame's time, flag and (when a duplicate) index; yields after
+    each frame."""
+    for i, t, flag, dup in tracked:
+        flags.append(flag)
+        times.append(t)
+        if dup:
+            duplicates.append(i)
+        yield i
+
+
+def _chunk_results(L, R, bodies, calibration, cfg, scheduler, start: int, stop: int):
+    """Track the frames ``start <= i < stop`` in independent chunks (processes, threads or
+    dask tasks, :func:`_chunk_executor`); yields each chunk's result in order. The chunks not
+    started yet are cancelled when one stops with an error."""
+    ranges = [(a, min(a + cfg.chunk_size, stop)) for a in range(start, stop, cfg.chunk_size)]
+    with _chunk_executor(cfg.workers, scheduler) as chunks:
+        futures = [
+            chunks.submit(_run_chunk, L, R, bodies, calibration, cfg, a, b) for a, b in ranges
+        ]
+        for fut in futures:
+            part = fut.result()
+            if part["error"]:
+                for other in futures:
+                    other.cancel()  # chunks not started yet
+            yield part
+
+
+class _Checkpoint:
+    """Write the partial result to ``out`` after a chunk. Partial results are rewritten whole,
+    so on a long recording each write costs more; a chunk's write is skipped while the
+    previous write took more than 1/_CHECKPOINT_OVERHEAD of the time since, keeping the
+    writes' share of the run bounded."""
+
+    def __init__(self, out, inputs, bodies, assemble_args: tuple) -> None:
+        self.out, self.inputs, self.bodies = out, inputs, bodies
+        self.args = assemble_args  # (states, times, flags, duplicates, L, R, cfg, calibration)
+        self.end, self.cost = _time.perf_counter(), 0.0
+
+    def __call__(self, status: str, *, force: bool = False) -> None:
+        times = self.args[1]
+        if self.out is None or not times:
+            return
+        now = _time.perf_counter()
+        if not force and (now - self.end) * _CHECKPOINT_OVERHEAD < self.cost:
+            return
+        ds = _assemble(*self.args, status)
+        _write(ds, self.out, self.inputs, self.args[6], self.bodies)
+        self.end = _time.perf_counter()
+        self.cost = self.end - now
+
+
 def _finish_result(
     states, times, flags, duplicates, L, R, cfg, calibration, out, inputs, bodies, t_start
 ) -> xr.Dataset:
@@ -299,7 +332,7 @@ def _finish_result(
     return result
 
 
-#: largest share of a tracking run spent writing partial results (see track_footage's save)
+#: largest share of a tracking run spent writing partial results (see _Checkpoint)
 _CHECKPOINT_OVERHEAD = 0.1
 
 
@@ -329,13 +362,11 @@ def _run_chunk(L, R, bodies, calibration, cfg, start: int, stop: int) -> dict:
     try:
         frames = _paired_frames(L, R, max(start - 1, 0), stop)
         # the frame before the chunk serves only the duplicate check
-        for i, t, flag, dup in _run_frames(
+        tracked = _run_frames(
             states, frames, cfg, calibration, None, first=start, reinit_first=start > 0
-        ):
-            flags.append(flag)
-            times.append(t)
-            if dup:
-                duplicates.append(i)
+        )
+        for _ in _recorded(tracked, times, flags, duplicates):
+            pass
     except BadInputError as exc:
         error = str(exc)
     return {

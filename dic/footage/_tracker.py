@@ -5,7 +5,12 @@ from __future__ import annotations
 import numpy as np
 
 from jointwear.dic.footage._config import TrackConfig
-from jointwear.dic.footage._features import _homography_guess, _sift_features, _sift_homography
+from jointwear.dic.footage._features import (
+    _homography_guess,
+    _sift_features,
+    _sift_homography,
+    affine_guess,
+)
 from jointwear.dic.icgn._interp import prefilter_region
 
 
@@ -272,17 +277,7 @@ class _CameraBodyTracker:
         J = np.empty((len(guess), 2, 2))
         J[:, 0, 0], J[:, 0, 1] = 1.0 + guess[:, 1], guess[:, 2]
         J[:, 1, 0], J[:, 1, 1] = guess[:, 4], 1.0 + guess[:, 5]
-        Jn = M[:, :2] @ J
-        out = np.column_stack(
-            [
-                new_pos[:, 0] - C[:, 0],
-                Jn[:, 0, 0] - 1.0,
-                Jn[:, 0, 1],
-                new_pos[:, 1] - C[:, 1],
-                Jn[:, 1, 0],
-                Jn[:, 1, 1] - 1.0,
-            ]
-        )
+        out = affine_guess(C, new_pos, M[:, :2] @ J)
         out[idx[ok]] = sub.params[ok][:, [0, 1, 2, 6, 7, 8]]  # probes start from their match
         return out, moved
 

@@ -305,21 +305,51 @@ _Z5 = (
 )
 
 
+@njit(cache=True, inline="always")
+def _gain(z1, z2, npoles):
+    """Gain of the B-spline prefilter with poles ``z1`` (and ``z2``)."""
+    lam = (1.0 - z1) * (1.0 - 1.0 / z1)
+    if npoles == 2:
+        lam *= (1.0 - z2) * (1.0 - 1.0 / z2)
+    return lam
+
+
+@njit(cache=True, inline="always")
+def _horizon(z):
+    """Samples after which ``z**k`` falls below 1e-14 (truncated causal initialisation)."""
+    return int(math.ceil(math.log(1e-14) / math.log(abs(z))))
+
+
+@njit(cache=True, inline="always")
+def _mirror_start(c, z):
+    """Exact causal initialisation of a line ``c`` shorter than the horizon (mirror
+    boundary, the whole line summed)."""
+    n = c.shape[0]
+    zn = z
+    iz = 1.0 / z
+    z2n = z ** (n - 1)
+    s = c[0] + z2n * c[n - 1]
+    z2n *= z2n * iz
+    for k in range(1, n - 1):
+        s += (zn + z2n) * c[k]
+        zn *= z
+        z2n *= iz
+    return s / (1.0 - zn * zn)
+
+
 @njit(cache=True, nogil=True)
 def _filter_line(c, z1, z2, npoles):
     """In-place recursive B-spline prefilter of one line, mirror boundary (s[-k] = s[k])."""
     n = c.shape[0]
     if n == 1:
         return
-    lam = (1.0 - z1) * (1.0 - 1.0 / z1)
-    if npoles == 2:
-        lam *= (1.0 - z2) * (1.0 - 1.0 / z2)
+    lam = _gain(z1, z2, npoles)
     for i in range(n):
         c[i] *= lam
     for q in range(npoles):
         z = z1 if q == 0 else z2
         # causal initialisation (mirror boundary), truncated at 1e-14 relative
-        horizon = int(math.ceil(math.log(1e-14) / math.log(abs(z))))
+        horizon = _horizon(z)
         if horizon < n:
             zn = z
             s = c[0]
@@ -328,16 +358,7 @@ def _filter_line(c, z1, z2, npoles):
                 zn *= z
             c[0] = s
         else:
-            zn = z
-            iz = 1.0 / z
-            z2n = z ** (n - 1)
-            s = c[0] + z2n * c[n - 1]
-            z2n *= z2n * iz
-            for k in range(1, n - 1):
-                s += (zn + z2n) * c[k]
-                zn *= z
-                z2n *= iz
-            c[0] = s / (1.0 - zn * zn)
+            c[0] = _mirror_start(c, z)
         for k in range(1, n):
             c[k] += z * c[k - 1]
         c[n - 1] = (z / (z * z - 1.0)) * (z * c[n - 2] + c[n - 1])
@@ -351,16 +372,14 @@ def _filter_columns(c, j0, j1, z1, z2, npoles):
     n = c.shape[0]
     if n == 1:
         return
-    lam = (1.0 - z1) * (1.0 - 1.0 / z1)
-    if npoles == 2:
-        lam *= (1.0 - z2) * (1.0 - 1.0 / z2)
+    lam = _gain(z1, z2, npoles)
     for i in range(n):
         for j in range(j0, j1):
             c[i, j] *= lam
     acc = np.empty(j1 - j0)
     for q in range(npoles):
         z = z1 if q == 0 else z2
-        horizon = int(math.ceil(math.log(1e-14) / math.log(abs(z))))
+        horizon = _horizon(z)
         if horizon < n:
             for j in range(j0, j1):
                 acc[j - j0] = c[0, j]
@@ -373,17 +392,7 @@ def _filter_columns(c, j0, j1, z1, z2, npoles):
                 c[0, j] = acc[j - j0]
         else:
             for j in range(j0, j1):
-                col = c[:, j].copy()
-                zn = z
-                iz = 1.0 / z
-                z2n = z ** (n - 1)
-                s = col[0] + z2n * col[n - 1]
-                z2n *= z2n * iz
-                for k in range(1, n - 1):
-                    s += (zn + z2n) * col[k]
-                    zn *= z
-                    z2n *= iz
-                c[0, j] = s / (1.0 - zn * zn)
+                c[0, j] = _mirror_start(c[:, j].copy(), z)
         for k in range(1, n):
             for j in range(j0, j1):
                 c[k, j] += z * c[k - 1, j]
@@ -410,18 +419,19 @@ def _prefilter_2d(img, order, out):
         _filter_columns(tmp, blk * 64, min(w, blk * 64 + 64), z1, z2, npoles)
     # mirrored padding (reflect without repeating the edge sample)
     for i in range(h + 2 * PAD):
-        si = i - PAD
-        if si < 0:
-            si = -si
-        elif si > h - 1:
-            si = 2 * (h - 1) - si
+        si = _reflect(i - PAD, h)
         for j in range(w + 2 * PAD):
-            sj = j - PAD
-            if sj < 0:
-                sj = -sj
-            elif sj > w - 1:
-                sj = 2 * (w - 1) - sj
-            out[i, j] = tmp[si, sj]
+            out[i, j] = tmp[si, _reflect(j - PAD, w)]
+
+
+@njit(cache=True, inline="always")
+def _reflect(i, n):
+    """Index ``i`` reflected into ``0 .. n - 1`` without repeating the edge sample."""
+    if i < 0:
+        return -i
+    if i > n - 1:
+        return 2 * (n - 1) - i
+    return i
 
 
 @njit(cache=True)
@@ -451,6 +461,19 @@ def node_filters(order):
     )
 
 
+@njit(cache=True, inline="always")
+def node_row_sums(row, j0, val, der):
+    """Value and derivative filters over ``row[j0 : j0 + len(val)]``: ``(sum val c,
+    sum der c)``."""
+    sv = 0.0
+    sd = 0.0
+    for b in range(val.shape[0]):
+        cv = row[j0 + b]
+        sv += val[b] * cv
+        sd += der[b] * cv
+    return sv, sd
+
+
 @njit(cache=True)
 def _node_gradients(coef, order, gx, gy):
     """Exact derivatives of the interpolant at the pixel nodes [grey level / pixel]."""
@@ -463,14 +486,7 @@ def _node_gradients(coef, order, gx, gy):
     for i in range(h + 2 * r):
         row = coef[i + PAD - r]
         for j in range(w):
-            sv = 0.0
-            sd = 0.0
-            for b in range(2 * r + 1):
-                cv = row[j + PAD - r + b]
-                sv += val[b] * cv
-                sd += der[b] * cv
-            tv[i, j] = sv
-            td[i, j] = sd
+            tv[i, j], td[i, j] = node_row_sums(row, j + PAD - r, val, der)
     for i in range(h):
         for j in range(w):
             sx = 0.0
@@ -545,11 +561,12 @@ def interp_value(coef, order, x, y, wx, wy):
     tx = x - ix
     ty = y - iy
     acc = 0.0
+    lead = 1 if order == 3 else 2  # nodes before the point's own: 1 cubic, 2 quintic
+    bx = ix + PAD - lead
+    by = iy + PAD - lead
     if order == 3:
         _weights3(tx, wx)
         _weights3(ty, wy)
-        bx = ix + PAD - 1
-        by = iy + PAD - 1
         for r in range(4):
             row = coef[by + r]
             s = wx[0] * row[bx] + wx[1] * row[bx + 1] + wx[2] * row[bx + 2] + wx[3] * row[bx + 3]
@@ -557,8 +574,6 @@ def interp_value(coef, order, x, y, wx, wy):
     else:
         _weights5(tx, wx)
         _weights5(ty, wy)
-        bx = ix + PAD - 2
-        by = iy + PAD - 2
         for r in range(6):
             row = coef[by + r]
             s = 0.0
@@ -580,17 +595,15 @@ def interp_value_grad(coef, order, x, y, wx, wy, dx, dy):
         _weights3(ty, wy)
         _dweights3(tx, dx)
         _dweights3(ty, dy)
-        n = 4
-        bx = ix + PAD - 1
-        by = iy + PAD - 1
     else:
         _weights5(tx, wx)
         _weights5(ty, wy)
         _dweights5(tx, dx)
         _dweights5(ty, dy)
-        n = 6
-        bx = ix + PAD - 2
-        by = iy + PAD - 2
+    lead = 1 if order == 3 else 2  # nodes before the point's own: 1 cubic, 2 quintic
+    n = 2 * lead + 2
+    bx = ix + PAD - lead
+    by = iy + PAD - lead
     f = 0.0
     fx = 0.0
     fy = 0.0

@@ -9,7 +9,7 @@ import numpy as np
 from numba import njit
 
 from jointwear.dic.icgn._flags import FLAG_INVALID_PIXELS, FLAG_NO_TEXTURE, FLAG_OK, FLAG_OUTSIDE
-from jointwear.dic.icgn._interp import PAD, interp_value, node_filters
+from jointwear.dic.icgn._interp import PAD, interp_value, node_filters, node_row_sums
 
 
 @njit(cache=True)
@@ -174,13 +174,7 @@ def subset_kappa(coef, order, gx, gy, centres, half, out):
                 sx = 0.0
                 sy = 0.0
                 for p in range(2 * r + 1):
-                    row = coef[y + PAD - r + p]
-                    vd = 0.0
-                    vv = 0.0
-                    for q in range(2 * r + 1):
-                        c = row[x + PAD - r + q]
-                        vd += der[q] * c
-                        vv += val[q] * c
+                    vv, vd = node_row_sums(coef[y + PAD - r + p], x + PAD - r, val, der)
                     sx += val[p] * vd
                     sy += der[p] * vv
                 a += gx[y, x] * gx[y, x] + gy[y, x] * gy[y, x]

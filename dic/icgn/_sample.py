@@ -45,15 +45,16 @@ def interp_point(coef, order, xw, yw):
     """B-spline value at (xw, yw) >= 0 [pixel] on padded prefiltered coefficients."""
     ix = int(xw)
     iy = int(yw)
+    lead = 1 if order == 3 else 2  # nodes before the point's own: 1 cubic, 2 quintic
+    bx = ix + PAD - lead
+    by = iy + PAD - lead
+    r0 = coef[by]
+    r1 = coef[by + 1]
+    r2 = coef[by + 2]
+    r3 = coef[by + 3]
     if order == 3:
         w0, w1, w2, w3 = bspline3(xw - ix)
         v0, v1, v2, v3 = bspline3(yw - iy)
-        bx = ix + PAD - 1
-        by = iy + PAD - 1
-        r0 = coef[by]
-        r1 = coef[by + 1]
-        r2 = coef[by + 2]
-        r3 = coef[by + 3]
         return (
             v0 * (w0 * r0[bx] + w1 * r0[bx + 1] + w2 * r0[bx + 2] + w3 * r0[bx + 3])
             + v1 * (w0 * r1[bx] + w1 * r1[bx + 1] + w2 * r1[bx + 2] + w3 * r1[bx + 3])
@@ -62,12 +63,6 @@ def interp_point(coef, order, xw, yw):
         ) * (1.0 / 36.0)
     w0, w1, w2, w3, w4, w5 = bspline5(xw - ix)
     v0, v1, v2, v3, v4, v5 = bspline5(yw - iy)
-    bx = ix + PAD - 2
-    by = iy + PAD - 2
-    r0 = coef[by]
-    r1 = coef[by + 1]
-    r2 = coef[by + 2]
-    r3 = coef[by + 3]
     r4 = coef[by + 4]
     r5 = coef[by + 5]
     acc = 0.0
@@ -75,6 +70,15 @@ def interp_point(coef, order, xw, yw):
         b = bx + q
         acc += wq * (v0 * r0[b] + v1 * r1[b] + v2 * r2[b] + v3 * r3[b] + v4 * r4[b] + v5 * r5[b])
     return acc * (1.0 / 14400.0)
+
+
+@njit(cache=True, inline="always")
+def add_row_sums(out, o, s, sc, rr):
+    """Add one subset row's sums of ``q`` and ``q c`` (``s``, ``sc``; ``rr`` the row) to
+    ``out[o : o + 3]``: the sums of ``q (1, c, r)``, an affine Jacobian's pattern."""
+    out[o] += s
+    out[o + 1] += sc
+    out[o + 2] += s * rr
 
 
 @njit(cache=True, fastmath=_FM)
@@ -107,9 +111,5 @@ def sample_affine(coef, order, x_start, y_start, a11, a12, a21, a22, half, f, gx
         acc[0] += sg
         acc[1] += sgg
         acc[2] += sgf
-        acc[3] += ga
-        acc[4] += gac
-        acc[5] += ga * rr
-        acc[6] += gb
-        acc[7] += gbc
-        acc[8] += gb * rr
+        add_row_sums(acc, 3, ga, gac, rr)
+        add_row_sums(acc, 6, gb, gbc, rr)

@@ -29,7 +29,7 @@ from jointwear.dic.icgn._flags import (
 )
 from jointwear.dic.icgn._interp import PAD
 from jointwear.dic.icgn._reference import _box_has_invalid, _load_reference, _store_sigma
-from jointwear.dic.icgn._sample import interp_point, sample_affine
+from jointwear.dic.icgn._sample import add_row_sums, interp_point, sample_affine
 from jointwear.dic.icgn._warp import _compose_affine, _compose_quadratic, _solve_spd
 
 # a subset still below this ZNCC after this many iterations is not going to match
@@ -84,18 +84,10 @@ def _hessian_affine(f, gx, gy, half, Hm, jf, js):
             m[o + 3] += scc
             m[o + 4] += sc * rr
             m[o + 5] += s1 * rr * rr
-        jf[0] += rfa
-        jf[1] += rfac
-        jf[2] += rfa * rr
-        jf[3] += rfb
-        jf[4] += rfbc
-        jf[5] += rfb * rr
-        js[0] += rsa
-        js[1] += rsac
-        js[2] += rsa * rr
-        js[3] += rsb
-        js[4] += rsbc
-        js[5] += rsb * rr
+        add_row_sums(jf, 0, rfa, rfac, rr)
+        add_row_sums(jf, 3, rfb, rfbc, rr)
+        add_row_sums(js, 0, rsa, rsac, rr)
+        add_row_sums(js, 3, rsb, rsbc, rr)
     # J = [a, a c, a r, b, b c, b r]: block (i, j) of sum J J^T from the moments
     for blk_i in range(2):
         for blk_j in range(blk_i, 2):
@@ -161,6 +153,72 @@ def _quadratic_system(f, gx, gy, half, Hinv, jf, js):
     return _solve_spd(Hm, Hinv, 12)
 
 
+@njit(cache=True, inline="always")
+def _valid_box(def_coef, border):
+    """Where warped subset pixels may lie in the deformed image: ``lo <= x <= hix``,
+    ``lo <= y <= hiy`` [pixel] (``border`` pixels from its edges)."""
+    Hd = def_coef.shape[0] - 2 * PAD
+    Wd = def_coef.shape[1] - 2 * PAD
+    return float(border), Wd - 1.0 - border, Hd - 1.0 - border
+
+
+@njit(cache=True, inline="always")
+def _invalid_near(def_invalid, xmin, ymin, xmax, ymax):
+    """True if the deformed image has invalid pixels within 3 pixels of the warped subset's
+    bounding box (``def_invalid`` of shape (1, 1): no invalid pixels)."""
+    return def_invalid.shape[0] > 1 and _box_has_invalid(
+        def_invalid,
+        int(math.floor(xmin)) - 3,
+        int(math.floor(ymin)) - 3,
+        int(math.ceil(xmax)) + 3,
+        int(math.ceil(ymax)) + 3,
+    )
+
+
+@njit(cache=True, inline="always")
+def _zncc_of(sg, sgg, sgf, n, fn, it):
+    """ZNCC of the sampled deformed subset from its sums ``sum g``, ``sum g^2``, ``sum g f``
+    (``fn``: the reference's norm). Returns ``(flag, zncc, gm, ratio)``: flag -1 to go on
+    (``gm`` the subset mean, ``ratio`` = fn / gn), else the flag to stop with."""
+    gm = sg / n
+    gn2 = sgg - n * gm * gm
+    if not gn2 > 1e-300:
+        return FLAG_NO_TEXTURE, np.nan, gm, 0.0
+    gn = math.sqrt(gn2)
+    zncc = sgf / (fn * gn)
+    if it >= _HOPELESS_AFTER and not (zncc >= _HOPELESS_ZNCC):
+        return FLAG_NOT_CONVERGED, zncc, gm, 0.0  # far from any match: stop early
+    return -1, zncc, gm, fn / gn
+
+
+@njit(cache=True, inline="always")
+def _gauss_newton_step(Hinv, jf, js, jg, gm, ratio, e, dp, index):
+    """The Gauss-Newton increment ``dp[index] = -Hinv (Jf - ratio (Jg - gm Js))``."""
+    m = e.shape[0]
+    for j in range(m):
+        e[j] = jf[j] - ratio * (jg[j] - gm * js[j])
+    for i in range(m):
+        s = 0.0
+        for j in range(m):
+            s += Hinv[i, j] * e[j]
+        dp[index[i]] = -s
+
+
+@njit(cache=True, inline="always")
+def _diverged(p, p_start_u, p_start_v, max_shift):
+    """True if a parameter is not finite or (u, v) moved more than ``max_shift`` [pixel]
+    from the start."""
+    ok = True
+    for i in range(12):
+        if not math.isfinite(p[i]):
+            ok = False
+    return not ok or abs(p[0] - p_start_u) > max_shift or abs(p[6] - p_start_v) > max_shift
+
+
+#: positions of the second-order increment in the 12 parameters (all of them)
+QUADRATIC_INDEX = np.arange(12)
+
+
 @njit(cache=True, nogil=True)
 def _iterate_affine(
     f, gx, gy, fn, Hinv, jf, js, def_coef, def_invalid, order, xc, yc, half, p, max_iter, tol,
@@ -171,8 +229,7 @@ def _iterate_affine(
     Uses ``sum J (f - fm - fn/gn (g - gm)) = Jf - fn/gn (Jg - gm Js)`` with ``Jf``, ``Js``
     fixed per subset, so each iteration samples the deformed subset once and accumulates.
     """
-    Hd = def_coef.shape[0] - 2 * PAD
-    Wd = def_coef.shape[1] - 2 * PAD
+    lo, hix, hiy = _valid_box(def_coef, border)
     n = (2 * half + 1) ** 2
     acc = np.empty(9)
     e = np.empty(6)
@@ -202,47 +259,20 @@ def _iterate_affine(
             xmax = max(xmax, xw)
             ymin = min(ymin, yw)
             ymax = max(ymax, yw)
-        if not (
-            xmin >= border
-            and ymin >= border
-            and xmax <= Wd - 1 - border
-            and ymax <= Hd - 1 - border
-        ):
+        if not (xmin >= lo and ymin >= lo and xmax <= hix and ymax <= hiy):
             return np.nan, it, FLAG_OUTSIDE
-        if def_invalid.shape[0] > 1 and _box_has_invalid(
-            def_invalid,
-            int(math.floor(xmin)) - 3,
-            int(math.floor(ymin)) - 3,
-            int(math.ceil(xmax)) + 3,
-            int(math.ceil(ymax)) + 3,
-        ):
+        if _invalid_near(def_invalid, xmin, ymin, xmax, ymax):
             return np.nan, it, FLAG_INVALID_PIXELS
         x_start = xc + p[0] - a11 * half
         y_start = yc + p[6] - a21 * half
         sample_affine(def_coef, order, x_start, y_start, a11, a12, a21, a22, half, f, gx, gy, acc)
-        gm = acc[0] / n
-        gn2 = acc[1] - n * gm * gm
-        if not gn2 > 1e-300:
-            return np.nan, it, FLAG_NO_TEXTURE
-        gn = math.sqrt(gn2)
-        zncc = acc[2] / (fn * gn)
-        if it >= _HOPELESS_AFTER and not (zncc >= _HOPELESS_ZNCC):
-            return zncc, it, FLAG_NOT_CONVERGED  # far from any match: stop early
-        ratio = fn / gn
-        for j in range(6):
-            e[j] = jf[j] - ratio * (acc[3 + j] - gm * js[j])
-        for i in range(6):
-            s = 0.0
-            for j in range(6):
-                s += Hinv[i, j] * e[j]
-            dp[AFFINE_INDEX[i]] = -s
+        stop, zncc, gm, ratio = _zncc_of(acc[0], acc[1], acc[2], n, fn, it)
+        if stop >= 0:
+            return zncc, it, stop
+        _gauss_newton_step(Hinv, jf, js, acc[3:], gm, ratio, e, dp, AFFINE_INDEX)
         if not _compose_affine(p, dp):
             return zncc, it, FLAG_DIVERGED
-        ok = True
-        for i in range(12):
-            if not math.isfinite(p[i]):
-                ok = False
-        if not ok or abs(p[0] - p_start_u) > max_shift or abs(p[6] - p_start_v) > max_shift:
+        if _diverged(p, p_start_u, p_start_v, max_shift):
             return np.nan, it, FLAG_DIVERGED
         norm = dp[0] * dp[0] + dp[6] * dp[6]
         norm += hh2 * (dp[1] * dp[1] + dp[2] * dp[2] + dp[7] * dp[7] + dp[8] * dp[8])
@@ -259,8 +289,7 @@ def _iterate_quadratic(
 ):  # fmt: skip
     """Gauss-Newton iterations of the second-order IC-GN (as :func:`_iterate_affine`, with the
     12-parameter Jacobian, every warped pixel bounds-checked and 6x6 warp composition)."""
-    Hd = def_coef.shape[0] - 2 * PAD
-    Wd = def_coef.shape[1] - 2 * PAD
+    lo, hix, hiy = _valid_box(def_coef, border)
     n = (2 * half + 1) ** 2
     jg = np.empty(12)
     e = np.empty(12)
@@ -270,9 +299,6 @@ def _iterate_quadratic(
     zncc = np.nan
     it = 0
     hh = float(half)
-    lo = float(border)
-    hix = Wd - 1.0 - border
-    hiy = Hd - 1.0 - border
     while it < max_iter:
         it += 1
         for i in range(12):
@@ -323,37 +349,15 @@ def _iterate_quadratic(
             jg[9] += 0.5 * rbcc
             jg[10] += rbc * rr
             jg[11] += 0.5 * rb * rr * rr
-        if def_invalid.shape[0] > 1 and _box_has_invalid(
-            def_invalid,
-            int(math.floor(xmin)) - 3,
-            int(math.floor(ymin)) - 3,
-            int(math.ceil(xmax)) + 3,
-            int(math.ceil(ymax)) + 3,
-        ):
+        if _invalid_near(def_invalid, xmin, ymin, xmax, ymax):
             return np.nan, it, FLAG_INVALID_PIXELS
-        gm = sg / n
-        gn2 = sgg - n * gm * gm
-        if not gn2 > 1e-300:
-            return np.nan, it, FLAG_NO_TEXTURE
-        gn = math.sqrt(gn2)
-        zncc = sgf / (fn * gn)
-        if it >= _HOPELESS_AFTER and not (zncc >= _HOPELESS_ZNCC):
-            return zncc, it, FLAG_NOT_CONVERGED  # far from any match: stop early
-        ratio = fn / gn
-        for j in range(12):
-            e[j] = jf[j] - ratio * (jg[j] - gm * js[j])
-        for i in range(12):
-            s = 0.0
-            for j in range(12):
-                s += Hinv[i, j] * e[j]
-            dp[i] = -s
+        stop, zncc, gm, ratio = _zncc_of(sg, sgg, sgf, n, fn, it)
+        if stop >= 0:
+            return zncc, it, stop
+        _gauss_newton_step(Hinv, jf, js, jg, gm, ratio, e, dp, QUADRATIC_INDEX)
         if not _compose_quadratic(p, dp):
             return zncc, it, FLAG_DIVERGED
-        ok = True
-        for i in range(12):
-            if not math.isfinite(p[i]):
-                ok = False
-        if not ok or abs(p[0] - p_start_u) > max_shift or abs(p[6] - p_start_v) > max_shift:
+        if _diverged(p, p_start_u, p_start_v, max_shift):
             return np.nan, it, FLAG_DIVERGED
         norm = dp[0] * dp[0] + dp[6] * dp[6]
         norm += hh * hh * (dp[1] * dp[1] + dp[2] * dp[2] + dp[7] * dp[7] + dp[8] * dp[8])

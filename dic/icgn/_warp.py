@@ -45,6 +45,29 @@ def _solve_spd(A, b, n):
     return True
 
 
+@njit(cache=True, inline="always")
+def _square_row(M, i, a0, a1, a2, a3, a4, a5):
+    """Row ``i`` of :func:`_quad_matrix`: the square of a warp component
+    ``a0 + a1 x + a2 y + a3 x^2 + a4 x y + a5 y^2`` in the basis (x^2, x y, y^2, x, y, 1)."""
+    M[i, 0] = a1 * a1 + 2 * a0 * a3
+    M[i, 1] = 2 * a1 * a2 + 2 * a0 * a4
+    M[i, 2] = a2 * a2 + 2 * a0 * a5
+    M[i, 3] = 2 * a0 * a1
+    M[i, 4] = 2 * a0 * a2
+    M[i, 5] = a0 * a0
+
+
+@njit(cache=True, inline="always")
+def _linear_row(M, i, a0, a1, a2, a3, a4, a5):
+    """Row ``i`` of :func:`_quad_matrix`: a warp component itself in that basis."""
+    M[i, 0] = a3
+    M[i, 1] = a4
+    M[i, 2] = a5
+    M[i, 3] = a1
+    M[i, 4] = a2
+    M[i, 5] = a0
+
+
 @njit(cache=True)
 def _quad_matrix(p, M):
     a0 = p[0]
@@ -59,36 +82,16 @@ def _quad_matrix(p, M):
     b3 = 0.5 * p[9]
     b4 = p[10]
     b5 = 0.5 * p[11]
-    M[0, 0] = a1 * a1 + 2 * a0 * a3
-    M[0, 1] = 2 * a1 * a2 + 2 * a0 * a4
-    M[0, 2] = a2 * a2 + 2 * a0 * a5
-    M[0, 3] = 2 * a0 * a1
-    M[0, 4] = 2 * a0 * a2
-    M[0, 5] = a0 * a0
+    _square_row(M, 0, a0, a1, a2, a3, a4, a5)
     M[1, 0] = a1 * b1 + a0 * b3 + a3 * b0
     M[1, 1] = a1 * b2 + a2 * b1 + a0 * b4 + a4 * b0
     M[1, 2] = a2 * b2 + a0 * b5 + a5 * b0
     M[1, 3] = a0 * b1 + a1 * b0
     M[1, 4] = a0 * b2 + a2 * b0
     M[1, 5] = a0 * b0
-    M[2, 0] = b1 * b1 + 2 * b0 * b3
-    M[2, 1] = 2 * b1 * b2 + 2 * b0 * b4
-    M[2, 2] = b2 * b2 + 2 * b0 * b5
-    M[2, 3] = 2 * b0 * b1
-    M[2, 4] = 2 * b0 * b2
-    M[2, 5] = b0 * b0
-    M[3, 0] = a3
-    M[3, 1] = a4
-    M[3, 2] = a5
-    M[3, 3] = a1
-    M[3, 4] = a2
-    M[3, 5] = a0
-    M[4, 0] = b3
-    M[4, 1] = b4
-    M[4, 2] = b5
-    M[4, 3] = b1
-    M[4, 4] = b2
-    M[4, 5] = b0
+    _square_row(M, 2, b0, b1, b2, b3, b4, b5)
+    _linear_row(M, 3, a0, a1, a2, a3, a4, a5)
+    _linear_row(M, 4, b0, b1, b2, b3, b4, b5)
     for j in range(5):
         M[5, j] = 0.0
     M[5, 5] = 1.0

@@ -23,13 +23,10 @@ _GRAD_NAMES = [
     ("dv_dx", 7, "1", "displacement gradient dv/dx"),
     ("dv_dy", 8, "1", "displacement gradient dv/dy"),
 ]
-_SECOND = [
-    ("d2u_dx2", 3, "pixel-1", "second derivative d2u/dx2"),
-    ("d2u_dxdy", 4, "pixel-1", "second derivative d2u/dxdy"),
-    ("d2u_dy2", 5, "pixel-1", "second derivative d2u/dy2"),
-    ("d2v_dx2", 9, "pixel-1", "second derivative d2v/dx2"),
-    ("d2v_dxdy", 10, "pixel-1", "second derivative d2v/dxdy"),
-    ("d2v_dy2", 11, "pixel-1", "second derivative d2v/dy2"),
+_SECOND = [  # d2u_dx2 .. d2v_dy2: shape parameters 3-5 (u) and 9-11 (v)
+    (f"d2{c}_{d}", first + k, "pixel-1", f"second derivative d2{c}/{d}")
+    for c, first in (("u", 3), ("v", 9))
+    for k, d in enumerate(("dx2", "dxdy", "dy2"))
 ]
 
 

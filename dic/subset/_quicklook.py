@@ -96,7 +96,4 @@ def save_quicklook(ds: xr.Dataset, path: str | Path, **kwargs) -> Path:
     """Write :func:`plot_displacement` to ``path`` (png/pdf/svg), atomically."""
     from jointwear.io import save_figure
 
-    path = Path(path)
-    fig = plot_displacement(ds, **kwargs)
-    save_figure(fig, path, dpi=90)
-    return path
+    return save_figure(plot_displacement(ds, **kwargs), path, dpi=90)

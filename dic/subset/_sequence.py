@@ -207,14 +207,7 @@ def correlate_sequence(
         ``converged``, ``flag`` over ``time`` and ``point`` (or ``y``, ``x``), and
         ``reference_frame``.
     """
-    from jointwear.dic.icgn import _flags as _icgn
-    from jointwear.dic.subset._correlator import (
-        SubsetCorrelator,
-        check_image,
-        check_pair,
-        result_dataset,
-    )
-    from jointwear.progress import progress_bar
+    from jointwear.dic.subset._correlator import SubsetCorrelator
 
     if update_every is not None and (not isinstance(update_every, int) or update_every < 1):
         raise ParameterError(f"update_every={update_every!r}: expected an integer >= 1 frame")
@@ -222,6 +215,20 @@ def correlate_sequence(
         raise ParameterError(
             f"reference={reference!r}: expected 'absolute' (always frame 0) or 'incremental'"
         )
+    first, frame_list, fps = _checked_frames(frames)
+    t, time_note = _frame_times(times, frame_rate, fps, len(frame_list))
+    base = SubsetCorrelator(first, points=points, roi=roi, params=params, **options)
+    seeds0 = base.check_seeds(seed_points) if seed_points is not None else None
+    tracker = _SequenceTracker(base, first, frame_list, seeds0)
+    tracker.track(reference, update_zncc, update_every, progress)
+    return tracker.dataset(reference, t, time_note)
+
+
+def _checked_frames(frames) -> tuple[np.ndarray, list, float | None]:
+    """The checked first frame, the frames (at least 2, all alike, see :func:`read_frames`)
+    and the video's frame rate [1/s] (None if unknown)."""
+    from jointwear.dic.subset._correlator import check_image, check_pair
+
     if isinstance(frames, tuple) and len(frames) == 2 and isinstance(frames[0], list):
         frame_list, fps = frames
     else:
@@ -231,60 +238,69 @@ def correlate_sequence(
     first = check_image(frame_list[0], "frame 0")
     for k, fr in enumerate(frame_list[1:], start=1):
         check_pair(first, check_image(fr, f"frame {k}"), what=f"frame {k}")
-    n_t = len(frame_list)
-    time_note = None
+    return first, frame_list, fps
+
+
+def _frame_times(times, frame_rate, fps, n_t: int) -> tuple[np.ndarray, str | None]:
+    """Time of every frame [s] (given, or from the frame rate) and a note when assumed."""
     if times is not None:
         t = np.asarray(times, dtype=float)
         if t.shape != (n_t,) or not np.all(np.isfinite(t)) or np.any(np.diff(t) <= 0):
             raise BadInputError(
                 f"times: expected {n_t} finite, strictly increasing values [s], got shape {t.shape}"
             )
-    else:
-        rate = frame_rate or fps
-        if rate is None:
-            rate = 1.0
-            time_note = "frame rate unknown: time = frame index (1 frame per second assumed)"
-        if not rate > 0:
-            raise ParameterError(f"frame_rate={frame_rate!r}: expected > 0 frames per second")
-        t = np.arange(n_t) / float(rate)
+        return t, None
+    time_note = None
+    rate = frame_rate or fps
+    if rate is None:
+        rate = 1.0
+        time_note = "frame rate unknown: time = frame index (1 frame per second assumed)"
+    if not rate > 0:
+        raise ParameterError(f"frame_rate={frame_rate!r}: expected > 0 frames per second")
+    return np.arange(n_t) / float(rate), time_note
 
-    base = SubsetCorrelator(first, points=points, roi=roi, params=params, **options)
-    seeds0 = base.check_seeds(seed_points) if seed_points is not None else None
-    prm = base.params
-    n = base.n_points
-    P = np.full((n_t, n, 12), np.nan)
-    Z = np.full((n_t, n), np.nan)
-    It = np.zeros((n_t, n), dtype=np.int32)
-    Fl = np.full((n_t, n), _icgn.FLAG_NOT_REACHED, dtype=np.int8)
-    S = np.full((n_t, n, 2), np.nan)
-    ref_frame = np.zeros(n_t, dtype=np.int32)
-    r0 = base.match(first, initial_guess=np.zeros((n, 2)))
-    P[0], Z[0], It[0], Fl[0] = r0.params, r0.zncc, r0.iterations, r0.flag
-    S[0] = np.where(r0.ok[:, None], 0.0, np.nan)  # the reference against itself
-    tracked = r0.ok.copy()
 
-    corr = base
-    m = 0  # index of the current reference frame
-    P_ref = np.zeros((n, 12))  # total parameters of the current reference frame
-    P_prev_inc = np.zeros((n, 12))  # last increment w.r.t. the current reference
+class _SequenceTracker:
+    """The subsets of frame 0 (``base``) followed through ``frame_list``: parameters ``P``
+    accumulated from frame 0, their (u, v) uncertainties ``S``, ZNCC ``Z``, iterations
+    ``It``, flags ``Fl`` and the reference frame of every frame."""
 
-    def seeds_for(correlator):
+    def __init__(self, base, first: np.ndarray, frame_list: list, seeds0: np.ndarray | None):
+        from jointwear.dic.icgn import _flags as _icgn
+
+        self.base, self.frame_list, self.seeds0 = base, frame_list, seeds0
+        n_t, n = len(frame_list), base.n_points
+        self.P = np.full((n_t, n, 12), np.nan)
+        self.Z = np.full((n_t, n), np.nan)
+        self.It = np.zeros((n_t, n), dtype=np.int32)
+        self.Fl = np.full((n_t, n), _icgn.FLAG_NOT_REACHED, dtype=np.int8)
+        self.S = np.full((n_t, n, 2), np.nan)
+        self.ref_frame = np.zeros(n_t, dtype=np.int32)
+        self.shape = first.shape
+        r0 = base.match(first, initial_guess=np.zeros((n, 2)))
+        self.P[0], self.Z[0], self.It[0], self.Fl[0] = r0.params, r0.zncc, r0.iterations, r0.flag
+        self.S[0] = np.where(r0.ok[:, None], 0.0, np.nan)  # the reference against itself
+        self.tracked = r0.ok.copy()
+
+    def seeds_for(self, correlator):
         """The seeds moved with the tracked point nearest to each (incremental reference)."""
+        base, seeds0 = self.base, self.seeds0
         if seeds0 is None or correlator is base:
             return seeds0
         near = np.argmin(np.hypot(*(base.centres[None, :, :] - seeds0[:, None, :]).T), axis=0)
         moved = correlator.centres[near] + (seeds0 - base.centres[near])
-        h, w = first.shape
+        h, w = self.shape
         inside = np.isfinite(moved).all(axis=1)
         inside &= (moved[:, 0] >= 0) & (moved[:, 0] <= w - 1)
         inside &= (moved[:, 1] >= 0) & (moved[:, 1] <= h - 1)
         moved = moved[inside]
         return moved if len(moved) else None
 
-    def run(correlator, img, guess_inc):
+    def run(self, correlator, img, guess_inc):
+        """Match ``img`` from the increments ``guess_inc``; search afresh if they were poor."""
         guess = np.where(np.isfinite(guess_inc).all(axis=1)[:, None], guess_inc, np.nan)
         res = correlator.match(img, initial_guess=guess)
-        if res.ok.sum() < 0.5 * max(1, tracked.sum()):
+        if res.ok.sum() < 0.5 * max(1, self.tracked.sum()):
             # the guesses were poor (jump between frames): search again from seeds
             known = np.isfinite(guess_inc).all(axis=1)
             centre = (
@@ -292,66 +308,92 @@ def correlate_sequence(
                 if known.any()
                 else (0.0, 0.0)
             )
-            res2 = correlator.match(img, search_centre=centre, seed_points=seeds_for(correlator))
+            res2 = correlator.match(
+                img, search_centre=centre, seed_points=self.seeds_for(correlator)
+            )
             if res2.ok.sum() > res.ok.sum():
                 res = res2
         return res
 
-    def move_reference(new_m):
+    def move_reference(self, new_m):
         """The reference becomes frame ``new_m``: subsets centred at the tracked positions."""
-        P_new = P[new_m].copy()
-        good = Fl[new_m] == _icgn.FLAG_OK
+        from jointwear.dic.icgn import _flags as _icgn
+        from jointwear.dic.subset._correlator import SubsetCorrelator
+
+        base = self.base
+        P_new = self.P[new_m].copy()
+        good = self.Fl[new_m] == _icgn.FLAG_OK
         centres = base.centres + np.column_stack([P_new[:, 0], P_new[:, 6]])
         centres[~good] = np.nan
-        c = SubsetCorrelator(frame_list[new_m], points=centres, params=prm, _graph=base.graph)
-        return c, P_new, np.zeros((n, 12)), new_m
+        c = SubsetCorrelator(
+            self.frame_list[new_m], points=centres, params=base.params, _graph=base.graph
+        )
+        return c, P_new, np.zeros((base.n_points, 12)), new_m
 
-    with progress_bar("correlating frames", total=n_t - 1, enabled=progress) as bar:
-        task = bar.tasks[0].id
-        for k in range(1, n_t):
-            img = frame_list[k]
-            due = update_every is not None and k - m > update_every
-            if reference == "incremental" and k - 1 > m and due:
-                corr, P_ref, P_prev_inc, m = move_reference(k - 1)
-            res = run(corr, img, P_prev_inc)
-            if reference == "incremental" and k - 1 > m:
-                okk = res.ok & tracked
-                med = np.nanmedian(res.zncc[okk]) if okk.any() else -1.0
-                if med < update_zncc or okk.sum() < 0.9 * tracked.sum():
-                    corr, P_ref, P_prev_inc, m = move_reference(k - 1)
-                    res = run(corr, img, P_prev_inc)
-            ok = res.ok
-            P_prev_inc = np.where(ok[:, None], res.params, P_prev_inc)
-            if m == 0:
-                P[k] = res.params
-                S[k] = res.sigma
-            else:
-                P[k] = _compose(res.params, P_ref)
-                # independent increments: variances add
-                S[k] = np.sqrt(res.sigma**2 + S[m] ** 2)
-            Z[k], It[k], Fl[k] = res.zncc, res.iterations, res.flag
-            lost = ~np.isfinite(corr.centres).all(axis=1)
-            Fl[k][lost] = _icgn.FLAG_NOT_REACHED
-            ref_frame[k] = m
-            bar.update(task, advance=1)
+    def track(self, reference, update_zncc, update_every, progress) -> None:
+        """Follow the subsets through every frame (see the module docstring)."""
+        from jointwear.dic.icgn import _flags as _icgn
+        from jointwear.progress import progress_bar
 
-    ds = result_dataset(base.centres, P, Z, It, Fl, prm, base.grid, sigma=S)
-    if reference == "incremental" and prm.quadratic:
-        for name in ("d2u_dx2", "d2u_dxdy", "d2u_dy2", "d2v_dx2", "d2v_dxdy", "d2v_dy2"):
-            later = ref_frame > 0
-            ds[name].values[later] = np.nan
-    ds = ds.assign_coords(
-        time=("time", t, {"units": "s", "long_name": "elapsed time since the first frame"}),
-        frame=("time", np.arange(n_t), {"long_name": "frame index"}),
-    )
-    if time_note:
-        ds["time"].attrs["note"] = time_note
-    ds["reference_frame"] = xr.DataArray(
-        ref_frame,
-        dims="time",
-        attrs={"units": "1", "long_name": "index of the reference frame used"},
-    )
-    ds.attrs["title"] = "2D subset DIC displacement over an image sequence"
-    ds.attrs["dic_reference_strategy"] = reference
-    ds.attrs["dic_reference_updates"] = int(np.count_nonzero(np.diff(ref_frame)))
-    return ds
+        P, S, Fl, tracked = self.P, self.S, self.Fl, self.tracked
+        n_t, n = P.shape[:2]
+        corr = self.base
+        m = 0  # index of the current reference frame
+        P_ref = np.zeros((n, 12))  # total parameters of the current reference frame
+        P_prev_inc = np.zeros((n, 12))  # last increment w.r.t. the current reference
+        with progress_bar("correlating frames", total=n_t - 1, enabled=progress) as bar:
+            task = bar.tasks[0].id
+            for k in range(1, n_t):
+                img = self.frame_list[k]
+                due = update_every is not None and k - m > update_every
+                if reference == "incremental" and k - 1 > m and due:
+                    corr, P_ref, P_prev_inc, m = self.move_reference(k - 1)
+                res = self.run(corr, img, P_prev_inc)
+                if reference == "incremental" and k - 1 > m:
+                    okk = res.ok & tracked
+                    med = np.nanmedian(res.zncc[okk]) if okk.any() else -1.0
+                    if med < update_zncc or okk.sum() < 0.9 * tracked.sum():
+                        corr, P_ref, P_prev_inc, m = self.move_reference(k - 1)
+                        res = self.run(corr, img, P_prev_inc)
+                ok = res.ok
+                P_prev_inc = np.where(ok[:, None], res.params, P_prev_inc)
+                if m == 0:
+                    P[k] = res.params
+                    S[k] = res.sigma
+                else:
+                    P[k] = _compose(res.params, P_ref)
+                    # independent increments: variances add
+                    S[k] = np.sqrt(res.sigma**2 + S[m] ** 2)
+                self.Z[k], self.It[k], Fl[k] = res.zncc, res.iterations, res.flag
+                lost = ~np.isfinite(corr.centres).all(axis=1)
+                Fl[k][lost] = _icgn.FLAG_NOT_REACHED
+                self.ref_frame[k] = m
+                bar.update(task, advance=1)
+
+    def dataset(self, reference, t, time_note) -> xr.Dataset:
+        """The tracked sequence as a Dataset over ``time``."""
+        from jointwear.dic.subset._correlator import result_dataset
+
+        base, prm, ref_frame = self.base, self.base.params, self.ref_frame
+        ds = result_dataset(
+            base.centres, self.P, self.Z, self.It, self.Fl, prm, base.grid, sigma=self.S
+        )
+        if reference == "incremental" and prm.quadratic:
+            for name in ("d2u_dx2", "d2u_dxdy", "d2u_dy2", "d2v_dx2", "d2v_dxdy", "d2v_dy2"):
+                later = ref_frame > 0
+                ds[name].values[later] = np.nan
+        ds = ds.assign_coords(
+            time=("time", t, {"units": "s", "long_name": "elapsed time since the first frame"}),
+            frame=("time", np.arange(len(t)), {"long_name": "frame index"}),
+        )
+        if time_note:
+            ds["time"].attrs["note"] = time_note
+        ds["reference_frame"] = xr.DataArray(
+            ref_frame,
+            dims="time",
+            attrs={"units": "1", "long_name": "index of the reference frame used"},
+        )
+        ds.attrs["title"] = "2D subset DIC displacement over an image sequence"
+        ds.attrs["dic_reference_strategy"] = reference
+        ds.attrs["dic_reference_updates"] = int(np.count_nonzero(np.diff(ref_frame)))
+        return ds

@@ -76,26 +76,14 @@ def test_sequence_input_errors(sequence, tmp_path):
         read_frames(tmp_path)
 
 
+def _speckle_cli(folder, size: str, *options: str) -> int:
+    """Exit code of ``jointwear datasets speckle`` writing synthetic images to ``folder``."""
+    return main(["datasets", "speckle", str(folder), "--size", size, *options])
+
+
 def test_cli_pair_writes_field_and_figure(tmp_path):
     data = tmp_path / "speckle"
-    assert (
-        main(
-            [
-                "datasets",
-                "speckle",
-                str(data),
-                "--size",
-                "112x96",
-                "--u",
-                "1.25",
-                "--v",
-                "-0.5",
-                "--seed",
-                "3",
-            ]
-        )
-        == 0
-    )
+    assert _speckle_cli(data, "112x96", "--u", "1.25", "--v", "-0.5", "--seed", "3") == 0
     truth = io.load(data / "truth.nc")
     out = tmp_path / "field.nc"
     fig = tmp_path / "field.png"
@@ -140,24 +128,7 @@ def test_cli_pair_writes_field_and_figure(tmp_path):
 
 def test_cli_folder_sequence(tmp_path):
     data = tmp_path / "frames"
-    assert (
-        main(
-            [
-                "datasets",
-                "speckle",
-                str(data),
-                "--size",
-                "96x96",
-                "--frames",
-                "3",
-                "--u",
-                "0.9",
-                "--v",
-                "0.3",
-            ]
-        )
-        == 0
-    )
+    assert _speckle_cli(data, "96x96", "--frames", "3", "--u", "0.9", "--v", "0.3") == 0
     out = tmp_path / "seq.nc"
     assert (
         main(

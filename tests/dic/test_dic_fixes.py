@@ -184,29 +184,20 @@ def pair(tmp_path_factory):
 
 
 @pytest.mark.parametrize(
-    "extra, named",
+    "command, extra, named",
     [
-        (["--sequence-mode", "incremental"], "--sequence-mode"),
-        (["--fps", "50"], "--fps"),
+        # sequence options on a pair of images
+        ("correlate", ["--sequence-mode", "incremental"], "--sequence-mode"),
+        ("correlate", ["--fps", "50"], "--fps"),
+        # stereo options on a 2D field
+        ("field", ["--frame", "plane"], "--frame"),
+        ("field", ["--epipolar-max", "2"], "--epipolar-max"),
     ],
 )
-def test_correlate_flags_that_cannot_apply_to_a_pair_are_errors(pair, extra, named, capsys):
+def test_flags_that_cannot_apply_to_the_input_are_usage_errors(pair, command, extra, named, capsys):
     tmp, names = pair
-    code = main(["dic", "correlate", *names, *extra, "--out", str(tmp / "c.nc"), "--overwrite"])
-    assert code == 2, capsys.readouterr()
-    assert named in capsys.readouterr().err
-
-
-@pytest.mark.parametrize(
-    "extra, named",
-    [
-        (["--frame", "plane"], "--frame"),
-        (["--epipolar-max", "2"], "--epipolar-max"),
-    ],
-)
-def test_field_stereo_flags_on_a_2d_field_are_errors(pair, extra, named, capsys):
-    tmp, names = pair
-    code = main(["dic", "field", *names, *extra, "--out", str(tmp / "f.nc"), "--overwrite"])
+    out = tmp / f"{command}.nc"
+    code = main(["dic", command, *names, *extra, "--out", str(out), "--overwrite"])
     assert code == 2
     assert named in capsys.readouterr().err
 
@@ -243,9 +234,18 @@ def test_track_stereo_flags_with_one_camera_are_errors(mono, tmp_path, extra, na
     assert named in capsys.readouterr().err
 
 
-def test_calibrate_marker_on_a_chessboard_is_an_error(tmp_path, capsys):
+@pytest.mark.parametrize(
+    "extra, named",
+    [
+        (["--marker", "18"], "--marker"),  # a chessboard has no markers
+        (["--dictionary", "DICT_4X4_50"], "--dictionary"),  # nor an ArUco dictionary
+        (["--every", "5"], "--every"),  # a folder of images has no frames to skip
+    ],
+)
+def test_calibrate_options_that_cannot_apply_are_errors(tmp_path, extra, named, capsys):
     args = ["dic", "calibrate", "--left", str(tmp_path), "--right", str(tmp_path)]
-    args += ["--board", "chessboard"]
-    args += ["--square", "25", "--unit", "mm", "--marker", "18", "--out", str(tmp_path / "c.nc")]
-    assert main(args) == 2
-    assert "--marker" in capsys.readouterr().err
+    args += ["--board", "chessboard", "--square", "25", "--unit", "mm", *extra]
+    assert main([*args, "--out", str(tmp_path / "c.nc")]) == 2
+    err = capsys.readouterr().err
+    assert named in err and "applies to" in err
+    assert not (tmp_path / "c.nc").exists()

@@ -153,6 +153,16 @@ def _track_small(small, *, config=None, max_frames=None, folders=None, **options
     )
 
 
+def _track_cli(left, right, bodies, cal, out, *options: str) -> int:
+    """Exit code of ``jointwear dic track`` on the two cameras' footage."""
+    from jointwear.cli import main
+
+    return main(
+        ["dic", "track", "--left", str(left), "--right", str(right), "--bodies", str(bodies),
+         "-c", str(cal), "--out", str(out), *options]
+    )  # fmt: skip
+
+
 def test_cli_chain_calibrate_track_plot(small):
     from jointwear.cli import main
 
@@ -181,29 +191,9 @@ def test_cli_chain_calibrate_track_plot(small):
         == 0
     )
     motion = out / "motion.nc"
-    assert (
-        main(
-            [
-                "dic",
-                "track",
-                "--left",
-                str(written["left_images"]),
-                "--right",
-                str(written["right_images"]),
-                "--fps",
-                "50",
-                "--bodies",
-                str(written["bodies"]),
-                "-c",
-                str(cal),
-                "--out",
-                str(motion),
-                "--plot",
-                str(out / "motion.png"),
-            ]
-        )
-        == 0
-    )
+    images = (written["left_images"], written["right_images"])
+    assert _track_cli(*images, written["bodies"], cal, motion, "--fps", "50", "--plot",
+                      str(out / "motion.png")) == 0  # fmt: skip
     ds = io.load(motion)
     truth = io.load(written["truth"])
     # the duplicated frame (frame 4 repeats frame 3) and the dropped frame 6 are reported
@@ -222,27 +212,8 @@ def test_cli_chain_calibrate_track_plot(small):
     assert (out / "motion.png").stat().st_size > 10_000
     # videos (FFV1, lossless): same result for the first frames, frame rate from the container
     motion_v = out / "motion_video.nc"
-    assert (
-        main(
-            [
-                "dic",
-                "track",
-                "--left",
-                str(written["left_video"]),
-                "--right",
-                str(written["right_video"]),
-                "--bodies",
-                str(written["bodies"]),
-                "-c",
-                str(cal),
-                "--out",
-                str(motion_v),
-                "--max-frames",
-                "4",
-            ]
-        )
-        == 0
-    )
+    videos = (written["left_video"], written["right_video"])
+    assert _track_cli(*videos, written["bodies"], cal, motion_v, "--max-frames", "4") == 0
     dv = io.load(motion_v)
     assert np.allclose(
         dv["follower_position"].values, ds["follower_position"].values[:4], atol=1e-9
