@@ -177,7 +177,7 @@ def test_verification_figures_and_pdf_determinism(built, tmp_path):
     import numpy as np
     import xarray as xr
 
-    from jointwear.reports import render_html, write_pdf
+    from jointwear.reports import build_report, render_html, write_pdf
 
     _, result = built
     # a convergence study: error ~ h^2 over four grid sizes
@@ -197,9 +197,20 @@ def test_verification_figures_and_pdf_determinism(built, tmp_path):
     assert page.h2 == EXPECTED_SECTIONS
     # polar plots, motion and the verification figure
     assert page.tags.get("svg", 0) == 3
-    a = write_pdf(result, tmp_path / "a.pdf", verification=[conv])
-    b = write_pdf(result, tmp_path / "b.pdf", verification=[conv])
+    a = write_pdf(result, tmp_path / "a.pdf", verification=[conv], notes=["made by a test"])
+    b = write_pdf(result, tmp_path / "b.pdf", verification=[conv], notes=["made by a test"])
     assert a.read_bytes() == b.read_bytes() and a.read_bytes().startswith(b"%PDF")
+    # build_report's PDF is write_pdf's with the same page, notes included (they were dropped)
+    plain = write_pdf(result, tmp_path / "plain.pdf", verification=[conv])
+    assert plain.read_bytes() != a.read_bytes()
+    build_report(
+        result,
+        tmp_path / "r.html",
+        verification=[conv],
+        notes=["made by a test"],
+        pdf=tmp_path / "r.pdf",
+    )
+    assert (tmp_path / "r.pdf").read_bytes() == a.read_bytes()
 
 
 def test_generated_scan_stays_synthetic_into_the_decision_card(tmp_path):
