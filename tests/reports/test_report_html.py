@@ -71,18 +71,9 @@ def parse(path) -> _Page:
 
 
 @pytest.fixture(scope="module")
-def built(report_files, tmp_path_factory):
+def built(report_of_all, tmp_path_factory):
     out = tmp_path_factory.mktemp("report") / "report.html"
-    f = report_files
-    path, result = report_from_files(
-        out,
-        sim=[f["sim_wear"], f["sim_motion"]],
-        metrology=[f["metrology"]],
-        dic=[f["dic"]],
-        command="jointwear report (test)",
-        criteria=STRICT,
-    )
-    return path, result
+    return report_of_all(out, "jointwear report (test)")
 
 
 def test_report_structure(built):
@@ -123,16 +114,8 @@ def test_report_lists_inputs_with_sha256(built, report_files):
         assert str(p) in html
 
 
-def test_report_is_byte_identical(report_files, built, tmp_path):
-    f = report_files
-    again, _ = report_from_files(
-        tmp_path / "again.html",
-        sim=[f["sim_wear"], f["sim_motion"]],
-        metrology=[f["metrology"]],
-        dic=[f["dic"]],
-        command="jointwear report (test)",
-        criteria=STRICT,
-    )
+def test_report_is_byte_identical(report_of_all, built, tmp_path):
+    again, _ = report_of_all(tmp_path / "again.html", "jointwear report (test)")
     assert again.read_bytes() == built[0].read_bytes()
 
 
