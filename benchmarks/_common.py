@@ -38,18 +38,32 @@ def machine() -> dict[str, Any]:
     }
 
 
-def median_time(
-    fn: Callable[[], Any], *, repeat: int = 5, warmup: int = 1
-) -> tuple[float, list[float]]:
-    """Median wall time of ``fn()`` over ``repeat`` runs after ``warmup`` runs [s]."""
+def _times(
+    fn: Callable[[], Any], clock: Callable[[], float], repeat: int, warmup: int
+) -> list[float]:
+    """``clock`` time of each of ``repeat`` runs of ``fn()`` after ``warmup`` runs [s]."""
     for _ in range(warmup):
         fn()
     times = []
     for _ in range(repeat):
-        t0 = time.perf_counter()
+        t0 = clock()
         fn()
-        times.append(time.perf_counter() - t0)
+        times.append(clock() - t0)
+    return times
+
+
+def median_time(
+    fn: Callable[[], Any], *, repeat: int = 5, warmup: int = 1
+) -> tuple[float, list[float]]:
+    """Median wall time of ``fn()`` over ``repeat`` runs after ``warmup`` runs [s]."""
+    times = _times(fn, time.perf_counter, repeat, warmup)
     return statistics.median(times), times
+
+
+def cpu_time(fn: Callable[[], Any], *, repeat: int = 3, warmup: int = 0) -> float:
+    """Median CPU time of ``fn()`` in this process over ``repeat`` runs after ``warmup`` runs
+    [s] (less sensitive to a shared machine than wall time)."""
+    return statistics.median(_times(fn, time.process_time, repeat, warmup))
 
 
 def write_results(name: str, figures: dict[str, Any]) -> Path:

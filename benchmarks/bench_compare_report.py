@@ -24,7 +24,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "compare"))
 
 import _jw_synth as syn  # noqa: E402
-from _common import median_time, write_results  # noqa: E402
+from _common import cpu_time, median_time, write_results  # noqa: E402
 
 from jointwear.compare import align_wear_maps, compare  # noqa: E402
 from jointwear.reports import build_report, render_html  # noqa: E402
@@ -33,16 +33,6 @@ from jointwear.reports import build_report, render_html  # noqa: E402
 PHASE = re.compile(r"\[(\d+)/\d+\] ")
 #: What the demo says when it compiles the numba kernels (a cold cache): that run is repeated.
 COMPILING = "compiling numerical kernels"
-
-
-def cpu_time(fn, repeat: int = 3) -> float:
-    """Median CPU time of ``fn()`` in this process [s] (less sensitive to a shared machine)."""
-    times = []
-    for _ in range(repeat):
-        t0 = time.process_time()
-        fn()
-        times.append(time.process_time() - t0)
-    return sorted(times)[len(times) // 2]
 
 
 def demo_run(quick: bool) -> dict[str, object]:

@@ -16,24 +16,13 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from _common import median_time, write_results  # noqa: E402
+from _common import cpu_time, median_time, write_results  # noqa: E402
 
 from jointwear import io  # noqa: E402
 from jointwear.datasets.instruments import generate, write  # noqa: E402
 from jointwear.metrology import assess, cylindricity, read_scan, wear_map  # noqa: E402
 
 CONV = ("+y", "counterclockwise")
-
-
-def cpu_time(fn, repeat: int = 3) -> float:
-    """Median CPU time of ``fn()`` in this process [s] (less sensitive to a loaded machine)."""
-    fn()
-    times = []
-    for _ in range(repeat):
-        t0 = time.process_time()
-        fn()
-        times.append(time.process_time() - t0)
-    return sorted(times)[len(times) // 2]
 
 
 def main() -> None:
@@ -90,10 +79,12 @@ def main() -> None:
 
         t_cmd_inproc, _ = median_time(in_process_command, repeat=3)
         cpu = {
-            "import_folder": cpu_time(lambda: read_scan(tmp / "folder", convention=CONV)),
-            "cylindricity_MZ": cpu_time(lambda: cylindricity(da, reference="MZ"), repeat=5),
-            "assess_all_references": cpu_time(full),
-            "load_and_assess_filter50": cpu_time(in_process_command),
+            "import_folder": cpu_time(lambda: read_scan(tmp / "folder", convention=CONV), warmup=1),
+            "cylindricity_MZ": cpu_time(
+                lambda: cylindricity(da, reference="MZ"), repeat=5, warmup=1
+            ),
+            "assess_all_references": cpu_time(full, warmup=1),
+            "load_and_assess_filter50": cpu_time(in_process_command, warmup=1),
         }
         b = before.truth[["radius"]]
         w = sc.truth[["radius"]]

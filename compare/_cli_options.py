@@ -17,11 +17,16 @@ __all__ = [
     "CyclesOpt",
     "EnsembleOpt",
     "PeriodOpt",
+    "SimOpt",
     "StrictOpt",
     "VariableOpt",
     "VerificationOpt",
 ]
 
+SimOpt = Annotated[
+    list[Path] | None,
+    typer.Option("--sim", help="Simulated wear map and/or motion record (.nc); repeatable."),
+]
 CriteriaOpt = Annotated[
     Path | None, typer.Option("--criteria", help="TOML file with validation criteria.")
 ]

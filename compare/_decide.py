@@ -112,34 +112,69 @@ def threshold_state(ok: bool, finite: bool = True) -> str:
     return vd.PASS if ok else vd.FAIL
 
 
-def scalar_decision(
-    rows: Rows,
-    decisions: list[dict[str, Any]],
-    quantity: str,
-    label: str,
-    s: float,
-    d: float,
-    units: str,
-    *,
-    u_num: Uncertainty,
-    u_input: Uncertainty,
-    u_d: Uncertainty,
-    k: float,
-    relative_error_max: float,
-    not_comparable: str = "",
-) -> None:
-    """Metric rows and decisions of one scalar quantity: V&V 20, or why it cannot be decided.
+@dataclass(frozen=True)
+class Budget:
+    """The uncertainties V&V 20 combines for one quantity, and the coverage factor.
 
-    The V&V 20 criterion is always on the card: *not comparable* when ``not_comparable``
-    states why the data do not cover the quantity, *not assessed* when one of its
-    uncertainties is unknown (the relative error against the screening threshold
-    ``relative_error_max`` is then shown in its value, labelled *screening only*: it is never
-    counted as a pass or a fail), else pass/fail.
+    Attributes
+    ----------
+    u_num, u_input, u_d : Uncertainty
+        Numerical, input and measurement standard uncertainty [units of the quantity].
+    k : float
+        Coverage factor, ``U_val = k u_val`` [1].
     """
-    rows.add(quantity, "value_sim", s, units)
-    rows.add(quantity, "value_meas", d, units)
+
+    u_num: Uncertainty
+    u_input: Uncertainty
+    u_d: Uncertainty
+    k: float
+
+    def parts(self) -> tuple[tuple[str, Uncertainty], ...]:
+        """The uncertainties by metric name."""
+        return (("u_num", self.u_num), ("u_input", self.u_input), ("u_D", self.u_d))
+
+
+@dataclass(frozen=True)
+class Discrepancy:
+    """What one V&V 20 criterion judges, and how the decision card words it.
+
+    Attributes
+    ----------
+    s, d : float
+        The simulated and measured values V&V 20 is given [units]; for an angle ``s`` is
+        ``d + e``, so that V&V 20 sees the wrapped error.
+    e : float
+        The error ``E`` (NaN: the values are undefined, not comparable) [units].
+    units : str
+        Units of the quantity.
+    values : tuple of (str, float)
+        Metric rows written before ``E`` (``value_sim``, ``value_meas``, ...).
+    shown : str
+        Value of a *not comparable* decision.
+    not_assessed_text : str
+        Value of a *not assessed* decision; may carry a screening figure (never a pass or fail).
+    result_text : callable
+        Value of a pass or a fail, from the :class:`~jointwear.compare.metrics.VV20` result.
+    criterion_note : str
+        Added to the criterion's text (e.g. how an angle error is wrapped).
+    """
+
+    s: float
+    d: float
+    e: float
+    units: str
+    values: tuple[tuple[str, float], ...]
+    shown: str
+    not_assessed_text: str
+    result_text: Callable[[Any], str]
+    criterion_note: str = ""
+
+
+def scalar_discrepancy(s: float, d: float, units: str, relative_error_max: float) -> Discrepancy:
+    """``E = S - D`` of a scalar quantity; when V&V 20 is not assessed the card shows the
+    relative error against the screening threshold ``relative_error_max``, labelled *screening
+    only* (never counted as a pass or a fail)."""
     rel = (s - d) / abs(d) if d != 0 else float("nan")
-    rows.add(quantity, "relative_error", rel, units)
     finite = bool(np.isfinite(s) and np.isfinite(d))
     screen = (
         f"; screening only, not a verdict: |S - D| / |D| = {abs(rel):.3g} "
@@ -147,24 +182,15 @@ def scalar_decision(
         if np.isfinite(rel)
         else ""
     )
-    vv20_decision(
-        rows,
-        decisions,
-        quantity,
-        label,
+    return Discrepancy(
         s,
         d,
         (s - d) if finite else float("nan"),
         units,
-        u_num=u_num,
-        u_input=u_input,
-        u_d=u_d,
-        k=k,
-        criterion=f"|E| <= U_val = {k:g} u_val (ASME V&V 20)",
+        values=(("value_sim", s), ("value_meas", d), ("relative_error", rel)),
         shown=f"S = {fmt(s, units)}, D = {fmt(d, units)}",
         not_assessed_text=f"E = {fmt(s - d, units)} (S = {fmt(s, units)}, D = {fmt(d, units)}){screen}",
         result_text=lambda res: f"|E| = {fmt(abs(res.E), units)}, U_val = {fmt(res.U_val, units)}",
-        not_comparable=not_comparable,
     )
 
 
@@ -173,40 +199,30 @@ def vv20_decision(
     decisions: list[dict[str, Any]],
     quantity: str,
     label: str,
-    s: float,
-    d: float,
-    e: float,
-    units: str,
-    *,
-    u_num: Uncertainty,
-    u_input: Uncertainty,
-    u_d: Uncertainty,
-    k: float,
-    criterion: str,
-    shown: str,
-    not_assessed_text: str,
-    result_text: Callable[[Any], str],
+    error: Discrepancy,
+    budget: Budget,
     not_comparable: str = "",
 ) -> None:
-    """The four states of one V&V 20 criterion of ``s`` against ``d`` with the error ``e``.
+    """Metric rows and the decision of one V&V 20 criterion: its four states.
 
-    ``e`` is ``s - d`` for a scalar and the wrapped difference for an angle (then ``s`` is
-    ``d + e``, so that V&V 20 sees the same error).
-
-    Adds the ``E`` and uncertainty rows, then one decision: *not comparable* (``not_comparable``
-    or a non-finite ``e``; value ``shown``), *not assessed* when an uncertainty is unknown (value
-    ``not_assessed_text``, which may carry a screening figure: never a pass or a fail), else pass
-    or fail with ``result_text(vv20 result)``. Shared by :func:`scalar_decision` and the
-    circular (angle) decision of reported measurements.
+    Adds the rows of ``error.values``, ``E`` and the uncertainties, then one decision: *not
+    comparable* (``not_comparable`` states why the data do not cover the quantity, or ``E`` is
+    not finite), *not assessed* when an uncertainty of ``budget`` is unknown, else pass or fail.
     """
+    units, e = error.units, error.e
+    for metric, value in error.values:
+        rows.add(quantity, metric, value, units)
     rows.add(quantity, "E", e, units)
-    parts = (("u_num", u_num), ("u_input", u_input), ("u_D", u_d))
+    parts = budget.parts()
     for name, u in parts:
         rows.add(quantity, name, u.value if u.known else float("nan"), units, u.basis)
+    criterion = f"|E| <= U_val = {budget.k:g} u_val (ASME V&V 20{error.criterion_note})"
     if not_comparable or not np.isfinite(e):
         reason = not_comparable or "the simulated or measured value is undefined"
         decisions.append(
-            decision(label, criterion, shown, vd.NOT_COMPARABLE, "V&V 20", reason, key=quantity)
+            decision(
+                label, criterion, error.shown, vd.NOT_COMPARABLE, "V&V 20", reason, key=quantity
+            )
         )
         return
     if not all(u.known for _, u in parts):
@@ -216,7 +232,7 @@ def vv20_decision(
             decision(
                 label,
                 criterion,
-                not_assessed_text,
+                error.not_assessed_text,
                 vd.NOT_ASSESSED,
                 "V&V 20",
                 reason,
@@ -225,7 +241,12 @@ def vv20_decision(
         )
         return
     res = mt.vv20(
-        s, d, u_num=float(u_num.value), u_input=float(u_input.value), u_d=float(u_d.value), k=k
+        error.s,
+        error.d,
+        u_num=float(budget.u_num.value),
+        u_input=float(budget.u_input.value),
+        u_d=float(budget.u_d.value),
+        k=budget.k,
     )
     rows.add(quantity, "u_val", res.u_val, units)
     rows.add(quantity, "U_val", res.U_val, units)
@@ -233,7 +254,7 @@ def vv20_decision(
         decision(
             label,
             criterion,
-            result_text(res),
+            error.result_text(res),
             vd.PASS if res.passed else vd.FAIL,
             "V&V 20",
             key=quantity,

@@ -8,7 +8,13 @@ import numpy as np
 import xarray as xr
 
 import jointwear.compare.metrics as mt
-from jointwear.compare._decide import Rows, decision, scalar_decision, threshold_state
+from jointwear.compare._decide import (
+    Rows,
+    decision,
+    scalar_discrepancy,
+    threshold_state,
+    vv20_decision,
+)
 from jointwear.compare.sources import Sources
 
 
@@ -83,17 +89,8 @@ def motion_metrics(
         rms_d = float(np.sqrt(np.mean(d**2)))
         rms_u = {k: float(np.sqrt(np.nanmean(v**2))) for k, v in u.items()}
         quantity = f"{q}_rms"
-        scalar_decision(
-            rows,
-            decisions,
-            quantity,
-            f"{label} RMS",
-            rms_s,
-            rms_d,
-            units,
-            u_num=src.u_num(quantity, rms_s, rms_u.get("sim"), "motion"),
-            u_input=src.u_input(quantity, rms_s, "motion"),
-            u_d=src.u_d(rms_u.get("meas")),
-            k=criteria.k,
-            relative_error_max=criteria.relative_error_max,
+        budget = src.budget(
+            quantity, rms_s, "motion", sim_u=rms_u.get("sim"), meas_u=rms_u.get("meas")
         )
+        error = scalar_discrepancy(rms_s, rms_d, units, criteria.relative_error_max)
+        vv20_decision(rows, decisions, quantity, f"{label} RMS", error, budget)

@@ -10,7 +10,13 @@ import xarray as xr
 
 import jointwear.compare.metrics as mt
 import jointwear.compare.verdicts as vd
-from jointwear.compare._decide import Rows, decision, scalar_decision, threshold_state
+from jointwear.compare._decide import (
+    Rows,
+    decision,
+    scalar_discrepancy,
+    threshold_state,
+    vv20_decision,
+)
 from jointwear.compare.sources import Sources
 
 
@@ -264,19 +270,22 @@ def wear_metrics(al: xr.Dataset, rows: Rows, decisions: list[dict[str, Any]], sr
         value = sim_q[name] if name != "max_wear_depth" else vs
         meas = meas_q[name] if name != "max_wear_depth" else vd_
         (us, us_note), (ud, ud_note) = stated[name]["sim"], stated[name]["meas"]
-        scalar_decision(
+        budget = src.budget(
+            name,
+            value,
+            "wear",
+            sim_u=us,
+            meas_u=ud,
+            sim_note=us_note,
+            meas_note=f"stated by the measurement: {ud_note}" if ud_note else "",
+        )
+        vv20_decision(
             rows,
             decisions,
             name,
             f"{labels[name]} {band}",
-            value,
-            meas,
-            units[name],
-            u_num=src.u_num(name, value, us, "wear", us_note),
-            u_input=src.u_input(name, value, "wear"),
-            u_d=src.u_d(ud, f"stated by the measurement: {ud_note}" if ud_note else ""),
-            k=criteria.k,
-            relative_error_max=criteria.relative_error_max,
+            scalar_discrepancy(value, meas, units[name], criteria.relative_error_max),
+            budget,
             not_comparable=peak_nc if name == "max_wear_depth" else whole_nc,
         )
     cs, cd = al.attrs.get("cylindricity_stated_sim_m"), al.attrs.get("cylindricity_stated_meas_m")

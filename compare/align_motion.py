@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from dataclasses import dataclass
 
 import numpy as np
 import xarray as xr
@@ -104,6 +105,226 @@ def _unit_check(sim_da: xr.DataArray, meas_da: xr.DataArray, name: str) -> str:
     return str(us)
 
 
+def _crank_period(
+    sim: xr.Dataset, meas: xr.Dataset, ts: np.ndarray, period_s: float | None
+) -> float:
+    """The crank period [s]: given, else from the simulation's crank angle, else the
+    measurement's; the simulation must cover one whole period."""
+    period = period_s if period_s is not None else _period_from_crank(sim)
+    if period is None:
+        period = _period_from_crank(meas)
+    if period is None or not (np.isfinite(period) and period > 0):
+        raise BadInputError(
+            "cannot tell the crank period: neither record has a usable 'crank_angle'; pass "
+            "period_s= (or --period) [s]"
+        )
+    if ts[-1] - ts[0] < period * (1 - 1e-9):
+        raise BadInputError(
+            f"the simulated motion covers {ts[-1] - ts[0]:.4g} s, less than one crank cycle "
+            f"({period:.4g} s); simulate at least one whole cycle"
+        )
+    return period
+
+
+def _alignment_method(method: str, sim: xr.Dataset, meas: xr.Dataset) -> str:
+    """``method`` with ``"auto"`` resolved: by crank angle when both records have one."""
+    if method not in ("auto", "crank_angle", "cross_correlation"):
+        raise BadInputError(
+            f"method must be 'auto', 'crank_angle' or 'cross_correlation', got {method!r}"
+        )
+    has_crank = "crank_angle" in sim and "crank_angle" in meas
+    if method == "auto":
+        method = "crank_angle" if has_crank else "cross_correlation"
+    if method == "crank_angle" and not has_crank:
+        raise BadInputError("method='crank_angle' needs 'crank_angle' in both records")
+    return method
+
+
+@dataclass(frozen=True)
+class _Window:
+    """The measurement samples compared and the simulated record they are taken from."""
+
+    ts: np.ndarray  # simulated time [s]
+    keep: np.ndarray  # mask of the measurement's samples kept
+    time: np.ndarray  # the measurement's time at the kept samples [s]
+    period: float  # crank period [s]
+    n_cycles: float  # crank cycles of the measurement kept
+    note: str  # what was kept, for the interpolation statement
+
+    @property
+    def t0(self) -> float:
+        """Start of the simulation's last whole cycle [s]."""
+        return self.ts[-1] - self.period
+
+    def sim_at(self, t_sim: np.ndarray, values: np.ndarray) -> np.ndarray:
+        """``values`` of the simulation at ``t_sim``, its last whole cycle repeated."""
+        phase = self.t0 + np.mod(t_sim - self.t0, self.period)
+        return np.interp(phase, self.ts, values)
+
+
+def _window(ts: np.ndarray, tm: np.ndarray, period: float, whole_cycles: bool) -> _Window:
+    """The measurement window: whole cycles from its start (or all of it)."""
+    n_cycles = (tm[-1] - tm[0] + np.median(np.diff(tm))) / period
+    if whole_cycles and n_cycles >= 1:
+        n_keep = int(math.floor(n_cycles + 1e-9))
+        keep = tm < tm[0] + n_keep * period - 1e-12
+        note = f"{n_keep} whole crank cycle(s) of the measurement"
+    else:
+        keep = np.ones_like(tm, dtype=bool)
+        n_keep = float(n_cycles)
+        note = f"the whole measurement ({n_cycles:.3g} cycles; less than one whole cycle)"
+    return _Window(ts, keep, tm[keep], period, n_keep, note)
+
+
+def _phase_by_crank_angle(
+    sim: xr.Dataset, meas: xr.Dataset, w: _Window
+) -> tuple[np.ndarray, float]:
+    """Each kept frame matched to the simulated instant at the same crank angle: that instant
+    [s] per frame, and the time shift [s] (measurement minus simulation, circular mean)."""
+    phi_s = np.unwrap(np.asarray(sim["crank_angle"].values, dtype=float))
+    phi_m = np.asarray(meas["crank_angle"].values, dtype=float)[w.keep]
+    sign = 1.0 if phi_s[-1] >= phi_s[0] else -1.0
+    ps = sign * phi_s
+    if np.any(np.diff(ps) <= 0):
+        raise BadInputError(
+            "the simulated crank angle is not monotonic in time; cannot align by crank angle "
+            "(use method='cross_correlation')"
+        )
+    start = ps[-1] - 2 * math.pi
+    target = start + np.mod(sign * phi_m - start, 2 * math.pi)
+    t_sim = np.interp(target, ps, w.ts)
+    # shift = measurement time - simulation time, modulo the period (circular mean)
+    ang = 2 * math.pi * (w.time - t_sim) / w.period
+    shift = math.atan2(np.mean(np.sin(ang)), np.mean(np.cos(ang))) * w.period / (2 * math.pi)
+    return t_sim, shift
+
+
+def _phase_by_cross_correlation(
+    sim: xr.Dataset, meas: xr.Dataset, names: list[str], w: _Window
+) -> tuple[np.ndarray, float]:
+    """The time shift [s] maximising the summed correlation of the normalised signals of every
+    common component (the simulation's last whole cycle repeated): the simulated instant [s]
+    per kept frame, and the shift."""
+    pairs = []
+    for name in names:
+        comps = _components(sim[name], meas[name], name)
+        for c in comps or [None]:
+            s = sim[name] if c is None else sim[name].sel(axis=c)
+            m = meas[name] if c is None else meas[name].sel(axis=c)
+            sv = np.asarray(s.transpose("time").values, dtype=float)
+            mv = np.asarray(m.transpose("time").values, dtype=float)[w.keep]
+            ok = np.isfinite(mv)
+            if ok.sum() < 4 or np.nanstd(mv) == 0:
+                continue
+            pairs.append((sv, (mv - np.nanmean(mv)) / np.nanstd(mv), ok))
+    if not pairs:
+        raise BadInputError("no usable signal for the cross-correlation (all constant or NaN)")
+
+    def score(tau: float) -> float:
+        total = 0.0
+        for sv, mz, ok in pairs:
+            x = w.sim_at(w.time[ok] - tau, sv)
+            sd = x.std()
+            if sd == 0:
+                continue
+            total += float(np.mean((x - x.mean()) / sd * mz[ok]))
+        return total
+
+    from scipy.optimize import minimize_scalar
+
+    period = w.period
+    grid = np.linspace(0.0, period, 720, endpoint=False)
+    scores = np.array([score(t) for t in grid])
+    best = grid[int(np.argmax(scores))]
+    step = period / 720
+    res = minimize_scalar(
+        lambda t: -score(t),
+        bounds=(best - step, best + step),
+        method="bounded",
+        options={"xatol": period * 1e-7},
+    )
+    tau = float(res.x) if -res.fun >= scores.max() else float(best)
+    shift = (tau + period / 2) % period - period / 2
+    return w.t0 + np.mod(w.time - shift - w.t0, period), shift
+
+
+_ALIGNMENTS = {
+    "crank_angle": "by crank angle (each frame matched to the simulated instant at the same "
+    "crank angle)",
+    "cross_correlation": "by cross-correlation of the normalised signals over whole cycles (the "
+    "simulation's last whole cycle repeated periodically)",
+}
+
+
+def _axis_union(comps_of: dict[str, list[str] | None]) -> list[str]:
+    """The output's vector components: x, y, z first, then any other in name order."""
+    union = [c for c in ("x", "y", "z") if any(c in (v or []) for v in comps_of.values())]
+    union += sorted({c for v in comps_of.values() for c in (v or []) if c not in union})
+    return union
+
+
+def _columns(
+    da: xr.DataArray,
+    comps: list[str] | None,
+    union: list[str],
+    w: _Window,
+    times: np.ndarray | None,
+) -> np.ndarray:
+    """Values on the output grid: sampled at ``times`` in the simulation (None: kept rows)."""
+    ts, keep = w.ts, w.keep
+    if comps is None or "axis" not in da.dims:
+        v = np.asarray(da.transpose("time", ...).values, dtype=float).reshape(da.sizes["time"])
+        v = v[keep] if times is None else np.interp(times, ts, v)
+        return v if comps is None else np.repeat(v[:, None], len(union), axis=1)
+    result = np.full((w.time.size, len(union)), np.nan)
+    for c in comps:
+        v = np.asarray(da.sel(axis=c).transpose("time").values, dtype=float)
+        result[:, union.index(c)] = v[keep] if times is None else np.interp(times, ts, v)
+    return result
+
+
+def _add_variable(
+    out: xr.Dataset,
+    name: str,
+    sim: xr.Dataset,
+    meas: xr.Dataset,
+    comps: list[str] | None,
+    w: _Window,
+    t_sim: np.ndarray,
+) -> None:
+    """Add ``<name>_sim``, ``_meas``, ``_diff`` and the uncertainties given to ``out``."""
+    union = list(map(str, out["axis"].values)) if "axis" in out.coords else []
+    units = _unit_check(sim[name], meas[name], name)
+    long = meas[name].attrs.get("long_name", sim[name].attrs.get("long_name", name))
+    dims = ("time", "axis") if comps is not None else ("time",)
+    svals = _columns(sim[name], comps, union, w, t_sim)
+    mv = _columns(meas[name], comps, union, w, None)
+    out[f"{name}_sim"] = (dims, svals, {"units": units, "long_name": f"simulated {long}"})
+    out[f"{name}_meas"] = (dims, mv, {"units": units, "long_name": f"measured {long}"})
+    out[f"{name}_diff"] = (
+        dims,
+        svals - mv,
+        {"units": units, "long_name": f"{long}: simulation minus measurement"},
+    )
+    for side, src in (("meas", meas), ("sim", sim)):
+        uname = f"{name}_u"
+        if uname not in src:
+            continue
+        uv = _columns(src[uname], comps, union, w, None if side == "meas" else t_sim)
+        uv, note = to_standard(uv, src[uname].attrs, f"{uname} of the {side} record")
+        out[f"{name}_{side}_u"] = (
+            dims,
+            uv,
+            {
+                "units": units,
+                "long_name": f"standard uncertainty of {name}_{side}",
+                "coverage_factor": 1.0,
+                "basis": f"{uname}: {note}",
+            },
+        )
+        out[f"{name}_{side}"].attrs["ancillary_variables"] = f"{name}_{side}_u"
+
+
 def align_time_series(
     sim: xr.Dataset,
     meas: xr.Dataset,
@@ -144,167 +365,28 @@ def align_time_series(
     ts = _time(sim, "simulated motion")
     tm = _time(meas, "measured motion")
     names = _common_variables(sim, meas, variables)
-    period = period_s if period_s is not None else _period_from_crank(sim)
-    if period is None:
-        period = _period_from_crank(meas)
-    if period is None or not (np.isfinite(period) and period > 0):
-        raise BadInputError(
-            "cannot tell the crank period: neither record has a usable 'crank_angle'; pass "
-            "period_s= (or --period) [s]"
-        )
-    if ts[-1] - ts[0] < period * (1 - 1e-9):
-        raise BadInputError(
-            f"the simulated motion covers {ts[-1] - ts[0]:.4g} s, less than one crank cycle "
-            f"({period:.4g} s); simulate at least one whole cycle"
-        )
-    if method not in ("auto", "crank_angle", "cross_correlation"):
-        raise BadInputError(
-            f"method must be 'auto', 'crank_angle' or 'cross_correlation', got {method!r}"
-        )
-    has_crank = "crank_angle" in sim and "crank_angle" in meas
-    if method == "auto":
-        method = "crank_angle" if has_crank else "cross_correlation"
-    if method == "crank_angle" and not has_crank:
-        raise BadInputError("method='crank_angle' needs 'crank_angle' in both records")
-
-    # measurement window: whole cycles from its start
-    n_cycles = (tm[-1] - tm[0] + np.median(np.diff(tm))) / period
-    if whole_cycles and n_cycles >= 1:
-        n_keep = int(math.floor(n_cycles + 1e-9))
-        keep = tm < tm[0] + n_keep * period - 1e-12
-        cycles_note = f"{n_keep} whole crank cycle(s) of the measurement"
-    else:
-        keep = np.ones_like(tm, dtype=bool)
-        n_keep = float(n_cycles)
-        cycles_note = f"the whole measurement ({n_cycles:.3g} cycles; less than one whole cycle)"
-    tm_k = tm[keep]
-    t0 = ts[-1] - period  # start of the simulation's last whole cycle
-
-    def sim_at(t_sim: np.ndarray, values: np.ndarray) -> np.ndarray:
-        phase = t0 + np.mod(t_sim - t0, period)
-        return np.interp(phase, ts, values)
-
+    period = _crank_period(sim, meas, ts, period_s)
+    method = _alignment_method(method, sim, meas)
+    w = _window(ts, tm, period, whole_cycles)
     if method == "crank_angle":
-        phi_s = np.unwrap(np.asarray(sim["crank_angle"].values, dtype=float))
-        phi_m = np.asarray(meas["crank_angle"].values, dtype=float)[keep]
-        sign = 1.0 if phi_s[-1] >= phi_s[0] else -1.0
-        ps = sign * phi_s
-        if np.any(np.diff(ps) <= 0):
-            raise BadInputError(
-                "the simulated crank angle is not monotonic in time; cannot align by crank angle "
-                "(use method='cross_correlation')"
-            )
-        start = ps[-1] - 2 * math.pi
-        target = start + np.mod(sign * phi_m - start, 2 * math.pi)
-        t_sim = np.interp(target, ps, ts)
-        # shift = measurement time - simulation time, modulo the period (circular mean)
-        ang = 2 * math.pi * (tm_k - t_sim) / period
-        shift = math.atan2(np.mean(np.sin(ang)), np.mean(np.cos(ang))) * period / (2 * math.pi)
-        how = "by crank angle (each frame matched to the simulated instant at the same crank angle)"
+        t_sim, shift = _phase_by_crank_angle(sim, meas, w)
     else:
-        # normalised signals of every common component, simulation on a fine periodic grid
-        pairs = []
-        for name in names:
-            comps = _components(sim[name], meas[name], name)
-            for c in comps or [None]:
-                s = sim[name] if c is None else sim[name].sel(axis=c)
-                m = meas[name] if c is None else meas[name].sel(axis=c)
-                sv = np.asarray(s.transpose("time").values, dtype=float)
-                mv = np.asarray(m.transpose("time").values, dtype=float)[keep]
-                ok = np.isfinite(mv)
-                if ok.sum() < 4 or np.nanstd(mv) == 0:
-                    continue
-                pairs.append((sv, (mv - np.nanmean(mv)) / np.nanstd(mv), ok))
-        if not pairs:
-            raise BadInputError("no usable signal for the cross-correlation (all constant or NaN)")
+        t_sim, shift = _phase_by_cross_correlation(sim, meas, names, w)
 
-        def score(tau: float) -> float:
-            total = 0.0
-            for sv, mz, ok in pairs:
-                x = sim_at(tm_k[ok] - tau, sv)
-                sd = x.std()
-                if sd == 0:
-                    continue
-                total += float(np.mean((x - x.mean()) / sd * mz[ok]))
-            return total
-
-        from scipy.optimize import minimize_scalar
-
-        grid = np.linspace(0.0, period, 720, endpoint=False)
-        scores = np.array([score(t) for t in grid])
-        best = grid[int(np.argmax(scores))]
-        step = period / 720
-        res = minimize_scalar(
-            lambda t: -score(t),
-            bounds=(best - step, best + step),
-            method="bounded",
-            options={"xatol": period * 1e-7},
-        )
-        tau = float(res.x) if -res.fun >= scores.max() else float(best)
-        shift = (tau + period / 2) % period - period / 2
-        t_sim = t0 + np.mod(tm_k - shift - t0, period)
-        how = (
-            "by cross-correlation of the normalised signals over whole cycles (the simulation's "
-            "last whole cycle repeated periodically)"
-        )
-
-    time = xr.DataArray(tm_k, dims="time", attrs=dict(meas["time"].attrs))
+    time = xr.DataArray(w.time, dims="time", attrs=dict(meas["time"].attrs))
     time.attrs.setdefault("units", "s")
     time.attrs.setdefault("long_name", conventions.COORDINATES["time"][1])
     out = xr.Dataset(coords={"time": time})
     comps_of = {name: _components(sim[name], meas[name], name) for name in names}
-    union = [c for c in ("x", "y", "z") if any(c in (v or []) for v in comps_of.values())]
-    union += sorted({c for v in comps_of.values() for c in (v or []) if c not in union})
+    union = _axis_union(comps_of)
     if union:
         out = out.assign_coords(
             axis=xr.DataArray(
                 np.array(union, dtype=str), dims="axis", attrs={"long_name": "vector component"}
             )
         )
-
-    def columns(da: xr.DataArray, comps: list[str] | None, times: np.ndarray | None) -> np.ndarray:
-        """Values on the output grid: sampled at ``times`` in the simulation (None: kept rows)."""
-        if comps is None or "axis" not in da.dims:
-            v = np.asarray(da.transpose("time", ...).values, dtype=float).reshape(da.sizes["time"])
-            v = v[keep] if times is None else np.interp(times, ts, v)
-            return v if comps is None else np.repeat(v[:, None], len(union), axis=1)
-        result = np.full((tm_k.size, len(union)), np.nan)
-        for c in comps:
-            v = np.asarray(da.sel(axis=c).transpose("time").values, dtype=float)
-            result[:, union.index(c)] = v[keep] if times is None else np.interp(times, ts, v)
-        return result
-
     for name in names:
-        comps = comps_of[name]
-        units = _unit_check(sim[name], meas[name], name)
-        long = meas[name].attrs.get("long_name", sim[name].attrs.get("long_name", name))
-        dims = ("time", "axis") if comps is not None else ("time",)
-        svals = columns(sim[name], comps, t_sim)
-        mv = columns(meas[name], comps, None)
-        out[f"{name}_sim"] = (dims, svals, {"units": units, "long_name": f"simulated {long}"})
-        out[f"{name}_meas"] = (dims, mv, {"units": units, "long_name": f"measured {long}"})
-        out[f"{name}_diff"] = (
-            dims,
-            svals - mv,
-            {"units": units, "long_name": f"{long}: simulation minus measurement"},
-        )
-        for side, src in (("meas", meas), ("sim", sim)):
-            uname = f"{name}_u"
-            if uname not in src:
-                continue
-            uv = columns(src[uname], comps, None if side == "meas" else t_sim)
-            uv, note = to_standard(uv, src[uname].attrs, f"{uname} of the {side} record")
-            out[f"{name}_{side}_u"] = (
-                dims,
-                uv,
-                {
-                    "units": units,
-                    "long_name": f"standard uncertainty of {name}_{side}",
-                    "coverage_factor": 1.0,
-                    "basis": f"{uname}: {note}",
-                },
-            )
-            out[f"{name}_{side}"].attrs["ancillary_variables"] = f"{name}_{side}_u"
+        _add_variable(out, name, sim, meas, comps_of[name], w, t_sim)
     out["sim_time"] = (
         "time",
         t_sim,
@@ -313,7 +395,7 @@ def align_time_series(
     if "crank_angle" in meas:
         out["crank_angle_meas"] = (
             "time",
-            np.asarray(meas["crank_angle"].values, dtype=float)[keep],
+            np.asarray(meas["crank_angle"].values, dtype=float)[w.keep],
             {"units": "rad", "long_name": "measured crank angle"},
         )
     fps = 1.0 / float(np.median(np.diff(tm)))
@@ -321,13 +403,13 @@ def align_time_series(
         {
             "title": "simulated and measured motion on a common time base",
             "alignment_method": method,
-            "alignment": how,
+            "alignment": _ALIGNMENTS[method],
             "time_shift_s": float(shift),
             "time_shift_deg": float(shift / period * 360.0),
             "period_s": float(period),
-            "n_cycles": float(n_keep),
+            "n_cycles": float(w.n_cycles),
             "interpolation": (
-                f"common time base: the measurement's samples ({fps:.4g} per s), {cycles_note}; "
+                f"common time base: the measurement's samples ({fps:.4g} per s), {w.note}; "
                 "simulation interpolated linearly onto them after the phase alignment"
             ),
         }

@@ -24,10 +24,7 @@ def compare_cmd(
         typer.Option("--out", "-o", help="netCDF of aligned fields, differences, metrics."),
     ] = Path("metrics.nc"),
     overwrite: Overwrite = False,
-    sim_extra: Annotated[
-        list[Path] | None,
-        typer.Option("--sim", help="Further simulated file (e.g. the motion record)."),
-    ] = None,
+    sim_extra: opt.SimOpt = None,
     meas_extra: Annotated[
         list[Path] | None,
         typer.Option("--meas", help="Further measured file (e.g. the DIC motion record)."),

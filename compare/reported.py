@@ -52,11 +52,13 @@ import xarray as xr
 import jointwear.compare.metrics as mt
 import jointwear.compare.verdicts as vd
 from jointwear.compare._decide import (
+    Budget,
+    Discrepancy,
     Rows,
     Uncertainty,
     decision,
     fmt,
-    scalar_decision,
+    scalar_discrepancy,
     unknown,
     vv20_decision,
 )
@@ -75,7 +77,7 @@ from jointwear.compare.verification import _formal_order, gci
 from jointwear.errors import BadInputError
 from jointwear.reported import is_reported
 
-__all__ = ["split_reported", "reported_metrics", "circular_decision"]
+__all__ = ["split_reported", "reported_metrics", "circular_discrepancy"]
 
 
 def split_reported(items: Sequence[xr.Dataset]) -> tuple[list[xr.Dataset], list[xr.Dataset]]:
@@ -84,57 +86,32 @@ def split_reported(items: Sequence[xr.Dataset]) -> tuple[list[xr.Dataset], list[
     return rep, [d for d in items if not is_reported(d)]
 
 
-def circular_decision(
-    rows: Rows,
-    decisions: list[dict[str, Any]],
-    quantity: str,
-    label: str,
-    s: float,
-    d: float,
-    *,
-    u_num: Uncertainty,
-    u_input: Uncertainty,
-    u_d: Uncertainty,
-    k: float,
-    max_error_deg: float,
-    not_comparable: str = "",
-) -> None:
-    """V&V 20 of an angle [degree]: ``E = wrap(S - D)`` in (-180, 180] against ``U_val``.
+def circular_discrepancy(s: float, d: float, max_error_deg: float) -> Discrepancy:
+    """The error of an angle [degree]: ``E = wrap(S - D)`` in (-180, 180].
 
-    Like :func:`jointwear.compare._decide.scalar_decision`, but the error is circular and the
+    Like :func:`jointwear.compare._decide.scalar_discrepancy`, but the error is circular and the
     screening threshold shown when V&V 20 is not assessed is an angle, ``|E| <= max_error_deg``
     (screening only, never a pass or a fail).
     """
     finite = bool(np.isfinite(s) and np.isfinite(d))
     e = float(mt.wrap_angle_deg(s - d)) if finite else float("nan")
-    units = "degree"
-    rows.add(quantity, "value_sim", s, units)
-    rows.add(quantity, "value_meas", d, units)
     shown = f"S = {s:.1f} degree, D = {d:.1f} degree"
     screen = (
         f"; screening only, not a verdict: |E| {'<=' if abs(e) <= max_error_deg else '>'} "
         f"{max_error_deg:g} degree"
     )
-    vv20_decision(
-        rows,
-        decisions,
-        quantity,
-        label,
+    return Discrepancy(
         d + e,
         d,
         e,
-        units,
-        u_num=u_num,
-        u_input=u_input,
-        u_d=u_d,
-        k=k,
-        criterion=f"|E| <= U_val = {k:g} u_val (ASME V&V 20, E wrapped to (-180, 180] degree)",
+        "degree",
+        values=(("value_sim", s), ("value_meas", d)),
         shown=shown,
         not_assessed_text=f"E = {e:+.1f} degree ({shown}){screen}",
         result_text=lambda res: (
             f"|E| = {abs(e):.1f} degree, U_val = {res.U_val:.1f} degree ({shown})"
         ),
-        not_comparable=not_comparable,
+        criterion_note=", E wrapped to (-180, 180] degree",
     )
 
 
@@ -386,24 +363,13 @@ def _one_reading(
         _u_num(name, q, attrs, reading, s, cycles, studies, criteria) if not why else unknown(why)
     )
     u_in = _u_input(q, attrs, reading, s, cycles, ens, criteria) if not why else unknown(why)
-    common = {"u_num": u_num, "u_input": u_in, "u_d": u_d, "k": criteria.k, "not_comparable": why}
+    budget = Budget(u_num, u_in, u_d, criteria.k)
     if q["kind"] == "max_wear_angle":
-        circular_decision(
-            rows, decs, name, label, s, d, max_error_deg=criteria.max_angle_error_deg, **common
-        )
+        error = circular_discrepancy(s, d, criteria.max_angle_error_deg)
     else:
         unit = "m" if q["units"] == "m" else str(q["units"])
-        scalar_decision(
-            rows,
-            decs,
-            name,
-            label,
-            s if not why else nan,
-            d,
-            unit,
-            relative_error_max=criteria.relative_error_max,
-            **common,
-        )
+        error = scalar_discrepancy(s if not why else nan, d, unit, criteria.relative_error_max)
+    vv20_decision(rows, decs, name, label, error, budget, not_comparable=why)
     return rows, decs
 
 

@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from jointwear.compare._decide import Uncertainty, unknown
+from jointwear.compare._decide import Budget, Uncertainty, unknown
 from jointwear.compare.budget import Component, combine
 from jointwear.compare.criteria import Criteria
 from jointwear.compare.ensemble import Ensemble, spread
@@ -157,6 +157,27 @@ class Sources:
         return unknown(
             f"no ensemble of simulations was given (--ensemble) and the criteria state no "
             f"{family}_u_input_rel"
+        )
+
+    def budget(
+        self,
+        quantity: str,
+        s: float,
+        family: str,
+        *,
+        sim_u: float | None,
+        meas_u: float | None,
+        sim_note: str = "",
+        meas_note: str = "",
+    ) -> Budget:
+        """The V&V 20 budget of a simulated value ``s``: :meth:`u_num` (the simulation's own
+        standard uncertainty ``sim_u``), :meth:`u_input`, :meth:`u_d` (the measurement's
+        ``meas_u``) and the criteria's coverage factor."""
+        return Budget(
+            self.u_num(quantity, s, sim_u, family, sim_note),
+            self.u_input(quantity, s, family),
+            self.u_d(meas_u, meas_note),
+            self.criteria.k,
         )
 
     @staticmethod

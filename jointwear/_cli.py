@@ -266,8 +266,9 @@ def _name_the_input(message: str, cmd: Any, ctx: Any) -> str:
     return f"'{inputs.pop()}': {message}" if len(inputs) == 1 else message
 
 
-class Command(TyperCommand):
-    """A jointwear command (see the module docstring)."""
+class _Tidied:
+    """Help text with its brackets escaped and tidied parameters (see the module docstring);
+    the base of :class:`Command` and :class:`CommandGroup`, which also claim their outputs."""
 
     def __init__(self, *args: Any, **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)
@@ -281,18 +282,14 @@ class Command(TyperCommand):
         return _invoke(self, ctx, super().invoke)
 
 
-class CommandGroup(TyperGroup):
+class Command(_Tidied, TyperCommand):
+    """A jointwear command (see the module docstring)."""
+
+
+class CommandGroup(_Tidied, TyperGroup):
     """A group; when its callback is the command itself (``jointwear compare A B``), it claims
     outputs like :class:`Command` and, while it has no sub-commands, its usage line shows no
     ``COMMAND [ARGS]...``."""
-
-    def __init__(self, *args: Any, **kwargs: Any) -> None:
-        super().__init__(*args, **kwargs)
-        self.help = escape_brackets(self.help)
-        _tidy(self.params)
-
-    def get_params(self, ctx: Any) -> list[Any]:
-        return _tidy(super().get_params(ctx))
 
     def collect_usage_pieces(self, ctx: Any) -> list[str]:
         # (Click itself is not imported: Typer >= 0.26 vendors it and no longer installs it)
@@ -300,9 +297,6 @@ class CommandGroup(TyperGroup):
         if not self.commands and pieces and pieces[-1] == self.subcommand_metavar:
             pieces = pieces[:-1]
         return pieces
-
-    def invoke(self, ctx: Any) -> Any:
-        return _invoke(self, ctx, super().invoke)
 
 
 def apply_classes(app: typer.Typer) -> None:

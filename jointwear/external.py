@@ -190,6 +190,24 @@ def _stamp(ds: xr.Dataset, path: Path, data_origin: str, tool: str | None, what:
     return ds
 
 
+def _vector(
+    table: pd.DataFrame, names: Sequence[str], path: Path, option: str, unit: str, kind: str
+) -> np.ndarray:
+    """Columns ``names`` as the components of a vector in SI units, a row per sample (``option``:
+    the CLI option prefix, ``--velocity`` for ``--velocity-columns`` / ``--velocity-unit``)."""
+    return np.column_stack(
+        [
+            to_si(
+                _column(table, c, path, f"{option}-columns"),
+                unit,
+                kind=kind,
+                option=f"{option}-unit",
+            )
+            for c in names
+        ]
+    )
+
+
 def import_motion(
     path: str | Path,
     *,
@@ -251,17 +269,7 @@ def import_motion(
             f"(it does not at data row {where}); sort the rows or remove duplicates"
         )
     axes = ["x", "y", "z"][: len(velocity_columns)]
-    velocity = np.column_stack(
-        [
-            to_si(
-                _column(table, c, path, "--velocity-columns"),
-                velocity_unit,
-                kind="velocity",
-                option="--velocity-unit",
-            )
-            for c in velocity_columns
-        ]
-    )
+    velocity = _vector(table, velocity_columns, path, "--velocity", velocity_unit, "velocity")
     ds = xr.Dataset(coords={"time": t - t[0], "axis": axes})
     ds["follower_velocity"] = (("time", "axis"), velocity)
     if position_columns:
@@ -269,17 +277,7 @@ def import_motion(
             raise ParameterError("--position-unit: give the unit of the position columns")
         if len(position_columns) != len(axes):
             raise ParameterError("--position-columns: give as many columns as --velocity-columns")
-        position = np.column_stack(
-            [
-                to_si(
-                    _column(table, c, path, "--position-columns"),
-                    position_unit,
-                    kind="length",
-                    option="--position-unit",
-                )
-                for c in position_columns
-            ]
-        )
+        position = _vector(table, position_columns, path, "--position", position_unit, "length")
         ds["follower_position"] = (("time", "axis"), position)
     ds = conventions.annotate(ds)
     return _stamp(ds, path, data_origin, tool, "follower motion")

@@ -74,24 +74,19 @@ def decode_attrs(attrs: Mapping[str, Any]) -> dict[str, Any]:
 
 
 def check_writable(path: str | Path, *, what: str = "output") -> Path:
-    """Fail early (before a long computation) if ``path`` cannot be written.
+    """Fail early (before a long computation) if the file ``path`` cannot be written.
 
-    Creates the parent folder if needed and tries a temporary file there.
+    Creates the parent folder if needed and tries a temporary file there
+    (:func:`jointwear.outputs.check_location`); a folder, or a place that cannot be written, is
+    a :class:`~jointwear.errors.BadInputError` (the path given is the problem).
     """
     path = Path(path)
     if path.is_dir():
         raise BadInputError(f"{what} path '{path}' is a folder; give a file name")
     try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".check")
-        os.close(fd)
-        with contextlib.suppress(FileNotFoundError):  # removed as stale by a concurrent writer
-            os.unlink(tmp)
-    except OSError as exc:
-        raise BadInputError(
-            f"{what} path '{path}' is not writable ({exc.strerror}); choose another location"
-        ) from None
-    return path
+        return outputs.check_location(path, what=what)
+    except outputs.OutputError as exc:
+        raise BadInputError(str(exc)) from None
 
 
 @contextlib.contextmanager

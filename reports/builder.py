@@ -68,6 +68,19 @@ class ReportInput:
     dataset: xr.Dataset | None = None
 
 
+@dataclass(frozen=True)
+class _Page:
+    """What a report shows beside the comparison (see :func:`build_report`)."""
+
+    inputs: Sequence[ReportInput] = ()
+    verification: Sequence[xr.Dataset] = ()
+    missing: Sequence[str] = ()
+    notes: Sequence[str] = ()
+    title: str = DEFAULT_TITLE
+    command: str | None = None
+    parameters: dict[str, Any] | None = None
+
+
 def _template(name: str) -> str:
     return (resources.files("jointwear.reports") / "templates" / name).read_text(encoding="utf-8")
 
@@ -101,19 +114,11 @@ def _input_records(inputs: Sequence[ReportInput]) -> tuple[list[dict[str, str]],
     return records, (max(created) if created else None)
 
 
-def _context(
-    c: Comparison,
-    *,
-    inputs: Sequence[ReportInput],
-    verification: Sequence[xr.Dataset],
-    missing: Sequence[str],
-    notes: Sequence[str],
-    title: str,
-    command: str | None,
-    parameters: dict[str, Any] | None,
-) -> dict[str, Any]:
+def _context(c: Comparison, page: _Page) -> dict[str, Any]:
     import jointwear.compare.verdicts as vd
     from jointwear.reports import figures
+
+    missing, notes, verification = page.missing, page.notes, page.verification
 
     n = len(c.decisions)
     counts = vd.counts(c.states)
@@ -127,7 +132,7 @@ def _context(
     origin = dict(c.data_origin)
     ctx: dict[str, Any] = {
         "version": __version__,
-        "title": title,
+        "title": page.title,
         "css": _template("report.css"),
         "passed": c.passed,
         "card_class": verdict_class,
@@ -218,13 +223,13 @@ def _context(
         (m for m in missing if m.lower().startswith("verification")),
         "No verification data (convergence study) was supplied with the simulation.",
     )
-    records, as_of = _input_records(inputs)
+    records, as_of = _input_records(page.inputs)
     ctx["inputs"] = records
     ctx["as_of"] = as_of
     ctx["software"] = sorted(software_versions().items())
-    params = {"criteria": to_jsonable(c.criteria), **(parameters or {})}
+    params = {"criteria": to_jsonable(c.criteria), **(page.parameters or {})}
     ctx["parameters"] = json.dumps(to_jsonable(params), indent=2, sort_keys=True)
-    ctx["command"] = command if command is not None else command_line()
+    ctx["command"] = page.command if page.command is not None else command_line()
     return ctx
 
 
@@ -240,6 +245,11 @@ def render_html(
     parameters: dict[str, Any] | None = None,
 ) -> str:
     """The report as an HTML string (see :func:`build_report` for the parameters)."""
+    page = _Page(inputs, verification, missing, notes, title, command, parameters)
+    return _render(comparison, page)
+
+
+def _render(comparison: Comparison, page: _Page) -> str:
     import jinja2
     import matplotlib
 
@@ -250,16 +260,7 @@ def render_html(
         keep_trailing_newline=True,
     )
     with matplotlib.rc_context({"svg.hashsalt": "jointwear-report"}):
-        ctx = _context(
-            comparison,
-            inputs=inputs,
-            verification=verification,
-            missing=missing,
-            notes=notes,
-            title=title,
-            command=command,
-            parameters=parameters,
-        )
+        ctx = _context(comparison, page)
     for key in ("polar_svg", "motion_svg", "verification_svg"):
         if ctx.get(key):
             ctx[key] = jinja2.utils.markupsafe.Markup(ctx[key])
@@ -327,26 +328,20 @@ def build_report(
     >>> page.name, "maximum wear depth" in page.read_text(encoding="utf-8")
     ('report.html', True)
     """
-    html = render_html(
-        comparison,
-        inputs=inputs,
-        verification=verification,
-        missing=missing,
-        notes=notes,
-        title=title,
-        command=command,
-        parameters=parameters,
-    )
-    out = Path(out)
+    page = _Page(inputs, verification, missing, notes, title, command, parameters)
+    return _write(comparison, Path(out), page, pdf)
+
+
+def _write(comparison: Comparison, out: Path, page: _Page, pdf: str | Path | None) -> Path:
+    """Write the HTML report to ``out`` (atomically, readable by all) and the PDF to ``pdf``."""
+    html = _render(comparison, page)
     with io.atomic_path(out) as tmp:
         tmp.write_text(html, encoding="utf-8")
         tmp.chmod(0o644)  # a report is meant to be shared (mkstemp creates 0600)
     if pdf is not None:
-        from jointwear.reports.pdf import write_pdf
+        from jointwear.reports.pdf import pdf_of_page
 
-        write_pdf(
-            comparison, pdf, inputs=inputs, verification=verification, missing=missing, title=title
-        )
+        pdf_of_page(comparison, pdf, page)
     return out
 
 
@@ -468,21 +463,9 @@ def report_from_files(
     inputs += [
         ReportInput("verification", Path(p), d) for p, d in zip(verification, vers, strict=True)
     ]
+    page = _Page(inputs, vers, missing, title=title, command=command)
     if Path(out).suffix.lower() == ".pdf":  # PDF only (no browser at hand)
-        from jointwear.reports.pdf import write_pdf
+        from jointwear.reports.pdf import pdf_of_page
 
-        path = write_pdf(
-            result, out, inputs=inputs, verification=vers, missing=missing, title=title
-        )
-        return path, result
-    path = build_report(
-        result,
-        out,
-        inputs=inputs,
-        verification=vers,
-        missing=missing,
-        title=title,
-        command=command,
-        pdf=pdf,
-    )
-    return path, result
+        return pdf_of_page(result, out, page), result
+    return _write(result, Path(out), page, pdf), result

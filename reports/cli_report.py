@@ -18,10 +18,7 @@ def report_cmd(
         typer.Option("--out", "-o", help="HTML report to write (.pdf: the PDF version only)."),
     ] = Path("report.html"),
     overwrite: Overwrite = False,
-    sim: Annotated[
-        list[Path] | None,
-        typer.Option("--sim", help="Simulated wear map and/or motion (.nc); repeatable."),
-    ] = None,
+    sim: opt.SimOpt = None,
     metrology: Annotated[
         list[Path] | None,
         typer.Option("--metrology", help="Measured wear map (.nc from jointwear metrology)."),

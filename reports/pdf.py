@@ -13,7 +13,7 @@ from jointwear._version import __version__
 from jointwear.compare import Comparison
 from jointwear.provenance import software_versions
 from jointwear.reports._sections import _coverage, _verdict, format_value
-from jointwear.reports.builder import DEFAULT_TITLE, ReportInput, _input_records
+from jointwear.reports.builder import DEFAULT_TITLE, ReportInput, _input_records, _Page
 
 __all__ = ["write_pdf"]
 
@@ -43,10 +43,18 @@ def write_pdf(
     title: str = DEFAULT_TITLE,
 ) -> Path:
     """Write the report as a PDF with matplotlib only (no browser needed). Deterministic."""
+    page = _Page(inputs, verification, missing, notes, title)
+    return pdf_of_page(comparison, path, page)
+
+
+def pdf_of_page(comparison: Comparison, path: str | Path, page: _Page) -> Path:
+    """:func:`write_pdf` of a report's page (what it shows beside the comparison)."""
     import matplotlib
     from matplotlib.backends.backend_pdf import PdfPages
 
     from jointwear.reports import figures
+
+    inputs, verification, title = page.inputs, page.verification, page.title
 
     c = comparison
     path = Path(path)
@@ -76,9 +84,9 @@ def write_pdf(
                 f"why: {r.reason}", 100, initial_indent=" " * 6, subsequent_indent=" " * 6
             )
     lines = [piece for line in lines for piece in (wrap(line, 110) or [""])]
-    for m in [*missing, *c.notes]:
+    for m in [*page.missing, *c.notes]:
         lines += ["", f"Not covered: {m}"]
-    for m in notes:
+    for m in page.notes:
         lines += ["", f"Note: {m}"]
     metric_lines = []
     for r in c.metrics.itertuples():

@@ -1,8 +1,8 @@
 """(Re)write the ``__init__.pyi`` stub of every package that uses ``jointwear._lazy.lazy_api``.
 
 ``python docs/scripts/lazy_stubs.py``: the packages are those of ``pyproject.toml``; a stub
-re-exports the names the package's ``__getattr__`` serves, for type checkers and editors
-(``tests/root/test_lazy_api.py`` checks each stub against its package).
+star-imports the API modules whose ``__all__`` the package's ``__getattr__`` serves, for type
+checkers and editors (``tests/root/test_lazy_api.py`` checks each stub against its package).
 """
 
 from __future__ import annotations

@@ -32,6 +32,13 @@ def sim_wear(*, n_layers=20, n_points=200, width=15e-3, cycles=(0.0, 2e5, 4e5), 
     theta = np.arange(n_points) * 360.0 / n_points
     base = wear_field(z, theta, rotate_deg=rotate_deg)
     depth = np.stack([base * c / cycles[-1] for c in cycles])
+    ds = wear_history(depth, cycles, z, theta)
+    ds.attrs.update({"title": "synthetic simulated wear", "bearing_radius_m": RADIUS})
+    return ds
+
+
+def wear_history(depth, cycles, z, theta):
+    """A simulator-style wear map ``depth`` [m] over (cycles, z [m], theta [degree, canonical])."""
     ds = xr.Dataset(
         coords={
             "cycles": ("cycles", np.asarray(cycles, float), {"units": "1", "long_name": "cycles"}),
@@ -40,7 +47,6 @@ def sim_wear(*, n_layers=20, n_points=200, width=15e-3, cycles=(0.0, 2e5, 4e5), 
         }
     )
     ds["wear_depth"] = (("cycles", "z", "theta"), depth, conventions.variable_attrs("wear_depth"))
-    ds.attrs.update({"title": "synthetic simulated wear", "bearing_radius_m": RADIUS})
     return ds
 
 
@@ -104,6 +110,18 @@ def velocity(phi):
     )
 
 
+def follower_motion(t, v):
+    """A motion record: follower velocity ``v`` [m/s] over time ``t`` [s] and axis x, y, z."""
+    ds = xr.Dataset(
+        coords={
+            "time": ("time", t, {"units": "s", "long_name": "time"}),
+            "axis": ("axis", np.array(["x", "y", "z"])),
+        }
+    )
+    ds["follower_velocity"] = (("time", "axis"), v, conventions.variable_attrs("follower_velocity"))
+    return ds
+
+
 def sim_motion(*, theta0=0.3, duration=1.2, seed=1):
     """Variable-step simulated motion with crank angle."""
     rng = np.random.default_rng(seed)
@@ -111,17 +129,7 @@ def sim_motion(*, theta0=0.3, duration=1.2, seed=1):
     t = np.concatenate([[0.0], np.cumsum(steps)])
     t = t[t <= duration]
     phi = theta0 + OMEGA * t
-    ds = xr.Dataset(
-        coords={
-            "time": ("time", t, {"units": "s", "long_name": "time"}),
-            "axis": ("axis", np.array(["x", "y", "z"])),
-        }
-    )
-    ds["follower_velocity"] = (
-        ("time", "axis"),
-        velocity(phi),
-        conventions.variable_attrs("follower_velocity"),
-    )
+    ds = follower_motion(t, velocity(phi))
     ds["crank_angle"] = ("time", phi, conventions.variable_attrs("crank_angle"))
     ds.attrs["title"] = "synthetic simulated motion"
     return ds
@@ -131,17 +139,7 @@ def meas_motion(*, phi0=1.7, duration=2.1, fps=50.0, with_crank=True, scale=1.0,
     """50 fps measured motion, crank angle phi0 at t = 0."""
     t = np.arange(int(duration * fps)) / fps
     phi = phi0 + OMEGA * t
-    ds = xr.Dataset(
-        coords={
-            "time": ("time", t, {"units": "s", "long_name": "time"}),
-            "axis": ("axis", np.array(["x", "y", "z"])),
-        }
-    )
-    ds["follower_velocity"] = (
-        ("time", "axis"),
-        scale * velocity(phi),
-        conventions.variable_attrs("follower_velocity"),
-    )
+    ds = follower_motion(t, scale * velocity(phi))
     if u is not None:
         ds["follower_velocity_u"] = (
             ("time", "axis"),

@@ -74,16 +74,14 @@ def test_compare_cli_writes_metrics_and_table(files, tmp_path, capsys):
     assert basis.startswith("user-stated")
 
 
+def _compare_wear(files, meas, out_flag, out):
+    """Arguments of ``jointwear compare`` of the simulated wear map with ``files[meas]``."""
+    return ["compare", str(files["sim_wear"]), str(files[meas]), out_flag, str(out), "--overwrite"]
+
+
 def test_compare_cli_exit_codes(files, tmp_path, capsys):
     out = tmp_path / "m.nc"
-    bad = [
-        "compare",
-        str(files["sim_wear"]),
-        str(files["meas_wear_bad"]),
-        "--out",
-        str(out),
-        "--overwrite",
-    ]
+    bad = _compare_wear(files, "meas_wear_bad", "--out", out)
     # without u_num and u_input the depth that is 2x off is not assessed: the screening
     # threshold it exceeds is shown, never counted as a fail (nor, elsewhere, as a pass)
     assert main(bad) == 0
@@ -95,14 +93,7 @@ def test_compare_cli_exit_codes(files, tmp_path, capsys):
     assert "validation failed for: maximum wear depth" in captured.err
     # nothing fails, but V&V 20 is not assessed and the narrow scan leaves part of the
     # simulation unvalidated: exit 0 with a summary saying so; --strict makes it exit 1
-    undecided = [
-        "compare",
-        str(files["sim_wear"]),
-        str(files["meas_wear"]),
-        "-o",
-        str(out),
-        "--overwrite",
-    ]
+    undecided = _compare_wear(files, "meas_wear", "-o", out)
     assert main(undecided) == 0
     text = capsys.readouterr().out
     assert "not assessed (an uncertainty is unknown" in text

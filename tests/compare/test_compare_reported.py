@@ -11,12 +11,12 @@ from __future__ import annotations
 
 import copy
 
+import _jw_synth as syn
 import numpy as np
 import pytest
 import xarray as xr
 
 import jointwear.compare.verdicts as vd
-from jointwear import conventions
 from jointwear.compare import Criteria, compare
 from jointwear.compare._reported_quantities import mz_cylindricity
 from jointwear.compare.metrics import lsq_cylindricity
@@ -53,14 +53,7 @@ def sim_map(*, bump=0.0, rotate=0.0, scale=1.0, cycles=(1e5, 4e5, 1e6), n_layers
             for c in cycles
         ]
     )
-    ds = xr.Dataset(
-        coords={
-            "cycles": ("cycles", np.asarray(cycles, float), {"units": "1", "long_name": "cycles"}),
-            "z": conventions.z_coord(z),
-            "theta": conventions.theta_coord(theta),
-        }
-    )
-    ds["wear_depth"] = (("cycles", "z", "theta"), depth, conventions.variable_attrs("wear_depth"))
+    ds = syn.wear_history(depth, cycles, z, theta)
     ds.attrs.update({"title": "synthetic simulated wear", "data_origin": "simulated"})
     return ds
 

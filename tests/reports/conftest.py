@@ -29,3 +29,25 @@ def report_files(tmp_path_factory):
         paths[name] = folder / f"{name}.nc"
         io.save(ds, paths[name], command=f"synthetic {name}")
     return paths
+
+
+@pytest.fixture(scope="session")
+def report_of_all(report_files):
+    """``report_of_all(out, command)``: the report of every file of ``report_files`` with the
+    strict coverage rule (the narrow scan leaves some criteria not comparable)."""
+    from jointwear.compare import Criteria
+    from jointwear.reports import report_from_files
+
+    f = report_files
+
+    def build(out, command):
+        return report_from_files(
+            out,
+            sim=[f["sim_wear"], f["sim_motion"]],
+            metrology=[f["metrology"]],
+            dic=[f["dic"]],
+            command=command,
+            criteria=Criteria(strict_coverage=True),
+        )
+
+    return build

@@ -10,9 +10,6 @@ import numpy as np
 import pytest
 from test_report_html import EXPECTED_SECTIONS, _Page  # noqa: I001
 
-from jointwear.compare import Criteria
-from jointwear.reports import report_from_files
-
 pytestmark = pytest.mark.browser
 
 FLAGS = [
@@ -50,18 +47,10 @@ def _run(args: list[str], tmp_path) -> subprocess.CompletedProcess:
     )
 
 
-def test_report_renders_in_chromium(report_files, tmp_path):
+def test_report_renders_in_chromium(report_of_all, tmp_path):
     exe = _chromium()
     assert exe
-    f = report_files
-    html, _ = report_from_files(
-        tmp_path / "report.html",
-        sim=[f["sim_wear"], f["sim_motion"]],
-        metrology=[f["metrology"]],
-        dic=[f["dic"]],
-        command="browser test",
-        criteria=Criteria(strict_coverage=True),  # a narrow scan: some not comparable
-    )
+    html, _ = report_of_all(tmp_path / "report.html", "browser test")
     url = html.resolve().as_uri()
     shot = tmp_path / "shot.png"
     res = _run(["--window-size=1200,2400", f"--screenshot={shot}", url], tmp_path)

@@ -71,18 +71,9 @@ def parse(path) -> _Page:
 
 
 @pytest.fixture(scope="module")
-def built(report_files, tmp_path_factory):
+def built(report_of_all, tmp_path_factory):
     out = tmp_path_factory.mktemp("report") / "report.html"
-    f = report_files
-    path, result = report_from_files(
-        out,
-        sim=[f["sim_wear"], f["sim_motion"]],
-        metrology=[f["metrology"]],
-        dic=[f["dic"]],
-        command="jointwear report (test)",
-        criteria=STRICT,
-    )
-    return path, result
+    return report_of_all(out, "jointwear report (test)")
 
 
 def test_report_structure(built):
@@ -123,16 +114,8 @@ def test_report_lists_inputs_with_sha256(built, report_files):
         assert str(p) in html
 
 
-def test_report_is_byte_identical(report_files, built, tmp_path):
-    f = report_files
-    again, _ = report_from_files(
-        tmp_path / "again.html",
-        sim=[f["sim_wear"], f["sim_motion"]],
-        metrology=[f["metrology"]],
-        dic=[f["dic"]],
-        command="jointwear report (test)",
-        criteria=STRICT,
-    )
+def test_report_is_byte_identical(report_of_all, built, tmp_path):
+    again, _ = report_of_all(tmp_path / "again.html", "jointwear report (test)")
     assert again.read_bytes() == built[0].read_bytes()
 
 
@@ -177,7 +160,7 @@ def test_verification_figures_and_pdf_determinism(built, tmp_path):
     import numpy as np
     import xarray as xr
 
-    from jointwear.reports import render_html, write_pdf
+    from jointwear.reports import build_report, render_html, write_pdf
 
     _, result = built
     # a convergence study: error ~ h^2 over four grid sizes
@@ -197,9 +180,20 @@ def test_verification_figures_and_pdf_determinism(built, tmp_path):
     assert page.h2 == EXPECTED_SECTIONS
     # polar plots, motion and the verification figure
     assert page.tags.get("svg", 0) == 3
-    a = write_pdf(result, tmp_path / "a.pdf", verification=[conv])
-    b = write_pdf(result, tmp_path / "b.pdf", verification=[conv])
+    a = write_pdf(result, tmp_path / "a.pdf", verification=[conv], notes=["made by a test"])
+    b = write_pdf(result, tmp_path / "b.pdf", verification=[conv], notes=["made by a test"])
     assert a.read_bytes() == b.read_bytes() and a.read_bytes().startswith(b"%PDF")
+    # build_report's PDF is write_pdf's with the same page, notes included (they were dropped)
+    plain = write_pdf(result, tmp_path / "plain.pdf", verification=[conv])
+    assert plain.read_bytes() != a.read_bytes()
+    build_report(
+        result,
+        tmp_path / "r.html",
+        verification=[conv],
+        notes=["made by a test"],
+        pdf=tmp_path / "r.pdf",
+    )
+    assert (tmp_path / "r.pdf").read_bytes() == a.read_bytes()
 
 
 def test_generated_scan_stays_synthetic_into_the_decision_card(tmp_path):

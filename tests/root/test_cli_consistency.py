@@ -173,19 +173,8 @@ def test_error_from_the_library_names_the_flag_end_to_end(tmp_path, capsys):
     scan = tmp_path / "layer.txt"
     theta = np.arange(0, 360, 2.0)
     scan.write_text("angle;value\n" + "".join(f"{t:.1f};{np.sin(t):.4f}\n" for t in theta))
-    code = main(
-        [
-            "metrology",
-            "import",
-            str(scan),
-            "--angle-zero",
-            "+x",
-            "--angle-direction",
-            "counterclockwise",
-            "--out",
-            str(tmp_path / "s.nc"),
-        ]
-    )
+    convention = "--angle-zero +x --angle-direction counterclockwise".split()
+    code = main(["metrology", "import", str(scan), *convention, "--out", str(tmp_path / "s.nc")])
     err = capsys.readouterr().err
     assert code == 3, err
     assert "--units" in err and "units=" not in err and "Traceback" not in err

@@ -13,14 +13,12 @@ import os
 import tempfile
 from pathlib import Path
 
-import numpy as np
 import pytest
 import typer
-import xarray as xr
+from _small_map import small_wear_map
 from hypothesis import HealthCheck, Phase, given, settings
 from hypothesis import strategies as st
 
-from jointwear import conventions as C
 from jointwear import io
 from jointwear._cli import OUTPUT_PARAMS
 from jointwear.cli import app, main
@@ -82,13 +80,7 @@ FLOATS = ["0", "-1", "0.5", "nan", "inf", "-inf", "1e300", "x", ""]
 
 def _files(folder: Path) -> dict[str, Path]:
     """Inputs of every kind: missing, empty, garbage, binary, a folder, valid netCDF."""
-    theta = C.theta_coord(np.arange(0.0, 360.0, 10.0))
-    z = C.z_coord(np.linspace(-5e-3, 5e-3, 5))
-    depth = 1e-6 * np.abs(np.sin(np.radians(theta.values)))[None, :] * np.ones((5, 1))
-    wear = xr.Dataset(
-        {"wear_depth": (("z", "theta"), depth, C.variable_attrs("wear_depth"))},
-        coords={"z": z, "theta": theta},
-    )
+    wear = small_wear_map()
     files = {
         "missing": folder / "missing.nc",
         "empty": folder / "empty.txt",

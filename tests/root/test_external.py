@@ -263,15 +263,19 @@ def test_cli_bad_origin_is_a_usage_error(tmp_path):
     assert code == 2
 
 
-def test_loading_a_foreign_cf_file_points_to_jointwear_import(tmp_path):
+def _si_wear_file(path, attrs):
+    """The true wear map in SI units (no angle convention), global ``attrs``, as netCDF."""
     theta_c, z, depth = _wear_truth()
-    foreign = xr.Dataset(
+    xr.Dataset(
         {"wear_depth": (("z", "theta"), depth, {"units": "m"})},
         coords={"z": ("z", z, {"units": "m"}), "theta": ("theta", theta_c, {"units": "degree"})},
-        attrs={"Conventions": "CF-1.11", "title": "wear from another tool"},
-    )
+        attrs=attrs,
+    ).to_netcdf(path)
+
+
+def test_loading_a_foreign_cf_file_points_to_jointwear_import(tmp_path):
     path = tmp_path / "foreign.nc"
-    foreign.to_netcdf(path)
+    _si_wear_file(path, {"Conventions": "CF-1.11", "title": "wear from another tool"})
     with pytest.raises(BadInputError, match="jointwear import wearmap") as info:
         io.load(path)
     assert "not written by jointwear" in str(info.value)
@@ -329,13 +333,7 @@ def test_foreign_cf_without_z_zero_is_refused_for_comparison(tmp_path):
 
 
 def test_a_broken_jointwear_file_is_not_taken_as_foreign(tmp_path):
-    theta_c, z, depth = _wear_truth()
-    ds = xr.Dataset(
-        {"wear_depth": (("z", "theta"), depth, {"units": "m"})},
-        coords={"z": ("z", z, {"units": "m"}), "theta": ("theta", theta_c, {"units": "degree"})},
-        attrs={"provenance": "{}", "title": "t"},
-    )
     path = tmp_path / "broken.nc"
-    ds.to_netcdf(path)
+    _si_wear_file(path, {"provenance": "{}", "title": "t"})
     with pytest.raises(BadInputError, match="data contract"):
         external.load_for_comparison(path, role="simulated", warn=lambda s: None)

@@ -7,11 +7,9 @@ into a .pdf.
 
 from __future__ import annotations
 
-import numpy as np
 import pytest
-import xarray as xr
+from _small_map import small_wear_map
 
-import jointwear.conventions as C
 from jointwear import io
 from jointwear.cli import main
 from jointwear.errors import BadInputError
@@ -21,15 +19,8 @@ MAGIC = {".png": b"\x89PNG", ".pdf": b"%PDF", ".svg": b"<?xml"}
 
 @pytest.fixture
 def wear_map(tmp_path):
-    theta = C.theta_coord(np.arange(0.0, 360.0, 10.0))
-    z = C.z_coord(np.linspace(-5e-3, 5e-3, 5))
-    depth = 1e-6 * np.abs(np.sin(np.radians(theta.values)))[None, :] * np.ones((5, 1))
-    ds = xr.Dataset(
-        {"wear_depth": (("z", "theta"), depth, C.variable_attrs("wear_depth"))},
-        coords={"z": z, "theta": theta},
-    )
     path = tmp_path / "wear.nc"
-    io.save(ds, path)
+    io.save(small_wear_map(), path)
     return path
 
 

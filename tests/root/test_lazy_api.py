@@ -68,23 +68,23 @@ def test_function_wins_when_the_submodule_was_imported_first():
 
 @pytest.mark.parametrize("package", PACKAGES)
 def test_the_static_stub_lists_exactly_the_lazy_api(package):
-    """``__init__.pyi`` (what type checkers and editors read) re-exports every public name the
-    package's ``__getattr__`` serves, from the module that defines it, and nothing else."""
+    """``__init__.pyi`` (what type checkers and editors read) star-imports the modules whose
+    ``__all__`` (PEP 484: what a star-import in a stub re-exports) is exactly the public API the
+    package's ``__getattr__`` serves, each name once, and holds nothing else."""
     import ast
     from pathlib import Path
 
     pkg = importlib.import_module(package)
     stub = Path(pkg.__file__).with_suffix(".pyi")
     tree = ast.parse(stub.read_text())
-    exported = {}
-    listed = None
-    for node in tree.body:
-        if isinstance(node, ast.ImportFrom):
-            for alias in node.names:
-                assert alias.asname == alias.name  # explicit re-export
-                exported[alias.name] = node.module
-        elif isinstance(node, ast.Assign) and node.targets[0].id == "__all__":
-            listed = [e.value for e in node.value.elts]
-    assert sorted(exported) == sorted(pkg.__all__) == sorted(listed)
-    for name, module in exported.items():
-        assert getattr(importlib.import_module(module), name) is getattr(pkg, name)
+    docstring, *imports = tree.body
+    assert isinstance(docstring, ast.Expr) and isinstance(docstring.value, ast.Constant)
+    assert imports and all(
+        isinstance(node, ast.ImportFrom) and [a.name for a in node.names] == ["*"]
+        for node in imports
+    )
+    modules = [importlib.import_module(node.module) for node in imports]
+    exported = [(name, module) for module in modules for name in module.__all__]
+    assert sorted(name for name, _ in exported) == sorted(pkg.__all__)
+    for name, module in exported:
+        assert getattr(module, name) is getattr(pkg, name)
