@@ -62,7 +62,28 @@ def _element_label(param: Any) -> str:
     return label.lower()
 
 
+def _refuse_empty_path(param: Any, value: Any, positional: bool = False) -> None:
+    """An empty path (``''``, often an unset shell variable) would read as the current folder
+    ``.``: a usage error naming the parameter instead. ``positional``: every positional
+    argument of jointwear names files or images, whatever its declared type."""
+    described = param.type_descriptor
+    is_path = described.is_path or "pathlib.Path" in str(described.annotation)
+    if value is None or not (is_path or positional):
+        return
+    values = value if isinstance(value, list | tuple) else [value]
+    if any(isinstance(v, str) and not v.strip() for v in values):
+        raise typer.BadParameter(
+            "an empty path '' was given (an unset shell variable?); give a file or folder "
+            "name (. for the current folder)",
+            param=param,
+        )
+
+
 class _TidyOption(TyperOption):
+    def process_value(self, ctx: Any, value: Any) -> Any:
+        _refuse_empty_path(self, value)
+        return super().process_value(ctx, value)
+
     def display_type(self, ctx: Any) -> str:
         if self.is_flag and not self.count:
             return ""
@@ -76,6 +97,10 @@ class _TidyOption(TyperOption):
 
 
 class _TidyArgument(TyperArgument):
+    def process_value(self, ctx: Any, value: Any) -> Any:
+        _refuse_empty_path(self, value, positional=True)
+        return super().process_value(ctx, value)
+
     def _usage_display_name(self) -> str:
         # FILE, [DEFORMED], PATHS... (click's convention) rather than {file}
         name = (self.metavar or self.name or "arg").upper()

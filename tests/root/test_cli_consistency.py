@@ -98,6 +98,41 @@ def test_bad_option_values_are_usage_errors_naming_the_flag(argv, tmp_path, caps
     assert not list(tmp_path.iterdir())  # nothing written
 
 
+def _empty_path_cases():
+    """(argv, parameter name) giving '' to every path parameter and positional argument of
+    every command: '' would read as the current folder '.'."""
+    cases = []
+    for path, cmd in COMMANDS:
+        arguments = [p for p in cmd.params if p.param_type_name == "argument"]
+        for prm in cmd.params:
+            described = getattr(prm, "type_descriptor", None)
+            positional = prm.param_type_name == "argument"
+            if positional and prm is not arguments[0]:
+                continue  # '' would be read as the first argument
+            if described is None or not (positional or "Path" in str(described.annotation)):
+                continue
+            flag = None if positional else next(o for o in prm.opts if o.startswith("--"))
+            cases.append(([*path, ""] if positional else [*path, flag, ""], flag or prm.name))
+    return cases
+
+
+EMPTY_PATH_CASES = _empty_path_cases()
+
+
+def test_an_empty_path_is_a_usage_error_naming_the_parameter(capsys, tmp_path, monkeypatch):
+    # an unset shell variable ('jointwear info "$F"') must not read the current folder
+    monkeypatch.chdir(tmp_path)
+    assert len(EMPTY_PATH_CASES) >= 60
+    wrong = []
+    for argv, name in EMPTY_PATH_CASES:
+        code = main(argv)
+        err = re.sub(r"[\s│]+", " ", capsys.readouterr().err)  # unwrap the rich box
+        if code != 2 or "empty path" not in err or name not in err:
+            wrong.append((argv, code, err[-300:]))
+    assert not wrong, wrong
+    assert not list(tmp_path.iterdir())  # nothing was written
+
+
 def test_one_name_per_concept():
     # a frame rate is --fps everywhere (--frame-rate only as the old second name of it)
     rates = [
