@@ -216,6 +216,7 @@ def _robust_reference(
     smooth_deg: float = 2.0,
     start: np.ndarray | None = None,
     one_sided: bool = True,
+    symmetric: bool = False,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, float, int]:
     """Fit X b ~ d on the unworn points (found iteratively unless given).
 
@@ -223,6 +224,15 @@ def _robust_reference(
     the median, and it is not within ``margin_deg`` of a worn region (where the residual
     smoothed over ``smooth_deg`` exceeds ``threshold`` robust deviations of the smoothed
     residual) -- so the faint tails of a worn patch do not bias the reference.
+
+    ``one_sided``: wear only removes material, so only a high residual is taken as wear (low
+    ones down to twice the threshold are kept); without ``unworn`` and for a limaçon basis the
+    first unworn set comes from a lower-quantile fit, which a broad groove hardly pulls.
+    ``symmetric`` (for the difference to a before-scan, whose unworn points hold noise only; the
+    lower-quantile start is kept): points and smoothed regions are rejected symmetrically about
+    the noise centre. A one-sided cut drops only the high tail of the noise, so the points kept
+    read low on average and every depth, hence the volume, reads high (0.0044 sigma per point
+    at 3 sigma, plus the high smoothed windows).
     """
     finite = np.isfinite(d)
     mask = finite.copy() if unworn is None else (finite & unworn)
@@ -256,7 +266,7 @@ def _robust_reference(
         med = np.median(rm)
         # floor: 10 pm, far below any instrument's resolution (noise-free synthetic data)
         scale = max(1.4826 * np.median(np.abs(rm - med)), _SCALE_FLOOR)
-        if one_sided:  # wear removes material: only a high residual can be wear
+        if one_sided and not symmetric:  # only a high residual can be wear
             new = finite & (resid - med <= threshold * scale)
             new &= resid - med >= -2.0 * threshold * scale  # dents and spikes
         else:
@@ -266,7 +276,7 @@ def _robust_reference(
             smm = sm.ravel()[mask]
             smed = np.nanmedian(smm)
             sscale = max(1.4826 * np.nanmedian(np.abs(smm - smed)), _SCALE_FLOOR)
-            high = (sm - smed) if one_sided else np.abs(sm - smed)
+            high = (sm - smed) if one_sided and not symmetric else np.abs(sm - smed)
             region = ~(high > threshold * sscale)
             region = _dilate(region, theta_deg, margin_deg)
             new &= region.ravel()
@@ -515,7 +525,8 @@ def wear_map(
                     "wear_map",
                     rw.shape,
                     th,
-                    margin_deg,
+                    margin_deg,                    margin_deg,
+                    symmetric=True,
                 )
                 done = abs(new_off - offset) < 1e-3
                 offset = new_off
@@ -545,7 +556,7 @@ def wear_map(
             "scan (no before-wear scan)"
         )
     X, fit, alt = _reference(
-        d, X, shape, z, th, harmonics, threshold, mask_in, max_iter, margin_deg
+        d, X, shape, z, th, harmonics, threshold, mask_in, max_iter, margin_deg, rbz is not None
     )
     resid, mask, var_fit, s2, n_iter = fit
     # exact centring: the limaçon leaves each scan's e^2/(4R) second harmonic, which differs
@@ -560,21 +571,36 @@ def wear_map(
             "form model: its second harmonic, quadratic in z, holds the limaçon's e^2/(4R) term"
         )
     elif r0_w is not None and not isinstance(X, FormBasis):
-        rw_c = _recentre(rw + r0_w, z, th, mask)
         if rbz is not None:
             r0_b = 0.0 if bname == "radius" else (radius or _attr_radius(before, b) or r0_w)
-            rb_c = _recentre(_rotate(th, thb, rbz, offset) + r0_b, z, th, np.isfinite(d))
-            d = sign * (rw_c - rb_c).ravel()
+            rb_abs = _rotate(th, thb, rbz, offset) + r0_b
+            ok = np.isfinite(d)
+            # the before scan's axis from the whole circle (its form is orthogonal to the
+            # limaçon); the worn scan's = that plus the change of set-up fitted to the difference
+            # on the unworn points, where the form cancels. Fitted to the worn scan's unworn arc
+            # alone, the form shifts the axis by delta, and the second-order term e delta / R
+            # (a constant and a second harmonic) biases the map by 0.1-0.6 nm
+            axis_b = _axis(rb_abs, z, th, ok)
+            rb_c = _recentre(rb_abs, z, th, axis_b)
+            axis_w = axis_b + _axis(rw + r0_w - rb_abs, z, th, mask & ok)
+            for _ in range(2):  # the set-ups' e^2/(4R) terms, not orthogonal on an arc: iterate
+                diff = _recentre(rw + r0_w, z, th, axis_w) - rb_c
+                axis_w = axis_w + _axis(diff, z, th, mask & ok)
+            d = sign * (_recentre(rw + r0_w, z, th, axis_w) - rb_c).ravel()
         else:
+            rw_c = _recentre(rw + r0_w, z, th, _axis(rw + r0_w, z, th, mask))
             d = sign * (rw_c - r0_w).ravel()
         X, fit, alt = _reference(
-            d, X, shape, z, th, harmonics, threshold, mask_in, max_iter, margin_deg
+            d, X, shape, z, th, harmonics, threshold, mask_in, max_iter, margin_deg, rbz is not None
         )
         resid, mask, var_fit, s2, n_iter = fit
         centring = (
-            "exact: each scan re-centred on its own least-squares axis (unworn points), then the "
-            "limaçon reference fitted to the unworn points"
-        )
+            "exact: the before scan re-centred on its least-squares axis (all points), the "
+            "worn scan on that axis plus the change of set-up (difference on the unworn "
+            "points)"
+            if rbz is not None
+            else "exact: the scan re-centred on its least-squares axis (unworn points)"
+        ) + ", then the limaçon reference fitted to the unworn points"
     wear = resid.reshape(rw.shape)
     u = np.sqrt(s2 + var_fit).reshape(rw.shape)
     mask2 = mask.reshape(rw.shape)
@@ -694,13 +720,15 @@ def wear_map(
     return out
 
 
-def _recentre(
-    r_abs: np.ndarray, z: np.ndarray, theta_deg: np.ndarray, mask: np.ndarray
-) -> np.ndarray:
-    """Exact distance of each point from the scan's own LS axis (fitted on ``mask``) [m]."""
+def _axis(r_abs: np.ndarray, z: np.ndarray, theta_deg: np.ndarray, mask: np.ndarray):
+    """Least-squares limaçon cylinder of ``r_abs`` on ``mask``: coefficients (5,) [m]."""
     X = _basis(z, theta_deg, "cylinder")
     m = np.asarray(mask, dtype=bool).ravel() & np.isfinite(r_abs.ravel())
-    b = np.linalg.lstsq(X[m], r_abs.ravel()[m], rcond=None)[0]
+    return np.linalg.lstsq(X[m], r_abs.ravel()[m], rcond=None)[0]
+
+
+def _recentre(r_abs: np.ndarray, z: np.ndarray, theta_deg: np.ndarray, b: np.ndarray):
+    """Exact distance of each point from the axis ``b`` (see :func:`_axis`) [m]."""
     zc = z - 0.5 * (z.min() + z.max())
     zz = zc / max(np.ptp(zc), 1e-12)
     xc = (b[1] + b[3] * zz)[:, None]
@@ -859,8 +887,14 @@ def _scalars(q: dict, cyl_before, cyl_after, note: str, noise: float) -> dict:
     return out
 
 
-def _reference(d, X, shape, z, th, harmonics, threshold, mask_in, max_iter, margin_deg):
+def _reference(
+    d, X, shape, z, th, harmonics, threshold, mask_in, max_iter, margin_deg, difference=False
+):
     """(basis used, robust fit, fit at the neighbouring lobing order or None).
+
+    ``difference``: ``d`` is the difference to a before-scan, whose unworn points hold noise
+    only: the iteration rejects them symmetrically about the noise centre (an unbiased volume;
+    see :func:`_robust_reference`).
 
     For the form model the lobing order starts at 2 (which also holds the limaçon's
     e^2/(4R) second harmonic) and grows one harmonic at a time, up to ``harmonics``, while the
@@ -872,7 +906,7 @@ def _reference(d, X, shape, z, th, harmonics, threshold, mask_in, max_iter, marg
     shape2d = (z.size, th.size)
     args = (threshold, mask_in, max_iter, "wear_map", shape2d, th, margin_deg)
     if not isinstance(X, FormBasis):
-        return X, _robust_reference(d, X, *args), None
+        return X, _robust_reference(d, X, *args, symmetric=difference), None
     k = min(2, X.harmonics)
     basis = FormBasis(z, th, k, X.deg)
     fit = _robust_reference(d, basis, *args, one_sided=True)
