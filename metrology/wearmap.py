@@ -291,6 +291,63 @@ def _robust_reference(
     return resid, mask, var_fit, s2, n_iter
 
 
+def _exclude_tails(
+    d: np.ndarray,
+    X,
+    mask: np.ndarray,
+    shape: tuple[int, int],
+    theta_deg: np.ndarray,
+    z_crit: float,
+    step_deg: float = 2.0,
+    min_fraction: float = 0.25,
+) -> tuple[np.ndarray, str]:
+    """Drop from the unworn set the bands next to the worn region that hold wear (a test).
+
+    The faint tails of a worn region (wear below the point-wise threshold) sit among the points
+    taken as unworn and pull the reference up (a limaçon fitted on an arc extrapolates that
+    pull to the worn side: 1-2 % of a wide groove's volume). The noise of the unworn points is
+    centred on the reference (symmetric rejection), so the mean residual of a band of unworn
+    points next to the worn region is an unbiased estimate of the wear there, with standard
+    error s sqrt(tau / n) (s the residual RMS, tau its correlation length, n the band's
+    points). Band after band (``step_deg`` wide, on every layer), a band whose mean exceeds
+    ``z_crit`` standard errors holds wear: it leaves the unworn set and the reference is
+    refitted; the first band consistent with no wear ends the growth (or keeping at least
+    ``min_fraction`` of the points). What stays below the test is covered by the "unworn
+    selection" term of the uncertainty (the change when a further 10 degree is left out).
+    Returns (mask, description).
+    """
+    nz, nt = shape
+    win = max(1, int(round(step_deg * nt / 360.0)))
+    # the worn region: most of a step-wide window not unworn (not each isolated noise outlier)
+    region = _smooth_theta((~mask).reshape(shape).astype(float), win) > 0.5
+    if not region.any() or region.all():
+        return mask, "none found (no worn region)"
+    n_bands, note = 0, ""
+    while True:
+        grown = ~_dilate(~region, theta_deg, step_deg)
+        band = (grown & ~region).ravel() & mask
+        new = mask & ~band
+        n = int(band.sum())
+        if n == 0 or new.sum() < min_fraction * mask.size:
+            break
+        # the band's residual from the reference fitted without it (its own wear cannot pull
+        # the reference it is tested against)
+        _, fitted, G = _lsq(X, d, new)
+        r = d - fitted
+        s2 = max(float(np.mean(r[new] ** 2)), _SCALE_FLOOR**2)
+        tau = correlation_length(r.reshape(shape), new.reshape(shape))
+        var_pred = float(np.mean(_fit_variance(X, G, s2)[band]))  # >= var of the band's mean
+        tbar, se = float(np.mean(r[band])), float(np.sqrt(s2 * tau / n + var_pred))
+        note = f"last band tested: mean {tbar * 1e9:.3g} nm, standard error {se * 1e9:.2g} nm"
+        if tbar <= z_crit * se:
+            break
+        mask, region, n_bands = new, grown, n_bands + 1
+    return mask, (
+        f"{n_bands} band(s) of {step_deg:g} degree next to the worn region held wear above "
+        f"{z_crit:g} standard errors and were left out of the unworn set ({note})"
+    )
+
+
 def _dilate(unworn: np.ndarray, theta_deg: np.ndarray, margin_deg: float) -> np.ndarray:
     """Shrink the unworn mask: drop points within ``margin_deg`` (in theta) of a worn point."""
     if margin_deg <= 0:
@@ -601,6 +658,12 @@ def wear_map(
             if rbz is not None
             else "exact: the scan re-centred on its least-squares axis (unworn points)"
         ) + ", then the limaçon reference fitted to the unworn points"
+    tails = "not assessed (explicit unworn mask)" if mask_in is not None else "none found"
+    if mask_in is None and not isinstance(X, FormBasis):
+        mask, tails = _exclude_tails(d, X, mask, rw.shape, th, 2.0, 5.0)
+        resid, mask, var_fit, s2, _ = _robust_reference(
+            d, X, threshold, mask, 1, "wear_map", rw.shape, th, margin_deg
+        )
     wear = resid.reshape(rw.shape)
     u = np.sqrt(s2 + var_fit).reshape(rw.shape)
     mask2 = mask.reshape(rw.shape)
@@ -622,8 +685,11 @@ def wear_map(
         u = np.hypot(u, wear - other)  # each depth's dependence on the model order
     if rbz is not None and mask_in is None and not mask2.all():
         # faint wear tails next to the worn region bias the reference: refit without the
-        # points within a further 10 degree of it and count the change
-        narrower = _dilate(mask2, th, 10.0).ravel()
+        # points within a further 10 degree of it and count the change. The worn region: where
+        # most of a 2-degree window is not unworn (not every isolated noise outlier)
+        win = max(1, int(round(2.0 * th.size / 360.0)))
+        region = _smooth_theta((~mask2).astype(float), win) <= 0.5
+        narrower = (mask2 & _dilate(region, th, 10.0)).ravel()
         if narrower.sum() > 0.1 * narrower.size:
             try:
                 sel, *_ = _robust_reference(
@@ -711,6 +777,7 @@ def wear_map(
             "surface": surface,
             "registered": bool(register),
             "centring": centring,
+            "faint_wear_tails": tails,
         },
     )
     origins = {str(getattr(o, "attrs", {}).get("data_origin", "")) for o in (worn, before)}
