@@ -984,8 +984,13 @@ def _reference(
         k += 1
         basis = FormBasis(z, th, k, X.deg)
         fit = _robust_reference(d, basis, *args, start=fit[1], one_sided=True)
+    # the worn region found one-sidedly, the noise is then rejected symmetrically about its
+    # centre (a one-sided cut keeps the low tail only: every depth, hence the volume, high)
+    one_sided_mask = fit[1]
+    fit = _robust_reference(d, basis, *args, start=one_sided_mask, symmetric=True)
     k_alt = k + 1 if k < max(X.harmonics, 3) else k - 1
-    alt = _robust_reference(d, FormBasis(z, th, k_alt, X.deg), *args, start=fit[1], one_sided=True)
+    alt_basis = FormBasis(z, th, k_alt, X.deg)
+    alt = _robust_reference(d, alt_basis, *args, start=one_sided_mask, symmetric=True)
     return basis, fit, alt
 
 
