@@ -582,7 +582,7 @@ def wear_map(
                     "wear_map",
                     rw.shape,
                     th,
-                    margin_deg,                    margin_deg,
+                    margin_deg,
                     symmetric=True,
                 )
                 done = abs(new_off - offset) < 1e-3
@@ -658,8 +658,13 @@ def wear_map(
             if rbz is not None
             else "exact: the scan re-centred on its least-squares axis (unworn points)"
         ) + ", then the limaçon reference fitted to the unworn points"
-    tails = "not assessed (explicit unworn mask)" if mask_in is not None else "none found"
-    if mask_in is None and not isinstance(X, FormBasis):
+    tails = (
+        "not assessed (explicit unworn mask)"
+        if mask_in is not None
+        else "not tested (no before-scan: the unworn form is modelled; a margin of "
+        f"{margin_deg:g} degree around the worn region is left out instead)"
+    )
+    if mask_in is None and rbz is not None:
         mask, tails = _exclude_tails(d, X, mask, rw.shape, th, 2.0, 5.0)
         resid, mask, var_fit, s2, _ = _robust_reference(
             d, X, threshold, mask, 1, "wear_map", rw.shape, th, margin_deg
