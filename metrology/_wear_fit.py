@@ -157,6 +157,7 @@ def _robust_reference(
     start: np.ndarray | None = None,
     one_sided: bool = True,
     symmetric: bool = False,
+    symmetric_regions: bool | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, float, int]:
     """Fit X b ~ d on the unworn points (found iteratively unless given).
 
@@ -172,7 +173,9 @@ def _robust_reference(
     lower-quantile start is kept): points and smoothed regions are rejected symmetrically about
     the noise centre. A one-sided cut drops only the high tail of the noise, so the points kept
     read low on average and every depth, hence the volume, reads high (0.0044 sigma per point
-    at 3 sigma, plus the high smoothed windows).
+    at 3 sigma, plus the high smoothed windows). ``symmetric_regions`` False: the margin is
+    kept around high windows only (a low window of a modelled form is no evidence of wear; a
+    margin around it could empty a layer).
     """
     finite = np.isfinite(d)
     mask = finite.copy() if unworn is None else (finite & unworn)
@@ -216,9 +219,15 @@ def _robust_reference(
             smm = sm.ravel()[mask]
             smed = np.nanmedian(smm)
             sscale = max(1.4826 * np.nanmedian(np.abs(smm - smed)), _SCALE_FLOOR)
-            high = (sm - smed) if one_sided and not symmetric else np.abs(sm - smed)
-            region = ~(high > threshold * sscale)
-            region = _dilate(region, theta_deg, margin_deg)
+            dev = sm - smed
+            both = symmetric if symmetric_regions is None else symmetric_regions
+            if one_sided and not symmetric:
+                region = _dilate(~(dev > threshold * sscale), theta_deg, margin_deg)
+            elif both:
+                region = _dilate(~(np.abs(dev) > threshold * sscale), theta_deg, margin_deg)
+            else:  # low windows dropped too (unbiased), without a margin (no wear beside them)
+                region = _dilate(~(dev > threshold * sscale), theta_deg, margin_deg)
+                region &= ~(dev < -threshold * sscale)
             new &= region.ravel()
         changed = int(np.count_nonzero(new != mask))
         mask = new
@@ -321,8 +330,11 @@ def _reference(
     # the worn region found one-sidedly, the noise is then rejected symmetrically about its
     # centre (a one-sided cut keeps the low tail only: every depth, hence the volume, high)
     one_sided_mask = fit[1]
-    fit = _robust_reference(d, basis, *args, start=one_sided_mask, symmetric=True)
+    # (point by point: a low smoothed region of a modelled form is no evidence of wear, and
+    # leaving it out with its margin could empty a layer)
+    polish = {"start": one_sided_mask, "symmetric": True, "symmetric_regions": False}
+    fit = _robust_reference(d, basis, *args, **polish)
     k_alt = k + 1 if k < max(X.harmonics, 3) else k - 1
     alt_basis = FormBasis(z, th, k_alt, X.deg)
-    alt = _robust_reference(d, alt_basis, *args, start=one_sided_mask, symmetric=True)
+    alt = _robust_reference(d, alt_basis, *args, **polish)
     return basis, fit, alt
