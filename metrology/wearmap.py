@@ -9,16 +9,19 @@ Two ways to get the unworn reference
   re-mounted: a different eccentricity and tilt, and for deviation data an unknown radius
   offset), so a limaçon cylinder c + (x0 + tx z) cos(theta) + (y0 + ty z) sin(theta) is fitted to
   d on the *unworn* points and removed. The bore's own form errors cancel in d.
-* **Without one**: a reference cylinder (or one circle per layer, ``shape="circle"``) is fitted
-  by least squares to the unworn part of the worn scan itself; the original form errors of the
-  bore then stay in the map and are counted in its uncertainty.
+  Each scan is re-centred exactly on its axis first (:mod:`._wear_setup`), and the faint wear
+  tails next to the worn region are tested band by band (:func:`._wear_fit._exclude_tails`).
+* **Without one**: the form model of :mod:`~jointwear.metrology.baseline` (or a cylinder, or one
+  circle per layer, ``shape="circle"``) is fitted by least squares to the unworn part of the
+  worn scan itself; what the model does not hold is counted in the uncertainty.
 
 How the unworn part is chosen: unless given explicitly (``unworn``), it is found iteratively.
 Start with all points; fit the reference; estimate the scatter of the residuals of the current
 unworn set robustly (1.4826 x median absolute deviation); call unworn the points whose residual
 lies within ``threshold`` times that scatter of the median; refit; repeat until the set no longer
 changes. Worn points (material removed) sit far on one side and drop out after one or two
-rounds. This assumes that a part of the bore is unworn (true for a journal bearing loaded on one
+rounds; once the worn region is found, the noise is rejected symmetrically about its centre (a
+one-sided cut keeps the low tail of the noise only, and every depth reads high). This assumes that a part of the bore is unworn (true for a journal bearing loaded on one
 side); if wear covers the whole circumference, pass a before-scan.
 
 Uncertainty: ``wear_depth_u`` [m] combines in quadrature the RMS residual of the unworn points
