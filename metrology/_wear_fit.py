@@ -274,22 +274,31 @@ def _exclude_tails(
     n_bands, note = 0, ""
     while True:
         grown = ~_dilate(~region, theta_deg, step_deg)
-        band = (grown & ~region).ravel() & mask
-        new = mask & ~band
-        n = int(band.sum())
-        if n == 0 or new.sum() < min_fraction * mask.size:
+        new = mask & ~(grown & ~region).ravel()
+        if new.sum() == mask.sum():
             break
-        # the band's residual from the reference fitted without it (its own wear cannot pull
-        # the reference it is tested against)
-        _, fitted, G = _lsq(X, d, new)
-        r = d - fitted
-        s2 = max(float(np.mean(r[new] ** 2)), _SCALE_FLOOR**2)
-        tau = correlation_length(r.reshape(shape), new.reshape(shape))
-        var_pred = float(np.mean(_fit_variance(X, G, s2)[band]))  # >= var of the band's mean
-        tbar, se = float(np.mean(r[band])), float(np.sqrt(s2 * tau / n + var_pred))
-        note = f"last band tested: mean {tbar * 1e9:.3g} nm, standard error {se * 1e9:.2g} nm"
-        if tbar <= z_crit * se:
+        # zones of 1, 2, 4 and 8 bands: a long faint tail shows in a wide zone's mean
+        found = False
+        for k in (1, 2, 4, 8):
+            zone = ~_dilate(~region, theta_deg, k * step_deg)
+            zone = (zone & ~region).ravel() & mask
+            if mask.sum() - zone.sum() < 0.4 * min_fraction * mask.size:
+                break  # too few points left to test against
+            tbar, se = _deleted_mean(d, X, mask & ~zone, zone, shape)
+            note = f"last zone tested: mean {tbar * 1e9:.3g} nm, standard error {se * 1e9:.2g} nm"
+            if tbar > max(z_crit * se, _SCALE_FLOOR):  # (noise-free data: 10 pm)
+                found = True
+                break
+        if not found:
             break
+        if new.sum() < min_fraction * mask.size:
+            raise BadInputError(
+                f"wear_map: the wear's faint tails reach around the bore (the unworn points "
+                f"next to the worn region still hold {tbar * 1e9:.2g} ± {se * 1e9:.2g} nm of "
+                f"wear with only {new.mean():.0%} of the points left): the reference fitted on "
+                "what is left would absorb them and the volume would read low; pass an explicit "
+                "unworn mask (unworn=...) of points known to be unworn"
+            )
         mask, region, n_bands = new, grown, n_bands + 1
     return mask, (
         f"{n_bands} band(s) of {step_deg:g} degree next to the worn region held wear above "
@@ -297,10 +306,30 @@ def _exclude_tails(
     )
 
 
+def _deleted_mean(d, X, fit_mask, zone, shape) -> tuple[float, float]:
+    """Mean residual [m] of the points ``zone`` from the reference fitted on ``fit_mask``
+    (without them: their own wear cannot pull the reference they are tested against), and
+    its standard error: s sqrt(tau / n) and the reference's prediction error."""
+    _, fitted, G = _lsq(X, d, fit_mask)
+    r = d - fitted
+    s2 = max(float(np.mean(r[fit_mask] ** 2)), _SCALE_FLOOR**2)
+    tau = correlation_length(r.reshape(shape), fit_mask.reshape(shape))
+    n = int(zone.sum())
+    a = _design_sum(X, zone.reshape(shape) / n)  # the zone's mean design row
+    cov = np.linalg.inv(G) * s2
+    if cov.ndim == 3:  # one block per layer (circle per layer)
+        from scipy.linalg import block_diag
+
+        cov = block_diag(*cov)
+    var_pred = max(float(a @ cov @ a), 0.0)
+    return float(np.mean(r[zone])), float(np.sqrt(s2 * tau / n + var_pred))
+
+
 def _reference(
     d, X, shape, z, th, harmonics, threshold, mask_in, max_iter, margin_deg, difference=False
 ):
-    """(basis used, robust fit, fit at the neighbouring lobing order or None).
+    """(basis used, robust fit, fit at the neighbouring lobing order or None, the one-sided
+    (fit, neighbouring fit) of the form model or None).
 
     ``difference``: ``d`` is the difference to a before-scan, whose unworn points hold noise
     only: the iteration rejects them symmetrically about the noise centre (an unbiased volume;
@@ -316,7 +345,7 @@ def _reference(
     shape2d = (z.size, th.size)
     args = (threshold, mask_in, max_iter, "wear_map", shape2d, th, margin_deg)
     if not isinstance(X, FormBasis):
-        return X, _robust_reference(d, X, *args, symmetric=difference), None
+        return X, _robust_reference(d, X, *args, symmetric=difference), None, None
     k = min(2, X.harmonics)
     basis = FormBasis(z, th, k, X.deg)
     fit = _robust_reference(d, basis, *args, one_sided=True)
@@ -333,8 +362,10 @@ def _reference(
     # (point by point: a low smoothed region of a modelled form is no evidence of wear, and
     # leaving it out with its margin could empty a layer)
     polish = {"start": one_sided_mask, "symmetric": True, "symmetric_regions": False}
-    fit = _robust_reference(d, basis, *args, **polish)
+    # the one-sided fits are kept: wear_map refuses where either cannot separate wear from form
     k_alt = k + 1 if k < max(X.harmonics, 3) else k - 1
     alt_basis = FormBasis(z, th, k_alt, X.deg)
+    first = (fit, _robust_reference(d, alt_basis, *args, start=one_sided_mask, one_sided=True))
+    fit = _robust_reference(d, basis, *args, **polish)
     alt = _robust_reference(d, alt_basis, *args, **polish)
-    return basis, fit, alt
+    return basis, fit, alt, first

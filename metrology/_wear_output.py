@@ -145,24 +145,34 @@ def _model_order_term(q: dict, other: np.ndarray, wts: np.ndarray, z, th, what: 
 def selection_term(q, u, wear, d, X, mask2, wts, z, th, threshold, margin_deg) -> np.ndarray:
     """Add the dependence on the unworn selection to ``q`` and return the widened per-point u.
 
-    Faint wear tails next to the worn region bias the reference: refit without the points
-    within a further 10 degree of it and count the change. The worn region: where most of a
-    2-degree window is not unworn (not every isolated noise outlier).
+    Faint wear tails next to the worn region, too faint for the band test, bias the reference:
+    refit without the points within a further 10, 20 and 30 degree of it and count the largest
+    change of the volume (each a defensible selection; while at least 10 % of the points stay).
+    The worn region: where most of a 2-degree window is not unworn (not every isolated noise
+    outlier).
     """
     win = max(1, int(round(2.0 * th.size / 360.0)))
     region = _smooth_theta((~mask2).astype(float), win) <= 0.5
-    narrower = (mask2 & _dilate(region, th, 10.0)).ravel()
-    if narrower.sum() <= 0.1 * narrower.size:
+    vol = float(np.sum(wts * np.nan_to_num(wear)))
+    best, change = None, -1.0
+    for width in (10.0, 20.0, 30.0):
+        narrower = (mask2 & _dilate(region, th, width)).ravel()
+        if narrower.sum() <= 0.1 * narrower.size:
+            break
+        try:
+            sel, *_ = _robust_reference(
+                d, X, threshold, narrower, 1, "wear_map", mask2.shape, th, margin_deg
+            )
+        except BadInputError:
+            break
+        other = sel.reshape(mask2.shape)
+        dv = abs(float(np.sum(wts * np.nan_to_num(other))) - vol)
+        if dv > change:
+            best, change = other, dv
+    if best is None:
         return u
-    try:
-        sel, *_ = _robust_reference(
-            d, X, threshold, narrower, 1, "wear_map", mask2.shape, th, margin_deg
-        )
-    except BadInputError:
-        return u
-    other = sel.reshape(mask2.shape)
-    _model_order_term(q, other, wts, z, th, "unworn selection")
-    return np.hypot(u, wear - other)
+    _model_order_term(q, best, wts, z, th, "unworn selection")
+    return np.hypot(u, wear - best)
 
 
 def refuse_inseparable_difference(s2: float, noise: float, tau: float) -> None:

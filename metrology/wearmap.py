@@ -223,7 +223,7 @@ def wear_map(
         raise BadInputError("wear_map: register=True needs a before scan")
     else:
         d = sign * rw.ravel()
-    X, fit, alt = _reference(d, X, shape, z, th, harmonics, *fit_args, rbz is not None)
+    X, fit, alt, first = _reference(d, X, shape, z, th, harmonics, *fit_args, rbz is not None)
     resid, mask, var_fit, s2, n_iter = fit
     # exact centring: the limaçon leaves each scan's e^2/(4R) second harmonic, which differs
     # between set-ups; with the bore radius known, re-centre each scan exactly on its axis
@@ -237,7 +237,7 @@ def wear_map(
         else:
             rw_c = _recentre(rw + r0_w, z, th, _axis(rw + r0_w, z, th, mask))
             d = sign * (rw_c - r0_w).ravel()
-        X, fit, alt = _reference(d, X, shape, z, th, harmonics, *fit_args, rbz is not None)
+        X, fit, alt, _ = _reference(d, X, shape, z, th, harmonics, *fit_args, rbz is not None)
         resid, mask, var_fit, s2, n_iter = fit
     tails = _tails_note(mask_in is not None, margin_deg)
     if mask_in is None and rbz is not None:
@@ -251,8 +251,10 @@ def wear_map(
     if rbz is not None:
         refuse_inseparable_difference(s2, noise, tau)
     else:
-        lobing = _lobing_rms((d - resid).reshape(rw.shape)) if isinstance(X, FormBasis) else 0.0
-        _separable(q, s2, noise, mask2, threshold, lobing)
+        _refuse_inseparable(q, d, X, fit, noise, threshold, rw.shape)
+        if first is not None:  # the one-sided search of the worn region must pass as well
+            q1 = _quantities(d, X, first[0], first[1], z, th, radius, False, fit_args)[0]
+            _refuse_inseparable(q1, d, X, first[0], noise, threshold, rw.shape)
     cyl_after, cyl_before, cyl_before_note = _cylindricities(
         rw, rbz, z, th, thb if rbz is not None else th, mask2
     )
@@ -284,6 +286,13 @@ def _origin(worn, before) -> dict:
     if not origins:
         return {}
     return {"data_origin": "synthetic" if "synthetic" in origins else sorted(origins)[0]}
+
+
+def _refuse_inseparable(q, d, X, fit, noise, threshold, shape) -> None:
+    """Refuse a map without a before-scan where wear cannot be told from form."""
+    resid, mask, _, s2, _ = fit
+    lobing = _lobing_rms((d - resid).reshape(shape)) if isinstance(X, FormBasis) else 0.0
+    _separable(q, s2, noise, mask.reshape(shape), threshold, lobing)
 
 
 def _options(shape, before, margin_deg, surface, threshold) -> tuple[str, float]:
