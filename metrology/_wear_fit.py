@@ -258,10 +258,11 @@ def _exclude_tails(
     centred on the reference (symmetric rejection), so the mean residual of a band of unworn
     points next to the worn region is an unbiased estimate of the wear there, with standard
     error s sqrt(tau / n) (s the residual RMS, tau its correlation length, n the band's
-    points). Band after band (``step_deg`` wide, on every layer), a band whose mean exceeds
-    ``z_crit`` standard errors holds wear: it leaves the unworn set and the reference is
-    refitted; the first band consistent with no wear ends the growth (or keeping at least
-    ``min_fraction`` of the points). What stays below the test is covered by the "unworn
+    points). While a zone of 1, 2, 4 or 8 bands (``step_deg`` wide, on every layer) next to the
+    worn region has a mean above ``z_crit`` standard errors, the next band leaves the unworn
+    set and the reference is refitted. Where that would leave fewer than ``min_fraction`` of
+    the points and the zone's mean exceeds 1.5 ``z_crit`` standard errors, the tails reach
+    around the bore: refused (a BadInputError naming the explicit unworn mask). What stays below the test is covered by the "unworn
     selection" term of the uncertainty (the change when a further 10 degree is left out).
     Returns (mask, description).
     """
@@ -292,6 +293,8 @@ def _exclude_tails(
         if not found:
             break
         if new.sum() < min_fraction * mask.size:
+            if tbar <= 1.5 * z_crit * se:  # a refusal needs stronger evidence: stop here
+                break
             raise BadInputError(
                 f"wear_map: the wear's faint tails reach around the bore (the unworn points "
                 f"next to the worn region still hold {tbar * 1e9:.2g} ± {se * 1e9:.2g} nm of "
