@@ -9,16 +9,19 @@ Two ways to get the unworn reference
   re-mounted: a different eccentricity and tilt, and for deviation data an unknown radius
   offset), so a limaçon cylinder c + (x0 + tx z) cos(theta) + (y0 + ty z) sin(theta) is fitted to
   d on the *unworn* points and removed. The bore's own form errors cancel in d.
-* **Without one**: a reference cylinder (or one circle per layer, ``shape="circle"``) is fitted
-  by least squares to the unworn part of the worn scan itself; the original form errors of the
-  bore then stay in the map and are counted in its uncertainty.
+  Each scan is re-centred exactly on its axis first (:mod:`._wear_setup`), and the faint wear
+  tails next to the worn region are tested band by band (:func:`._wear_fit._exclude_tails`).
+* **Without one**: the form model of :mod:`~jointwear.metrology.baseline` (or a cylinder, or one
+  circle per layer, ``shape="circle"``) is fitted by least squares to the unworn part of the
+  worn scan itself; what the model does not hold is counted in the uncertainty.
 
 How the unworn part is chosen: unless given explicitly (``unworn``), it is found iteratively.
 Start with all points; fit the reference; estimate the scatter of the residuals of the current
 unworn set robustly (1.4826 x median absolute deviation); call unworn the points whose residual
 lies within ``threshold`` times that scatter of the median; refit; repeat until the set no longer
 changes. Worn points (material removed) sit far on one side and drop out after one or two
-rounds. This assumes that a part of the bore is unworn (true for a journal bearing loaded on one
+rounds; once the worn region is found, the noise is rejected symmetrically about its centre (a
+one-sided cut keeps the low tail of the noise only, and every depth reads high). This assumes that a part of the bore is unworn (true for a journal bearing loaded on one
 side); if wear covers the whole circumference, pass a before-scan.
 
 Uncertainty: ``wear_depth_u`` [m] combines in quadrature the RMS residual of the unworn points
@@ -35,22 +38,39 @@ from jointwear.conventions import (
     CANONICAL,
     angle_convention_of,
     convert_theta,
-    theta_coord,
-    z_coord,
 )
 from jointwear.errors import BadInputError
-from jointwear.metrology.baseline import (
-    FormBasis,
-    correlation_length,
-    noise_sigma,
-    select_harmonics,
+from jointwear.metrology._wear_fit import (
+    _basis,
+    _design_sum,
+    _exclude_tails,
+    _lsq,
+    _reference,
+    _robust_reference,
 )
-from jointwear.metrology.form import cylinder_zone
-from jointwear.metrology.wear_quantities import derived_quantities, uncertainty_attrs
+from jointwear.metrology._wear_output import (
+    _cylindricities,
+    _lobing_rms,
+    _model_order_term,
+    _scalars,
+    _separable,
+    refuse_inseparable_difference,
+    selection_term,
+    wear_dataset,
+)
+from jointwear.metrology._wear_setup import (
+    _axis,
+    _recentre,
+    _rotate,
+    before_on_layers,
+    exact_difference,
+    register_angle,
+    registered_offset,
+)
+from jointwear.metrology.baseline import FormBasis, correlation_length, noise_sigma
+from jointwear.metrology.wear_quantities import derived_quantities
 
 __all__ = ["wear_map", "worn_volume", "register_angle"]
-
-_SCALE_FLOOR = 1e-11  # [m]
 
 
 def _radius_var(ds: xr.Dataset | xr.DataArray, what: str) -> tuple[xr.DataArray, str]:
@@ -75,31 +95,6 @@ def _radius_var(ds: xr.Dataset | xr.DataArray, what: str) -> tuple[xr.DataArray,
     angle_convention_of(da, what=what)
     da = convert_theta(da, CANONICAL).transpose("z", "theta")
     return da, name
-
-
-def _periodic_interp(theta_new: np.ndarray, theta: np.ndarray, values: np.ndarray) -> np.ndarray:
-    """Linear interpolation of each row of ``values`` (over ``theta`` [degree]) periodically."""
-    order = np.argsort(theta)
-    th = theta[order]
-    v = values[:, order]
-    th_ext = np.concatenate([th[-1:] - 360.0, th, th[:1] + 360.0])
-    v_ext = np.concatenate([v[:, -1:], v, v[:, :1]], axis=1)
-    tn = np.mod(theta_new, 360.0)
-    return np.stack([np.interp(tn, th_ext, row) for row in v_ext])
-
-
-def _rotate(theta_new: np.ndarray, theta: np.ndarray, values: np.ndarray, off: float) -> np.ndarray:
-    """Values of a scan rotated by ``off`` [degree] (feature at t moves to t + off), sampled at
-    ``theta_new``. Exact Fourier shift when both grids are the same uniform grid (keeps the noise
-    variance, so registration is not biased towards half-sample shifts), else periodic linear
-    interpolation."""
-    n = theta.size
-    uniform = n > 2 and np.allclose(np.diff(theta), 360.0 / n, atol=1e-9, rtol=0)
-    if uniform and theta_new.size == n and np.allclose(theta_new, theta, atol=1e-9, rtol=0):
-        k = np.arange(n // 2 + 1)
-        spec = np.fft.rfft(values, axis=1) * np.exp(-2j * np.pi * k * off / 360.0)[None, :]
-        return np.fft.irfft(spec, n, axis=1)
-    return _periodic_interp(theta_new, np.mod(theta + off, 360.0), values)
 
 
 def _theta_weights(theta: np.ndarray) -> np.ndarray:
@@ -131,239 +126,6 @@ def worn_volume(
     h = np.nan_to_num(np.asarray(wear_depth, dtype=float))
     w = _z_weights(np.asarray(z, dtype=float))[:, None] * _theta_weights(theta_deg)[None, :]
     return float(radius * np.sum(w * h))
-
-
-def _basis(z: np.ndarray, theta_deg: np.ndarray, shape: str):
-    nz, nt = z.size, theta_deg.size
-    t = np.radians(theta_deg)
-    c = np.broadcast_to(np.cos(t)[None, :], (nz, nt)).ravel()
-    s = np.broadcast_to(np.sin(t)[None, :], (nz, nt)).ravel()
-    if shape == "cylinder":
-        zc = z - 0.5 * (z.min() + z.max())
-        span = max(np.ptp(zc), 1e-12)
-        zz = np.broadcast_to((zc / span)[:, None], (nz, nt)).ravel()
-        return np.column_stack([np.ones(nz * nt), c, s, zz * c, zz * s])
-    return _LayerBasis(nz, np.stack([np.ones(nt), np.cos(t), np.sin(t)]))
-
-
-class _LayerBasis:
-    """One circle (1, cos, sin) per layer: a block-diagonal basis kept as its shared block."""
-
-    def __init__(self, nz: int, block: np.ndarray):
-        self.nz = nz
-        self.block = block  # (3, nt)
-        self.shape = (nz * block.shape[1], 3 * nz)
-
-
-def _lsq(X, d: np.ndarray, mask: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Least squares of d on the masked rows: (coefficients, fitted values, normal matrix)."""
-    if isinstance(X, FormBasis):
-        return X.lsq(d, mask)
-    if isinstance(X, _LayerBasis):
-        B = X.block
-        m = mask.reshape(X.nz, -1).astype(float)
-        dd = np.where(mask, d, 0.0).reshape(X.nz, -1)
-        G = np.einsum("ln,jn,kn->ljk", m, B, B)
-        rhs = np.einsum("ln,jn->lj", dd * m, B)
-        b = np.linalg.solve(G, rhs[..., None])[..., 0]
-        return b, np.einsum("lj,jn->ln", b, B).ravel(), G
-    Xw = X * mask[:, None]  # weights instead of fancy indexing: no copies of rows
-    G = np.einsum("nj,nk->jk", Xw, X)
-    b = np.linalg.solve(G, np.einsum("nj,n->j", Xw, np.where(mask, d, 0.0)))
-    return b, np.einsum("nj,j->n", X, b), G
-
-
-def _fit_variance(X, G: np.ndarray, s2: float) -> np.ndarray:
-    """Variance of the fitted reference at every point [m^2]."""
-    cov = np.linalg.inv(G) * s2
-    if isinstance(X, FormBasis):
-        return X.fit_variance(cov)
-    if isinstance(X, _LayerBasis):
-        return np.einsum("jn,ljk,kn->ln", X.block, cov, X.block).ravel()
-    return np.einsum("nj,jk,nk->n", X, cov, X)
-
-
-def _smooth_theta(v: np.ndarray, win: int) -> np.ndarray:
-    """Periodic moving average of each row over ``win`` samples (NaN ignored)."""
-    if win <= 1:
-        return v
-    ok = np.isfinite(v)
-    x = np.where(ok, v, 0.0)
-    h = win // 2
-    n = v.shape[1]
-    h = min(h, n - 1)
-    ext = np.concatenate([x[:, n - h :], x, x[:, :h]], axis=1) if h else x
-    cnt = np.concatenate([ok[:, n - h :], ok, ok[:, :h]], axis=1) if h else ok
-    cs = np.concatenate([np.zeros((v.shape[0], 1)), np.cumsum(ext, axis=1)], axis=1)
-    cc = np.concatenate([np.zeros((v.shape[0], 1)), np.cumsum(cnt, axis=1)], axis=1)
-    w = 2 * h + 1
-    num = cs[:, w:] - cs[:, :-w]
-    den = cc[:, w:] - cc[:, :-w]
-    with np.errstate(invalid="ignore", divide="ignore"):
-        return np.where(den > 0, num / np.maximum(den, 1), np.nan)
-
-
-def _robust_reference(
-    d: np.ndarray,
-    X: np.ndarray,
-    threshold: float,
-    unworn: np.ndarray | None,
-    max_iter: int,
-    what: str,
-    shape: tuple[int, int] | None = None,
-    theta_deg: np.ndarray | None = None,
-    margin_deg: float = 5.0,
-    smooth_deg: float = 2.0,
-    start: np.ndarray | None = None,
-    one_sided: bool = True,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, float, int]:
-    """Fit X b ~ d on the unworn points (found iteratively unless given).
-
-    A point is unworn when its residual is within ``threshold`` robust standard deviations of
-    the median, and it is not within ``margin_deg`` of a worn region (where the residual
-    smoothed over ``smooth_deg`` exceeds ``threshold`` robust deviations of the smoothed
-    residual) -- so the faint tails of a worn patch do not bias the reference.
-    """
-    finite = np.isfinite(d)
-    mask = finite.copy() if unworn is None else (finite & unworn)
-    if start is None and unworn is None and one_sided and not isinstance(X, FormBasis):
-        start = _lower_quantile_start(X, d, finite, threshold)
-    if start is not None and unworn is None:
-        mask = finite & start
-    n_iter = 0
-    win = 1
-    if shape is not None and theta_deg is not None:
-        win = max(1, int(round(smooth_deg * shape[1] / 360.0)))
-    for n_iter in range(1, max_iter + 1):  # noqa: B007
-        if mask.sum() < X.shape[1] + 2:
-            raise BadInputError(
-                f"{what}: only {int(mask.sum())} unworn points left to fit the reference; "
-                "pass a before-wear scan (before=..., CLI --before BEFORE.nc), a larger threshold, "
-                "or an explicit unworn mask"
-            )
-        try:
-            b, fitted, G = _lsq(X, d, mask)
-        except np.linalg.LinAlgError:
-            raise BadInputError(
-                f"{what}: the unworn points do not determine the reference (they cover too "
-                "little of the circumference), so wear cannot be separated from form; pass a "
-                "before-wear scan (before=..., CLI --before BEFORE.nc) or an explicit unworn mask"
-            ) from None
-        resid = d - fitted
-        if unworn is not None:
-            break
-        rm = resid[mask]
-        med = np.median(rm)
-        # floor: 10 pm, far below any instrument's resolution (noise-free synthetic data)
-        scale = max(1.4826 * np.median(np.abs(rm - med)), _SCALE_FLOOR)
-        if one_sided:  # wear removes material: only a high residual can be wear
-            new = finite & (resid - med <= threshold * scale)
-            new &= resid - med >= -2.0 * threshold * scale  # dents and spikes
-        else:
-            new = finite & (np.abs(resid - med) <= threshold * scale)
-        if shape is not None and theta_deg is not None:
-            sm = _smooth_theta(resid.reshape(shape), win)
-            smm = sm.ravel()[mask]
-            smed = np.nanmedian(smm)
-            sscale = max(1.4826 * np.nanmedian(np.abs(smm - smed)), _SCALE_FLOOR)
-            high = (sm - smed) if one_sided else np.abs(sm - smed)
-            region = ~(high > threshold * sscale)
-            region = _dilate(region, theta_deg, margin_deg)
-            new &= region.ravel()
-        changed = int(np.count_nonzero(new != mask))
-        mask = new
-        if changed <= 1e-4 * mask.size:
-            break
-    b, fitted, G = _lsq(X, d, mask)
-    resid = d - fitted
-    s2 = float(np.mean(resid[mask] ** 2) * mask.sum() / max(mask.sum() - X.shape[1], 1))
-    var_fit = _fit_variance(X, G, s2)
-    return resid, mask, var_fit, s2, n_iter
-
-
-def _dilate(unworn: np.ndarray, theta_deg: np.ndarray, margin_deg: float) -> np.ndarray:
-    """Shrink the unworn mask: drop points within ``margin_deg`` (in theta) of a worn point."""
-    if margin_deg <= 0:
-        return unworn
-    worn = ~unworn
-    th = np.asarray(theta_deg, dtype=float)
-    step = 360.0 / th.size if th.size else 360.0
-    k = int(np.ceil(margin_deg / step))
-    if k <= 0 or not worn.any():
-        return unworn
-    k = min(k, th.size)
-    # running maximum over a periodic window of 2k+1 samples via cumulative sums
-    ext = np.concatenate([worn[:, -k:], worn, worn[:, :k]], axis=1).astype(np.int32)
-    c = np.concatenate([np.zeros((worn.shape[0], 1), np.int32), np.cumsum(ext, axis=1)], axis=1)
-    win = c[:, 2 * k + 1 :] - c[:, : -(2 * k + 1)]
-    return unworn & (win == 0)
-
-
-def _refine_offset(
-    rw: np.ndarray,
-    rbz: np.ndarray,
-    th: np.ndarray,
-    thb: np.ndarray,
-    X: np.ndarray,
-    sign: float,
-    offset: float,
-    mask: np.ndarray,
-) -> float:
-    """Offset [degree] minimising the RMS of the set-up-corrected difference on ``mask``."""
-    from scipy.optimize import minimize_scalar
-
-    Xm = X[mask]
-    lhs = np.einsum("nj,nk->jk", Xm, Xm)
-
-    def cost(off: float) -> float:
-        d = sign * (rw - _rotate(th, thb, rbz, off)).ravel()[mask]
-        b = np.linalg.solve(lhs, np.einsum("nj,n->j", Xm, d))
-        return float(np.mean((d - np.einsum("nj,j->n", Xm, b)) ** 2))
-
-    step = max(4.0 * 360.0 / max(thb.size, 1), 2.0)
-    res = minimize_scalar(
-        cost, bounds=(offset - step, offset + step), method="bounded", options={"xatol": 1e-3}
-    )
-    return float(res.x) if res.fun <= cost(offset) else offset
-
-
-def register_angle(
-    worn: xr.DataArray, before: xr.DataArray, *, exclude: np.ndarray | None = None
-) -> float:
-    """Angular offset [degree] that best aligns ``before`` with ``worn`` (canonical theta).
-
-    Both are reduced to their residual from a least-squares limaçon cylinder, averaged over z,
-    resampled on a common uniform angle grid and circularly cross-correlated (points flagged in
-    ``exclude``, e.g. the worn region, are set to zero); the peak is refined by a parabola.
-    Returns the offset to add to the before-scan's theta.
-    """
-    th_w = np.asarray(worn["theta"].values, dtype=float)
-    n = max(th_w.size, 64)
-    grid = np.arange(n) * 360.0 / n
-    prof = []
-    for da, ex in ((worn, exclude), (before, None)):
-        z = np.asarray(da["z"].values, dtype=float)
-        th = np.asarray(da["theta"].values, dtype=float)
-        v = np.asarray(da.values, dtype=float)
-        X = _basis(z, th, "cylinder")
-        vv = v.ravel()
-        ok = np.isfinite(vv)
-        if ex is not None:
-            ok &= ~ex.ravel()
-        b, *_ = np.linalg.lstsq(X[ok], vv[ok], rcond=None)
-        res = (vv - X @ b).reshape(v.shape)
-        if ex is not None:
-            res = np.where(ex, np.nan, res)
-        res = np.where(np.isfinite(res), res, 0.0)
-        prof.append(_periodic_interp(grid, th, res).mean(axis=0))
-    a, b = prof
-    xc = np.fft.irfft(np.fft.rfft(a) * np.conj(np.fft.rfft(b)), n)
-    k = int(np.argmax(xc))
-    y0, y1, y2 = xc[(k - 1) % n], xc[k], xc[(k + 1) % n]
-    den = y0 - 2 * y1 + y2
-    frac = 0.5 * (y0 - y2) / den if den != 0 else 0.0
-    off = (k + frac) * 360.0 / n
-    return float((off + 180.0) % 360.0 - 180.0)
 
 
 def wear_map(
@@ -435,6 +197,106 @@ def wear_map(
         ``worn_volume`` and ``worn_volume_u`` [m^3], ``cylindricity_before`` and
         ``cylindricity_after`` [m] (MZ), ``angle_offset`` [degree]; method in attrs.
     """
+    shape, margin_deg = _options(shape, before, margin_deg, surface, threshold)
+    w, wname = _radius_var(worn, "worn scan")
+    z = np.asarray(w["z"].values, dtype=float)
+    th = np.asarray(w["theta"].values, dtype=float)
+    rw = np.asarray(w.values, dtype=float)
+    sign = 1.0 if surface == "bore" else -1.0
+    X = FormBasis(z, th, harmonics, axial_degree) if shape == "form" else _basis(z, th, shape)
+    mask_in = _mask_in(unworn, rw.shape)
+    method = _method(shape, X, before is not None)
+    fit_args = (threshold, mask_in, max_iter, margin_deg)
+    offset = float(angle_offset_deg)
+    rbz = thb = None
+    if before is not None:
+        b, bname = _radius_var(before, "before scan")
+        thb = np.asarray(b["theta"].values, dtype=float)
+        rbz = before_on_layers(
+            z, np.asarray(b["z"].values, dtype=float), thb, np.asarray(b.values, dtype=float)
+        )
+        if register:
+            Xcyl = X if shape == "cylinder" else _basis(z, th, "cylinder")
+            offset = registered_offset(rw, rbz, z, th, thb, X, Xcyl, sign, offset, fit_args)
+        d = sign * (rw - _rotate(th, thb, rbz, offset)).ravel()
+    elif register:
+        raise BadInputError("wear_map: register=True needs a before scan")
+    else:
+        d = sign * rw.ravel()
+    X, fit, alt, first = _reference(d, X, shape, z, th, harmonics, *fit_args, rbz is not None)
+    resid, mask, var_fit, s2, n_iter = fit
+    # exact centring: the limaçon leaves each scan's e^2/(4R) second harmonic, which differs
+    # between set-ups; with the bore radius known, re-centre each scan exactly on its axis
+    r0_w = 0.0 if wname == "radius" else (radius or _attr_radius(worn, w))
+    centring = _centring_note(exact_centring, X, r0_w, rbz is not None)
+    if exact_centring and r0_w is not None and not isinstance(X, FormBasis):
+        if rbz is not None:
+            r0_b = 0.0 if bname == "radius" else (radius or _attr_radius(before, b) or r0_w)
+            rb_abs = _rotate(th, thb, rbz, offset) + r0_b
+            d = exact_difference(rw + r0_w, rb_abs, z, th, mask, sign)
+        else:
+            rw_c = _recentre(rw + r0_w, z, th, _axis(rw + r0_w, z, th, mask))
+            d = sign * (rw_c - r0_w).ravel()
+        X, fit, alt, _ = _reference(d, X, shape, z, th, harmonics, *fit_args, rbz is not None)
+        resid, mask, var_fit, s2, n_iter = fit
+    tails = _tails_note(mask_in is not None, margin_deg)
+    if mask_in is None and rbz is not None:
+        fit, tails = _without_tails(d, X, mask, rw.shape, th, threshold, margin_deg)
+        resid, mask, var_fit, s2, _ = fit
+    radius = _volume_radius(radius, wname, rw, worn, w)
+    selection = rbz is not None and mask_in is None
+    q, u, tau, noise = _quantities(d, X, fit, alt, z, th, radius, selection, fit_args)
+    mask2 = mask.reshape(rw.shape)
+    wear = resid.reshape(rw.shape)
+    if rbz is not None:
+        refuse_inseparable_difference(s2, noise, tau)
+    else:
+        _refuse_inseparable(q, d, X, fit, noise, threshold, rw.shape)
+        if first is not None:  # the one-sided search of the worn region must pass as well
+            q1 = _quantities(d, X, first[0], first[1], z, th, radius, False, fit_args)[0]
+            _refuse_inseparable(q1, d, X, first[0], noise, threshold, rw.shape)
+    cyl_after, cyl_before, cyl_before_note = _cylindricities(
+        rw, rbz, z, th, thb if rbz is not None else th, mask2
+    )
+    attrs = {
+        "wear_reference": method,
+        "unworn_selection": "explicit mask"
+        if mask_in is not None
+        else f"iterative: |residual - median| <= {threshold} x 1.4826 MAD ({n_iter} rounds)",
+        "n_unworn_points": int(mask.sum()),
+        "reference_rms_residual": float(np.sqrt(s2)),
+        "residual_correlation_length_samples": float(tau),
+        "instrument_noise_estimate": float(noise),
+        "volume_radius": float(radius),
+        "surface": surface,
+        "registered": bool(register),
+        "centring": centring,
+        "faint_wear_tails": tails,
+    }
+    scalars = _scalars(q, cyl_before, cyl_after, cyl_before_note, noise)
+    out = wear_dataset(z, th, wear, u, mask2, scalars, offset, attrs)
+    out.attrs.update(_origin(worn, before))
+    return out
+
+
+def _origin(worn, before) -> dict:
+    """The inputs' data_origin: one synthetic scan makes the map synthetic ({} if none)."""
+    origins = {str(getattr(o, "attrs", {}).get("data_origin", "")) for o in (worn, before)}
+    origins.discard("")
+    if not origins:
+        return {}
+    return {"data_origin": "synthetic" if "synthetic" in origins else sorted(origins)[0]}
+
+
+def _refuse_inseparable(q, d, X, fit, noise, threshold, shape) -> None:
+    """Refuse a map without a before-scan where wear cannot be told from form."""
+    resid, mask, _, s2, _ = fit
+    lobing = _lobing_rms((d - resid).reshape(shape)) if isinstance(X, FormBasis) else 0.0
+    _separable(q, s2, noise, mask.reshape(shape), threshold, lobing)
+
+
+def _options(shape, before, margin_deg, surface, threshold) -> tuple[str, float]:
+    """Checked options: (reference shape, margin around worn regions [degree])."""
     if shape not in ("auto", "cylinder", "circle", "form"):
         raise BadInputError(
             f"wear_map: shape must be 'auto', 'cylinder', 'circle' or 'form', got {shape!r}"
@@ -447,138 +309,86 @@ def wear_map(
         raise BadInputError(f"wear_map: surface must be 'bore' or 'shaft', got {surface!r}")
     if not threshold > 0:
         raise BadInputError(f"wear_map: threshold must be > 0, got {threshold!r}")
-    w, wname = _radius_var(worn, "worn scan")
-    z = np.asarray(w["z"].values, dtype=float)
-    th = np.asarray(w["theta"].values, dtype=float)
-    rw = np.asarray(w.values, dtype=float)
-    sign = 1.0 if surface == "bore" else -1.0
-    if shape == "form":
-        X = FormBasis(z, th, harmonics, axial_degree)
-    else:
-        X = _basis(z, th, shape)
-    Xcyl = X if shape == "cylinder" else _basis(z, th, "cylinder")
-    mask_in = None
-    if unworn is not None:
-        mask_in = np.asarray(unworn, dtype=bool)
-        if mask_in.shape != rw.shape:
-            raise BadInputError(
-                f"wear_map: unworn mask has shape {mask_in.shape}, expected {rw.shape} (z, theta)"
-            )
-        mask_in = mask_in.ravel()
-    offset = float(angle_offset_deg)
-    if before is not None:
-        b, bname = _radius_var(before, "before scan")
-        if (bname == "radius") != (wname == "radius"):
-            pass  # a constant offset is fitted anyway
-        zb = np.asarray(b["z"].values, dtype=float)
-        thb = np.asarray(b["theta"].values, dtype=float)
-        rb = np.asarray(b.values, dtype=float)
-        if zb.size == z.size and np.allclose(zb, z, atol=1e-6, rtol=0):
-            rbz = rb
-        elif z.min() >= zb.min() - 1e-9 and z.max() <= zb.max() + 1e-9 and zb.size > 1:
-            o = np.argsort(zb)
-            rbz = np.stack([np.interp(z, zb[o], rb[o, j]) for j in range(thb.size)], axis=1)
-        else:
-            raise BadInputError(
-                f"wear_map: the before scan covers z = [{zb.min():.6g}, {zb.max():.6g}] m but the "
-                f"worn scan needs [{z.min():.6g}, {z.max():.6g}] m; scan the same layers or crop "
-                "the worn scan"
-            )
-        if register:
-            wz = xr.DataArray(rw, dims=("z", "theta"), coords={"z": z, "theta": th})
-            # first guess of the worn region from the worn scan alone
-            _, m0, _, _, _ = _robust_reference(
-                sign * rw.ravel(),
-                X,
-                threshold,
-                mask_in,
-                max_iter,
-                "wear_map",
-                rw.shape,
-                th,
-                margin_deg,
-            )
-            excl = ~m0.reshape(rw.shape)
-            rb_i = _rotate(th, thb, rbz, offset)
-            bz = xr.DataArray(rb_i, dims=("z", "theta"), coords={"z": z, "theta": th})
-            offset += register_angle(wz, bz, exclude=excl)
-            unw = ~excl.ravel()
-            for _ in range(3):
-                new_off = _refine_offset(rw, rbz, th, thb, Xcyl, sign, offset, unw)
-                rb_i = _rotate(th, thb, rbz, new_off)
-                _, unw, _, _, _ = _robust_reference(
-                    sign * (rw - rb_i).ravel(),
-                    X,
-                    threshold,
-                    mask_in,
-                    max_iter,
-                    "wear_map",
-                    rw.shape,
-                    th,
-                    margin_deg,
-                )
-                done = abs(new_off - offset) < 1e-3
-                offset = new_off
-                if done:
-                    break
-        rb_i = _rotate(th, thb, rbz, offset)
-        d = sign * (rw - rb_i).ravel()
-        method = (
+    return shape, margin_deg
+
+
+def _mask_in(unworn, shape: tuple[int, int]) -> np.ndarray | None:
+    """The explicit unworn mask, flattened (None if not given)."""
+    if unworn is None:
+        return None
+    mask_in = np.asarray(unworn, dtype=bool)
+    if mask_in.shape != shape:
+        raise BadInputError(
+            f"wear_map: unworn mask has shape {mask_in.shape}, expected {shape} (z, theta)"
+        )
+    return mask_in.ravel()
+
+
+def _method(shape: str, X, with_before: bool) -> str:
+    """How the reference was obtained (the ``wear_reference`` attribute)."""
+    if with_before:
+        return (
             "difference to the before-wear scan (rotated by angle_offset and interpolated onto "
             "the worn grid) minus a limaçon "
             + ("cylinder" if shape == "cylinder" else "circle per layer")
             + " fitted to the unworn points (change of set-up)"
         )
-    else:
-        if register:
-            raise BadInputError("wear_map: register=True needs a before scan")
-        d = sign * rw.ravel()
-        rbz = None
-        model = {
-            "cylinder": "a limaçon cylinder",
-            "circle": "a limaçon circle per layer",
-            "form": f"the form model (a centre per layer; radius and lobing 2..{getattr(X, 'harmonics', 0)} UPR "
-            f"as polynomials of degree {getattr(X, 'deg', 0)} in z)",
-        }[shape]
-        method = (
-            f"residual from {model} fitted by least squares to the unworn part of the worn "
-            "scan (no before-wear scan)"
-        )
-    X, fit, alt = _reference(
-        d, X, shape, z, th, harmonics, threshold, mask_in, max_iter, margin_deg
+    model = {
+        "cylinder": "a limaçon cylinder",
+        "circle": "a limaçon circle per layer",
+        "form": f"the form model (a centre per layer; radius and lobing "
+        f"2..{getattr(X, 'harmonics', 0)} UPR as polynomials of degree {getattr(X, 'deg', 0)} "
+        "in z)",
+    }[shape]
+    return (
+        f"residual from {model} fitted by least squares to the unworn part of the worn "
+        "scan (no before-wear scan)"
     )
-    resid, mask, var_fit, s2, n_iter = fit
-    # exact centring: the limaçon leaves each scan's e^2/(4R) second harmonic, which differs
-    # between set-ups; with the bore radius known, re-centre each scan exactly on its own axis
-    # (fitted to the unworn points) and redo the fit
-    r0_w = 0.0 if wname == "radius" else (radius or _attr_radius(worn, w))
-    centring = "limaçon only (bore radius unknown: pass radius= for exact centring)"
-    if not exact_centring:
-        centring = "limaçon only (exact_centring=False)"
-    elif isinstance(X, FormBasis):
-        centring = (
-            "form model: its second harmonic, quadratic in z, holds the limaçon's e^2/(4R) term"
-        )
-    elif r0_w is not None and not isinstance(X, FormBasis):
-        rw_c = _recentre(rw + r0_w, z, th, mask)
-        if rbz is not None:
-            r0_b = 0.0 if bname == "radius" else (radius or _attr_radius(before, b) or r0_w)
-            rb_c = _recentre(_rotate(th, thb, rbz, offset) + r0_b, z, th, np.isfinite(d))
-            d = sign * (rw_c - rb_c).ravel()
-        else:
-            d = sign * (rw_c - r0_w).ravel()
-        X, fit, alt = _reference(
-            d, X, shape, z, th, harmonics, threshold, mask_in, max_iter, margin_deg
-        )
-        resid, mask, var_fit, s2, n_iter = fit
-        centring = (
-            "exact: each scan re-centred on its own least-squares axis (unworn points), then the "
-            "limaçon reference fitted to the unworn points"
-        )
-    wear = resid.reshape(rw.shape)
-    u = np.sqrt(s2 + var_fit).reshape(rw.shape)
-    mask2 = mask.reshape(rw.shape)
-    radius = _volume_radius(radius, wname, rw, worn, w)
+
+
+def _centring_note(exact: bool, X, r0_w, with_before: bool) -> str:
+    """The ``centring`` attribute."""
+    if not exact:
+        return "limaçon only (exact_centring=False)"
+    if isinstance(X, FormBasis):
+        return "form model: its second harmonic, quadratic in z, holds the limaçon's e^2/(4R) term"
+    if r0_w is None:
+        return "limaçon only (bore radius unknown: pass radius= for exact centring)"
+    return (
+        "exact: the before scan re-centred on its least-squares axis (all points), the "
+        "worn scan on that axis plus the change of set-up (difference on the unworn "
+        "points)"
+        if with_before
+        else "exact: the scan re-centred on its least-squares axis (unworn points)"
+    ) + ", then the limaçon reference fitted to the unworn points"
+
+
+def _without_tails(d, X, mask, shape, th, threshold, margin_deg):
+    """The robust fit after the faint-tail test (:func:`_exclude_tails`), and its note."""
+    mask, tails = _exclude_tails(d, X, mask, shape, th, 2.0, 5.0)
+    fit = _robust_reference(d, X, threshold, mask, 1, "wear_map", shape, th, margin_deg)
+    return fit, tails
+
+
+def _tails_note(explicit: bool, margin_deg: float) -> str:
+    """The ``faint_wear_tails`` attribute when the tails are not tested."""
+    if explicit:
+        return "not assessed (explicit unworn mask)"
+    return (
+        "not tested (no before-scan: the unworn form is modelled; a margin of "
+        f"{margin_deg:g} degree around the worn region is left out instead)"
+    )
+
+
+def _quantities(d, X, fit, alt, z, th, radius, selection, fit_args):
+    """Derived quantities with their u, the per-point u, the residual's correlation length
+    [samples] and the instrument noise [m] (successive differences of the map)."""
+    resid, mask, var_fit, s2, _ = fit
+    threshold, _, _, margin = fit_args
+    shape = (z.size, th.size)
+    wear = resid.reshape(shape)
+    u = np.sqrt(s2 + var_fit).reshape(shape)
+    mask2 = mask.reshape(shape)
     wts = _z_weights(z)[:, None] * _theta_weights(th)[None, :] * radius
     _, _, G = _lsq(X, d, mask)
     cov = np.linalg.inv(G) * s2
@@ -588,125 +398,15 @@ def wear_map(
         cov = block_diag(*cov)
     tau = correlation_length(wear, mask2)
     q = derived_quantities(
-        wear, var_fit.reshape(rw.shape), s2, tau, _design_sum(X, wts), cov, wts, z, th
+        wear, var_fit.reshape(shape), s2, tau, _design_sum(X, wts), cov, wts, z, th
     )
     if alt is not None:
-        other = alt[0].reshape(rw.shape)
+        other = alt[0].reshape(shape)
         _model_order_term(q, other, wts, z, th, "form-model order")
         u = np.hypot(u, wear - other)  # each depth's dependence on the model order
-    if rbz is not None and mask_in is None and not mask2.all():
-        # faint wear tails next to the worn region bias the reference: refit without the
-        # points within a further 10 degree of it and count the change
-        narrower = _dilate(mask2, th, 10.0).ravel()
-        if narrower.sum() > 0.1 * narrower.size:
-            try:
-                sel, *_ = _robust_reference(
-                    d, X, threshold, narrower, 1, "wear_map", rw.shape, th, margin_deg
-                )
-                other = sel.reshape(rw.shape)
-                _model_order_term(q, other, wts, z, th, "unworn selection")
-                u = np.hypot(u, wear - other)
-            except BadInputError:
-                pass
-    noise = noise_sigma(wear)  # successive differences of the residual: the probe noise
-    if rbz is not None and np.sqrt(s2) > max(1.5 * noise, 1e-9) and tau > 20.0:
-        raise BadInputError(
-            f"wear_map: the difference of the scans leaves {np.sqrt(s2) * 1e9:.3g} nm RMS of "
-            f"smooth structure (correlation length {tau:.0f} samples) on the points taken as "
-            f"unworn, against {noise * 1e9:.3g} nm of noise: wear spread around most of the "
-            "bore (or a change of form between the scans) cannot be separated from the change "
-            "of set-up; pass an explicit unworn mask (unworn=...) of points known to be unworn"
-        )
-    if rbz is None:
-        lobing = _lobing_rms((d - resid).reshape(rw.shape)) if isinstance(X, FormBasis) else 0.0
-        _separable(q, s2, noise, mask2, threshold, lobing)
-    cyl_after, cyl_before, cyl_before_note = _cylindricities(
-        rw, rbz, z, th, thb if rbz is not None else th, mask2
-    )
-    zc = z_coord(z)
-    tc = theta_coord(th, CANONICAL)
-    out = xr.Dataset(
-        {
-            "wear_depth": (
-                ("z", "theta"),
-                wear,
-                {
-                    "units": "m",
-                    "long_name": "wear depth of the bearing surface (positive = material removed)",
-                    "ancillary_variables": "wear_depth_u",
-                },
-            ),
-            "wear_depth_u": (
-                ("z", "theta"),
-                u,
-                {
-                    "units": "m",
-                    "long_name": "standard uncertainty of wear_depth",
-                    **uncertainty_attrs(
-                        "scatter of the unworn points about the reference (instrument noise, "
-                        "unmodelled form and set-up) and the fitted reference's standard error"
-                    ),
-                },
-            ),
-            "unworn": (
-                ("z", "theta"),
-                mask2.astype(np.int8),
-                {
-                    "units": "1",
-                    "long_name": "point used as unworn reference",
-                    "flag_values": np.array([0, 1], dtype=np.int8),
-                    "flag_meanings": "worn_or_outlier unworn_reference",
-                },
-            ),
-            **_scalars(q, cyl_before, cyl_after, cyl_before_note, noise),
-            "angle_offset": (
-                (),
-                offset,
-                {
-                    "units": "degree",
-                    "long_name": "rotation applied to the before-wear scan (canonical theta)",
-                },
-            ),
-        },
-        coords={"z": zc, "theta": tc},
-        attrs={
-            "title": "wear map",
-            "wear_reference": method,
-            "unworn_selection": (
-                "explicit mask"
-                if mask_in is not None
-                else f"iterative: |residual - median| <= {threshold} x 1.4826 MAD ({n_iter} rounds)"
-            ),
-            "n_unworn_points": int(mask.sum()),
-            "reference_rms_residual": float(np.sqrt(s2)),
-            "residual_correlation_length_samples": float(tau),
-            "instrument_noise_estimate": float(noise),
-            "volume_radius": float(radius),
-            "surface": surface,
-            "registered": bool(register),
-            "centring": centring,
-        },
-    )
-    origins = {str(getattr(o, "attrs", {}).get("data_origin", "")) for o in (worn, before)}
-    origins.discard("")
-    if origins:  # keep the inputs' origin: one synthetic scan makes the map synthetic
-        out.attrs["data_origin"] = "synthetic" if "synthetic" in origins else sorted(origins)[0]
-    return out
-
-
-def _recentre(
-    r_abs: np.ndarray, z: np.ndarray, theta_deg: np.ndarray, mask: np.ndarray
-) -> np.ndarray:
-    """Exact distance of each point from the scan's own LS axis (fitted on ``mask``) [m]."""
-    X = _basis(z, theta_deg, "cylinder")
-    m = np.asarray(mask, dtype=bool).ravel() & np.isfinite(r_abs.ravel())
-    b = np.linalg.lstsq(X[m], r_abs.ravel()[m], rcond=None)[0]
-    zc = z - 0.5 * (z.min() + z.max())
-    zz = zc / max(np.ptp(zc), 1e-12)
-    xc = (b[1] + b[3] * zz)[:, None]
-    yc = (b[2] + b[4] * zz)[:, None]
-    t = np.radians(theta_deg)[None, :]
-    return np.sqrt(r_abs**2 + xc**2 + yc**2 - 2.0 * r_abs * (xc * np.cos(t) + yc * np.sin(t)))
+    if selection and not mask2.all():
+        u = selection_term(q, u, wear, d, X, mask2, wts, z, th, threshold, margin)
+    return q, u, tau, noise_sigma(wear)
 
 
 def _attr_radius(orig: xr.Dataset | xr.DataArray, da: xr.DataArray) -> float | None:
@@ -730,197 +430,3 @@ def _volume_radius(radius, wname, rw, worn, w) -> float:
             "attribute; pass radius=<bore radius in m> for the worn volume"
         )
     return float(radius)
-
-
-def _design_sum(X, w: np.ndarray) -> np.ndarray:
-    """sum_i w_i X_i over all points (p,): the volume's sensitivity to the coefficients."""
-    if isinstance(X, FormBasis):
-        return X.weighted_sum(w)
-    if isinstance(X, _LayerBasis):
-        return (w @ X.block.T).ravel()
-    return w.ravel() @ X
-
-
-def _lobing_rms(surface: np.ndarray) -> float:
-    """RMS of the harmonics 2 and up of a fitted surface (nz, nt) [m]."""
-    spec = np.fft.rfft(surface, axis=1) / surface.shape[1]
-    return float(np.sqrt(np.mean(2.0 * np.sum(np.abs(spec[:, 2:]) ** 2, axis=1))))
-
-
-def _separable(
-    q: dict, s2: float, noise: float, unworn: np.ndarray, threshold: float, lobing: float
-) -> None:
-    """Refuse a map without a before-scan where wear cannot be told from form."""
-    frac = float(unworn.mean())
-    fix = (
-        "pass the scan of the bore before wear (before=..., CLI --before BEFORE.nc), or an "
-        "explicit unworn mask"
-    )
-    if frac < 0.25:
-        raise BadInputError(
-            f"wear_map: only {frac:.0%} of the points look unworn: too little of the bore is "
-            f"left to fit its unworn form, so wear cannot be separated from form; {fix}"
-        )
-    depth, u_depth, _ = q["max_wear_depth"]
-    s = float(np.sqrt(s2))
-    if depth < 5.0 * u_depth and np.isfinite(noise) and lobing > 5.0 * noise:
-        raise BadInputError(
-            f"wear_map: without a before-wear scan no significant wear stands out (max "
-            f"{depth * 1e6:.3g} ± {u_depth * 1e6:.2g} µm), but the bore's "
-            f"lobing ({lobing * 1e6:.3g} µm RMS, instrument noise {noise * 1e6:.3g} µm) could "
-            "hold wear as broad as its lobes: whether the bore is unworn or evenly worn "
-            f"cannot be separated from its form; {fix}"
-        )
-    if u_depth > 0.3 * depth and not (np.isfinite(noise) and u_depth <= 5.0 * noise):
-        raise BadInputError(
-            f"wear_map: without a before-wear scan the wear found (max {depth * 1e6:.3g} µm) "
-            f"depends on the form model (standard uncertainty {u_depth * 1e6:.2g} µm, including "
-            "the change at the neighbouring lobing order): the worn region is as wide as the "
-            f"bore's lobes, so wear cannot be separated from form; {fix}"
-        )
-    if np.isfinite(noise) and s > 3.0 * noise and depth < 5.0 * s:
-        raise BadInputError(
-            f"wear_map: without a before-wear scan the form model leaves {s * 1e6:.3g} µm RMS "
-            f"on the unworn points (instrument noise {noise * 1e6:.3g} µm): unmodelled form of "
-            f"the size of the wear found (max {depth * 1e6:.3g} ± {u_depth * 1e6:.2g} µm), so "
-            f"wear cannot be separated from form; {fix}"
-        )
-
-
-def _cylindricities(rw, rbz, z, th, thb, unworn):
-    """(MZ cylindricity of the worn scan, of the before-scan or the unworn points, note)."""
-    if z.size < 2:
-        return float("nan"), float("nan"), "not assessed: one layer"
-
-    def zone(v, t):
-        return cylinder_zone(
-            np.broadcast_to(z[:, None], v.shape), np.broadcast_to(t, v.shape), v
-        ).total
-
-    if rbz is not None:
-        return zone(rw, th), zone(rbz, thb), "MZ cylindricity of the before-wear scan"
-    return (
-        zone(rw, th),
-        zone(np.where(unworn, rw, np.nan), th),
-        "MZ cylindricity of the unworn points of the worn scan (estimate of the cylindricity "
-        "before wear; no before-wear scan)",
-    )
-
-
-_LONG = {
-    "worn_volume": ("m3", "volume of material removed over the measured band"),
-    "max_wear_depth": ("m", "largest wear depth (map averaged over about 1 degree)"),
-    "wear_cylindricity": ("m", "MZ cylindricity of the wear map"),
-}
-
-
-def _scalars(q: dict, cyl_before, cyl_after, note: str, noise: float) -> dict:
-    """The map's scalar quantities with their ``_u`` variables."""
-    out = {}
-    for name, (v, u, comment) in q.items():
-        unit, long_name = _LONG[name]
-        out[name] = (
-            (),
-            v,
-            {"units": unit, "long_name": long_name, "ancillary_variables": f"{name}_u"},
-        )
-        out[f"{name}_u"] = (
-            (),
-            u,
-            {
-                "units": unit,
-                "long_name": f"standard uncertainty of {name}",
-                **uncertainty_attrs(comment),
-            },
-        )
-    u_zone = float(np.sqrt(2.0) * noise) if np.isfinite(cyl_after) else float("nan")
-    zone_comment = (
-        "instrument noise (from successive differences) at the zone's two extreme points; the "
-        "upward bias of a zone by noise is not corrected"
-    )
-    for name, v, long_name in (
-        ("cylindricity_before", cyl_before, note),
-        ("cylindricity_after", cyl_after, "MZ cylindricity of the worn scan"),
-    ):
-        out[name] = (
-            (),
-            v,
-            {"units": "m", "long_name": long_name, "ancillary_variables": f"{name}_u"},
-        )
-        out[f"{name}_u"] = (
-            (),
-            u_zone,
-            {
-                "units": "m",
-                "long_name": f"standard uncertainty of {name}",
-                **uncertainty_attrs(zone_comment),
-            },
-        )
-    return out
-
-
-def _reference(d, X, shape, z, th, harmonics, threshold, mask_in, max_iter, margin_deg):
-    """(basis used, robust fit, fit at the neighbouring lobing order or None).
-
-    For the form model the lobing order starts at 2 (which also holds the limaçon's
-    e^2/(4R) second harmonic) and grows one harmonic at a time, up to ``harmonics``, while the
-    Bayesian information criterion on the current unworn points asks for more; every stage is
-    refitted robustly (one-sided: only material removed is wear) from the previous stage's
-    unworn points, so that wear found at a low order is not absorbed by a higher one. The fit
-    at the neighbouring order measures how much the result depends on that choice.
-    """
-    shape2d = (z.size, th.size)
-    args = (threshold, mask_in, max_iter, "wear_map", shape2d, th, margin_deg)
-    if not isinstance(X, FormBasis):
-        return X, _robust_reference(d, X, *args), None
-    k = min(2, X.harmonics)
-    basis = FormBasis(z, th, k, X.deg)
-    fit = _robust_reference(d, basis, *args, one_sided=True)
-    while k < X.harmonics:
-        best, _ = select_harmonics(X, d, fit[1])
-        if best <= k:
-            break
-        k += 1
-        basis = FormBasis(z, th, k, X.deg)
-        fit = _robust_reference(d, basis, *args, start=fit[1], one_sided=True)
-    k_alt = k + 1 if k < max(X.harmonics, 3) else k - 1
-    alt = _robust_reference(d, FormBasis(z, th, k_alt, X.deg), *args, start=fit[1], one_sided=True)
-    return basis, fit, alt
-
-
-def _model_order_term(q: dict, other: np.ndarray, wts: np.ndarray, z, th, what: str) -> None:
-    """Add, in quadrature, how much each quantity changes under another defensible choice
-    (the form model's order, the unworn selection): a source of uncertainty."""
-    zeros = np.zeros_like(other)
-    alt = derived_quantities(other, zeros, 0.0, 1.0, np.zeros(1), np.zeros((1, 1)), wts, z, th)
-    for name, (v, u, comment) in list(q.items()):
-        dv = abs(alt[name][0] - v)
-        if np.isfinite(dv):
-            q[name] = (v, float(np.hypot(u, dv)), comment + f"; {what} ({dv:.3g})")
-
-
-def _lower_quantile_start(X, d: np.ndarray, finite: np.ndarray, threshold: float, tau=0.25):
-    """First unworn set from a ``tau``-quantile fit (iteratively reweighted least squares).
-
-    Wear only removes material, so it lies above the unworn surface: a low quantile of the
-    data is hardly pulled by a broad groove, which a least-squares fit to all points absorbs
-    (into the centre terms, then nothing stands out and the map reads zero wear).
-    """
-    dd = np.where(finite, d, 0.0)
-    w = finite.astype(float)
-    r = dd
-    for _ in range(30):
-        try:
-            _, fitted, _ = _lsq(X, dd, w)
-        except np.linalg.LinAlgError:
-            return finite
-        r = dd - fitted
-        scale = max(float(np.median(np.abs(r[finite]))), _SCALE_FLOOR)
-        w = np.where(
-            finite, np.where(r > 0, tau, 1.0 - tau) / np.maximum(np.abs(r), 1e-3 * scale), 0.0
-        )
-    rf = r[finite]
-    med = np.median(rf[rf <= np.percentile(rf, 50)])  # centre of the lower half
-    low = rf[rf <= np.percentile(rf, 50)]
-    scale = max(1.4826 * np.median(np.abs(low - np.median(low))) * 1.5, _SCALE_FLOOR)
-    return finite & (r - med <= threshold * scale)

@@ -1,0 +1,218 @@
+"""Wear maps against exact truth at the reference study's scan size (13 layers x 18000 points):
+the worn volume has no offset beyond its stated uncertainty, and a noise-free measurement reads
+the truth.
+
+On that many points u(volume) is a fraction of a nanometre times the bore's area, so biases that
+a coverage check on small maps cannot see show: a one-sided noise rejection (the high tail cut
+at +3 sigma, the low kept to -6 sigma) read 0.2-0.35 nm x area high; the worn scan's axis fitted
+to its unworn arc alone let the form shift it (a constant and a second harmonic e delta / R);
+faint wear tails among the unworn points pulled the reference up. The scans here are the
+generator's (:func:`jointwear.datasets.instruments.generate`: exact eccentric set-up, form
+harmonics drifting along z, 20 nm noise, 1 nm quantisation) with a known imposed wear.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import xarray as xr
+
+from jointwear.conventions import CANONICAL, theta_coord, z_coord
+from jointwear.datasets.instruments import generate
+from jointwear.metrology.wearmap import wear_map, worn_volume
+
+R = 8e-3
+COMMON = {"n_layers": 13, "n_points": 18000, "radius": R, "seed": 7}
+BEFORE_SETUP = {"eccentricity": (-5e-6, 12e-6), "tilt": (0.5e-3, 1e-3)}
+
+
+def _patch(depth):
+    """A cos^2 patch 80 degree wide at 100 degree, deeper at one end (compact support)."""
+
+    def wear(theta_deg, z):
+        dth = (np.asarray(theta_deg) - 100.0 + 180.0) % 360.0 - 180.0
+        patch = np.where(np.abs(dth) < 40.0, np.cos(np.radians(dth) * 90.0 / 40.0) ** 2, 0.0)
+        return depth * patch * (0.6 + 0.4 * (np.asarray(z) + 6e-3) / 12e-3)
+
+    return wear
+
+
+def _gauss(depth, width_deg):
+    """A Gaussian groove (sigma ``width_deg``) at 100 degree: tails far below the noise."""
+
+    def wear(theta_deg, z):
+        dth = (np.asarray(theta_deg) - 100.0 + 180.0) % 360.0 - 180.0
+        return depth * np.exp(-0.5 * (dth / width_deg) ** 2) * (0.6 + 0.4 * (z + 6e-3) / 12e-3)
+
+    return wear
+
+
+GROOVES = {"patch 1 um": _patch(1e-6), "gauss 10 deg 3 um": _gauss(3e-6, 10.0)}
+GROOVES["gauss 20 deg 1 um"] = _gauss(1e-6, 20.0)
+
+
+def _pair(wear, noise_seed, noisy=True):
+    kw = {} if noisy else {"noise": 0.0, "quantisation": 0.0}
+    worn = generate(**COMMON, wear=wear, noise_seed=100 + noise_seed, **kw)
+    before = generate(**COMMON, wear=None, noise_seed=200 + noise_seed, **BEFORE_SETUP, **kw)
+    t = worn.truth
+    truth = worn_volume(t.wear_depth.values, t.z.values, t.theta.values, R)
+    return worn.truth[["radius"]], before.truth[["radius"]], truth, t.wear_depth.values
+
+
+@pytest.mark.parametrize("name", list(GROOVES))
+def test_noise_free_scans_with_a_before_scan_read_the_truth(name):
+    worn, before, truth, depth = _pair(GROOVES[name], 0, noisy=False)
+    out = wear_map(worn, before)
+    # exact to a few parts in 10^5 (tails below the 10 pm selection floor; the one-sided
+    # rejection and the arc-fitted axis: 1e-3 .. 5e-2)
+    assert out["worn_volume"].item() == pytest.approx(truth, rel=5e-5)
+    np.testing.assert_allclose(out["wear_depth"].values, depth, atol=1e-10)
+    assert out.attrs["centring"].startswith("exact: the before scan")
+
+
+def test_noisy_scans_with_a_before_scan_have_no_volume_offset_beyond_u():
+    z = []
+    for wear in GROOVES.values():
+        for seed in (1, 2):
+            worn, before, truth, _ = _pair(wear, seed)
+            out = wear_map(worn, before)
+            z.append((truth - out["worn_volume"].item()) / out["worn_volume_u"].item())
+    z = np.asarray(z)
+    # before the fix: -1.4 .. -10 (patch high by the one-sided rejection, wide Gaussians
+    # low by their tails); each within 2.5 u, their mean near 0 (N(0, 1/n) if u holds)
+    assert np.all(np.abs(z) < 2.5), z
+    assert abs(z.mean()) < 1.0, z
+    # and u is not inflated: the standardised errors are of order one
+    assert np.sqrt(np.mean(z**2)) > 0.2, z
+
+
+def test_faint_tails_are_tested_and_a_wrong_reference_is_seen():
+    """The tail test leaves out the bands next to the worn region that hold wear; it must be
+    able to fail: the same map with the tails forced into the unworn set reads low."""
+    worn, before, truth, depth = _pair(GROOVES["gauss 20 deg 1 um"], 3)
+    out = wear_map(worn, before)
+    assert "band(s)" in out.attrs["faint_wear_tails"]
+    u = out["worn_volume_u"].item()
+    # every point with truth below 20 nm called unworn: the tails pull the reference up
+    forced = wear_map(worn, before, unworn=depth < 20e-9)
+    assert truth - forced["worn_volume"].item() > 2.0 * u
+    assert abs(truth - out["worn_volume"].item()) < 2.5 * u
+
+
+# -- without a before-scan: the form model ------------------------------------------------
+
+NZ, NT = 13, 1440
+Z = (np.arange(NZ) - 6) * 1e-3
+TH = np.arange(NT) * 360.0 / NT
+RAD = np.radians(TH)
+
+
+def _bore_in_model(depth, width_deg, sigma, seed, lobe=0.3e-6):
+    """A bore whose form the form model holds exactly (taper, 2 UPR lobing with coefficients
+    quadratic in z, a centre per layer), a Gaussian groove and probe noise ``sigma``."""
+    rng = np.random.default_rng(seed)
+    zeta = Z / Z.max()
+    dth = (TH - 120.0 + 180.0) % 360.0 - 180.0
+    wear = depth * np.exp(-0.5 * (dth / width_deg) ** 2)[None, :] * (0.7 + 0.3 * zeta[:, None])
+    form = 8e-6 * zeta[:, None] + lobe * (1.0 + 0.3 * zeta[:, None] ** 2) * np.cos(2 * RAD + 0.4)
+    setup = (10e-6 + 1e-3 * Z[:, None]) * np.cos(RAD) + (-6e-6 + 0.5e-3 * Z[:, None]) * np.sin(RAD)
+    r = R + form + setup + wear + sigma * rng.standard_normal(wear.shape)
+    ds = xr.Dataset(
+        {"radius": (("z", "theta"), r, {"units": "m", "long_name": "radius"})},
+        coords={"z": z_coord(Z), "theta": theta_coord(TH, CANONICAL)},
+    )
+    return ds, wear
+
+
+@pytest.mark.parametrize(("depth", "width"), [(2e-6, 12.0), (5e-6, 20.0)])
+def test_noise_free_scan_without_a_before_scan_reads_the_truth(depth, width):
+    scan, wear = _bore_in_model(depth, width, 0.0, 0)
+    out = wear_map(scan)
+    truth = worn_volume(wear, Z, TH, R)
+    assert out["worn_volume"].item() == pytest.approx(truth, rel=1e-4)
+    # the maximum of the map averaged over about 1 degree: the peak's curvature lowers it
+    assert out["max_wear_depth"].item() == pytest.approx(wear.max(), rel=1e-3)
+    np.testing.assert_allclose(out["wear_depth"].values, wear, atol=2e-10)
+
+
+def test_without_a_before_scan_the_volume_has_no_offset_beyond_u():
+    """Noisy bores in the model, grooves and an unworn bore: no systematic offset (the one-sided
+    rejection read an unworn bore's volume +0.9 u high on every realisation)."""
+    z = []
+    cases = [(2e-6, 12.0, 0.3e-6), (1e-6, 20.0, 0.3e-6), (0.0, 10.0, 0.0)] * 3
+    for k, (depth, width, lobe) in enumerate(cases):
+        scan, wear = _bore_in_model(depth, width, 20e-9, 10 + k, lobe)
+        out = wear_map(scan)
+        v, u = out["worn_volume"].item(), out["worn_volume_u"].item()
+        z.append((worn_volume(wear, Z, TH, R) - v) / u)
+    z = np.asarray(z)
+    assert np.all(np.abs(z) < 2.5), z
+    assert abs(z.mean()) < 2.0 / np.sqrt(z.size), z
+
+
+def test_tails_around_the_bore_are_refused_not_read_low():
+    """A groove 36 degree wide (sigma), 8 um deep: its tails reach around the bore and the
+    reference fitted on what is left would absorb them. The tail test finds wear (above 3
+    standard errors) in the bands it would have to leave out with fewer than 25 % of the
+    points left: refused, asking for a mask."""
+    from test_wearmap_form import _bore
+
+    from jointwear.errors import BadInputError
+
+    worn, _ = _bore(25.0, 1.5, 8.0, 36.0, seed=300, centre_deg=81.0)
+    before, _ = _bore(25.0, 1.5, 0.0, 36.0, seed=600, centre_deg=81.0)
+    with pytest.raises(BadInputError, match="faint tails reach around the bore.*unworn="):
+        wear_map(worn, before)
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="open: grooves 37-38 degree wide (sigma) with a "
+    "before-scan can read 3.6-5.5 u low when the tail test stays below 3 "
+    "standard errors",
+)
+def test_open_tails_of_a_groove_38_degree_wide():
+    from test_wearmap_form import TH, Z, _bore
+
+    worn, wear = _bore(25.0, 1.5, 8.0, 38.0, seed=300, centre_deg=81.0)
+    before, _ = _bore(25.0, 1.5, 0.0, 38.0, seed=600, centre_deg=81.0)
+    try:
+        out = wear_map(worn, before)
+    except Exception:  # a refusal is right
+        return
+    z = (out["worn_volume"].item() - worn_volume(wear, Z, TH, R)) / out["worn_volume_u"].item()
+    assert abs(z) < 3.0, z
+
+
+def test_wide_shallow_groove_without_a_before_scan_is_refused_not_read_low():
+    """0.3 um deep, 28 degree wide on a tapered bore: the symmetric refit alone read the volume
+    35 % low (7.4 u, exit 0); the one-sided search of the worn region cannot separate it from
+    the form either, and that refuses."""
+    from test_wearmap_form import _bore
+
+    from jointwear.errors import BadInputError
+
+    # the benchmark's case 27 (bench_wearmap_form.py)
+    scan, _ = _bore(27.524, 0.0, 0.3, 27.984, seed=127, centre_deg=105.545)
+    with pytest.raises(BadInputError, match="cannot be separated from form"):
+        wear_map(scan)
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="open: a wide shallow groove on a tapered bore without a "
+    "before-scan is absorbed by the form model (-5.6 u before issue 22 item 5)",
+)
+def test_open_wide_shallow_groove_next_to_the_refused_one():
+    """The same groove, parameters rounded: mapped with the volume 35 % low (7.5 u), exit 0.
+    Known defect of the form-model path (it read 5.6 u low before the symmetric refit too)."""
+    from test_wearmap_form import TH, Z, _bore
+
+    scan, wear = _bore(27.5, 0.0, 0.3, 28.0, seed=127, centre_deg=105.5)
+    try:
+        out = wear_map(scan)
+    except Exception:  # a refusal is right
+        return
+    z = (out["worn_volume"].item() - worn_volume(wear, Z, TH, R)) / out["worn_volume_u"].item()
+    assert abs(z) < 3.0, z
