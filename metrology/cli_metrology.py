@@ -298,7 +298,7 @@ def import_cmd(
         typer.Option(
             "--ignore-header",
             help="A header claim known to be wrong (repeat): units, nominal_radius, points, "
-            "filter, layers, layer_spacing, z.",
+            "filter, layers, z_extent, layer_spacing, z.",
         ),
     ] = None,
     z_source: Annotated[
@@ -389,6 +389,8 @@ def import_cmd(
             f"{target}: {var} {ds.sizes['z']} layers x {ds.sizes['theta']} points "
             f"(instrument 0 deg along {angle_zero}, {ds.attrs['instrument_angle_direction']})"
         )
+        if ds.attrs.get("z_unconfirmed"):
+            typer.echo(f"  note: {ds.attrs['z_unconfirmed']}")
 
 
 def _require_convention(angle_zero: str | None, angle_direction: str | None) -> None:

@@ -153,7 +153,7 @@ def read_scan(
         Instrument name for ``source`` (default: from the header, else ``"roundness instrument"``).
     ignore_header : sequence of str
         Header claims known to be wrong, dropped before reading (``units``, ``nominal_radius``,
-        ``points``, ``filter``, ``layers``, ``layer_spacing``, ``z``); recorded.
+        ``points``, ``filter``, ``layers``, ``z_extent``, ``layer_spacing``, ``z``); recorded.
     z_source : str
         Where z comes from (:data:`~.zsource.Z_SOURCES`; ``auto``: the one source there is,
         refused when two disagree).
@@ -320,7 +320,9 @@ def read_scan(
         z_source=z_source,
         where=f"'{folder or files[0]}'",
     )
-    check_layers(layers, metadata, zsrc, limits, f"'{files[0] if len(files) == 1 else folder}'")
+    unconfirmed = check_layers(
+        layers, metadata, zsrc, limits, f"'{files[0] if len(files) == 1 else folder}'"
+    )
     notes["z_from"] = zsrc
     if instrument is None:
         instrument = next(
@@ -355,4 +357,6 @@ def read_scan(
     ds.attrs["reader_columns"] = [resolve.get(c, c) for c in parsed[0].columns]
     if parsed[0].units:
         ds.attrs["instrument_units"] = parsed[0].units
+    if unconfirmed:
+        ds.attrs["z_unconfirmed"] = unconfirmed
     return ds
