@@ -31,6 +31,7 @@ import xarray as xr
 from scipy.optimize import linprog
 
 from jointwear.errors import BadInputError
+from jointwear.metrology.choices import REFERENCES
 
 __all__ = [
     "REFERENCES",
@@ -44,13 +45,6 @@ __all__ = [
     "limacon_error",
 ]
 
-#: Reference names accepted (short form -> ISO circle / cylinder names).
-REFERENCES: dict[str, tuple[str, str]] = {
-    "LS": ("LSCI", "LSCY"),
-    "MZ": ("MZCI", "MZCY"),
-    "MI": ("MICI", "MICY"),
-    "MC": ("MCCI", "MCCY"),
-}
 _ALIASES = {
     **{k: k for k in REFERENCES},
     **{v[0]: k for k, v in REFERENCES.items()},
@@ -205,6 +199,17 @@ class _Sectors:
         return self.order[hit[first]], mx
 
 
+def _initial_candidates(sectors: _Sectors, e0: np.ndarray, kind: str) -> np.ndarray:
+    """The points the zone LP starts from: per sector the largest residual (MZ, MC) and the
+    smallest (MZ, MI) of the LS solution."""
+    parts = []
+    if kind in ("MZ", "MC"):
+        parts.append(sectors.argmax(e0)[0])
+    if kind in ("MZ", "MI"):
+        parts.append(sectors.argmax(-e0)[0])
+    return np.unique(np.concatenate(parts))
+
+
 def _zone_lp(
     G: np.ndarray,
     r: np.ndarray,
@@ -222,12 +227,7 @@ def _zone_lp(
     m = G.shape[1]
     p0, _ = _ls(G, r)
     e0 = r - G.dot(p0)
-    parts = []
-    if kind in ("MZ", "MC"):
-        parts.append(sectors.argmax(e0)[0])
-    if kind in ("MZ", "MI"):
-        parts.append(sectors.argmax(-e0)[0])
-    cand = np.unique(np.concatenate(parts))
+    cand = _initial_candidates(sectors, e0, kind)
     tol = _TOL * _SCALE
     for _ in range(200):
         Gs, rs = G.rows(cand), r[cand]
@@ -436,12 +436,7 @@ def circle_zones(
         p[i] = sol[:2]
     e0 = rs - c * p[g, 0] - sn * p[g, 1]
     sectors = _Sectors(t, g, 64)
-    parts = []
-    if kind in ("MZ", "MC"):
-        parts.append(sectors.argmax(e0)[0])
-    if kind in ("MZ", "MI"):
-        parts.append(sectors.argmax(-e0)[0])
-    cand = np.unique(np.concatenate(parts))
+    cand = _initial_candidates(sectors, e0, kind)
     nv = 4 if kind == "MZ" else 3  # per layer: x, y, a [, t]
     tol = _TOL * _SCALE
     for _ in range(200):

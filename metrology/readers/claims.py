@@ -2,7 +2,7 @@
 
 A header line is a claim about the table under it; a claim the numbers contradict is refused,
 naming both and the option that settles it (:class:`~.advice.Refusal`), never silently
-believed or silently overridden. Checked here (limits in :data:`~.advice.PLAUSIBILITY`,
+believed or silently overridden. Checked here (limits in :data:`~jointwear.metrology.choices.PLAUSIBILITY`,
 overridable):
 
 * the length unit against the magnitude of the values: a radius must make a bore of plausible
@@ -161,7 +161,7 @@ def check_magnitude(
     meta : dict
         Header metadata (for the nominal radius).
     limits : dict
-        Plausibility limits (:data:`~.advice.PLAUSIBILITY` with overrides).
+        Plausibility limits (:data:`~jointwear.metrology.choices.PLAUSIBILITY` with overrides).
     """
     v = np.asarray(values, dtype=float)
     v = v[np.isfinite(v)]

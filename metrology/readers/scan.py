@@ -48,6 +48,7 @@ from jointwear.conventions import (
     AngleConvention,
 )
 from jointwear.errors import BadInputError
+from jointwear.metrology.choices import LAYOUTS, VALUE_KINDS
 from jointwear.metrology.readers.advice import plausibility
 from jointwear.metrology.readers.claims import check_layers
 from jointwear.metrology.readers.dataset import _as_convention, _assemble
@@ -152,9 +153,9 @@ def read_scan(
         Header claims known to be wrong, dropped before reading (``units``, ``nominal_radius``,
         ``points``, ``filter``, ``layers``, ``z_extent``, ``layer_spacing``, ``z``); recorded.
     z_source : str
-        Where z comes from (:data:`~.zsource.Z_SOURCES`; ``auto``: the one there is).
+        Where z comes from (:data:`~jointwear.metrology.choices.Z_SOURCES`; ``auto``: the one there is).
     radius_range, max_deviation, nominal_tolerance, min_form : optional
-        Plausibility limits of the header cross-checks (:data:`~.advice.PLAUSIBILITY`): bore
+        Plausibility limits of the header cross-checks (:data:`~jointwear.metrology.choices.PLAUSIBILITY`): bore
         radius (min, max) [m] (0.5 mm to 2 m), largest |radial deviation| [m] (1 mm), relative
         tolerance against a stated nominal radius (0.05), smallest peak-to-valley of a
         deviation trace [m] (10 nm).
@@ -230,9 +231,9 @@ def read_scan(
 def _checked(convention, value: str, layout: str) -> AngleConvention:
     """The instrument's angle convention, once the choices are checked."""
     conv = _as_convention(convention)
-    if value not in ("auto", "radius", "deviation"):
+    if value not in ("auto", *VALUE_KINDS):
         raise BadInputError(f"value must be 'auto', 'radius' or 'deviation', got {value!r}")
-    if layout not in ("auto", "single", "folder", "long", "wide", "blocks"):
+    if layout not in LAYOUTS:
         raise BadInputError(
             f"layout {layout!r} is not known; use auto, single, folder, long, wide or blocks"
         )

@@ -249,14 +249,12 @@ def test_sole_header_spacing_is_read_and_said_to_be_unconfirmed(tmp_path):
     assert "z_unconfirmed" not in ds.attrs
 
 
-def test_import_summary_says_the_spacing_is_unconfirmed(tmp_path, capsys):
+def test_import_summary_says_the_spacing_is_unconfirmed(tmp_path, capsys, run_import):
     from jointwear import io
-    from jointwear.cli import main
 
     f = _numbered(tmp_path / "sole.txt", "Layer spacing: 1 mm\n")
     out = tmp_path / "o.nc"
-    args = ["metrology", "import", str(f), "--angle-zero", "-x", "--angle-direction"]
-    assert main(args + ["clockwise", "--out", str(out)]) == 0
+    assert run_import(f, out, zero="-x", direction="clockwise") == 0
     assert "note: z from the header's Layer spacing = '1 mm' alone" in capsys.readouterr().out
     assert "alone" in io.load(out).attrs["z_unconfirmed"]
 

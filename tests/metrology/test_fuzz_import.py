@@ -43,12 +43,17 @@ def _rows(n, unit, arc_deg, kind, lu, rng):
     return cells, truth_th, truth_v
 
 
-@settings(
-    # 40 in CI; JOINTWEAR_FUZZ_EXAMPLES=2000 for a long run
-    max_examples=int(os.environ.get("JOINTWEAR_FUZZ_EXAMPLES", "40")),
-    deadline=None,
-    suppress_health_check=[HealthCheck.function_scoped_fixture],
-)
+def _fuzz(examples_in_ci: int):
+    """Hypothesis settings: ``examples_in_ci`` examples, JOINTWEAR_FUZZ_EXAMPLES=2000 for a
+    long run."""
+    return settings(
+        max_examples=int(os.environ.get("JOINTWEAR_FUZZ_EXAMPLES", str(examples_in_ci))),
+        deadline=None,
+        suppress_health_check=[HealthCheck.function_scoped_fixture],
+    )
+
+
+@_fuzz(40)
 @given(
     n=st.integers(8, 300),
     unit=st.sampled_from(["deg", "rad", "index"]),
@@ -129,11 +134,7 @@ def _num(c):
         return c
 
 
-@settings(
-    max_examples=int(os.environ.get("JOINTWEAR_FUZZ_EXAMPLES", "15")),
-    deadline=None,
-    suppress_health_check=[HealthCheck.function_scoped_fixture],
-)
+@_fuzz(15)
 @given(
     n=st.integers(12, 200),
     layers=st.integers(1, 4),
