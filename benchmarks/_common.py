@@ -39,16 +39,22 @@ def machine() -> dict[str, Any]:
 
 
 def median_time(
-    fn: Callable[[], Any], *, repeat: int = 5, warmup: int = 1
+    fn: Callable[[], Any],
+    *,
+    repeat: int = 5,
+    warmup: int = 1,
+    clock: Callable[[], float] = time.perf_counter,
 ) -> tuple[float, list[float]]:
-    """Median wall time of ``fn()`` over ``repeat`` runs after ``warmup`` runs [s]."""
+    """Median time of ``fn()`` over ``repeat`` runs after ``warmup`` runs [s]: wall time, or
+    with ``clock=time.process_time`` the CPU time of this process (less sensitive to a loaded
+    machine)."""
     for _ in range(warmup):
         fn()
     times = []
     for _ in range(repeat):
-        t0 = time.perf_counter()
+        t0 = clock()
         fn()
-        times.append(time.perf_counter() - t0)
+        times.append(clock() - t0)
     return statistics.median(times), times
 
 

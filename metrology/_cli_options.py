@@ -77,7 +77,7 @@ ImportOut = Annotated[
 PresetOpt = Annotated[
     Preset, _opt("--preset", "generic or talyrond (values in µm, whole revolutions).")
 ]
-LayoutOpt = Annotated[Layout, _opt("--layout", "auto, single, folder, long or wide.")]
+LayoutOpt = Annotated[Layout, _opt("--layout", f"{', '.join(LAYOUTS)}.")]
 Units = Annotated[
     str | None,
     _opt(
@@ -111,8 +111,8 @@ AngleUnitOpt = Annotated[
     AngleUnit | None,
     _opt(
         "--angle-unit",
-        "Unit of the angle column when the file does not state it: deg, rad or index (point "
-        "number over one turn).",
+        "Unit of the angle column when the file does not state it: deg, rad, index (point "
+        "number over one turn) or grad.",
     ),
 ]
 ArcOpt = Annotated[
