@@ -33,7 +33,7 @@ from jointwear.metrology.form import (
     normalise_reference,
 )
 
-__all__ = ["CentringWarning", "assess", "assess_points", "form_table"]
+__all__ = ["CentringWarning", "assess", "assess_points", "assess_point_file", "form_table"]
 
 _PARAMS = {"t": "peak-to-valley", "p": "peak", "v": "valley", "q": "RMS"}
 
@@ -395,6 +395,44 @@ def assess_points(
         },
     )
     return ds
+
+
+def assess_point_file(path, units: str | None = None) -> tuple[xr.Dataset, str]:
+    """:func:`assess_points` of a text/Excel file of x, y (and z) points.
+
+    Parameters
+    ----------
+    path : path
+        The file; its columns must be named X, Y (and Z).
+    units : str, optional
+        Length unit of the points when the file does not state it (um, mm, m, inch).
+
+    Returns
+    -------
+    (Dataset, str)
+        The exact least-squares circle per layer, and the unit the points were read in.
+    """
+    from jointwear.metrology.readers.table import TextFormat, parse_file, unit_factor
+
+    pf = parse_file(path, TextFormat(units=units))
+    cols = list(pf.columns)
+    if "x" not in cols or "y" not in cols:
+        raise BadInputError(
+            f"'{path}': not a netCDF scan, and its columns ({', '.join(cols)}) are not x, y "
+            "points; import instrument traces with 'jointwear metrology import' first, or name "
+            "the columns X, Y (and Z)"
+        )
+    if pf.units is None:
+        raise BadInputError(
+            f"'{path}': the length unit of the points is not stated; pass --units (um, mm, m)"
+        )
+    f = unit_factor(pf.units)
+    x, y = pf.data[:, cols.index("x")] * f, pf.data[:, cols.index("y")] * f
+    z = None
+    if "z" in cols:
+        zu = pf.column_units.get(str(cols.index("z"))) or pf.z_units or pf.units
+        z = pf.data[:, cols.index("z")] * unit_factor(zu)
+    return assess_points(x, y, z, source=str(path)), pf.units
 
 
 def form_table(result: xr.Dataset) -> pd.DataFrame:

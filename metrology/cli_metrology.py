@@ -19,29 +19,9 @@ _SOURCE = source_attribute("metrology")
 def _assess_point_file(path: Path, target: Path | None, units: str | None) -> None:
     """``assess`` of a file of Cartesian points: exact LS circle per layer, printed in mm/µm."""
     from jointwear import io
-    from jointwear.errors import BadInputError
-    from jointwear.metrology.assess import assess_points
-    from jointwear.metrology.readers.table import TextFormat, parse_file, unit_factor
+    from jointwear.metrology.assess import assess_point_file
 
-    pf = parse_file(path, TextFormat(units=units))
-    cols = list(pf.columns)
-    if "x" not in cols or "y" not in cols:
-        raise BadInputError(
-            f"'{path}': not a netCDF scan, and its columns ({', '.join(cols)}) are not x, y "
-            "points; import instrument traces with 'jointwear metrology import' first, or name "
-            "the columns X, Y (and Z)"
-        )
-    if pf.units is None:
-        raise BadInputError(
-            f"'{path}': the length unit of the points is not stated; pass --units (um, mm, m)"
-        )
-    f = unit_factor(pf.units)
-    x, y = pf.data[:, cols.index("x")] * f, pf.data[:, cols.index("y")] * f
-    z = None
-    if "z" in cols:
-        zu = pf.column_units.get(str(cols.index("z"))) or pf.z_units or pf.units
-        z = pf.data[:, cols.index("z")] * unit_factor(zu)
-    ds = assess_points(x, y, z, source=str(path))
+    ds, units = assess_point_file(path, units)
     typer.echo(f"{path}  (exact least-squares circle per layer; lengths in mm, form in µm)")
     for i in range(ds.sizes["z"]):
         typer.echo(
@@ -51,7 +31,7 @@ def _assess_point_file(path: Path, target: Path | None, units: str | None) -> No
             f"RONt {float(ds['RONt_LS'][i]) * 1e6:.4f}  RONq {float(ds['RONq_LS'][i]) * 1e6:.4f}"
         )
     if target is not None:
-        io.save(ds, target, inputs=[path], source=_SOURCE, parameters={"units": pf.units})
+        io.save(ds, target, inputs=[path], source=_SOURCE, parameters={"units": units})
         typer.echo(f"wrote {target}")
 
 
