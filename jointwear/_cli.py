@@ -38,6 +38,7 @@ __all__ = [
     "lazy_groups",
     "AngleZero",
     "AngleDirection",
+    "FigureOut",
 ]
 
 Overwrite = Annotated[
@@ -433,3 +434,8 @@ AngleDirection = Annotated[
     ),
 ]
 """``--angle-direction`` of the commands that read angles in a file's own convention."""
+
+FigureOut = Annotated[
+    Path, typer.Option("--out", "-o", help="Figure file (PNG, PDF or SVG, by its suffix).")
+]
+"""``--out`` of the commands that draw one figure."""

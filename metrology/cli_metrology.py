@@ -7,7 +7,7 @@ from typing import Annotated
 
 import typer
 
-from jointwear._cli import AngleDirection, AngleZero, Overwrite
+from jointwear._cli import AngleDirection, AngleZero, FigureOut, Overwrite
 from jointwear._version import source_attribute
 from jointwear.metrology import _cli_options as opt
 from jointwear.metrology._cli_options import FilterKind, Shape
@@ -288,9 +288,7 @@ def wearmap_cmd(
 
 def plot_cmd(
     wear: Annotated[Path, typer.Argument(help="Wear map (.nc) with wear_depth(z, theta).")],
-    out: Annotated[Path, typer.Option("--out", "-o", help="Figure file (PNG, PDF, SVG).")] = Path(
-        "wear_map.png"
-    ),
+    out: FigureOut = Path("wear_map.png"),
     overwrite: Overwrite = False,
     layers: Annotated[
         str | None,

@@ -210,6 +210,17 @@ def _initial_candidates(sectors: _Sectors, e0: np.ndarray, kind: str) -> np.ndar
     return np.unique(np.concatenate(parts))
 
 
+def _grown_candidates(res, cand: np.ndarray, n: int, what: str, why: str) -> np.ndarray | None:
+    """After the zone LP on the candidate points: None when it is solved; more candidates when
+    the subset does not surround the axis yet (unbounded) and points are left; else refused."""
+    if res.status == 3 and cand.size < n:
+        more = np.linspace(0, n - 1, min(n, 4 * cand.size), dtype=np.int64)
+        return np.union1d(cand, more)
+    if res.status != 0:
+        raise BadInputError(f"{what} could not be computed ({res.message.strip()}); {why}")
+    return None
+
+
 def _zone_lp(
     G: np.ndarray,
     r: np.ndarray,
@@ -258,17 +269,17 @@ def _zone_lp(
             b = -rs
             bounds = [(None, None)] * (m + 1)
         res = linprog(c, A_ub=A, b_ub=b, bounds=bounds, method="highs")
-        if res.status == 3 and len(cand) < len(r):
-            # the candidate subset does not surround the axis yet: take more points
-            more = np.linspace(0, len(r) - 1, min(len(r), 4 * len(cand)), dtype=np.int64)
-            cand = np.union1d(cand, more)
+        grown = _grown_candidates(
+            res,
+            cand,
+            len(r),
+            f"{what}: the {kind} reference",
+            "the points probably do not surround the axis (a closed profile needs angles "
+            "spread over more than half a turn, a cylinder at least two layers)",
+        )
+        if grown is not None:
+            cand = grown
             continue
-        if res.status != 0:
-            raise BadInputError(
-                f"{what}: the {kind} reference could not be computed ({res.message.strip()}); "
-                "the points probably do not surround the axis (a closed profile needs angles "
-                "spread over more than half a turn, a cylinder at least two layers)"
-            )
         x = res.x
         p = x[:m]
         e = r - G.dot(p)
@@ -472,15 +483,16 @@ def circle_zones(
             nrows = m
         A = coo_matrix((vals, (rows, cols)), shape=(nrows, nv * nl)).tocsr()
         res = linprog(cost, A_ub=A, b_ub=b, bounds=bounds, method="highs")
-        if res.status == 3 and cand.size < rs.size:
-            more = np.linspace(0, rs.size - 1, min(rs.size, 4 * cand.size), dtype=np.int64)
-            cand = np.union1d(cand, more)
+        grown = _grown_candidates(
+            res,
+            cand,
+            rs.size,
+            f"{what}: the {kind} reference",
+            "the points of some layer probably do not surround the axis",
+        )
+        if grown is not None:
+            cand = grown
             continue
-        if res.status != 0:
-            raise BadInputError(
-                f"{what}: the {kind} reference could not be computed ({res.message.strip()}); "
-                "the points of some layer probably do not surround the axis"
-            )
         x = res.x.reshape(nl, nv)
         e = rs - c * x[g, 0] - sn * x[g, 1]
         if kind == "MZ":
