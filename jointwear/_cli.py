@@ -36,6 +36,9 @@ __all__ = [
     "OUTPUT_PARAMS",
     "speak_flags",
     "lazy_groups",
+    "AngleZero",
+    "AngleDirection",
+    "FigureOut",
 ]
 
 Overwrite = Annotated[
@@ -410,3 +413,48 @@ def lazy_groups(groups: dict[str, str]) -> type:
             self.commands = commands
 
     return LazyGroups
+
+
+# options shared by CLIs (metrology) -------------------------------------------------------
+def _angle_direction(value: str | None) -> str | None:
+    """Check ``--angle-direction`` at parse time (a bad value is a usage error, exit 2); the
+    value is passed on as given (the library accepts ``clockwise``, ``counterclockwise``,
+    ``cw``, ``ccw``, ...)."""
+    if value is None:
+        return None
+    from jointwear.conventions import AngleConvention
+    from jointwear.errors import ConventionError
+
+    try:
+        AngleConvention("-x", value)
+    except ConventionError:
+        raise typer.BadParameter(
+            f"{value!r} is not a direction; use clockwise or counterclockwise (seen from +z)"
+        ) from None
+    return value
+
+
+AngleZero = Annotated[
+    str | None,
+    typer.Option(
+        "--angle-zero",
+        help="Where the angle's 0 points in the bearing frame: +x, +y, -x, -y or degrees "
+        "counter-clockwise from +x. Required (never guessed).",
+    ),
+]
+"""``--angle-zero`` of the commands that read angles in a file's own convention."""
+
+AngleDirection = Annotated[
+    str | None,
+    typer.Option(
+        "--angle-direction",
+        help="clockwise or counterclockwise, seen from +z. Required (never guessed).",
+        callback=_angle_direction,
+    ),
+]
+"""``--angle-direction`` of the commands that read angles in a file's own convention."""
+
+FigureOut = Annotated[
+    Path, typer.Option("--out", "-o", help="Figure file (PNG, PDF or SVG, by its suffix).")
+]
+"""``--out`` of the commands that draw one figure."""

@@ -8,7 +8,7 @@ from typing import Annotated
 
 import typer
 
-from jointwear._cli import Overwrite
+from jointwear._cli import AngleDirection, AngleZero, Overwrite
 
 app = typer.Typer(
     help="Import your own data (CSV or CF netCDF from other simulators and instruments).",
@@ -22,13 +22,6 @@ class Origin(StrEnum):
     simulated = "simulated"
     measured = "measured"
     synthetic = "synthetic"
-
-
-class Direction(StrEnum):
-    """Which way theta grows, seen from +z."""
-
-    clockwise = "clockwise"
-    counterclockwise = "counterclockwise"
 
 
 _ORIGIN = typer.Option(
@@ -113,16 +106,8 @@ def wearmap(
     out: Annotated[Path, _OUT],
     overwrite: Overwrite = False,
     origin: Annotated[Origin | None, _ORIGIN] = None,
-    angle_zero: Annotated[
-        str | None,
-        typer.Option(
-            "--angle-zero", help="Where theta = 0 points: +x, -x, +y, -y or degrees from +x."
-        ),
-    ] = None,
-    angle_direction: Annotated[
-        Direction | None,
-        typer.Option("--angle-direction", help="clockwise or counterclockwise, seen from +z."),
-    ] = None,
+    angle_zero: AngleZero = None,
+    angle_direction: AngleDirection = None,
     theta_unit: Annotated[str | None, typer.Option("--theta-unit", help="deg or rad.")] = None,
     z_unit: Annotated[str | None, typer.Option("--z-unit", help="Unit of z, e.g. mm.")] = None,
     depth_unit: Annotated[
@@ -145,7 +130,6 @@ def wearmap(
     from jointwear.errors import ParameterError
 
     origin = origin.value if origin else None
-    angle_direction = angle_direction.value if angle_direction else None
     if file.suffix.lower() in (".nc", ".nc4", ".cdf"):
         ds = external.import_cf(
             file,

@@ -33,7 +33,7 @@ from jointwear.metrology.form import (
     normalise_reference,
 )
 
-__all__ = ["CentringWarning", "assess", "assess_points", "form_table"]
+__all__ = ["CentringWarning", "assess", "assess_points", "assess_point_file", "form_table"]
 
 _PARAMS = {"t": "peak-to-valley", "p": "peak", "v": "valley", "q": "RMS"}
 
@@ -108,8 +108,6 @@ def assess(
     refs = tuple(normalise_reference(r) for r in references)
     z = np.asarray(da["z"].values, dtype=float)
     th = np.asarray(da["theta"].values, dtype=float)
-    v = np.asarray(da.values, dtype=float)
-    nz = z.size
     attrs: dict = {
         "title": "form assessment",
         "references": ",".join(refs),
@@ -118,8 +116,50 @@ def assess(
         "angle_convention_of_eccentricity_angle": f"theta of the scan (zero {da['theta'].attrs.get('angle_zero', '?')}, "
         f"{da['theta'].attrs.get('angle_direction', '?')})",
     }
-    removed = np.zeros(nz, dtype=np.int64)
     uniform = is_uniform(th)
+    v, removed = _prepare(
+        np.asarray(da.values, dtype=float), uniform, outliers, filter_upr, filter_kind, attrs
+    )
+    out, ecc = _roundness(th, v, refs)
+    out["outliers_removed"] = (
+        ("z",),
+        removed,
+        {"units": "1", "long_name": "points replaced as outliers"},
+    )
+    if radius is None:
+        radius = _bore_radius(scan, da, name, v)
+    _check_centring(ecc, radius, limacon_tolerance, attrs)
+    if z.size > 1:
+        out.update(_cylinders(z, th, v, refs))
+    if exact:
+        out.update(_exact_fits(z, th, v, name, radius))
+    coords = {"z": da["z"]}
+    if uniform and np.all(np.isfinite(v)):
+        spec = harmonic_spectrum(v, max_order=max_harmonic)
+        out["harmonic_amplitude"] = (
+            ("z", "harmonic"),
+            spec,
+            {"units": "m", "long_name": "harmonic amplitude of each layer"},
+        )
+        coords["harmonic"] = (
+            "harmonic",
+            np.arange(spec.shape[1]),
+            {"units": "1", "long_name": "harmonic order (undulations per revolution)"},
+        )
+    return xr.Dataset(out, coords=coords, attrs=attrs)
+
+
+def _prepare(
+    v: np.ndarray,
+    uniform: bool,
+    outliers: float | None,
+    filter_upr: float | None,
+    filter_kind: str,
+    attrs: dict,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Outlier removal and filtering of the (z, theta) values; returns (values, points removed
+    per layer) and records both in ``attrs``."""
+    removed = np.zeros(v.shape[0], dtype=np.int64)
     if outliers is not None:
         if not uniform:
             raise BadInputError(
@@ -143,32 +183,37 @@ def assess(
         attrs["filter"] = f"{filter_kind} {float(filter_upr):g} UPR"
     else:
         attrs["filter"] = "none"
+    return v, removed
 
+
+def _zone_params(res, what: str, desc_of: str, dims: tuple, iso: str, ref: str) -> dict:
+    """``{what}{t,p,v,q}_{ref}`` entries of one reference's zone results (``res``: one result,
+    or a list of per-layer results)."""
+    many = isinstance(res, list)
+    out = {}
+    for k, desc in _PARAMS.items():
+        attr = {"t": "total", "p": "peak", "v": "valley", "q": "rms"}[k]
+        val = np.array([getattr(r, attr) for r in res]) if many else getattr(res, attr)
+        out[f"{what}{k}_{ref}"] = (
+            dims,
+            val,
+            {"units": "m", "long_name": f"{desc_of} {what}{k} ({desc}) from the {iso} reference"},
+        )
+    return out
+
+
+def _roundness(th: np.ndarray, v: np.ndarray, refs: tuple[str, ...]) -> tuple[dict, np.ndarray]:
+    """RON{t,p,v,q} per layer for each reference, and the LS eccentricity (and its angle)."""
     out: dict[str, tuple] = {}
     ls_layers = []
     for ref in refs:
-        vals = {k: np.full(nz, np.nan) for k in _PARAMS}
         results = circle_zones(th, v, reference=ref, what="scan")
-        for i, res in enumerate(results):
-            vals["t"][i], vals["p"][i], vals["v"][i], vals["q"][i] = (
-                res.total,
-                res.peak,
-                res.valley,
-                res.rms,
-            )
         if ref == "LS":
             ls_layers = results
-        iso = REFERENCES[ref][0]
-        for k, desc in _PARAMS.items():
-            out[f"RON{k}_{ref}"] = (
-                ("z",),
-                vals[k],
-                {"units": "m", "long_name": f"roundness RON{k} ({desc}) from the {iso} reference"},
-            )
+        out.update(_zone_params(results, "RON", "roundness", ("z",), REFERENCES[ref][0], ref))
     if not ls_layers:
-        ls_layers = [circle_zone(th, v[i], reference="LS") for i in range(nz)]
+        ls_layers = [circle_zone(th, v[i], reference="LS") for i in range(v.shape[0])]
     ecc = np.array([r.eccentricity for r in ls_layers])
-    ang = np.array([r.eccentricity_angle_deg for r in ls_layers])
     out["eccentricity"] = (
         ("z",),
         ecc,
@@ -176,88 +221,58 @@ def assess(
     )
     out["eccentricity_angle"] = (
         ("z",),
-        ang,
+        np.array([r.eccentricity_angle_deg for r in ls_layers]),
         {
             "units": "degree",
             "long_name": "direction of the LS centre offset (scan's theta convention)",
         },
     )
-    out["outliers_removed"] = (
-        ("z",),
-        removed,
-        {"units": "1", "long_name": "points replaced as outliers"},
-    )
-    # centring check
-    if radius is None:
-        if name == "radius":
-            radius = float(np.nanmean(v))
-        else:
-            src = scan.attrs if isinstance(scan, xr.Dataset) else da.attrs
-            radius = src.get("nominal_radius")
-            radius = float(radius) if radius is not None else None
-    if radius is not None and radius > 0:
-        err = limacon_error(float(np.max(ecc)), radius)
-        attrs["limacon_error_max"] = err
-        if err > limacon_tolerance:
-            msg = (
-                f"eccentricity up to {np.max(ecc) * 1e6:.3g} µm on radius {radius * 1e3:.4g} mm: the "
-                f"limaçon approximation is off by up to e²/(4R) = {err * 1e9:.3g} nm (tolerance "
-                f"{limacon_tolerance * 1e9:.3g} nm); re-centre the part or rely on the exact fit"
-            )
-            warnings.warn(msg, CentringWarning, stacklevel=2)
-            attrs["centring_warning"] = msg
-    else:
+    return out, ecc
+
+
+def _bore_radius(scan, da: xr.DataArray, name: str, v: np.ndarray) -> float | None:
+    """The bore radius for the centring check: the mean radius, or the ``nominal_radius``
+    attribute of deviation data (None if unknown)."""
+    if name == "radius":
+        return float(np.nanmean(v))
+    src = scan.attrs if isinstance(scan, xr.Dataset) else da.attrs
+    radius = src.get("nominal_radius")
+    return float(radius) if radius is not None else None
+
+
+def _check_centring(ecc: np.ndarray, radius: float | None, tolerance: float, attrs: dict) -> None:
+    """Warn (:class:`CentringWarning`) when the limaçon's neglected term exceeds ``tolerance``."""
+    if radius is None or not radius > 0:
         attrs["limacon_error_max"] = "not checked: bore radius unknown (pass radius=)"
-    # cylinders
-    if nz > 1:
-        zz = np.broadcast_to(z[:, None], v.shape)
-        tt = np.broadcast_to(th[None, :], v.shape)
-        for ref in refs:
-            res = cylinder_zone(zz, tt, v, reference=ref)
-            iso = REFERENCES[ref][1]
-            for k, desc in _PARAMS.items():
-                val = {"t": res.total, "p": res.peak, "v": res.valley, "q": res.rms}[k]
-                out[f"CYL{k}_{ref}"] = (
-                    (),
-                    val,
-                    {
-                        "units": "m",
-                        "long_name": f"cylindricity CYL{k} ({desc}) from the {iso} reference",
-                    },
-                )
-            if ref == "LS":
-                out["axis_tilt_x"] = (
-                    (),
-                    res.tilt[0],
-                    {"units": "1", "long_name": "LS axis slope dx/dz (scan frame)"},
-                )
-                out["axis_tilt_y"] = (
-                    (),
-                    res.tilt[1],
-                    {"units": "1", "long_name": "LS axis slope dy/dz (scan frame)"},
-                )
-    if exact:
-        out.update(_exact_fits(z, th, v, name, radius))
-    # spectrum
-    if uniform and np.all(np.isfinite(v)):
-        spec = harmonic_spectrum(v, max_order=max_harmonic)
-        out["harmonic_amplitude"] = (
-            ("z", "harmonic"),
-            spec,
-            {"units": "m", "long_name": "harmonic amplitude of each layer"},
+        return
+    err = limacon_error(float(np.max(ecc)), radius)
+    attrs["limacon_error_max"] = err
+    if err > tolerance:
+        msg = (
+            f"eccentricity up to {np.max(ecc) * 1e6:.3g} µm on radius {radius * 1e3:.4g} mm: the "
+            f"limaçon approximation is off by up to e²/(4R) = {err * 1e9:.3g} nm (tolerance "
+            f"{tolerance * 1e9:.3g} nm); re-centre the part or rely on the exact fit"
         )
-    ds = xr.Dataset(
-        out,
-        coords={"z": da["z"]}
-        | ({"harmonic": np.arange(spec.shape[1])} if "harmonic_amplitude" in out else {}),
-        attrs=attrs,
-    )
-    if "harmonic" in ds.coords:
-        ds["harmonic"].attrs = {
-            "units": "1",
-            "long_name": "harmonic order (undulations per revolution)",
-        }
-    return ds
+        warnings.warn(msg, CentringWarning, stacklevel=3)
+        attrs["centring_warning"] = msg
+
+
+def _cylinders(z: np.ndarray, th: np.ndarray, v: np.ndarray, refs: tuple[str, ...]) -> dict:
+    """CYL{t,p,v,q} for each reference and the LS axis tilt."""
+    zz = np.broadcast_to(z[:, None], v.shape)
+    tt = np.broadcast_to(th[None, :], v.shape)
+    out: dict[str, tuple] = {}
+    for ref in refs:
+        res = cylinder_zone(zz, tt, v, reference=ref)
+        out.update(_zone_params(res, "CYL", "cylindricity", (), REFERENCES[ref][1], ref))
+        if ref == "LS":
+            for i, ax in enumerate("xy"):
+                out[f"axis_tilt_{ax}"] = (
+                    (),
+                    res.tilt[i],
+                    {"units": "1", "long_name": f"LS axis slope d{ax}/dz (scan frame)"},
+                )
+    return out
 
 
 def _exact_fits(
@@ -380,6 +395,44 @@ def assess_points(
         },
     )
     return ds
+
+
+def assess_point_file(path, units: str | None = None) -> tuple[xr.Dataset, str]:
+    """:func:`assess_points` of a text/Excel file of x, y (and z) points.
+
+    Parameters
+    ----------
+    path : path
+        The file; its columns must be named X, Y (and Z).
+    units : str, optional
+        Length unit of the points when the file does not state it (um, mm, m, inch).
+
+    Returns
+    -------
+    (Dataset, str)
+        The exact least-squares circle per layer, and the unit the points were read in.
+    """
+    from jointwear.metrology.readers.table import TextFormat, parse_file, unit_factor
+
+    pf = parse_file(path, TextFormat(units=units))
+    cols = list(pf.columns)
+    if "x" not in cols or "y" not in cols:
+        raise BadInputError(
+            f"'{path}': not a netCDF scan, and its columns ({', '.join(cols)}) are not x, y "
+            "points; import instrument traces with 'jointwear metrology import' first, or name "
+            "the columns X, Y (and Z)"
+        )
+    if pf.units is None:
+        raise BadInputError(
+            f"'{path}': the length unit of the points is not stated; pass --units (um, mm, m)"
+        )
+    f = unit_factor(pf.units)
+    x, y = pf.data[:, cols.index("x")] * f, pf.data[:, cols.index("y")] * f
+    z = None
+    if "z" in cols:
+        zu = pf.column_units.get(str(cols.index("z"))) or pf.z_units or pf.units
+        z = pf.data[:, cols.index("z")] * unit_factor(zu)
+    return assess_points(x, y, z, source=str(path)), pf.units
 
 
 def form_table(result: xr.Dataset) -> pd.DataFrame:

@@ -2,158 +2,26 @@
 
 from __future__ import annotations
 
-from enum import StrEnum
 from pathlib import Path
 from typing import Annotated
 
 import typer
 
-from jointwear._cli import Overwrite
+from jointwear._cli import AngleDirection, AngleZero, FigureOut, Overwrite
 from jointwear._version import source_attribute
-
-
-class AngleUnit(StrEnum):
-    """Unit of the angle column."""
-
-    deg = "deg"
-    rad = "rad"
-    index = "index"
-    grad = "grad"
-
-
-class Arc(StrEnum):
-    """Angular span of each layer."""
-
-    full = "full"
-    partial = "partial"
-
-
-class Preset(StrEnum):
-    """Reader preset."""
-
-    generic = "generic"
-    talyrond = "talyrond"
-
-
-class Layout(StrEnum):
-    """Multi-layer layout."""
-
-    auto = "auto"
-    single = "single"
-    folder = "folder"
-    long = "long"
-    wide = "wide"
-    blocks = "blocks"
-
-
-class Decimal(StrEnum):
-    """Decimal separator."""
-
-    point = "."
-    comma = ","
-
-
-class FilterKind(StrEnum):
-    """Profile filter."""
-
-    gaussian = "gaussian"
-    rc2 = "2rc"
-
-
-class Shape(StrEnum):
-    """Unworn reference shape."""
-
-    auto = "auto"
-    cylinder = "cylinder"
-    circle = "circle"
-    form = "form"
-
-
-class Reference(StrEnum):
-    """ISO reference."""
-
-    LS = "LS"
-    MZ = "MZ"
-    MI = "MI"
-    MC = "MC"
-
-
-class ValueKind(StrEnum):
-    """Meaning of the value column(s)."""
-
-    auto = "auto"
-    radius = "radius"
-    deviation = "deviation"
-
+from jointwear.metrology import _cli_options as opt
+from jointwear.metrology._cli_options import FilterKind, Shape
+from jointwear.metrology.choices import REFERENCES
 
 _SOURCE = source_attribute("metrology")
-
-
-def _length_unit(value: str | None) -> str | None:
-    """Validate a length-unit option at parse time (a bad value is a usage error, exit 2)."""
-    if value is None:
-        return None
-    from jointwear.errors import BadInputError
-    from jointwear.metrology.readers.table import unit_factor
-
-    try:
-        unit_factor(value)
-    except BadInputError:
-        raise typer.BadParameter(f"unit {value!r} is not known; use um, mm, m or inch") from None
-    return value
-
-
-def _outputs(inputs: list[Path], out: Path, suffix: str) -> list[Path]:
-    """One output per input: ``out`` itself for one input, ``out/<name><suffix>`` for several."""
-    if len(inputs) == 1 and out.suffix:
-        return [out]
-    out.mkdir(parents=True, exist_ok=True)
-    names = [p.stem if p.is_file() else p.name for p in inputs]
-    return [out / f"{n}{suffix}" for n in names]
-
-
-def _expand_batch(paths: list[Path], batch: bool) -> list[Path]:
-    if not batch:
-        return paths
-    from jointwear.errors import BadInputError
-
-    items: list[Path] = []
-    for p in paths:
-        if not p.is_dir():
-            raise BadInputError(f"--batch: '{p}' is not a folder of scans")
-        children = sorted(c for c in p.iterdir() if not c.name.startswith("."))
-        if not children:
-            raise BadInputError(f"--batch: folder '{p}' is empty")
-        items.extend(children)
-    return items
 
 
 def _assess_point_file(path: Path, target: Path | None, units: str | None) -> None:
     """``assess`` of a file of Cartesian points: exact LS circle per layer, printed in mm/µm."""
     from jointwear import io
-    from jointwear.errors import BadInputError
-    from jointwear.metrology.assess import assess_points
-    from jointwear.metrology.readers.table import TextFormat, parse_file, unit_factor
+    from jointwear.metrology.assess import assess_point_file
 
-    pf = parse_file(path, TextFormat(units=units))
-    cols = list(pf.columns)
-    if "x" not in cols or "y" not in cols:
-        raise BadInputError(
-            f"'{path}': not a netCDF scan, and its columns ({', '.join(cols)}) are not x, y "
-            "points; import instrument traces with 'jointwear metrology import' first, or name "
-            "the columns X, Y (and Z)"
-        )
-    if pf.units is None:
-        raise BadInputError(
-            f"'{path}': the length unit of the points is not stated; pass --units (um, mm, m)"
-        )
-    f = unit_factor(pf.units)
-    x, y = pf.data[:, cols.index("x")] * f, pf.data[:, cols.index("y")] * f
-    z = None
-    if "z" in cols:
-        zu = pf.column_units.get(str(cols.index("z"))) or pf.z_units or pf.units
-        z = pf.data[:, cols.index("z")] * unit_factor(zu)
-    ds = assess_points(x, y, z, source=str(path))
+    ds, units = assess_point_file(path, units)
     typer.echo(f"{path}  (exact least-squares circle per layer; lengths in mm, form in µm)")
     for i in range(ds.sizes["z"]):
         typer.echo(
@@ -163,199 +31,69 @@ def _assess_point_file(path: Path, target: Path | None, units: str | None) -> No
             f"RONt {float(ds['RONt_LS'][i]) * 1e6:.4f}  RONq {float(ds['RONq_LS'][i]) * 1e6:.4f}"
         )
     if target is not None:
-        io.save(ds, target, inputs=[path], source=_SOURCE, parameters={"units": pf.units})
+        io.save(ds, target, inputs=[path], source=_SOURCE, parameters={"units": units})
         typer.echo(f"wrote {target}")
 
 
+def _si(value: float | None, scale: float) -> float | None:
+    """An option given in mm/nm in SI (None stays None)."""
+    return value * scale if value is not None else None
+
+
+def _text(value) -> str | None:
+    """A choice option's value as the library's string (None stays None)."""
+    return str(value) if value is not None else None
+
+
 def import_cmd(
-    paths: Annotated[
-        list[Path],
-        typer.Argument(
-            help="Scan(s): a text export, a folder of per-layer files, or (with --batch) "
-            "folders holding many scans."
-        ),
-    ],
-    out: Annotated[
-        Path,
-        typer.Option("--out", "-o", help="Output .nc (one scan) or folder (several scans)."),
-    ] = Path("scan.nc"),
+    paths: opt.ScanPaths,
+    out: opt.ImportOut = Path("scan.nc"),
     overwrite: Overwrite = False,
-    angle_zero: Annotated[
-        str | None,
-        typer.Option(
-            "--angle-zero",
-            help="Where the instrument's 0 degree points in the bearing frame: +x, +y, -x, "
-            "-y or degrees CCW from +x. Required (never guessed).",
-        ),
-    ] = None,
-    angle_direction: Annotated[
-        str | None,
-        typer.Option(
-            "--angle-direction", help="clockwise or counterclockwise, seen from +z. Required."
-        ),
-    ] = None,
-    preset: Annotated[
-        Preset,
-        typer.Option("--preset", help="generic or talyrond (values in µm, whole revolutions)."),
-    ] = Preset.generic,
-    layout: Annotated[
-        Layout, typer.Option("--layout", help="auto, single, folder, long or wide.")
-    ] = Layout.auto,
-    units: Annotated[
-        str | None,
-        typer.Option(
-            "--units",
-            help="Length unit of files that do not state it: um, mm, m or inch (a unit the "
-            "file contradicts is an error).",
-            callback=_length_unit,
-        ),
-    ] = None,
-    delimiter: Annotated[
-        str | None, typer.Option("--delimiter", help="tab, semicolon, comma or whitespace.")
-    ] = None,
-    decimal: Annotated[
-        Decimal | None, typer.Option("--decimal", help="Decimal separator: '.' or ','.")
-    ] = None,
-    header_lines: Annotated[
-        int | None, typer.Option("--header-lines", help="Lines before the numeric table.")
-    ] = None,
-    columns: Annotated[
-        str | None,
-        typer.Option(
-            "--columns",
-            help="Comma-separated column meanings: angle_deg, angle_rad, index, x, y, z, "
-            "radius, deviation, ignore.",
-        ),
-    ] = None,
-    value: Annotated[
-        ValueKind,
-        typer.Option(
-            "--value-kind",
-            "--value",
-            help="Values are radius or deviation (auto: from the column name, else from "
-            "unambiguous numbers, else refused).",
-        ),
-    ] = ValueKind.auto,
-    angle_unit: Annotated[
-        AngleUnit | None,
-        typer.Option(
-            "--angle-unit",
-            help="Unit of the angle column when the file does not state it: deg, rad or "
-            "index (point number over one turn).",
-        ),
-    ] = None,
-    arc: Annotated[
-        Arc | None,
-        typer.Option(
-            "--arc",
-            help="Each layer is one full turn or a partial arc (settles an ambiguous angle "
-            "unit; 'full' is needed for files without an angle column).",
-        ),
-    ] = None,
-    z_units: Annotated[
-        str | None,
-        typer.Option(
-            "--z-units",
-            help="Unit of z (column, header, file names) when not stated: mm, um, m.",
-        ),
-    ] = None,
-    sheet: Annotated[
-        str | None,
-        typer.Option("--sheet", help="Worksheet of an Excel workbook with several sheets."),
-    ] = None,
-    layer_spacing_mm: Annotated[
-        float | None, typer.Option("--layer-spacing-mm", help="Layer spacing [mm].")
-    ] = None,
-    z_mid_mm: Annotated[
-        float | None,
-        typer.Option(
-            "--z-mid-mm",
-            help="Instrument height of the bearing mid-width [mm] (default: middle of the layers).",
-        ),
-    ] = None,
-    expected_points: Annotated[
-        int | None, typer.Option("--expected-points", help="Points every layer must have.")
-    ] = None,
-    allow_partial: Annotated[
-        bool, typer.Option("--allow-partial", help="Accept incomplete layers (NaN).")
-    ] = False,
-    resample: Annotated[
-        bool, typer.Option("--resample", help="Interpolate layers onto one uniform grid.")
-    ] = False,
-    batch: Annotated[
-        bool,
-        typer.Option("--batch", help="Each entry of each PATH folder is a separate scan."),
-    ] = False,
-    pattern: Annotated[
-        str,
-        typer.Option("--pattern", help="Glob of the per-layer files in a folder, e.g. '*.txt'."),
-    ] = "*",
-    instrument: Annotated[
-        str | None, typer.Option("--instrument", help="Instrument name for 'source'.")
-    ] = None,
-    ignore_header: Annotated[
-        list[str] | None,
-        typer.Option(
-            "--ignore-header",
-            help="A header claim known to be wrong (repeat): units, nominal_radius, points, "
-            "filter, layers, layer_spacing, z.",
-        ),
-    ] = None,
-    z_source: Annotated[
-        str,
-        typer.Option(
-            "--z-source",
-            help="Where z comes from: auto, option, column, numbers, manifest, header, names, "
-            "spacing (auto refuses when two sources disagree).",
-        ),
-    ] = "auto",
-    thousands: Annotated[
-        str | None,
-        typer.Option("--thousands", help="Thousands separator of the numbers: , . ' or space."),
-    ] = None,
-    radius_range_mm: Annotated[
-        tuple[float, float] | None,
-        typer.Option(
-            "--radius-range-mm", help="Plausible bore radius MIN MAX [mm] (default 0.5 2000)."
-        ),
-    ] = None,
-    max_deviation_mm: Annotated[
-        float | None,
-        typer.Option("--max-deviation-mm", help="Largest plausible |deviation| [mm] (default 1)."),
-    ] = None,
-    nominal_tolerance: Annotated[
-        float | None,
-        typer.Option(
-            "--nominal-tolerance",
-            help="Relative tolerance of the radius against the header's nominal (default 0.05).",
-        ),
-    ] = None,
-    min_form_nm: Annotated[
-        float | None,
-        typer.Option(
-            "--min-form-nm", help="Smallest plausible peak-to-valley of deviations [nm] (10)."
-        ),
-    ] = None,
+    angle_zero: AngleZero = None,
+    angle_direction: AngleDirection = None,
+    preset: opt.PresetOpt = opt.Preset.generic,
+    layout: opt.LayoutOpt = opt.Layout.auto,
+    units: opt.Units = None,
+    delimiter: opt.Delimiter = None,
+    decimal: opt.DecimalOpt = None,
+    header_lines: opt.HeaderLines = None,
+    columns: opt.Columns = None,
+    value: opt.ValueKindOpt = opt.ValueKind.auto,
+    angle_unit: opt.AngleUnitOpt = None,
+    arc: opt.ArcOpt = None,
+    z_units: opt.ZUnits = None,
+    sheet: opt.Sheet = None,
+    layer_spacing_mm: opt.LayerSpacingMm = None,
+    z_mid_mm: opt.ZMidMm = None,
+    expected_points: opt.ExpectedPoints = None,
+    allow_partial: opt.AllowPartial = False,
+    resample: opt.Resample = False,
+    batch: opt.Batch = False,
+    pattern: opt.Pattern = "*",
+    instrument: opt.Instrument = None,
+    ignore_header: opt.IgnoreHeader = None,
+    z_source: opt.ZSource = "auto",
+    thousands: opt.Thousands = None,
+    radius_range_mm: opt.RadiusRangeMm = None,
+    max_deviation_mm: opt.MaxDeviationMm = None,
+    nominal_tolerance: opt.NominalTolerance = None,
+    min_form_nm: opt.MinFormNm = None,
 ) -> None:
     """Import roundness/cylindricity text exports into contract netCDF files."""
-    from jointwear import io
-    from jointwear.metrology.readers import read_scan, read_talyrond
+    from jointwear.metrology.readers.importing import import_scans
 
-    _require_convention(angle_zero, angle_direction)
-    reader = read_talyrond if preset == "talyrond" else read_scan
-    items, targets = _import_items(paths, batch, out)
-    opts = dict(
+    options = dict(
         layout=str(layout),
         delimiter=delimiter,
-        decimal=str(decimal) if decimal is not None else None,
+        decimal=_text(decimal),
         header_lines=header_lines,
         columns=tuple(c.strip() for c in columns.split(",")) if columns else None,
         value=str(value),
-        angle_unit=str(angle_unit) if angle_unit is not None else None,
-        arc=str(arc) if arc is not None else None,
+        angle_unit=_text(angle_unit),
+        arc=_text(arc),
         z_units=z_units,
         sheet=sheet,
-        layer_spacing=layer_spacing_mm * 1e-3 if layer_spacing_mm is not None else None,
+        layer_spacing=_si(layer_spacing_mm, 1e-3),
         z_mid=z_mid_mm * 1e-3 if z_mid_mm is not None else "centre",
         expected_points=expected_points,
         allow_partial=allow_partial,
@@ -365,109 +103,45 @@ def import_cmd(
         z_source=z_source,
         thousands=thousands,
         radius_range=tuple(v * 1e-3 for v in radius_range_mm) if radius_range_mm else None,
-        max_deviation=max_deviation_mm * 1e-3 if max_deviation_mm is not None else None,
+        max_deviation=_si(max_deviation_mm, 1e-3),
         nominal_tolerance=nominal_tolerance,
-        min_form=min_form_nm * 1e-9 if min_form_nm is not None else None,
+        min_form=_si(min_form_nm, 1e-9),
     )
     if instrument is not None:
-        opts["instrument"] = instrument
+        options["instrument"] = instrument
     if units is not None:
-        opts["units"] = units
-    for item, target in zip(items, targets, strict=True):
-        io.check_writable(target)
-        ds = reader(item, convention=(angle_zero, angle_direction), **opts)
-        files = ds.attrs.get("files", [])
-        io.save(
-            ds,
-            target,
-            inputs=[Path(f) for f in files],
-            parameters={"angle_zero": angle_zero, "angle_direction": angle_direction, **opts},
-            source=ds.attrs.get("source", _SOURCE),
-        )
+        options["units"] = units
+
+    def summary(target: Path, ds) -> None:
         var = "radius" if "radius" in ds else "radial_deviation"
         typer.echo(
             f"{target}: {var} {ds.sizes['z']} layers x {ds.sizes['theta']} points "
             f"(instrument 0 deg along {angle_zero}, {ds.attrs['instrument_angle_direction']})"
         )
+        if ds.attrs.get("z_unconfirmed"):
+            typer.echo(f"  note: {ds.attrs['z_unconfirmed']}")
 
-
-def _require_convention(angle_zero: str | None, angle_direction: str | None) -> None:
-    if angle_zero is None or angle_direction is None:
-        from jointwear.errors import ConventionError
-
-        raise ConventionError(
-            "give the instrument's angle convention: --angle-zero (where its 0 degree points "
-            "in the bearing frame: +x, +y, -x, -y or degrees) and --angle-direction "
-            "(clockwise or counterclockwise seen from +z); text exports rarely state it and "
-            "jointwear never guesses it"
-        )
-
-
-def _import_items(paths: list[Path], batch: bool, out: Path) -> tuple[list, list[Path]]:
-    """(what to import: a path or a list of layer files per scan, the output of each)."""
-    from jointwear.errors import BadInputError
-
-    if batch:
-        items: list = _expand_batch(paths, batch)
-    elif len(paths) > 1 and all(p.is_file() for p in paths):
-        items = [list(paths)]  # several files: the layers of one scan
-    else:
-        items = list(paths)
-    names = [i if isinstance(i, Path) else i[0].parent for i in items]
-    if len(items) > 1 and out.suffix:
-        raise BadInputError(f"{len(items)} scans to import: --out must be a folder, not '{out}'")
-    return items, _outputs(names, out, ".nc")
+    import_scans(
+        paths,
+        out,
+        angle_zero=angle_zero,
+        angle_direction=angle_direction,
+        preset=str(preset),
+        batch=batch,
+        on_saved=summary,
+        **options,
+    )
 
 
 def assess_cmd(
-    scans: Annotated[
-        list[Path],
-        typer.Argument(
-            help="Imported scan(s) (.nc), or text/Excel files of x, y (and z) points, which "
-            "get an exact least-squares circle per layer (need not surround the origin)."
-        ),
-    ],
-    filter_upr: Annotated[
-        float | None,
-        typer.Option(
-            "--filter",
-            help="Filter cut-off in UPR (undulations per revolution), e.g. 15, 50, 150, 500.",
-        ),
-    ] = None,
-    filter_kind: Annotated[
-        FilterKind, typer.Option("--filter-kind", help="gaussian or 2rc.")
-    ] = FilterKind.gaussian,
-    reference: Annotated[
-        list[Reference] | None,
-        typer.Option("--reference", "-r", help="LS, MZ, MI, MC (repeat; default: all four)."),
-    ] = None,
-    outliers: Annotated[
-        float | None,
-        typer.Option("--outliers", help="Remove spikes beyond this many robust std devs."),
-    ] = None,
-    exact: Annotated[
-        bool,
-        typer.Option(
-            "--exact",
-            help="Also the exact geometric LS circle per layer (and cylinder for several layers).",
-        ),
-    ] = False,
-    nominal_radius_mm: Annotated[
-        float | None,
-        typer.Option(
-            "--nominal-radius-mm",
-            help="Bore radius in mm for the centring check and --exact on deviation data "
-            "(default: the mean radius, or the file's nominal radius).",
-        ),
-    ] = None,
-    units: Annotated[
-        str | None,
-        typer.Option(
-            "--units",
-            help="Length unit of a point file that does not state it: um, mm, m or inch.",
-            callback=_length_unit,
-        ),
-    ] = None,
+    scans: opt.AssessScans,
+    filter_upr: opt.FilterUpr = None,
+    filter_kind: opt.FilterKindOpt = FilterKind.gaussian,
+    reference: opt.ReferenceOpt = None,
+    outliers: opt.Outliers = None,
+    exact: opt.Exact = False,
+    nominal_radius_mm: opt.NominalRadiusMm = None,
+    units: opt.Units = None,
     csv: Annotated[Path | None, typer.Option("--csv", help="Write the table as CSV.")] = None,
     out: Annotated[
         Path | None,
@@ -482,12 +156,13 @@ def assess_cmd(
 
     from jointwear import io
     from jointwear.metrology.assess import CentringWarning, assess, form_table
+    from jointwear.metrology.readers.importing import output_paths
 
-    refs = tuple(str(r) for r in reference) if reference else ("LS", "MZ", "MI", "MC")
+    refs = tuple(str(r) for r in reference) if reference else tuple(REFERENCES)
     filter_kind = str(filter_kind)
     if csv is not None:
         io.check_writable(csv)
-    targets = _outputs(scans, out, "_form.nc") if out is not None else [None] * len(scans)
+    targets = output_paths(scans, out, "_form.nc") if out is not None else [None] * len(scans)
     tables = []
     if nominal_radius_mm is not None and not nominal_radius_mm > 0:
         raise typer.BadParameter(
@@ -567,9 +242,10 @@ def wearmap_cmd(
 ) -> None:
     """Wear depth over (z, theta) from a worn scan and a before-scan or fitted reference."""
     from jointwear import io
+    from jointwear.metrology.readers.importing import output_paths
     from jointwear.metrology.wearmap import wear_map
 
-    targets = _outputs(worn, out, "_wear.nc")
+    targets = output_paths(worn, out, "_wear.nc")
     ref = io.load(before) if before is not None else None
     for path, target in zip(worn, targets, strict=True):
         io.check_writable(target)
@@ -612,9 +288,7 @@ def wearmap_cmd(
 
 def plot_cmd(
     wear: Annotated[Path, typer.Argument(help="Wear map (.nc) with wear_depth(z, theta).")],
-    out: Annotated[Path, typer.Option("--out", "-o", help="Figure file (PNG, PDF, SVG).")] = Path(
-        "wear_map.png"
-    ),
+    out: FigureOut = Path("wear_map.png"),
     overwrite: Overwrite = False,
     layers: Annotated[
         str | None,

@@ -31,6 +31,7 @@ import xarray as xr
 from scipy.optimize import linprog
 
 from jointwear.errors import BadInputError
+from jointwear.metrology.choices import REFERENCES
 
 __all__ = [
     "REFERENCES",
@@ -44,13 +45,6 @@ __all__ = [
     "limacon_error",
 ]
 
-#: Reference names accepted (short form -> ISO circle / cylinder names).
-REFERENCES: dict[str, tuple[str, str]] = {
-    "LS": ("LSCI", "LSCY"),
-    "MZ": ("MZCI", "MZCY"),
-    "MI": ("MICI", "MICY"),
-    "MC": ("MCCI", "MCCY"),
-}
 _ALIASES = {
     **{k: k for k in REFERENCES},
     **{v[0]: k for k, v in REFERENCES.items()},
@@ -205,6 +199,28 @@ class _Sectors:
         return self.order[hit[first]], mx
 
 
+def _initial_candidates(sectors: _Sectors, e0: np.ndarray, kind: str) -> np.ndarray:
+    """The points the zone LP starts from: per sector the largest residual (MZ, MC) and the
+    smallest (MZ, MI) of the LS solution."""
+    parts = []
+    if kind in ("MZ", "MC"):
+        parts.append(sectors.argmax(e0)[0])
+    if kind in ("MZ", "MI"):
+        parts.append(sectors.argmax(-e0)[0])
+    return np.unique(np.concatenate(parts))
+
+
+def _grown_candidates(res, cand: np.ndarray, n: int, what: str, why: str) -> np.ndarray | None:
+    """After the zone LP on the candidate points: None when it is solved; more candidates when
+    the subset does not surround the axis yet (unbounded) and points are left; else refused."""
+    if res.status == 3 and cand.size < n:
+        more = np.linspace(0, n - 1, min(n, 4 * cand.size), dtype=np.int64)
+        return np.union1d(cand, more)
+    if res.status != 0:
+        raise BadInputError(f"{what} could not be computed ({res.message.strip()}); {why}")
+    return None
+
+
 def _zone_lp(
     G: np.ndarray,
     r: np.ndarray,
@@ -222,12 +238,7 @@ def _zone_lp(
     m = G.shape[1]
     p0, _ = _ls(G, r)
     e0 = r - G.dot(p0)
-    parts = []
-    if kind in ("MZ", "MC"):
-        parts.append(sectors.argmax(e0)[0])
-    if kind in ("MZ", "MI"):
-        parts.append(sectors.argmax(-e0)[0])
-    cand = np.unique(np.concatenate(parts))
+    cand = _initial_candidates(sectors, e0, kind)
     tol = _TOL * _SCALE
     for _ in range(200):
         Gs, rs = G.rows(cand), r[cand]
@@ -258,17 +269,17 @@ def _zone_lp(
             b = -rs
             bounds = [(None, None)] * (m + 1)
         res = linprog(c, A_ub=A, b_ub=b, bounds=bounds, method="highs")
-        if res.status == 3 and len(cand) < len(r):
-            # the candidate subset does not surround the axis yet: take more points
-            more = np.linspace(0, len(r) - 1, min(len(r), 4 * len(cand)), dtype=np.int64)
-            cand = np.union1d(cand, more)
+        grown = _grown_candidates(
+            res,
+            cand,
+            len(r),
+            f"{what}: the {kind} reference",
+            "the points probably do not surround the axis (a closed profile needs angles "
+            "spread over more than half a turn, a cylinder at least two layers)",
+        )
+        if grown is not None:
+            cand = grown
             continue
-        if res.status != 0:
-            raise BadInputError(
-                f"{what}: the {kind} reference could not be computed ({res.message.strip()}); "
-                "the points probably do not surround the axis (a closed profile needs angles "
-                "spread over more than half a turn, a cylinder at least two layers)"
-            )
         x = res.x
         p = x[:m]
         e = r - G.dot(p)
@@ -436,12 +447,7 @@ def circle_zones(
         p[i] = sol[:2]
     e0 = rs - c * p[g, 0] - sn * p[g, 1]
     sectors = _Sectors(t, g, 64)
-    parts = []
-    if kind in ("MZ", "MC"):
-        parts.append(sectors.argmax(e0)[0])
-    if kind in ("MZ", "MI"):
-        parts.append(sectors.argmax(-e0)[0])
-    cand = np.unique(np.concatenate(parts))
+    cand = _initial_candidates(sectors, e0, kind)
     nv = 4 if kind == "MZ" else 3  # per layer: x, y, a [, t]
     tol = _TOL * _SCALE
     for _ in range(200):
@@ -477,15 +483,16 @@ def circle_zones(
             nrows = m
         A = coo_matrix((vals, (rows, cols)), shape=(nrows, nv * nl)).tocsr()
         res = linprog(cost, A_ub=A, b_ub=b, bounds=bounds, method="highs")
-        if res.status == 3 and cand.size < rs.size:
-            more = np.linspace(0, rs.size - 1, min(rs.size, 4 * cand.size), dtype=np.int64)
-            cand = np.union1d(cand, more)
+        grown = _grown_candidates(
+            res,
+            cand,
+            rs.size,
+            f"{what}: the {kind} reference",
+            "the points of some layer probably do not surround the axis",
+        )
+        if grown is not None:
+            cand = grown
             continue
-        if res.status != 0:
-            raise BadInputError(
-                f"{what}: the {kind} reference could not be computed ({res.message.strip()}); "
-                "the points of some layer probably do not surround the axis"
-            )
         x = res.x.reshape(nl, nv)
         e = rs - c * x[g, 0] - sn * x[g, 1]
         if kind == "MZ":

@@ -14,6 +14,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 
 from jointwear.errors import BadInputError
+from jointwear.metrology.choices import PLAUSIBILITY
 
 __all__ = ["Refusal", "advise", "plausibility", "PLAUSIBILITY"]
 
@@ -66,20 +67,6 @@ def advise(options: list[tuple[Mapping, str]]) -> tuple[str, tuple[dict, ...]]:
         for opts, why in options
     ]
     return "pass " + ", or ".join(parts), tuple(dict(o) for o, _ in options)
-
-
-#: Plausibility limits of the header cross-checks (override with the same-named options).
-PLAUSIBILITY: dict[str, float] = {
-    "radius_min": 0.5e-3,  # [m] smallest bore/shaft radius a roundness instrument measures here
-    "radius_max": 2.0,  # [m] largest
-    "max_deviation": 1e-3,  # [m] largest |radial deviation| (a roundness gauge's range)
-    "min_form": 10e-9,  # [m] smallest peak-to-valley of a deviation trace (below any probe noise)
-    "nominal_tolerance": 0.05,  # relative: measured radius within 5 % of the stated nominal
-    "deviation_fraction": 0.05,  # |deviation| at most 5 % of the stated nominal radius
-    "spacing_tolerance": 0.01,  # relative: stated layer spacing vs the layers found
-    "points_tolerance": 0.01,  # relative: stated angular step vs the step of the angles
-    "filter_ratio": 0.1,  # high-band / mid-band amplitude above which a filter claim is false
-}
 
 
 def plausibility(**overrides: float | None) -> dict[str, float]:

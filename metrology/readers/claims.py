@@ -2,7 +2,7 @@
 
 A header line is a claim about the table under it; a claim the numbers contradict is refused,
 naming both and the option that settles it (:class:`~.advice.Refusal`), never silently
-believed or silently overridden. Checked here (limits in :data:`~.advice.PLAUSIBILITY`,
+believed or silently overridden. Checked here (limits in :data:`~jointwear.metrology.choices.PLAUSIBILITY`,
 overridable):
 
 * the length unit against the magnitude of the values: a radius must make a bore of plausible
@@ -12,7 +12,11 @@ overridable):
 * the points per revolution against the rows of a layer and its angular step;
 * a stated Gaussian filter against the spectrum (a profile filtered at k_c UPR holds almost
   nothing above 3 k_c);
-* the stated number of layers and layer spacing against the layers found (:func:`check_layers`).
+* the stated number of layers, z extent and layer spacing against the layers found
+  (:func:`check_layers`); a layer spacing that is the only source of z is recorded as
+  unconfirmed unless a z extent confirms it, and refused when its key does not say it is
+  between layers (``Spacing``, ``Pitch``);
+* an inch/mm slip: the 25.4 ratio is named in the refusal of a radius magnitude or a nominal.
 
 A claim the user knows to be wrong is dropped with ``ignore_header=<claim>`` (CLI
 ``--ignore-header``), and the dropped claim is recorded.
@@ -51,6 +55,10 @@ CLAIMS: dict[str, re.Pattern] = {
     ),
     "layer_spacing": re.compile(
         r"^((layer|plane|trace)[ _]?(spacing|pitch|step|distance)|spacing|pitch)$", re.I
+    ),
+    "z_extent": re.compile(
+        r"^((z|height|axial)[ _]?(range|span|extent)|axial length|total height)$",
+        re.I,
     ),
     "z": re.compile(
         r"^(z|z[ _]?position|height|level|layer[ _]?height|position|axial position|"
@@ -118,6 +126,16 @@ def _fmt(v_m: float) -> str:
 _TRY_UNITS = ("um", "mm", "m", "inch")
 
 
+def _ratio(unit: str, other: str) -> str:
+    """How many times a value in ``other`` is the same number in ``unit``: ``25.4`` and
+    ``1/25.4`` (an inch/mm slip) spelled exactly, else to 4 digits."""
+    k = unit_factor(other) / unit_factor(unit)
+    for exact, text in ((25.4, "25.4"), (1 / 25.4, "1/25.4")):
+        if abs(k / exact - 1) < 1e-9:
+            return text
+    return f"{k:.4g}"
+
+
 def check_magnitude(
     values: np.ndarray,
     kind: str,
@@ -143,7 +161,7 @@ def check_magnitude(
     meta : dict
         Header metadata (for the nominal radius).
     limits : dict
-        Plausibility limits (:data:`~.advice.PLAUSIBILITY` with overrides).
+        Plausibility limits (:data:`~jointwear.metrology.choices.PLAUSIBILITY` with overrides).
     """
     v = np.asarray(values, dtype=float)
     v = v[np.isfinite(v)]
@@ -166,7 +184,8 @@ def check_magnitude(
                 [
                     (
                         _units_fix(stated_by_file, u),
-                        f"if the values are in {u}: a radius of {_fmt(med * unit_factor(u))}",
+                        f"if the values are in {u}: a radius of {_fmt(med * unit_factor(u))}, "
+                        f"{_ratio(unit, u)} x the {unit} reading",
                     )
                     for u in alts
                 ]
@@ -180,24 +199,28 @@ def check_magnitude(
                 sugg,
             )
         if nominal is not None and not _agree(r, nominal[1], limits):
-            alts = [
-                (_units_fix(stated_by_file, u), f"if the values are in {u}")
+            agree = [
+                u
                 for u in _TRY_UNITS
                 if unit_factor(u) != f and _agree(med * unit_factor(u), nominal[1], limits)
             ]
+            alts = [(_units_fix(stated_by_file, u), f"if the values are in {u}") for u in agree]
             alts.append(
                 ({"ignore_header": ("nominal_radius",)}, f"if the header's {nominal[0]!r} is wrong")
             )
             text, sugg = advise(alts)
-            twice = (
-                " (twice the nominal: is the header's radius a diameter?)"
-                if abs(r / nominal[1] - 2) < limits["nominal_tolerance"]
-                else ""
-            )
+            if abs(r / nominal[1] - 2) < limits["nominal_tolerance"]:
+                why = f"{r / nominal[1]:.3g} x: is the header's radius a diameter?"
+            elif agree:  # name the unit ratio exactly: 25.4 is an inch/mm slip
+                why = f"{_ratio(agree[0], unit)} x: values in {agree[0]} read as {unit}?"
+            elif _agree(r, nominal[1] * 25.4, limits) or _agree(r, nominal[1] / 25.4, limits):
+                k = "25.4" if r > nominal[1] else "1/25.4"
+                why = f"{k} x: an inch/mm slip between the nominal and the values?"
+            else:
+                why = f"{r / nominal[1]:.3g} x"
             raise Refusal(
                 f"{where}: the header says {nominal[0]} = {meta[nominal[0]]!r} ({_fmt(nominal[1])} "
-                f"radius) but the measured radii are about {_fmt(r)} ({r / nominal[1]:.3g} x)"
-                f"{twice}, beyond the {limits['nominal_tolerance']:.0%} tolerance "
+                f"radius) but the measured radii are about {_fmt(r)} ({why}), beyond the {limits['nominal_tolerance']:.0%} tolerance "
                 f"(nominal_tolerance); {text}",
                 sugg,
             )
@@ -390,34 +413,127 @@ def check_filter(
     return f"header {key} = {text!r}: consistent with the spectrum (ratio {ratio:.2g})"
 
 
-def check_layers(layers, meta: dict[str, str], zsrc: str, limits: dict, where: str) -> None:
-    """Refuse a stated number of layers or layer spacing that the layers found contradict."""
+def _z_extent(meta: dict[str, str], z_unit: str | None) -> tuple[str, str, float] | None:
+    """(key, value, stated z extent [m]) from a ``Z range: 0 - 4 mm`` / ``Total height: 4 mm``
+    line, else None (also when it gives no unit and the file states none for z)."""
+    c = claim(meta, "z_extent")
+    if c is None:
+        return None
+    m = re.match(
+        rf"^\s*({_NUMU})(?:\s*(?:-|–|to|\.\.|…)\s*({_NUMU}))?\s*([A-Za-zµμ\"]+)?\s*$", c[1]
+    )
+    unit = (m.group(3) if m else None) or z_unit
+    if m is None or unit is None:
+        return None
+    a = float(m.group(1).replace(",", "."))
+    b = float(m.group(2).replace(",", ".")) if m.group(2) else 0.0
+    try:
+        return c[0], c[1], abs(b - a) * unit_factor(unit)
+    except Exception:  # not a length unit: not a z extent
+        return None
+
+
+def check_layers(layers, meta: dict[str, str], zsrc: str, limits: dict, where: str) -> str | None:
+    """Refuse a stated number of layers, layer spacing or z extent that the layers found
+    contradict.
+
+    Returns
+    -------
+    str or None
+        A note when z rests on the header's layer spacing alone (nothing in the file confirms
+        it: no z column, per-layer heights or stated z extent); the reader records it in the
+        ``z_unconfirmed`` attribute and the import summary prints it.
+    """
     c = claim(meta, "layers")
     if c is not None:
         m = re.match(r"^\s*(\d+)\s*$", c[1])
         if m and int(m.group(1)) != len(layers):
-            text, sugg = advise(
-                [({"ignore_header": ("layers",)}, "if the header's count is wrong")]
+            _refuse_claim(
+                where,
+                c,
+                f"but {len(layers)} layer(s) were found; a missing or extra layer file/block? "
+                "restore it, or",
+                "layers",
+                "count",
             )
-            raise Refusal(
-                f"{where}: the header says {c[0]} = {c[1]!r} but {len(layers)} layer(s) were "
-                f"found; a missing or extra layer file/block? restore it, or {text}",
-                sugg,
-            )
+    if len(layers) < 2:
+        return None
+    zs = np.sort([lay.z for lay in layers])
+    ext = _z_extent(meta, None)
+    if (
+        ext is not None
+        and abs((zs[-1] - zs[0]) - ext[2]) > limits["spacing_tolerance"] * ext[2] + 1e-9
+    ):
+        sp = claim(meta, "layer_spacing")
+        also = (
+            [
+                (
+                    {"ignore_header": ("layer_spacing",), "layer_spacing": "<m>"},
+                    f"if the header's {sp[0]!r} is wrong",
+                )
+            ]
+            if sp is not None and "header" in zsrc and sp[0] in zsrc
+            else []
+        )
+        _refuse_claim(
+            where,
+            ext[:2],
+            f"but the layers span {_fmt(zs[-1] - zs[0])} (z from the {zsrc});",
+            "z_extent",
+            "z extent",
+            also,
+        )
     c = claim(meta, "layer_spacing")
-    if c is None or "header" in zsrc and c[0] in zsrc or len(layers) < 2:
-        return
-    stated = _length(c[1], None)
-    if stated is None:
-        return
-    d = np.diff(np.sort([lay.z for lay in layers]))
-    found = float(np.median(d))
+    stated = None if c is None else _length(c[1], None)
+    if c is None or stated is None:
+        return None
+    if "header" in zsrc and c[0] in zsrc:  # the header's spacing is the source of z
+        return _sole_spacing(c, ext, len(layers), where)
+    found = float(np.median(np.diff(zs)))
     if abs(found - stated) > limits["spacing_tolerance"] * stated:
+        _refuse_claim(
+            where,
+            c,
+            f"({_fmt(stated)}) but the layers are {_fmt(found)} apart (z from the {zsrc});",
+            "layer_spacing",
+            "spacing",
+        )
+    return None
+
+
+def _refuse_claim(
+    where: str, c: tuple[str, str], found: str, name: str, what: str, also: list = ()
+) -> None:
+    """Refuse header line ``c`` (claim ``name``) that ``found`` contradicts (``found`` ends
+    with the separator before "pass ignore_header=..."; ``also``: further fixes)."""
+    text, sugg = advise([({"ignore_header": (name,)}, f"if the header's {what} is wrong"), *also])
+    raise Refusal(f"{where}: the header says {c[0]} = {c[1]!r} {found} {text}", sugg)
+
+
+def _sole_spacing(c: tuple[str, str], ext, n_layers: int, where: str) -> str:
+    """The header's layer spacing gives z alone: refuse a key that does not say it is between
+    layers (``Spacing``, ``Pitch``: the sampling step of the trace as much as the layers'),
+    else say what confirms it, or that nothing does."""
+    if not re.match(r"^(layer|plane|trace)", c[0].strip(), re.I):
         text, sugg = advise(
-            [({"ignore_header": ("layer_spacing",)}, "if the header's spacing is wrong")]
+            [
+                ({"layer_spacing": "<m>"}, f"if {c[0].strip()!r} is the distance between layers"),
+                (
+                    {"ignore_header": ("layer_spacing",), "layer_spacing": "<m>"},
+                    f"the distance between layers, if {c[0].strip()!r} is another spacing",
+                ),
+            ]
         )
         raise Refusal(
-            f"{where}: the header says {c[0]} = {c[1]!r} ({_fmt(stated)}) but the layers are "
-            f"{_fmt(found)} apart (z from the {zsrc}); {text}",
+            f"{where}: z would come from the header's {c[0]} = {c[1]!r} alone, and "
+            f"{c[0].strip()!r} does not say it is the distance between layers (a sampling "
+            f"step along the trace is written the same way); {text}",
             sugg,
         )
+    if ext is not None:
+        return ""  # the stated z extent agrees (checked above)
+    return (
+        f"z from the header's {c[0]} = {c[1]!r} alone over {n_layers} layers: nothing in the "
+        "file confirms it (no z column, per-layer heights or z range); check it, or pass "
+        "layer_spacing=<m> (--layer-spacing-mm)"
+    )

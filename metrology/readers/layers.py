@@ -19,6 +19,7 @@ from jointwear.metrology.readers.meaning import (
     absurd_length,
     angle_reading,
     closed_profile,
+    oriented_steps,
     rounded_full_turn,
 )
 from jointwear.metrology.readers.meaning import value_kind as decide_value_kind
@@ -87,12 +88,8 @@ def _check_angles(theta: np.ndarray, pf: ParsedFile, rows: np.ndarray, where: st
     th = np.asarray(theta, dtype=float)
     if th.size < 3:
         return th
-    d = np.diff(th)
-    sgn = 1.0 if np.sum(d > 0) >= np.sum(d < 0) else -1.0
-    d = d * sgn
-    # allow one wrap of about -360
-    wraps = np.flatnonzero(d < -180.0)
-    if wraps.size == 1:
+    sgn, d, wraps = oriented_steps(th)
+    if wraps.size == 1:  # allow one wrap of about -360
         th = th.copy()
         th[wraps[0] + 1 :] += sgn * 360.0
         d = np.diff(th) * sgn

@@ -20,6 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from jointwear.errors import BadInputError
+from jointwear.metrology.choices import ANGLE_UNITS, ARCS, VALUE_KINDS
 from jointwear.metrology.readers.advice import Refusal
 
 __all__ = [
@@ -32,14 +33,8 @@ __all__ = [
     "value_kind",
 ]
 
-#: Units an angle column may have (``index`` = sample number over one full turn).
-ANGLE_UNITS = ("deg", "rad", "index", "grad")
 #: One full turn in each angle unit that has one.
 TURN = {"deg": 360.0, "rad": 2.0 * np.pi, "grad": 400.0}
-#: Angular spans a layer may have.
-ARCS = ("full", "partial")
-#: Meanings of a value column.
-VALUE_KINDS = ("radius", "deviation")
 
 _ANGLE_FLAG = "angle_unit= (CLI --angle-unit deg|rad|index|grad)"
 _ARC_FLAG = "arc= (CLI --arc full|partial)"
@@ -91,6 +86,15 @@ class AngleReading:
         return f"as {name}: {what}"
 
 
+def oriented_steps(th: np.ndarray) -> tuple[float, np.ndarray, np.ndarray]:
+    """(direction +1/-1 of most steps, the steps times it, where a step wraps back through 360:
+    indices of steps below -180 degree)."""
+    d = np.diff(th)
+    sgn = 1.0 if np.sum(d > 0) >= np.sum(d < 0) else -1.0
+    d = d * sgn
+    return sgn, d, np.flatnonzero(d < -180.0)
+
+
 def angle_span(theta_deg: np.ndarray) -> float:
     """Span of monotonic angles including one sample step [degree]; one wrap through 360 allowed.
 
@@ -102,10 +106,7 @@ def angle_span(theta_deg: np.ndarray) -> float:
     th = np.asarray(theta_deg, dtype=float)
     if th.size < 2:
         return 0.0
-    d = np.diff(th)
-    sgn = 1.0 if np.sum(d > 0) >= np.sum(d < 0) else -1.0
-    d = d * sgn
-    wraps = np.flatnonzero(d < -180.0)
+    _, d, wraps = oriented_steps(th)
     if wraps.size == 1:
         d = d.copy()
         d[wraps[0]] += 360.0
@@ -403,21 +404,20 @@ def value_kind(
                 ),
                 () if stated else ({"value": "deviation"},),
             )
-        if stated is None and robust_dev and not robust_radius:
+    if kind in VALUE_KINDS:  # named (or stated): unless the numbers clearly say the other
+        if kind == "radius":
+            other, looks = "deviation", robust_dev and not robust_radius
+            seen = f"({finite.min():g} to {finite.max():g}) look like deviations about zero"
+        else:
+            other, looks = "radius", robust_radius and not robust_dev
+            seen = f"(median {med:g}, spread {spread:g}) look like radii"
+        if stated is None and looks:
             raise Refusal(
-                f"{where}: the column name says radius but the values ({finite.min():g} to "
-                f"{finite.max():g}) look like deviations about zero; say which with {_VALUE_FLAG}",
-                ({"value": "radius"}, {"value": "deviation"}),
+                f"{where}: the column name says {kind} but the values {seen}; say which with "
+                f"{_VALUE_FLAG}",
+                ({"value": kind}, {"value": other}),
             )
-        return "radius", ("stated" if stated else "from the column name")
-    if kind == "deviation":
-        if stated is None and robust_radius and not robust_dev:
-            raise Refusal(
-                f"{where}: the column name says deviation but the values (median {med:g}, spread "
-                f"{spread:g}) look like radii; say which with {_VALUE_FLAG}",
-                ({"value": "deviation"}, {"value": "radius"}),
-            )
-        return "deviation", ("stated" if stated else "from the column name")
+        return kind, ("stated" if stated else "from the column name")
     if robust_radius and rows_bad.size == 0 and ptp < med / 25:
         return "radius", (f"radius: values positive, median {med:g} over 25 x their spread {ptp:g}")
     if robust_dev and not robust_radius:

@@ -48,6 +48,7 @@ from jointwear.conventions import (
     AngleConvention,
 )
 from jointwear.errors import BadInputError
+from jointwear.metrology.choices import LAYOUTS, VALUE_KINDS
 from jointwear.metrology.readers.advice import plausibility
 from jointwear.metrology.readers.claims import check_layers
 from jointwear.metrology.readers.dataset import _as_convention, _assemble
@@ -112,16 +113,16 @@ def read_scan(
     Parameters
     ----------
     paths : path, folder or list of paths
-        One file (single trace, long or wide layout), a folder of per-layer files, or a list of
-        per-layer files.
+        One file (single trace, long, wide or blocks layout), a folder or list of layer files.
     convention : AngleConvention or (zero, direction)
         The instrument's angle convention in the bearing frame. Required: never guessed.
-    layout : {"auto", "single", "folder", "long", "wide"}
-        Multi-layer layout (``auto``: a folder/list -> folder; a z column -> long; several
-        value columns -> wide; else single).
+    layout : {"auto", "single", "folder", "long", "wide", "blocks"}
+        Multi-layer layout (``auto``: a folder/list -> folder; layer blocks in one file ->
+        blocks; a z column -> long; several value columns -> wide; else single).
     fmt : TextFormat, optional
         Format overrides (or give ``delimiter``, ``decimal``, ``header_lines``, ``columns``,
-        ``units`` directly).
+        ``units``, ``thousands`` -- the thousands separator, sniffed only where unambiguous --
+        and ``sheet`` -- of an Excel workbook with several sheets of data -- directly).
     value : {"auto", "radius", "deviation"}
         Meaning of the value column(s) when the column names do not say it (``auto``: from the
         numbers if they are unambiguous, else refused).
@@ -133,8 +134,6 @@ def read_scan(
         unit, and is required (``"full"``) for files without an angle column.
     z_units : str, optional
         Unit of z (long-file column, header keyword, file names, manifest) when not stated.
-    sheet : str, optional
-        Worksheet of an Excel workbook with several sheets of data.
     z : sequence of float, optional
         Instrument height of each layer [m], in file/column order (overrides everything else).
     layer_spacing : float, optional
@@ -143,38 +142,29 @@ def read_scan(
         Instrument height of the bearing mid-width [m]; ``"centre"`` = middle of the layers.
     expected_points : int, optional
         Points each layer must have (e.g. 18000); a shorter layer is an error.
-    allow_partial : bool
-        Accept layers with fewer points (missing points become NaN).
-    resample : bool
-        Interpolate layers with different angle samples onto one uniform grid.
+    allow_partial, resample : bool
+        Accept layers with fewer points (missing points become NaN); interpolate layers with
+        different angle samples onto one uniform grid.
     pattern : str
         Glob pattern of the per-layer files in a folder (manifest files are skipped).
     instrument : str, optional
         Instrument name for ``source`` (default: from the header, else ``"roundness instrument"``).
     ignore_header : sequence of str
         Header claims known to be wrong, dropped before reading (``units``, ``nominal_radius``,
-        ``points``, ``filter``, ``layers``, ``layer_spacing``, ``z``); recorded.
+        ``points``, ``filter``, ``layers``, ``z_extent``, ``layer_spacing``, ``z``); recorded.
     z_source : str
-        Where z comes from (:data:`~.zsource.Z_SOURCES`; ``auto``: the one source there is,
-        refused when two disagree).
-    thousands : str, optional
-        Thousands separator of the numbers (sniffed only where unambiguous).
-    radius_range : (float, float), optional
-        Plausible bore radius [m] (default 0.5 mm to 2 m): a unit that puts the radii outside
-        is refused.
-    max_deviation : float, optional
-        Largest plausible |radial deviation| [m] (default 1 mm).
-    nominal_tolerance : float, optional
-        Relative tolerance of the measured radius against a stated nominal (default 0.05).
-    min_form : float, optional
-        Smallest plausible peak-to-valley of a deviation trace [m] (default 10 nm).
+        Where z comes from (:data:`~jointwear.metrology.choices.Z_SOURCES`; ``auto``: the one there is).
+    radius_range, max_deviation, nominal_tolerance, min_form : optional
+        Plausibility limits of the header cross-checks (:data:`~jointwear.metrology.choices.PLAUSIBILITY`): bore
+        radius (min, max) [m] (0.5 mm to 2 m), largest |radial deviation| [m] (1 mm), relative
+        tolerance against a stated nominal radius (0.05), smallest peak-to-valley of a
+        deviation trace [m] (10 nm).
 
     Returns
     -------
     Dataset
         ``radius`` or ``radial_deviation`` [m] over (``z`` [m], ``theta`` [degree, canonical]);
-        attrs record the instrument convention, files, every guess of the reader and the header
-        metadata.
+        attrs: the instrument convention, files, every guess of the reader, header metadata.
 
     Examples
     --------
@@ -189,69 +179,146 @@ def read_scan(
     >>> dict(scan.sizes), scan["radial_deviation"].attrs["units"], scan.attrs["data_origin"]
     ({'z': 3, 'theta': 360}, 'm', 'synthetic')
     """
+    conv = _checked(convention, value, layout)
+    base = _text_format(
+        fmt,
+        delimiter,
+        decimal,
+        header_lines,
+        columns,
+        units,
+        z_units,
+        sheet,
+        ignore_header,
+        thousands,
+    )
+    files, folder = _collect_files(paths, pattern)
+    limits = _limits(radius_range, max_deviation, nominal_tolerance, min_form)
+    parsed = [pf for f in files for pf in parse_blocks(f, base)]
+    layers, metadata, notes = _read_layers(
+        parsed, len(files), expected_points, allow_partial, value, angle_unit, arc, limits
+    )
+    layout_used = _layout_used(layout, parsed, layers, files)
+    zsrc = assign_z(
+        layers,
+        parsed,
+        layout_used,
+        folder,
+        z=None if z is None else list(z),
+        layer_spacing=layer_spacing,
+        z_units=z_units,
+        z_source=z_source,
+        where=f"'{folder or files[0]}'",
+    )
+    notes["z_from"] = zsrc
+    where = f"'{files[0] if len(files) == 1 else folder}'"
+    unconfirmed = check_layers(layers, metadata, zsrc, limits, where)
+    ds = _assemble(
+        layers,
+        convention=conv,
+        z_mid=z_mid,
+        instrument=_instrument(instrument, metadata),
+        fmt_notes=notes,
+        metadata=metadata,
+        files=[str(f) for f in files],
+        layout=layout_used,
+        allow_partial=allow_partial,
+        resample=resample,
+    )
+    return _record_reading(ds, parsed[0], notes, unconfirmed)
+
+
+def _checked(convention, value: str, layout: str) -> AngleConvention:
+    """The instrument's angle convention, once the choices are checked."""
     conv = _as_convention(convention)
-    if value not in ("auto", "radius", "deviation"):
+    if value not in ("auto", *VALUE_KINDS):
         raise BadInputError(f"value must be 'auto', 'radius' or 'deviation', got {value!r}")
-    if layout not in ("auto", "single", "folder", "long", "wide", "blocks"):
+    if layout not in LAYOUTS:
         raise BadInputError(
             f"layout {layout!r} is not known; use auto, single, folder, long, wide or blocks"
         )
-    base = fmt or TextFormat()
-    over = {
-        k: v
-        for k, v in dict(
-            delimiter=delimiter,
-            decimal=decimal,
-            header_lines=header_lines,
-            columns=tuple(columns) if columns is not None else None,
-            units=units,
-            z_units=z_units,
-            sheet=sheet,
-            ignore_header=tuple(ignore_header) if ignore_header else None,
-            thousands=thousands,
-        ).items()
-        if v is not None
-    }
-    base = replace(base, **over) if over else base
-    # collect files
-    if isinstance(paths, (str, Path)):
-        p = Path(paths)
-        if p.is_dir():
-            files = sorted(
-                (
-                    f
-                    for f in p.glob(pattern)
-                    if f.is_file()
-                    and not f.name.startswith(".")
-                    and f.stem.lower() not in ("manifest", "layers")
-                ),
-                key=_natural_key,
-            )
-            if not files:
-                raise BadInputError(f"folder '{p}' holds no files matching {pattern!r}")
-            folder = p
-        else:
-            if not p.exists():
-                raise BadInputError(f"'{p}' does not exist")
-            files = [p]
-            folder = None
-    else:
-        files = [Path(f) for f in paths]
-        if not files:
-            raise BadInputError("no input files given")
-        folder = files[0].parent if len(files) > 1 else None
-    if layout == "folder" and len(files) < 1:
-        raise BadInputError("layout='folder' needs a folder or several files")
-    value_kind = None if value == "auto" else value
-    limits = plausibility(
-        radius_min=None if radius_range is None else radius_range[0],
-        radius_max=None if radius_range is None else radius_range[1],
+    return conv
+
+
+def _limits(radius_range, max_deviation, nominal_tolerance, min_form) -> dict[str, float]:
+    """The plausibility limits with the options given."""
+    rmin, rmax = (None, None) if radius_range is None else radius_range
+    return plausibility(
+        radius_min=rmin,
+        radius_max=rmax,
         max_deviation=max_deviation,
         nominal_tolerance=nominal_tolerance,
         min_form=min_form,
     )
-    parsed = [pf for f in files for pf in parse_blocks(f, base)]
-    blocks = len(files) == 1 and len(parsed) > 1
+
+
+def _instrument(given: str | None, metadata: dict) -> str:
+    """The instrument name: given, else from the header, else "roundness instrument"."""
+    if given is not None:
+        return given
+    keys = ("instrument", "machine", "model", "gauge", "device")
+    return next((v for k, v in metadata.items() if k.lower() in keys), "roundness instrument")
+
+
+def _text_format(
+    fmt, delimiter, decimal, header_lines, columns, units, z_units, sheet, ignore_header, thousands
+) -> TextFormat:
+    """``fmt`` (default: sniff everything) with the options given (not None) replaced."""
+    base = fmt or TextFormat()
+    over = dict(
+        delimiter=delimiter,
+        decimal=decimal,
+        header_lines=header_lines,
+        columns=tuple(columns) if columns is not None else None,
+        units=units,
+        z_units=z_units,
+        sheet=sheet,
+        ignore_header=tuple(ignore_header) if ignore_header else None,
+        thousands=thousands,
+    )
+    over = {k: v for k, v in over.items() if v is not None}
+    return replace(base, **over) if over else base
+
+
+def _collect_files(paths, pattern: str) -> tuple[list[Path], Path | None]:
+    """(the files to read, the folder they came from or None for one file)."""
+    if not isinstance(paths, (str, Path)):
+        files = [Path(f) for f in paths]
+        if not files:
+            raise BadInputError("no input files given")
+        return files, files[0].parent if len(files) > 1 else None
+    p = Path(paths)
+    if not p.is_dir():
+        if not p.exists():
+            raise BadInputError(f"'{p}' does not exist")
+        return [p], None
+    files = sorted(
+        (
+            f
+            for f in p.glob(pattern)
+            if f.is_file()
+            and not f.name.startswith(".")
+            and f.stem.lower() not in ("manifest", "layers")
+        ),
+        key=_natural_key,
+    )
+    if not files:
+        raise BadInputError(f"folder '{p}' holds no files matching {pattern!r}")
+    return files, p
+
+
+def _read_layers(
+    parsed: list,
+    n_files: int,
+    expected_points: int | None,
+    allow_partial: bool,
+    value: str,
+    angle_unit: str | None,
+    arc: str | None,
+    limits: dict,
+) -> tuple[list[_Layer], dict, dict]:
+    """The layers of every parsed file (or block), the first file's header metadata, and the
+    guesses made per file (``reader_guesses``)."""
     layers: list[_Layer] = []
     metadata: dict = {}
     notes: dict = {}
@@ -260,7 +327,7 @@ def read_scan(
         ls = _layers_from_file(
             pf,
             None if allow_partial else expected_points,
-            value_kind=value_kind,
+            value_kind=None if value == "auto" else value,
             angle_unit=angle_unit,
             arc=arc or pf.arc,
             notes=decided,
@@ -276,11 +343,11 @@ def read_scan(
                 + "; per-layer files or blocks hold one layer each"
             )
         if pf.block is not None:
-            num = layer_numbers_from_meta(pf)
-            ls[0].index = num
+            ls[0].index = layer_numbers_from_meta(pf)
         layers.extend(ls)
         if not metadata:
             metadata = dict(pf.metadata)
+    blocks = n_files == 1 and len(parsed) > 1
     if blocks and any(lay.index is None for lay in layers):
         for lay in layers:
             lay.index = None
@@ -291,68 +358,43 @@ def read_scan(
                     f"'{lay.source}': layer {k + 1} has {lay.value.size} points, more than the "
                     f"expected {expected_points}"
                 )
-    if layout == "auto":
-        if blocks:
-            layout_used = "blocks"
-        elif len(parsed) > 1:
-            layout_used = "folder"
-        elif any(c in ("z", "layer") for c in parsed[0].columns):
-            layout_used = "long"
-        elif len(layers) > 1:
-            layout_used = "wide"
-        else:
-            layout_used = "single"
-    else:
-        layout_used = layout
+    return layers, metadata, notes
+
+
+def _layout_used(layout: str, parsed: list, layers: list, files: list[Path]) -> str:
+    """The layout ``auto`` stands for (blocks, folder, long, wide or single), or the one given
+    (checked)."""
+    if layout != "auto":
         if layout == "single" and len(layers) != 1:
             raise BadInputError(
                 f"layout='single' but '{files[0]}' holds {len(layers)} layers; use layout='long' "
                 "or 'wide'"
             )
-    zsrc = assign_z(
-        layers,
-        parsed,
-        layout_used,
-        folder,
-        z=None if z is None else list(z),
-        layer_spacing=layer_spacing,
-        z_units=z_units,
-        z_source=z_source,
-        where=f"'{folder or files[0]}'",
-    )
-    check_layers(layers, metadata, zsrc, limits, f"'{files[0] if len(files) == 1 else folder}'")
-    notes["z_from"] = zsrc
-    if instrument is None:
-        instrument = next(
-            (
-                v
-                for k, v in metadata.items()
-                if k.lower() in ("instrument", "machine", "model", "gauge", "device")
-            ),
-            "roundness instrument",
-        )
-    ds = _assemble(
-        layers,
-        convention=conv,
-        z_mid=z_mid,
-        instrument=instrument,
-        fmt_notes=notes,
-        metadata=metadata,
-        files=[str(f) for f in files],
-        layout=layout_used,
-        allow_partial=allow_partial,
-        resample=resample,
-    )
+        return layout
+    if len(files) == 1 and len(parsed) > 1:
+        return "blocks"
+    if len(parsed) > 1:
+        return "folder"
+    if any(c in ("z", "layer") for c in parsed[0].columns):
+        return "long"
+    return "wide" if len(layers) > 1 else "single"
+
+
+def _record_reading(ds: xr.Dataset, first, notes: dict, unconfirmed: str | None) -> xr.Dataset:
+    """Attributes of how the file was read: final format, resolved column meanings, the
+    instrument's unit, an unconfirmed z."""
     ds.attrs["reader_format"] = {
-        k: v for k, v in asdict(parsed[0].fmt).items() if v is not None and k != "columns"
+        k: v for k, v in asdict(first.fmt).items() if v is not None and k != "columns"
     }
     # the meaning every column was finally read with (placeholders resolved)
-    first = notes.get(Path(parsed[0].path).name, {})
+    guessed = notes.get(Path(first.path).name, {})
     resolve = {
-        "angle": first.get("angle_column", "angle"),
-        "value": first.get("value_column", "value"),
+        "angle": guessed.get("angle_column", "angle"),
+        "value": guessed.get("value_column", "value"),
     }
-    ds.attrs["reader_columns"] = [resolve.get(c, c) for c in parsed[0].columns]
-    if parsed[0].units:
-        ds.attrs["instrument_units"] = parsed[0].units
+    ds.attrs["reader_columns"] = [resolve.get(c, c) for c in first.columns]
+    if first.units:
+        ds.attrs["instrument_units"] = first.units
+    if unconfirmed:
+        ds.attrs["z_unconfirmed"] = unconfirmed
     return ds

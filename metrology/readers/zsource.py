@@ -20,6 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from jointwear.errors import BadInputError
+from jointwear.metrology.choices import Z_SOURCES
 from jointwear.metrology.readers.advice import Refusal, advise
 from jointwear.metrology.readers.claims import claim
 from jointwear.metrology.readers.heights import (
@@ -34,8 +35,6 @@ from jointwear.metrology.readers.units import unit_factor
 
 __all__ = ["Z_SOURCES", "assign_z", "wide_name_z"]
 
-#: Values of ``z_source``.
-Z_SOURCES = ("auto", "option", "column", "numbers", "manifest", "header", "names", "spacing")
 
 _UNIT = r"(mm|um|µm|μm|m|in|inch)"
 _Z_NAME = re.compile(
@@ -86,6 +85,17 @@ def _spacing(
 def _need_spacing(where: str, what: str) -> Refusal:
     text, sugg = advise([({"layer_spacing": "<m>"}, "the distance between layers")])
     return Refusal(f"{where}: {what}; {text}, or z=[...]", sugg)
+
+
+def _numbered_spacing(
+    layer_spacing, meta, z_units, where: str, numbered: str, what: str = "layers"
+) -> tuple[float, str]:
+    """The spacing that turns layer numbers into z (option or header), else a refusal saying
+    that the ``what`` are ``numbered`` (which says nothing of their height)."""
+    sp = _spacing(layer_spacing, meta, z_units, where)
+    if sp is None:
+        raise _need_spacing(where, f"the {what} are {numbered}, which says nothing of their height")
+    return sp
 
 
 def assign_z(
@@ -153,13 +163,8 @@ def _find_z(layers, parsed, layout, folder, z, layer_spacing, z_units, z_source,
     if all(v is not None for v in numbers) and (
         (auto and not heights) or z_source in ("numbers", "spacing")
     ):
-        sp = _spacing(layer_spacing, meta, z_units, where)
-        if sp is None:
-            raise _need_spacing(
-                where,
-                f"the layers are numbered ({', '.join(f'{v:g}' for v in numbers[:4])}"
-                f"{', ...' if len(numbers) > 4 else ''}), which says nothing of their height",
-            )
+        listed = ", ".join(f"{v:g}" for v in numbers[:4]) + (", ..." if len(numbers) > 4 else "")
+        sp = _numbered_spacing(layer_spacing, meta, z_units, where, f"numbered ({listed})")
         for lay, v in zip(layers, numbers, strict=True):
             lay.z = float(v) * sp[0]
         return (
@@ -278,13 +283,10 @@ def _z_wide(layers, pf, layer_spacing, z_units, z_source, where, meta):
     if said and all(k == "index" for k, _, _ in said) and z_source in ("auto", "numbers"):
         for lay, (_, v, _) in zip(layers, said, strict=True):
             lay.index = v
-        sp = _spacing(layer_spacing, meta, z_units, where)
-        if sp is None:
-            raise _need_spacing(
-                where,
-                f"the value columns are numbered as layers ({', '.join(names[i] for i in vidx[:3])}"
-                f"{', ...' if len(vidx) > 3 else ''}), which says nothing of their height",
-            )
+        listed = ", ".join(names[i] for i in vidx[:3]) + (", ..." if len(vidx) > 3 else "")
+        sp = _numbered_spacing(
+            layer_spacing, meta, z_units, where, f"numbered as layers ({listed})", "value columns"
+        )
         for lay in layers:
             lay.z = float(lay.index) * sp[0]
         return (

@@ -146,6 +146,156 @@ def test_layer_count_and_spacing_claims(tmp_path):
     np.testing.assert_allclose(ds["z"].values, [-1e-3, 0, 1e-3], atol=1e-15)
 
 
+# --- 1a. an inch/mm slip (25.4 x) is named, and its fix reads right ------------------------
+
+R_IN = (8.0 + 1e-3 * DEV_UM) / 25.4  # an 8-mm bore radius exported in inch (0.315 in)
+
+
+def _refused_then_read(path, match, k, truth_mm, **opts):
+    """The file is refused with ``match``; suggestion ``k`` applied as given reads
+    ``truth_mm`` (the radii, mm, as written in the file's true unit)."""
+    with pytest.raises(Refusal, match=match) as e:
+        read_scan(path, convention=CONV, **opts)
+    ds = _apply(path, e.value, k, base=opts)
+    np.testing.assert_allclose(ds["radius"].values[0], truth_mm * 1e-3, rtol=1e-12)
+    return e.value
+
+
+def test_radii_in_inch_under_a_mm_header_name_25_4(tmp_path):
+    f = _write(tmp_path / "in.txt", _rows(TH, R_IN, fv="{:.9f}"), "Units: mm\nAngle\tRadius\n")
+    exc = _refused_then_read(
+        f,
+        r"about 315 µm.*units='inch' \(if the values are in inch: a radius of 8 mm, 25.4 x",
+        1,
+        np.round(R_IN, 9) * 25.4,
+    )
+    assert exc.suggestions[1] == {"ignore_header": ("units",), "units": "inch"}
+    # with a nominal diameter in mm, inch is the only reading left
+    g = _write(
+        tmp_path / "nom.txt",
+        _rows(TH, R_IN, fv="{:.9f}"),
+        "Units: mm\nNominal diameter: 16 mm\nAngle\tRadius\n",
+    )
+    exc = _refused_then_read(g, r"units='inch'.*25.4 x the mm reading", 0, np.round(R_IN, 9) * 25.4)
+    assert len(exc.suggestions) == 1
+
+
+def test_units_option_mm_over_inch_radii_names_25_4(tmp_path):
+    f = _write(tmp_path / "bare.txt", _rows(TH, R_IN, fv="{:.9f}"), "Angle\tRadius\n")
+    exc = _refused_then_read(
+        f,
+        r"read in 'mm' \(units= given\).*units='inch'.*25.4 x",
+        1,
+        np.round(R_IN, 9) * 25.4,
+        units="mm",
+    )
+    assert exc.suggestions[1] == {"units": "inch"}
+
+
+def test_large_bore_in_inch_under_a_mm_nominal_names_1_over_25_4(tmp_path):
+    # 40 mm radius written as 1.5748 in under "Units: mm": 1.57 mm is a plausible bore, so only
+    # the nominal diameter can tell; the refusal names the exact ratio
+    r_in = (40.0 + 1e-3 * DEV_UM) / 25.4
+    head = "Units: mm\nNominal diameter: 80 mm\nAngle\tRadius\n"
+    f = _write(tmp_path / "big.txt", _rows(TH, r_in, fv="{:.9f}"), head)
+    exc = _refused_then_read(
+        f, r"about 1.575 mm \(1/25.4 x: values in inch read as mm\?\)", 0, np.round(r_in, 9) * 25.4
+    )
+    assert exc.suggestions[0] == {"ignore_header": ("units",), "units": "inch"}
+
+
+def test_mm_radii_under_an_inch_header_name_25_4(tmp_path):
+    r = 8.0 + 1e-3 * DEV_UM
+    head = "Units: inch\nNominal radius: 8 mm\nAngle\tRadius\n"
+    f = _write(tmp_path / "mm.txt", _rows(TH, r, fv="{:.7f}"), head)
+    _refused_then_read(
+        f, r"about 203.2 mm \(25.4 x: values in mm read as inch\?\)", 0, np.round(r, 7)
+    )
+
+
+def test_nominal_in_inch_without_unit_names_25_4(tmp_path):
+    r = 8.0 + 1e-3 * DEV_UM
+    head = "Units: mm\nNominal diameter: 0.63\nAngle\tRadius\n"
+    f = _write(tmp_path / "nin.txt", _rows(TH, r, fv="{:.7f}"), head)
+    exc = _refused_then_read(f, r"\(25.4 x: an inch/mm slip between the nominal", 0, np.round(r, 7))
+    assert exc.suggestions == ({"ignore_header": ("nominal_radius",)},)
+
+
+# --- 1b. a header layer spacing that is the only source of z ------------------------------
+
+
+def _numbered(path, head, n=3):
+    rows = [
+        [str(k + 1), f"{t:.6f}", f"{v + k:.6f}"]
+        for k in range(n)
+        for t, v in zip(TH, DEV_UM, strict=True)
+    ]
+    return _write(path, rows, "Units: um\n" + head + "Layer\tAngle (deg)\tDeviation\n")
+
+
+def test_sole_header_spacing_is_read_and_said_to_be_unconfirmed(tmp_path):
+    ds = read_scan(_numbered(tmp_path / "sole.txt", "Layer spacing: 1 mm\n"), convention=CONV)
+    np.testing.assert_allclose(ds["z"].values, [-1e-3, 0, 1e-3], atol=1e-15)
+    note = ds.attrs["z_unconfirmed"]
+    assert "Layer spacing = '1 mm' alone" in note and "layer_spacing=<m>" in note
+    # a stated z range that agrees confirms it: no note
+    ds = read_scan(
+        _numbered(tmp_path / "conf.txt", "Layer spacing: 1 mm\nZ range: 0 - 2 mm\n"),
+        convention=CONV,
+    )
+    assert "z_unconfirmed" not in ds.attrs
+    # the option gives z: nothing to confirm
+    ds = read_scan(_numbered(tmp_path / "opt.txt", ""), convention=CONV, layer_spacing=1e-3)
+    assert "z_unconfirmed" not in ds.attrs
+
+
+def test_import_summary_says_the_spacing_is_unconfirmed(tmp_path, capsys, run_import):
+    from jointwear import io
+
+    f = _numbered(tmp_path / "sole.txt", "Layer spacing: 1 mm\n")
+    out = tmp_path / "o.nc"
+    assert run_import(f, out, zero="-x", direction="clockwise") == 0
+    assert "note: z from the header's Layer spacing = '1 mm' alone" in capsys.readouterr().out
+    assert "alone" in io.load(out).attrs["z_unconfirmed"]
+
+
+def test_sole_header_spacing_contradicted_by_the_z_range(tmp_path):
+    # the truth: layers 2 mm apart (z range 0-4 mm); the header's spacing (1 mm) is wrong
+    f = _numbered(tmp_path / "rng.txt", "Layer spacing: 1 mm\nZ range: 0 - 4 mm\n")
+    with pytest.raises(Refusal, match=r"Z range = '0 - 4 mm' but the layers span 2 mm") as e:
+        read_scan(f, convention=CONV)
+    ds = _apply(f, e.value, 1, fill={"layer_spacing": 2e-3})
+    np.testing.assert_allclose(ds["z"].values, [-2e-3, 0, 2e-3], atol=1e-15)
+    assert "z_unconfirmed" not in ds.attrs
+    # the range alone against a z column
+    rows = [
+        [f"{k:.1f}", f"{t:.6f}", f"{v:.6f}"]
+        for k in range(3)
+        for t, v in zip(TH, DEV_UM, strict=True)
+    ]
+    g = _write(
+        tmp_path / "zc.txt", rows, "Units: um\nTotal height: 4 mm\nz [mm]\tAngle (deg)\tDeviation\n"
+    )
+    with pytest.raises(
+        Refusal, match=r"Total height = '4 mm' but the layers span 2 mm.*z column"
+    ) as e:
+        read_scan(g, convention=CONV)
+    assert _apply(g, e.value).sizes["z"] == 3
+
+
+def test_bare_spacing_key_as_sole_source_is_refused(tmp_path):
+    # "Spacing: 0.5 mm" may be the sampling step along the trace; z from it would be a guess
+    f = _numbered(tmp_path / "bare.txt", "Spacing: 0.5 mm\n")
+    with pytest.raises(
+        Refusal, match=r"'Spacing' does not say it is the distance between layers"
+    ) as e:
+        read_scan(f, convention=CONV)
+    ds = _apply(f, e.value, 1, fill={"layer_spacing": 1.5e-3})  # it was another spacing
+    np.testing.assert_allclose(ds["z"].values, [-1.5e-3, 0, 1.5e-3], atol=1e-15)
+    ds = _apply(f, e.value, 0, fill={"layer_spacing": 0.5e-3})  # it was the layers'
+    np.testing.assert_allclose(ds["z"].values, [-0.5e-3, 0, 0.5e-3], atol=1e-15)
+
+
 def test_z_in_file_names_against_z_in_headers(tmp_path):
     d = tmp_path / "scan"
     d.mkdir()

@@ -84,7 +84,7 @@ def test_assess_points_off_the_origin_against_constructed_circle():
     assert float(ds["RONq_LS"][0]) == pytest.approx(0.5e-6 / np.sqrt(2), rel=1e-9)
 
 
-def test_cli_assess_point_file_that_does_not_surround_the_origin(tmp_path, capsys):
+def test_cli_assess_point_file_that_does_not_surround_the_origin(tmp_path, capsys, run_import):
     t = np.radians(np.linspace(0, 90, 91))
     f = tmp_path / "cmm.csv"
     f.write_text(
@@ -92,20 +92,7 @@ def test_cli_assess_point_file_that_does_not_surround_the_origin(tmp_path, capsy
         + "".join(f"{100 + 20 * np.cos(a):.9f},{50 + 20 * np.sin(a):.9f}\n" for a in t)
     )
     # import refuses: angle and radius about the origin would be meaningless
-    code = main(
-        [
-            "metrology",
-            "import",
-            str(f),
-            "--angle-zero",
-            "+x",
-            "--angle-direction",
-            "counterclockwise",
-            "--out",
-            str(tmp_path / "s.nc"),
-        ]
-    )
-    assert code == 3
+    assert run_import(f, tmp_path / "s.nc") == 3
     assert "do not surround the origin" in capsys.readouterr().err
     out = tmp_path / "circle.nc"
     assert main(["metrology", "assess", str(f), "--out", str(out)]) == 0

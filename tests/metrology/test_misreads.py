@@ -20,6 +20,11 @@ def _table(path, angles, values, head=""):
     return path
 
 
+def _read(path, **options):
+    """The file read in the test convention, values in µm unless ``units`` says otherwise."""
+    return read_scan(path, convention=CONV, **{"units": "um", **options})
+
+
 def _dev(n):
     """A deviation profile about zero [um] (second harmonic, 2 um)."""
     return 2.0 * np.cos(2 * np.linspace(0, 2 * np.pi, n, endpoint=False))
@@ -35,29 +40,29 @@ def test_half_turn_of_integer_degrees_is_not_taken_as_an_index(tmp_path):
         match=r"ambiguous.*as degrees: a partial arc of 180.*"
         r"as a point index: one full turn.*--arc.*--angle-unit",
     ) as exc:
-        read_scan(f, convention=CONV, units="um")
+        _read(f)
     assert "half.txt" in str(exc.value)
-    ds = read_scan(f, convention=CONV, units="um", angle_unit="deg")
+    ds = _read(f, angle_unit="deg")
     th = np.sort(ds["theta"].values)
     # a half turn at 1 degree, not 0..358 at 2 degree: consecutive angles 1 degree apart
     assert ds.sizes["theta"] == 180
     assert np.median(np.diff(th)) == pytest.approx(1.0)
     assert ds.attrs["reader_guesses"]["half.txt"]["angle"].startswith("angle unit deg (stated)")
     # --arc partial settles it as well (only degrees give a partial arc)
-    ds2 = read_scan(f, convention=CONV, units="um", arc="partial")
+    ds2 = _read(f, arc="partial")
     np.testing.assert_allclose(ds2["theta"].values, ds["theta"].values)
     # and the index reading on request: a full turn of 2 degree steps
-    ds3 = read_scan(f, convention=CONV, units="um", angle_unit="index")
+    ds3 = _read(f, angle_unit="index")
     assert np.median(np.diff(np.sort(ds3["theta"].values))) == pytest.approx(2.0)
 
 
 def test_two_turns_of_integer_degrees_are_not_squeezed_into_one(tmp_path):
     f = _table(tmp_path / "two.txt", np.arange(720), _dev(720))
     with pytest.raises(BadInputError, match=r"ambiguous.*as degrees: 2 turns.*point index"):
-        read_scan(f, convention=CONV, units="um")
+        _read(f)
     with pytest.raises(BadInputError, match=r"2 full turns.*at most one turn.*split"):
-        read_scan(f, convention=CONV, units="um", angle_unit="deg")
-    ds = read_scan(f, convention=CONV, units="um", arc="full")  # only an index gives one turn
+        _read(f, angle_unit="deg")
+    ds = _read(f, arc="full")  # only an index gives one turn
     assert np.median(np.diff(np.sort(ds["theta"].values))) == pytest.approx(0.5)
 
 
@@ -69,8 +74,8 @@ def test_radians_are_not_read_as_degrees(tmp_path):
         match=r"ambiguous.*as degrees: a partial arc of 6.28.*"
         r"as radians: one full turn of 8 points",
     ):
-        read_scan(f, convention=CONV, units="um")
-    ds = read_scan(f, convention=CONV, units="um", arc="full")
+        _read(f)
+    ds = _read(f, arc="full")
     assert np.median(np.diff(np.sort(ds["theta"].values))) == pytest.approx(45.0)
 
 
@@ -83,16 +88,16 @@ def test_a_small_arc_in_degrees_is_not_read_as_radians(tmp_path):
         match=r"as degrees: a partial arc of 6.06.*as radians: a "
         r"partial arc of 347.*--angle-unit",
     ) as exc:
-        read_scan(f, convention=CONV, units="um")
+        _read(f)
     assert "--arc" not in str(exc.value)
-    ds = read_scan(f, convention=CONV, units="um", angle_unit="deg")
+    ds = _read(f, angle_unit="deg")
     assert np.ptp(ds["theta"].values) == pytest.approx(6.0, abs=1e-6)
 
 
 def test_unambiguous_angles_need_no_option(tmp_path):
     a = np.arange(3600) * 0.1  # 0.0 .. 359.9: only degrees give at most one turn
     f = _table(tmp_path / "deg.txt", a, _dev(3600))
-    ds = read_scan(f, convention=CONV, units="um")
+    ds = _read(f)
     note = ds.attrs["reader_guesses"]["deg.txt"]["angle"]
     assert note.startswith("angle unit deg: the only reading")
     # 0..359 integers: degrees and index give the same angles - nothing to decide
@@ -103,10 +108,10 @@ def test_unambiguous_angles_need_no_option(tmp_path):
 
 def test_header_states_the_angle_unit_and_contradiction_is_refused(tmp_path):
     f = _table(tmp_path / "h.txt", np.arange(180), _dev(180), head="Angle unit: deg\n")
-    ds = read_scan(f, convention=CONV, units="um")
+    ds = _read(f)
     assert ds.sizes["theta"] == 180 and np.ptp(ds["theta"].values) == pytest.approx(179.0)
     with pytest.raises(BadInputError, match=r"--angle-unit\) contradicts the file.*'deg'"):
-        read_scan(f, convention=CONV, units="um", angle_unit="index")
+        _read(f, angle_unit="index")
     g = _table(
         tmp_path / "hn.txt", np.arange(180), _dev(180), head="Angle unit: rad\nAngle (deg)\tDev\n"
     )
@@ -118,8 +123,8 @@ def test_values_without_angle_column_need_the_span(tmp_path):
     f = tmp_path / "vals.txt"
     f.write_text("".join(f"{v:.4f}\n" for v in _dev(90)))
     with pytest.raises(BadInputError, match=r"no angle column.*--arc full"):
-        read_scan(f, convention=CONV, units="um")
-    ds = read_scan(f, convention=CONV, units="um", arc="full")
+        _read(f)
+    ds = _read(f, arc="full")
     assert np.median(np.diff(np.sort(ds["theta"].values))) == pytest.approx(4.0)
     # the Talyrond preset states it (its traces are whole revolutions)
     read_talyrond(f, convention=CONV)
@@ -149,10 +154,10 @@ def test_one_corrupt_negative_radius_does_not_flip_the_column(tmp_path):
         match=r"neg.txt.* line 101: the values look like radii.*"
         r"-25000.*--value-kind",
     ):
-        read_scan(f, convention=CONV, units="um")
+        _read(f)
     # even when the user says radius, a negative radius is refused naming the line
     with pytest.raises(BadInputError, match=r"line 101: radius -25000 is not positive"):
-        read_scan(f, convention=CONV, units="um", value="radius")
+        _read(f, value="radius")
     # named 'Radius': same
     g = _table(tmp_path / "negn.txt", np.arange(360) * 1.0, v, head="Angle (deg)\tRadius (um)\n")
     with pytest.raises(BadInputError, match=r"line 102: radius -25000 is not positive"):
@@ -169,8 +174,8 @@ def test_value_kind_that_the_numbers_cannot_tell_is_refused(tmp_path):
     v = 100.0 + _dev(360)  # 100 um offset, 4 um spread: a 0.1 mm radius? a deviation?
     f = _table(tmp_path / "amb.txt", np.arange(360) * 1.0, v)
     with pytest.raises(BadInputError, match=r"cannot tell radius from deviation.*--value-kind"):
-        read_scan(f, convention=CONV, units="um")
-    ds = read_scan(f, convention=CONV, units="um", value="deviation")
+        _read(f)
+    ds = _read(f, value="deviation")
     assert float(ds["radial_deviation"].mean()) == pytest.approx(100e-6, rel=1e-6)
 
 
@@ -193,7 +198,7 @@ def test_units_option_contradicting_the_header_is_an_error(tmp_path):
         tmp_path / "mm.txt", np.arange(360) * 1.0, 25.0 + _dev(360) * 1e-3, head="Units: mm\n"
     )
     with pytest.raises(BadInputError, match=r"mm.txt'.*--units um.*contradicts.*'mm' in line 1"):
-        read_scan(f, convention=CONV, units="um")
+        _read(f)
     ds = read_scan(f, convention=CONV, units="mm")  # agreeing is fine
     assert float(ds["radius"].mean()) == pytest.approx(25e-3, rel=1e-9)
     # a column name stating another unit than the header: the file contradicts itself
@@ -280,29 +285,18 @@ def test_long_file_z_column_unit_is_not_borrowed_from_the_values(tmp_path):
 # --- the command line speaks the same options ------------------------------------------------
 
 
-def test_cli_refuses_with_exit_3_and_accepts_with_the_flag(tmp_path, capsys):
+def test_cli_refuses_with_exit_3_and_accepts_with_the_flag(tmp_path, capsys, run_import):
     f = _table(tmp_path / "half.txt", np.arange(180), _dev(180))
-    base = [
-        "metrology",
-        "import",
-        str(f),
-        "--angle-zero",
-        "+x",
-        "--angle-direction",
-        "counterclockwise",
-        "--units",
-        "um",
-        "--out",
-        str(tmp_path / "o.nc"),
-    ]
-    assert main(base) == 3
+    o = tmp_path / "o.nc"
+    assert run_import(f, o, "--units", "um") == 3
     assert "--angle-unit" in capsys.readouterr().err
-    assert main(base + ["--angle-unit", "degrees"]) == 2  # not a choice: usage error
-    assert main(base + ["--layout", "diagonal"]) == 2
-    assert main(base[:-4] + ["--units", "furlong", "--out", str(tmp_path / "o.nc")]) == 2
-    assert main(base + ["--decimal", ";"]) == 2
-    assert not (tmp_path / "o.nc").exists()
-    assert main(base + ["--angle-unit", "deg"]) == 0
+    assert run_import(f, o, "--units", "um", "--angle-unit", "degrees") == 2  # not a choice
+    assert run_import(f, o, "--units", "um", "--layout", "diagonal") == 2
+    assert run_import(f, o, "--units", "furlong") == 2
+    assert run_import(f, o, "--units", "um", "--decimal", ";") == 2
+    assert run_import(f, o, "--units", "um", direction="sideways") == 2  # a usage error too
+    assert not o.exists()
+    assert run_import(f, o, "--units", "um", "--angle-unit", "deg") == 0
     assert (tmp_path / "o.nc").exists()
 
 
@@ -335,9 +329,9 @@ def test_point_numbers_from_one_start_at_zero_degree_and_say_so(tmp_path):
 
 def test_reader_columns_record_the_resolved_meaning(tmp_path):
     f = _table(tmp_path / "res.txt", np.arange(180), _dev(180))
-    ds = read_scan(f, convention=CONV, units="um", arc="partial")
+    ds = _read(f, arc="partial")
     assert ds.attrs["reader_columns"] == ["angle_deg", "deviation"]
-    ds = read_scan(f, convention=CONV, units="um", arc="full")
+    ds = _read(f, arc="full")
     assert ds.attrs["reader_columns"] == ["index", "deviation"]
 
 

@@ -1,0 +1,53 @@
+"""The choices and defaults of the metrology options, in one place.
+
+The library checks its keywords against these and the command line offers them as its
+choices and shows the defaults in its help (``metrology/_cli_options.py``). This module imports
+nothing heavy, so that ``jointwear --help`` stays fast.
+"""
+
+from __future__ import annotations
+
+__all__ = [
+    "ANGLE_UNITS",
+    "ARCS",
+    "VALUE_KINDS",
+    "LAYOUTS",
+    "Z_SOURCES",
+    "PRESETS",
+    "REFERENCES",
+    "PLAUSIBILITY",
+]
+
+#: Units an angle column may have (``index`` = sample number over one full turn).
+ANGLE_UNITS = ("deg", "rad", "index", "grad")
+#: Angular spans a layer may have.
+ARCS = ("full", "partial")
+#: Meanings of a value column.
+VALUE_KINDS = ("radius", "deviation")
+#: Values of ``layout`` of :func:`~jointwear.metrology.read_scan`.
+LAYOUTS = ("auto", "single", "folder", "long", "wide", "blocks")
+#: Values of ``z_source`` of :func:`~jointwear.metrology.read_scan`.
+Z_SOURCES = ("auto", "option", "column", "numbers", "manifest", "header", "names", "spacing")
+#: Reader presets: the generic reader, or its Talyrond defaults (values in µm, whole turns).
+PRESETS = ("generic", "talyrond")
+
+#: Reference names accepted (short form -> ISO circle / cylinder names).
+REFERENCES: dict[str, tuple[str, str]] = {
+    "LS": ("LSCI", "LSCY"),
+    "MZ": ("MZCI", "MZCY"),
+    "MI": ("MICI", "MICY"),
+    "MC": ("MCCI", "MCCY"),
+}
+
+#: Plausibility limits of the header cross-checks (override with the same-named options).
+PLAUSIBILITY: dict[str, float] = {
+    "radius_min": 0.5e-3,  # [m] smallest bore/shaft radius a roundness instrument measures here
+    "radius_max": 2.0,  # [m] largest
+    "max_deviation": 1e-3,  # [m] largest |radial deviation| (a roundness gauge's range)
+    "min_form": 10e-9,  # [m] smallest peak-to-valley of a deviation trace (below any probe noise)
+    "nominal_tolerance": 0.05,  # relative: measured radius within 5 % of the stated nominal
+    "deviation_fraction": 0.05,  # |deviation| at most 5 % of the stated nominal radius
+    "spacing_tolerance": 0.01,  # relative: stated layer spacing vs the layers found
+    "points_tolerance": 0.01,  # relative: stated angular step vs the step of the angles
+    "filter_ratio": 0.1,  # high-band / mid-band amplitude above which a filter claim is false
+}
