@@ -1,5 +1,7 @@
 """Public names of the wear part of jointwear.sim (Archard wear, cycle updates, wear maps)."""
 
+from jointwear.sim import wearmap
+from jointwear.sim.wear import _loop
 from jointwear.sim.wear._calibration import (
     KwCalibration,
     Measurement,
@@ -17,55 +19,25 @@ from jointwear.sim.wear._contact import (
     DynamicContact,
     WinklerContact,
 )
-from jointwear.sim.wear._loop import (
-    DEFAULT_KW,
-    KW_RANGE,
-    WearRun,
-    WearSettings,
-    apply_overrides,
-    default_snapshots,
-    halved_schedule,
-    simulate_wear,
-)
-from jointwear.sim.wearmap import (
-    BearingGrid,
-    bore_cylindricity,
-    bore_radius,
-    edge_volume_share,
-    plot_wear_history,
-    plot_wear_map,
-    wear_map_dataset,
-    worn_volume,
-)
+
+# the names of the wear loop and of the wear maps, as those modules list them
+from jointwear.sim.wear._loop import *  # noqa: F403
+from jointwear.sim.wearmap import *  # noqa: F403
 
 __all__ = [
-    "DEFAULT_KW",
-    "KW_RANGE",
-    "WearSettings",
-    "WearRun",
-    "simulate_wear",
-    "apply_overrides",
-    "default_snapshots",
     "KwCalibration",
     "calibrate_kw",
     "Measurement",
     "MultiCalibration",
     "calibrate_kw_multi",
     "calibrate_kw_and_parameter",
-    "halved_schedule",
     "check_accuracy",
     "resimulator",
-    "BearingGrid",
-    "wear_map_dataset",
-    "worn_volume",
-    "edge_volume_share",
-    "bore_radius",
-    "bore_cylindricity",
-    "plot_wear_map",
-    "plot_wear_history",
     "CycleWear",
     "ContactModel",
     "ConstantContact",
     "WinklerContact",
     "DynamicContact",
 ]
+__all__ += _loop.__all__
+__all__ += wearmap.__all__
