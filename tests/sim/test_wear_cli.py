@@ -112,28 +112,34 @@ def test_resume_errors(tmp_path, capsys):
     assert "wear.kw: 1e-13 in the checkpoint, 3e-13 now" in capsys.readouterr().err
 
 
+def _interrupt(run: list[str], out, sig: int, timeout: float) -> tuple[int, bytes]:
+    """Run ``jointwear *run --out out`` in a process and send it ``sig`` once the run's
+    checkpoint exists (it is then mid-run); the exit code and stderr."""
+    ckpt = out.with_name(out.name + ".ckpt")
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "jointwear", *run, "--out", str(out)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        env=dict(os.environ, PYTHONUNBUFFERED="1"),
+    )
+    t0 = time.monotonic()
+    while not ckpt.exists() and proc.poll() is None and time.monotonic() - t0 < timeout:
+        time.sleep(0.02)
+    time.sleep(0.3)
+    assert proc.poll() is None, "the run finished before it could be interrupted"
+    proc.send_signal(sig)
+    _, err = proc.communicate(timeout=timeout)
+    return proc.returncode, err
+
+
 def test_ctrl_c_leaves_valid_partial_output_and_resume_is_identical(tmp_path):
     run = ["sim", "wear", *SMALL, "--scheme", "fixed", "--dn", "200", "--cycles", "3e4"]
     ref = tmp_path / "ref.nc"
     assert main([*run, "--out", str(ref)]) == 0
 
     out = tmp_path / "w.nc"
-    ckpt = tmp_path / "w.nc.ckpt"
-    env = dict(os.environ, PYTHONUNBUFFERED="1")
-    proc = subprocess.Popen(
-        [sys.executable, "-m", "jointwear", *run, "--out", str(out)],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        env=env,
-    )
-    t0 = time.monotonic()
-    while not ckpt.exists() and proc.poll() is None and time.monotonic() - t0 < 60:
-        time.sleep(0.02)
-    time.sleep(0.3)
-    assert proc.poll() is None, "the run finished before it could be interrupted"
-    proc.send_signal(signal.SIGINT)
-    _, err = proc.communicate(timeout=60)
-    assert proc.returncode == 130
+    returncode, err = _interrupt(run, out, signal.SIGINT, timeout=60)
+    assert returncode == 130
     assert b"interrupted after" in err
     partial = io.load(out)  # valid contract, provenance
     assert partial.attrs["status"] == "partial"
@@ -145,6 +151,28 @@ def test_ctrl_c_leaves_valid_partial_output_and_resume_is_identical(tmp_path):
     assert resumed.attrs["status"] == "complete"
     for name in ("wear_depth", "worn_volume", "normal_work", "update_dn", "update_rate_change"):
         np.testing.assert_array_equal(resumed[name].values, full[name].values)
+
+
+def test_sigterm_is_handled_like_ctrl_c_and_the_partial_map_is_flagged(tmp_path, capsys):
+    out = tmp_path / "w.nc"
+    run = ["sim", "wear", *SMALL, "--scheme", "fixed", "--dn", "200", "--cycles", "3e5"]
+    returncode, err = _interrupt(run, out, signal.SIGTERM, timeout=120)
+    assert returncode == 143, err
+    assert b"interrupted after" in err and b"Traceback" not in err
+    partial = io.load(out)
+    assert partial.attrs["status"] == "partial"
+    done = int(partial.attrs["cycles_done"])
+    assert 0 < done < 300_000
+
+    assert main(["info", str(out)]) == 0
+    text = capsys.readouterr().out
+    assert f"status: PARTIAL result: the run stopped after {done:g} of 300000 cycles" in text
+    # any command reading it says so too
+    main(["sim", "calibrate-kw", str(out), "--max-depth-um", "1", "--linear"])
+    assert f"warning: {out}: PARTIAL result" in capsys.readouterr().err
+    # and a rerun without --resume does not silently replace it
+    assert main([*run, "--out", str(out)]) == 3
+    assert "--resume" in capsys.readouterr().err
 
 
 def test_calibrate_kw_command_recovers_the_kw_of_a_run(tmp_path, capsys):
