@@ -47,6 +47,7 @@ from jointwear.metrology._wear_fit import (
     _lsq,
     _reference,
     _robust_reference,
+    undetected_tail,
 )
 from jointwear.metrology._wear_output import (
     _cylindricities,
@@ -56,6 +57,7 @@ from jointwear.metrology._wear_output import (
     _separable,
     refuse_inseparable_difference,
     selection_term,
+    tail_term,
     wear_dataset,
 )
 from jointwear.metrology._wear_setup import (
@@ -406,6 +408,7 @@ def _quantities(d, X, fit, alt, z, th, radius, selection, fit_args):
         u = np.hypot(u, wear - other)  # each depth's dependence on the model order
     if selection and not mask2.all():
         u = selection_term(q, u, wear, d, X, mask2, wts, z, th, threshold, margin)
+        u = tail_term(q, u, wear, *undetected_tail(d, X, mask, shape, th, wts))
     return q, u, tau, noise_sigma(wear)
 
 

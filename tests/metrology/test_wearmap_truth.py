@@ -166,23 +166,26 @@ def test_tails_around_the_bore_are_refused_not_read_low():
         wear_map(worn, before)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="open: grooves 37-38 degree wide (sigma) with a "
-    "before-scan can read 3.6-5.5 u low when the tail test stays below 3 "
-    "standard errors",
-)
-def test_open_tails_of_a_groove_38_degree_wide():
+@pytest.mark.parametrize("width", [37.0, 38.0, 39.0])
+def test_tails_of_a_groove_38_degree_wide_are_covered_by_u(width):
+    """Grooves 37-39 degree wide (sigma) with a before-scan: the tail test stays below its
+    threshold (1.5-2 standard errors), yet the tails left on the short unworn arc (a quarter of
+    the bore) pull the change of set-up fitted there, and the volume read 3.6-5.5 u low. The
+    largest tail the band test cannot see (:func:`undetected_tail`) is now in the u: the truth
+    within 3 u, and the term is what covers it (the u without it misses the truth)."""
     from test_wearmap_form import TH, Z, _bore
 
-    worn, wear = _bore(25.0, 1.5, 8.0, 38.0, seed=300, centre_deg=81.0)
-    before, _ = _bore(25.0, 1.5, 0.0, 38.0, seed=600, centre_deg=81.0)
-    try:
-        out = wear_map(worn, before)
-    except Exception:  # a refusal is right
-        return
-    z = (out["worn_volume"].item() - worn_volume(wear, Z, TH, R)) / out["worn_volume_u"].item()
-    assert abs(z) < 3.0, z
+    worn, wear = _bore(25.0, 1.5, 8.0, width, seed=300, centre_deg=81.0)
+    before, _ = _bore(25.0, 1.5, 0.0, width, seed=600, centre_deg=81.0)
+    out = wear_map(worn, before)
+    err = out["worn_volume"].item() - worn_volume(wear, Z, TH, R)
+    u = out["worn_volume_u"].item()
+    assert abs(err) < 3.0 * u, (err, u)
+    comment = out["worn_volume_u"].attrs["comment"]
+    tail = float(comment.split("undetected wear tail (")[1].split(":")[0])
+    assert abs(err) > 3.0 * np.sqrt(u**2 - tail**2), (err, u, tail)
+    # not inflated beyond use: a few percent of the volume
+    assert u < 0.05 * abs(out["worn_volume"].item())
 
 
 def test_wide_shallow_groove_without_a_before_scan_is_refused_not_read_low():
