@@ -254,6 +254,7 @@ def wear_map(
         refuse_inseparable_difference(s2, noise, tau)
     else:
         _refuse_inseparable(q, d, X, fit, noise, threshold, rw.shape)
+        _refuse_form_tails(q, d, X, mask, z, th, radius)
         if first is not None:  # the one-sided search of the worn region must pass as well
             q1 = _quantities(d, X, first[0], first[1], z, th, radius, False, fit_args)[0]
             _refuse_inseparable(q1, d, X, first[0], noise, threshold, rw.shape)
@@ -295,6 +296,27 @@ def _refuse_inseparable(q, d, X, fit, noise, threshold, shape) -> None:
     resid, mask, _, s2, _ = fit
     lobing = _lobing_rms((d - resid).reshape(shape)) if isinstance(X, FormBasis) else 0.0
     _separable(q, s2, noise, mask.reshape(shape), threshold, lobing)
+
+
+def _refuse_form_tails(q, d, X, mask, z, th, radius, limit: float = 0.3) -> None:
+    """Refuse a map without a before-scan where faint wear tails that the data cannot tell
+    from the form model could change the volume by more than ``limit`` of itself.
+
+    The form model fitted to the unworn part absorbs tails of the wear beyond the margin and
+    extrapolates them to the worn side (a shallow groove as wide as the lobes read 35 % low);
+    :func:`undetected_tail` gives the largest such tail the data allow and its volume change.
+    """
+    wts = _z_weights(z)[:, None] * _theta_weights(th)[None, :] * radius
+    dv, _, note = undetected_tail(d, X, mask, (z.size, th.size), th, wts)
+    vol, u_vol, _ = q["worn_volume"]
+    if np.isfinite(dv) and dv > limit * max(abs(vol), 3.0 * u_vol):
+        raise BadInputError(
+            f"wear_map: without a before-wear scan the wear cannot be separated from form: "
+            f"{note} (bands next to the worn region against the form model fitted to the rest), "
+            f"yet it would change the worn volume "
+            f"({vol * 1e9:.3g} mm³) by {dv * 1e9:.2g} mm³ ({dv / max(abs(vol), 1e-30):.0%}); "
+            "pass the scan of the bore before wear (before=..., CLI --before BEFORE.nc)"
+        )
 
 
 def _options(shape, before, margin_deg, surface, threshold) -> tuple[str, float]:
