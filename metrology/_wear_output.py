@@ -35,7 +35,7 @@ def _separable(
         )
     depth, u_depth, _ = q["max_wear_depth"]
     s = float(np.sqrt(s2))
-    if depth < 5.0 * u_depth and np.isfinite(noise) and lobing > 5.0 * noise:
+    if depth < 5.0 * u_depth and np.isfinite(noise) and lobing > 2.0 * noise:
         raise BadInputError(
             f"wear_map: without a before-wear scan no significant wear stands out (max "
             f"{depth * 1e6:.3g} ± {u_depth * 1e6:.2g} µm), but the bore's "
