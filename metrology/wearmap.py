@@ -26,7 +26,10 @@ side); if wear covers the whole circumference, pass a before-scan.
 
 Uncertainty: ``wear_depth_u`` [m] combines in quadrature the RMS residual of the unworn points
 (noise of both scans, unmodelled form and misalignment: how far an unworn point's "wear" scatters
-about 0) with the standard error of the fitted reference at each point.
+about 0) with the standard error of the fitted reference at each point; with a before-scan,
+also the dependence on the unworn selection and the largest faint wear tail the band test
+cannot see (:func:`._wear_fit.undetected_tail`). Without one, a map is refused where such a
+tail could change the volume by more than 30 % (the form model absorbs it).
 """
 
 from __future__ import annotations

@@ -244,3 +244,27 @@ def test_groove_absorbed_whole_by_the_form_is_refused_and_the_before_scan_reads_
     truth = worn_volume(wear, Z, TH, R)
     assert abs(out["worn_volume"].item() - truth) < 3.0 * out["worn_volume_u"].item()
     assert abs(out["worn_volume"].item() - truth) < 0.1 * truth
+
+
+def test_the_refusals_suggestion_through_the_cli(tmp_path, capsys):
+    """The shallow groove's refusal as a user meets it: exit 3 naming --before; the command
+    it suggests (the same file with --before) exits 0 with the volume within its printed u."""
+    import re
+
+    from test_wearmap_form import TH, Z, _bore
+
+    from jointwear import io
+    from jointwear.cli import main
+
+    scan, wear = _bore(27.5, 0.0, 0.3, 28.0, seed=127, centre_deg=105.5)
+    before, _ = _bore(27.5, 0.0, 0.0, 28.0, seed=527, centre_deg=105.5)
+    worn_f, before_f = tmp_path / "worn.nc", tmp_path / "before.nc"
+    io.save(scan, worn_f, source="test", parameters={})
+    io.save(before, before_f, source="test", parameters={})
+    assert main(["metrology", "wearmap", str(worn_f), "--out", str(tmp_path / "a.nc")]) == 3
+    assert "--before BEFORE.nc" in capsys.readouterr().err
+    args = ["metrology", "wearmap", str(worn_f), "--before", str(before_f)]
+    assert main([*args, "--out", str(tmp_path / "b.nc")]) == 0
+    text = capsys.readouterr().out
+    v, u = map(float, re.search(r"worn volume ([-\d.]+) ± ([\d.]+) mm³", text).groups())
+    assert abs(v - worn_volume(wear, Z, TH, R) * 1e9) <= 3 * u, text
