@@ -26,7 +26,10 @@ side); if wear covers the whole circumference, pass a before-scan.
 
 Uncertainty: ``wear_depth_u`` [m] combines in quadrature the RMS residual of the unworn points
 (noise of both scans, unmodelled form and misalignment: how far an unworn point's "wear" scatters
-about 0) with the standard error of the fitted reference at each point.
+about 0) with the standard error of the fitted reference at each point; with a before-scan,
+also the dependence on the unworn selection and the largest faint wear tail the band test
+cannot see (:func:`._wear_fit.undetected_tail`). Without one, a map is refused where such a
+tail could change the volume by more than 30 % (the form model absorbs it).
 """
 
 from __future__ import annotations
@@ -47,6 +50,7 @@ from jointwear.metrology._wear_fit import (
     _lsq,
     _reference,
     _robust_reference,
+    undetected_tail,
 )
 from jointwear.metrology._wear_output import (
     _cylindricities,
@@ -56,6 +60,7 @@ from jointwear.metrology._wear_output import (
     _separable,
     refuse_inseparable_difference,
     selection_term,
+    tail_term,
     wear_dataset,
 )
 from jointwear.metrology._wear_setup import (
@@ -244,16 +249,18 @@ def wear_map(
         fit, tails = _without_tails(d, X, mask, rw.shape, th, threshold, margin_deg)
         resid, mask, var_fit, s2, _ = fit
     radius = _volume_radius(radius, wname, rw, worn, w)
-    selection = rbz is not None and mask_in is None
-    q, u, tau, noise = _quantities(d, X, fit, alt, z, th, radius, selection, fit_args)
+    terms = ("selection", "tail") if rbz is not None else ("tail",)
+    terms = terms if mask_in is None else ()
+    q, u, tau, noise, tail = _quantities(d, X, fit, alt, z, th, radius, terms, fit_args)
     mask2 = mask.reshape(rw.shape)
     wear = resid.reshape(rw.shape)
     if rbz is not None:
         refuse_inseparable_difference(s2, noise, tau)
     else:
         _refuse_inseparable(q, d, X, fit, noise, threshold, rw.shape)
+        _refuse_form_tails(q, tail)
         if first is not None:  # the one-sided search of the worn region must pass as well
-            q1 = _quantities(d, X, first[0], first[1], z, th, radius, False, fit_args)[0]
+            q1 = _quantities(d, X, first[0], first[1], z, th, radius, (), fit_args)[0]
             _refuse_inseparable(q1, d, X, first[0], noise, threshold, rw.shape)
     cyl_after, cyl_before, cyl_before_note = _cylindricities(
         rw, rbz, z, th, thb if rbz is not None else th, mask2
@@ -293,6 +300,30 @@ def _refuse_inseparable(q, d, X, fit, noise, threshold, shape) -> None:
     resid, mask, _, s2, _ = fit
     lobing = _lobing_rms((d - resid).reshape(shape)) if isinstance(X, FormBasis) else 0.0
     _separable(q, s2, noise, mask.reshape(shape), threshold, lobing)
+
+
+def _refuse_form_tails(q, tail, limit: float = 0.3) -> None:
+    """Refuse a map without a before-scan where faint wear tails that the data cannot tell
+    from the form model could change the volume by more than ``limit`` of itself.
+
+    The form model fitted to the unworn part absorbs tails of the wear beyond the margin and
+    extrapolates them to the worn side (a shallow groove as wide as the lobes read 35 % low);
+    :func:`undetected_tail` gives the largest such tail the data allow and its volume change
+    ``tail`` = (change [m^3], description, u of the volume without it [m^3]), in the u below
+    the limit.
+    """
+    if tail is None:
+        return
+    dv, note, u_vol = tail
+    vol = q["worn_volume"][0]
+    if np.isfinite(dv) and dv > limit * max(abs(vol), 3.0 * u_vol):
+        raise BadInputError(
+            f"wear_map: without a before-wear scan the wear cannot be separated from form: "
+            f"{note} (bands next to the worn region against the form model fitted to the rest), "
+            f"yet it would change the worn volume "
+            f"({vol * 1e9:.3g} mm³) by {dv * 1e9:.2g} mm³ ({dv / max(abs(vol), 1e-30):.0%}); "
+            "pass the scan of the bore before wear (before=..., CLI --before BEFORE.nc)"
+        )
 
 
 def _options(shape, before, margin_deg, surface, threshold) -> tuple[str, float]:
@@ -380,9 +411,11 @@ def _tails_note(explicit: bool, margin_deg: float) -> str:
     )
 
 
-def _quantities(d, X, fit, alt, z, th, radius, selection, fit_args):
+def _quantities(d, X, fit, alt, z, th, radius, terms, fit_args):
     """Derived quantities with their u, the per-point u, the residual's correlation length
-    [samples] and the instrument noise [m] (successive differences of the map)."""
+    [samples], the instrument noise [m] (successive differences of the map) and the undetected
+    tail (volume change [m^3], description, u of the volume without it [m^3]; None if not
+    assessed). ``terms``: which of the "selection" and "tail" terms to add to the u."""
     resid, mask, var_fit, s2, _ = fit
     threshold, _, _, margin = fit_args
     shape = (z.size, th.size)
@@ -404,9 +437,14 @@ def _quantities(d, X, fit, alt, z, th, radius, selection, fit_args):
         other = alt[0].reshape(shape)
         _model_order_term(q, other, wts, z, th, "form-model order")
         u = np.hypot(u, wear - other)  # each depth's dependence on the model order
-    if selection and not mask2.all():
+    tail = None
+    if "selection" in terms and not mask2.all():
         u = selection_term(q, u, wear, d, X, mask2, wts, z, th, threshold, margin)
-    return q, u, tau, noise_sigma(wear)
+    if "tail" in terms and not mask2.all():
+        dv, shift, note = undetected_tail(d, X, mask, shape, th, wts)
+        tail = (dv, note, q["worn_volume"][1])
+        u = tail_term(q, u, wear, dv, shift, note)
+    return q, u, tau, noise_sigma(wear), tail
 
 
 def _attr_radius(orig: xr.Dataset | xr.DataArray, da: xr.DataArray) -> float | None:

@@ -166,23 +166,26 @@ def test_tails_around_the_bore_are_refused_not_read_low():
         wear_map(worn, before)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="open: grooves 37-38 degree wide (sigma) with a "
-    "before-scan can read 3.6-5.5 u low when the tail test stays below 3 "
-    "standard errors",
-)
-def test_open_tails_of_a_groove_38_degree_wide():
+@pytest.mark.parametrize("width", [37.0, 38.0, 39.0])
+def test_tails_of_a_groove_38_degree_wide_are_covered_by_u(width):
+    """Grooves 37-39 degree wide (sigma) with a before-scan: the tail test stays below its
+    threshold (1.5-2 standard errors), yet the tails left on the short unworn arc (a quarter of
+    the bore) pull the change of set-up fitted there, and the volume read 3.6-5.5 u low. The
+    largest tail the band test cannot see (:func:`undetected_tail`) is now in the u: the truth
+    within 3 u, and the term is what covers it (the u without it misses the truth)."""
     from test_wearmap_form import TH, Z, _bore
 
-    worn, wear = _bore(25.0, 1.5, 8.0, 38.0, seed=300, centre_deg=81.0)
-    before, _ = _bore(25.0, 1.5, 0.0, 38.0, seed=600, centre_deg=81.0)
-    try:
-        out = wear_map(worn, before)
-    except Exception:  # a refusal is right
-        return
-    z = (out["worn_volume"].item() - worn_volume(wear, Z, TH, R)) / out["worn_volume_u"].item()
-    assert abs(z) < 3.0, z
+    worn, wear = _bore(25.0, 1.5, 8.0, width, seed=300, centre_deg=81.0)
+    before, _ = _bore(25.0, 1.5, 0.0, width, seed=600, centre_deg=81.0)
+    out = wear_map(worn, before)
+    err = out["worn_volume"].item() - worn_volume(wear, Z, TH, R)
+    u = out["worn_volume_u"].item()
+    assert abs(err) < 3.0 * u, (err, u)
+    comment = out["worn_volume_u"].attrs["comment"]
+    tail = float(comment.split("undetected wear tail (")[1].split(":")[0])
+    assert abs(err) > 3.0 * np.sqrt(u**2 - tail**2), (err, u, tail)
+    # not inflated beyond use: a few percent of the volume
+    assert u < 0.05 * abs(out["worn_volume"].item())
 
 
 def test_wide_shallow_groove_without_a_before_scan_is_refused_not_read_low():
@@ -199,20 +202,85 @@ def test_wide_shallow_groove_without_a_before_scan_is_refused_not_read_low():
         wear_map(scan)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="open: a wide shallow groove on a tapered bore without a "
-    "before-scan is absorbed by the form model (-5.6 u before issue 22 item 5)",
+@pytest.mark.parametrize(
+    ("taper", "width", "centre"), [(27.5, 28.0, 105.5), (27.524, 27.984, 105.545)]
 )
-def test_open_wide_shallow_groove_next_to_the_refused_one():
-    """The same groove, parameters rounded: mapped with the volume 35 % low (7.5 u), exit 0.
-    Known defect of the form-model path (it read 5.6 u low before the symmetric refit too)."""
+def test_wide_shallow_groove_is_refused_and_the_before_scan_it_asks_for_reads_it(
+    taper, width, centre
+):
+    """0.3 um deep, 28 degree wide on a 28 um taper without a before-scan: the form model
+    fitted to the unworn part absorbed the groove's faint tails and read the volume 35 % low
+    (7.5 u, exit 0). The largest tail the data cannot tell from the form would change the
+    volume by a third of itself: refused, asking for the before-scan - and with the before-scan
+    the suggestion names, the same bore is read right."""
     from test_wearmap_form import TH, Z, _bore
 
+    from jointwear.errors import BadInputError
+
+    scan, wear = _bore(taper, 0.0, 0.3, width, seed=127, centre_deg=centre)
+    with pytest.raises(BadInputError, match=r"cannot be separated from form.*--before"):
+        wear_map(scan)
+    before, _ = _bore(taper, 0.0, 0.0, width, seed=527, centre_deg=centre)
+    out = wear_map(scan, before)
+    err = out["worn_volume"].item() - worn_volume(wear, Z, TH, R)
+    assert abs(err) < 3.0 * out["worn_volume_u"].item()
+    assert abs(err) < 0.1 * worn_volume(wear, Z, TH, R)
+
+
+def test_groove_absorbed_whole_by_the_form_is_refused_and_the_before_scan_reads_it():
+    """0.5 um deep, 25 degree wide on a 16 um taper, no lobing: the form model fitted to the
+    whole bore absorbed the groove (82 nm RMS of fitted lobing), nothing stood out and the map
+    read 'no wear' (volume 0.2 % of the truth, 88 u low, exit 0): the lobing rule waited for
+    5 x the instrument noise. Now refused; the before-scan it asks for reads the groove."""
+    from test_wearmap_form import TH, Z, _bore
+
+    from jointwear.errors import BadInputError
+
+    scan, wear = _bore(16.3, 0.0, 0.5, 24.9, seed=901, centre_deg=16.3)
+    with pytest.raises(BadInputError, match=r"no significant wear.*lobing.*--before"):
+        wear_map(scan)
+    before, _ = _bore(16.3, 0.0, 0.0, 24.9, seed=501, centre_deg=16.3)
+    out = wear_map(scan, before)
+    truth = worn_volume(wear, Z, TH, R)
+    assert abs(out["worn_volume"].item() - truth) < 3.0 * out["worn_volume_u"].item()
+    assert abs(out["worn_volume"].item() - truth) < 0.1 * truth
+
+
+def test_the_refusals_suggestion_through_the_cli(tmp_path, capsys):
+    """The shallow groove's refusal as a user meets it: exit 3 naming --before; the command
+    it suggests (the same file with --before) exits 0 with the volume within its printed u."""
+    import re
+
+    from test_wearmap_form import TH, Z, _bore
+
+    from jointwear import io
+    from jointwear.cli import main
+
     scan, wear = _bore(27.5, 0.0, 0.3, 28.0, seed=127, centre_deg=105.5)
-    try:
-        out = wear_map(scan)
-    except Exception:  # a refusal is right
-        return
-    z = (out["worn_volume"].item() - worn_volume(wear, Z, TH, R)) / out["worn_volume_u"].item()
-    assert abs(z) < 3.0, z
+    before, _ = _bore(27.5, 0.0, 0.0, 28.0, seed=527, centre_deg=105.5)
+    worn_f, before_f = tmp_path / "worn.nc", tmp_path / "before.nc"
+    io.save(scan, worn_f, source="test", parameters={})
+    io.save(before, before_f, source="test", parameters={})
+    assert main(["metrology", "wearmap", str(worn_f), "--out", str(tmp_path / "a.nc")]) == 3
+    assert "--before BEFORE.nc" in capsys.readouterr().err
+    args = ["metrology", "wearmap", str(worn_f), "--before", str(before_f)]
+    assert main([*args, "--out", str(tmp_path / "b.nc")]) == 0
+    text = capsys.readouterr().out
+    v, u = map(float, re.search(r"worn volume ([-\d.]+) ± ([\d.]+) mm³", text).groups())
+    assert abs(v - worn_volume(wear, Z, TH, R) * 1e9) <= 3 * u, text
+
+
+def test_shallow_groove_without_a_before_scan_within_its_u():
+    """0.3 um deep, 22 degree wide on a 35 um taper: read 5.8 % low at 3.4 u with exit 0 - the
+    form model absorbs the faint tails and the u did not say so. The undetected-tail term
+    covers it; the map without the term misses (the term can fail)."""
+    from test_wearmap_form import TH, Z, _bore
+
+    scan, wear = _bore(34.74, 0.0, 0.3, 21.65, seed=937, centre_deg=140.54)
+    out = wear_map(scan)
+    err = out["worn_volume"].item() - worn_volume(wear, Z, TH, R)
+    u = out["worn_volume_u"].item()
+    assert abs(err) < 3.0 * u, (err, u)
+    comment = out["worn_volume_u"].attrs["comment"]
+    tail = float(comment.split("undetected wear tail (")[1].split(":")[0])
+    assert abs(err) > 3.0 * np.sqrt(u**2 - tail**2), (err, u, tail)
