@@ -1,0 +1,83 @@
+"""The demo's worker processes: its independent parts run side by side, one per core.
+
+``jointwear demo`` (full size) runs the compared wear run with the virtual roundness scans, the
+motion's tolerance study with the stereo footage, the input-uncertainty ensemble and every run
+of the verification study as tasks of one pool of worker processes. The pool is forked before
+the demo opens any file (the workers inherit the imported modules and the numba kernels already
+loaded, instead of importing and loading them again), and each part's messages are captured in
+its worker and printed by the demo when the part is done. ``--quick`` (and a one-core machine)
+runs the same parts one after the other in the demo's own process (:class:`InlineExecutor`).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import multiprocessing
+import os
+from collections.abc import Callable, Iterator
+from concurrent.futures import Executor, Future, ProcessPoolExecutor
+from typing import Any
+
+__all__ = ["InlineExecutor", "MAX_WORKERS", "available_cores", "run_part", "worker_pool"]
+
+#: At most this many worker processes (each holds a simulation's memory, a few hundred MB).
+MAX_WORKERS = 4
+
+
+class InlineExecutor(Executor):
+    """An executor that runs each task at once, in this process (``--quick``, one core)."""
+
+    def submit(self, fn: Callable[..., Any], /, *args: Any, **kwargs: Any) -> Future:
+        fut: Future = Future()
+        try:
+            fut.set_result(fn(*args, **kwargs))
+        except Exception as exc:  # handed on by fut.result(), as a process pool would
+            fut.set_exception(exc)
+        return fut
+
+
+def available_cores() -> int:
+    """Cores this process may run on."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # not on Linux
+        return os.cpu_count() or 1
+
+
+def _init_worker() -> None:
+    """One thread per worker process for BLAS (one part or run per core)."""
+    from jointwear.sim.sweep._exec import WORKER_ENV
+
+    os.environ.update(WORKER_ENV)
+
+
+@contextlib.contextmanager
+def worker_pool(workers: int) -> Iterator[Executor]:
+    """A pool of ``workers`` forked processes (an :class:`InlineExecutor` for ``workers <= 1``
+    or where fork does not exist); shut down on leaving, queued tasks cancelled."""
+    if workers <= 1 or "fork" not in multiprocessing.get_all_start_methods():
+        yield InlineExecutor()
+        return
+    pool = ProcessPoolExecutor(
+        workers, mp_context=multiprocessing.get_context("fork"), initializer=_init_worker
+    )
+    try:
+        pool.submit(os.getpid).result()  # fork now, before this process opens any file
+        yield pool
+    finally:
+        pool.shutdown(wait=True, cancel_futures=True)
+
+
+def run_part(fn: Callable[..., Any], *args: Any) -> tuple[Any, str]:
+    """``fn(*args)`` with what it prints on stderr captured: ``(result, text)``."""
+    import sys
+
+    buf = io.StringIO()
+    try:
+        with contextlib.redirect_stderr(buf):
+            result = fn(*args)
+    except BaseException:  # what the part said before it failed is not lost
+        sys.stderr.write(buf.getvalue())
+        raise
+    return result, buf.getvalue()
