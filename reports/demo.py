@@ -680,4 +680,20 @@ def run_demo(out: Path, *, quick: bool = False, workers: int | None = None) -> P
     if not parts.sims or not parts.meas:
         raise ValidationFailed("the demo could not compare anything: " + "; ".join(parts.missing))
     _phase(2, "comparing and writing the report")
-    return _compare_and_report(out, size, quick, parts)
+    try:
+        return _compare_and_report(out, size, quick, parts)
+    finally:
+        _say(_cpu_line())
+
+
+def _cpu_line() -> str:
+    """CPU time (user + system) of this process and of the worker processes it has joined."""
+    try:
+        import resource
+    except ImportError:  # not POSIX
+        return "CPU: not measured on this system"
+    own, workers = (resource.getrusage(w) for w in (resource.RUSAGE_SELF, resource.RUSAGE_CHILDREN))
+    return (
+        f"CPU: {own.ru_utime + own.ru_stime:.1f} s in this process, "
+        f"{workers.ru_utime + workers.ru_stime:.1f} s in worker processes"
+    )
