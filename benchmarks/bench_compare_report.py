@@ -5,7 +5,8 @@ instrument map (13 layers x 18000 points, other angle convention); time of the f
 (wear + motion: variable-step simulation vs 50 frames/s over 2 s); time to render the HTML
 report (figures included) and its size; wall and CPU time of ``jointwear demo --quick`` and
 of the full ``jointwear demo`` (in a subprocess, each the second run: warm numba cache), with the
-time of each phase the demo announces and its outcome (criteria by state, exit code). Medians of repeated runs; the machine is shared, so
+time of each phase the demo announces, the CPU split between the demo's process and its worker
+processes, and its outcome (criteria by state, exit code). Medians of repeated runs; the machine is shared, so
 the load average is recorded with the figures.
 """
 
@@ -33,6 +34,10 @@ from jointwear.reports import build_report, render_html  # noqa: E402
 PHASE = re.compile(r"\[(\d+)/\d+\] ")
 #: What the demo says when it compiles the numba kernels (a cold cache): that run is repeated.
 COMPILING = "compiling numerical kernels"
+#: The demo's last line: CPU of its own process and of its worker processes.
+CPU_LINE = re.compile(r"CPU: ([\d.]+) s in this process, ([\d.]+) s in worker processes")
+#: How many worker processes the demo ran its parts on.
+WORKERS = re.compile(r"in (\d+) worker processes")
 
 
 def cpu_time(fn, repeat: int = 3) -> float:
@@ -52,7 +57,12 @@ def demo_run(quick: bool) -> dict[str, object]:
     process it started and waited for); the 1-minute load average is recorded before and after,
     as the machine is shared. ``phases_s`` is the wall time from each announced phase
     (``[k/5]`` on stderr) to the next one (the last to the end of the run); ``criteria`` counts
-    the decisions of the demo's ``metrics.nc`` by state.
+    the decisions of the demo's ``metrics.nc`` by state. ``cpu_s_demo_process`` and
+    ``cpu_s_worker_processes`` split the CPU time between the demo's own process (start, the
+    comparison and the report) and its ``workers`` worker processes (the parts of phase 1);
+    ``wall_s_idle_estimate`` is what the wall time would be on an idle machine if the workers
+    shared their CPU time evenly: own CPU + worker CPU / workers (an estimate, not a
+    measurement: the machine is shared).
     """
     from jointwear.compare import load_comparison
 
@@ -63,6 +73,8 @@ def demo_run(quick: bool) -> dict[str, object]:
         t0 = time.perf_counter()
         marks: list[tuple[str, float]] = []
         compiled = False
+        cpu_split: tuple[float, float] | None = None
+        workers = 1
         with subprocess.Popen(
             [*args, "--quick"] if quick else args,
             stdout=subprocess.DEVNULL,
@@ -71,6 +83,10 @@ def demo_run(quick: bool) -> dict[str, object]:
         ) as proc:
             for line in proc.stderr:
                 compiled = compiled or COMPILING in line
+                if CPU_LINE.search(line):
+                    cpu_split = tuple(float(v) for v in CPU_LINE.search(line).groups())
+                if WORKERS.search(line):
+                    workers = int(WORKERS.search(line).group(1))
                 found = PHASE.match(line)
                 if found:
                     marks.append((found.group(1), time.perf_counter() - t0))
@@ -87,9 +103,19 @@ def demo_run(quick: bool) -> dict[str, object]:
     ends = [t for _, t in marks[1:]] + [wall]
     phases = {k: round(end - start, 1) for (k, start), end in zip(marks, ends, strict=True)}
     cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    split = {}
+    if cpu_split is not None:
+        own, others = cpu_split
+        split = {
+            "cpu_s_demo_process": own,
+            "cpu_s_worker_processes": others,
+            "workers": workers,
+            "wall_s_idle_estimate": round(own + others / workers, 1),
+        }
     return {
         "wall_s": round(wall, 1),
         "cpu_s": round(cpu, 1),
+        **split,
         "exit_code": code,
         "phases_s": phases,
         "criteria": {str(k): int(v) for k, v in sorted(states.items())},
