@@ -306,9 +306,7 @@ def verify_wear(
     ParameterError, BadInputError
         A bad spec or parameter (named), an unwritable ``out``, resume of another study.
     """
-    from jointwear import io
-    from jointwear._version import source_attribute
-    from jointwear.sim.sweep._driver import _already_complete, _base, run_and_save
+    from jointwear.sim.sweep._driver import Execution, _base, run_and_save
     from jointwear.sim.sweep._params import apply_values
 
     if workers is not None and workers < 0:
@@ -351,30 +349,15 @@ def verify_wear(
             )
     record = {"study": vspec.describe(), "base": base_record, "band_m": band}
     digest = _digest(record)
-    if resume and _already_complete(out, digest):
-        ds = io.load(out)
-        ds.attrs.update(runs_computed_now=0, executor="none (all runs resumed)")
-        return ds
 
     def build(results: dict[int, Any], lost: dict[int, str]) -> xr.Dataset:
         ds = study_dataset(vspec, sim, values, where, results, lost, band=band)
         ds.attrs["parameters_json"] = json.dumps(base_record, sort_keys=True)
         return ds
 
-    return run_and_save(
-        tasks,
-        values,
-        build,
-        out=out,
-        digest=digest,
-        record=record,
-        resume=resume,
-        workers=workers,
-        scheduler=scheduler,
-        on_progress=on_progress,
-        inputs=[*spec_file, *inputs],
-        source=source_attribute("sim.sweep.verify"),
-    )
+    how = Execution(out, resume, workers, scheduler, on_progress)
+    inputs = [*spec_file, *inputs]
+    return run_and_save(tasks, values, build, how, digest, record, inputs, "sim.sweep.verify")
 
 
 def _relative_cost(row: np.ndarray, base: np.ndarray) -> float:
@@ -562,15 +545,14 @@ def study_dataset(
                 gmaps[rep] = depth
     coords.update(_study_coords(spec, qnames, values))
     ds = xr.Dataset(coords=coords)
-    ds["replicate_value"] = (
-        ("quantity", "level", "replicate"),
-        rv,
-        {"units": "1", "long_name": "value of each run (units: quantity_units)"},
-    )
-    ds["grid_replicate_value"] = (
+    dims = ("quantity", "level", "replicate")
+    _put(ds, "replicate_value", dims, rv, "value of each run")
+    _put(
+        ds,
+        "grid_replicate_value",
         ("quantity", "grid_replicate"),
         gv,
-        {"units": "1", "long_name": "value of each run on the next grid (units: quantity_units)"},
+        "value of each run on the next grid",
     )
     _add_quantity_info(ds, qnames, units, coords)
     ds["wear_depth_run"] = (
@@ -620,6 +602,11 @@ def study_dataset(
         }
     )
     return _add_fits(ds, units)
+
+
+def _put(ds: xr.Dataset, name: str, dims: tuple[str, ...], values: Any, long_name: str) -> None:
+    """``ds[name]``: values of the studied quantities, each in its ``quantity_units``."""
+    ds[name] = (dims, values, {"units": "1", "long_name": f"{long_name} (units: quantity_units)"})
 
 
 def _band_units(band: tuple[float, float]) -> dict[str, tuple[str, str]]:
@@ -692,16 +679,8 @@ def _add_fits(ds: xr.Dataset, units: Mapping[str, tuple[str, str]]) -> xr.Datase
     for k, q in enumerate(qnames):
         vals = ds["replicate_value"].sel(quantity=q).transpose("level", "replicate").values
         lm[k], ls[k], _ = level_statistics(vals, period=periods[k])
-    ds["level_mean"] = (
-        ("quantity", "level"),
-        lm,
-        {"units": "1", "long_name": "mean of the replicates per level (units: quantity_units)"},
-    )
-    ds["level_sem"] = (
-        ("quantity", "level"),
-        ls,
-        {"units": "1", "long_name": "standard error of the level mean (units: quantity_units)"},
-    )
+    _put(ds, "level_mean", ("quantity", "level"), lm, "mean of the replicates per level")
+    _put(ds, "level_sem", ("quantity", "level"), ls, "standard error of the level mean")
     u_attrs = {
         "units": "1",
         "coverage_factor": 1,
