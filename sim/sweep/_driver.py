@@ -15,6 +15,7 @@ import logging
 import time
 import warnings
 from collections.abc import Callable
+from concurrent.futures import Executor
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -502,7 +503,7 @@ def run_sweep(
     params: Any = None,
     wear: Any = None,
     workers: int | None = None,
-    scheduler: str | None = None,
+    scheduler: str | Executor | None = None,
     resume: bool = False,
     on_progress: Callable[[dict[str, Any]], None] | None = None,
     base: str | None = None,
@@ -524,8 +525,9 @@ def run_sweep(
     workers : int, optional
         0: run in this process (no dask); N: a local dask cluster of N single-threaded worker
         processes (default: one per core).
-    scheduler : str, optional
-        Address of a running dask scheduler; ``workers`` is then ignored.
+    scheduler : str or Executor, optional
+        Address of a running dask scheduler, or a :class:`concurrent.futures.Executor` of the
+        caller's (each run one task); ``workers`` is then ignored.
     resume : bool
         Continue an interrupted sweep writing ``out``: only runs without a part file are
         computed (the spec and base parameters must be the same).
