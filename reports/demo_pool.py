@@ -15,6 +15,7 @@ import contextlib
 import io
 import multiprocessing
 import os
+import threading
 from collections.abc import Callable, Iterator
 from concurrent.futures import Executor, Future, ProcessPoolExecutor
 from typing import Any
@@ -54,14 +55,17 @@ def _init_worker() -> None:
 
 @contextlib.contextmanager
 def worker_pool(workers: int) -> Iterator[Executor]:
-    """A pool of ``workers`` forked processes (an :class:`InlineExecutor` for ``workers <= 1``
-    or where fork does not exist); shut down on leaving, queued tasks cancelled."""
-    if workers <= 1 or "fork" not in multiprocessing.get_all_start_methods():
+    """A pool of ``workers`` forked processes (spawned where fork does not exist or this process
+    runs other threads; an :class:`InlineExecutor` for ``workers <= 1``); shut down on
+    leaving, queued tasks cancelled."""
+    if workers <= 1:
         yield InlineExecutor()
         return
-    pool = ProcessPoolExecutor(
-        workers, mp_context=multiprocessing.get_context("fork"), initializer=_init_worker
-    )
+    # fork only a process with one thread (a fork copies no other thread, whatever lock it
+    # held); otherwise the workers start afresh and import what they need
+    fork = "fork" in multiprocessing.get_all_start_methods() and threading.active_count() == 1
+    context = multiprocessing.get_context("fork" if fork else "spawn")
+    pool = ProcessPoolExecutor(workers, mp_context=context, initializer=_init_worker)
     try:
         pool.submit(os.getpid).result()  # fork now, before this process opens any file
         yield pool
