@@ -474,6 +474,7 @@ class _Parts:
     verification: list[Path] = field(default_factory=list)
     missing: list[str] = field(default_factory=list)
     notes: list[str] = field(default_factory=lambda: [SYNTHETIC_NOTE])
+    worker_cpu: list[float] = field(default_factory=list)  # CPU [s] of each worker process
 
 
 def _echo_part(fut: Any) -> None:
@@ -528,7 +529,7 @@ def _run_parts(out: Path, size: DemoSize, workers: int) -> _Parts:
     t0 = time.perf_counter()
     motion = _simulate_motion(size, params)  # before the fork: the workers inherit its kernels
     verify = bool(size.verification_replicates)
-    with worker_pool(workers) as pool:
+    with worker_pool(workers, parts.worker_cpu) as pool:
         sim_motion = _save_motion(out, size, params, motion)
         _say(f"  simulated motion: {size.motion_cycles:g} crank cycles")
         others = [pool.submit(run_part, _motion_part, out, size, params, sim_motion, verify)]
@@ -683,11 +684,12 @@ def run_demo(out: Path, *, quick: bool = False, workers: int | None = None) -> P
     try:
         return _compare_and_report(out, size, quick, parts)
     finally:
-        _say(_cpu_line())
+        _say(_cpu_line(parts.worker_cpu))
 
 
-def _cpu_line() -> str:
-    """CPU time (user + system) of this process and of the worker processes it has joined."""
+def _cpu_line(each: list[float]) -> str:
+    """CPU time (user + system) of this process and of the worker processes it has joined
+    (``each``: of every worker, where known)."""
     try:
         import resource
     except ImportError:  # not POSIX
@@ -696,4 +698,5 @@ def _cpu_line() -> str:
     return (
         f"CPU: {own.ru_utime + own.ru_stime:.1f} s in this process, "
         f"{workers.ru_utime + workers.ru_stime:.1f} s in worker processes"
+        + (f" ({', '.join(f'{t:.1f}' for t in each)} s each)" if each else "")
     )

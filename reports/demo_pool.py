@@ -53,11 +53,22 @@ def _init_worker() -> None:
     os.environ.update(WORKER_ENV)
 
 
+def process_cpu(pid: int) -> float | None:
+    """CPU seconds (user + system) of a running process (from Linux's /proc), else None."""
+    try:
+        with open(f"/proc/{pid}/stat") as f:
+            fields = f.read().rsplit(")", 1)[1].split()
+        return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+    except (OSError, IndexError, ValueError, AttributeError):
+        return None
+
+
 @contextlib.contextmanager
-def worker_pool(workers: int) -> Iterator[Executor]:
+def worker_pool(workers: int, cpu: list[float] | None = None) -> Iterator[Executor]:
     """A pool of ``workers`` forked processes (spawned where fork does not exist or this process
     runs other threads; an :class:`InlineExecutor` for ``workers <= 1``); shut down on
-    leaving, queued tasks cancelled."""
+    leaving, queued tasks cancelled. ``cpu`` receives each worker's CPU seconds when the pool
+    is left (where the system says them)."""
     if workers <= 1:
         yield InlineExecutor()
         return
@@ -70,6 +81,9 @@ def worker_pool(workers: int) -> Iterator[Executor]:
         pool.submit(os.getpid).result()  # fork now, before this process opens any file
         yield pool
     finally:
+        if cpu is not None:
+            times = [process_cpu(pid) for pid in list(getattr(pool, "_processes", None) or {})]
+            cpu.extend(t for t in times if t is not None)
         pool.shutdown(wait=True, cancel_futures=True)
 
 

@@ -12,7 +12,7 @@ import pytest
 
 from jointwear import io
 from jointwear.reports import demo
-from jointwear.reports.demo_pool import InlineExecutor, run_part, worker_pool
+from jointwear.reports.demo_pool import InlineExecutor, process_cpu, run_part, worker_pool
 from jointwear.reports.demo_studies import demo_study, main_wear_settings
 
 #: A study small enough for a test: 1600 cycles, ΔN = 100 ... 800, a 4 x 24 bearing grid.
@@ -61,6 +61,26 @@ def test_another_run_is_refused_as_the_compared_run(tmp_path):
     other = dataclasses.replace(task, values={**task.values, "wear.dn": 200.0})
     with pytest.raises(SimulationError, match="not the compared wear run"):
         demo._compared_study_run(other, tmp_path, TINY, params, False)
+
+
+def _spin(seconds):
+    import time
+
+    t0 = time.process_time()
+    while time.process_time() - t0 < seconds:
+        pass
+
+
+@pytest.mark.skipif(not os.path.exists("/proc/self/stat"), reason="needs /proc")
+def test_process_cpu_reads_a_process_cpu_time():
+    _spin(0.2)
+    import time
+
+    before = time.process_time()
+    measured = process_cpu(os.getpid())
+    tick = 1.0 / os.sysconf("SC_CLK_TCK")
+    assert before - 2 * tick <= measured <= time.process_time() + 2 * tick
+    assert process_cpu(2**22 + 12345) is None  # no such process
 
 
 class _Task:
@@ -112,9 +132,13 @@ def test_run_part_captures_what_the_part_says():
 
 @pytest.mark.skipif(not hasattr(os, "fork"), reason="needs fork")
 def test_worker_pool_forks_a_lone_thread_and_spawns_beside_others():
-    with worker_pool(2) as pool:
+    cpu: list[float] = []
+    with worker_pool(2, cpu) as pool:
         assert pool._mp_context.get_start_method() == "fork"
         assert pool.submit(os.getpid).result() != os.getpid()
+        pool.submit(_spin, 0.3).result()
+    if os.path.exists("/proc/self/stat"):  # each worker's CPU, the spinning one's included
+        assert len(cpu) == 2 and 0.25 <= max(cpu) < 5.0
     stop = threading.Event()
     other = threading.Thread(target=stop.wait)
     other.start()
