@@ -174,6 +174,10 @@ class _StudyPool(Executor):
         outer: Future = Future()
 
         def split(fut: Future) -> None:
+            if fut.cancelled():  # the demo was stopped
+                self.wear.cancel()
+                outer.cancel()
+                return
             if fut.exception() is not None:
                 self.wear.set_exception(fut.exception())
                 if not outer.cancelled():

@@ -47,10 +47,16 @@ def available_cores() -> int:
 
 
 def _init_worker() -> None:
-    """One thread per worker process for BLAS (one part or run per core)."""
+    """One thread per worker process for BLAS (one part or run per core); Ctrl-C is the demo
+    process's to handle (it stops the workers), and SIGTERM ends a worker at once (the
+    command line's handler, inherited by a fork, would turn it into an exception)."""
+    import signal
+
     from jointwear.sim.sweep._exec import WORKER_ENV
 
     os.environ.update(WORKER_ENV)
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
 
 
 def process_cpu(pid: int) -> float | None:
@@ -67,7 +73,8 @@ def process_cpu(pid: int) -> float | None:
 def worker_pool(workers: int, cpu: list[float] | None = None) -> Iterator[Executor]:
     """A pool of ``workers`` forked processes (spawned where fork does not exist or this process
     runs other threads; an :class:`InlineExecutor` for ``workers <= 1``); shut down on
-    leaving, queued tasks cancelled. ``cpu`` receives each worker's CPU seconds when the pool
+    leaving, queued tasks cancelled; on an exception (Ctrl-C, a failed part) the workers are
+    terminated at once. ``cpu`` receives each worker's CPU seconds when the pool
     is left (where the system says them)."""
     if workers <= 1:
         yield InlineExecutor()
@@ -80,11 +87,22 @@ def worker_pool(workers: int, cpu: list[float] | None = None) -> Iterator[Execut
     try:
         pool.submit(os.getpid).result()  # fork now, before this process opens any file
         yield pool
-    finally:
-        if cpu is not None:
-            times = [process_cpu(pid) for pid in list(getattr(pool, "_processes", None) or {})]
-            cpu.extend(t for t in times if t is not None)
-        pool.shutdown(wait=True, cancel_futures=True)
+    except BaseException:  # Ctrl-C or a failed part: stop the workers, do not wait for them
+        processes = list(_processes(pool).values())
+        pool.shutdown(wait=False, cancel_futures=True)
+        for proc in processes:
+            proc.terminate()
+        for proc in processes:
+            proc.join(timeout=10)
+        raise
+    if cpu is not None:
+        cpu.extend(t for t in map(process_cpu, _processes(pool)) if t is not None)
+    pool.shutdown(wait=True, cancel_futures=True)
+
+
+def _processes(pool: ProcessPoolExecutor) -> dict[int, Any]:
+    """The pool's worker processes by pid (the executor does not publish them)."""
+    return dict(getattr(pool, "_processes", None) or {})
 
 
 def run_part(fn: Callable[..., Any], *args: Any) -> tuple[Any, str]:

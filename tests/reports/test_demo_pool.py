@@ -150,3 +150,18 @@ def test_worker_pool_forks_a_lone_thread_and_spawns_beside_others():
         other.join()
     with worker_pool(1) as pool:
         assert isinstance(pool, InlineExecutor)
+
+
+def test_a_cancelled_compared_run_cancels_the_wear_part():
+    held: list[Future] = []
+
+    class Holding(InlineExecutor):  # keeps each task queued, as a busy pool does
+        def submit(self, fn, /, *args, **kwargs):
+            held.append(Future())
+            return held[-1]
+
+    pool = demo._StudyPool(Holding(), "out", TINY, None, True)
+    first = pool.submit(lambda t: "never", _Task(0))
+    assert not first.done() and not pool.wear.done()
+    assert held[0].cancel()  # the demo is stopped: its pool cancels the queued task
+    assert first.cancelled() and pool.wear.cancelled()
