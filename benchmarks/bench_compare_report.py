@@ -7,7 +7,8 @@ report (figures included) and its size; wall and CPU time of ``jointwear demo --
 of the full ``jointwear demo`` (in a subprocess, each the second run: warm numba cache), with the
 time of each phase the demo announces, the CPU split between the demo's process and its worker
 processes, and its outcome (criteria by state, exit code). Medians of repeated runs; the machine is shared, so
-the load average is recorded with the figures.
+the load average is recorded with the figures. ``--quiet-load L``: before the full demo, wait
+(at most ``--patience`` seconds) until the 1-minute load average is below ``L``.
 """
 
 from __future__ import annotations
@@ -133,7 +134,27 @@ def demo_run(quick: bool) -> dict[str, object]:
     }
 
 
+def wait_for_quiet(load: float, patience_s: float) -> float:
+    """Wait until the 1-minute load average is below ``load`` (at most ``patience_s``); the
+    load average then (the demo's wall time means something only on a quiet machine)."""
+    deadline = time.monotonic() + patience_s
+    while os.getloadavg()[0] >= load and time.monotonic() < deadline:
+        time.sleep(10)
+    return os.getloadavg()[0]
+
+
 def main() -> None:
+    import argparse
+
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument(
+        "--quiet-load",
+        type=float,
+        default=None,
+        help="before the full demo, wait until the 1-minute load average is below this",
+    )
+    ap.add_argument("--patience", type=float, default=900.0, help="longest wait [s]")
+    a = ap.parse_args()
     sim_w = syn.sim_wear(n_layers=20, n_points=200)
     meas_w = syn.meas_wear(n_points=18000, u=1e-6)
     sim_m = syn.sim_motion(duration=1.2)
@@ -159,6 +180,8 @@ def main() -> None:
     # is repeated, with a fresh output folder
     demos = {}
     for name, quick in (("demo_quick", True), ("demo_full", False)):
+        if a.quiet_load is not None and not quick:
+            wait_for_quiet(a.quiet_load, a.patience)
         run = demo_run(quick)
         demos[name] = demo_run(quick) if run.pop("compiled") else run
     write_results(
