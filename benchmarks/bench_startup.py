@@ -12,6 +12,12 @@ Throughput through the command line (item 5): a 1024x1024 pair, 33-pixel subsets
 correlate`` process (start, reading, correlation, writing netCDF) against the library's
 ``correlate`` call in a warm process, medians of ``--repeat-mp`` runs each.
 
+The floor under every command that computes: CPU seconds of a fresh process that only imports
+what ``dic correlate`` cannot do without - the interpreter with numpy and the command line
+(``jointwear --help``), xarray (the netCDF output), and numba with its first cached kernel (numba
+builds its whole compiler context, including its BLAS and random-generator support, before it
+can load any cached kernel): ``floor`` in the results, minimum of ``--repeat`` runs.
+
 ``--quick``: 3 runs, no 1-MP pair, written to ``results/startup_quick.json`` (the docs quote
 ``results/startup.json``).
 """
@@ -75,6 +81,41 @@ def _measure(args: list[str], cwd: Path, env: dict, repeat: int) -> dict:
     }
 
 
+#: A cached kernel for the numba floor (written to the work folder, compiled once).
+KERNEL = """from numba import njit
+
+
+@njit(cache=True)
+def total(a):
+    s = 0.0
+    for x in a:
+        s += x
+    return s
+"""
+
+#: What each floor probe runs in a fresh process (``-c``), timed from the start of the process.
+FLOOR = {
+    "python_numpy": "import numpy",
+    "python_numpy_xarray": "import numpy, xarray",
+    "python_numpy_numba_first_cached_kernel": "import numpy, kernel; kernel.total(numpy.ones(3))",
+}
+
+
+def _floor(cwd: Path, env: dict, repeat: int) -> dict:
+    """Minimum CPU seconds of each :data:`FLOOR` probe (after one warm-up run)."""
+    (cwd / "kernel.py").write_text(KERNEL)
+    out = {}
+    for name, code in FLOOR.items():
+        runs = []
+        for _ in range(repeat + 1):
+            before = resource.getrusage(resource.RUSAGE_CHILDREN)
+            subprocess.run([sys.executable, "-c", code], cwd=cwd, env=env, check=True)
+            after = resource.getrusage(resource.RUSAGE_CHILDREN)
+            runs.append((after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime))
+        out[f"{name}_cpu_s_min"] = round(min(runs[1:]), 3)
+    return out
+
+
 def _images(folder: Path, size: int, name: str) -> Path:
     from jointwear.cli import main
 
@@ -136,6 +177,8 @@ def main() -> None:
                 rows[label]["target_cpu_s"] = targets[label]
             print(label, rows[label], flush=True)
         figures["commands"] = rows
+        figures["floor"] = _floor(work, env, repeat)
+        print("floor", figures["floor"], flush=True)
         if not a.quick:
             mp = _images(work, 1024, "mp")
             args = ["dic", "correlate", "mp/reference.png", "mp/deformed.png", "--subset", "33"]

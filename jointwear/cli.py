@@ -92,15 +92,18 @@ def demo(
         bool,
         typer.Option(
             "--quick",
-            help="Reduced size, no ensemble (u_input not assessed) and no footage: about 30 s "
-            "instead of about 2 minutes.",
+            help="Reduced size, in one process: no ensemble (u_input not assessed), no "
+            "verification study and no footage.",
         ),
     ] = False,
     overwrite: Overwrite = False,
 ) -> None:
     """Run the whole chain on the embedded default data and write a validation report.
 
-    Phases [1/5]..[5/5]: simulation and verification, an ensemble over the uncertain inputs, virtual roundness scans, stereo footage, comparison and report. The report is always written; exit code 1 when a validation criterion fails.
+    Phase [1/2]: simulation, its verification study, an ensemble over the uncertain inputs,
+    virtual roundness scans and stereo footage, side by side in one worker process per core;
+    [2/2]: comparison and report. The report is always written; exit code 1 when a validation
+    criterion fails.
     """
     from jointwear.reports.demo import run_demo
 

@@ -24,7 +24,8 @@ from __future__ import annotations
 
 import importlib
 import time
-from dataclasses import dataclass
+from concurrent.futures import Executor, Future
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -35,6 +36,7 @@ from jointwear import io
 from jointwear.errors import JointwearError, ValidationFailed
 from jointwear.reports.demo_studies import (
     ENSEMBLE_INPUTS,
+    is_compared_run,
     main_wear_settings,
     motion_verification,
     run_ensemble,
@@ -89,23 +91,20 @@ def _available(module: str, *names: str) -> bool:
     return all(hasattr(mod, n) for n in names)
 
 
-def _simulate(folder: Path, size: DemoSize) -> tuple[Path, Path, Any, list[Path], float]:
+def _params(size: DemoSize) -> Any:
     from jointwear.params import replace_nested
-    from jointwear.sim import DEFAULT_PARAMETER_SET, PARAMETER_SETS, run_cycles, simulate_wear
+    from jointwear.sim import DEFAULT_PARAMETER_SET, PARAMETER_SETS
 
-    params = replace_nested(
+    return replace_nested(
         PARAMETER_SETS[DEFAULT_PARAMETER_SET],
         **{"joint.n_layers": size.n_layers, "joint.n_points": size.n_points},
     )
-    t0 = time.perf_counter()
-    wear = simulate_wear(
-        params,
-        cycles=size.cycles,
-        snapshots=list(size.snapshots),
-        settings=main_wear_settings(size),
-    )
+
+
+def _save_wear(folder: Path, size: DemoSize, params: Any, wear: xr.Dataset, t0: float) -> Path:
+    """The compared wear run of joint C, saved as ``sim_wear.nc``."""
     wear.attrs["data_origin"] = "simulated"
-    sim_wear = io.save(
+    path = io.save(
         wear,
         folder / "sim_wear.nc",
         parameters={"simulation": params, "cycles": size.cycles},
@@ -116,50 +115,168 @@ def _simulate(folder: Path, size: DemoSize) -> tuple[Path, Path, Any, list[Path]
         f"max depth {float(wear['max_wear_depth'][-1]) * 1e6:.1f} µm "
         f"({time.perf_counter() - t0:.0f} s)"
     )
+    return path
+
+
+def _wear_part(folder: Path, size: DemoSize, params: Any, metrology: bool) -> tuple[Path, Any]:
+    """Worker part without a study (``--quick``): the compared wear run, then the virtual
+    roundness scans made from it."""
+    from jointwear.sim import simulate_wear
+
     t0 = time.perf_counter()
+    wear = simulate_wear(
+        params,
+        cycles=size.cycles,
+        snapshots=list(size.snapshots),
+        settings=main_wear_settings(size),
+    )
+    sim_wear = _save_wear(folder, size, params, wear, t0)
+    return sim_wear, _measure_wear(folder, sim_wear, size)[0] if metrology else None
+
+
+def _compared_study_run(
+    task: Any, folder: Path, size: DemoSize, params: Any, metrology: bool
+) -> tuple[Any, tuple[Path, Any]]:
+    """Worker part with a study: its run that is the compared wear run (replicate 0 of the
+    finest level, :func:`~jointwear.reports.demo_studies.is_compared_run`), simulated once: the
+    study gets its result, ``sim_wear.nc`` its whole wear map; then the roundness scans."""
+    from jointwear.errors import SimulationError
+    from jointwear.sim.sweep._run import evaluate_run
+
+    if not is_compared_run(task, params, size):
+        raise SimulationError("demo: the study's run 0 is not the compared wear run")
+    t0 = time.perf_counter()
+    saved: list[Path] = []
+    result = evaluate_run(
+        task, on_dataset=lambda ds: saved.append(_save_wear(folder, size, params, ds, t0))
+    )
+    if result.status != "ok" or not saved:
+        raise SimulationError(f"demo: the compared wear run failed: {result.error}")
+    return result, (saved[0], _measure_wear(folder, saved[0], size)[0] if metrology else None)
+
+
+class _StudyPool(Executor):
+    """The study's view of the pool: every run is one task, except the compared run (index
+    0), which runs as :func:`_compared_study_run`; ``wear`` receives that part's
+    ``((sim_wear, metrology), text)`` as :func:`_wear_part` would give it."""
+
+    def __init__(self, pool: Executor, *args: Any) -> None:
+        self.pool, self.args = pool, args
+        self.wear: Future = Future()
+
+    def submit(self, fn: Any, /, *args: Any, **kwargs: Any) -> Future:
+        (task,) = args
+        if task.index != 0:
+            return self.pool.submit(fn, task)
+        from jointwear.reports.demo_pool import run_part
+
+        inner = self.pool.submit(run_part, _compared_study_run, task, *self.args)
+        outer: Future = Future()
+
+        def split(fut: Future) -> None:
+            if fut.cancelled():  # the demo was stopped
+                self.wear.cancel()
+                outer.cancel()
+                return
+            if fut.exception() is not None:
+                self.wear.set_exception(fut.exception())
+                if not outer.cancelled():
+                    outer.set_exception(fut.exception())
+                return
+            (result, files), text = fut.result()
+            self.wear.set_result((files, text))
+            if not outer.cancelled():
+                outer.set_result(result)
+
+        inner.add_done_callback(split)
+        return outer
+
+
+#: Variables of the simulated motion the demo keeps.
+MOTION_VARIABLES = (
+    "follower_velocity",
+    "follower_position",
+    "journal_offset",
+    "contact_force",
+    "crank_angle",
+)
+
+
+def _simulate_motion(size: DemoSize, params: Any) -> xr.Dataset:
+    """The motion over ``size.motion_cycles`` crank cycles (variables :data:`MOTION_VARIABLES`)."""
+    from jointwear.sim import run_cycles
+
     motion = run_cycles(params, cycles=size.motion_cycles).dataset
-    keep = [
-        v
-        for v in (
-            "follower_velocity",
-            "follower_position",
-            "journal_offset",
-            "contact_force",
-            "crank_angle",
-        )
-        if v in motion
-    ]
-    motion = motion[keep]
+    motion = motion[[v for v in MOTION_VARIABLES if v in motion]]
     motion.attrs["data_origin"] = "simulated"
-    sim_motion = io.save(
+    return motion
+
+
+def _save_motion(folder: Path, size: DemoSize, params: Any, motion: xr.Dataset) -> Path:
+    return io.save(
         motion,
         folder / "sim_motion.nc",
         parameters={"simulation": params, "cycles": size.motion_cycles},
         source="jointwear (sim.dynamics) via jointwear demo",
     )
-    _say(
-        f"  simulated motion: {size.motion_cycles:g} crank cycles ({time.perf_counter() - t0:.0f} s)"
-    )
-    verification_paths: list[Path] = []
-    if size.verification_replicates:
-        from jointwear.compare import numerical_uncertainty
-        from jointwear.refinement import describe_study
 
-        t0 = time.perf_counter()
-        study_path, study = wear_verification(params, size, folder)
-        ver = motion_verification(params, size, motion)
-        motion_path = io.save(
+
+def _motion_part(
+    folder: Path, size: DemoSize, params: Any, sim_motion: Path, verify: bool
+) -> tuple[Path | None, Path | None, str | None]:
+    """Worker part: the motion's solver-tolerance study (``verify``), then the stereo footage.
+
+    Returns the study file, the tracked motion and why the footage is missing (or None).
+    """
+    ver_path = None
+    if verify:
+        from jointwear.compare import numerical_uncertainty
+
+        ver = motion_verification(params, size, io.load(sim_motion))
+        ver_path = io.save(
             ver,
             folder / "sim_verification_motion.nc",
             parameters={"simulation": params, "solver_rtols": list(ver["solver_rtol"].values)},
             source="jointwear (sim.dynamics) via jointwear demo",
         )
-        verification_paths = [study_path, motion_path]
-        _say(f"  verification studies ({time.perf_counter() - t0:.0f} s):")
-        _say("      " + describe_study(study).replace("\n", "\n      "))
+        _say("  motion verification (solver tolerance):")
         for g in numerical_uncertainty(ver).values():
             _say(f"      {g.describe()}")
-    return sim_wear, sim_motion, params, verification_paths, 0.0
+    try:
+        dic_path, dic_missing = _measure_motion(folder, size, sim_motion)
+    except JointwearError as exc:  # the footage chain failed: say so, keep the rest
+        dic_path, dic_missing = None, f"motion: the stereo DIC chain failed ({exc})"
+        _say(f"  {dic_missing}")
+    return ver_path, dic_path, dic_missing
+
+
+def _ensemble_part(folder: Path, size: DemoSize, params: Any, motion_time: np.ndarray) -> Path:
+    """Worker part: the input-uncertainty ensemble, saved as ``ensemble.nc``."""
+    t0 = time.perf_counter()
+    ens = run_ensemble(params, size, motion_time, progress=False)
+    path = io.save(
+        ens,
+        folder / "ensemble.nc",
+        parameters={"inputs": {k: v[0] for k, v in ENSEMBLE_INPUTS.items()}},
+        source="jointwear (sim.wear, sim.dynamics) ensemble via jointwear demo",
+    )
+    _say(
+        f"  ensemble: {ens.sizes['run']} runs, {int(ens.attrs.get('n_failed', 0))} failed "
+        f"({time.perf_counter() - t0:.0f} s)"
+    )
+    return path
+
+
+def _study(folder: Path, size: DemoSize, params: Any, pool: Executor) -> Path:
+    """The verification study of the wear, its runs on ``pool`` (a :class:`_StudyPool`);
+    prints its u_num."""
+    from jointwear.refinement import describe_study
+
+    t0 = time.perf_counter()
+    path, study = wear_verification(params, size, folder, scheduler=pool)
+    _say(f"  wear verification study ({time.perf_counter() - t0:.0f} s):")
+    _say("      " + describe_study(study).replace("\n", "\n      "))
+    return path
 
 
 def measured_wear_function(sim_wear: xr.Dataset) -> Any:
@@ -336,169 +453,170 @@ def _in_plane(ds: xr.Dataset) -> xr.Dataset:
     return ds[keep].sel(axis=["x", "y"])
 
 
-PHASES = 5
+PHASES = 2
+
+#: What the demo says about the measured side (every report carries it).
+SYNTHETIC_NOTE = (
+    "The measured side is SYNTHETIC: instrument files and footage are generated by "
+    "jointwear.datasets from a known 'true' wear map (the simulated map 10 % deeper, turned "
+    "by 6 degree) and then imported and processed like real measurements. The report shows "
+    "the chain working; it does not validate the model against a real rig."
+)
 
 
 def _phase(k: int, text: str) -> None:
     _say(f"[{k}/{PHASES}] {text}")
 
 
-def run_demo(out: Path, *, quick: bool = False) -> Path:
-    """Run the whole chain on the embedded default data and write a validation report.
+@dataclass
+class _Parts:
+    """What the first phase made: files by role, and what is missing and why."""
 
-    Parameters
-    ----------
-    out : Path
-        Output folder (created); receives the simulated and measured files, the ensemble,
-        ``metrics.nc`` and ``report.html``.
-    quick : bool
-        Reduced size and no ensemble (u_input is then not assessed).
+    sims: list[Path] = field(default_factory=list)
+    meas: list[tuple[str, Path]] = field(default_factory=list)
+    ensemble: Path | None = None
+    verification: list[Path] = field(default_factory=list)
+    missing: list[str] = field(default_factory=list)
+    notes: list[str] = field(default_factory=lambda: [SYNTHETIC_NOTE])
+    worker_cpu: list[float] = field(default_factory=list)  # CPU [s] of each worker process
 
-    Returns
-    -------
-    Path
-        The HTML report.
 
-    Raises
-    ------
-    ValidationFailed
-        A validation criterion failed (exit code 1); the report is written first and the
-        message says which criteria failed and where the report is.
+def _echo_part(fut: Any) -> None:
+    """Print what a finished part said (a failed part's error is raised where it is awaited)."""
+    if not fut.cancelled() and fut.exception() is None and fut.result()[1]:
+        import typer
+
+        typer.echo(fut.result()[1], err=True, nl=False)
+
+
+def _skipped(size: DemoSize, parts: _Parts, sim_ok: bool, metrology_ok: bool) -> None:
+    """Record the parts this size or installation does not run (and say so)."""
+    if not sim_ok:
+        parts.missing.append("simulation: jointwear.sim is not available, nothing was simulated")
+    elif not size.verification_replicates:
+        parts.missing.append(
+            "verification: the sim verify study is skipped with --quick; u_num of the wear is "
+            "the simulation's own wear_depth_u (update interval and cycle-to-cycle "
+            "variability; the wear grid is not assessed)"
+        )
+    if not (size.ensemble_runs and sim_ok):
+        _say("  ensemble skipped (--quick): u_input not assessed")
+        parts.missing.append(
+            "input uncertainty: no ensemble with --quick, so u_input is not assessed and the "
+            "V&V 20 criteria are NOT ASSESSED; run 'jointwear demo' without --quick"
+        )
+    if not metrology_ok:
+        parts.missing.append(
+            "wear maps: the metrology chain (jointwear.metrology, jointwear.datasets.instruments) "
+            "is not available, so no measured wear map was made"
+        )
+
+
+def _run_parts(out: Path, size: DemoSize, workers: int) -> _Parts:
+    """Phase 1: simulate and measure, the independent parts side by side on ``workers``.
+
+    The motion is simulated here first (it is short and every motion part needs it); then the
+    pool runs the wear run with the roundness scans, the motion study with the footage, the
+    ensemble, and the runs of the wear verification study, whose results this process gathers.
     """
-    from jointwear.compare import compare, save_comparison
-    from jointwear.compare.outcome import card_lines, origin_line, outcome_lines
-    from jointwear.reports.builder import ReportInput, build_report
+    from jointwear.reports.demo_pool import run_part, worker_pool
 
-    out = Path(out)
-    size = QUICK if quick else FULL
-    out.mkdir(parents=True, exist_ok=True)
-    io.check_writable(out / "report.html", what="--out")
-    _say(f"jointwear demo ({'quick' if quick else 'full'} size) -> {out}")
-    missing: list[str] = []
-    notes = [
-        "The measured side is SYNTHETIC: instrument files and footage are generated by "
-        "jointwear.datasets from a known 'true' wear map (the simulated map 10 % deeper, turned "
-        "by 6 degree) and then imported and processed like real measurements. The report shows "
-        "the chain working; it does not validate the model against a real rig.",
-    ]
-    sims: list[Path] = []
-    meas: list[tuple[str, Path]] = []
-    sim_wear_path = sim_motion_path = ensemble_path = None
-    verification_paths: list[Path] = []
-    params = None
-    _phase(1, "simulating the reference mechanism: wear and motion")
-    if _available("jointwear.sim", "simulate_wear", "run_cycles", "PARAMETER_SETS"):
-        sim_wear_path, sim_motion_path, params, verification_paths, _ = _simulate(out, size)
-        sims += [sim_wear_path, sim_motion_path]
-        if not verification_paths:
-            missing.append(
-                "verification: the sim verify study is skipped with --quick; u_num of the wear is "
-                "the simulation's own wear_depth_u (update interval and cycle-to-cycle "
-                "variability; the wear grid is not assessed)"
-            )
-    else:
-        missing.append("simulation: jointwear.sim is not available, nothing was simulated")
-    if size.ensemble_runs and params is not None:
-        _phase(
-            2,
-            f"ensemble over the uncertain inputs (jointwear.sim.run_sweep: {size.ensemble_runs} "
-            f"LHS runs of {size.ensemble_cycles:g} cycles, fixed update interval)",
-        )
-        t0 = time.perf_counter()
-        motion_time = np.asarray(io.load(sim_motion_path)["time"].values, dtype=float)
-        ens = run_ensemble(params, size, motion_time)
-        ensemble_path = io.save(
-            ens,
-            out / "ensemble.nc",
-            parameters={"inputs": {k: v[0] for k, v in ENSEMBLE_INPUTS.items()}},
-            source="jointwear (sim.wear, sim.dynamics) ensemble via jointwear demo",
-        )
-        _say(
-            f"      ensemble: {ens.sizes['run']} runs, {int(ens.attrs.get('n_failed', 0))} failed "
-            f"({time.perf_counter() - t0:.0f} s)"
-        )
-        notes.append(
-            f"Input uncertainty u_input: spread of a {ens.sizes['run']}-run ensemble over "
+    parts = _Parts()
+    sim_ok = _available("jointwear.sim", "simulate_wear", "run_cycles", "PARAMETER_SETS")
+    metrology_ok = _available("jointwear.metrology", "wear_map") and _available(
+        "jointwear.datasets.instruments", "generate", "write"
+    )
+    _skipped(size, parts, sim_ok, metrology_ok)
+    if not sim_ok:
+        return parts
+    params = _params(size)
+    t0 = time.perf_counter()
+    motion = _simulate_motion(size, params)  # before the fork: the workers inherit its kernels
+    verify = bool(size.verification_replicates)
+    with worker_pool(workers, parts.worker_cpu) as pool:
+        sim_motion = _save_motion(out, size, params, motion)
+        _say(f"  simulated motion: {size.motion_cycles:g} crank cycles")
+        others = [pool.submit(run_part, _motion_part, out, size, params, sim_motion, verify)]
+        if size.ensemble_runs:
+            motion_time = np.asarray(motion["time"].values, dtype=float)
+            others.append(pool.submit(run_part, _ensemble_part, out, size, params, motion_time))
+        for fut in others:
+            fut.add_done_callback(_echo_part)
+        if verify:  # the compared wear run is one of the study's runs
+            study_pool = _StudyPool(pool, out, size, params, metrology_ok)
+            wear = study_pool.wear
+            wear.add_done_callback(_echo_part)
+            study = _study(out, size, params, study_pool)
+        else:
+            wear = pool.submit(run_part, _wear_part, out, size, params, metrology_ok)
+            wear.add_done_callback(_echo_part)
+            study = None
+        sim_wear, metrology = wear.result()[0]
+        motion_ver, dic_path, dic_missing = others[0].result()[0]
+        parts.ensemble = others[1].result()[0] if size.ensemble_runs else None
+    _say(f"  simulated and measured ({time.perf_counter() - t0:.0f} s)")
+    parts.sims += [sim_wear, sim_motion]
+    parts.verification += [p for p in (study, motion_ver) if p is not None]
+    parts.meas += [("metrology", metrology)] if metrology is not None else []
+    parts.meas += [("DIC", dic_path)] if dic_path is not None else []
+    parts.missing += [dic_missing] if dic_missing else []
+    if parts.ensemble is not None:
+        parts.notes.append(
+            f"Input uncertainty u_input: spread of a {size.ensemble_runs}-run ensemble over "
             + ", ".join(f"{k} (±{v[0]:.1%})" for k, v in ENSEMBLE_INPUTS.items())
             + f", run for {size.ensemble_cycles:g} cycles (reduced; wear spreads are scaled "
             "relative to the compared run) - see the uncertainty budget."
         )
-    else:
-        _phase(2, "ensemble skipped (--quick): u_input not assessed")
-        missing.append(
-            "input uncertainty: no ensemble with --quick, so u_input is not assessed and the "
-            "V&V 20 criteria are NOT ASSESSED; run 'jointwear demo' without --quick"
-        )
-    _phase(3, "measured wear: generating and importing virtual roundness scans")
-    if (
-        sim_wear_path is not None
-        and _available("jointwear.metrology", "wear_map")
-        and _available("jointwear.datasets.instruments", "generate", "write")
-    ):
-        metro_path, _ = _measure_wear(out, sim_wear_path, size)
-        meas.append(("metrology", metro_path))
-    else:
-        missing.append(
-            "wear maps: the metrology chain (jointwear.metrology, jointwear.datasets.instruments) "
-            "is not available, so no measured wear map was made"
-        )
-    _phase(
-        4,
-        "measured motion: rendering, calibrating and tracking stereo footage"
-        if size.rig_size
-        else "measured motion skipped (--quick)",
-    )
-    try:
-        dic_path, dic_missing = _measure_motion(out, size, sim_motion_path)
-    except JointwearError as exc:  # the footage chain failed: say so, keep the rest
-        dic_path, dic_missing = None, f"motion: the stereo DIC chain failed ({exc})"
-        _say(f"  {dic_missing}")
     if dic_path is not None:
-        meas.append(("DIC", dic_path))
-    if dic_missing:
-        missing.append(dic_missing)
-    if not sims or not meas:
-        raise ValidationFailed("the demo could not compare anything: " + "; ".join(missing))
-    _phase(5, "comparing and writing the report")
-    sim_ds = [io.load(p) for p in sims]
-    meas_ds = [io.load(p) for _, p in meas]
-    if dic_path is not None:
-        notes.append(
+        parts.notes.append(
             "Motion: only the in-plane follower velocity (x, y) is a validation target (the "
             "default of jointwear compare). The virtual rig prescribes the out-of-plane motion of "
             "joint C as one sinusoid (the first harmonic of the simulated motion), so its z "
             "component is not a measurement of the mechanism; tracked positions are in the "
             "calibration's world frame (the board), not the mechanism frame, and are not compared."
         )
-    ens_ds = [io.load(ensemble_path)] if ensemble_path is not None else []
-    ver_ds = [io.load(p) for p in verification_paths]
+    return parts
+
+
+def _compare_and_report(out: Path, size: DemoSize, quick: bool, parts: _Parts) -> Path:
+    """Phase 2: compare, write ``metrics.nc`` and the report, print the outcome."""
+    from jointwear.compare import compare, save_comparison
+    from jointwear.compare.outcome import card_lines, origin_line, outcome_lines
+    from jointwear.reports.builder import ReportInput, build_report
+
+    sims, meas = parts.sims, parts.meas
+    sim_ds = [io.load(p) for p in sims]
+    meas_ds = [io.load(p) for _, p in meas]
+    motion = any(role == "DIC" for role, _ in meas)
+    ens_ds = [io.load(parts.ensemble)] if parts.ensemble is not None else []
+    ver_ds = [io.load(p) for p in parts.verification]
     result = compare(
         sim_ds,
         [_in_plane(d) if role == "DIC" else d for (role, _), d in zip(meas, meas_ds, strict=True)],
-        variables=["follower_velocity"] if dic_path is not None else None,
+        variables=["follower_velocity"] if motion else None,
         ensemble=ens_ds or None,
         verification=ver_ds or None,
     )
+    ens_paths = [parts.ensemble] if parts.ensemble is not None else []
     save_comparison(
         result,
         out / "metrics.nc",
-        inputs=[*sims, *(p for _, p in meas), *([ensemble_path] if ensemble_path else [])],
+        inputs=[*sims, *(p for _, p in meas), *ens_paths],
         parents=[*sim_ds, *meas_ds],
     )
     inputs = [ReportInput("simulation", p, d) for p, d in zip(sims, sim_ds, strict=True)]
     inputs += [ReportInput(role, p, d) for (role, p), d in zip(meas, meas_ds, strict=True)]
-    if ensemble_path is not None:
-        inputs.append(ReportInput("ensemble", ensemble_path, ens_ds[0]))
+    inputs += [ReportInput("ensemble", p, d) for p, d in zip(ens_paths, ens_ds, strict=True)]
     inputs += [
-        ReportInput("verification", p, d) for p, d in zip(verification_paths, ver_ds, strict=True)
+        ReportInput("verification", p, d) for p, d in zip(parts.verification, ver_ds, strict=True)
     ]
     report = build_report(
         result,
         out / "report.html",
         inputs=inputs,
         verification=ver_ds,
-        missing=missing,
-        notes=notes,
+        missing=parts.missing,
+        notes=parts.notes,
         title="jointwear demo: wear of the clearance joint, simulation against measurement",
         parameters={"demo": {"quick": quick, "size": size.__dict__}},
     )
@@ -517,3 +635,72 @@ def run_demo(out: Path, *, quick: bool = False) -> Path:
             "this is the honest outcome of the demo's data, see the report's decision card"
         )
     return report
+
+
+def run_demo(out: Path, *, quick: bool = False, workers: int | None = None) -> Path:
+    """Run the whole chain on the embedded default data and write a validation report.
+
+    Parameters
+    ----------
+    out : Path
+        Output folder (created); receives the simulated and measured files, the ensemble,
+        ``metrics.nc`` and ``report.html``.
+    quick : bool
+        Reduced size and no ensemble (u_input is then not assessed), in this process.
+    workers : int, optional
+        Worker processes of the full run (default: one per core, at most
+        :data:`~jointwear.reports.demo_pool.MAX_WORKERS`); 1 runs everything in this process.
+
+    Returns
+    -------
+    Path
+        The HTML report.
+
+    Raises
+    ------
+    ValidationFailed
+        A validation criterion failed (exit code 1); the report is written first and the
+        message says which criteria failed and where the report is.
+    """
+    from jointwear.reports.demo_pool import MAX_WORKERS, available_cores
+
+    out = Path(out)
+    size = QUICK if quick else FULL
+    out.mkdir(parents=True, exist_ok=True)
+    io.check_writable(out / "report.html", what="--out")
+    if workers is None:
+        workers = 1 if quick else min(available_cores(), MAX_WORKERS)
+    _say(f"jointwear demo ({'quick' if quick else 'full'} size) -> {out}")
+    where = f"{workers} worker processes" if workers > 1 else "this process"
+    _phase(
+        1,
+        "simulating and measuring in "
+        + where
+        + (
+            ": the wear run and virtual roundness scans, the motion"
+            + ("" if quick else ", its stereo footage, the ensemble and the verification study")
+        ),
+    )
+    parts = _run_parts(out, size, workers)
+    if not parts.sims or not parts.meas:
+        raise ValidationFailed("the demo could not compare anything: " + "; ".join(parts.missing))
+    _phase(2, "comparing and writing the report")
+    try:
+        return _compare_and_report(out, size, quick, parts)
+    finally:
+        _say(_cpu_line(parts.worker_cpu))
+
+
+def _cpu_line(each: list[float]) -> str:
+    """CPU time (user + system) of this process and of the worker processes it has joined
+    (``each``: of every worker, where known)."""
+    try:
+        import resource
+    except ImportError:  # not POSIX
+        return "CPU: not measured on this system"
+    own, workers = (resource.getrusage(w) for w in (resource.RUSAGE_SELF, resource.RUSAGE_CHILDREN))
+    return (
+        f"CPU: {own.ru_utime + own.ru_stime:.1f} s in this process, "
+        f"{workers.ru_utime + workers.ru_stime:.1f} s in worker processes"
+        + (f" ({', '.join(f'{t:.1f}' for t in each)} s each)" if each else "")
+    )

@@ -18,6 +18,7 @@ __all__ = [
     "MOTION_RTOLS",
     "demo_study",
     "ensemble_spec",
+    "is_compared_run",
     "main_wear_settings",
     "motion_verification",
     "run_ensemble",
@@ -74,11 +75,14 @@ def main_wear_settings(size: DemoSize) -> Any:
     return WearSettings(scheme="fixed", dn=demo_study(size).levels[0])
 
 
-def wear_verification(params: Any, size: DemoSize, folder: Any) -> tuple[Any, xr.Dataset]:
+def wear_verification(
+    params: Any, size: DemoSize, folder: Any, *, scheduler: Any = None
+) -> tuple[Any, xr.Dataset]:
     """The demo's verification study of the simulated wear (:func:`jointwear.sim.verify_wear`).
 
     Replicates at four wear-update intervals ΔN and runs on the next grid (:func:`demo_study`),
-    in this process; :func:`jointwear.refinement.study_uncertainty` turns the study into u_num of
+    in this process or on ``scheduler`` (the demo's pool of worker processes, see
+    :mod:`jointwear.reports.demo_pool`); :func:`jointwear.refinement.study_uncertainty` turns the study into u_num of
     any wear quantity (Eça & Hoekstra 2014 on the replicate means, plus the grid term), so max
     depth, volume and cylindricity are assessed with a value (the earlier refinement of the
     adaptive update's ``tol`` was inert: the noise floor, not ``tol``, set the interval).
@@ -93,7 +97,7 @@ def wear_verification(params: Any, size: DemoSize, folder: Any) -> tuple[Any, xr
     from jointwear.sim import verify_wear
 
     path = Path(folder) / "sim_verification.nc"
-    study = verify_wear(params, spec=demo_study(size), workers=0, out=path)
+    study = verify_wear(params, spec=demo_study(size), workers=0, scheduler=scheduler, out=path)
     return path, study
 
 
@@ -263,3 +267,18 @@ def run_ensemble(
         }
     )
     return ds
+
+
+def is_compared_run(task: Any, params: Any, size: DemoSize) -> bool:
+    """True if the study run ``task`` is the demo's compared wear run: the same parameters,
+    wear settings (:func:`main_wear_settings`), cycles and snapshots, so that one simulation
+    serves both (replicate 0 of the finest level)."""
+    from jointwear.sim.sweep._params import apply_values
+
+    sim, wear = apply_values(task.sim_params, task.wear_settings, task.values)
+    return (
+        sim == params
+        and wear == main_wear_settings(size)
+        and task.spec.cycles == size.cycles
+        and list(size.snapshots) == [size.cycles]
+    )

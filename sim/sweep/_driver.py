@@ -15,6 +15,8 @@ import logging
 import time
 import warnings
 from collections.abc import Callable
+from concurrent.futures import Executor
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -501,7 +503,7 @@ def run_sweep(
     params: Any = None,
     wear: Any = None,
     workers: int | None = None,
-    scheduler: str | None = None,
+    scheduler: str | Executor | None = None,
     resume: bool = False,
     on_progress: Callable[[dict[str, Any]], None] | None = None,
     base: str | None = None,
@@ -523,8 +525,9 @@ def run_sweep(
     workers : int, optional
         0: run in this process (no dask); N: a local dask cluster of N single-threaded worker
         processes (default: one per core).
-    scheduler : str, optional
-        Address of a running dask scheduler; ``workers`` is then ignored.
+    scheduler : str or Executor, optional
+        Address of a running dask scheduler, or a :class:`concurrent.futures.Executor` of the
+        caller's (each run one task); ``workers`` is then ignored.
     resume : bool
         Continue an interrupted sweep writing ``out``: only runs without a part file are
         computed (the spec and base parameters must be the same).
@@ -555,8 +558,6 @@ def run_sweep(
     >>> run_sweep({"sweep": sweep, "parameters": grid}, workers=0)["y"].values.tolist()
     [0.0, 1.0, 1.0, 2.0]
     """
-    from jointwear import io
-    from jointwear._version import source_attribute
 
     if resume and out is None:
         raise BadInputError("resume needs the sweep's result file (out=/--out)")
@@ -575,56 +576,57 @@ def run_sweep(
         RunTask(i, design.run_values(names, i), int(design.seeds[i]), spec, sim, wear)
         for i in range(design.n_runs)
     ]
-    if resume and _already_complete(out, digest):
-        ds = io.load(out)
-        ds.attrs.update(runs_computed_now=0, runs_resumed=design.n_runs)
-        ds.attrs["executor"] = "none (all runs resumed)"
-        return ds
 
     def build(results: dict[int, RunResult], lost: dict[int, str]) -> xr.Dataset:
         return sensitivity(assemble(spec, design, results, lost, sim=sim), spec, design)
 
-    return run_and_save(
-        tasks,
-        design.values,
-        build,
-        out=out,
-        digest=digest,
-        record=record,
-        resume=resume,
-        workers=workers,
-        scheduler=scheduler,
-        on_progress=on_progress,
-        inputs=[*spec_file, *inputs],
-        source=source_attribute("sim.sweep"),
-    )
+    how = Execution(out, resume, workers, scheduler, on_progress)
+    inputs = [*spec_file, *inputs]
+    return run_and_save(tasks, design.values, build, how, digest, record, inputs, "sim.sweep")
+
+
+@dataclass(frozen=True)
+class Execution:
+    """Where the runs of a sweep or study go (see :func:`run_sweep`): the result file, resume,
+    executor (``workers``, ``scheduler``: an address or a caller's executor) and progress."""
+
+    out: str | Path | None
+    resume: bool
+    workers: int | None
+    scheduler: Any
+    on_progress: Callable[[dict[str, Any]], None] | None
 
 
 def run_and_save(
     tasks: list[RunTask],
     values: np.ndarray,
     build: Callable[[dict[int, RunResult], dict[int, str]], xr.Dataset],
-    *,
-    out: str | Path | None,
+    how: Execution,
     digest: str,
     record: dict[str, Any],
-    resume: bool,
-    workers: int | None,
-    scheduler: str | None,
-    on_progress: Callable[[dict[str, Any]], None] | None,
     inputs: list[Path],
     source: str,
 ) -> xr.Dataset:
     """Run ``tasks`` through the part store and an executor, build the result and write it.
+
+    A finished result of the same ``digest`` in ``how.out`` is returned as it is on resume.
 
     Each finished run goes at once to ``<out>.parts/`` (checked against ``digest`` and its row
     of ``values`` on resume), the runs are executed in the order given, ``build(results, lost)``
     makes the Dataset, which gets ``sweep_digest``, ``runs_computed_now``, ``runs_resumed`` and
     ``executor`` and is written atomically to ``out``; the part files are removed once it is
     written and no run was lost. Shared by :func:`run_sweep` and
-    :func:`jointwear.sim.verify_wear`.
+    :func:`jointwear.sim.verify_wear`; ``source`` names the producer (``"sim.sweep"``).
     """
     from jointwear import io
+    from jointwear._version import source_attribute
+
+    out, resume, on_progress = how.out, how.resume, how.on_progress
+    if resume and _already_complete(out, digest):
+        ds = io.load(out)
+        ds.attrs.update(runs_computed_now=0, runs_resumed=len(tasks))
+        ds.attrs["executor"] = "none (all runs resumed)"
+        return ds
 
     store = None
     results: dict[int, RunResult] = {}
@@ -669,8 +671,8 @@ def run_and_save(
 
         execute_runs(
             todo,
-            workers=workers,
-            scheduler=scheduler,
+            workers=how.workers,
+            scheduler=how.scheduler,
             on_result=got,
             on_lost=gone,
             on_start=started,
@@ -681,7 +683,7 @@ def run_and_save(
         ds.attrs["runs_resumed"] = state["resumed"]
         ds.attrs["executor"] = state["executor"] or "none (all runs resumed)"
         if out is not None:
-            io.save(ds, out, inputs=inputs, parameters=record, source=source)
+            io.save(ds, out, inputs=inputs, parameters=record, source=source_attribute(source))
             finished = not lost
     finally:
         if store is not None:

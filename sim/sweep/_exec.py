@@ -1,4 +1,5 @@
-"""Executors of sweep runs: in-process, a local dask cluster, or an existing one by address.
+"""Executors of sweep runs: in-process, a local dask cluster, an existing one by address, or a
+caller's :class:`concurrent.futures.Executor` (e.g. the demo's pool of forked processes).
 
 Each run is one dask task (:func:`jointwear.sim.sweep._run.evaluate_run`); results are handed
 to ``on_result`` in the order they finish, so the caller writes each at once. A run whose
@@ -12,6 +13,7 @@ import logging
 import os
 import uuid
 from collections.abc import Callable, Sequence
+from concurrent import futures as cf
 from typing import Any
 
 from jointwear.errors import BadInputError
@@ -35,6 +37,27 @@ def _serial(tasks: Sequence[RunTask], on_result: Callable[[RunResult], None]) ->
     for task in tasks:
         on_result(evaluate_run(task))
     return "in-process"
+
+
+def _pool(
+    tasks: Sequence[RunTask],
+    pool: cf.Executor,
+    on_result: Callable[[RunResult], None],
+    on_lost: Callable[[int, str], None],
+) -> None:
+    """Runs on a caller's executor (which the caller shuts down), handed on as they finish."""
+    index_of = {pool.submit(evaluate_run, t): t.index for t in tasks}
+    try:
+        for fut in cf.as_completed(index_of):
+            try:
+                res = fut.result()
+            except Exception as exc:  # a worker process died (BrokenProcessPool), ...
+                on_lost(index_of[fut], f"{type(exc).__name__}: {exc}")
+            else:
+                on_result(res)
+    finally:  # interrupted: runs not yet started are not started
+        for fut in index_of:
+            fut.cancel()
 
 
 def _client(workers: int | None, scheduler: str | None) -> tuple[Any, Any, str]:
@@ -73,7 +96,7 @@ def execute(
     tasks: Sequence[RunTask],
     *,
     workers: int | None,
-    scheduler: str | None,
+    scheduler: str | cf.Executor | None,
     on_result: Callable[[RunResult], None],
     on_lost: Callable[[int, str], None],
     on_start: Callable[[str], None] | None = None,
@@ -86,14 +109,20 @@ def execute(
     workers : int or None
         0: in this process, no dask; N: a local cluster of N worker processes (default: one per
         core). Ignored with ``scheduler``.
-    scheduler : str or None
-        Address of a running dask scheduler (``tcp://host:8786``).
+    scheduler : str, Executor or None
+        Address of a running dask scheduler (``tcp://host:8786``), or an executor of the
+        caller's (``submit``; each run one task, results in the order they finish).
     on_result, on_lost : callable
         Called with each :class:`RunResult`, or with ``(index, reason)`` for a run dask lost.
     on_start : callable, optional
         Called with a description of the executor once it is up.
     """
     if not tasks:
+        return
+    if isinstance(scheduler, cf.Executor):
+        if on_start:
+            on_start(f"the caller's {type(scheduler).__name__}")
+        _pool(tasks, scheduler, on_result, on_lost)
         return
     if scheduler is None and workers == 0:
         if on_start:

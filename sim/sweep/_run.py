@@ -12,6 +12,7 @@ import os
 import socket
 import time
 import traceback
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -79,7 +80,9 @@ def _run_quietly(run: Any) -> Any:
         log.propagate = propagate
 
 
-def _wear(task: RunTask) -> tuple[dict[str, float], dict[str, np.ndarray]]:
+def _wear(
+    task: RunTask, on_dataset: Callable[[Any], None] | None = None
+) -> tuple[dict[str, float], dict[str, np.ndarray]]:
     from jointwear.errors import SimulationError
     from jointwear.sim.sweep._outputs import (
         MOTION_OUTPUTS,
@@ -115,6 +118,8 @@ def _wear(task: RunTask) -> tuple[dict[str, float], dict[str, np.ndarray]]:
         on_update=within_budget,
     )
     ds = _run_quietly(run)
+    if on_dataset is not None:
+        on_dataset(ds)
     out = wear_outputs(ds)
     out["__accuracy_status"] = ds.attrs.get("accuracy_status", "not assessed")
     out["__warnings"] = tuple(f"{k}: {ds.attrs[k]}" for k in WARNING_ATTRS if k in ds.attrs)
@@ -162,15 +167,20 @@ def _error_text(exc: BaseException) -> str:
     return f"{type(exc).__name__}: {exc}{where}"
 
 
-def evaluate_run(task: RunTask) -> RunResult:
+def evaluate_run(task: RunTask, on_dataset: Callable[[Any], None] | None = None) -> RunResult:
     """Run one member of a sweep; a failure is returned as ``status = "failed"`` with its error.
 
-    Only the requested outputs are returned (missing ones as NaN).
+    Only the requested outputs are returned (missing ones as NaN). ``on_dataset`` (wear runs):
+    called with the run's whole wear map Dataset before it is reduced (``jointwear demo`` keeps
+    the study run that is also its compared run).
     """
     t0 = time.perf_counter()
     host = f"{socket.gethostname()}:{os.getpid()}"
     try:
-        out, fields = _RUNNERS[task.spec.run](task)
+        if on_dataset is not None and task.spec.run == "wear":
+            out, fields = _wear(task, on_dataset)
+        else:
+            out, fields = _RUNNERS[task.spec.run](task)
     except Exception as exc:  # a failing run is recorded, not raised: the sweep goes on
         return RunResult(
             task.index, "failed", {}, {}, _error_text(exc), time.perf_counter() - t0, host

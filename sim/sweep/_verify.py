@@ -23,6 +23,7 @@ import hashlib
 import json
 import math
 from collections.abc import Callable, Mapping, Sequence
+from concurrent.futures import Executor
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -230,6 +231,22 @@ def _sweep_spec(spec: VerifySpec, table: np.ndarray, wear: Any) -> Any:
     )
 
 
+def study_tasks(spec: VerifySpec, sim: Any, wear: Any) -> tuple[np.ndarray, list[tuple], list]:
+    """The runs of a study: values (:data:`_COLUMNS`), places (kind, level, replicate) and
+    their :class:`~jointwear.sim.sweep._run.RunTask`, the longest first (so that no worker is
+    left with a long run at the end). Run 0 is replicate 0 of the finest level."""
+    from jointwear.sim.sweep._run import RunTask
+
+    values, where = _run_table(spec, sim, wear)
+    sweep = _sweep_spec(spec, values, wear)
+    tasks = [
+        RunTask(i, dict(zip(_COLUMNS, map(float, values[i]), strict=True)), i, sweep, sim, wear)
+        for i in range(len(values))
+    ]
+    tasks.sort(key=lambda t: -_relative_cost(values[t.index], values[0]))
+    return values, where, tasks
+
+
 def _digest(record: Mapping[str, Any]) -> str:
     return hashlib.sha256(json.dumps(record, sort_keys=True, default=str).encode()).hexdigest()
 
@@ -245,7 +262,7 @@ def verify_wear(
     band: tuple[float, float] | None = None,
     wear: Any = None,
     workers: int | None = None,
-    scheduler: str | None = None,
+    scheduler: str | Executor | None = None,
     out: str | Path | None = None,
     resume: bool = False,
     on_progress: Callable[[dict[str, Any]], None] | None = None,
@@ -269,7 +286,9 @@ def verify_wear(
         Base wear settings (kw, settling); the scheme is set to ``"fixed"`` with each level's ΔN.
     workers, scheduler :
         As for :func:`jointwear.sim.run_sweep` (0: in this process; N: a local dask cluster;
-        an address: a running scheduler).
+        an address: a running scheduler); ``scheduler`` may also be a
+        :class:`concurrent.futures.Executor` of the caller's (``jointwear demo`` passes its
+        pool of worker processes), which runs each run as one task.
     out : path, optional
         Study file (netCDF); runs go to ``<out>.parts/`` first, so an interrupted study resumes.
     resume : bool
@@ -287,11 +306,8 @@ def verify_wear(
     ParameterError, BadInputError
         A bad spec or parameter (named), an unwritable ``out``, resume of another study.
     """
-    from jointwear import io
-    from jointwear._version import source_attribute
-    from jointwear.sim.sweep._driver import _already_complete, _base, run_and_save
+    from jointwear.sim.sweep._driver import Execution, _base, run_and_save
     from jointwear.sim.sweep._params import apply_values
-    from jointwear.sim.sweep._run import RunTask
 
     if workers is not None and workers < 0:
         raise BadInputError(f"workers must be >= 0, got {workers}")
@@ -318,8 +334,7 @@ def verify_wear(
     sim, base_wear, base_record, inputs = _base(_WearKind, params, wear)
     base_wear = dataclasses.replace(base_wear, scheme="fixed")
     base_record["wear"]["scheme"] = "fixed"
-    values, where = _run_table(vspec, sim, base_wear)
-    sweep = _sweep_spec(vspec, values, base_wear)
+    values, where, tasks = study_tasks(vspec, sim, base_wear)
     for row in {tuple(r) for r in values}:  # refuse impossible runs before starting any
         apply_values(sim, base_wear, dict(zip(_COLUMNS, row, strict=True)))
     if band is not None:
@@ -334,38 +349,15 @@ def verify_wear(
             )
     record = {"study": vspec.describe(), "base": base_record, "band_m": band}
     digest = _digest(record)
-    tasks = [
-        RunTask(
-            i, dict(zip(_COLUMNS, map(float, values[i]), strict=True)), i, sweep, sim, base_wear
-        )
-        for i in range(len(values))
-    ]
-    # the longest runs first, so that no worker is left with a long run at the end
-    tasks.sort(key=lambda t: -_relative_cost(values[t.index], values[0]))
-    if resume and _already_complete(out, digest):
-        ds = io.load(out)
-        ds.attrs.update(runs_computed_now=0, executor="none (all runs resumed)")
-        return ds
 
     def build(results: dict[int, Any], lost: dict[int, str]) -> xr.Dataset:
         ds = study_dataset(vspec, sim, values, where, results, lost, band=band)
         ds.attrs["parameters_json"] = json.dumps(base_record, sort_keys=True)
         return ds
 
-    return run_and_save(
-        tasks,
-        values,
-        build,
-        out=out,
-        digest=digest,
-        record=record,
-        resume=resume,
-        workers=workers,
-        scheduler=scheduler,
-        on_progress=on_progress,
-        inputs=[*spec_file, *inputs],
-        source=source_attribute("sim.sweep.verify"),
-    )
+    how = Execution(out, resume, workers, scheduler, on_progress)
+    inputs = [*spec_file, *inputs]
+    return run_and_save(tasks, values, build, how, digest, record, inputs, "sim.sweep.verify")
 
 
 def _relative_cost(row: np.ndarray, base: np.ndarray) -> float:
@@ -553,15 +545,14 @@ def study_dataset(
                 gmaps[rep] = depth
     coords.update(_study_coords(spec, qnames, values))
     ds = xr.Dataset(coords=coords)
-    ds["replicate_value"] = (
-        ("quantity", "level", "replicate"),
-        rv,
-        {"units": "1", "long_name": "value of each run (units: quantity_units)"},
-    )
-    ds["grid_replicate_value"] = (
+    dims = ("quantity", "level", "replicate")
+    _put(ds, "replicate_value", dims, rv, "value of each run")
+    _put(
+        ds,
+        "grid_replicate_value",
         ("quantity", "grid_replicate"),
         gv,
-        {"units": "1", "long_name": "value of each run on the next grid (units: quantity_units)"},
+        "value of each run on the next grid",
     )
     _add_quantity_info(ds, qnames, units, coords)
     ds["wear_depth_run"] = (
@@ -611,6 +602,11 @@ def study_dataset(
         }
     )
     return _add_fits(ds, units)
+
+
+def _put(ds: xr.Dataset, name: str, dims: tuple[str, ...], values: Any, long_name: str) -> None:
+    """``ds[name]``: values of the studied quantities, each in its ``quantity_units``."""
+    ds[name] = (dims, values, {"units": "1", "long_name": f"{long_name} (units: quantity_units)"})
 
 
 def _band_units(band: tuple[float, float]) -> dict[str, tuple[str, str]]:
@@ -683,16 +679,8 @@ def _add_fits(ds: xr.Dataset, units: Mapping[str, tuple[str, str]]) -> xr.Datase
     for k, q in enumerate(qnames):
         vals = ds["replicate_value"].sel(quantity=q).transpose("level", "replicate").values
         lm[k], ls[k], _ = level_statistics(vals, period=periods[k])
-    ds["level_mean"] = (
-        ("quantity", "level"),
-        lm,
-        {"units": "1", "long_name": "mean of the replicates per level (units: quantity_units)"},
-    )
-    ds["level_sem"] = (
-        ("quantity", "level"),
-        ls,
-        {"units": "1", "long_name": "standard error of the level mean (units: quantity_units)"},
-    )
+    _put(ds, "level_mean", ("quantity", "level"), lm, "mean of the replicates per level")
+    _put(ds, "level_sem", ("quantity", "level"), ls, "standard error of the level mean")
     u_attrs = {
         "units": "1",
         "coverage_factor": 1,

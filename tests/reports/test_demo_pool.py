@@ -1,0 +1,167 @@
+"""The demo's worker pool: its compared wear run is the study's run 0, simulated once."""
+
+from __future__ import annotations
+
+import dataclasses
+import os
+import threading
+from concurrent.futures import Future
+
+import numpy as np
+import pytest
+
+from jointwear import io
+from jointwear.reports import demo
+from jointwear.reports.demo_pool import InlineExecutor, process_cpu, run_part, worker_pool
+from jointwear.reports.demo_studies import demo_study, main_wear_settings
+
+#: A study small enough for a test: 1600 cycles, ΔN = 100 ... 800, a 4 x 24 bearing grid.
+TINY = dataclasses.replace(
+    demo.FULL, cycles=1600.0, snapshots=(1600.0,), n_layers=4, n_points=24, rig_size=None
+)
+
+
+def _run0():
+    from jointwear.sim.sweep._driver import _base
+    from jointwear.sim.sweep._verify import _WearKind, study_tasks
+
+    params = demo._params(TINY)
+    sim, wear, _, _ = _base(_WearKind, params, None)
+    _, _, tasks = study_tasks(demo_study(TINY), sim, dataclasses.replace(wear, scheme="fixed"))
+    return params, next(t for t in tasks if t.index == 0)
+
+
+def test_the_compared_wear_file_is_the_study_run_and_the_serial_run(tmp_path):
+    from jointwear.sim import simulate_wear
+
+    params, task = _run0()
+    result, (path, metrology) = demo._compared_study_run(task, tmp_path, TINY, params, False)
+    saved = io.load(path)
+    assert result.status == "ok" and metrology is None
+    assert saved.attrs["data_origin"] == "simulated"
+    # the study keeps exactly the map the compared file holds ...
+    final = np.asarray(saved["wear_depth"].isel(cycles=-1).values)
+    np.testing.assert_array_equal(result.fields["wear_depth"], final)
+    assert result.outputs["max_wear_depth"] == pytest.approx(float(final.max()), rel=1e-12)
+    # ... and it is the run the serial demo simulated on its own (simulate_wear)
+    serial = simulate_wear(
+        params,
+        cycles=TINY.cycles,
+        snapshots=list(TINY.snapshots),
+        settings=main_wear_settings(TINY),
+    )
+    np.testing.assert_array_equal(serial["wear_depth"].values, saved["wear_depth"].values)
+    assert float(final.max()) > 0
+
+
+def test_another_run_is_refused_as_the_compared_run(tmp_path):
+    from jointwear.errors import SimulationError
+
+    params, task = _run0()
+    other = dataclasses.replace(task, values={**task.values, "wear.dn": 200.0})
+    with pytest.raises(SimulationError, match="not the compared wear run"):
+        demo._compared_study_run(other, tmp_path, TINY, params, False)
+
+
+def _spin(seconds):
+    import time
+
+    t0 = time.process_time()
+    while time.process_time() - t0 < seconds:
+        pass
+
+
+@pytest.mark.skipif(not os.path.exists("/proc/self/stat"), reason="needs /proc")
+def test_process_cpu_reads_a_process_cpu_time():
+    _spin(0.2)
+    import time
+
+    before = time.process_time()
+    measured = process_cpu(os.getpid())
+    tick = 1.0 / os.sysconf("SC_CLK_TCK")
+    assert before - 2 * tick <= measured <= time.process_time() + 2 * tick
+    assert process_cpu(2**22 + 12345) is None  # no such process
+
+
+class _Task:
+    def __init__(self, index):
+        self.index = index
+
+
+def test_study_pool_hands_run_zero_to_the_wear_part(monkeypatch):
+    calls = []
+
+    def fake(task, *args):
+        calls.append(task.index)
+        print("compared run done", file=__import__("sys").stderr)
+        return f"result {task.index}", ("sim_wear.nc", "metrology.nc")
+
+    monkeypatch.setattr(demo, "_compared_study_run", fake)
+    pool = demo._StudyPool(InlineExecutor(), "out", TINY, None, True)
+    other = pool.submit(lambda t: f"run {t.index}", _Task(3))
+    first = pool.submit(lambda t: "never", _Task(0))
+    assert other.result() == "run 3" and first.result() == "result 0" and calls == [0]
+    files, text = pool.wear.result()
+    assert files == ("sim_wear.nc", "metrology.nc") and "compared run done" in text
+
+
+def test_a_failed_compared_run_fails_the_study_run_and_the_wear_part(monkeypatch):
+    def fails(task, *args):
+        raise RuntimeError("no wear")
+
+    monkeypatch.setattr(demo, "_compared_study_run", fails)
+    pool = demo._StudyPool(InlineExecutor(), "out", TINY, None, True)
+    first = pool.submit(lambda t: "never", _Task(0))
+    for fut in (first, pool.wear):
+        with pytest.raises(RuntimeError, match="no wear"):
+            fut.result()
+
+
+def test_run_part_captures_what_the_part_says():
+    def part(x):
+        import sys
+
+        print(f"part {x}", file=sys.stderr)
+        return x + 1
+
+    assert run_part(part, 1) == (2, "part 1\n")
+    assert isinstance(InlineExecutor().submit(int, "x"), Future)
+    with pytest.raises(ValueError):
+        InlineExecutor().submit(int, "x").result()
+
+
+@pytest.mark.skipif(not hasattr(os, "fork"), reason="needs fork")
+def test_worker_pool_forks_a_lone_thread_and_spawns_beside_others():
+    cpu: list[float] = []
+    with worker_pool(2, cpu) as pool:
+        assert pool._mp_context.get_start_method() == "fork"
+        assert pool.submit(os.getpid).result() != os.getpid()
+        pool.submit(_spin, 0.3).result()
+    if os.path.exists("/proc/self/stat"):  # each worker's CPU, the spinning one's included
+        assert len(cpu) == 2 and 0.25 <= max(cpu) < 5.0
+    stop = threading.Event()
+    other = threading.Thread(target=stop.wait)
+    other.start()
+    try:
+        with worker_pool(2) as pool:
+            assert pool._mp_context.get_start_method() == "spawn"
+    finally:
+        stop.set()
+        other.join()
+    with worker_pool(1) as pool:
+        assert isinstance(pool, InlineExecutor)
+
+
+def test_a_cancelled_compared_run_cancels_the_wear_part():
+    held: list[Future] = []
+
+    class Holding(InlineExecutor):  # keeps each task queued, as a busy pool does
+        def submit(self, fn, /, *args, **kwargs):
+            held.append(Future())
+            return held[-1]
+
+    pool = demo._StudyPool(Holding(), "out", TINY, None, True)
+    first = pool.submit(lambda t: "never", _Task(0))
+    assert not first.done() and not pool.wear.done()
+    assert held[0].cancel()  # the demo is stopped: its pool cancels the queued task
+    assert first.cancelled() and pool.wear.cancelled()
