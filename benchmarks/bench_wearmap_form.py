@@ -124,6 +124,7 @@ def _reference_size(seeds=(1, 2, 3)) -> dict:
         "before_13x18000_volume_truth_minus_D_over_u": z,
         "before_13x18000_max_abs": float(np.max(np.abs(z))),
         "before_13x18000_mean": float(np.mean(z)),
+        "before_13x18000_rms": float(np.sqrt(np.mean(np.square(z)))),
         "before_13x18000_noise_free_max_relative_error": float(np.max(rel)),
     }
 

@@ -262,8 +262,9 @@ def _exclude_tails(
     worn region has a mean above ``z_crit`` standard errors, the next band leaves the unworn
     set and the reference is refitted. Where that would leave fewer than ``min_fraction`` of
     the points and the zone's mean exceeds 1.5 ``z_crit`` standard errors, the tails reach
-    around the bore: refused (a BadInputError naming the explicit unworn mask). What stays below the test is covered by the "unworn
-    selection" term of the uncertainty (the change when a further 10 degree is left out).
+    around the bore: refused (a BadInputError naming the explicit unworn mask). What stays
+    below the test is in the uncertainty: the larger of the "unworn selection" term (the change
+    when a further 10-30 degree is left out) and the undetected tail (:func:`undetected_tail`).
     Returns (mask, description).
     """
     nz, nt = shape

@@ -131,22 +131,28 @@ def _scalars(q: dict, cyl_before, cyl_after, note: str, noise: float) -> dict:
     return out
 
 
-def _model_order_term(q: dict, other: np.ndarray, wts: np.ndarray, z, th, what: str) -> None:
-    """Add, in quadrature, how much each quantity changes under another defensible choice
-    (the form model's order, the unworn selection): a source of uncertainty."""
+def _changes(q: dict, other: np.ndarray, wts: np.ndarray, z, th) -> dict:
+    """How much each quantity of ``q`` changes when the map is ``other`` (absolute)."""
     zeros = np.zeros_like(other)
     alt = derived_quantities(other, zeros, 0.0, 1.0, np.zeros(1), np.zeros((1, 1)), wts, z, th)
-    for name, (v, u, comment) in list(q.items()):
-        dv = abs(alt[name][0] - v)
+    return {name: abs(alt[name][0] - v) for name, (v, _, _) in q.items()}
+
+
+def _model_order_term(q: dict, other: np.ndarray, wts: np.ndarray, z, th, what: str) -> None:
+    """Add, in quadrature, how much each quantity changes under another defensible choice
+    (the form model's order): a source of uncertainty."""
+    for name, dv in _changes(q, other, wts, z, th).items():
+        v, u, comment = q[name]
         if np.isfinite(dv):
             q[name] = (v, float(np.hypot(u, dv)), comment + f"; {what} ({dv:.3g})")
 
 
-def selection_term(q, u, wear, d, X, mask2, wts, z, th, threshold, margin_deg) -> np.ndarray:
-    """Add the dependence on the unworn selection to ``q`` and return the widened per-point u.
+def selection_term(q, wear, d, X, mask2, wts, z, th, threshold, margin_deg):
+    """The dependence on the unworn selection: (change of each quantity, of every depth [m]);
+    None where no other selection can be fitted.
 
     Faint wear tails next to the worn region, too faint for the band test, bias the reference:
-    refit without the points within a further 10, 20 and 30 degree of it and count the largest
+    refit without the points within a further 10, 20 and 30 degree of it and take the largest
     change of the volume (each a defensible selection; while at least 10 % of the points stay).
     The worn region: where most of a 2-degree window is not unworn (not every isolated noise
     outlier).
@@ -170,30 +176,59 @@ def selection_term(q, u, wear, d, X, mask2, wts, z, th, threshold, margin_deg) -
         if dv > change:
             best, change = other, dv
     if best is None:
-        return u
-    _model_order_term(q, best, wts, z, th, "unworn selection")
-    return np.hypot(u, wear - best)
+        return None
+    return _changes(q, best, wts, z, th), np.abs(wear - best)
 
 
-def tail_term(q: dict, u: np.ndarray, wear: np.ndarray, dv: float, shift, note: str):
-    """Add the bias of a faint wear tail the band test cannot see (:func:`undetected_tail`:
-    volume change ``dv`` [m^3], reference ``shift`` at every point [m]) to ``q`` in quadrature
-    and return the widened per-point u (``dv`` NaN: the tails could not be tested, said so)."""
-    shift = np.abs(np.asarray(shift, dtype=float)).reshape(wear.shape)
+def tail_term(q: dict, wear: np.ndarray, wts, dv: float, shift):
+    """The standard uncertainty of a faint wear tail the band test cannot see: (of each
+    quantity, of every depth [m]); None where the tails could not be tested (``dv`` NaN).
+
+    :func:`undetected_tail` bounds the tail: it shifts the reference by at most ``shift`` at
+    every point [m] (``wts`` the points' areas [m^2]). A bound +-a on an effect is, per the GUM
+    (4.3.7), a rectangular distribution of standard uncertainty a/sqrt(3). (The tail is one-
+    sided - it pulls the reference up, every depth reads low - but its correction by a/2 with
+    u = a/sqrt(12) over-corrected: the bound is a worst case, most maps hold far less, and
+    read high by 0.7-1.3 u; so no correction and the symmetric bound.)"""
+    if not np.isfinite(dv):
+        return None
+    shift = np.asarray(shift, dtype=float).reshape(wear.shape)
     k = np.unravel_index(int(np.argmax(np.nan_to_num(wear))), wear.shape)
-    change = {
-        "worn_volume": dv,
-        "max_wear_depth": float(shift[k]),
-        "wear_cylindricity": float(shift.max() - shift.min()),
+    bound = {
+        "worn_volume": abs(float(np.sum(wts * shift))),
+        "max_wear_depth": abs(float(shift[k])),
+        "wear_cylindricity": float(np.ptp(shift)),
     }
+    return {name: b / np.sqrt(3.0) for name, b in bound.items()}, np.abs(shift) / np.sqrt(3.0)
+
+
+def reference_bias_terms(q: dict, u: np.ndarray, selection, tail, note: str) -> np.ndarray:
+    """Add to ``q`` the uncertainty of the reference's bias by faint wear tails and return the
+    widened per-point u. ``selection`` (:func:`selection_term`) and ``tail``
+    (:func:`tail_term`) are two estimates of that one effect (leaving the tails out changes
+    the map by about what they bias it): the larger of the two counts, not their sum. Either
+    may be None (not assessed); ``note`` describes the tail."""
+    per_point = [t[1] for t in (selection, tail) if t is not None]
     for name, (v, uu, comment) in list(q.items()):
-        dq = change[name] if np.isfinite(dv) else float("nan")
-        if not np.isfinite(dq):
-            q[name] = (v, uu, comment + f"; faint wear tails {note}")
-        elif np.isfinite(uu) and dq > 0:
-            text = f"; undetected wear tail ({dq:.3g}: {note})"
-            q[name] = (v, float(np.hypot(uu, dq)), comment + text)
-    return np.hypot(u, shift)
+        parts, terms = [], []
+        if selection is not None and np.isfinite(selection[0][name]):
+            parts.append(f"unworn selection ({selection[0][name]:.3g})")
+            terms.append(selection[0][name])
+        if tail is None:
+            parts.append(f"faint wear tails {note}")
+        elif np.isfinite(tail[0][name]):
+            parts.append(
+                f"undetected wear tail ({tail[0][name]:.3g}: bound/sqrt(3), rectangular; {note})"
+            )
+            terms.append(tail[0][name])
+        du = max(terms, default=0.0)
+        text = "; " + " and ".join(parts)
+        if len(terms) == 2:
+            text += " (one effect: the larger counted)"
+        q[name] = (v, float(np.hypot(uu, du)) if np.isfinite(uu) else uu, comment + text)
+    if per_point:
+        u = np.hypot(u, np.maximum.reduce(per_point))
+    return u
 
 
 def refuse_inseparable_difference(s2: float, noise: float, tau: float) -> None:

@@ -58,6 +58,7 @@ from jointwear.metrology._wear_output import (
     _model_order_term,
     _scalars,
     _separable,
+    reference_bias_terms,
     refuse_inseparable_difference,
     selection_term,
     tail_term,
@@ -438,12 +439,17 @@ def _quantities(d, X, fit, alt, z, th, radius, terms, fit_args):
         _model_order_term(q, other, wts, z, th, "form-model order")
         u = np.hypot(u, wear - other)  # each depth's dependence on the model order
     tail = None
-    if "selection" in terms and not mask2.all():
-        u = selection_term(q, u, wear, d, X, mask2, wts, z, th, threshold, margin)
-    if "tail" in terms and not mask2.all():
+    if mask2.all() or not terms:
+        return q, u, tau, noise_sigma(wear), tail
+    selection = tail_u = None
+    note = "not assessed"
+    if "selection" in terms:
+        selection = selection_term(q, wear, d, X, mask2, wts, z, th, threshold, margin)
+    if "tail" in terms:
         dv, shift, note = undetected_tail(d, X, mask, shape, th, wts)
         tail = (dv, note, q["worn_volume"][1])
-        u = tail_term(q, u, wear, dv, shift, note)
+        tail_u = tail_term(q, wear, wts, dv, shift)
+    u = reference_bias_terms(q, u, selection, tail_u, note)
     return q, u, tau, noise_sigma(wear), tail
 
 

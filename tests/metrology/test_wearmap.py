@@ -162,3 +162,39 @@ def test_circle_per_layer_reference():
     # the form model (default without a before-scan) has a centre per layer
     form = wear_map(_scan(worn))
     assert np.sqrt(np.mean((form["wear_depth"].values - WEAR) ** 2)) < 1.1 * sigma
+
+
+def test_tail_bound_is_a_rectangular_u_and_not_added_to_the_selection_term():
+    """The undetected tail's bound a enters as a rectangular distribution (a / sqrt(3), GUM
+    4.3.7; it was a itself, 2-4 x the scatter), and it and the unworn-selection change - two
+    estimates of one effect, the reference's bias by faint tails - are not summed: the larger
+    counts (closed forms on a flat map)."""
+    from jointwear.metrology._wear_output import reference_bias_terms, tail_term
+
+    z, th = np.array([0.0, 1e-3]), np.arange(0.0, 360.0, 10.0)
+    wear = np.zeros((z.size, th.size))
+    wear[:, 3] = 1e-6
+    wts = np.full(wear.shape, 2e-6)  # areas [m^2]
+    a = 30e-9
+    shift = np.full(wear.shape, a)
+    tail = tail_term(
+        {"worn_volume": 0, "max_wear_depth": 0, "wear_cylindricity": 0}, wear, wts, 1.0, shift
+    )
+    assert tail[0]["worn_volume"] == pytest.approx(a * wts.sum() / np.sqrt(3.0))
+    assert tail[0]["max_wear_depth"] == pytest.approx(a / np.sqrt(3.0))
+    assert tail[0]["wear_cylindricity"] == 0.0  # a uniform shift leaves the form
+    np.testing.assert_allclose(tail[1], a / np.sqrt(3.0))
+    # untested tails (NaN) are not assessed, not zero
+    assert tail_term({}, wear, wts, float("nan"), shift) is None
+    q = {"worn_volume": (1.0, 3.0, "noise"), "max_wear_depth": (1.0, 3.0, "noise")}
+    q["wear_cylindricity"] = (1.0, 3.0, "noise")
+    sel = ({k: 4.0 for k in q}, np.full(wear.shape, 4.0))
+    tl = ({k: 4.0 for k in q}, np.full(wear.shape, 2.0))
+    u = reference_bias_terms(q, np.full(wear.shape, 3.0), sel, tl, "note")
+    assert q["worn_volume"][1] == pytest.approx(5.0)  # hypot(3, max(4, 4)), not hypot(3, 4, 4)
+    np.testing.assert_allclose(u, 5.0)
+    assert "the larger counted" in q["worn_volume"][2]
+    q2 = {"worn_volume": (1.0, 3.0, "noise")}
+    reference_bias_terms(q2, np.full(wear.shape, 3.0), None, None, "not assessed (few points)")
+    assert q2["worn_volume"][1] == 3.0
+    assert "faint wear tails not assessed" in q2["worn_volume"][2]
