@@ -31,13 +31,14 @@ checked against the tables in this work**: the searchable text available when th
 from __future__ import annotations
 
 import dataclasses
-from typing import Literal
-
-import numpy as np
+from typing import TYPE_CHECKING, Literal
 
 from jointwear.errors import ParameterError
 from jointwear.params import check_non_negative, check_positive
 from jointwear.sim._crank import CrankDriven, check_finite, principal_inertias
+
+if TYPE_CHECKING:  # numpy is imported where the kinematics are computed: 'jointwear --help'
+    import numpy as np  # lists the sim options without it
 
 __all__ = ["SliderCrankParameters", "BENCHMARK_TABLES", "slider_crank_kinematics"]
 
@@ -191,6 +192,8 @@ def slider_crank_kinematics(
         raise ParameterError(
             f"slider-crank needs rod_length > crank_length > 0, got {l2!r} and {l1!r}"
         )
+    import numpy as np
+
     from jointwear.sim.kernels._slider_kinematics import closed_form  # numba: loaded on first use
 
     th = np.asarray(theta, dtype=float)

@@ -3,12 +3,14 @@ checks, numba thread count, and the summed-area table of invalid pixels."""
 
 from __future__ import annotations
 
+import numbers
 from dataclasses import dataclass
-from typing import Literal
-
-import numpy as np
+from typing import TYPE_CHECKING, Literal
 
 from jointwear.errors import BadInputError, ParameterError
+
+if TYPE_CHECKING:  # numpy is imported by the checks that use it: the CLI's option
+    import numpy as np  # declarations read this module without it
 
 __all__ = [
     "CorrelationParams",
@@ -79,13 +81,13 @@ class CorrelationParams:
 
     def __post_init__(self) -> None:
         s = self.subset_size
-        is_int = isinstance(s, (int, np.integer)) and not isinstance(s, bool)
+        is_int = isinstance(s, numbers.Integral) and not isinstance(s, bool)
         if not is_int or s < MIN_SUBSET or s % 2 == 0:
             raise ParameterError(
                 f"subset_size={s!r}: expected an odd integer >= {MIN_SUBSET} (the subset is "
                 f"centred on its point); use {s + 1 if is_int and s >= MIN_SUBSET - 1 else 31}"
             )
-        if not isinstance(self.step, (int, np.integer)) or self.step < MIN_STEP:
+        if not isinstance(self.step, numbers.Integral) or self.step < MIN_STEP:
             raise ParameterError(f"step={self.step!r}: expected an integer >= {MIN_STEP} pixel")
         if self.shape not in _SHAPES:
             raise ParameterError(
@@ -101,7 +103,7 @@ class CorrelationParams:
             raise ParameterError(f"zncc_min={self.zncc_min!r}: expected a value in [-1, 1)")
         if self.max_iterations < 1:
             raise ParameterError(f"max_iterations={self.max_iterations!r}: expected >= 1")
-        if not isinstance(self.border, (int, np.integer)) or self.border < 0:
+        if not isinstance(self.border, numbers.Integral) or self.border < 0:
             raise ParameterError(f"border={self.border!r}: expected an integer >= 0 pixel")
         if self.search_radius < 0:
             raise ParameterError(f"search_radius={self.search_radius!r}: expected >= 0 pixel")
@@ -127,6 +129,8 @@ def set_threads(threads: int = 0) -> int:
 
 def check_image(image, name: str) -> np.ndarray:
     """A 2D numeric image as an array, or a BadInputError naming ``name``."""
+    import numpy as np
+
     arr = np.asarray(image)
     if arr.ndim == 3 and arr.shape[2] in (3, 4):
         raise BadInputError(
@@ -164,6 +168,8 @@ def check_pair(reference: np.ndarray, deformed: np.ndarray, what: str = "deforme
 
 def _integral_invalid(valid: np.ndarray) -> np.ndarray:
     """Summed-area table of invalid pixels; a (1, 1) array when every pixel is valid."""
+    import numpy as np
+
     if valid.all():
         return np.zeros((1, 1), dtype=np.int64)
     inv = (~valid).astype(np.int64)

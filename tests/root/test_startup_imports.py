@@ -67,3 +67,17 @@ def test_unknown_group_is_a_usage_error():
     from jointwear.cli import main
 
     assert main(["no-such-group"]) == 2
+
+
+@pytest.mark.parametrize("argv", [["--help"], ["dic", "--help"], ["sim", "--help"]])
+def test_help_imports_no_numerical_stack(argv, tmp_path):
+    # the help lists every group's options: their declarations must not pull in numpy
+    # (a module-level 'import numpy' behind an option's default cost 0.13 CPU s per call)
+    script = (
+        f"from jointwear.cli import main\nassert main({argv!r}) == 0\nimport sys\n"
+        "print('LOADED', *(m for m in ('numpy', 'xarray', 'pandas', 'scipy') if m in sys.modules))"
+    )
+    out = subprocess.run(
+        [sys.executable, "-c", script], capture_output=True, text=True, cwd=tmp_path, check=True
+    )
+    assert out.stdout.splitlines()[-1].split()[1:] == []
