@@ -107,6 +107,24 @@ def _u_field(al: xr.Dataset, name: str) -> tuple[np.ndarray | None, str]:
     return (u, str(al[name].attrs.get("basis", ""))) if np.isfinite(u).any() else (None, "")
 
 
+def _cell_u(al: xr.Dataset, name: str, u: np.ndarray, basis: str) -> tuple[np.ndarray, str]:
+    """The u of each grid value: the per-point u ``u`` split, when the map states its
+    independent part (``{name}_random``), into the systematic part sqrt(u^2 - u_random^2) per
+    point (correlated over the map: not reduced by the cell averaging) and the independent part
+    reduced by it (:func:`jointwear.compare.align._random_on_grid`), combined in quadrature.
+    Without that part (older files, simulated maps) the per-point u itself, as before."""
+    rname = f"{name}_random"
+    if rname not in al:
+        return u, basis
+    r_cell = np.asarray(al[rname].values, dtype=float)
+    factor = float(al[rname].attrs.get("per_point_factor", 1.0))
+    if not (np.isfinite(r_cell).any() and 0 < factor <= 1):
+        return u, basis
+    r_point = np.minimum(r_cell / factor, u)
+    cell = np.sqrt(u**2 - r_point**2 + np.where(np.isfinite(r_cell), r_cell, r_point) ** 2)
+    return cell, f"{basis}; its independent part averaged over the cell: {al[rname].attrs['basis']}"
+
+
 def _edge_max(f: np.ndarray) -> int:
     """-1 / +1 when the maximum of ``f`` lies on the first / last layer of the band, else 0."""
     i = int(np.unravel_index(np.nanargmax(f), f.shape)[0])
@@ -149,10 +167,12 @@ def _stated(al: xr.Dataset, s: np.ndarray, d: np.ndarray) -> dict[str, tuple]:
             for name in ("max_wear_depth", "worn_volume", "cylindricity"):
                 out.setdefault(name, {})[side] = (None, "")
             continue
+        cell, cell_basis = _cell_u(al, f"wear_depth_{side}_u", u, basis)
+        what = "per-point u" if cell is u else "u of the grid value"
         i, j = np.unravel_index(np.nanargmax(f), f.shape)
         out.setdefault("max_wear_depth", {})[side] = (
-            float(u[i, j]),
-            f"per-point u at the maximum ({basis})",
+            float(cell[i, j]),
+            f"{what} at the maximum ({cell_basis})",
         )
         vol = mt.worn_volume(u, z, th, float(radius)) if radius else None
         out.setdefault("worn_volume", {})[side] = (
@@ -160,8 +180,8 @@ def _stated(al: xr.Dataset, s: np.ndarray, d: np.ndarray) -> dict[str, tuple]:
             f"per-point u integrated over the band as fully correlated (an upper bound; {basis})",
         )
         out.setdefault("cylindricity", {})[side] = (
-            math.sqrt(2) * float(np.sqrt(np.nanmean(u**2))),
-            f"√2 · rms of the per-point u (peak-to-valley of two independent points; {basis})",
+            math.sqrt(2) * float(np.sqrt(np.nanmean(cell**2))),
+            f"√2 · rms of the {what} (peak-to-valley of two independent points; {cell_basis})",
         )
     vol_meas = _stated_volume_u(al, mt.worn_volume(d, z, th, float(radius)) if radius else np.nan)
     if vol_meas is not None:

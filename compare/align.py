@@ -154,7 +154,9 @@ def _cell_mean(
 
 def _prepare_map(
     obj: xr.Dataset | xr.DataArray, variable: str, cycles: float | None, what: str
-) -> tuple[xr.DataArray, xr.DataArray | None, float | None, str, xr.Dataset]:
+) -> tuple[xr.DataArray, dict[str, xr.DataArray], float | None, str, xr.Dataset]:
+    """The map [m] at the compared cycles, canonical, over (z, theta); its uncertainties
+    (``{"u": ..., "u_random": ...}``, standard, same grid; the random part only with a u)."""
     ds = obj.to_dataset(name=obj.name or variable) if isinstance(obj, xr.DataArray) else obj
     name = variable if variable in ds else (obj.name if isinstance(obj, xr.DataArray) else None)
     if name is None or name not in ds:
@@ -174,21 +176,27 @@ def _prepare_map(
             f"{exc}. Refusing to compare a wear map whose angle convention is not stated."
         ) from None
     da = to_metres(da, what)
-    unc = None
-    uname = f"{name}_u"
-    if uname in ds:
-        # converted to a standard uncertainty by its declared coverage factor (sim wear: k = 2)
-        std, u_note = to_standard(ds[uname].values, ds[uname].attrs, f"{what}: {uname}")
-        unc = to_metres(ds[uname].copy(data=std), what)
+    uncs = {}
+    for suffix in ("u", "u_random"):
+        uname = f"{name}_{suffix}"
+        if uname in ds and (suffix == "u" or "u" in uncs):
+            # converted to a standard uncertainty by its declared coverage factor (sim: k = 2)
+            std, u_note = to_standard(ds[uname].values, ds[uname].attrs, f"{what}: {uname}")
+            tau = float(ds[uname].attrs.get("correlation_length_samples", 1.0))
+            uncs[suffix] = (to_metres(ds[uname].copy(data=std), what), f"{uname}: {u_note}", tau)
     da, n_cycles, how = _pick_cycles(da, ds, cycles, what)
-    if unc is not None:
+    flip = str(da["z"].attrs.get("z_direction", "+z")).strip() == "-z"
+    for suffix, (unc, basis, tau) in uncs.items():
         unc, _, _ = _pick_cycles(unc, ds, n_cycles if "cycles" in unc.dims else None, what)
-        unc.attrs = {"units": "m", "basis": f"{uname}: {u_note}"}
+        unc = unc.assign_coords(z=-unc["z"]) if flip else unc
+        unc = conventions.convert_theta(
+            unc.transpose("z", "theta"), source=conventions.angle_convention_of(ds[name])
+        ).sortby("z")
+        unc.attrs = {"units": "m", "basis": basis, "correlation_length_samples": tau}
+        uncs[suffix] = unc
     zattrs = da["z"].attrs
-    if str(zattrs.get("z_direction", "+z")).strip() == "-z":
+    if flip:
         da = da.assign_coords(z=-da["z"])
-        if unc is not None:
-            unc = unc.assign_coords(z=-unc["z"])
     elif str(zattrs.get("z_direction", "+z")).strip() not in ("+z", "z"):
         raise ConventionError(
             f"{what}: z_direction {zattrs.get('z_direction')!r} not understood; use '+z' or '-z'"
@@ -200,13 +208,7 @@ def _prepare_map(
             "bearing mid-width - shift the z coordinate and set z_zero='bearing mid-width'"
         )
     da = conventions.to_canonical(da.transpose("z", "theta")).sortby("z")
-    if unc is not None:
-        basis = unc.attrs["basis"]
-        unc = conventions.convert_theta(
-            unc.transpose("z", "theta"), source=conventions.angle_convention_of(ds[name])
-        ).sortby("z")
-        unc.attrs["basis"] = basis
-    return da, unc, n_cycles, how, ds
+    return da, uncs, n_cycles, how, ds
 
 
 def _bearing_radius(*datasets: xr.Dataset) -> float | None:
@@ -255,6 +257,49 @@ def _resample(
     return out, how_theta + ", linear interpolation in z between layers"
 
 
+def _random_on_grid(
+    unc: xr.DataArray,
+    z_tgt: np.ndarray,
+    theta_tgt: np.ndarray,
+    step: float,
+    native: bool,
+    variable: str,
+    side: str,
+) -> tuple:
+    """The independent (point-to-point) part of a map's u, of the values on the common grid.
+
+    A grid value is the cell mean of the map's periodic linear interpolant: it weights the
+    ``n`` samples inside the cell about equally (trapezoid weights, ``1/n`` each), so the
+    variance of their independent noise drops by ``1/n``. Noise correlated over ``tau``
+    samples (the map's integrated correlation length, ``correlation_length_samples``: the
+    variance of a mean of ``n >> tau`` such samples is ``sigma^2 tau / n``) counts as
+    ``n / tau`` independent samples: ``n_eff = max(1, n / max(1, tau))``, and the random part
+    of the grid value is the per-point part / sqrt(n_eff). Between layers in z it is
+    interpolated linearly (an upper bound: the interpolant's weights w, 1 - w give
+    sqrt(w^2 + (1 - w)^2) <= 1); where the map is not averaged (``native``), n_eff = 1.
+    """
+    on_grid = native and _on_grid(unc, theta_tgt)
+    vals, _ = _resample(unc, z_tgt, theta_tgt, step, on_grid)
+    tau = max(1.0, float(unc.attrs.get("correlation_length_samples", 1.0)))
+    per_cell = 1.0 if on_grid else max(1.0, step / _theta_step(np.asarray(unc["theta"].values)))
+    n_eff = max(1.0, per_cell / tau)
+    return (
+        ("z", "theta"),
+        vals / np.sqrt(n_eff),
+        {
+            "units": "m",
+            "long_name": f"independent part of {variable}_{side}_u, of the grid value",
+            "coverage_factor": 1.0,
+            "basis": (
+                f"{unc.attrs.get('basis', '')}; per-point part / sqrt(n_eff), n_eff = "
+                f"{n_eff:.4g} independent samples per cell ({per_cell:.4g} samples, "
+                f"correlation length {tau:.3g} samples)"
+            ),
+            "per_point_factor": 1.0 / float(np.sqrt(n_eff)),
+        },
+    )
+
+
 def align_wear_maps(
     sim: xr.Dataset | xr.DataArray,
     meas: xr.Dataset | xr.DataArray,
@@ -271,7 +316,9 @@ def align_wear_maps(
         Wear maps with ``wear_depth`` over ``(cycles,) z, theta`` [m] (``mm``/``um`` are
         converted); theta must state its angle convention (``angle_zero``,
         ``angle_direction``) - a map without one is refused with :class:`ConventionError`.
-        Optional ``wear_depth_u`` (standard uncertainty) is carried along.
+        Optional ``wear_depth_u`` (standard uncertainty) is carried along, and with it its
+        independent part ``wear_depth_u_random`` (reduced by the cell averaging, see
+        :func:`_random_on_grid`).
     variable : str
         Name of the compared variable.
     cycles : float, optional
@@ -285,7 +332,8 @@ def align_wear_maps(
     -------
     Dataset
         Over ``(z, theta)`` (canonical): ``wear_depth_sim``, ``wear_depth_meas``,
-        ``wear_depth_diff`` (sim - meas) [m], uncertainties ``*_u`` when given; attributes
+        ``wear_depth_diff`` (sim - meas) [m], uncertainties ``*_u`` when given (the per-point
+        u, cell-averaged) and ``*_u_random`` (the independent part of the grid value); attributes
         ``interpolation``, ``z_overlap_m``, ``cycles_sim``, ``cycles_meas``,
         ``bearing_radius_m`` (if either input states it).
     """
@@ -344,9 +392,10 @@ def align_wear_maps(
         {"units": "m", "long_name": "wear depth difference, simulation minus measurement"},
     )
     anc = []
-    for unc, side in ((s_u, "sim"), (m_u, "meas")):
-        if unc is None:
+    for uncs, side in ((s_u, "sim"), (m_u, "meas")):
+        if "u" not in uncs:
             continue
+        unc = uncs["u"]
         vals, _ = _resample(unc, z_tgt, theta_tgt, step, native and _on_grid(unc, theta_tgt))
         uname = f"{variable}_{side}_u"
         out[uname] = (
@@ -361,6 +410,10 @@ def align_wear_maps(
         )
         out[f"{variable}_{side}"].attrs["ancillary_variables"] = uname
         anc.append(uname)
+        if "u_random" in uncs:
+            out[f"{uname}_random"] = _random_on_grid(
+                uncs["u_random"], z_tgt, theta_tgt, step, native, variable, side
+            )
     radius = _bearing_radius(s_ds, m_ds)
     out = _with_coverage(out, s_da, lo, hi, variable, theta_tgt, covered)
     out.attrs.update(

@@ -243,8 +243,34 @@ def refuse_inseparable_difference(s2: float, noise: float, tau: float) -> None:
         )
 
 
-def wear_dataset(z, th, wear, u, mask2, scalars: dict, offset: float, attrs: dict):
-    """The wear map Dataset: per-point depth and u, the unworn flag, scalars, attributes."""
+def random_part(u: np.ndarray, noise: float, tau: float) -> tuple[str, tuple]:
+    """``wear_depth_u_random``: the independent (point-to-point) part of each point's u [m].
+
+    The instrument noise estimate (successive differences of the map: form, set-up and the
+    fitted reference vary smoothly between neighbouring samples, noise does not), capped at the
+    point's whole u. The rest of ``wear_depth_u`` (reference fit, unmodelled form, selection
+    and tail terms) is correlated over the map and does not average down; this part does, over
+    about ``tau`` samples per independent one (``correlation_length_samples``).
+    """
+    ur = np.minimum(u, noise) if np.isfinite(noise) else np.full_like(u, np.nan)
+    attrs = {
+        "units": "m",
+        "long_name": "independent (point-to-point random) part of wear_depth_u",
+        **uncertainty_attrs(
+            "instrument noise estimate (1.4826 MAD of second differences of the map / sqrt(6)) "
+            "capped at wear_depth_u; included in wear_depth_u, independent from point to point "
+            "(the rest of wear_depth_u is correlated over the map)"
+        ),
+        "correlation_length_samples": float(tau) if np.isfinite(tau) else 1.0,
+    }
+    return "wear_depth_u_random", (("z", "theta"), ur, attrs)
+
+
+def wear_dataset(
+    z, th, wear, u, mask2, scalars: dict, offset: float, attrs: dict, extra: dict | None = None
+):
+    """The wear map Dataset: per-point depth and u, the unworn flag, scalars, attributes;
+    ``extra`` further variables (e.g. :func:`random_part`)."""
     return xr.Dataset(
         {
             "wear_depth": (
@@ -278,6 +304,7 @@ def wear_dataset(z, th, wear, u, mask2, scalars: dict, offset: float, attrs: dic
                     "flag_meanings": "worn_or_outlier unworn_reference",
                 },
             ),
+            **(extra or {}),
             **scalars,
             "angle_offset": (
                 (),

@@ -30,6 +30,9 @@ about 0) with the standard error of the fitted reference at each point; with a b
 also the dependence on the unworn selection and the largest faint wear tail the band test
 cannot see (:func:`._wear_fit.undetected_tail`). Without one, a map is refused where such a
 tail could change the volume by more than 30 % (the form model absorbs it).
+``wear_depth_u_random`` [m] states the part of ``wear_depth_u`` that is independent from point
+to point (the instrument noise estimate): it averages down when the map is averaged over cells
+(:func:`jointwear.compare.align_wear_maps`), the rest does not.
 """
 
 from __future__ import annotations
@@ -58,6 +61,7 @@ from jointwear.metrology._wear_output import (
     _model_order_term,
     _scalars,
     _separable,
+    random_part,
     reference_bias_terms,
     refuse_inseparable_difference,
     selection_term,
@@ -199,7 +203,7 @@ def wear_map(
     -------
     Dataset
         ``wear_depth`` and ``wear_depth_u`` [m] over (z, theta) in the canonical convention,
-        ``unworn`` (flag: 1 if the point was used as unworn reference), scalars
+        ``wear_depth_u_random`` [m] (its point-to-point independent part), ``unworn`` (flag: 1 if the point was used as unworn reference), scalars
         ``worn_volume`` and ``worn_volume_u`` [m^3], ``cylindricity_before`` and
         ``cylindricity_after`` [m] (MZ), ``angle_offset`` [degree]; method in attrs.
     """
@@ -282,7 +286,8 @@ def wear_map(
         "faint_wear_tails": tails,
     }
     scalars = _scalars(q, cyl_before, cyl_after, cyl_before_note, noise)
-    out = wear_dataset(z, th, wear, u, mask2, scalars, offset, attrs)
+    extra = dict([random_part(u, noise, tau)])
+    out = wear_dataset(z, th, wear, u, mask2, scalars, offset, attrs, extra)
     out.attrs.update(_origin(worn, before))
     return out
 

@@ -325,7 +325,10 @@ def test_noise_free_measurement_of_a_sharp_peak_reads_as_the_simulation(tmp_path
     for q in ("max_wear_depth", "worn_volume", "cylindricity"):
         e, u_d = budget[(q, "E")], budget[(q, "u_D")]
         assert np.isfinite(u_d) and u_d > 0, q
-        assert abs(e) <= 2 * u_d, f"{q}: E = {e:.3g}, u_D = {u_d:.3g}"
+        # without noise u_D is the file's resolution averaged over a cell (< 0.1 nm): the bias
+        # looked for is 3-5 % of the value, so |E| within 0.1 % of it (or 2 u_D) rules it out
+        tol = max(2 * u_d, 1e-3 * abs(budget[(q, "value_meas")]))
+        assert abs(e) <= tol, f"{q}: E = {e:.3g}, u_D = {u_d:.3g}"
     # the criterion is not blind: the same peak measured 3 % deeper is seen
     s, m = budget[("max_wear_depth", "value_sim")], budget[("max_wear_depth", "value_meas")]
     assert abs(s - 1.03 * m) > 10 * budget[("max_wear_depth", "u_D")]

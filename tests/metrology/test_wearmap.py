@@ -46,6 +46,12 @@ def test_wear_map_with_before_scan_recovers_imposed_wear():
     assert out["cylindricity_after"].item() > out["cylindricity_before"].item()
     # uncertainty estimate matches the actual scatter
     assert out["wear_depth_u"].mean().item() == pytest.approx(np.sqrt(2) * sigma, rel=0.2)
+    # its independent part is the noise of the difference (white: correlation length ~1)
+    rnd = out["wear_depth_u_random"]
+    assert rnd.attrs["units"] == "m" and "noise" in rnd.attrs["comment"]
+    assert float(rnd.mean()) == pytest.approx(np.sqrt(2) * sigma, rel=0.1)
+    assert bool((rnd <= out["wear_depth_u"]).all())
+    assert 1.0 <= rnd.attrs["correlation_length_samples"] < 1.5
     assert out["theta"].attrs["angle_zero"] == "-x"
 
 
