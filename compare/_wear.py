@@ -120,8 +120,9 @@ def _cell_u(al: xr.Dataset, name: str, u: np.ndarray, basis: str) -> tuple[np.nd
     factor = float(al[rname].attrs.get("per_point_factor", 1.0))
     if not (np.isfinite(r_cell).any() and 0 < factor <= 1):
         return u, basis
-    r_point = np.minimum(r_cell / factor, u)
-    cell = np.sqrt(u**2 - r_point**2 + np.where(np.isfinite(r_cell), r_cell, r_point) ** 2)
+    known = np.isfinite(r_cell)  # where the part is not stated the per-point u stays whole
+    r_point = np.where(known, np.minimum(r_cell / factor, u), 0.0)
+    cell = np.sqrt(u**2 - (1.0 - factor**2) * r_point**2)  # sys^2 + (factor r_point)^2
     return cell, f"{basis}; its independent part averaged over the cell: {al[rname].attrs['basis']}"
 
 
