@@ -91,3 +91,13 @@ def test_without_the_random_part_the_per_point_u_is_used(maps):
     ds["wear_depth_u"] = ds["wear_depth_u"] * np.sqrt(2.0)
     _, u = _compared_max(ds, sim)
     assert u == pytest.approx(SIGMA * np.sqrt(1 + 1 / 50), rel=0.02)
+
+
+def test_unstated_random_part_in_some_cells_keeps_their_whole_u(maps):
+    """A NaN random part (not stated there) is not a zero u: those cells keep the per-point u."""
+    th, sim, _ = maps
+    ds = _map(th, _wear(th), **_u_vars((Z.size, th.size), True))
+    near_peak = (th > 100.0) & (th < 140.0)
+    ds["wear_depth_u_random"][:, near_peak] = np.nan
+    _, u = _compared_max(ds, sim)
+    assert u == pytest.approx(SIGMA, rel=1e-9)
