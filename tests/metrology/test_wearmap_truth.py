@@ -166,6 +166,21 @@ def test_tails_around_the_bore_are_refused_not_read_low():
         wear_map(worn, before)
 
 
+def _assert_covered_only_by_the_tail_term(out, wear) -> float:
+    """The worn volume's u, after checking that the volume is within 3 u of the truth and that
+    the u without its undetected-tail term (read from the u's comment) would miss it: the term
+    is what covers the error (the check can fail)."""
+    from test_wearmap_form import TH, Z
+
+    err = out["worn_volume"].item() - worn_volume(wear, Z, TH, R)
+    u = out["worn_volume_u"].item()
+    assert abs(err) < 3.0 * u, (err, u)
+    comment = out["worn_volume_u"].attrs["comment"]
+    tail = float(comment.split("undetected wear tail (")[1].split(":")[0])
+    assert abs(err) > 3.0 * np.sqrt(u**2 - tail**2), (err, u, tail)
+    return u
+
+
 @pytest.mark.parametrize("width", [37.0, 38.0, 39.0])
 def test_tails_of_a_groove_38_degree_wide_are_covered_by_u(width):
     """Grooves 37-39 degree wide (sigma) with a before-scan: the tail test stays below its
@@ -173,17 +188,12 @@ def test_tails_of_a_groove_38_degree_wide_are_covered_by_u(width):
     the bore) pull the change of set-up fitted there, and the volume read 3.6-5.5 u low. The
     largest tail the band test cannot see (:func:`undetected_tail`) is now in the u: the truth
     within 3 u, and the term is what covers it (the u without it misses the truth)."""
-    from test_wearmap_form import TH, Z, _bore
+    from test_wearmap_form import _bore
 
     worn, wear = _bore(25.0, 1.5, 8.0, width, seed=300, centre_deg=81.0)
     before, _ = _bore(25.0, 1.5, 0.0, width, seed=600, centre_deg=81.0)
     out = wear_map(worn, before)
-    err = out["worn_volume"].item() - worn_volume(wear, Z, TH, R)
-    u = out["worn_volume_u"].item()
-    assert abs(err) < 3.0 * u, (err, u)
-    comment = out["worn_volume_u"].attrs["comment"]
-    tail = float(comment.split("undetected wear tail (")[1].split(":")[0])
-    assert abs(err) > 3.0 * np.sqrt(u**2 - tail**2), (err, u, tail)
+    u = _assert_covered_only_by_the_tail_term(out, wear)
     # not inflated beyond use: a few percent of the volume
     assert u < 0.05 * abs(out["worn_volume"].item())
 
@@ -274,13 +284,8 @@ def test_shallow_groove_without_a_before_scan_within_its_u():
     """0.3 um deep, 22 degree wide on a 35 um taper: read 5.8 % low at 3.4 u with exit 0 - the
     form model absorbs the faint tails and the u did not say so. The undetected-tail term
     covers it; the map without the term misses (the term can fail)."""
-    from test_wearmap_form import TH, Z, _bore
+    from test_wearmap_form import _bore
 
     scan, wear = _bore(34.74, 0.0, 0.3, 21.65, seed=937, centre_deg=140.54)
     out = wear_map(scan)
-    err = out["worn_volume"].item() - worn_volume(wear, Z, TH, R)
-    u = out["worn_volume_u"].item()
-    assert abs(err) < 3.0 * u, (err, u)
-    comment = out["worn_volume_u"].attrs["comment"]
-    tail = float(comment.split("undetected wear tail (")[1].split(":")[0])
-    assert abs(err) > 3.0 * np.sqrt(u**2 - tail**2), (err, u, tail)
+    _assert_covered_only_by_the_tail_term(out, wear)
