@@ -14,12 +14,6 @@ from jointwear.dic import _cli_options as opt
 
 def _refuse_misapplied(p: dict) -> None:
     """Usage errors (exit 2): 2D and stereo inputs mixed, stereo options on a 2D field."""
-    for flag in ("left", "right"):
-        if any(not str(v).strip() for v in p[flag] or ()):
-            raise typer.BadParameter(
-                f"--{flag}: an empty path '' was given (an unset shell variable?); give the "
-                "images, a folder or a quoted pattern"
-            )
     stereo = bool(p["left"] or p["right"])
     if stereo and p["images"]:
         raise typer.BadParameter("give either IMAGES (2D) or --left/--right (stereo)")
@@ -55,11 +49,11 @@ def field_cmd(
         ),
     ] = None,
     left: Annotated[
-        list[str] | None,
+        list[Path] | None,
         typer.Option("--left", help="Stereo: left images (repeatable) or a folder/pattern."),
     ] = None,
     right: Annotated[
-        list[str] | None,
+        list[Path] | None,
         typer.Option("--right", help="Stereo: right images (repeatable) or a folder/pattern."),
     ] = None,
     calibration: Annotated[

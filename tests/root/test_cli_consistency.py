@@ -113,11 +113,7 @@ def _empty_path_cases():
     return cases
 
 
-EMPTY_PATH_CASES = _empty_path_cases() + [
-    # image options typed as text (they take patterns): checked by the command
-    (["dic", "field", "--left", "", "--right", "r"], "--left"),
-    (["dic", "field", "--left", "l", "--right", ""], "--right"),
-]
+EMPTY_PATH_CASES = _empty_path_cases()
 
 
 def test_an_empty_path_is_a_usage_error_naming_the_parameter(capsys, tmp_path, monkeypatch):
