@@ -3,12 +3,13 @@
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 import numbers
 import tomllib
 import types
 import typing
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any, TypeVar
 
@@ -21,6 +22,13 @@ __all__ = [
     "replace_nested",
     "check_positive",
     "check_non_negative",
+    "check_finite",
+    "checked",
+    "positive",
+    "non_negative",
+    "finite",
+    "within",
+    "check_fields",
 ]
 
 T = TypeVar("T")
@@ -120,23 +128,102 @@ def _coerce(value: Any, tp: Any, where: str) -> Any:
     return value
 
 
+def _positive(where: str, name: str, value: float) -> float:
+    if not (value > 0 and math.isfinite(value)):
+        raise ParameterError(
+            f"{where}.{name} must be a positive finite number, got {value!r}; "
+            "set a physical (SI) value"
+        )
+    return value
+
+
+def _non_negative(where: str, name: str, value: float, unit: str = "") -> float:
+    if not (value >= 0 and math.isfinite(value)):
+        unit = f" {unit}" if unit else ""
+        raise ParameterError(f"{where}.{name} must be >= 0{unit}, got {value!r}")
+    return value
+
+
+def _finite(where: str, name: str, value: float) -> float:
+    if not math.isfinite(value):
+        raise ParameterError(f"{where}.{name} must be finite")
+    return value
+
+
+def _within(where: str, name: str, value: float, interval: str) -> float:
+    lo, hi = (float(v) for v in interval[1:-1].split(","))
+    above = value >= lo if interval[0] == "[" else value > lo
+    below = value <= hi if interval[-1] == "]" else value < hi
+    if not (above and below):
+        raise ParameterError(f"{where}.{name} must be in {interval}, got {value!r}")
+    return value
+
+
 def check_positive(where: str, **values: float) -> None:
     """Raise :class:`~jointwear.errors.ParameterError` naming ``where.name`` unless every value
     is a positive finite number."""
     for name, value in values.items():
-        if not (value > 0 and math.isfinite(value)):
-            raise ParameterError(
-                f"{where}.{name} must be a positive finite number, got {value!r}; "
-                "set a physical (SI) value"
-            )
+        _positive(where, name, value)
 
 
 def check_non_negative(where: str, **values: float) -> None:
     """Raise :class:`~jointwear.errors.ParameterError` naming ``where.name`` unless every value
     is a finite number >= 0."""
     for name, value in values.items():
-        if not (value >= 0 and math.isfinite(value)):
-            raise ParameterError(f"{where}.{name} must be >= 0, got {value!r}")
+        _non_negative(where, name, value)
+
+
+def check_finite(where: str, **values: float) -> None:
+    """Raise :class:`~jointwear.errors.ParameterError` naming ``where.name`` for the first value
+    that is not finite."""
+    for name, value in values.items():
+        _finite(where, name, value)
+
+
+#: A field's check: ``check(where, name, value)`` returns the value to keep (possibly
+#: converted) or raises :class:`~jointwear.errors.ParameterError` naming ``where.name``.
+FieldCheck = Callable[[str, str, Any], Any]
+
+
+def checked(default: Any, check: FieldCheck) -> Any:
+    """A dataclass field with its default and the check its value must pass.
+
+    The check is declared where the field is and run by :func:`check_fields` (from the
+    dataclass's ``__post_init__``), so that no field is listed a second time to be checked.
+    """
+    return dataclasses.field(default=default, metadata={"check": check})
+
+
+def positive(default: float) -> Any:
+    """A field that must be a positive finite number."""
+    return checked(default, _positive)
+
+
+def non_negative(default: float, *, unit: str = "") -> Any:
+    """A field that must be a finite number >= 0 (``unit``, if given, is named in the error)."""
+    return checked(default, functools.partial(_non_negative, unit=unit))
+
+
+def finite(default: float) -> Any:
+    """A field that must be a finite number."""
+    return checked(default, _finite)
+
+
+def within(default: float, interval: str) -> Any:
+    """A field that must lie in ``interval``, written as in the error: ``"(0, 1]"``, ``"[-1, 1)"``."""
+    return checked(default, functools.partial(_within, interval=interval))
+
+
+def check_fields(obj: Any, where: str) -> None:
+    """Run the checks the fields of the dataclass instance ``obj`` declare (:func:`checked`), in
+    field order; errors name ``where.field``. A check's converted value replaces the field's."""
+    for f in dataclasses.fields(obj):
+        check = f.metadata.get("check")
+        if check is not None:
+            value = getattr(obj, f.name)
+            kept = check(where, f.name, value)
+            if kept is not value:
+                object.__setattr__(obj, f.name, kept)
 
 
 def from_mapping(cls: type[T], mapping: Mapping[str, Any], *, where: str | None = None) -> T:

@@ -1,18 +1,20 @@
 """What the parameters of every crank-driven mechanism share (four-bar, slider-crank).
 
-The crank's speed and period from ``crank_speed_rpm``, and the checks of a body's three
-principal moments of inertia and of values that must be finite.
+The crank's speed and period from ``crank_speed_rpm``, and the field of a body's three
+principal moments of inertia with its check.
 """
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Sequence
+from typing import Any
 
 from jointwear.errors import ParameterError
-from jointwear.params import check_positive
+from jointwear.params import check_positive, checked
 
-__all__ = ["CrankDriven", "principal_inertias", "check_finite"]
+__all__ = ["CrankDriven", "principal_inertias", "inertias"]
 
 
 class CrankDriven:
@@ -46,8 +48,8 @@ def principal_inertias(
     return out
 
 
-def check_finite(where: str, **values: float) -> None:
-    """Raise a ParameterError naming ``where.name`` for the first value that is not finite."""
-    for name, value in values.items():
-        if not math.isfinite(value):
-            raise ParameterError(f"{where}.{name} must be finite")
+def inertias(default: tuple[float, ...], axes: str) -> Any:
+    """A dataclass field of three principal moments of inertia [kg m2] about ``axes``
+    (checked by :func:`principal_inertias` and kept as floats; see
+    :func:`jointwear.params.check_fields`)."""
+    return checked(default, functools.partial(principal_inertias, axes=axes))

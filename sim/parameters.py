@@ -14,10 +14,16 @@ from pathlib import Path
 from typing import Literal
 
 from jointwear.errors import ParameterError
-from jointwear.params import check_non_negative as _non_negative
-from jointwear.params import check_positive as _positive
-from jointwear.params import from_mapping, read_toml
-from jointwear.sim._crank import CrankDriven, check_finite, principal_inertias
+from jointwear.params import (
+    check_fields,
+    finite,
+    from_mapping,
+    non_negative,
+    positive,
+    read_toml,
+    within,
+)
+from jointwear.sim._crank import CrankDriven, inertias
 from jointwear.sim.slider_crank import BENCHMARK_TABLES, SliderCrankParameters
 
 __all__ = [
@@ -47,53 +53,32 @@ class MechanismParameters(CrankDriven):
     lets the contact forces turn the follower out of plane about the spherical joint D.
     """
 
-    crank_length: float = 0.10
-    coupler_length: float = 0.40
-    follower_length: float = 0.30
-    ground_length: float = 0.30
-    crank_mass: float = 0.46
-    coupler_mass: float = 1.45
-    follower_mass: float = 1.50
-    crank_inertia: float = 0.0019
-    coupler_inertia: float = 0.0927
+    crank_length: float = positive(0.10)
+    coupler_length: float = positive(0.40)
+    follower_length: float = positive(0.30)
+    ground_length: float = positive(0.30)
+    crank_mass: float = positive(0.46)
+    coupler_mass: float = positive(1.45)
+    follower_mass: float = positive(1.50)
+    crank_inertia: float = positive(0.0019)
+    coupler_inertia: float = positive(0.0927)
     # tuple[float, ...]: jointwear.params mis-coerces fixed-length tuple annotations
-    follower_inertia: tuple[float, ...] = (0.0317, 0.0004, 0.0317)
-    gravity: float = 9.81
-    joint_offset: float = 0.01
-    crank_speed_rpm: float = 120.0
-    initial_crank_angle_deg: float = 0.0
+    follower_inertia: tuple[float, ...] = inertias((0.0317, 0.0004, 0.0317), "I3x, I3y, I3z")
+    gravity: float = non_negative(9.81)
+    joint_offset: float = finite(0.01)
+    crank_speed_rpm: float = finite(120.0)
+    initial_crank_angle_deg: float = finite(0.0)
     driver: bool = True
     bearing_on: Literal["follower", "coupler"] = "follower"
 
     def __post_init__(self) -> None:
-        w = "mechanism"
-        _positive(
-            w,
-            crank_length=self.crank_length,
-            coupler_length=self.coupler_length,
-            follower_length=self.follower_length,
-            ground_length=self.ground_length,
-            crank_mass=self.crank_mass,
-            coupler_mass=self.coupler_mass,
-            follower_mass=self.follower_mass,
-            crank_inertia=self.crank_inertia,
-            coupler_inertia=self.coupler_inertia,
-        )
-        inertia = principal_inertias(w, "follower_inertia", self.follower_inertia, "I3x, I3y, I3z")
-        object.__setattr__(self, "follower_inertia", inertia)
-        _non_negative(w, gravity=self.gravity)
-        check_finite(
-            w,
-            joint_offset=self.joint_offset,
-            crank_speed_rpm=self.crank_speed_rpm,
-            initial_crank_angle_deg=self.initial_crank_angle_deg,
-        )
+        check_fields(self, "mechanism")
         lengths = sorted(
             [self.crank_length, self.coupler_length, self.follower_length, self.ground_length]
         )
         if lengths[0] + lengths[3] > lengths[1] + lengths[2] or (self.crank_length != lengths[0]):
             raise ParameterError(
-                f"{w}: link lengths crank={self.crank_length}, coupler={self.coupler_length}, "
+                f"mechanism: link lengths crank={self.crank_length}, coupler={self.coupler_length}, "
                 f"follower={self.follower_length}, ground={self.ground_length} m do not make a "
                 "Grashof crank-rocker (the crank must be the shortest link and "
                 "shortest + longest <= sum of the other two); the crank could not turn fully"
@@ -114,34 +99,20 @@ class JointParameters:
     """
 
     model: Literal["clearance", "ideal"] = "clearance"
-    journal_radius: float = 7.5e-3
-    journal_length: float = 17e-3
-    bearing_radius: float = 8.0e-3
-    bearing_width: float = 15e-3
-    axial_clearance: float = 1e-3
-    thrust_radius: float = 9.5e-3
+    journal_radius: float = positive(7.5e-3)
+    journal_length: float = positive(17e-3)
+    bearing_radius: float = positive(8.0e-3)
+    bearing_width: float = positive(15e-3)
+    axial_clearance: float = non_negative(1e-3)
+    thrust_radius: float = positive(9.5e-3)
     n_layers: int = 20
     n_points: int = 200
     axial_grading: float = 0.75
-    tilt_stiffness: float = 0.0
-    tilt_damping: float = 0.0
+    tilt_stiffness: float = non_negative(0.0)
+    tilt_damping: float = non_negative(0.0)
 
     def __post_init__(self) -> None:
-        w = "joint"
-        _positive(
-            w,
-            journal_radius=self.journal_radius,
-            journal_length=self.journal_length,
-            bearing_radius=self.bearing_radius,
-            bearing_width=self.bearing_width,
-            thrust_radius=self.thrust_radius,
-        )
-        _non_negative(
-            w,
-            axial_clearance=self.axial_clearance,
-            tilt_stiffness=self.tilt_stiffness,
-            tilt_damping=self.tilt_damping,
-        )
+        check_fields(self, "joint")
         if self.bearing_radius <= self.journal_radius:
             raise ParameterError(
                 f"joint.journal_radius ({self.journal_radius} m) must be smaller than "
@@ -209,33 +180,18 @@ class ContactParameters:
     impact_latch: Literal["region", "layer"] = "region"
     stiffness: Literal["time_varying", "constant"] = "time_varying"
     worn_radius_in_denominator: bool = False
-    exponent: float = 1.5
-    restitution: float = 0.9
-    journal_modulus: float = 207e9
-    journal_poisson: float = 0.29
-    bearing_modulus: float = 100e9
-    bearing_poisson: float = 0.39
-    impact_velocity_floor: float = 1e-2
-    axial_stiffness: float = 0.0
-    max_penetration_fraction: float = 0.5
+    exponent: float = positive(1.5)
+    restitution: float = within(0.9, "(0, 1]")
+    journal_modulus: float = positive(207e9)
+    journal_poisson: float = within(0.29, "(-1, 0.5)")
+    bearing_modulus: float = positive(100e9)
+    bearing_poisson: float = within(0.39, "(-1, 0.5)")
+    impact_velocity_floor: float = positive(1e-2)
+    axial_stiffness: float = non_negative(0.0)
+    max_penetration_fraction: float = positive(0.5)
 
     def __post_init__(self) -> None:
-        w = "contact"
-        _positive(
-            w,
-            exponent=self.exponent,
-            journal_modulus=self.journal_modulus,
-            bearing_modulus=self.bearing_modulus,
-            impact_velocity_floor=self.impact_velocity_floor,
-            max_penetration_fraction=self.max_penetration_fraction,
-        )
-        _non_negative(w, axial_stiffness=self.axial_stiffness)
-        if not 0 < self.restitution <= 1:
-            raise ParameterError(f"contact.restitution must be in (0, 1], got {self.restitution}")
-        for name in ("journal_poisson", "bearing_poisson"):
-            v = getattr(self, name)
-            if not -1 < v < 0.5:
-                raise ParameterError(f"contact.{name} must be in (-1, 0.5), got {v}")
+        check_fields(self, "contact")
 
 
 @dataclasses.dataclass(frozen=True)
@@ -243,20 +199,13 @@ class FrictionParameters:
     """Smoothed Coulomb friction of eq. 12 (``enabled = false`` switches friction off)."""
 
     enabled: bool = True
-    static_coefficient: float = 0.2
-    dynamic_coefficient: float = 0.1
-    stick_velocity: float = 1e-3
-    slide_velocity: float = 1e-2
+    static_coefficient: float = non_negative(0.2)
+    dynamic_coefficient: float = non_negative(0.1)
+    stick_velocity: float = positive(1e-3)
+    slide_velocity: float = positive(1e-2)
 
     def __post_init__(self) -> None:
-        _non_negative(
-            "friction",
-            static_coefficient=self.static_coefficient,
-            dynamic_coefficient=self.dynamic_coefficient,
-        )
-        _positive(
-            "friction", stick_velocity=self.stick_velocity, slide_velocity=self.slide_velocity
-        )
+        check_fields(self, "friction")
         if self.slide_velocity <= self.stick_velocity:
             raise ParameterError(
                 f"friction.slide_velocity ({self.slide_velocity}) must exceed "
@@ -273,25 +222,16 @@ class SolverParameters:
     at most this deep (else it is retried shorter), so impact velocities are taken at the onset.
     """
 
-    rtol: float = 1e-6
-    atol: float = 1e-9
-    max_step: float = 1e-3
-    min_step: float = 1e-11
-    output_interval: float = 1e-4
-    onset_penetration: float = 1e-7
-    baumgarte: float = 1000.0
+    rtol: float = positive(1e-6)
+    atol: float = positive(1e-9)
+    max_step: float = positive(1e-3)
+    min_step: float = positive(1e-11)
+    output_interval: float = positive(1e-4)
+    onset_penetration: float = positive(1e-7)
+    baumgarte: float = positive(1000.0)
 
     def __post_init__(self) -> None:
-        _positive(
-            "solver",
-            rtol=self.rtol,
-            atol=self.atol,
-            max_step=self.max_step,
-            min_step=self.min_step,
-            output_interval=self.output_interval,
-            onset_penetration=self.onset_penetration,
-            baumgarte=self.baumgarte,
-        )
+        check_fields(self, "solver")
         if self.min_step >= self.max_step:
             raise ParameterError("solver.min_step must be smaller than solver.max_step")
 

@@ -34,8 +34,8 @@ import dataclasses
 from typing import TYPE_CHECKING, Literal
 
 from jointwear.errors import ParameterError
-from jointwear.params import check_non_negative, check_positive
-from jointwear.sim._crank import CrankDriven, check_finite, principal_inertias
+from jointwear.params import check_fields, finite, non_negative, positive
+from jointwear.sim._crank import CrankDriven, inertias
 
 if TYPE_CHECKING:  # numpy is imported where the kinematics are computed: 'jointwear --help'
     import numpy as np  # lists the sim options without it
@@ -94,42 +94,25 @@ class SliderCrankParameters(CrankDriven):
     """
 
     kind: Literal["slider_crank"] = "slider_crank"
-    crank_length: float = 0.05
-    rod_length: float = 0.12
-    crank_mass: float = 0.30
-    rod_mass: float = 0.21
-    slider_mass: float = 0.14
-    crank_inertia: float = 1.0e-4
+    crank_length: float = positive(0.05)
+    rod_length: float = positive(0.12)
+    crank_mass: float = positive(0.30)
+    rod_mass: float = positive(0.21)
+    slider_mass: float = positive(0.14)
+    crank_inertia: float = positive(1.0e-4)
     # tuple[float, ...]: jointwear.params mis-coerces fixed-length tuple annotations
-    rod_inertia: tuple[float, ...] = (2.5e-4, 2.5e-6, 2.5e-4)
-    gravity: float = 9.81
-    joint_offset: float = 0.0
-    crank_speed_rpm: float = 5000.0
-    initial_crank_angle_deg: float = 0.0
+    rod_inertia: tuple[float, ...] = inertias((2.5e-4, 2.5e-6, 2.5e-4), "Ix, Iy, Iz")
+    gravity: float = non_negative(9.81)
+    joint_offset: float = finite(0.0)
+    crank_speed_rpm: float = finite(5000.0)
+    initial_crank_angle_deg: float = finite(0.0)
     driver: bool = True
     clearance_at: Literal["rod_slider", "crank_rod"] = "rod_slider"
     bearing_on: Literal["slider", "rod", "crank"] = "slider"
     planar: bool = True
 
     def __post_init__(self) -> None:
-        check_positive(
-            "mechanism",
-            crank_length=self.crank_length,
-            rod_length=self.rod_length,
-            crank_mass=self.crank_mass,
-            rod_mass=self.rod_mass,
-            slider_mass=self.slider_mass,
-            crank_inertia=self.crank_inertia,
-        )
-        inertia = principal_inertias("mechanism", "rod_inertia", self.rod_inertia, "Ix, Iy, Iz")
-        object.__setattr__(self, "rod_inertia", inertia)
-        check_non_negative("mechanism", gravity=self.gravity)
-        check_finite(
-            "mechanism",
-            joint_offset=self.joint_offset,
-            crank_speed_rpm=self.crank_speed_rpm,
-            initial_crank_angle_deg=self.initial_crank_angle_deg,
-        )
+        check_fields(self, "mechanism")
         if self.rod_length <= self.crank_length:
             raise ParameterError(
                 f"mechanism.rod_length ({self.rod_length} m) must exceed mechanism.crank_length "

@@ -5,9 +5,10 @@ from __future__ import annotations
 import math
 import numbers
 from dataclasses import dataclass
-from typing import Literal
+from typing import Any, Literal
 
 from jointwear.errors import ParameterError
+from jointwear.params import check_fields, checked, non_negative, within
 
 __all__ = [
     "DEFAULT_KW",
@@ -63,12 +64,17 @@ def default_snapshots(target: float) -> list[float]:
     return [*out, float(target)]
 
 
-def _whole(name: str, v: object) -> int:
+def _whole(where: str, name: str, v: object) -> int:
     if isinstance(v, float) and v.is_integer():
         v = int(v)
     if not isinstance(v, numbers.Integral) or isinstance(v, bool) or v < 1:
-        raise ParameterError(f"wear.{name} must be an integer >= 1 [cycles], got {v!r}")
+        raise ParameterError(f"{where}.{name} must be an integer >= 1 [cycles], got {v!r}")
     return int(v)
+
+
+def _cycles(default: int) -> Any:
+    """A field holding a whole number of cycles >= 1 (kept as int)."""
+    return checked(default, _whole)
 
 
 @dataclass(frozen=True)
@@ -110,17 +116,17 @@ class WearSettings:
 
     kw: float = DEFAULT_KW
     scheme: Literal["adaptive", "fixed", "schedule"] = "adaptive"
-    dn: int = 200
+    dn: int = _cycles(200)
     schedule: tuple[int, ...] = ()
-    tol: float = 0.1
-    dn_min: int = 1
-    dn_max: int = 200_000
+    tol: float = within(0.1, "(0, 1)")
+    dn_min: int = _cycles(1)
+    dn_max: int = _cycles(200_000)
     max_increment: float | None = None
-    settle_cycles: float = 1.0
-    initial_settle_cycles: float = 2.0
+    settle_cycles: float = non_negative(1.0, unit="cycles")
+    initial_settle_cycles: float = non_negative(2.0, unit="cycles")
     reject_factor: float = 3.0
-    average_cycles: int = 2
-    max_average_cycles: int = 8
+    average_cycles: int = _cycles(2)
+    max_average_cycles: int = _cycles(8)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "kw", check_kw(self.kw))
@@ -139,8 +145,7 @@ class WearSettings:
         if self.scheme == "schedule" and not sched:
             raise ParameterError("wear.scheme = 'schedule' needs a non-empty wear.schedule")
         object.__setattr__(self, "schedule", sched)
-        for name in ("dn", "dn_min", "dn_max", "average_cycles", "max_average_cycles"):
-            object.__setattr__(self, name, _whole(name, getattr(self, name)))
+        check_fields(self, "wear")
         if self.dn_min > self.dn_max:
             raise ParameterError(f"wear.dn_min = {self.dn_min} exceeds wear.dn_max = {self.dn_max}")
         if self.average_cycles > self.max_average_cycles:
@@ -148,17 +153,11 @@ class WearSettings:
                 f"wear.average_cycles = {self.average_cycles} exceeds wear.max_average_cycles = "
                 f"{self.max_average_cycles}"
             )
-        if not (0 < self.tol < 1):
-            raise ParameterError(f"wear.tol must be in (0, 1), got {self.tol!r}")
         if self.max_increment is not None and not (
             math.isfinite(self.max_increment) and self.max_increment > 0
         ):
             raise ParameterError(
                 f"wear.max_increment must be a positive depth [m] or None, got {self.max_increment!r}"
             )
-        for name in ("settle_cycles", "initial_settle_cycles"):
-            v = getattr(self, name)
-            if not (math.isfinite(v) and v >= 0):
-                raise ParameterError(f"wear.{name} must be >= 0 cycles, got {v!r}")
         if not self.reject_factor > 1:
             raise ParameterError(f"wear.reject_factor must be > 1, got {self.reject_factor!r}")
