@@ -233,20 +233,13 @@ def _context(c: Comparison, page: _Page) -> dict[str, Any]:
     return ctx
 
 
-def render_html(
-    comparison: Comparison,
-    *,
-    inputs: Sequence[ReportInput] = (),
-    verification: Sequence[xr.Dataset] = (),
-    missing: Sequence[str] = (),
-    notes: Sequence[str] = (),
-    title: str = DEFAULT_TITLE,
-    command: str | None = None,
-    parameters: dict[str, Any] | None = None,
-) -> str:
-    """The report as an HTML string (see :func:`build_report` for the parameters)."""
-    page = _Page(inputs, verification, missing, notes, title, command, parameters)
-    return _render(comparison, page)
+def render_html(comparison: Comparison, **page: Any) -> str:
+    """The report as an HTML string.
+
+    ``page``: the keywords of :func:`build_report` but ``pdf`` (``inputs``, ``verification``,
+    ``missing``, ``notes``, ``title``, ``command``, ``parameters``).
+    """
+    return _render(comparison, _Page(**page))
 
 
 def _render(comparison: Comparison, page: _Page) -> str:

@@ -6,14 +6,12 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-import xarray as xr
-
 from jointwear import io
 from jointwear._version import __version__
 from jointwear.compare import Comparison
 from jointwear.provenance import software_versions
 from jointwear.reports._sections import _coverage, _verdict, format_value
-from jointwear.reports.builder import DEFAULT_TITLE, ReportInput, _input_records, _Page
+from jointwear.reports.builder import _input_records, _Page
 
 __all__ = ["write_pdf"]
 
@@ -32,19 +30,14 @@ def _text_page(pdf: Any, title: str, lines: Sequence[str]) -> None:
         pdf.savefig(fig)
 
 
-def write_pdf(
-    comparison: Comparison,
-    path: str | Path,
-    *,
-    inputs: Sequence[ReportInput] = (),
-    verification: Sequence[xr.Dataset] = (),
-    missing: Sequence[str] = (),
-    notes: Sequence[str] = (),
-    title: str = DEFAULT_TITLE,
-) -> Path:
-    """Write the report as a PDF with matplotlib only (no browser needed). Deterministic."""
-    page = _Page(inputs, verification, missing, notes, title)
-    return pdf_of_page(comparison, path, page)
+def write_pdf(comparison: Comparison, path: str | Path, **page: Any) -> Path:
+    """Write the report as a PDF with matplotlib only (no browser needed). Deterministic.
+
+    ``page``: the keywords of :func:`~jointwear.reports.build_report` but ``pdf``
+    (``inputs``, ``verification``, ``missing``, ``notes``, ``title``; the PDF does not show
+    ``command`` and ``parameters``).
+    """
+    return pdf_of_page(comparison, path, _Page(**page))
 
 
 def pdf_of_page(comparison: Comparison, path: str | Path, page: _Page) -> Path:
