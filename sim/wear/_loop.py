@@ -240,29 +240,18 @@ class WearRun:
         contact: Any,
         settings: WearSettings | None = None,
         *,
-        cycles: float,
-        snapshots: Sequence[float] | None = None,
-        checkpoint: str | Path | None = None,
         resume: bool = False,
-        initial_wear: np.ndarray | None = None,
-        on_update: Callable[[dict[str, Any]], None] | None = None,
+        **run: Any,
     ) -> WearRun:
-        """A new run, or with ``resume`` the run of ``checkpoint`` continued (:meth:`resume`)."""
+        """A new run, ``WearRun(contact, settings, **run)``, or with ``resume`` the run of
+        ``run["checkpoint"]`` continued (:meth:`resume`; the initial wear is the checkpoint's)."""
         if not resume:
-            return cls(
-                contact,
-                settings,
-                cycles=cycles,
-                snapshots=snapshots,
-                checkpoint=checkpoint,
-                initial_wear=initial_wear,
-                on_update=on_update,
-            )
+            return cls(contact, settings, **run)
+        checkpoint = run.pop("checkpoint", None)
         if checkpoint is None:
             raise BadInputError("resume=True needs the checkpoint path")
-        return cls.resume(
-            checkpoint, contact, settings, cycles=cycles, snapshots=snapshots, on_update=on_update
-        )
+        run.pop("initial_wear", None)
+        return cls.resume(checkpoint, contact, settings, **run)
 
     @classmethod
     def resume(
