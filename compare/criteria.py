@@ -4,15 +4,48 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 from jointwear.errors import ParameterError
-from jointwear.params import from_mapping, read_toml
+from jointwear.params import check_fields, checked, from_mapping, read_toml
 
 __all__ = ["Criteria", "load_criteria"]
 
-_STATED = ("wear_u_input_rel", "motion_u_input_rel", "wear_u_num_rel", "motion_u_num_rel")
+
+def _limit(where: str, name: str, value: Any) -> Any:
+    if not (isinstance(value, (int, float)) and np.isfinite(value) and value >= 0):
+        raise ParameterError(f"{where}.{name} must be a finite number >= 0, got {value!r}")
+    return value
+
+
+def _coverage_factor(where: str, name: str, value: Any) -> Any:
+    if _limit(where, name, value) == 0:
+        raise ParameterError(f"{where}.{name} (coverage factor) must be > 0")
+    return value
+
+
+def _fraction(where: str, name: str, value: Any) -> Any:
+    if _limit(where, name, value) >= 1:
+        raise ParameterError(f"{where}.{name} is a fraction in [0, 1), got {value!r}")
+    return value
+
+
+def _stated(where: str, name: str, value: Any) -> Any:
+    """A user-stated relative uncertainty: None (not stated) or a fraction > 0."""
+    if value is not None and _limit(where, name, value) == 0:
+        raise ParameterError(
+            f"{where}.{name} = 0 states that the uncertainty is exactly zero, which no "
+            "simulation has; leave it out (not assessed) or state the real fraction"
+        )
+    return value
+
+
+def _true_or_false(where: str, name: str, value: Any) -> Any:
+    if not isinstance(value, bool):
+        raise ParameterError(f"{where}.{name} must be true or false, got {value!r}")
+    return value
 
 
 @dataclass(frozen=True)
@@ -60,45 +93,22 @@ class Criteria:
         None (default) = not stated.
     """
 
-    k: float = 2.0
-    wear_nrmse_max: float = 0.25
-    wear_r_min: float = 0.5
-    max_angle_error_deg: float = 30.0
-    max_z_error_m: float = 3.0e-3
-    relative_error_max: float = 0.30
-    motion_sg_c_max: float = 0.30
-    max_volume_outside: float = 0.10
-    strict_coverage: bool = False
-    wear_u_input_rel: float | None = None
-    motion_u_input_rel: float | None = None
-    wear_u_num_rel: float | None = None
-    motion_u_num_rel: float | None = None
+    k: float = checked(2.0, _coverage_factor)
+    wear_nrmse_max: float = checked(0.25, _limit)
+    wear_r_min: float = checked(0.5, _limit)
+    max_angle_error_deg: float = checked(30.0, _limit)
+    max_z_error_m: float = checked(3.0e-3, _limit)
+    relative_error_max: float = checked(0.30, _limit)
+    motion_sg_c_max: float = checked(0.30, _limit)
+    max_volume_outside: float = checked(0.10, _fraction)
+    strict_coverage: bool = checked(False, _true_or_false)
+    wear_u_input_rel: float | None = checked(None, _stated)
+    motion_u_input_rel: float | None = checked(None, _stated)
+    wear_u_num_rel: float | None = checked(None, _stated)
+    motion_u_num_rel: float | None = checked(None, _stated)
 
     def __post_init__(self) -> None:
-        for f in self.__dataclass_fields__:
-            value = getattr(self, f)
-            if value is None and f in _STATED:
-                continue
-            if f == "strict_coverage":
-                if not isinstance(value, bool):
-                    raise ParameterError(
-                        f"criteria.strict_coverage must be true or false, got {value!r}"
-                    )
-                continue
-            if not (isinstance(value, (int, float)) and np.isfinite(value) and value >= 0):
-                raise ParameterError(f"criteria.{f} must be a finite number >= 0, got {value!r}")
-        for f in _STATED:
-            if getattr(self, f) == 0:
-                raise ParameterError(
-                    f"criteria.{f} = 0 states that the uncertainty is exactly zero, which no "
-                    "simulation has; leave it out (not assessed) or state the real fraction"
-                )
-        if self.k == 0:
-            raise ParameterError("criteria.k (coverage factor) must be > 0")
-        if self.max_volume_outside >= 1:
-            raise ParameterError(
-                f"criteria.max_volume_outside is a fraction in [0, 1), got {self.max_volume_outside!r}"
-            )
+        check_fields(self, "criteria")
 
 
 def load_criteria(path: str | Path | None) -> Criteria:
