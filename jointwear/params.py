@@ -22,7 +22,6 @@ __all__ = [
     "replace_nested",
     "check_positive",
     "check_non_negative",
-    "check_finite",
     "checked",
     "positive",
     "non_negative",
@@ -150,8 +149,7 @@ def _finite(where: str, name: str, value: float) -> float:
     return value
 
 
-def _within(where: str, name: str, value: float, interval: str) -> float:
-    lo, hi = (float(v) for v in interval[1:-1].split(","))
+def _within(where: str, name: str, value: float, interval: str, lo: float, hi: float) -> float:
     above = value >= lo if interval[0] == "[" else value > lo
     below = value <= hi if interval[-1] == "]" else value < hi
     if not (above and below):
@@ -171,13 +169,6 @@ def check_non_negative(where: str, **values: float) -> None:
     is a finite number >= 0."""
     for name, value in values.items():
         _non_negative(where, name, value)
-
-
-def check_finite(where: str, **values: float) -> None:
-    """Raise :class:`~jointwear.errors.ParameterError` naming ``where.name`` for the first value
-    that is not finite."""
-    for name, value in values.items():
-        _finite(where, name, value)
 
 
 #: A field's check: ``check(where, name, value)`` returns the value to keep (possibly
@@ -211,7 +202,11 @@ def finite(default: float) -> Any:
 
 def within(default: float, interval: str) -> Any:
     """A field that must lie in ``interval``, written as in the error: ``"(0, 1]"``, ``"[-1, 1)"``."""
-    return checked(default, functools.partial(_within, interval=interval))
+    bounds = interval[1:-1].split(",")
+    if interval[0] not in "([" or interval[-1] not in ")]" or len(bounds) != 2:
+        raise ValueError(f"interval {interval!r}: expected '(lo, hi)' with ( or [ and ) or ]")
+    lo, hi = (float(b) for b in bounds)
+    return checked(default, functools.partial(_within, interval=interval, lo=lo, hi=hi))
 
 
 def check_fields(obj: Any, where: str) -> None:

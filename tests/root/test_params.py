@@ -3,12 +3,24 @@
 from __future__ import annotations
 
 import dataclasses
+import math
 from typing import Literal
 
 import pytest
 
 from jointwear.errors import BadInputError, ParameterError
-from jointwear.params import from_mapping, read_toml, replace_nested, to_jsonable
+from jointwear.params import (
+    check_fields,
+    checked,
+    finite,
+    from_mapping,
+    non_negative,
+    positive,
+    read_toml,
+    replace_nested,
+    to_jsonable,
+    within,
+)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -92,3 +104,61 @@ def test_binary_or_folder_toml_is_refused_naming_the_file(tmp_path):
         read_toml(binary)
     with pytest.raises(BadInputError, match="is a folder"):
         read_toml(tmp_path)
+
+
+def _as_int(where: str, name: str, value: float) -> int:
+    if value != int(value):
+        raise ParameterError(f"{where}.{name} must be whole, got {value!r}")
+    return int(value)
+
+
+@dataclasses.dataclass(frozen=True)
+class Declared:
+    length: float = positive(1.0)
+    play: float = non_negative(0.0, unit="m")
+    offset: float = finite(0.0)
+    share: float = within(0.5, "(0, 1]")
+    poisson: float = within(0.3, "[-1, 0.5)")
+    count: int = checked(2, _as_int)
+    free: float = -3.0  # no check declared: anything goes
+
+    def __post_init__(self) -> None:
+        check_fields(self, "part")
+
+
+@pytest.mark.parametrize(
+    ("values", "message"),
+    [
+        ({"length": 0.0}, r"part\.length must be a positive finite number, got 0\.0"),
+        ({"length": math.inf}, r"part\.length must be a positive finite number"),
+        ({"play": -1e-9}, r"part\.play must be >= 0 m, got -1e-09"),
+        ({"play": math.nan}, r"part\.play must be >= 0 m"),
+        ({"offset": -math.inf}, r"part\.offset must be finite"),
+        ({"share": 0.0}, r"part\.share must be in \(0, 1\], got 0\.0"),
+        ({"share": 1.0 + 1e-12}, r"part\.share must be in \(0, 1\]"),
+        ({"share": math.nan}, r"part\.share must be in \(0, 1\]"),
+        ({"poisson": 0.5}, r"part\.poisson must be in \[-1, 0\.5\), got 0\.5"),
+        ({"count": 2.5}, r"part\.count must be whole, got 2\.5"),
+        # two wrong fields: the first in field order is named
+        ({"share": 2.0, "length": -1.0}, r"part\.length"),
+    ],
+)
+def test_declared_field_checks_refuse_naming_the_field(values, message):
+    with pytest.raises(ParameterError, match=message):
+        Declared(**values)
+
+
+def test_declared_field_checks_accept_the_bounds_and_keep_converted_values():
+    d = Declared(play=0.0, share=1.0, poisson=-1.0, count=3.0, free=-7.0)
+    assert (d.share, d.poisson, d.free) == (1.0, -1.0, -7.0)
+    assert d.count == 3 and type(d.count) is int  # the check's conversion is stored
+    assert Declared().count == 2 and Declared.length == 1.0  # defaults as declared
+    # from TOML tables too, and replace() checks again
+    assert from_mapping(Declared, {"share": 0.25}).share == 0.25
+    with pytest.raises(ParameterError, match=r"part\.share"):
+        dataclasses.replace(Declared(), share=0.0)
+
+
+def test_a_malformed_interval_is_refused_at_declaration():
+    with pytest.raises(ValueError, match="interval '0, 1'"):
+        within(0.5, "0, 1")
