@@ -15,6 +15,7 @@ import numpy as np
 import xarray as xr
 
 from jointwear.errors import BadInputError
+from jointwear.params import check_fields, positive
 
 L1, L2, L3, L4 = 0.10, 0.40, 0.30, 0.30
 
@@ -47,8 +48,8 @@ class RigConfig:
     look_at: tuple[float, float, float] = (0.29, 0.16, 0.0)
     distortion: tuple[float, float, float, float, float] = (-0.08, 0.10, 2e-4, -1e-4, 0.0)
     principal_offset_px: tuple[float, float] = (6.0, -4.0)
-    fps: float = 50.0
-    duration: float = 1.0
+    fps: float = positive(50.0)
+    duration: float = positive(1.0)
     crank_speed_rpm: float = 120.0
     crank_angle0_deg: float = 30.0
     z_amplitude: float = 2.5e-3
@@ -78,8 +79,7 @@ class RigConfig:
     def __post_init__(self) -> None:
         if self.width < 64 or self.height < 64:
             raise BadInputError(f"rig image size {self.width}x{self.height} is too small")
-        if not self.fps > 0 or not self.duration > 0:
-            raise BadInputError("rig fps and duration must be positive")
+        check_fields(self, "rig")
         if self.motion_blur_samples < 1:
             raise BadInputError("motion_blur_samples must be >= 1")
         if self.board_kind not in ("chessboard", "charuco"):

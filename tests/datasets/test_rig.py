@@ -149,3 +149,13 @@ def test_progress_reports_every_frame_and_calibration_view(tmp_path):
     views = [(d, t) for s, d, t in seen if s == "calibration"]
     n_boards = len(list((tmp_path / "calibration" / "left").glob("board_*.png")))
     assert views == [(k, n_boards) for k in range(1, n_boards + 1)]
+
+
+@pytest.mark.parametrize(
+    ("values", "name"),
+    [({"fps": 0.0}, "fps"), ({"duration": -1.0}, "duration"), ({"duration": np.inf}, "duration")],
+)
+def test_rig_timing_must_be_positive_and_finite(values, name):
+    # an infinite duration used to pass and end in an OverflowError when the frames were counted
+    with pytest.raises(BadInputError, match=rf"rig\.{name} must be a positive finite number"):
+        RigConfig(**values)
