@@ -5,8 +5,10 @@ The reference values (data/icgn_reference.json) were computed by the pre-refacto
 (commit 94bfa2d) on this synthetic pair; the refactored kernels reproduced them bit for bit on
 the development machine.
 The tolerance (1e-12 pixel) admits only the last-bit differences another CPU's vector width can
-give under fastmath; any change of the algorithm (a different iteration, weight or stopping
-rule) moves the matches by far more.
+give under fastmath, and those of LLVM inlining the fastmath sampling kernels or not, which
+depends on what numba compiles in the same session (a cold cache: the pre-refactor kernels
+themselves moved by up to 6e-14 pixel against a warm one); any change of the algorithm (a
+different iteration, weight or stopping rule) moves the matches by far more.
 """
 
 from __future__ import annotations
