@@ -117,6 +117,29 @@ def _affine_system(f, gx, gy, half, Hinv, jf, js):
     return _solve_spd(Hm, Hinv, 6)
 
 
+@njit(cache=True, inline="always")
+def _second_order_terms(out, o, g, c, r):
+    """``out[o : o + 6]`` = ``g (1, c, r, c^2/2, c r, r^2/2)``: one image gradient's half of
+    the second-order Jacobian at subset pixel (c, r)."""
+    out[o] = g
+    out[o + 1] = g * c
+    out[o + 2] = g * r
+    out[o + 3] = 0.5 * g * c * c
+    out[o + 4] = g * c * r
+    out[o + 5] = 0.5 * g * r * r
+
+
+@njit(cache=True, inline="always")
+def _add_second_order_row_sums(out, o, s, sc, scc, rr):
+    """Add one subset row's sums of ``q``, ``q c`` and ``q c^2`` (``rr`` the row) to
+    ``out[o : o + 6]``: the sums of ``q (1, c, r, c^2/2, c r, r^2/2)``, the second-order
+    Jacobian's pattern (:func:`~jointwear.dic.icgn._sample.add_row_sums` for the first three)."""
+    add_row_sums(out, o, s, sc, rr)
+    out[o + 3] += 0.5 * scc
+    out[o + 4] += sc * rr
+    out[o + 5] += 0.5 * s * rr * rr
+
+
 @njit(cache=True, nogil=True)
 def _quadratic_system(f, gx, gy, half, Hinv, jf, js):
     """As :func:`_affine_system` with the 12-parameter second-order Jacobian."""
@@ -125,20 +148,8 @@ def _quadratic_system(f, gx, gy, half, Hinv, jf, js):
     k = 0
     for r in range(-half, half + 1):
         for c in range(-half, half + 1):
-            a = gx[k]
-            b = gy[k]
-            J[0] = a
-            J[1] = a * c
-            J[2] = a * r
-            J[3] = 0.5 * a * c * c
-            J[4] = a * c * r
-            J[5] = 0.5 * a * r * r
-            J[6] = b
-            J[7] = b * c
-            J[8] = b * r
-            J[9] = 0.5 * b * c * c
-            J[10] = b * c * r
-            J[11] = 0.5 * b * r * r
+            _second_order_terms(J, 0, gx[k], c, r)
+            _second_order_terms(J, 6, gy[k], c, r)
             fk = f[k]
             for i in range(12):
                 ji = J[i]
@@ -310,18 +321,8 @@ def _sample_quadratic_warp(f, gx, gy, def_coef, def_invalid, order, xc, yc, half
             rbc += qb * cc
             rbcc += qb * cc * cc
             k += 1
-        jg[0] += ra
-        jg[1] += rac
-        jg[2] += ra * rr
-        jg[3] += 0.5 * racc
-        jg[4] += rac * rr
-        jg[5] += 0.5 * ra * rr * rr
-        jg[6] += rb
-        jg[7] += rbc
-        jg[8] += rb * rr
-        jg[9] += 0.5 * rbcc
-        jg[10] += rbc * rr
-        jg[11] += 0.5 * rb * rr * rr
+        _add_second_order_row_sums(jg, 0, ra, rac, racc, rr)
+        _add_second_order_row_sums(jg, 6, rb, rbc, rbcc, rr)
     if _invalid_near(def_invalid, xmin, ymin, xmax, ymax):
         return FLAG_INVALID_PIXELS
     acc[0] = sg
