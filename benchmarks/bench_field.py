@@ -14,35 +14,24 @@
 
 from __future__ import annotations
 
-import dataclasses
 import sys
 import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "dic"))
 
 import numpy as np  # noqa: E402
 from _common import write_results  # noqa: E402
+from _s_curve import s_curve  # noqa: E402
 
 from jointwear.datasets import speckle as sp  # noqa: E402
 from jointwear.datasets.rig import RigConfig  # noqa: E402
 from jointwear.datasets.surface import SurfaceScene  # noqa: E402
-from jointwear.dic import SubsetCorrelator, measure_field  # noqa: E402
-from jointwear.dic.icgn._interp import prefilter  # noqa: E402
+from jointwear.dic import measure_field  # noqa: E402
 
-
-def s_curve(size: float, gradient: str) -> list[float]:
-    params = sp.SpeckleParams(speckle_size=size)
-    out = []
-    for s in np.arange(0.0, 1.0001, 0.1):
-        pair = sp.speckle_pair((160, 160), sp.RigidField((s, 0.0)), params=params, seed=7)
-        corr = SubsetCorrelator(pair.reference, subset_size=21, step=6)
-        if gradient == "spline":
-            ref = prefilter(corr.reference_raw, "quintic", gradient="spline")
-            corr.ref = dataclasses.replace(corr.ref, gx=ref.gx, gy=ref.gy)
-        ds = corr.correlate(pair.deformed, initial_guess=np.array([s, 0.0]))
-        out.append(float(np.nanmean(ds.u.values - s)))
-    return out
+#: sub-pixel shifts [pixel] of the S-curve (160-pixel images)
+SHIFTS = np.arange(0.0, 1.0001, 0.1)
 
 
 def sigma_2d(size: float) -> dict:
@@ -63,14 +52,7 @@ def sigma_2d(size: float) -> dict:
 def sigma_stereo() -> dict:
     sc = SurfaceScene()
     pairs = [sc.pair(noise_seed=k) for k in range(3)]
-    ds = measure_field(
-        [p[0] for p in pairs],
-        [p[1] for p in pairs],
-        calibration=sc.calibration,
-        roi=sc.roi_left(),
-        subset_size=25,
-        step=12,
-    )
+    ds = sc.measure(pairs, subset_size=25, step=12)
     ok = (ds.flag.values == 0).all(axis=0)
     d = ds.displacement.values[1:][:, ok].reshape(-1, 3)
     du = ds.displacement_u.values[1:][:, ok].reshape(-1, 3)
@@ -98,15 +80,7 @@ def speed() -> dict:
     for n in (1, 2):
         for _rep in range(2):  # the first run may compile
             t0 = time.perf_counter()
-            ds = measure_field(
-                [p[0] for p in pairs[:n]],
-                [p[1] for p in pairs[:n]],
-                calibration=sc.calibration,
-                roi=sc.roi_left(),
-                subset_size=41,
-                step=56,
-                strain_window=3,
-            )
+            ds = sc.measure(pairs[:n], subset_size=41, step=56, strain_window=3)
             dt = time.perf_counter() - t0
         out[f"pairs_{n}"] = {
             "seconds": dt,
@@ -119,7 +93,10 @@ def speed() -> dict:
 def main() -> None:
     figures: dict = {"threads": 2}
     figures["s_curve"] = {
-        f"{size:g}px": {g: s_curve(size, g) for g in ("spline", "central")} for size in (3, 5, 8)
+        f"{size:g}px": {
+            g: s_curve(size, g, SHIFTS, size=160)[0].tolist() for g in ("spline", "central")
+        }
+        for size in (3, 5, 8)
     }
     for v in figures["s_curve"].values():
         for g in ("spline", "central"):

@@ -18,20 +18,17 @@ import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "sim"))
 
 from _common import write_results  # noqa: E402
+from _rigs import OFF_DEFAULT_RIGS  # noqa: E402
 
 from jointwear.sim import WearSettings, simulate_wear  # noqa: E402
 
 CYCLES = 1.2e6
 RIGS = {
     "default": {},
-    "bearing_radius_8.5mm": {"joint.bearing_radius": 8.5e-3},
-    "crank_60rpm": {"mechanism.crank_speed_rpm": 60.0},
-    "crank_240rpm": {"mechanism.crank_speed_rpm": 240.0},
-    "friction_0": {"friction.static_coefficient": 0.0, "friction.dynamic_coefficient": 0.0},
-    "axial_clearance_2mm": {"joint.axial_clearance": 2e-3},
-    "joint_offset_0": {"mechanism.joint_offset": 0.0},
+    **OFF_DEFAULT_RIGS,
     # issue 25: the slowest sensible rig (low crank speed: a cycle is 2 s of simulated time)
     "crank_30rpm": {"mechanism.crank_speed_rpm": 30.0},
 }

@@ -135,6 +135,20 @@ class SurfaceScene:
             self.render("right", motion, noise_seed=noise_seed),
         )
 
+    def measure(self, pairs, **options):
+        """:func:`~jointwear.dic.measure_field` of this scene's (left, right) image ``pairs``
+        (from :meth:`pair`) with the rig's calibration and the patch's left ROI
+        (:meth:`roi_left`); ``options`` (``subset_size``, ``step``, ...) are passed on."""
+        from jointwear.dic import measure_field
+
+        return measure_field(
+            [p[0] for p in pairs],
+            [p[1] for p in pairs],
+            calibration=self.calibration,
+            roi=self.roi_left(),
+            **options,
+        )
+
     def roi_left(self, shrink_px: float = 10.0) -> tuple[float, float, float, float]:
         """Rectangle (x0, y0, x1, y1) [pixel] of the left image inside the patch's image."""
         ox, oy = self.origin

@@ -31,6 +31,7 @@ from jointwear.metrology.form import (
     cylinder_zone,
     limacon_error,
     normalise_reference,
+    scan_variable,
 )
 
 __all__ = ["CentringWarning", "assess", "assess_points", "assess_point_file", "form_table"]
@@ -46,13 +47,7 @@ class CentringWarning(UserWarning):
 def _scan_var(scan: xr.Dataset | xr.DataArray) -> tuple[xr.DataArray, str]:
     if isinstance(scan, xr.DataArray):
         return scan, str(scan.name or "radius")
-    for name in ("radius", "radial_deviation"):
-        if name in scan:
-            return scan[name], name
-    raise BadInputError(
-        "assess: the scan has neither 'radius' nor 'radial_deviation' "
-        f"(variables: {', '.join(map(str, scan.data_vars)) or 'none'})"
-    )
+    return scan_variable(scan, "assess")
 
 
 def assess(

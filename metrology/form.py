@@ -578,17 +578,25 @@ def cylinder_zone(
     )
 
 
+#: The variables a scan dataset may hold its values in, the first found is taken.
+SCAN_VARIABLES = ("radius", "radial_deviation")
+
+
+def scan_variable(scan: xr.Dataset, what: str) -> tuple[xr.DataArray, str]:
+    """The values of a scan dataset: its ``radius`` or else its ``radial_deviation`` variable,
+    and that variable's name (``what`` names the caller in the refusal)."""
+    for name in SCAN_VARIABLES:
+        if name in scan:
+            return scan[name], name
+    raise BadInputError(
+        f"{what}: the dataset has neither 'radius' nor 'radial_deviation' "
+        f"(variables: {', '.join(map(str, scan.data_vars)) or 'none'})"
+    )
+
+
 def _as_grid(data: xr.DataArray | xr.Dataset, what: str) -> xr.DataArray:
     if isinstance(data, xr.Dataset):
-        for name in ("radius", "radial_deviation"):
-            if name in data:
-                data = data[name]
-                break
-        else:
-            raise BadInputError(
-                f"{what}: the dataset has neither 'radius' nor 'radial_deviation' "
-                f"(variables: {', '.join(map(str, data.data_vars)) or 'none'})"
-            )
+        data, _ = scan_variable(data, what)
     if "theta" not in data.dims:
         raise BadInputError(f"{what}: expected a 'theta' dimension, found dims {data.dims}")
     return data

@@ -78,6 +78,7 @@ from jointwear.metrology._wear_setup import (
     registered_offset,
 )
 from jointwear.metrology.baseline import FormBasis, correlation_length, noise_sigma
+from jointwear.metrology.form import SCAN_VARIABLES, scan_variable
 from jointwear.metrology.wear_quantities import derived_quantities
 
 __all__ = ["wear_map", "worn_volume", "register_angle"]
@@ -85,18 +86,10 @@ __all__ = ["wear_map", "worn_volume", "register_angle"]
 
 def _radius_var(ds: xr.Dataset | xr.DataArray, what: str) -> tuple[xr.DataArray, str]:
     if isinstance(ds, xr.DataArray):
-        name = str(ds.name) if ds.name in ("radius", "radial_deviation") else "radius"
+        name = str(ds.name) if ds.name in SCAN_VARIABLES else "radius"
         da = ds
     else:
-        for name in ("radius", "radial_deviation"):
-            if name in ds:
-                da = ds[name]
-                break
-        else:
-            raise BadInputError(
-                f"{what}: expected a 'radius' or 'radial_deviation' variable over (z, theta); "
-                f"found {', '.join(map(str, ds.data_vars)) or 'no variables'}"
-            )
+        da, name = scan_variable(ds, what)
     if set(da.dims) != {"z", "theta"}:
         raise BadInputError(f"{what}: '{name}' must have dims (z, theta), found {da.dims}")
     units = da.attrs.get("units", "m")

@@ -49,6 +49,7 @@ from pathlib import Path
 
 import xarray as xr
 
+from jointwear._dask import connect_scheduler
 from jointwear.dic.calibration._camera import StereoCalibration
 from jointwear.dic.footage._config import FRAME_FLAGS, BodySpec, TrackConfig, read_bodies
 from jointwear.dic.footage._features import (  # noqa: F401 (re-exported)
@@ -388,19 +389,7 @@ def _chunk_executor(workers: int, scheduler: str | None):
     from concurrent.futures import ProcessPoolExecutor
 
     if scheduler is not None:
-        try:
-            from distributed import Client
-        except ImportError:  # pragma: no cover - distributed is a dependency
-            raise BadInputError(
-                "--scheduler needs the 'distributed' package (pip install distributed)"
-            ) from None
-        try:
-            client = Client(scheduler, timeout="20s", set_as_default=False)
-        except (OSError, TimeoutError) as exc:
-            raise BadInputError(
-                f"cannot reach the dask scheduler at {scheduler!r} ({exc}); start one with "
-                "`dask scheduler` and workers with `dask worker ADDRESS`, or drop --scheduler"
-            ) from None
+        client = connect_scheduler(scheduler, timeout="20s")
         try:
             yield _DaskSubmitter(client)
         finally:

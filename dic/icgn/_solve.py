@@ -30,7 +30,7 @@ from jointwear.dic.icgn._flags import (
 from jointwear.dic.icgn._interp import PAD
 from jointwear.dic.icgn._reference import _box_has_invalid, _load_reference, _store_sigma
 from jointwear.dic.icgn._sample import add_row_sums, interp_point, sample_affine
-from jointwear.dic.icgn._warp import _compose_affine, _compose_quadratic, _solve_spd
+from jointwear.dic.icgn._warp import _compose_inverse, _solve_spd
 
 # a subset still below this ZNCC after this many iterations is not going to match
 _HOPELESS_AFTER = 10
@@ -117,6 +117,29 @@ def _affine_system(f, gx, gy, half, Hinv, jf, js):
     return _solve_spd(Hm, Hinv, 6)
 
 
+@njit(cache=True, inline="always")
+def _second_order_terms(out, o, g, c, r):
+    """``out[o : o + 6]`` = ``g (1, c, r, c^2/2, c r, r^2/2)``: one image gradient's half of
+    the second-order Jacobian at subset pixel (c, r)."""
+    out[o] = g
+    out[o + 1] = g * c
+    out[o + 2] = g * r
+    out[o + 3] = 0.5 * g * c * c
+    out[o + 4] = g * c * r
+    out[o + 5] = 0.5 * g * r * r
+
+
+@njit(cache=True, inline="always")
+def _add_second_order_row_sums(out, o, s, sc, scc, rr):
+    """Add one subset row's sums of ``q``, ``q c`` and ``q c^2`` (``rr`` the row) to
+    ``out[o : o + 6]``: the sums of ``q (1, c, r, c^2/2, c r, r^2/2)``, the second-order
+    Jacobian's pattern (:func:`~jointwear.dic.icgn._sample.add_row_sums` for the first three)."""
+    add_row_sums(out, o, s, sc, rr)
+    out[o + 3] += 0.5 * scc
+    out[o + 4] += sc * rr
+    out[o + 5] += 0.5 * s * rr * rr
+
+
 @njit(cache=True, nogil=True)
 def _quadratic_system(f, gx, gy, half, Hinv, jf, js):
     """As :func:`_affine_system` with the 12-parameter second-order Jacobian."""
@@ -125,20 +148,8 @@ def _quadratic_system(f, gx, gy, half, Hinv, jf, js):
     k = 0
     for r in range(-half, half + 1):
         for c in range(-half, half + 1):
-            a = gx[k]
-            b = gy[k]
-            J[0] = a
-            J[1] = a * c
-            J[2] = a * r
-            J[3] = 0.5 * a * c * c
-            J[4] = a * c * r
-            J[5] = 0.5 * a * r * r
-            J[6] = b
-            J[7] = b * c
-            J[8] = b * r
-            J[9] = 0.5 * b * c * c
-            J[10] = b * c * r
-            J[11] = 0.5 * b * r * r
+            _second_order_terms(J, 0, gx[k], c, r)
+            _second_order_terms(J, 6, gy[k], c, r)
             fk = f[k]
             for i in range(12):
                 ji = J[i]
@@ -219,67 +230,166 @@ def _diverged(p, p_start_u, p_start_v, max_shift):
 QUADRATIC_INDEX = np.arange(12)
 
 
-@njit(cache=True, nogil=True)
-def _iterate_affine(
+@njit(cache=True, inline="always")
+def _step_norm(dp, half, quadratic):
+    """Size of the increment ``dp`` [pixel]: how far it moves the subset's edge (``half``
+    pixels from the centre), the convergence measure of Pan, Li & Tong (2013)."""
+    hh = float(half)
+    norm = dp[0] * dp[0] + dp[6] * dp[6]
+    norm += hh * hh * (dp[1] * dp[1] + dp[2] * dp[2] + dp[7] * dp[7] + dp[8] * dp[8])
+    if quadratic:
+        q = 0.5 * hh * hh
+        norm += q * q * (dp[3] ** 2 + dp[5] ** 2 + dp[9] ** 2 + dp[11] ** 2)
+        norm += hh**4 * (dp[4] ** 2 + dp[10] ** 2)
+    return math.sqrt(norm)
+
+
+@njit(cache=True, inline="always")
+def _sample_affine_warp(f, gx, gy, def_coef, def_invalid, order, xc, yc, half, p, box, acc):
+    """Sample the deformed image over the affinely warped subset into ``acc`` = (``sum g``,
+    ``sum g^2``, ``sum g f``, ``sum J g`` (6)). Returns -1, or the flag to stop with: the
+    subset leaves ``box`` = ``(lo, hix, hiy)`` (:func:`_valid_box`) or has invalid pixels near.
+    """
+    lo, hix, hiy = box
+    a11 = 1.0 + p[1]
+    a12 = p[2]
+    a21 = p[7]
+    a22 = 1.0 + p[8]
+    # the warped subset is a parallelogram: its corners bound it
+    xmin = 1e300
+    xmax = -1e300
+    ymin = 1e300
+    ymax = -1e300
+    for corner in range(4):
+        c = -half if corner % 2 == 0 else half
+        r = -half if corner < 2 else half
+        xw = xc + p[0] + a11 * c + a12 * r
+        yw = yc + p[6] + a21 * c + a22 * r
+        xmin = min(xmin, xw)
+        xmax = max(xmax, xw)
+        ymin = min(ymin, yw)
+        ymax = max(ymax, yw)
+    if not (xmin >= lo and ymin >= lo and xmax <= hix and ymax <= hiy):
+        return FLAG_OUTSIDE
+    if _invalid_near(def_invalid, xmin, ymin, xmax, ymax):
+        return FLAG_INVALID_PIXELS
+    x_start = xc + p[0] - a11 * half
+    y_start = yc + p[6] - a21 * half
+    sample_affine(def_coef, order, x_start, y_start, a11, a12, a21, a22, half, f, gx, gy, acc)
+    return -1
+
+
+@njit(cache=True, inline="always")
+def _sample_quadratic_warp(f, gx, gy, def_coef, def_invalid, order, xc, yc, half, p, box, acc):
+    """As :func:`_sample_affine_warp` for the second-order warp: every warped pixel
+    bounds-checked, the 12-parameter ``sum J g``."""
+    lo, hix, hiy = box
+    jg = acc[3:]
+    for i in range(12):
+        jg[i] = 0.0
+    sg = sgg = sgf = 0.0
+    xmin = 1e300
+    xmax = -1e300
+    ymin = 1e300
+    ymax = -1e300
+    k = 0
+    for r in range(-half, half + 1):
+        rr = float(r)
+        ra = rb = rac = rbc = racc = rbcc = 0.0
+        for c in range(-half, half + 1):
+            cc = float(c)
+            xw = xc + cc + p[0] + p[1] * cc + p[2] * rr
+            xw += 0.5 * p[3] * cc * cc + p[4] * cc * rr + 0.5 * p[5] * rr * rr
+            yw = yc + rr + p[6] + p[7] * cc + p[8] * rr
+            yw += 0.5 * p[9] * cc * cc + p[10] * cc * rr + 0.5 * p[11] * rr * rr
+            if not (xw >= lo and yw >= lo and xw <= hix and yw <= hiy):
+                return FLAG_OUTSIDE
+            xmin = min(xmin, xw)
+            xmax = max(xmax, xw)
+            ymin = min(ymin, yw)
+            ymax = max(ymax, yw)
+            gv = interp_point(def_coef, order, xw, yw)
+            sg += gv
+            sgg += gv * gv
+            sgf += gv * f[k]
+            qa = gx[k] * gv
+            qb = gy[k] * gv
+            ra += qa
+            rac += qa * cc
+            racc += qa * cc * cc
+            rb += qb
+            rbc += qb * cc
+            rbcc += qb * cc * cc
+            k += 1
+        _add_second_order_row_sums(jg, 0, ra, rac, racc, rr)
+        _add_second_order_row_sums(jg, 6, rb, rbc, rbcc, rr)
+    if _invalid_near(def_invalid, xmin, ymin, xmax, ymax):
+        return FLAG_INVALID_PIXELS
+    acc[0] = sg
+    acc[1] = sgg
+    acc[2] = sgf
+    return -1
+
+
+@njit(cache=True, inline="always")
+def _iterate(
     f, gx, gy, fn, Hinv, jf, js, def_coef, def_invalid, order, xc, yc, half, p, max_iter, tol,
-    max_shift, border, w,
+    max_shift, border, w, quadratic,
 ):  # fmt: skip
-    """Gauss-Newton iterations of the affine IC-GN from the loaded reference subset.
+    """Gauss-Newton iterations of the IC-GN from the loaded reference subset, affine or
+    second order (``quadratic``); :func:`_iterate_affine` and :func:`_iterate_quadratic` are
+    its compiled forms.
 
     Uses ``sum J (f - fm - fn/gn (g - gm)) = Jf - fn/gn (Jg - gm Js)`` with ``Jf``, ``Js``
     fixed per subset, so each iteration samples the deformed subset once and accumulates.
     """
-    lo, hix, hiy = _valid_box(def_coef, border)
+    box = _valid_box(def_coef, border)
     n = (2 * half + 1) ** 2
-    acc = np.empty(9)
-    e = np.empty(6)
+    m = 12 if quadratic else 6
+    index = QUADRATIC_INDEX if quadratic else AFFINE_INDEX
+    acc = np.empty(3 + m)  # sum g, sum g^2, sum g f, sum J g
+    e = np.empty(m)
     dp = np.zeros(12)
     p_start_u = p[0]
     p_start_v = p[6]
     zncc = np.nan
     it = 0
-    hh2 = float(half) * float(half)
     while it < max_iter:
         it += 1
-        a11 = 1.0 + p[1]
-        a12 = p[2]
-        a21 = p[7]
-        a22 = 1.0 + p[8]
-        # the warped subset is a parallelogram: its corners bound it
-        xmin = 1e300
-        xmax = -1e300
-        ymin = 1e300
-        ymax = -1e300
-        for corner in range(4):
-            c = -half if corner % 2 == 0 else half
-            r = -half if corner < 2 else half
-            xw = xc + p[0] + a11 * c + a12 * r
-            yw = yc + p[6] + a21 * c + a22 * r
-            xmin = min(xmin, xw)
-            xmax = max(xmax, xw)
-            ymin = min(ymin, yw)
-            ymax = max(ymax, yw)
-        if not (xmin >= lo and ymin >= lo and xmax <= hix and ymax <= hiy):
-            return np.nan, it, FLAG_OUTSIDE
-        if _invalid_near(def_invalid, xmin, ymin, xmax, ymax):
-            return np.nan, it, FLAG_INVALID_PIXELS
-        x_start = xc + p[0] - a11 * half
-        y_start = yc + p[6] - a21 * half
-        sample_affine(def_coef, order, x_start, y_start, a11, a12, a21, a22, half, f, gx, gy, acc)
+        if quadratic:
+            stop = _sample_quadratic_warp(
+                f, gx, gy, def_coef, def_invalid, order, xc, yc, half, p, box, acc
+            )
+        else:
+            stop = _sample_affine_warp(
+                f, gx, gy, def_coef, def_invalid, order, xc, yc, half, p, box, acc
+            )
+        if stop >= 0:
+            return np.nan, it, stop
         stop, zncc, gm, ratio = _zncc_of(acc[0], acc[1], acc[2], n, fn, it)
         if stop >= 0:
             return zncc, it, stop
-        _gauss_newton_step(Hinv, jf, js, acc[3:], gm, ratio, e, dp, AFFINE_INDEX)
-        if not _compose_affine(p, dp):
+        _gauss_newton_step(Hinv, jf, js, acc[3:], gm, ratio, e, dp, index)
+        if not _compose_inverse(p, dp, quadratic):
             return zncc, it, FLAG_DIVERGED
         if _diverged(p, p_start_u, p_start_v, max_shift):
             return np.nan, it, FLAG_DIVERGED
-        norm = dp[0] * dp[0] + dp[6] * dp[6]
-        norm += hh2 * (dp[1] * dp[1] + dp[2] * dp[2] + dp[7] * dp[7] + dp[8] * dp[8])
-        if math.sqrt(norm) < tol:
-            _store_sigma(w, fn, zncc, n, 6, Hinv[0, 0], Hinv[3, 3])
+        if _step_norm(dp, half, quadratic) < tol:
+            _store_sigma(w, fn, zncc, n, m, Hinv[0, 0], Hinv[m // 2, m // 2])
             return zncc, it, FLAG_OK
     return zncc, it, FLAG_NOT_CONVERGED
+
+
+@njit(cache=True, nogil=True)
+def _iterate_affine(
+    f, gx, gy, fn, Hinv, jf, js, def_coef, def_invalid, order, xc, yc, half, p, max_iter, tol,
+    max_shift, border, w,
+):  # fmt: skip
+    """:func:`_iterate` with the affine warp (6 parameters)."""
+    return _iterate(
+        f, gx, gy, fn, Hinv, jf, js, def_coef, def_invalid, order, xc, yc, half, p, max_iter,
+        tol, max_shift, border, w, False,
+    )  # fmt: skip
 
 
 @njit(cache=True, fastmath=_FM)
@@ -287,87 +397,11 @@ def _iterate_quadratic(
     f, gx, gy, fn, Hinv, jf, js, def_coef, def_invalid, order, xc, yc, half, p, max_iter, tol,
     max_shift, border, w,
 ):  # fmt: skip
-    """Gauss-Newton iterations of the second-order IC-GN (as :func:`_iterate_affine`, with the
-    12-parameter Jacobian, every warped pixel bounds-checked and 6x6 warp composition)."""
-    lo, hix, hiy = _valid_box(def_coef, border)
-    n = (2 * half + 1) ** 2
-    jg = np.empty(12)
-    e = np.empty(12)
-    dp = np.zeros(12)
-    p_start_u = p[0]
-    p_start_v = p[6]
-    zncc = np.nan
-    it = 0
-    hh = float(half)
-    while it < max_iter:
-        it += 1
-        for i in range(12):
-            jg[i] = 0.0
-        sg = sgg = sgf = 0.0
-        xmin = 1e300
-        xmax = -1e300
-        ymin = 1e300
-        ymax = -1e300
-        k = 0
-        for r in range(-half, half + 1):
-            rr = float(r)
-            ra = rb = rac = rbc = racc = rbcc = 0.0
-            for c in range(-half, half + 1):
-                cc = float(c)
-                xw = xc + cc + p[0] + p[1] * cc + p[2] * rr
-                xw += 0.5 * p[3] * cc * cc + p[4] * cc * rr + 0.5 * p[5] * rr * rr
-                yw = yc + rr + p[6] + p[7] * cc + p[8] * rr
-                yw += 0.5 * p[9] * cc * cc + p[10] * cc * rr + 0.5 * p[11] * rr * rr
-                if not (xw >= lo and yw >= lo and xw <= hix and yw <= hiy):
-                    return np.nan, it, FLAG_OUTSIDE
-                xmin = min(xmin, xw)
-                xmax = max(xmax, xw)
-                ymin = min(ymin, yw)
-                ymax = max(ymax, yw)
-                gv = interp_point(def_coef, order, xw, yw)
-                sg += gv
-                sgg += gv * gv
-                sgf += gv * f[k]
-                qa = gx[k] * gv
-                qb = gy[k] * gv
-                ra += qa
-                rac += qa * cc
-                racc += qa * cc * cc
-                rb += qb
-                rbc += qb * cc
-                rbcc += qb * cc * cc
-                k += 1
-            jg[0] += ra
-            jg[1] += rac
-            jg[2] += ra * rr
-            jg[3] += 0.5 * racc
-            jg[4] += rac * rr
-            jg[5] += 0.5 * ra * rr * rr
-            jg[6] += rb
-            jg[7] += rbc
-            jg[8] += rb * rr
-            jg[9] += 0.5 * rbcc
-            jg[10] += rbc * rr
-            jg[11] += 0.5 * rb * rr * rr
-        if _invalid_near(def_invalid, xmin, ymin, xmax, ymax):
-            return np.nan, it, FLAG_INVALID_PIXELS
-        stop, zncc, gm, ratio = _zncc_of(sg, sgg, sgf, n, fn, it)
-        if stop >= 0:
-            return zncc, it, stop
-        _gauss_newton_step(Hinv, jf, js, jg, gm, ratio, e, dp, QUADRATIC_INDEX)
-        if not _compose_quadratic(p, dp):
-            return zncc, it, FLAG_DIVERGED
-        if _diverged(p, p_start_u, p_start_v, max_shift):
-            return np.nan, it, FLAG_DIVERGED
-        norm = dp[0] * dp[0] + dp[6] * dp[6]
-        norm += hh * hh * (dp[1] * dp[1] + dp[2] * dp[2] + dp[7] * dp[7] + dp[8] * dp[8])
-        q = 0.5 * hh * hh
-        norm += q * q * (dp[3] ** 2 + dp[5] ** 2 + dp[9] ** 2 + dp[11] ** 2)
-        norm += hh**4 * (dp[4] ** 2 + dp[10] ** 2)
-        if math.sqrt(norm) < tol:
-            _store_sigma(w, fn, zncc, n, 12, Hinv[0, 0], Hinv[6, 6])
-            return zncc, it, FLAG_OK
-    return zncc, it, FLAG_NOT_CONVERGED
+    """:func:`_iterate` with the second-order warp (12 parameters)."""
+    return _iterate(
+        f, gx, gy, fn, Hinv, jf, js, def_coef, def_invalid, order, xc, yc, half, p, max_iter,
+        tol, max_shift, border, w, True,
+    )  # fmt: skip
 
 
 @njit(cache=True)

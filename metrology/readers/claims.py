@@ -204,7 +204,7 @@ def check_magnitude(
                 for u in _TRY_UNITS
                 if unit_factor(u) != f and _agree(med * unit_factor(u), nominal[1], limits)
             ]
-            alts = [(_units_fix(stated_by_file, u), f"if the values are in {u}") for u in agree]
+            alts = _unit_fixes(stated_by_file, agree)
             alts.append(
                 ({"ignore_header": ("nominal_radius",)}, f"if the header's {nominal[0]!r} is wrong")
             )
@@ -247,30 +247,36 @@ def check_magnitude(
             and ptp / f * unit_factor(u) >= limits["min_form"]
             and float(np.max(np.abs(v))) * unit_factor(u) <= limit
         ][:1]
-        alts = [(_units_fix(stated_by_file, u), f"if the values are in {u}") for u in larger]
-        text, sugg = advise(alts) if alts else ("", ())
-        raise Refusal(
+        raise _wrong_deviation_unit(
             f"{where}: the values are read in {unit!r} ({unit_source}) as radial deviations "
             f"with a peak-to-valley of {_fmt(ptp)}, below any roundness probe's noise "
-            f"(min_form = {_fmt(limits['min_form'])}): a wrong unit"
-            + (f"? {text}" if alts else "?")
-            + "; if the trace really is that flat, lower the limit with min_form=<m>",
-            sugg,
+            f"(min_form = {_fmt(limits['min_form'])})",
+            _unit_fixes(stated_by_file, larger),
+            "if the trace really is that flat, lower the limit with min_form=<m>",
         )
     if dmax > limit:
         smaller = [
             u for u in ("mm", "um") if unit_factor(u) < f and dmax / f * unit_factor(u) <= limit
         ][:1]
-        alts = [(_units_fix(stated_by_file, u), f"if the values are in {u}") for u in smaller]
-        text, sugg = advise(alts) if alts else ("", ())
-        raise Refusal(
+        raise _wrong_deviation_unit(
             f"{where}: the values are read in {unit!r} ({unit_source}) as radial deviations of "
-            f"{_fmt(dmax)} and more (a tenth of them), more than {why}: a wrong unit"
-            + (f"? {text}" if alts else "?")
-            + "; if the deviations really are that large, raise the limit with "
-            "max_deviation=<m> (or pass value='radius' if the column holds radii)",
-            sugg,
+            f"{_fmt(dmax)} and more (a tenth of them), more than {why}",
+            _unit_fixes(stated_by_file, smaller),
+            "if the deviations really are that large, raise the limit with max_deviation=<m> "
+            "(or pass value='radius' if the column holds radii)",
         )
+
+
+def _unit_fixes(stated_by_file: bool, units: list[str]) -> list[tuple[dict, str]]:
+    """The fix that reads the values in each of ``units``, with when it is the right one."""
+    return [(_units_fix(stated_by_file, u), f"if the values are in {u}") for u in units]
+
+
+def _wrong_deviation_unit(finding: str, fixes: list[tuple[dict, str]], keep: str) -> Refusal:
+    """Refuse deviations whose magnitude (``finding``) says their unit is wrong: the ``fixes``
+    of :func:`_unit_fixes` that would read them plausibly, else ``keep`` (how to accept them)."""
+    text, sugg = advise(fixes) if fixes else ("", ())
+    return Refusal(f"{finding}: a wrong unit" + (f"? {text}" if fixes else "?") + f"; {keep}", sugg)
 
 
 def _agree(r: float, nominal: float, limits: dict[str, float]) -> bool:

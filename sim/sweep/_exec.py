@@ -16,7 +16,7 @@ from collections.abc import Callable, Sequence
 from concurrent import futures as cf
 from typing import Any
 
-from jointwear.errors import BadInputError
+from jointwear._dask import connect_scheduler
 from jointwear.sim.sweep._run import RunResult, RunTask, evaluate_run
 
 __all__ = ["execute", "WORKER_ENV", "LOOPBACK"]
@@ -65,13 +65,7 @@ def _client(workers: int | None, scheduler: str | None) -> tuple[Any, Any, str]:
     from distributed import Client, LocalCluster
 
     if scheduler is not None:
-        try:
-            client = Client(scheduler, timeout="15s", set_as_default=False)
-        except (OSError, TimeoutError) as exc:
-            raise BadInputError(
-                f"--scheduler {scheduler}: cannot connect to a dask scheduler there ({exc}); "
-                "check the address (tcp://host:port) and that the scheduler is running"
-            ) from None
+        client = connect_scheduler(scheduler, timeout="15s")
         n = len(client.scheduler_info().get("workers", {}))
         return client, None, f"dask scheduler {scheduler} ({n} worker(s) now)"
     n = workers if workers is not None else (os.cpu_count() or 1)

@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import json
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -255,50 +258,12 @@ def test_import_calibration_cli(tmp_path, rig, capsys):
 #    project; its <startpoint> entries hold VIC-3D's own automatic matches ("ref" guess in
 #    StaticB_0001_0.tif, "auto" guess in StaticB_0001_1.tif), its <coordinatetransformation
 #    name="OriginYAxis"> and, in <plotdata>, the X/Y/Z [mm] ranges VIC-3D showed for the data.
-_DSPEC_CAMERAS = (
-    "9.550537385e+02 6.452301624e+02 6.636033383e+03 6.636440175e+03 -5.693077075e-04 "
-    "-1.957515272e-04 8.739544595e-01 -2.691426143e+01",
-    "1.799332210e+02 9.415993919e+00 -5.775865407e-02 -5.820738494e+01 1.641145944e-01 "
-    "2.016820788e+01",
-    "9.713275619e+02 6.157965508e+02 6.609847619e+03 6.609166930e+03 7.051020868e-01 "
-    "-5.225966870e-03 1.077694686e+00 -3.005404073e+01",
-    "-1.799418875e+02 -9.416050875e+00 4.747312256e-02 5.984373321e+01 2.184759676e-01 "
-    "2.104719884e+01",
-)
-_DSPEC_MATCHES = np.array(  # x, y (camera 0), q, r [pixel]
-    [
-        [124, 624, -57.077, -44.673],
-        [124, 124, -54.752, -63.960],
-        [324, 324, -40.255, -52.329],
-        [424, 824, -36.508, -39.168],
-        [524, 124, -28.382, -52.008],
-        [624, 924, -27.957, -39.370],
-        [724, 124, -21.501, -46.232],
-        [924, 924, -22.388, -43.065],
-        [1024, 124, -19.007, -37.712],
-        [1224, 924, -25.866, -46.980],
-        [1324, 124, -25.478, -29.393],
-        [1424, 524, -31.247, -37.753],
-    ]
-)
-_CALA_CAMERAS = (
-    "6.389130236e+02 4.072947410e+02 2.468528613e+03 2.468253027e+03 -1.711976745e-01 "
-    "6.384132162e-02 0.000000000e+00 0.000000000e+00",
-    "1.799648062e+02 9.015158049e+00 3.368301490e-02 -6.322727157e+01 -3.371514296e-01 "
-    "1.870517821e+01",
-    "6.286069607e+02 3.945705260e+02 2.377107751e+03 2.376915841e+03 8.978417541e-02 "
-    "6.198448417e-02 0.000000000e+00 0.000000000e+00",
-    "-1.799590220e+02 -9.015133814e+00 -3.968800176e-02 6.484254707e+01 -8.762002049e-01 "
-    "1.534897551e+01",
-)
-_CALA_MATCHES = np.array(  # VIC-3D start points: camera 0 (x, y), camera 1 (x, y) [pixel]
-    [
-        [456, 121, 516.716, 104.7],
-        [544, 369, 571.169, 350.874],
-        [609, 326, 648.066, 309.293],
-        [611, 242, 637.642, 227.563],
-    ]
-)
+# The numbers are in data/vic3d_dice_reference.json.
+_DICE = json.loads((Path(__file__).parent / "data" / "vic3d_dice_reference.json").read_text())
+_DSPEC_CAMERAS = tuple(_DICE["stereo_d_spec"]["cameras"])
+_DSPEC_MATCHES = np.array(_DICE["stereo_d_spec"]["matches"])  # x, y (camera 0), q, r [pixel]
+_CALA_CAMERAS = tuple(_DICE["cal_a"]["cameras"])
+_CALA_MATCHES = np.array(_DICE["cal_a"]["matches"])  # camera 0 (x, y), camera 1 (x, y) [pixel]
 
 
 def _vic_file(cameras, size=None, root="project") -> str:

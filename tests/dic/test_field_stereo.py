@@ -22,15 +22,7 @@ MOTION = SurfaceMotion(u0=0.5e-3, v0=-0.3e-3, w=_bump(0.2e-3))
 def scene():
     sc = SurfaceScene(_bump(0.004))
     pairs = [sc.pair(noise_seed=k) for k in range(3)] + [sc.pair(MOTION, noise_seed=3)]
-    ds = measure_field(
-        [p[0] for p in pairs],
-        [p[1] for p in pairs],
-        calibration=sc.calibration,
-        roi=sc.roi_left(),
-        subset_size=25,
-        step=12,
-        data_origin="synthetic",
-    )
+    ds = sc.measure(pairs, subset_size=25, step=12, data_origin="synthetic")
     return sc, pairs, ds
 
 
@@ -110,10 +102,7 @@ def test_moved_fine_speckle_uncertainty_counts_the_pattern_mismatch():
     sc._coef = ndimage.spline_filter(sc.texture.astype(np.float64), order=3, mode="mirror")
     motion = SurfaceMotion(u0=0.5e-3, v0=-0.3e-3)
     pairs = [sc.pair(noise_seed=0), sc.pair(motion, noise_seed=1)]
-    ds = measure_field(
-        [p[0] for p in pairs], [p[1] for p in pairs], calibration=sc.calibration,
-        roi=sc.roi_left(), subset_size=25, step=12, strain_window=0,
-    )  # fmt: skip
+    ds = sc.measure(pairs, subset_size=25, step=12, strain_window=0)
     ok = ds.flag.values[1] == 0
     assert ok.mean() > 0.95
     err = ds.displacement.values[1][ok] - motion.displacement(0.0, 0.0)
@@ -126,10 +115,7 @@ def test_best_fit_plane_frame_and_refusals(scene):
     sc, pairs, _ = scene
     tilted = SurfaceScene(lambda x, y: 0.15 * (x - 0.29) - 0.1 * (y - 0.16))
     p0, p1 = tilted.pair(noise_seed=0), tilted.pair(noise_seed=1)
-    ds = measure_field(
-        [p0[0], p1[0]], [p0[1], p1[1]], calibration=tilted.calibration,
-        roi=tilted.roi_left(), subset_size=25, step=16, frame="plane",
-    )  # fmt: skip
+    ds = tilted.measure([p0, p1], subset_size=25, step=16, frame="plane")
     ok = ds.flag.values[1] == 0
     assert np.sqrt(np.mean(ds.position.values[ok, 2] ** 2)) < 10e-6  # flat in its own plane
     R = ds.frame_rotation.values
@@ -197,10 +183,7 @@ def test_uniform_stretch_gives_its_green_lagrange_strain():
     # a flat specimen in the world plane stretched by 0.3 % along x: E_xx = e + e^2 / 2
     sc = SurfaceScene()
     pairs = [sc.pair(noise_seed=0), sc.pair(SurfaceMotion(stretch=0.003), noise_seed=1)]
-    ds = measure_field(
-        [p[0] for p in pairs], [p[1] for p in pairs], calibration=sc.calibration,
-        roi=sc.roi_left(), subset_size=25, step=12, strain_window=5,
-    )  # fmt: skip
+    ds = sc.measure(pairs, subset_size=25, step=12, strain_window=5)
     E = ds.strain.values[1]
     good = np.isfinite(E).all(axis=1)
     assert good.mean() > 0.8
@@ -217,9 +200,8 @@ def test_subsets_straddling_a_depth_step_are_flagged_left_right_inconsistent():
         return np.where(x < 0.29, 0.0, -0.02)
 
     sc = SurfaceScene(step)
-    lft, rgt = sc.pair(noise_seed=0)
-    kw = dict(calibration=sc.calibration, roi=sc.roi_left(), subset_size=25, step=12)
-    ds = measure_field([lft], [rgt], strain_window=0, **kw)
+    pairs = [sc.pair(noise_seed=0)]
+    ds = sc.measure(pairs, subset_size=25, step=12, strain_window=0)
     flag = ds.flag.values[0]
     assert (flag == 0).mean() > 0.9
     flagged = flag == 10
@@ -229,6 +211,6 @@ def test_subsets_straddling_a_depth_step_are_flagged_left_right_inconsistent():
     assert (np.abs(ds.x.values[flagged] - col) < 40).all()
     P = ds.position.values[flag == 0]
     assert np.abs(P[:, 2] - step(P[:, 0], P[:, 1])).max() < 25e-6
-    loose = measure_field([lft], [rgt], strain_window=0, consistency_max_px=1e9, **kw)
+    loose = sc.measure(pairs, subset_size=25, step=12, strain_window=0, consistency_max_px=1e9)
     Q = loose.position.values[loose.flag.values[0] == 0]
     assert np.abs(Q[:, 2] - step(Q[:, 0], Q[:, 1])).max() > 100e-6  # what the flag prevents

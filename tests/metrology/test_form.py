@@ -9,6 +9,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from jointwear.errors import BadInputError
+from jointwear.metrology.assess import assess
 from jointwear.metrology.form import (
     circle_zone,
     circle_zones,
@@ -137,6 +138,8 @@ def test_bad_inputs():
         circle_zone(np.linspace(0, 30, 20), R + np.linspace(0, 1e-6, 20), reference="MI")
     with pytest.raises(BadInputError, match="neither 'radius' nor 'radial_deviation'"):
         cylindricity(xr.Dataset({"x": ("z", [1.0])}))
+    with pytest.raises(BadInputError, match=r"assess: .*neither 'radius' nor 'radial_deviation'"):
+        assess(xr.Dataset({"x": ("z", [1.0])}))
 
 
 def test_limacon_error():

@@ -105,6 +105,17 @@ def test_wear_map_errors():
     with pytest.raises(BadInputError, match="pass radius="):
         wear_map(dev)
     assert wear_map(dev, radius=R)["worn_volume"].item() > 0
+    # a dataset whose values are under another name is refused, naming what it holds
+    named = dev.rename({"radial_deviation": "height"})
+    with pytest.raises(
+        BadInputError,
+        match=r"worn scan: .*neither 'radius' nor 'radial_deviation' \(variables: height\)",
+    ):
+        wear_map(named, radius=R)
+    with pytest.raises(
+        BadInputError, match=r"before scan: .*neither 'radius'.*\(variables: none\)"
+    ):
+        wear_map(worn, xr.Dataset())
 
 
 def test_exact_centring_with_large_set_up_offsets():

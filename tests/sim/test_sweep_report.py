@@ -13,6 +13,7 @@ import math
 
 import numpy as np
 import pytest
+from _rigs import NOISE_LIMITED_TOML
 
 from jointwear import io
 from jointwear.cli import main
@@ -90,10 +91,7 @@ def test_sobol_of_an_angle_is_refused_and_its_linear_twin_assessed():
 @pytest.mark.slow
 def test_wear_sweep_record_holds_each_runs_accuracy_and_one_line_per_warning(tmp_path, capsys):
     base = tmp_path / "base.toml"
-    base.write_text(
-        "[joint]\nn_layers = 6\nn_points = 60\n"
-        "[wear]\nkw = 9e-14\ntol = 0.05\ndn = 50\nmax_average_cycles = 2\n"
-    )
+    base.write_text(NOISE_LIMITED_TOML + "max_average_cycles = 2\n")
     sweep = tmp_path / "s.toml"
     sweep.write_text(
         '[sweep]\nrun = "wear"\ncycles = 2000\nmethod = "lhs"\nsamples = 2\nseed = 1\n'

@@ -10,6 +10,7 @@ import time
 
 import numpy as np
 import pytest
+from _rigs import NOISE_LIMITED_TOML
 
 from jointwear import io
 from jointwear.cli import main
@@ -269,10 +270,7 @@ def test_calibrate_kw_command_with_several_snapshots_reports_each_residual(tmp_p
 
 def test_noise_limited_rig_finishes_and_says_how_accurate_it_is(tmp_path, capsys):
     toml = tmp_path / "rig.toml"
-    toml.write_text(
-        "[mechanism]\ncrank_speed_rpm = 60.0\n\n[joint]\nn_layers = 6\nn_points = 60\n\n"
-        "[wear]\nkw = 9.0e-14\ntol = 0.05\ndn = 50\n"
-    )
+    toml.write_text("[mechanism]\ncrank_speed_rpm = 60.0\n\n" + NOISE_LIMITED_TOML)
     out = tmp_path / "w.nc"
     assert main(["sim", "wear", "--cycles", "4000", "--out", str(out), "--params", str(toml)]) == 0
     cap = capsys.readouterr()

@@ -12,6 +12,7 @@ import json
 
 import numpy as np
 import pytest
+from _rigs import OFF_DEFAULT_RIGS
 
 from jointwear.errors import ParameterError
 from jointwear.params import replace_nested
@@ -21,19 +22,12 @@ PARAMS = replace_nested(PARAMETER_SETS["zhang2023"], **{"joint.n_layers": 6, "jo
 CYCLES = 4000
 SETTINGS = WearSettings(kw=DEFAULT_KW * 100, tol=0.2, dn=50)
 
-RIGS = {
-    "bearing_radius_8.5mm": {"joint.bearing_radius": 8.5e-3},
-    "60rpm": {"mechanism.crank_speed_rpm": 60.0},
-    "240rpm": {"mechanism.crank_speed_rpm": 240.0},
-    "friction_0": {"friction.static_coefficient": 0.0, "friction.dynamic_coefficient": 0.0},
-    "axial_clearance_2mm": {"joint.axial_clearance": 2e-3},
-    "joint_offset_0": {"mechanism.joint_offset": 0.0},
-}
 
-
-@pytest.mark.parametrize("rig", list(RIGS))
+@pytest.mark.parametrize("rig", list(OFF_DEFAULT_RIGS))
 def test_rig_finishes_with_its_accuracy_stated(rig):
-    ds = simulate_wear(PARAMS, cycles=CYCLES, snapshots=[], settings=SETTINGS, overrides=RIGS[rig])
+    ds = simulate_wear(
+        PARAMS, cycles=CYCLES, snapshots=[], settings=SETTINGS, overrides=OFF_DEFAULT_RIGS[rig]
+    )
     assert ds.attrs["status"] == "complete" and ds.attrs["cycles_done"] == CYCLES
     # the old controller needed thousands of 1-2 cycle updates here
     assert ds.attrs["n_updates"] <= 20
