@@ -24,12 +24,21 @@ class Origin(StrEnum):
     synthetic = "synthetic"
 
 
-_ORIGIN = typer.Option(
-    "--origin",
-    help="What the numbers are: simulated, measured or synthetic (required for CSV).",
-)
-_TOOL = typer.Option("--tool", help="The program that wrote the file, e.g. 'Adams 2024'.")
-_OUT = typer.Option("--out", "-o", help="The jointwear netCDF file to write.")
+# options of every import command
+_Out = Annotated[Path, typer.Option("--out", "-o", help="The jointwear netCDF file to write.")]
+_Origin = Annotated[
+    Origin | None,
+    typer.Option(
+        "--origin",
+        help="What the numbers are: simulated, measured or synthetic (required for CSV).",
+    ),
+]
+_Tool = Annotated[
+    str | None, typer.Option("--tool", help="The program that wrote the file, e.g. 'Adams 2024'.")
+]
+
+_CF_SUFFIXES = (".nc", ".nc4", ".cdf")
+"""File endings read as CF netCDF; any other file is read as a CSV table."""
 
 
 def _names(text: str, option: str, count: tuple[int, int]) -> list[str]:
@@ -43,6 +52,29 @@ def _names(text: str, option: str, count: tuple[int, int]) -> list[str]:
     return names
 
 
+def _from_cf(file: Path, variable: str, **options):
+    """A CF netCDF file read by :func:`jointwear.external.import_cf` with ``options``; refused
+    when it does not hold ``variable``."""
+    from jointwear import external
+    from jointwear.errors import ParameterError
+
+    ds = external.import_cf(file, **options)
+    if variable not in ds:
+        raise ParameterError(f"'{file}' has no variable '{variable}'")
+    return ds
+
+
+def _refuse_missing(table: str, given: tuple[tuple[str, object], ...], never: str) -> None:
+    """Refuse a CSV ``table`` when a flag of ``given`` (``(flag, value)`` pairs) is missing:
+    a CSV file states neither its units nor its conventions, and jointwear ``never`` guesses
+    them."""
+    from jointwear.errors import ParameterError
+
+    missing = [flag for flag, value in given if value is None]
+    if missing:
+        raise ParameterError(f"{table} needs {', '.join(missing)}: jointwear never guesses {never}")
+
+
 def _save(ds, out: Path, source: Path) -> None:
     from jointwear import io
 
@@ -53,9 +85,9 @@ def _save(ds, out: Path, source: Path) -> None:
 @app.command("motion")
 def motion(
     file: Annotated[Path, typer.Argument(help="CSV table (header row) or CF netCDF file.")],
-    out: Annotated[Path, _OUT],
+    out: _Out,
     overwrite: Overwrite = False,
-    origin: Annotated[Origin | None, _ORIGIN] = None,
+    origin: _Origin = None,
     velocity_unit: Annotated[
         str | None, typer.Option("--velocity-unit", help="Unit of the velocity columns, e.g. mm/s.")
     ] = None,
@@ -67,27 +99,20 @@ def motion(
         str,
         typer.Option("--velocity-columns", help="Velocity column names x,y[,z] (bearing frame)."),
     ] = "vx,vy,vz",
-    tool: Annotated[str | None, _TOOL] = None,
+    tool: _Tool = None,
 ) -> None:
     """Import a follower motion history: time and velocity columns with stated units."""
     from jointwear import external
-    from jointwear.errors import ParameterError
 
     origin = origin.value if origin else None
-
-    if file.suffix.lower() in (".nc", ".nc4", ".cdf"):
-        ds = external.import_cf(file, data_origin=origin, tool=tool)
-        if "follower_velocity" not in ds:
-            raise ParameterError(f"'{file}' has no variable 'follower_velocity'")
+    if file.suffix.lower() in _CF_SUFFIXES:
+        ds = _from_cf(file, "follower_velocity", data_origin=origin, tool=tool)
     else:
-        if velocity_unit is None:
-            raise ParameterError(
-                "--velocity-unit: give the unit of the velocity columns (e.g. mm/s)"
-            )
-        if origin is None:
-            raise ParameterError(
-                "--origin: say what the numbers are: simulated, measured or synthetic"
-            )
+        _refuse_missing(
+            "a CSV motion table",
+            (("--origin", origin), ("--velocity-unit", velocity_unit)),
+            "units or what the numbers are (simulated, measured or synthetic)",
+        )
         ds = external.import_motion(
             file,
             velocity_unit=velocity_unit,
@@ -103,9 +128,9 @@ def motion(
 @app.command("wearmap")
 def wearmap(
     file: Annotated[Path, typer.Argument(help="CSV table (theta, z, depth per row) or CF netCDF.")],
-    out: Annotated[Path, _OUT],
+    out: _Out,
     overwrite: Overwrite = False,
-    origin: Annotated[Origin | None, _ORIGIN] = None,
+    origin: _Origin = None,
     angle_zero: AngleZero = None,
     angle_direction: AngleDirection = None,
     theta_unit: Annotated[str | None, typer.Option("--theta-unit", help="deg or rad.")] = None,
@@ -123,41 +148,34 @@ def wearmap(
     cycles: Annotated[
         float | None, typer.Option("--cycles", help="Crank cycles the map belongs to.")
     ] = None,
-    tool: Annotated[str | None, _TOOL] = None,
+    tool: _Tool = None,
 ) -> None:
     """Import a wear map (depth positive where material was removed) with stated units and angle convention."""
     from jointwear import external
-    from jointwear.errors import ParameterError
 
     origin = origin.value if origin else None
-    if file.suffix.lower() in (".nc", ".nc4", ".cdf"):
-        ds = external.import_cf(
+    if file.suffix.lower() in _CF_SUFFIXES:
+        ds = _from_cf(
             file,
+            "wear_depth",
             data_origin=origin,
             angle_zero=angle_zero,
             angle_direction=angle_direction,
             tool=tool,
         )
-        if "wear_depth" not in ds:
-            raise ParameterError(f"'{file}' has no variable 'wear_depth'")
     else:
-        missing = [
-            flag
-            for flag, value in (
+        _refuse_missing(
+            "a CSV wear map",
+            (
                 ("--origin", origin),
                 ("--angle-zero", angle_zero),
                 ("--angle-direction", angle_direction),
                 ("--theta-unit", theta_unit),
                 ("--z-unit", z_unit),
                 ("--depth-unit", depth_unit),
-            )
-            if value is None
-        ]
-        if missing:
-            raise ParameterError(
-                f"a CSV wear map needs {', '.join(missing)}: jointwear never guesses units or where "
-                "theta = 0 is"
-            )
+            ),
+            "units or where theta = 0 is",
+        )
         ds = external.import_wear_map(
             file,
             theta_unit=theta_unit,
@@ -177,7 +195,7 @@ def wearmap(
 @app.command("reported")
 def reported(
     file: Annotated[Path, typer.Argument(help="Reported-measurement TOML file (schema in docs).")],
-    out: Annotated[Path, _OUT],
+    out: _Out,
     overwrite: Overwrite = False,
 ) -> None:
     """Import reported measurements (a lab sheet's or a paper's numbers) from a TOML file."""
