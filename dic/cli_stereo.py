@@ -7,7 +7,7 @@ from typing import Annotated, Literal
 
 import typer
 
-from jointwear._cli import Overwrite
+from jointwear._cli import FigureOut, Overwrite, Scheduler
 from jointwear.dic import _cli_options as opt
 from jointwear.dic.calibration._defaults import (
     CHARUCO_DICTIONARY,
@@ -360,10 +360,7 @@ def track_cmd(
             "overrides the TOML)."
         ),
     ] = None,
-    scheduler: Annotated[
-        str | None,
-        typer.Option(help="Run the chunks on this dask.distributed cluster (tcp://host:8786)."),
-    ] = None,
+    scheduler: Scheduler = None,
 ) -> None:
     """Track the bodies of rig footage: poses, follower velocity, journal out-of-plane motion.
 
@@ -416,9 +413,7 @@ def track_cmd(
 
 def plot_track_cmd(
     motion: Annotated[Path, typer.Argument(help="Output of `jointwear dic track` (.nc).")],
-    out: Annotated[Path, typer.Option("--out", "-o", help="Figure (.png/.svg/.pdf).")] = Path(
-        "motion.png"
-    ),
+    out: FigureOut = Path("motion.png"),
     overwrite: Overwrite = False,
     reference: Annotated[
         Path | None,

@@ -8,6 +8,7 @@ from typing import Annotated, Any
 
 import typer
 
+from jointwear._cli import Scheduler
 from jointwear.sim.parameters import DEFAULT_PARAMETER_SET
 
 __all__ = ["Base", "WearParams", "Progress", "Workers", "Scheduler", "Resume", "check_lost_runs"]
@@ -38,7 +39,8 @@ Progress = Annotated[
 ]
 """``--progress/--no-progress``: None shows the bar on a terminal only."""
 
-#: Options of the commands that run sweeps of dask tasks (sim sweep, sim verify).
+#: Options of the commands that run sweeps of dask tasks (sim sweep, sim verify; --scheduler is
+#: shared with other groups' commands, from jointwear._cli).
 Workers = Annotated[
     int | None,
     typer.Option(
@@ -46,10 +48,6 @@ Workers = Annotated[
         help="Local dask worker processes, one thread each (default: one per core; "
         "0 = in this process, no dask).",
     ),
-]
-Scheduler = Annotated[
-    str | None,
-    typer.Option("--scheduler", help="Address of a running dask scheduler, e.g. tcp://host:8786."),
 ]
 Resume = Annotated[
     bool,

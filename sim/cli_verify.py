@@ -9,6 +9,7 @@ import typer
 
 from jointwear._cli import Overwrite
 from jointwear.sim._cli_options import Progress, Resume, Scheduler, Workers, check_lost_runs
+from jointwear.sim.parameters import DEFAULT_PARAMETER_SET
 
 __all__ = ["register"]
 
@@ -32,7 +33,7 @@ def verify(
         typer.Option(
             "--params",
             help="The rig (TOML, as for 'sim wear', with an optional \\[wear] table); "
-            "default the zhang2023 set.",
+            f"default the {DEFAULT_PARAMETER_SET} set.",
         ),
     ] = None,
     workers: Workers = None,
