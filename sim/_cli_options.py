@@ -11,7 +11,16 @@ import typer
 from jointwear._cli import Scheduler
 from jointwear.sim.parameters import DEFAULT_PARAMETER_SET
 
-__all__ = ["Base", "WearParams", "Progress", "Workers", "Scheduler", "Resume", "check_lost_runs"]
+__all__ = [
+    "Base",
+    "WearParams",
+    "Progress",
+    "Workers",
+    "Scheduler",
+    "Resume",
+    "check_executor",
+    "check_lost_runs",
+]
 
 Base = Annotated[
     str,
@@ -53,6 +62,14 @@ Resume = Annotated[
     bool,
     typer.Option("--resume", help="Continue an interrupted run: compute only the missing runs."),
 ]
+
+
+def check_executor(workers: int | None, scheduler: str | None) -> None:
+    """Refuse ``--workers`` (local processes) together with ``--scheduler`` (a cluster)."""
+    if scheduler is not None and workers is not None:
+        from jointwear.errors import BadInputError
+
+        raise BadInputError("give --workers or --scheduler, not both")
 
 
 def check_lost_runs(ds: Any, where: str = "") -> None:
