@@ -13,6 +13,7 @@ from jointwear.dic.subset._params import MIN_STEP, MIN_SUBSET, CorrelationParams
 
 __all__ = [
     "AllowEmptyOpt",
+    "CalibrationOpt",
     "CalibrationOutOpt",
     "DEFAULTS",
     "FpsOpt",
@@ -43,6 +44,9 @@ SearchRadiusOpt = Annotated[
 ]
 ThreadsOpt = Annotated[int, typer.Option("--threads", min=0, help="numba threads (0: auto).")]
 OutOpt = NetcdfOut
+CalibrationOpt = Annotated[
+    Path | None, typer.Option("--calibration", "-c", help="Stereo calibration (.nc).")
+]
 CalibrationOutOpt = Annotated[Path, typer.Option("--out", "-o", help="Calibration file (.nc).")]
 PointsOpt = Annotated[
     Path | None,

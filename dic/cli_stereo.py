@@ -321,9 +321,7 @@ def track_cmd(
         Path | None,
         typer.Option("--right", help="Right footage, as --left (omit for one camera)."),
     ] = None,
-    calibration: Annotated[
-        Path | None, typer.Option("--calibration", "-c", help="Stereo calibration (.nc).")
-    ] = None,
+    calibration: opt.CalibrationOpt = None,
     out: Annotated[Path, typer.Option("--out", "-o", help="Body motion (.nc).")] = Path(
         "motion.nc"
     ),
@@ -371,15 +369,10 @@ def track_cmd(
     from jointwear.dic.footage._files import track_files
 
     if right is None:
-        for given, flag in (
-            (calibration, "--calibration"),
-            (max_epipolar_px, "--max-epipolar-px"),
-        ):
-            if given is not None:
-                raise typer.BadParameter(
-                    f"{flag} applies to two cameras (--right); one camera tracks in pixels "
-                    "of the left image"
-                )
+        opt.refuse_given(
+            ((calibration, "--calibration"), (max_epipolar_px, "--max-epipolar-px")),
+            "two cameras (--right); one camera tracks in pixels of the left image",
+        )
     io.check_writable(out)
     cfg, specs = _track_config(
         bodies,
