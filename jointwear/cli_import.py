@@ -64,15 +64,16 @@ def _from_cf(file: Path, variable: str, **options):
     return ds
 
 
-def _refuse_missing(table: str, given: tuple[tuple[str, object], ...], never: str) -> None:
-    """Refuse a CSV ``table`` when a flag of ``given`` (``(flag, value)`` pairs) is missing:
-    a CSV file states neither its units nor its conventions, and jointwear ``never`` guesses
-    them."""
+def _needed(table: str, never: str, *given: tuple[str, str | None]) -> list[str]:
+    """The values of ``given`` (``(flag, value)`` pairs), which a CSV ``table`` needs: it
+    states neither its units nor its conventions, and jointwear ``never`` guesses them; a
+    missing one is refused, naming every missing flag."""
     from jointwear.errors import ParameterError
 
     missing = [flag for flag, value in given if value is None]
     if missing:
         raise ParameterError(f"{table} needs {', '.join(missing)}: jointwear never guesses {never}")
+    return [value for _, value in given if value is not None]
 
 
 def _save(ds, out: Path, source: Path) -> None:
@@ -104,22 +105,23 @@ def motion(
     """Import a follower motion history: time and velocity columns with stated units."""
     from jointwear import external
 
-    origin = origin.value if origin else None
+    data_origin = origin.value if origin else None
     if file.suffix.lower() in _CF_SUFFIXES:
-        ds = _from_cf(file, "follower_velocity", data_origin=origin, tool=tool)
+        ds = _from_cf(file, "follower_velocity", data_origin=data_origin, tool=tool)
     else:
-        _refuse_missing(
+        csv_origin, unit = _needed(
             "a CSV motion table",
-            (("--origin", origin), ("--velocity-unit", velocity_unit)),
             "units or what the numbers are (simulated, measured or synthetic)",
+            ("--origin", data_origin),
+            ("--velocity-unit", velocity_unit),
         )
         ds = external.import_motion(
             file,
-            velocity_unit=velocity_unit,
+            velocity_unit=unit,
             time_unit=time_unit,
             time_column=time_column,
             velocity_columns=_names(velocity_columns, "--velocity-columns", (2, 3)),
-            data_origin=origin,
+            data_origin=csv_origin,
             tool=tool,
         )
     _save(ds, out, file)
@@ -153,37 +155,35 @@ def wearmap(
     """Import a wear map (depth positive where material was removed) with stated units and angle convention."""
     from jointwear import external
 
-    origin = origin.value if origin else None
+    data_origin = origin.value if origin else None
     if file.suffix.lower() in _CF_SUFFIXES:
         ds = _from_cf(
             file,
             "wear_depth",
-            data_origin=origin,
+            data_origin=data_origin,
             angle_zero=angle_zero,
             angle_direction=angle_direction,
             tool=tool,
         )
     else:
-        _refuse_missing(
+        csv_origin, zero, direction, theta_u, z_u, depth_u = _needed(
             "a CSV wear map",
-            (
-                ("--origin", origin),
-                ("--angle-zero", angle_zero),
-                ("--angle-direction", angle_direction),
-                ("--theta-unit", theta_unit),
-                ("--z-unit", z_unit),
-                ("--depth-unit", depth_unit),
-            ),
             "units or where theta = 0 is",
+            ("--origin", data_origin),
+            ("--angle-zero", angle_zero),
+            ("--angle-direction", angle_direction),
+            ("--theta-unit", theta_unit),
+            ("--z-unit", z_unit),
+            ("--depth-unit", depth_unit),
         )
         ds = external.import_wear_map(
             file,
-            theta_unit=theta_unit,
-            z_unit=z_unit,
-            depth_unit=depth_unit,
-            angle_zero=angle_zero,
-            angle_direction=angle_direction,
-            data_origin=origin,
+            theta_unit=theta_u,
+            z_unit=z_u,
+            depth_unit=depth_u,
+            angle_zero=zero,
+            angle_direction=direction,
+            data_origin=csv_origin,
             columns=_names(columns, "--columns", (3, 3)),
             z_mid_width=z_mid_width,
             cycles=cycles,
