@@ -8,10 +8,12 @@ from typing import Annotated
 
 import typer
 
+from jointwear._cli import NetcdfOut
 from jointwear.dic.subset._params import MIN_STEP, MIN_SUBSET, CorrelationParams
 
 __all__ = [
     "AllowEmptyOpt",
+    "CalibrationOpt",
     "CalibrationOutOpt",
     "DEFAULTS",
     "FpsOpt",
@@ -41,7 +43,10 @@ SearchRadiusOpt = Annotated[
     int, typer.Option("--search-radius", help="Seed search half-width (pixels).")
 ]
 ThreadsOpt = Annotated[int, typer.Option("--threads", min=0, help="numba threads (0: auto).")]
-OutOpt = Annotated[Path, typer.Option("--out", help="Output netCDF file.")]
+OutOpt = NetcdfOut
+CalibrationOpt = Annotated[
+    Path | None, typer.Option("--calibration", "-c", help="Stereo calibration (.nc).")
+]
 CalibrationOutOpt = Annotated[Path, typer.Option("--out", "-o", help="Calibration file (.nc).")]
 PointsOpt = Annotated[
     Path | None,

@@ -56,9 +56,7 @@ def field_cmd(
         list[Path] | None,
         typer.Option("--right", help="Stereo: right images (repeatable) or a folder/pattern."),
     ] = None,
-    calibration: Annotated[
-        Path | None, typer.Option("--calibration", help="Stereo calibration (.nc).")
-    ] = None,
+    calibration: opt.CalibrationOpt = None,
     roi: Annotated[
         str | None,
         typer.Option("--roi", help="x0,y0,x1,y1 (pixels), a polygon .toml or a mask image (left)."),

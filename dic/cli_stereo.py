@@ -7,7 +7,7 @@ from typing import Annotated, Literal
 
 import typer
 
-from jointwear._cli import Overwrite
+from jointwear._cli import FigureOut, Overwrite, Scheduler
 from jointwear.dic import _cli_options as opt
 from jointwear.dic.calibration._defaults import (
     CHARUCO_DICTIONARY,
@@ -321,9 +321,7 @@ def track_cmd(
         Path | None,
         typer.Option("--right", help="Right footage, as --left (omit for one camera)."),
     ] = None,
-    calibration: Annotated[
-        Path | None, typer.Option("--calibration", "-c", help="Stereo calibration (.nc).")
-    ] = None,
+    calibration: opt.CalibrationOpt = None,
     out: Annotated[Path, typer.Option("--out", "-o", help="Body motion (.nc).")] = Path(
         "motion.nc"
     ),
@@ -360,10 +358,7 @@ def track_cmd(
             "overrides the TOML)."
         ),
     ] = None,
-    scheduler: Annotated[
-        str | None,
-        typer.Option(help="Run the chunks on this dask.distributed cluster (tcp://host:8786)."),
-    ] = None,
+    scheduler: Scheduler = None,
 ) -> None:
     """Track the bodies of rig footage: poses, follower velocity, journal out-of-plane motion.
 
@@ -374,15 +369,10 @@ def track_cmd(
     from jointwear.dic.footage._files import track_files
 
     if right is None:
-        for given, flag in (
-            (calibration, "--calibration"),
-            (max_epipolar_px, "--max-epipolar-px"),
-        ):
-            if given is not None:
-                raise typer.BadParameter(
-                    f"{flag} applies to two cameras (--right); one camera tracks in pixels "
-                    "of the left image"
-                )
+        opt.refuse_given(
+            ((calibration, "--calibration"), (max_epipolar_px, "--max-epipolar-px")),
+            "two cameras (--right); one camera tracks in pixels of the left image",
+        )
     io.check_writable(out)
     cfg, specs = _track_config(
         bodies,
@@ -416,9 +406,7 @@ def track_cmd(
 
 def plot_track_cmd(
     motion: Annotated[Path, typer.Argument(help="Output of `jointwear dic track` (.nc).")],
-    out: Annotated[Path, typer.Option("--out", "-o", help="Figure (.png/.svg/.pdf).")] = Path(
-        "motion.png"
-    ),
+    out: FigureOut = Path("motion.png"),
     overwrite: Overwrite = False,
     reference: Annotated[
         Path | None,

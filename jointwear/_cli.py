@@ -39,6 +39,8 @@ __all__ = [
     "AngleZero",
     "AngleDirection",
     "FigureOut",
+    "NetcdfOut",
+    "Scheduler",
 ]
 
 Overwrite = Annotated[
@@ -415,7 +417,7 @@ def lazy_groups(groups: dict[str, str]) -> type:
     return LazyGroups
 
 
-# options shared by CLIs (metrology) -------------------------------------------------------
+# options shared by the commands of several groups -------------------------------------------------------
 def _angle_direction(value: str | None) -> str | None:
     """Check ``--angle-direction`` at parse time (a bad value is a usage error, exit 2); the
     value is passed on as given (the library accepts ``clockwise``, ``counterclockwise``,
@@ -458,3 +460,12 @@ FigureOut = Annotated[
     Path, typer.Option("--out", "-o", help="Figure file (PNG, PDF or SVG, by its suffix).")
 ]
 """``--out`` of the commands that draw one figure."""
+
+NetcdfOut = Annotated[Path, typer.Option("--out", help="Output netCDF file.")]
+"""``--out`` of the commands that write one netCDF file and say no more about it."""
+
+Scheduler = Annotated[
+    str | None,
+    typer.Option("--scheduler", help="Address of a running dask scheduler, e.g. tcp://host:8786."),
+]
+"""``--scheduler`` of the commands that can run their tasks on a dask cluster (None: local)."""

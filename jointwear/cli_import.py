@@ -24,12 +24,21 @@ class Origin(StrEnum):
     synthetic = "synthetic"
 
 
-_ORIGIN = typer.Option(
-    "--origin",
-    help="What the numbers are: simulated, measured or synthetic (required for CSV).",
-)
-_TOOL = typer.Option("--tool", help="The program that wrote the file, e.g. 'Adams 2024'.")
-_OUT = typer.Option("--out", "-o", help="The jointwear netCDF file to write.")
+# options of every import command
+_Out = Annotated[Path, typer.Option("--out", "-o", help="The jointwear netCDF file to write.")]
+_Origin = Annotated[
+    Origin | None,
+    typer.Option(
+        "--origin",
+        help="What the numbers are: simulated, measured or synthetic (required for CSV).",
+    ),
+]
+_Tool = Annotated[
+    str | None, typer.Option("--tool", help="The program that wrote the file, e.g. 'Adams 2024'.")
+]
+
+_CF_SUFFIXES = (".nc", ".nc4", ".cdf")
+"""File endings read as CF netCDF; any other file is read as a CSV table."""
 
 
 def _names(text: str, option: str, count: tuple[int, int]) -> list[str]:
@@ -43,6 +52,30 @@ def _names(text: str, option: str, count: tuple[int, int]) -> list[str]:
     return names
 
 
+def _from_cf(file: Path, variable: str, **options):
+    """A CF netCDF file read by :func:`jointwear.external.import_cf` with ``options``; refused
+    when it does not hold ``variable``."""
+    from jointwear import external
+    from jointwear.errors import ParameterError
+
+    ds = external.import_cf(file, **options)
+    if variable not in ds:
+        raise ParameterError(f"'{file}' has no variable '{variable}'")
+    return ds
+
+
+def _needed(table: str, never: str, *given: tuple[str, str | None]) -> list[str]:
+    """The values of ``given`` (``(flag, value)`` pairs), which a CSV ``table`` needs: it
+    states neither its units nor its conventions, and jointwear ``never`` guesses them; a
+    missing one is refused, naming every missing flag."""
+    from jointwear.errors import ParameterError
+
+    missing = [flag for flag, value in given if value is None]
+    if missing:
+        raise ParameterError(f"{table} needs {', '.join(missing)}: jointwear never guesses {never}")
+    return [value for _, value in given if value is not None]
+
+
 def _save(ds, out: Path, source: Path) -> None:
     from jointwear import io
 
@@ -53,9 +86,9 @@ def _save(ds, out: Path, source: Path) -> None:
 @app.command("motion")
 def motion(
     file: Annotated[Path, typer.Argument(help="CSV table (header row) or CF netCDF file.")],
-    out: Annotated[Path, _OUT],
+    out: _Out,
     overwrite: Overwrite = False,
-    origin: Annotated[Origin | None, _ORIGIN] = None,
+    origin: _Origin = None,
     velocity_unit: Annotated[
         str | None, typer.Option("--velocity-unit", help="Unit of the velocity columns, e.g. mm/s.")
     ] = None,
@@ -67,34 +100,28 @@ def motion(
         str,
         typer.Option("--velocity-columns", help="Velocity column names x,y[,z] (bearing frame)."),
     ] = "vx,vy,vz",
-    tool: Annotated[str | None, _TOOL] = None,
+    tool: _Tool = None,
 ) -> None:
     """Import a follower motion history: time and velocity columns with stated units."""
     from jointwear import external
-    from jointwear.errors import ParameterError
 
-    origin = origin.value if origin else None
-
-    if file.suffix.lower() in (".nc", ".nc4", ".cdf"):
-        ds = external.import_cf(file, data_origin=origin, tool=tool)
-        if "follower_velocity" not in ds:
-            raise ParameterError(f"'{file}' has no variable 'follower_velocity'")
+    data_origin = origin.value if origin else None
+    if file.suffix.lower() in _CF_SUFFIXES:
+        ds = _from_cf(file, "follower_velocity", data_origin=data_origin, tool=tool)
     else:
-        if velocity_unit is None:
-            raise ParameterError(
-                "--velocity-unit: give the unit of the velocity columns (e.g. mm/s)"
-            )
-        if origin is None:
-            raise ParameterError(
-                "--origin: say what the numbers are: simulated, measured or synthetic"
-            )
+        csv_origin, unit = _needed(
+            "a CSV motion table",
+            "units or what the numbers are (simulated, measured or synthetic)",
+            ("--origin", data_origin),
+            ("--velocity-unit", velocity_unit),
+        )
         ds = external.import_motion(
             file,
-            velocity_unit=velocity_unit,
+            velocity_unit=unit,
             time_unit=time_unit,
             time_column=time_column,
             velocity_columns=_names(velocity_columns, "--velocity-columns", (2, 3)),
-            data_origin=origin,
+            data_origin=csv_origin,
             tool=tool,
         )
     _save(ds, out, file)
@@ -103,9 +130,9 @@ def motion(
 @app.command("wearmap")
 def wearmap(
     file: Annotated[Path, typer.Argument(help="CSV table (theta, z, depth per row) or CF netCDF.")],
-    out: Annotated[Path, _OUT],
+    out: _Out,
     overwrite: Overwrite = False,
-    origin: Annotated[Origin | None, _ORIGIN] = None,
+    origin: _Origin = None,
     angle_zero: AngleZero = None,
     angle_direction: AngleDirection = None,
     theta_unit: Annotated[str | None, typer.Option("--theta-unit", help="deg or rad.")] = None,
@@ -123,49 +150,40 @@ def wearmap(
     cycles: Annotated[
         float | None, typer.Option("--cycles", help="Crank cycles the map belongs to.")
     ] = None,
-    tool: Annotated[str | None, _TOOL] = None,
+    tool: _Tool = None,
 ) -> None:
     """Import a wear map (depth positive where material was removed) with stated units and angle convention."""
     from jointwear import external
-    from jointwear.errors import ParameterError
 
-    origin = origin.value if origin else None
-    if file.suffix.lower() in (".nc", ".nc4", ".cdf"):
-        ds = external.import_cf(
+    data_origin = origin.value if origin else None
+    if file.suffix.lower() in _CF_SUFFIXES:
+        ds = _from_cf(
             file,
-            data_origin=origin,
+            "wear_depth",
+            data_origin=data_origin,
             angle_zero=angle_zero,
             angle_direction=angle_direction,
             tool=tool,
         )
-        if "wear_depth" not in ds:
-            raise ParameterError(f"'{file}' has no variable 'wear_depth'")
     else:
-        missing = [
-            flag
-            for flag, value in (
-                ("--origin", origin),
-                ("--angle-zero", angle_zero),
-                ("--angle-direction", angle_direction),
-                ("--theta-unit", theta_unit),
-                ("--z-unit", z_unit),
-                ("--depth-unit", depth_unit),
-            )
-            if value is None
-        ]
-        if missing:
-            raise ParameterError(
-                f"a CSV wear map needs {', '.join(missing)}: jointwear never guesses units or where "
-                "theta = 0 is"
-            )
+        csv_origin, zero, direction, theta_u, z_u, depth_u = _needed(
+            "a CSV wear map",
+            "units or where theta = 0 is",
+            ("--origin", data_origin),
+            ("--angle-zero", angle_zero),
+            ("--angle-direction", angle_direction),
+            ("--theta-unit", theta_unit),
+            ("--z-unit", z_unit),
+            ("--depth-unit", depth_unit),
+        )
         ds = external.import_wear_map(
             file,
-            theta_unit=theta_unit,
-            z_unit=z_unit,
-            depth_unit=depth_unit,
-            angle_zero=angle_zero,
-            angle_direction=angle_direction,
-            data_origin=origin,
+            theta_unit=theta_u,
+            z_unit=z_u,
+            depth_unit=depth_u,
+            angle_zero=zero,
+            angle_direction=direction,
+            data_origin=csv_origin,
             columns=_names(columns, "--columns", (3, 3)),
             z_mid_width=z_mid_width,
             cycles=cycles,
@@ -177,7 +195,7 @@ def wearmap(
 @app.command("reported")
 def reported(
     file: Annotated[Path, typer.Argument(help="Reported-measurement TOML file (schema in docs).")],
-    out: Annotated[Path, _OUT],
+    out: _Out,
     overwrite: Overwrite = False,
 ) -> None:
     """Import reported measurements (a lab sheet's or a paper's numbers) from a TOML file."""

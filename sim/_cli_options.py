@@ -8,9 +8,19 @@ from typing import Annotated, Any
 
 import typer
 
+from jointwear._cli import Scheduler
 from jointwear.sim.parameters import DEFAULT_PARAMETER_SET
 
-__all__ = ["Base", "WearParams", "Progress", "Workers", "Scheduler", "Resume", "check_lost_runs"]
+__all__ = [
+    "Base",
+    "WearParams",
+    "Progress",
+    "Workers",
+    "Scheduler",
+    "Resume",
+    "check_executor",
+    "check_lost_runs",
+]
 
 Base = Annotated[
     str,
@@ -38,7 +48,8 @@ Progress = Annotated[
 ]
 """``--progress/--no-progress``: None shows the bar on a terminal only."""
 
-#: Options of the commands that run sweeps of dask tasks (sim sweep, sim verify).
+#: Options of the commands that run sweeps of dask tasks (sim sweep, sim verify; --scheduler is
+#: shared with other groups' commands, from jointwear._cli).
 Workers = Annotated[
     int | None,
     typer.Option(
@@ -47,14 +58,18 @@ Workers = Annotated[
         "0 = in this process, no dask).",
     ),
 ]
-Scheduler = Annotated[
-    str | None,
-    typer.Option("--scheduler", help="Address of a running dask scheduler, e.g. tcp://host:8786."),
-]
 Resume = Annotated[
     bool,
     typer.Option("--resume", help="Continue an interrupted run: compute only the missing runs."),
 ]
+
+
+def check_executor(workers: int | None, scheduler: str | None) -> None:
+    """Refuse ``--workers`` (local processes) together with ``--scheduler`` (a cluster)."""
+    if scheduler is not None and workers is not None:
+        from jointwear.errors import BadInputError
+
+        raise BadInputError("give --workers or --scheduler, not both")
 
 
 def check_lost_runs(ds: Any, where: str = "") -> None:

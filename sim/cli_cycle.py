@@ -7,7 +7,7 @@ from typing import Annotated
 
 import typer
 
-from jointwear._cli import Overwrite
+from jointwear._cli import NetcdfOut, Overwrite
 from jointwear.sim._cli_options import Base, Progress
 from jointwear.sim.parameters import DEFAULT_PARAMETER_SET
 
@@ -15,7 +15,7 @@ __all__ = ["register"]
 
 
 def cycle(
-    out: Annotated[Path, typer.Option("--out", help="Output netCDF file.")] = Path("cycle.nc"),
+    out: NetcdfOut = Path("cycle.nc"),
     overwrite: Overwrite = False,
     cycles: Annotated[
         float, typer.Option("--cycles", help="Crank cycles to simulate (fractions allowed).")

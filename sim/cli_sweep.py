@@ -15,6 +15,7 @@ from jointwear.sim._cli_options import (
     Scheduler,
     WearParams,
     Workers,
+    check_executor,
     check_lost_runs,
 )
 from jointwear.sim.parameters import DEFAULT_PARAMETER_SET
@@ -43,14 +44,12 @@ def sweep(
 
     import numpy as np
 
-    from jointwear.errors import BadInputError
     from jointwear.progress import progress_bar, run_counter
     from jointwear.sim.sweep._driver import run_sweep
 
     # printed below, once (the runs keep their warnings in the record)
     logging.getLogger("jointwear.sim.sweep").addHandler(logging.NullHandler())
-    if scheduler is not None and workers is not None:
-        raise BadInputError("give --workers or --scheduler, not both")
+    check_executor(workers, scheduler)
     with progress_bar("sweep", total=None, enabled=progress) as bar:
         on_progress = run_counter(bar, "sweep")
 

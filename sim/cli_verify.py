@@ -8,7 +8,15 @@ from typing import Annotated
 import typer
 
 from jointwear._cli import Overwrite
-from jointwear.sim._cli_options import Progress, Resume, Scheduler, Workers, check_lost_runs
+from jointwear.sim._cli_options import (
+    Progress,
+    Resume,
+    Scheduler,
+    Workers,
+    check_executor,
+    check_lost_runs,
+)
+from jointwear.sim.parameters import DEFAULT_PARAMETER_SET
 
 __all__ = ["register"]
 
@@ -32,7 +40,7 @@ def verify(
         typer.Option(
             "--params",
             help="The rig (TOML, as for 'sim wear', with an optional \\[wear] table); "
-            "default the zhang2023 set.",
+            f"default the {DEFAULT_PARAMETER_SET} set.",
         ),
     ] = None,
     workers: Workers = None,
@@ -60,8 +68,7 @@ def verify(
     from jointwear.refinement import describe_study
     from jointwear.sim.sweep._verify import verify_wear
 
-    if scheduler is not None and workers is not None:
-        raise BadInputError("give --workers or --scheduler, not both")
+    check_executor(workers, scheduler)
     band = None
     if band_mm is not None:
         try:

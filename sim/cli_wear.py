@@ -227,26 +227,50 @@ _Snapshots = Annotated[
 ]
 
 
-def _setting(flag: str, field: str, kind: Any, text: str) -> Any:
-    """The option type of ``--<flag>``, which overrides ``WearSettings.<field>`` (None: the
-    ``[wear]`` table's or the library's value); its help shows the library's default."""
-    default = getattr(WearSettings, field)
-    shown = f"{default:g}" if isinstance(default, float) else default
-    return Annotated[kind | None, typer.Option(flag, help=f"{text}; default {shown}.")]
+def _default(field: str) -> str:
+    """The library's default of ``WearSettings.<field>``, as the help shows it (the option
+    overrides the ``[wear]`` table's value, which overrides this one)."""
+    value = getattr(WearSettings, field)
+    return f"{value:g}" if isinstance(value, float) else str(value)
 
 
-_Kw = _setting("--kw", "kw", float, "Archard wear coefficient \\[m²/N = m³/(N m)]")
-_Scheme = _setting(
-    "--scheme",
-    "scheme",
-    Literal["adaptive", "fixed", "schedule"],
-    "Update interval: adaptive, fixed, or schedule (intervals from the \\[wear] table)",
-)
-_Dn = _setting("--dn", "dn", int, "Cycles per update (fixed) or first interval (adaptive)")
-_Tol = _setting("--tol", "tol", float, "Adaptive: allowed relative change of the wear-rate field")
-_Settle = _setting(
-    "--settle", "settle_cycles", float, "Cycles discarded after each update before accumulating"
-)
+_Kw = Annotated[
+    float | None,
+    typer.Option(
+        "--kw", help=f"Archard wear coefficient \\[m²/N = m³/(N m)]; default {_default('kw')}."
+    ),
+]
+_Scheme = Annotated[
+    Literal["adaptive", "fixed", "schedule"] | None,
+    typer.Option(
+        "--scheme",
+        help="Update interval: adaptive, fixed, or schedule (intervals from the \\[wear] table); "
+        f"default {_default('scheme')}.",
+    ),
+]
+_Dn = Annotated[
+    int | None,
+    typer.Option(
+        "--dn",
+        help=f"Cycles per update (fixed) or first interval (adaptive); default {_default('dn')}.",
+    ),
+]
+_Tol = Annotated[
+    float | None,
+    typer.Option(
+        "--tol",
+        help="Adaptive: allowed relative change of the wear-rate field; "
+        f"default {_default('tol')}.",
+    ),
+]
+_Settle = Annotated[
+    float | None,
+    typer.Option(
+        "--settle",
+        help="Cycles discarded after each update before accumulating; "
+        f"default {_default('settle_cycles')}.",
+    ),
+]
 _Layers = Annotated[
     int | None,
     typer.Option(

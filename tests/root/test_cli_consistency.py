@@ -144,6 +144,19 @@ def test_one_name_per_concept():
     assert users == ["metrology assess"], users
 
 
+@pytest.mark.parametrize(
+    "flag",
+    ["--overwrite", "--progress", "--scheduler", "--calibration", "--criteria", "--sim", "--tool"],
+)
+def test_an_option_of_several_commands_is_declared_once(flag):
+    # the same flag with the same meaning shows the same names and help everywhere (declared
+    # once as an Annotated alias), so the commands cannot drift apart
+    users = [(p, prm) for p, c in COMMANDS for prm in c.params if flag in prm.opts]
+    assert len(users) >= 2, users
+    declarations = {(tuple(prm.opts), tuple(prm.secondary_opts), prm.help) for _, prm in users}
+    assert len(declarations) == 1, declarations
+
+
 def _speckle(tmp_path, *extra):
     return main(["datasets", "speckle", str(tmp_path / "sp"), "--size", "32x32", *extra])
 

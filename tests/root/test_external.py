@@ -253,6 +253,34 @@ def test_cli_imports_csv_and_refuses_missing_units(tmp_path, capsys):
     assert float(ds["theta"][ds["wear_depth"].isel(z=1).argmax(dim="theta")]) == pytest.approx(60.0)
 
 
+def test_cli_motion_csv_names_every_missing_flag_and_reads_once_given(tmp_path, capsys):
+    f = tmp_path / "m.csv"
+    t, v = _motion_csv(f)  # mm/s
+    out = tmp_path / "m.nc"
+    base = ["import", "motion", str(f), "--out", str(out), "--time-column", "t"]
+    assert main(base) == 3
+    err = capsys.readouterr().err
+    assert "--origin" in err and "--velocity-unit" in err and not out.exists()
+    assert main([*base, "--origin", "simulated"]) == 3
+    err = capsys.readouterr().err
+    assert "--velocity-unit" in err and "--origin" not in err
+    assert main([*base, "--origin", "simulated", "--velocity-unit", "mm/s"]) == 0
+    np.testing.assert_allclose(io.load(out)["follower_velocity"], v, rtol=1e-10)
+
+
+def test_cli_netcdf_without_the_variable_is_refused(tmp_path, capsys):
+    f = tmp_path / "force.nc"  # a CF record of something else
+    xr.Dataset(
+        {"contact_force": ("time", np.ones(3), {"units": "N"})},
+        coords={"time": ("time", np.arange(3.0), {"units": "s"})},
+        attrs={"data_origin": "simulated"},
+    ).to_netcdf(f)
+    out = tmp_path / "m.nc"
+    assert main(["import", "motion", str(f), "--out", str(out)]) == 3
+    assert "has no variable 'follower_velocity'" in capsys.readouterr().err
+    assert not out.exists()
+
+
 def test_cli_bad_origin_is_a_usage_error(tmp_path):
     f = tmp_path / "m.csv"
     _motion_csv(f)
