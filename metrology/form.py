@@ -588,9 +588,12 @@ def scan_variable(scan: xr.Dataset, what: str) -> tuple[xr.DataArray, str]:
     for name in SCAN_VARIABLES:
         if name in scan:
             return scan[name], name
+    source = scan.encoding.get("source")  # the file it was read from, if any
+    where = f"{what} '{source}'" if source else what
     raise BadInputError(
-        f"{what}: the dataset has neither 'radius' nor 'radial_deviation' "
-        f"(variables: {', '.join(map(str, scan.data_vars)) or 'none'})"
+        f"{where}: the dataset has neither 'radius' nor 'radial_deviation' "
+        f"(variables: {', '.join(map(str, scan.data_vars)) or 'none'}); give a scan "
+        "(jointwear metrology import)"
     )
 
 

@@ -118,6 +118,31 @@ def test_wear_map_errors():
         wear_map(worn, xr.Dataset())
 
 
+def test_a_file_without_scan_values_is_refused_naming_the_file(tmp_path, capsys):
+    """Two inputs (worn, before): the refusal names the file that holds no scan, not only the role."""
+    from jointwear.cli import main
+    from jointwear.io import save
+
+    good = tmp_path / "before.nc"
+    bad = tmp_path / "wear.nc"
+    dev = xr.Dataset(
+        {"radius": (("z", "theta"), R + WEAR * 0, {"units": "m", "long_name": "radius"})},
+        coords={"z": z_coord(Z), "theta": theta_coord(TH)},
+    )
+    dev.attrs["data_origin"] = "synthetic"
+    save(dev, good, source="test")
+    bad_ds = dev.rename({"radius": "wear_depth"})
+    bad_ds["wear_depth"].attrs["long_name"] = "wear depth"
+    save(bad_ds, bad, source="test")
+    code = main(
+        ["metrology", "wearmap", str(bad), "--before", str(good), "--out", str(tmp_path / "o.nc")]
+    )
+    err = capsys.readouterr().err
+    assert code == 3
+    assert "wear.nc" in err and "neither 'radius' nor 'radial_deviation'" in err
+    assert not (tmp_path / "o.nc").exists()
+
+
 def test_exact_centring_with_large_set_up_offsets():
     """Generated scans with an exact (non-limaçon) set-up of 60 µm: the e^2/(4R) term (112 nm)
     would dominate the error; exact re-centring brings it back to the noise of the difference."""
