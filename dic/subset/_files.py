@@ -8,6 +8,8 @@ of the library's Dataset); a sequence goes through xarray.
 
 from __future__ import annotations
 
+import contextlib
+import sys
 import time
 from collections.abc import Sequence
 from pathlib import Path
@@ -81,16 +83,23 @@ def _read_sequence(reference: Path, deformed: Path | None):
 def _correlate_pair(reference, deformed, *, roi, points, seed_points, params) -> Record:
     from jointwear.dic.subset._correlator import SubsetCorrelator
     from jointwear.dic.subset._sequence import read_image
-    from jointwear.progress import progress_bar
 
     ref_img = read_image(reference)
     def_img = read_image(deformed)
-    with progress_bar("correlating", total=2, enabled=None) as bar:
-        task = bar.tasks[0].id
+    if sys.stderr.isatty():  # the bar shows only on a terminal: rich is imported only then
+        from jointwear.progress import progress_bar
+
+        bar = progress_bar("correlating", total=2)
+    else:
+        bar = contextlib.nullcontext()
+    with bar as progress:
         corr = SubsetCorrelator(ref_img, roi=roi, points=points, params=params)
-        bar.update(task, advance=1, description=f"correlating {corr.n_points} points")
+        if progress is not None:
+            task = progress.tasks[0].id
+            progress.update(task, advance=1, description=f"correlating {corr.n_points} points")
         res = corr.match(def_img, seed_points=seed_points)
-        bar.update(task, advance=1)
+        if progress is not None:
+            progress.update(task, advance=1)
     return corr.to_record(res)
 
 
