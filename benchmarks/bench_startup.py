@@ -15,11 +15,11 @@ correlate`` process (start, reading, correlation, writing netCDF) against the li
 
 The floor under every command that computes: CPU seconds of a fresh process that only imports
 what ``dic correlate`` cannot do without - the interpreter with numpy and the command line
-(``jointwear --help``), OpenCV and netCDF4 (reading the images, writing the field; a pair's field
-is written without xarray, whose import is shown for comparison), and numba with its first
-cached kernel (numba builds its whole compiler context, including its BLAS and random-generator
-support, before it can load any cached kernel): ``floor`` in the results, minimum of
-``--repeat`` runs.
+(``jointwear --help``; typer's option conversion imports pydantic), OpenCV and netCDF4 (reading
+the images, writing the field; a pair's field is written without xarray, whose import is shown
+for comparison), and numba with its first cached kernel (numba builds its whole compiler
+context, including its BLAS and random-generator support, before it can load any cached
+kernel): ``floor`` in the results, minimum of ``--repeat`` runs.
 
 ``--quick``: 3 runs, no 1-MP pair, written to ``results/startup_quick.json`` (the docs quote
 ``results/startup.json``).
@@ -101,6 +101,8 @@ FLOOR = {
     "python_numpy": "import numpy",
     "python_numpy_xarray": "import numpy, xarray",
     "python_numpy_cv2_netcdf4": "import numpy, cv2, netCDF4",
+    # typer converts every option through a pydantic TypeAdapter: pydantic is imported then
+    "python_numpy_typer_pydantic_adapters": "import numpy, typer._adapters",
     "python_numpy_numba_first_cached_kernel": "import numpy, kernel; kernel.total(numpy.ones(3))",
 }
 
@@ -181,6 +183,7 @@ def main() -> None:
     os.environ["NUMBA_NUM_THREADS"] = "2"  # the library's run here too (before numba starts)
     env = {**os.environ}
     figures: dict = {"repeat": repeat, "numba_threads": 2}
+    load_at_start = round(os.getloadavg()[0], 2)  # a shared machine: say how busy it was
     with tempfile.TemporaryDirectory() as tmp:
         work = Path(tmp)
         _images(work, 256, "small")
@@ -213,6 +216,7 @@ def main() -> None:
         if not a.quick:
             figures["one_megapixel_step4"] = _throughput(work, env, a.repeat_mp)
             print(figures["one_megapixel_step4"], flush=True)
+    figures["load_average_1min"] = {"start": load_at_start, "end": round(os.getloadavg()[0], 2)}
     write_results("startup_quick" if a.quick else "startup", figures)
 
 
