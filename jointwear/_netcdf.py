@@ -151,6 +151,11 @@ def write_record(
                 nc.createDimension(dim, n)
             for name, var in variables.items():
                 values = np.asarray(var.values)
+                if values.dtype.kind not in "fiu":  # xarray encodes others its own way
+                    raise TypeError(
+                        f"write_record: variable {name!r} is {values.dtype}; only integer and "
+                        "floating-point values are written this way (use jointwear.io.save)"
+                    )
                 if not values.dtype.isnative:
                     values = values.astype(values.dtype.newbyteorder("="))
                 nc_var = nc.createVariable(
