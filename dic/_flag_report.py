@@ -5,14 +5,23 @@ for each such image, the flag that dominates and what would change it, with the 
 decides it (the median epipolar error against the gate, the median ZNCC against
 ``zncc_min``, ...), in the command line's terms. The commands print these lines on stderr and
 exit 1 when an image has no valid point at all, unless ``--allow-empty``.
+
+The result is read through ``result[name].values / .dims / .attrs`` and ``result.attrs`` only,
+so it may be a Dataset or the xarray-free :class:`~jointwear._netcdf.Record` that ``dic
+correlate`` writes for an image pair (which then starts without importing xarray).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
-import xarray as xr
+
+if TYPE_CHECKING:
+    import xarray as xr
+
+    from jointwear._netcdf import Record
 
 __all__ = ["FlagReport", "flag_report"]
 
@@ -47,7 +56,7 @@ class FlagReport:
         )
 
 
-def _median(ds: xr.Dataset, name: str, k: int | None, where: np.ndarray) -> float | None:
+def _median(ds: xr.Dataset | Record, name: str, k: int | None, where: np.ndarray) -> float | None:
     if name not in ds:
         return None
     values = ds[name].values if k is None or "time" not in ds[name].dims else ds[name].values[k]
@@ -56,7 +65,7 @@ def _median(ds: xr.Dataset, name: str, k: int | None, where: np.ndarray) -> floa
     return float(np.median(values)) if values.size else None
 
 
-def _hint(meaning: str, ds: xr.Dataset, k: int | None, where: np.ndarray) -> str:
+def _hint(meaning: str, ds: xr.Dataset | Record, k: int | None, where: np.ndarray) -> str:
     """What would change the flag ``meaning``, with the figure that decides it."""
     if meaning == "epipolar_mismatch":
         rep = _median(ds, "reprojection", k, where)
@@ -109,12 +118,12 @@ def _hint(meaning: str, ds: xr.Dataset, k: int | None, where: np.ndarray) -> str
     return "see the flag's meaning in the documentation"
 
 
-def flag_report(ds: xr.Dataset, *, name: str = "flag", names=None) -> FlagReport:
+def flag_report(ds: xr.Dataset | Record, *, name: str = "flag", names=None) -> FlagReport:
     """Report the images of ``ds`` whose points are mostly flagged (see module docstring).
 
     Parameters
     ----------
-    ds : Dataset
+    ds : Dataset or Record
         A DIC result with a CF flag variable ``name`` (``flag_meanings``), over ``time`` (or
         a single image).
     names : sequence of str, optional
@@ -155,7 +164,7 @@ def flag_report(ds: xr.Dataset, *, name: str = "flag", names=None) -> FlagReport
     return FlagReport(tuple(lines), tuple(empty))
 
 
-def check_flags(ds: xr.Dataset, *, allow_empty: bool, names=None, echo=None) -> None:
+def check_flags(ds: xr.Dataset | Record, *, allow_empty: bool, names=None, echo=None) -> None:
     """Command line: print :func:`flag_report`'s lines as warnings on stderr; raise
     :class:`~jointwear.errors.ValidationFailed` (exit 1) when an image has no valid point,
     unless ``allow_empty`` (then it is a warning too). Call after the result was written."""

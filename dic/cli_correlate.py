@@ -63,11 +63,14 @@ def _refuse_misapplied(ctx_params: dict, sequence: bool) -> None:
 
 
 def _summary(ds, out: Path, elapsed: float, plot: Path | None, mode, update_zncc) -> str:
+    """The command's report line; ``ds`` a Dataset or a Record (read through ``.values``)."""
+    import numpy as np
+
     ok = ds["flag"].values == 0
-    msg = (
-        f"{out}: {ok.sum()}/{ok.size} points ok, median ZNCC "
-        f"{float(ds['zncc'].where(ds['flag'] == 0).median()):.4f}, {elapsed:.2f} s"
-    )
+    zncc = ds["zncc"].values[ok]
+    zncc = zncc[np.isfinite(zncc)]
+    median = float(np.median(zncc)) if zncc.size else float("nan")
+    msg = f"{out}: {ok.sum()}/{ok.size} points ok, median ZNCC {median:.4f}, {elapsed:.2f} s"
     if plot is not None:
         msg += f"; figure {plot}"
     if mode == "incremental":

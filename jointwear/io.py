@@ -14,15 +14,17 @@ import os
 import tempfile
 from collections.abc import Iterable, Iterator, Mapping
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import xarray as xr
 
-from jointwear import conventions, outputs
+from jointwear import outputs
 from jointwear._version import source_attribute
 from jointwear.errors import BadInputError
 from jointwear.provenance import build_provenance, dumps, history_line
+
+if TYPE_CHECKING:  # xarray is imported where a Dataset is read or written (start-up cost)
+    import xarray as xr
 
 __all__ = [
     "save",
@@ -34,6 +36,7 @@ __all__ = [
     "encode_attrs",
     "decode_attrs",
     "parse_provenance",
+    "file_attrs",
 ]
 
 _JSON_PREFIX = "json:"
@@ -191,6 +194,44 @@ def figure_format(path: str | Path, *, what: str = "--out") -> str:
     return fmt
 
 
+def file_attrs(
+    attrs: Mapping[str, Any],
+    *,
+    inputs: Iterable[str | Path] = (),
+    parameters: Any = None,
+    command: str | None = None,
+    source: str | None = None,
+    title: str | None = None,
+    parents: Iterable[Mapping[str, Any]] = (),
+) -> dict[str, Any]:
+    """The global attributes :func:`save` writes: ``attrs`` with ``Conventions``, ``title``,
+    ``source``, a new ``history`` line and the ``provenance`` record, encoded for netCDF
+    (:func:`encode_attrs`). ``parents`` are provenance records (dicts); without any, the
+    provenance already in ``attrs`` is carried along. See :func:`save` for the rest."""
+    out = dict(attrs)
+    out["Conventions"] = "CF-1.11"
+    out["title"] = title or out.get("title") or "jointwear dataset"
+    out["source"] = source or out.get("source") or source_attribute()
+    line = history_line(command)
+    previous = out.get("history")
+    out["history"] = f"{previous}\n{line}" if previous else line
+    parent_records = list(parents)
+    if out.get("provenance") and not parent_records:
+        # keep the provenance of the data as it came in
+        try:
+            parent_records = [json.loads(out["provenance"])]
+        except (TypeError, ValueError):
+            parent_records = []
+    prov = build_provenance(
+        inputs=inputs,
+        parameters=parameters,
+        command=command,
+        parents=[p for p in parent_records if p],
+    )
+    out["provenance"] = dumps(prov)
+    return encode_attrs(out)
+
+
 def save(
     ds: xr.Dataset,
     path: str | Path,
@@ -231,31 +272,21 @@ def save(
     Path
         The written file.
     """
+    from jointwear import conventions
+
     path = Path(path)
     out = ds.copy()
     if validate:
         conventions.validate(out, what=f"dataset to be written to '{path}'")
-    out.attrs["Conventions"] = "CF-1.11"
-    out.attrs["title"] = title or out.attrs.get("title") or "jointwear dataset"
-    out.attrs["source"] = source or out.attrs.get("source") or source_attribute()
-    line = history_line(command)
-    previous = out.attrs.get("history")
-    out.attrs["history"] = f"{previous}\n{line}" if previous else line
-    parent_records = [parse_provenance(p) for p in parents]
-    if out.attrs.get("provenance") and not parent_records:
-        # keep the provenance of the data as it came in
-        try:
-            parent_records = [json.loads(out.attrs["provenance"])]
-        except (TypeError, ValueError):
-            parent_records = []
-    prov = build_provenance(
+    out.attrs = file_attrs(
+        out.attrs,
         inputs=inputs,
         parameters=parameters,
         command=command,
-        parents=[p for p in parent_records if p],
+        source=source,
+        title=title,
+        parents=[parse_provenance(p) for p in parents],
     )
-    out.attrs["provenance"] = dumps(prov)
-    out.attrs = encode_attrs(out.attrs)
     for name in list(out.variables):
         out[name].attrs = encode_attrs(out[name].attrs)
     with atomic_path(path) as tmp:
@@ -272,6 +303,10 @@ def load(path: str | Path, *, validate: bool = True) -> xr.Dataset:
         The file does not exist, is not netCDF, or breaks the contract (the message lists
         every problem).
     """
+    import xarray as xr
+
+    from jointwear import conventions
+
     path = Path(path)
     if not path.exists():
         raise BadInputError(f"'{path}' does not exist")

@@ -17,7 +17,8 @@ graph. Then, for each deformed image:
   their neighbours (reliability-guided DIC), in parallel bands.
 
 ``SubsetCorrelator.match(deformed, ...)`` returns the raw arrays (``MatchResult``) instead of a
-Dataset. Points that cannot be correlated are kept and flagged (``flag``, CF
+Dataset, and ``to_record`` packages them as the Dataset's arrays without xarray (what the command
+line writes). Points that cannot be correlated are kept and flagged (``flag``, CF
 ``flag_values``/``flag_meanings``), with NaN displacements.
 """
 
@@ -29,10 +30,9 @@ from dataclasses import asdict, dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
-import xarray as xr
 
 import jointwear.dic.icgn._flags as _flags
-from jointwear.dic.subset._output import result_dataset
+from jointwear.dic.subset._output import result_dataset, result_record
 from jointwear.dic.subset._params import (
     CorrelationParams,
     _integral_invalid,
@@ -43,6 +43,9 @@ from jointwear.dic.subset._params import (
 from jointwear.errors import BadInputError, ParameterError
 
 if TYPE_CHECKING:
+    import xarray as xr
+
+    from jointwear._netcdf import Record
     from jointwear.dic.icgn._interp import SplineImage
 
 __all__ = [
@@ -632,9 +635,10 @@ class SubsetCorrelator:
         return self.to_dataset(res)
 
     # ------------------------------------------------------------------ output
-    def to_dataset(self, res: MatchResult, *, time: float | None = None) -> xr.Dataset:
-        """Package a :class:`MatchResult` as an xarray Dataset (grid ``(y, x)`` or ``point``)."""
-        return result_dataset(
+    def to_record(self, res: MatchResult) -> Record:
+        """Package a :class:`MatchResult` as the arrays of :meth:`to_dataset` (a
+        :class:`~jointwear._netcdf.Record`, no xarray)."""
+        return result_record(
             self.centres,
             res.params,
             res.zncc,
@@ -644,3 +648,7 @@ class SubsetCorrelator:
             self.grid,
             sigma=res.sigma,
         )
+
+    def to_dataset(self, res: MatchResult, *, time: float | None = None) -> xr.Dataset:
+        """Package a :class:`MatchResult` as an xarray Dataset (grid ``(y, x)`` or ``point``)."""
+        return self.to_record(res).to_dataset()

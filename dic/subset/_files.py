@@ -1,17 +1,29 @@
 """Correlate image files: a pair, or a sequence (folder, pattern, video), read, correlated and
-saved to netCDF in one call (what ``jointwear dic correlate`` runs)."""
+saved to netCDF in one call (what ``jointwear dic correlate`` runs).
+
+A pair is written from the correlator's :class:`~jointwear._netcdf.Record` without importing
+xarray (a third of the command's start-up; the file is the one :func:`jointwear.io.save` writes
+of the library's Dataset); a sequence goes through xarray.
+"""
 
 from __future__ import annotations
 
+import contextlib
+import sys
 import time
 from collections.abc import Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
-import xarray as xr
 
 from jointwear.dic.subset._params import UPDATE_ZNCC, CorrelationParams
 from jointwear.errors import BadInputError, ParameterError
+
+if TYPE_CHECKING:
+    import xarray as xr
+
+    from jointwear._netcdf import Record
 
 __all__ = ["correlate_files", "is_sequence_input", "read_points_file"]
 
@@ -68,20 +80,27 @@ def _read_sequence(reference: Path, deformed: Path | None):
     return read_frames(reference), inputs
 
 
-def _correlate_pair(reference, deformed, *, roi, points, seed_points, params):
+def _correlate_pair(reference, deformed, *, roi, points, seed_points, params) -> Record:
     from jointwear.dic.subset._correlator import SubsetCorrelator
     from jointwear.dic.subset._sequence import read_image
-    from jointwear.progress import progress_bar
 
     ref_img = read_image(reference)
     def_img = read_image(deformed)
-    with progress_bar("correlating", total=2, enabled=None) as bar:
-        task = bar.tasks[0].id
+    if sys.stderr.isatty():  # the bar shows only on a terminal: rich is imported only then
+        from jointwear.progress import progress_bar
+
+        bar = progress_bar("correlating", total=2)
+    else:
+        bar = contextlib.nullcontext()
+    with bar as progress:
         corr = SubsetCorrelator(ref_img, roi=roi, points=points, params=params)
-        bar.update(task, advance=1, description=f"correlating {corr.n_points} points")
-        ds = corr.correlate(def_img, seed_points=seed_points)
-        bar.update(task, advance=1)
-    return ds
+        if progress is not None:
+            task = progress.tasks[0].id
+            progress.update(task, advance=1, description=f"correlating {corr.n_points} points")
+        res = corr.match(def_img, seed_points=seed_points)
+        if progress is not None:
+            progress.update(task, advance=1)
+    return corr.to_record(res)
 
 
 def correlate_files(
@@ -98,7 +117,7 @@ def correlate_files(
     update_zncc: float = UPDATE_ZNCC,
     update_every: int | None = None,
     plot: str | Path | None = None,
-) -> tuple[xr.Dataset, float]:
+) -> tuple[xr.Dataset | Record, float]:
     """Correlate an image pair or a sequence and save the field to ``out`` (netCDF).
 
     Parameters
@@ -122,13 +141,12 @@ def correlate_files(
 
     Returns
     -------
-    (Dataset, float)
-        The saved field and the correlation time [s].
+    (Dataset or Record, float)
+        The saved field (a pair's as a :class:`~jointwear._netcdf.Record`: ``field["u"].values``
+        etc.; ``.to_dataset()`` for the Dataset) and the correlation time [s].
     """
     from jointwear._version import source_attribute
-    from jointwear.dic.subset._quicklook import save_quicklook
-    from jointwear.dic.subset._sequence import correlate_sequence
-    from jointwear.io import check_writable, save
+    from jointwear.io import check_writable
 
     reference = Path(reference)
     deformed = None if deformed is None else Path(deformed)
@@ -141,9 +159,13 @@ def correlate_files(
     if isinstance(points, (str, Path)):
         points = read_points_file(Path(points))
     t0 = time.perf_counter()
-    if is_sequence_input(deformed):
+    sequence = is_sequence_input(deformed)
+    if sequence:
+        from jointwear.dic.subset._sequence import correlate_sequence
+        from jointwear.io import save as write
+
         frames, inputs = _read_sequence(reference, deformed)
-        ds = correlate_sequence(
+        field = correlate_sequence(
             frames,
             reference=reference_mode or "absolute",
             roi=roi,
@@ -156,12 +178,16 @@ def correlate_files(
             params=params,
         )
     else:
-        ds = _correlate_pair(
+        from jointwear._netcdf import write_record as write
+
+        field = _correlate_pair(
             reference, deformed, roi=roi, points=points, seed_points=seed_points, params=params
         )
         inputs = [reference, deformed]
     elapsed = time.perf_counter() - t0
-    save(ds, out, inputs=inputs, parameters=params, source=source_attribute("dic.correlate"))
+    write(field, out, inputs=inputs, parameters=params, source=source_attribute("dic.correlate"))
     if plot is not None:
-        save_quicklook(ds, plot, title=reference.name)
-    return ds, elapsed
+        from jointwear.dic.subset._quicklook import save_quicklook
+
+        save_quicklook(field if sequence else field.to_dataset(), plot, title=reference.name)
+    return field, elapsed

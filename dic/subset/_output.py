@@ -1,18 +1,23 @@
-"""Per-point results of the 2D subset-DIC engine as an xarray Dataset (the data contract)."""
+"""Per-point results of the 2D subset-DIC engine following the data contract: as a
+:class:`~jointwear._netcdf.Record` of NumPy arrays (:func:`result_record`, what ``jointwear dic
+correlate`` writes without importing xarray) and as the xarray Dataset built from it
+(:func:`result_dataset`, what the library returns)."""
 
 from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
 import numpy as np
-import xarray as xr
 
 import jointwear.dic.icgn._flags as _flags
+from jointwear._netcdf import Record, Variable
 
 if TYPE_CHECKING:
+    import xarray as xr
+
     from jointwear.dic.subset._params import CorrelationParams
 
-__all__ = ["result_dataset"]
+__all__ = ["result_dataset", "result_record"]
 
 
 _GRAD_NAMES = [
@@ -32,11 +37,20 @@ _SECOND = [  # d2u_dx2 .. d2v_dy2: shape parameters 3-5 (u) and 9-11 (v)
 
 def result_dataset(
     centres, P, zncc, iterations, flag, params: CorrelationParams, grid=None, sigma=None
-):
+) -> xr.Dataset:
     """Per-point arrays -> Dataset following the data contract (leading dims allowed).
 
     ``sigma`` (..., N, 2): standard uncertainty of (u, v) [pixel] -> ``u_u``, ``v_u``.
     """
+    return result_record(
+        centres, P, zncc, iterations, flag, params, grid=grid, sigma=sigma
+    ).to_dataset()
+
+
+def result_record(
+    centres, P, zncc, iterations, flag, params: CorrelationParams, grid=None, sigma=None
+) -> Record:
+    """Per-point arrays -> :class:`~jointwear._netcdf.Record` of :func:`result_dataset`."""
     P = np.asarray(P, float)
     ok = np.asarray(flag) == _flags.FLAG_OK
     lead = P.shape[:-2]
@@ -46,46 +60,57 @@ def result_dataset(
         dims = (*lead_dims, "y", "x")
         shape = (*lead, ys.size, xs.size)
         coords = {
-            "x": ("x", xs, {"units": "pixel", "long_name": "subset centre column (reference)"}),
-            "y": ("y", ys, {"units": "pixel", "long_name": "subset centre row (reference)"}),
+            "x": Variable(
+                ("x",), xs, {"units": "pixel", "long_name": "subset centre column (reference)"}
+            ),
+            "y": Variable(
+                ("y",), ys, {"units": "pixel", "long_name": "subset centre row (reference)"}
+            ),
         }
     else:
         dims = (*lead_dims, "point")
         shape = (*lead, centres.shape[0])
+        point = ("point",)
         coords = {
-            "point": ("point", np.arange(centres.shape[0]), {"long_name": "point of interest"}),
-            "x": ("point", centres[:, 0], {"units": "pixel", "long_name": "subset centre column"}),
-            "y": ("point", centres[:, 1], {"units": "pixel", "long_name": "subset centre row"}),
+            "point": Variable(
+                point, np.arange(centres.shape[0]), {"long_name": "point of interest"}
+            ),
+            "x": Variable(
+                point, centres[:, 0], {"units": "pixel", "long_name": "subset centre column"}
+            ),
+            "y": Variable(
+                point, centres[:, 1], {"units": "pixel", "long_name": "subset centre row"}
+            ),
         }
     data = {}
     names = _GRAD_NAMES + (_SECOND if params.quadratic else [])
     for name, k, units, long in names:
         vals = np.where(ok, P[..., k], np.nan).reshape(shape)
-        data[name] = xr.DataArray(vals, dims=dims, attrs={"units": units, "long_name": long})
-    data["zncc"] = xr.DataArray(
+        data[name] = Variable(dims, vals, {"units": units, "long_name": long})
+    data["zncc"] = Variable(
+        dims,
         np.asarray(zncc, float).reshape(shape),
-        dims=dims,
-        attrs={"units": "1", "long_name": "zero-normalised cross-correlation coefficient (final)"},
+        {"units": "1", "long_name": "zero-normalised cross-correlation coefficient (final)"},
     )
-    data["iterations"] = xr.DataArray(
+    data["iterations"] = Variable(
+        dims,
         np.asarray(iterations, np.int32).reshape(shape),
-        dims=dims,
-        attrs={"units": "1", "long_name": "IC-GN iterations"},
+        {"units": "1", "long_name": "IC-GN iterations"},
     )
-    data["converged"] = xr.DataArray(
+    data["converged"] = Variable(
+        dims,
         ok.astype(np.int8).reshape(shape),
-        dims=dims,
-        attrs={
+        {
             "units": "1",
             "long_name": "IC-GN converged to an accepted match",
             "flag_values": np.array([0, 1], np.int8),
             "flag_meanings": "no yes",
         },
     )
-    data["flag"] = xr.DataArray(
+    data["flag"] = Variable(
+        dims,
         np.asarray(flag, np.int8).reshape(shape),
-        dims=dims,
-        attrs={
+        {
             "units": "1",
             "long_name": "correlation quality flag",
             "flag_values": _flags.FLAG_VALUES,
@@ -95,33 +120,30 @@ def result_dataset(
     if sigma is not None:
         sig = np.asarray(sigma, float)
         for k, name in enumerate(("u", "v")):
-            data[f"{name}_u"] = xr.DataArray(
+            data[f"{name}_u"] = Variable(
+                dims,
                 np.where(ok, sig[..., k], np.nan).reshape(shape),
-                dims=dims,
-                attrs={
+                {
                     "units": "pixel",
                     "long_name": f"standard uncertainty of {name} from the match residual "
                     "(image noise; excludes interpolation bias)",
                 },
             )
-    ds = xr.Dataset(data, coords=coords)
     for name in ("u", "v"):
         extra = f" {name}_u" if sigma is not None else ""
-        ds[name].attrs["ancillary_variables"] = f"zncc flag{extra}"
-    ds.attrs.update(
-        {
-            "title": "2D subset DIC displacement field",
-            "dic_criterion": "ZNSSD (IC-GN)",
-            "dic_subset_size_pixel": int(params.subset_size),
-            "dic_step_pixel": int(params.step),
-            "dic_shape_function": params.shape,
-            "dic_interpolation": f"{params.interpolation} B-spline (prefiltered)",
-            "dic_tolerance_pixel": float(params.tolerance),
-            "dic_zncc_min": float(params.zncc_min),
-            "displacement_convention": (
-                "Lagrangian: the subset centred at (x, y) of the reference moved by (u, v); x to "
-                "the right, y down, pixel centres at integers"
-            ),
-        }
-    )
-    return ds
+        data[name].attrs["ancillary_variables"] = f"zncc flag{extra}"
+    attrs = {
+        "title": "2D subset DIC displacement field",
+        "dic_criterion": "ZNSSD (IC-GN)",
+        "dic_subset_size_pixel": int(params.subset_size),
+        "dic_step_pixel": int(params.step),
+        "dic_shape_function": params.shape,
+        "dic_interpolation": f"{params.interpolation} B-spline (prefiltered)",
+        "dic_tolerance_pixel": float(params.tolerance),
+        "dic_zncc_min": float(params.zncc_min),
+        "displacement_convention": (
+            "Lagrangian: the subset centred at (x, y) of the reference moved by (u, v); x to "
+            "the right, y down, pixel centres at integers"
+        ),
+    }
+    return Record(data, coords, attrs)

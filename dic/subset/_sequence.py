@@ -21,13 +21,16 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
-import xarray as xr
 
 from jointwear.dic.footage._video import check_frame_names  # noqa: F401 (re-exported)
 from jointwear.dic.subset._params import UPDATE_ZNCC
 from jointwear.errors import BadInputError, ParameterError
+
+if TYPE_CHECKING:  # read_image serves `dic correlate` of a pair, which does without xarray
+    import xarray as xr
 
 __all__ = ["read_frames", "correlate_sequence"]
 
@@ -372,6 +375,8 @@ class _SequenceTracker:
 
     def dataset(self, reference, t, time_note) -> xr.Dataset:
         """The tracked sequence as a Dataset over ``time``."""
+        import xarray as xr
+
         from jointwear.dic.subset._correlator import result_dataset
 
         base, prm, ref_frame = self.base, self.base.params, self.ref_frame

@@ -81,3 +81,30 @@ def test_help_imports_no_numerical_stack(argv, tmp_path):
         [sys.executable, "-c", script], capture_output=True, text=True, cwd=tmp_path, check=True
     )
     assert out.stdout.splitlines()[-1].split()[1:] == []
+
+
+def test_dic_correlate_of_a_pair_imports_neither_xarray_nor_pandas(tmp_path):
+    # xarray with pandas is about 0.3 CPU s of the command's ~1 s: a pair's field is written
+    # from NumPy arrays (jointwear._netcdf); only --plot and sequences need xarray
+    import cv2
+
+    from jointwear import io
+    from jointwear.datasets import speckle as sp
+
+    pair = sp.speckle_pair((80, 96), sp.RigidField((1.7, -0.4)), seed=3)
+    for name, img in (("r.png", pair.reference), ("d.png", pair.deformed)):
+        assert cv2.imwrite(str(tmp_path / name), img)
+    argv = ["dic", "correlate", "r.png", "d.png", "--subset", "21", "--step", "16"]
+    script = (
+        f"from jointwear.cli import main\nassert main({argv!r}) == 0\nimport sys\n"
+        "print('LOADED', *(m for m in ('xarray', 'pandas') + "
+        f"{HEAVY[:-1]!r} if m in sys.modules))"
+    )
+    out = subprocess.run(
+        [sys.executable, "-c", script], capture_output=True, text=True, cwd=tmp_path, check=True
+    )
+    assert out.stdout.splitlines()[-1].split()[1:] == []
+    field = io.load(tmp_path / "field.nc")  # the default --out, a valid jointwear file
+    assert (field["flag"].values == 0).all()
+    np.testing.assert_allclose(field["u"].values, 1.7, atol=0.02)
+    np.testing.assert_allclose(field["v"].values, -0.4, atol=0.02)
