@@ -161,6 +161,7 @@ def correlate_cmd(
     plot: opt.PlotOpt = None,
     threads: opt.ThreadsOpt = opt.DEFAULTS.threads,
     allow_empty: opt.AllowEmptyOpt = False,
+    origin: opt.OriginOpt = "measured",
 ) -> None:
     """Subset DIC (ZNSSD, IC-GN): displacement u, v (pixels) on a grid, written to netCDF."""
     from jointwear.dic._flag_report import check_flags
@@ -191,6 +192,7 @@ def correlate_cmd(
         update_zncc=update_zncc,
         update_every=update_every,
         plot=plot,
+        data_origin=origin,
     )
     typer.echo(_summary(ds, out, elapsed, plot, reference_mode, update_zncc))
     check_flags(ds, allow_empty=allow_empty)

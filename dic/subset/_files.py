@@ -117,6 +117,7 @@ def correlate_files(
     update_zncc: float = UPDATE_ZNCC,
     update_every: int | None = None,
     plot: str | Path | None = None,
+    data_origin: str = "measured",
 ) -> tuple[xr.Dataset | Record, float]:
     """Correlate an image pair or a sequence and save the field to ``out`` (netCDF).
 
@@ -138,6 +139,8 @@ def correlate_files(
         Sequences only: as in :func:`correlate_sequence` (``reference_mode`` None: absolute).
     plot : path, optional
         Also write a quick-look figure (png).
+    data_origin : {"measured", "synthetic"}
+        What the images are (camera images or generated ones): the file's ``data_origin``.
 
     Returns
     -------
@@ -156,6 +159,11 @@ def correlate_files(
         check_writable(plot, what="figure")
     if points is not None and roi is not None:
         raise ParameterError("give either points= or roi=, not both")
+    if data_origin not in ("measured", "synthetic"):
+        raise ParameterError(
+            f"data_origin={data_origin!r} (--origin): say what the images are, 'measured' "
+            "(camera images) or 'synthetic' (generated)"
+        )
     if isinstance(points, (str, Path)):
         points = read_points_file(Path(points))
     t0 = time.perf_counter()
@@ -185,6 +193,7 @@ def correlate_files(
         )
         inputs = [reference, deformed]
     elapsed = time.perf_counter() - t0
+    field.attrs["data_origin"] = data_origin
     write(field, out, inputs=inputs, parameters=params, source=source_attribute("dic.correlate"))
     if plot is not None:
         from jointwear.dic.subset._quicklook import save_quicklook

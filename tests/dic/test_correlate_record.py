@@ -107,6 +107,7 @@ def test_pair_file_is_the_one_save_writes_of_the_library_dataset(tmp_path, case)
 
     # the old way: the library's Dataset, saved by jointwear.io.save
     ds = SubsetCorrelator(read_image(ref), params=params, **where).correlate(read_image(dfm))
+    ds.attrs["data_origin"] = "measured"  # what correlate_files states by default
     inputs = [ref, dfm]
     io.save(ds, slow, inputs=inputs, parameters=params, source=source_attribute("dic.correlate"))
     _assert_same_file(fast, slow)
@@ -161,3 +162,18 @@ def test_command_summary_and_figure_from_the_record(tmp_path, capsys):
     median = float(np.median(ds["zncc"].values[ok]))
     assert f"{ok.sum()}/{ok.size} points ok, median ZNCC {median:.4f}" in text
     assert fig.stat().st_size > 1000
+
+
+def test_the_file_says_what_the_images_are(tmp_path, capsys):
+    """data_origin: measured by default, synthetic on request; anything else is refused before
+    any work, naming --origin."""
+    ref, dfm = _pair(tmp_path)
+    args = ["dic", "correlate", str(ref), str(dfm), "--subset", "21", "--step", "24"]
+    assert main([*args, "--out", str(tmp_path / "m.nc")]) == 0
+    assert io.load(tmp_path / "m.nc").attrs["data_origin"] == "measured"
+    assert main([*args, "--out", str(tmp_path / "s.nc"), "--origin", "synthetic"]) == 0
+    assert io.load(tmp_path / "s.nc").attrs["data_origin"] == "synthetic"
+    capsys.readouterr()
+    assert main([*args, "--out", str(tmp_path / "x.nc"), "--origin", "simulated"]) == 3
+    assert "--origin" in capsys.readouterr().err
+    assert not (tmp_path / "x.nc").exists()
