@@ -205,3 +205,21 @@ def test_datasets_help_imports_no_numerical_stack(tmp_path):
         [sys.executable, "-c", script], capture_output=True, text=True, cwd=tmp_path, check=True
     )
     assert out.stdout.splitlines()[-1].split()[1:] == []
+
+
+def test_wearmap_defaults_are_the_librarys():
+    from jointwear.metrology.cli_metrology import wearmap_cmd
+    from jointwear.metrology.wearmap import wear_map
+
+    kw = _keywords(wear_map)
+    mapping = {n: (kw[n], None) for n in ("angle_offset_deg", "register", "shape", "threshold")}
+    mapping["radius_mm"] = (kw["radius"], None)
+    params = _check(wearmap_cmd, mapping, {"worn", "before", "out", "overwrite", "plot"})
+    # every choice the command offers is one the library takes; another shape is refused
+    from jointwear.errors import BadInputError
+    from jointwear.metrology.wearmap import _options
+
+    for choice in params["shape"].type_descriptor.annotation:
+        _options(str(choice), None, None, "bore", kw["threshold"])
+    with pytest.raises(BadInputError, match="shape"):
+        _options("cone", None, None, "bore", kw["threshold"])
