@@ -223,3 +223,29 @@ def test_wearmap_defaults_are_the_librarys():
         _options(str(choice), None, None, "bore", kw["threshold"])
     with pytest.raises(BadInputError, match="shape"):
         _options("cone", None, None, "bore", kw["threshold"])
+
+
+def test_calibrate_defaults_are_the_librarys():
+    from jointwear.dic import CalibrationBoard, calibrate_stereo
+    from jointwear.dic.calibration._files import calibrate_files
+    from jointwear.dic.cli_stereo import calibrate_cmd
+
+    b, kw, files = (
+        _fields(CalibrationBoard),
+        _keywords(calibrate_stereo),
+        _keywords(calibrate_files),
+    )
+    mapping = {n: (kw[n], None) for n in ("min_views", "max_rms", "max_view_rms", "world_view")}
+    mapping |= {
+        "board": (b["kind"], None),
+        "squares": ((b["squares_x"], b["squares_y"]), None),
+        "accept_poor": (kw["accept_poor"], None),
+        # None: the library's default applies; the help states it
+        "dictionary": (None, None),
+        "every": (None, None),
+    }
+    without = {"left", "right", "out", "overwrite", "square", "unit", "square_u", "square_mm"}
+    without |= {"marker", "marker_mm"}
+    params = _check(calibrate_cmd, mapping, without)
+    assert f"(default {b['dictionary']})" in params["dictionary"].help
+    assert f"(default {files['every']})" in params["every"].help
