@@ -249,3 +249,25 @@ def test_calibrate_defaults_are_the_librarys():
     params = _check(calibrate_cmd, mapping, without)
     assert f"(default {b['dictionary']})" in params["dictionary"].help
     assert f"(default {files['every']})" in params["every"].help
+
+
+def test_cycle_and_calibrate_kw_defaults_are_the_librarys():
+    from jointwear.sim import calibrate_kw
+    from jointwear.sim._cycle_file import simulate_cycles_to_file
+    from jointwear.sim.cli_cycle import cycle
+    from jointwear.sim.cli_wear import calibrate
+    from jointwear.sim.parameters import DEFAULT_PARAMETER_SET
+    from jointwear.sim.wear._calibration import calibration_report
+
+    kw = _keywords(simulate_cycles_to_file)
+    mapping = {n: (kw[n], None) for n in ("cycles", "wear", "wear_cycles")}
+    mapping["base"] = (DEFAULT_PARAMETER_SET, None)
+    _check(cycle, mapping, {"out", "overwrite", "params", "progress"})
+
+    report = _keywords(calibration_report)
+    assert report["rtol"] == _keywords(calibrate_kw)["rtol"]
+    mapping = {n: (report[n], None) for n in ("resimulate", "rtol", "cycles")}
+    mapping["measured_map"] = (report["measured_map"], None)
+    mapping["vary"] = (report["vary"], None)
+    without = {"simulated", "max_depth_um", "volume_mm3", "cylindricity_um"}
+    _check(calibrate, mapping, without)
