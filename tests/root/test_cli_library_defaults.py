@@ -271,3 +271,24 @@ def test_cycle_and_calibrate_kw_defaults_are_the_librarys():
     mapping["vary"] = (report["vary"], None)
     without = {"simulated", "max_depth_um", "volume_mm3", "cylindricity_um"}
     _check(calibrate, mapping, without)
+
+
+def test_import_defaults_are_the_librarys():
+    from jointwear.cli_import import _names, motion, wearmap
+    from jointwear.external import import_motion, import_wear_map
+
+    kw = _keywords(import_motion)
+    mapping = {n: (kw[n], None) for n in ("time_unit", "time_column", "tool")}
+    params = _check(
+        motion, mapping, {"file", "out", "overwrite", "origin", "velocity_unit", "velocity_columns"}
+    )
+    columns = params["velocity_columns"].default
+    assert tuple(_names(columns, "--velocity-columns", (2, 3))) == kw["velocity_columns"]
+
+    kw = _keywords(import_wear_map)
+    mapping = {n: (kw[n], None) for n in ("z_mid_width", "cycles", "tool")}
+    required = ("theta_unit", "z_unit", "depth_unit", "angle_zero", "angle_direction")
+    assert all(kw[n] is inspect.Parameter.empty for n in required)
+    mapping |= {n: (None, None) for n in required}  # None: the command asks for them
+    params = _check(wearmap, mapping, {"file", "out", "overwrite", "origin", "columns"})
+    assert tuple(_names(params["columns"].default, "--columns", (3, 3))) == kw["columns"]
