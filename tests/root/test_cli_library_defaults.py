@@ -292,3 +292,20 @@ def test_import_defaults_are_the_librarys():
     mapping |= {n: (None, None) for n in required}  # None: the command asks for them
     params = _check(wearmap, mapping, {"file", "out", "overwrite", "origin", "columns"})
     assert tuple(_names(params["columns"].default, "--columns", (3, 3))) == kw["columns"]
+
+
+def test_instruments_default_run_is_the_librarys_bit_for_bit(tmp_path):
+    # the command converts its µm/mm/nm defaults back to SI: the scan is the library default's
+    import numpy as np
+
+    from jointwear import io
+    from jointwear.cli import main
+    from jointwear.datasets.instruments import generate
+
+    truth = tmp_path / "truth.nc"
+    argv = ["datasets", "instruments", str(tmp_path / "scan"), "--layers", "3", "--points", "64"]
+    assert main([*argv, "--truth", str(truth)]) == 0
+    expected = generate(n_layers=3, n_points=64).truth
+    got = io.load(truth)
+    for name in ("radius", "radius_true", "wear_depth"):
+        np.testing.assert_array_equal(got[name].values, expected[name].values, err_msg=name)
