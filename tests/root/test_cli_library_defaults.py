@@ -309,3 +309,36 @@ def test_instruments_default_run_is_the_librarys_bit_for_bit(tmp_path):
     got = io.load(truth)
     for name in ("radius", "radius_true", "wear_depth"):
         np.testing.assert_array_equal(got[name].values, expected[name].values, err_msg=name)
+
+
+def test_compare_defaults_and_help_are_the_librarys():
+    from jointwear.compare import DEFAULT_AXES, MOTION_VARIABLES
+    from jointwear.compare.align_motion import align_time_series
+    from jointwear.compare.cli_compare import compare_cmd
+    from jointwear.compare.storage import compare_files
+    from jointwear.errors import BadInputError
+
+    kw = _keywords(compare_files)
+    mapping = {n: (kw[n], None) for n in ("table", "criteria", "cycles", "variables")}
+    mapping |= {
+        "method": (kw["motion_method"], None),
+        "period": (kw["period_s"], None),
+        "axes": (None, None),  # None: DEFAULT_AXES, the help states them
+    }
+    without = {"sim", "meas", "out", "overwrite", "sim_extra", "meas_extra", "ensemble"}
+    params = _check(compare_cmd, mapping, without | {"verification", "strict"})
+    assert kw["axes"] == DEFAULT_AXES
+    assert f"default {' and '.join(DEFAULT_AXES)}," in params["axes"].help
+    assert f"default: {', '.join(MOTION_VARIABLES)} when" in params["variables"].help
+    assert _keywords(align_time_series)["method"] == kw["motion_method"]
+    # every method the help offers is one the library takes; another is refused
+    offered = params["method"].help.split(":", 1)[1].strip(" .").split(", ")
+    import xarray as xr
+
+    from jointwear.compare.align_motion import _alignment_method
+
+    both = xr.Dataset({"crank_angle": ("time", [0.0, 1.0])})
+    for method in offered:
+        _alignment_method(method, both, both)
+    with pytest.raises(BadInputError, match="method"):
+        _alignment_method("by_eye", both, both)
