@@ -342,3 +342,11 @@ def test_compare_defaults_and_help_are_the_librarys():
         _alignment_method(method, both, both)
     with pytest.raises(BadInputError, match="method"):
         _alignment_method("by_eye", both, both)
+
+
+def test_reference_study_help_states_the_reduced_size():
+    from jointwear.datasets.cli_reported import reference_study_cmd
+    from jointwear.datasets.reference_study import REDUCED
+
+    params = _check(reference_study_cmd, {}, {"out", "overwrite", "reduced"})
+    assert f"{REDUCED.ensemble_runs} ensemble members" in params["reduced"].help
