@@ -152,6 +152,7 @@ def test_rig_defaults_are_the_librarys():
 def test_field_defaults_help_and_limits_are_the_librarys():
     from jointwear.dic import CorrelationParams, FieldParams
     from jointwear.dic.cli_field import field_cmd
+    from jointwear.dic.field._files import measure_field_files
 
     f = _fields(FieldParams)
     mapping = {n: (f[n], None) for n in ("step", "zncc_min", "search_radius", "threads")} | {
@@ -161,8 +162,9 @@ def test_field_defaults_help_and_limits_are_the_librarys():
         "frame": (None, None),
         "epipolar_max": (None, None),
     }
+    mapping["origin"] = (_keywords(measure_field_files)["data_origin"], None)
     without = {"images", "left", "right", "calibration", "roi", "points", "fps"}
-    without |= {"origin", "out", "csv", "plot", "allow_empty", "overwrite"}
+    without |= {"out", "csv", "plot", "allow_empty", "overwrite"}
     params = _check(field_cmd, mapping, without)
     assert f"Default {f['strain_window']} (0 with --points)" in params["strain_window"].help
     assert f"Default {f['frame']}." in params["frame"].help
