@@ -11,6 +11,8 @@ from typing import Annotated
 
 import typer
 
+from jointwear.compare._choices import DEFAULT_AXES, MOTION_VARIABLES
+
 __all__ = [
     "AxisOpt",
     "CriteriaOpt",
@@ -44,16 +46,16 @@ VariableOpt = Annotated[
     list[str] | None,
     typer.Option(
         "--variable",
-        help="Motion variable to compare (repeatable; default: follower_velocity, "
-        "journal_offset, journal_displacement, contact_force when both sides have them).",
+        help=f"Motion variable to compare (repeatable; default: {', '.join(MOTION_VARIABLES)} "
+        "when both sides have them).",
     ),
 ]
 AxisOpt = Annotated[
     list[str] | None,
     typer.Option(
         "--axis",
-        help="Motion component to compare (repeatable; default x and y, the plane of "
-        "the mechanism).",
+        help=f"Motion component to compare (repeatable; default {' and '.join(DEFAULT_AXES)}, "
+        "the plane of the mechanism).",
     ),
 ]
 EnsembleOpt = Annotated[

@@ -13,20 +13,11 @@ import numpy as np
 import xarray as xr
 
 from jointwear import conventions
+from jointwear.compare._choices import ALIGN_METHOD, ALIGN_METHODS, MOTION_VARIABLES
 from jointwear.compare.budget import to_standard
 from jointwear.errors import BadInputError, ConventionError
 
 __all__ = ["align_time_series", "MOTION_VARIABLES"]
-
-#: time-series variables compared by default when both sides have them (contract names).
-#: Positions (``follower_position``) are left out: they depend on where each record puts its
-#: origin (a DIC calibration's world frame is the board's); ask for them explicitly.
-MOTION_VARIABLES = (
-    "follower_velocity",
-    "journal_offset",
-    "journal_displacement",
-    "contact_force",
-)
 
 
 def _time(ds: xr.Dataset, what: str) -> np.ndarray:
@@ -128,9 +119,9 @@ def _crank_period(
 
 def _alignment_method(method: str, sim: xr.Dataset, meas: xr.Dataset) -> str:
     """``method`` with ``"auto"`` resolved: by crank angle when both records have one."""
-    if method not in ("auto", "crank_angle", "cross_correlation"):
+    if method not in ALIGN_METHODS:
         raise BadInputError(
-            f"method must be 'auto', 'crank_angle' or 'cross_correlation', got {method!r}"
+            f"method must be one of {', '.join(map(repr, ALIGN_METHODS))}, got {method!r}"
         )
     has_crank = "crank_angle" in sim and "crank_angle" in meas
     if method == "auto":
@@ -330,7 +321,7 @@ def align_time_series(
     meas: xr.Dataset,
     *,
     variables: Sequence[str] | None = None,
-    method: str = "auto",
+    method: str = ALIGN_METHOD,
     period_s: float | None = None,
     whole_cycles: bool = True,
 ) -> xr.Dataset:

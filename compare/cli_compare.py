@@ -9,6 +9,7 @@ import typer
 
 from jointwear._cli import Overwrite
 from jointwear.compare import _cli_options as opt
+from jointwear.compare._choices import ALIGN_METHOD, ALIGN_METHODS
 
 
 def compare_cmd(
@@ -37,8 +38,8 @@ def compare_cmd(
     period: opt.PeriodOpt = None,
     method: Annotated[
         str,
-        typer.Option("--method", help="Motion alignment: auto, crank_angle, cross_correlation."),
-    ] = "auto",
+        typer.Option("--method", help=f"Motion alignment: {', '.join(ALIGN_METHODS)}."),
+    ] = ALIGN_METHOD,
     variables: opt.VariableOpt = None,
     axes: opt.AxisOpt = None,
     ensemble: opt.EnsembleOpt = None,

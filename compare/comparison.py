@@ -22,6 +22,7 @@ import xarray as xr
 
 import jointwear.compare.verdicts as vd
 from jointwear import conventions
+from jointwear.compare._choices import ALIGN_METHOD, DEFAULT_AXES
 from jointwear.compare._decide import DECISION_COLUMNS, Rows
 from jointwear.compare._motion import motion_metrics, rms_quantities
 from jointwear.compare._wear import sim_quantities, wear_metrics
@@ -42,10 +43,6 @@ __all__ = [
     "load_criteria",
     "DEFAULT_AXES",
 ]
-
-#: vector components compared by default: the mechanism is planar; the out-of-plane (z) motion of
-#: a rig record is set by the rig, not by the mechanism, unless the user asks for it (axes=)
-DEFAULT_AXES = ("x", "y")
 
 
 @dataclass(frozen=True)
@@ -426,7 +423,7 @@ def compare(
     criteria: Criteria | None = None,
     cycles: float | None = None,
     theta_step_deg: float | None = None,
-    motion_method: str = "auto",
+    motion_method: str = ALIGN_METHOD,
     period_s: float | None = None,
     variables: Sequence[str] | None = None,
     axes: Sequence[str] | None = DEFAULT_AXES,

@@ -14,6 +14,7 @@ import xarray as xr
 import jointwear.compare.metrics as mt
 import jointwear.compare.verdicts as vd
 from jointwear import io
+from jointwear.compare._choices import ALIGN_METHOD
 from jointwear.compare._decide import DECISION_COLUMNS, METRIC_COLUMNS
 from jointwear.compare.comparison import DEFAULT_AXES, Comparison
 from jointwear.compare.criteria import Criteria
@@ -211,7 +212,7 @@ def compare_files(
     criteria: Criteria | str | Path | None = None,
     cycles: float | None = None,
     period_s: float | None = None,
-    motion_method: str = "auto",
+    motion_method: str = ALIGN_METHOD,
     variables: Sequence[str] | None = None,
     axes: Sequence[str] | None = DEFAULT_AXES,
     ensemble: Sequence[str | Path] = (),

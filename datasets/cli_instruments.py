@@ -9,46 +9,62 @@ import typer
 
 from jointwear._cli import Overwrite
 from jointwear._version import source_attribute
+from jointwear.datasets import _instrument_defaults as D
+
+#: names of the field separators the command takes
+DELIMITERS = {"tab": "\t", "semicolon": ";", "comma": ",", "space": " ", "whitespace": " "}
+
+
+def _shown(value: float, per_si: float) -> float:
+    """A library default [SI] in the option's unit (``per_si`` units per SI unit), as typed."""
+    return float(f"{value * per_si:.12g}")
+
+
+def _ecc_um() -> tuple[float, float]:
+    return (_shown(D.ECCENTRICITY[0], 1e6), _shown(D.ECCENTRICITY[1], 1e6))
 
 
 def instruments_cmd(
     out: Annotated[Path, typer.Argument(help="Output folder (or file for long/wide/single).")],
     overwrite: Overwrite = False,
-    layers: Annotated[int, typer.Option("--layers", help="Number of layers.")] = 13,
-    points: Annotated[int, typer.Option("--points", help="Points per layer.")] = 18000,
+    layers: Annotated[int, typer.Option("--layers", help="Number of layers.")] = D.N_LAYERS,
+    points: Annotated[int, typer.Option("--points", help="Points per layer.")] = D.N_POINTS,
     radius_mm: Annotated[
         float | None,
         typer.Option(
             "--radius-mm",
-            help="Bore radius [mm] (default 8, or the simulated bore's with --wear-from).",
+            help=f"Bore radius [mm] (default {_shown(D.RADIUS, 1e3):g}, or the simulated bore's "
+            "with --wear-from).",
         ),
     ] = None,
-    spacing_mm: Annotated[float, typer.Option("--spacing-mm", help="Layer spacing [mm].")] = 1.0,
+    spacing_mm: Annotated[float, typer.Option("--spacing-mm", help="Layer spacing [mm].")] = _shown(
+        D.LAYER_SPACING, 1e3
+    ),
     layout: Annotated[
         Literal["folder", "folder-names", "folder-header", "long", "wide", "single"],
         typer.Option("--layout", help="folder, folder-names, folder-header, long, wide or single."),
-    ] = "folder",
+    ] = D.LAYOUT,
     value: Annotated[
         Literal["deviation", "radius"], typer.Option("--value", help="deviation or radius.")
-    ] = "deviation",
-    units: Annotated[str, typer.Option("--units", help="um, mm, m or inch.")] = "um",
+    ] = D.VALUE,
+    units: Annotated[str, typer.Option("--units", help="um, mm, m or inch.")] = D.UNITS,
     angle: Annotated[
         Literal["deg", "rad", "index", "none", "xy"],
         typer.Option("--angle", help="Angle column: deg, rad, index, none or xy."),
-    ] = "deg",
+    ] = D.ANGLE,
     delimiter: Annotated[
         str, typer.Option("--delimiter", help="tab, semicolon, comma or space.")
-    ] = "tab",
-    decimal: Annotated[str, typer.Option("--decimal", help="'.' or ','.")] = ".",
+    ] = next(k for k, v in DELIMITERS.items() if v == D.DELIMITER),
+    decimal: Annotated[str, typer.Option("--decimal", help="'.' or ','.")] = D.DECIMAL,
     eccentricity_um: Annotated[
         tuple[float, float], typer.Option("--eccentricity-um", help="Set-up offset x y [µm].")
-    ] = (15.0, -8.0),
+    ] = _ecc_um(),
     tilt: Annotated[
         tuple[float, float], typer.Option("--tilt", help="Axis slopes dx/dz dy/dz [1].")
-    ] = (1.5e-3, -0.8e-3),
+    ] = D.TILT,
     wear_um: Annotated[
         float, typer.Option("--wear-um", help="Peak depth of the imposed wear [µm] (0: none).")
-    ] = 20.0,
+    ] = _shown(D.WEAR_DEPTH, 1e6),
     wear_from: Annotated[
         Path | None,
         typer.Option(
@@ -68,17 +84,19 @@ def instruments_cmd(
             help="Turn of the wear taken with --wear-from, canonical sense [degree].",
         ),
     ] = 0.0,
-    noise_um: Annotated[float, typer.Option("--noise-um", help="Probe noise [µm].")] = 0.02,
+    noise_um: Annotated[float, typer.Option("--noise-um", help="Probe noise [µm].")] = _shown(
+        D.NOISE, 1e6
+    ),
     quantisation_nm: Annotated[
         float, typer.Option("--quantisation-nm", help="Reading resolution [nm].")
-    ] = 1.0,
+    ] = _shown(D.QUANTISATION, 1e9),
     angle_zero: Annotated[
         str, typer.Option("--angle-zero", help="Instrument 0 degree in the bearing frame.")
-    ] = "+y",
+    ] = D.CONVENTION[0],
     angle_direction: Annotated[
         str, typer.Option("--angle-direction", help="Instrument angle sense.")
-    ] = "counterclockwise",
-    seed: Annotated[int, typer.Option("--seed", help="Random seed (form and noise).")] = 0,
+    ] = D.CONVENTION[1],
+    seed: Annotated[int, typer.Option("--seed", help="Random seed (form and noise).")] = D.SEED,
     noise_seed: Annotated[
         int | None,
         typer.Option("--noise-seed", help="Separate noise seed (same bore, new measurement)."),
@@ -92,9 +110,8 @@ def instruments_cmd(
     from jointwear import io
     from jointwear.datasets.instruments import generate, write
 
-    delims = {"tab": "\t", "semicolon": ";", "comma": ",", "space": " ", "whitespace": " "}
     wear: object = "default" if wear_um > 0 else None
-    radius = 8e-3 if radius_mm is None else radius_mm * 1e-3
+    radius = D.RADIUS if radius_mm is None else radius_mm / 1e3
     if wear_from is not None:
         from jointwear.datasets.simulated_wear import wear_from_simulation
 
@@ -106,13 +123,13 @@ def instruments_cmd(
         n_layers=layers,
         n_points=points,
         radius=radius,
-        layer_spacing=spacing_mm * 1e-3,
-        eccentricity=(eccentricity_um[0] * 1e-6, eccentricity_um[1] * 1e-6),
+        layer_spacing=spacing_mm / 1e3,
+        eccentricity=(eccentricity_um[0] / 1e6, eccentricity_um[1] / 1e6),
         tilt=tilt,
         wear=wear,
-        wear_depth=wear_um * 1e-6,
-        noise=noise_um * 1e-6,
-        quantisation=quantisation_nm * 1e-9,
+        wear_depth=wear_um / 1e6,
+        noise=noise_um / 1e6,
+        quantisation=quantisation_nm / 1e9,
         convention=(angle_zero, angle_direction),
         seed=seed,
         noise_seed=noise_seed,
@@ -124,7 +141,7 @@ def instruments_cmd(
         value=value,
         units=units,
         angle=angle,
-        delimiter=delims.get(delimiter, delimiter),
+        delimiter=DELIMITERS.get(delimiter, delimiter),
         decimal=decimal,
     )
     typer.echo(f"wrote {len(files)} file(s) under {out}")

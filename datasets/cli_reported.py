@@ -8,6 +8,7 @@ from typing import Annotated
 import typer
 
 from jointwear._cli import Overwrite
+from jointwear.datasets._study_size import REDUCED
 
 
 def reported_cmd(
@@ -29,7 +30,10 @@ def reference_study_cmd(
     overwrite: Overwrite = False,
     reduced: Annotated[
         bool,
-        typer.Option("--reduced", help="Coarse grid, 3 ensemble members (about a minute)."),
+        typer.Option(
+            "--reduced",
+            help=f"Coarse grid, {REDUCED.ensemble_runs} ensemble members (about a minute).",
+        ),
     ] = False,
 ) -> None:
     """Decide the reference study's reported values against the default rig (with u_num, u_input).

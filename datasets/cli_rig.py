@@ -8,25 +8,33 @@ from typing import Annotated, Literal
 import typer
 
 from jointwear._cli import Overwrite
+from jointwear.datasets._rig_config import DEFAULT_CODEC, RigConfig
+
+#: the library's defaults (every option's default is read from them)
+_C = RigConfig
+_BOARD = (
+    f"{_C.board_squares[0]} x {_C.board_squares[1]} squares of {_C.board_square_size * 1e3:g} mm, "
+    f"{_C.board_marker_size * 1e3:g} mm {_C.board_dictionary} markers"
+)
 
 
 def rig(
     out: Annotated[Path, typer.Option("--out", "-o", help="Output folder.")],
     overwrite: Overwrite = False,
-    duration: Annotated[float, typer.Option(help="Recorded time (s).")] = 1.0,
-    fps: Annotated[float, typer.Option(help="Frame rate (1/s).")] = 50.0,
-    width: Annotated[int, typer.Option(help="Image width (px).")] = 1280,
-    height: Annotated[int, typer.Option(help="Image height (px).")] = 1024,
+    duration: Annotated[float, typer.Option(help="Recorded time (s).")] = _C.duration,
+    fps: Annotated[float, typer.Option(help="Frame rate (1/s).")] = _C.fps,
+    width: Annotated[int, typer.Option(help="Image width (px).")] = _C.width,
+    height: Annotated[int, typer.Option(help="Image height (px).")] = _C.height,
     z_amplitude_mm: Annotated[
         float, typer.Option(help="Out-of-plane amplitude of joint C (mm).")
-    ] = 2.5,
-    noise: Annotated[float, typer.Option(help="Sensor noise (grey levels).")] = 1.0,
-    blur: Annotated[float, typer.Option(help="Optical blur sigma (px).")] = 0.6,
-    exposure: Annotated[float, typer.Option(help="Brightness gain.")] = 1.0,
+    ] = _C.z_amplitude * 1e3,
+    noise: Annotated[float, typer.Option(help="Sensor noise (grey levels).")] = _C.noise_sigma,
+    blur: Annotated[float, typer.Option(help="Optical blur sigma (px).")] = _C.blur_sigma_px,
+    exposure: Annotated[float, typer.Option(help="Brightness gain.")] = _C.exposure,
     codec: Annotated[
         Literal["ffv1", "png", "grey", "mjpg", "mp4v"],
         typer.Option(help="ffv1, png or grey (lossless), mjpg or mp4v (lossy)."),
-    ] = "ffv1",
+    ] = DEFAULT_CODEC,
     video: Annotated[bool, typer.Option(help="Write videos.")] = True,
     images: Annotated[bool, typer.Option(help="Write image folders.")] = True,
     drop: Annotated[
@@ -35,18 +43,15 @@ def rig(
     duplicate: Annotated[
         list[int] | None, typer.Option(help="Frame index to duplicate (repeatable).")
     ] = None,
-    seed: Annotated[int, typer.Option(help="Random seed.")] = 0,
+    seed: Annotated[int, typer.Option(help="Random seed.")] = _C.seed,
     board: Annotated[
         Literal["chessboard", "charuco"],
-        typer.Option(
-            help="Calibration board: chessboard, or charuco (10 x 8 squares of 25 mm, "
-            "18.75 mm DICT_5X5_100 markers)."
-        ),
-    ] = "chessboard",
+        typer.Option(help=f"Calibration board: chessboard, or charuco ({_BOARD})."),
+    ] = _C.board_kind,
     board_legacy: Annotated[
         bool,
         typer.Option(help="ChArUco in the layout of OpenCV < 4.6 (boards printed from it)."),
-    ] = False,
+    ] = _C.board_legacy,
     motion: Annotated[
         Path | None,
         typer.Option(
@@ -56,14 +61,14 @@ def rig(
     ] = None,
 ) -> None:
     """Render what the rig's two cameras would record, board images and the ground truth."""
-    from jointwear.datasets.rig import RigConfig, generate_rig
+    from jointwear.datasets.rig import generate_rig
 
     cfg = RigConfig(
         width=width,
         height=height,
         fps=fps,
         duration=duration,
-        z_amplitude=z_amplitude_mm * 1e-3,
+        z_amplitude=z_amplitude_mm / 1e3,
         noise_sigma=noise,
         blur_sigma_px=blur,
         exposure=exposure,

@@ -1,4 +1,8 @@
-"""``jointwear datasets speckle``: synthetic speckle images with exact ground truth."""
+"""``jointwear datasets speckle``: synthetic speckle images with exact ground truth.
+
+Every default and limit is the library's (:mod:`jointwear.datasets._speckle_params`, read
+without numpy): ``SpeckleParams`` for the pattern and camera, ``SpeckleMotion`` for the field.
+"""
 
 from __future__ import annotations
 
@@ -8,6 +12,17 @@ from typing import Annotated, Literal
 import typer
 
 from jointwear._cli import Overwrite
+from jointwear.datasets._speckle_params import (
+    BIT_DEPTH_MAX,
+    DEFAULT_FRAMES,
+    DEFAULT_SEED,
+    MIN_FRAMES,
+    PNG_BIT_DEPTH_MIN,
+    SpeckleMotion,
+    SpeckleParams,
+)
+
+_Motion, _Params = SpeckleMotion, SpeckleParams
 
 
 def speckle_cmd(
@@ -17,39 +32,53 @@ def speckle_cmd(
     field: Annotated[
         Literal["rigid", "affine", "rotation", "sinusoidal"],
         typer.Option("--field", help="rigid, affine, rotation or sinusoidal."),
-    ] = "rigid",
-    u: Annotated[float, typer.Option("--u", help="Translation along x (pixels).")] = 1.5,
-    v: Annotated[float, typer.Option("--v", help="Translation along y (pixels).")] = -0.7,
+    ] = _Motion.field,
+    u: Annotated[float, typer.Option("--u", help="Translation along x (pixels).")] = _Motion.u,
+    v: Annotated[float, typer.Option("--v", help="Translation along y (pixels).")] = _Motion.v,
     theta_deg: Annotated[
         float, typer.Option("--theta-deg", help="Rotation (degrees), +x towards +y.")
-    ] = 0.0,
+    ] = _Motion.theta_deg,
     strain: Annotated[
         float, typer.Option("--strain", help="Affine: normal strain exx = -eyy/2.")
-    ] = 0.01,
+    ] = _Motion.strain,
     amplitude: Annotated[
         float, typer.Option("--amplitude", help="Sinusoidal: amplitude of u (pixels).")
-    ] = 2.0,
+    ] = _Motion.amplitude,
     wavelength: Annotated[
         float, typer.Option("--wavelength", help="Sinusoidal: wavelength (pixels).")
-    ] = 128.0,
+    ] = _Motion.wavelength,
     frames: Annotated[
-        int, typer.Option("--frames", min=1, help="Number of deformed frames (field ramps up).")
-    ] = 1,
+        int,
+        typer.Option(
+            "--frames", min=MIN_FRAMES, help="Number of deformed frames (field ramps up)."
+        ),
+    ] = DEFAULT_FRAMES,
     speckle_size: Annotated[
         float, typer.Option("--speckle-size", help="Speckle diameter (pixels).")
-    ] = 5.0,
-    density: Annotated[float, typer.Option("--density", help="Area fraction.")] = 0.6,
-    contrast: Annotated[float, typer.Option("--contrast", help="0..1 of full scale.")] = 0.8,
-    noise: Annotated[float, typer.Option("--noise", help="Noise std (grey levels).")] = 0.0,
-    blur: Annotated[float, typer.Option("--blur", help="Gaussian PSF std (pixels).")] = 0.0,
+    ] = _Params.speckle_size,
+    density: Annotated[float, typer.Option("--density", help="Area fraction.")] = _Params.density,
+    contrast: Annotated[
+        float, typer.Option("--contrast", help="0..1 of full scale.")
+    ] = _Params.contrast,
+    noise: Annotated[
+        float, typer.Option("--noise", help="Noise std (grey levels).")
+    ] = _Params.noise_std,
+    blur: Annotated[
+        float, typer.Option("--blur", help="Gaussian PSF std (pixels).")
+    ] = _Params.blur_std,
     bit_depth: Annotated[
-        int, typer.Option("--bit-depth", min=1, max=16, help="8 or up to 16.")
-    ] = 8,
-    seed: Annotated[int, typer.Option("--seed", help="Random seed.")] = 0,
+        int,
+        typer.Option(
+            "--bit-depth",
+            min=PNG_BIT_DEPTH_MIN,
+            max=BIT_DEPTH_MAX,
+            help=f"8 or up to {BIT_DEPTH_MAX}.",
+        ),
+    ] = _Params.bit_depth,
+    seed: Annotated[int, typer.Option("--seed", help="Random seed.")] = DEFAULT_SEED,
 ) -> None:
     """Write reference/deformed speckle PNGs and the exact displacement (truth.nc)."""
-    from jointwear.datasets.speckle import SpeckleParams
-    from jointwear.datasets.speckle_set import SpeckleMotion, write_speckle_set
+    from jointwear.datasets.speckle_set import write_speckle_set
     from jointwear.errors import BadInputError
 
     try:

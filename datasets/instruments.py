@@ -26,6 +26,8 @@ import numpy as np
 import xarray as xr
 
 from jointwear.conventions import CANONICAL, AngleConvention, theta_coord, z_coord
+from jointwear.datasets import _instrument_defaults as D
+from jointwear.datasets._instrument_defaults import ANGLE_COLUMNS, LAYOUTS
 from jointwear.errors import BadInputError
 from jointwear.io import atomic_path
 
@@ -38,16 +40,9 @@ __all__ = [
     "ANGLE_COLUMNS",
 ]
 
-#: Layouts :func:`write` supports.
-LAYOUTS = ("folder", "folder-names", "folder-header", "long", "wide", "single")
-#: Angle column styles :func:`write` supports.
-ANGLE_COLUMNS = ("deg", "rad", "index", "none", "xy")
-
-_UNITS = {"um": 1e-6, "mm": 1e-3, "m": 1.0, "inch": 0.0254}
-
 
 def default_wear(
-    theta_deg: np.ndarray, z: np.ndarray, *, depth: float = 20e-6, width_mm: float = 15.0
+    theta_deg: np.ndarray, z: np.ndarray, *, depth: float = D.WEAR_DEPTH, width_mm: float = 15.0
 ) -> np.ndarray:
     """A two-lobe wear pattern like the reference study's (canonical theta, z from mid-width).
 
@@ -138,20 +133,20 @@ def _imposed_wear(wear, theta_can: np.ndarray, zz: np.ndarray, shape, *, depth: 
 
 def generate(
     *,
-    n_layers: int = 13,
-    n_points: int = 18000,
-    radius: float = 8e-3,
-    layer_spacing: float = 1e-3,
-    eccentricity: tuple[float, float] = (15e-6, -8e-6),
-    tilt: tuple[float, float] = (1.5e-3, -0.8e-3),
+    n_layers: int = D.N_LAYERS,
+    n_points: int = D.N_POINTS,
+    radius: float = D.RADIUS,
+    layer_spacing: float = D.LAYER_SPACING,
+    eccentricity: tuple[float, float] = D.ECCENTRICITY,
+    tilt: tuple[float, float] = D.TILT,
     harmonics: Mapping[int, float] | None = None,
     wear: str | np.ndarray | Callable[[np.ndarray, np.ndarray], np.ndarray] | None = "default",
-    wear_depth: float = 20e-6,
-    noise: float = 0.02e-6,
-    quantisation: float = 1e-9,
-    convention: AngleConvention | tuple[str, str] = ("+y", "counterclockwise"),
+    wear_depth: float = D.WEAR_DEPTH,
+    noise: float = D.NOISE,
+    quantisation: float = D.QUANTISATION,
+    convention: AngleConvention | tuple[str, str] = D.CONVENTION,
     start_angle_deg: float = 0.0,
-    seed: int = 0,
+    seed: int = D.SEED,
     noise_seed: int | None = None,
 ) -> InstrumentScan:
     """Simulate a roundness-instrument scan of a (worn) bore with known truth.
@@ -193,8 +188,11 @@ def generate(
         Separate seed for the probe noise: two scans of the same bore (before / after wear)
         share ``seed`` and differ in ``noise_seed``.
     """
-    if n_layers < 1 or n_points < 8:
-        raise BadInputError(f"need n_layers >= 1 and n_points >= 8, got {n_layers}, {n_points}")
+    if n_layers < D.MIN_LAYERS or n_points < D.MIN_POINTS:
+        raise BadInputError(
+            f"need n_layers >= {D.MIN_LAYERS} and n_points >= {D.MIN_POINTS}, got {n_layers}, "
+            f"{n_points}"
+        )
     conv = convention if isinstance(convention, AngleConvention) else AngleConvention(*convention)
     rng = np.random.default_rng(seed)
     if harmonics is None:
@@ -317,7 +315,7 @@ class _TextFormat:
 
     def layer_columns(self, i: int) -> tuple[list[str], list[list[str]]]:
         """Column names and formatted columns of layer ``i``."""
-        scan, units, f = self.scan, self.units, _UNITS[self.units]
+        scan, units, f = self.scan, self.units, D.LENGTH_UNITS[self.units]
         th, n = scan.theta_deg, scan.radius.shape[1]
         fmt = self.numbers
         if self.angle == "xy":
@@ -395,12 +393,12 @@ def write(
     scan: InstrumentScan,
     path: str | Path,
     *,
-    layout: str = "folder",
-    value: str = "deviation",
-    units: str = "um",
-    angle: str = "deg",
-    delimiter: str = "\t",
-    decimal: str = ".",
+    layout: str = D.LAYOUT,
+    value: str = D.VALUE,
+    units: str = D.UNITS,
+    angle: str = D.ANGLE,
+    delimiter: str = D.DELIMITER,
+    decimal: str = D.DECIMAL,
     header: bool = True,
     column_names: bool = True,
     decimals: int | None = None,
@@ -445,16 +443,16 @@ def write(
         raise BadInputError(f"layout {layout!r} not supported; use one of {', '.join(LAYOUTS)}")
     if angle not in ANGLE_COLUMNS:
         raise BadInputError(f"angle {angle!r} not supported; use one of {', '.join(ANGLE_COLUMNS)}")
-    if value not in ("deviation", "radius"):
+    if value not in D.VALUES:
         raise BadInputError(f"value must be 'deviation' or 'radius', got {value!r}")
-    if units not in _UNITS:
-        raise BadInputError(f"units {units!r}: use one of {', '.join(_UNITS)}")
+    if units not in D.LENGTH_UNITS:
+        raise BadInputError(f"units {units!r}: use one of {', '.join(D.LENGTH_UNITS)}")
     if decimal == delimiter:
         raise BadInputError("decimal separator and delimiter must differ")
     if angle == "xy" and value == "deviation":
         value = "radius"  # Cartesian points are absolute positions
     if decimals is None:
-        decimals = max(0, int(np.ceil(-np.log10(1e-10 / _UNITS[units]))))
+        decimals = max(0, int(np.ceil(-np.log10(1e-10 / D.LENGTH_UNITS[units]))))
     sep = "  " if delimiter == " " else delimiter
     fmt = _TextFormat(
         scan, layout, value, units, angle, sep, decimal, header, column_names, decimals

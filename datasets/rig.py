@@ -38,6 +38,7 @@ import numpy as np
 import xarray as xr
 
 from jointwear._version import source_attribute
+from jointwear.datasets._rig_config import DEFAULT_CODEC
 from jointwear.datasets._rig_motion import (  # noqa: F401 (L1, L2, L4 re-exported)
     CODECS,
     L1,
@@ -584,7 +585,7 @@ def generate_rig(
     *,
     video: bool = True,
     images: bool = True,
-    codec: str = "ffv1",
+    codec: str = DEFAULT_CODEC,
     calibration_images: bool = True,
     motion: PrescribedMotion | xr.Dataset | None = None,
     progress: Callable[[str, int, int], None] | None = None,

@@ -37,6 +37,7 @@ import numpy as np
 import xarray as xr
 from numba import njit
 
+from jointwear.datasets._speckle_params import SpeckleParams
 from jointwear.errors import ParameterError
 
 __all__ = [
@@ -52,61 +53,6 @@ __all__ = [
     "speckle_sequence",
     "truth_dataset",
 ]
-
-
-@dataclass(frozen=True)
-class SpeckleParams:
-    """Pattern and camera parameters of a synthetic speckle image.
-
-    Parameters
-    ----------
-    speckle_size : float
-        Nominal speckle diameter [pixel]; each blob is a Gaussian of standard deviation
-        ``speckle_size / 4``.
-    density : float
-        Expected fraction of the area covered by speckles (number of blobs = ``density * area /
-        (pi * (speckle_size / 2)**2)``), in (0, 5].
-    contrast : float
-        Difference between the brightest and darkest intensity as a fraction of full scale,
-        in (0, 1].
-    bit_depth : int
-        Bits per pixel of the output (1..16); 0 returns floating point grey levels unrounded.
-    noise_std : float
-        Standard deviation of additive Gaussian noise [grey levels of the output scale].
-    blur_std : float
-        Standard deviation of a Gaussian point-spread function in the image plane [pixel].
-    dark_speckles : bool
-        Dark speckles on a bright background (default False: bright on dark).
-    """
-
-    speckle_size: float = 5.0
-    density: float = 0.6
-    contrast: float = 0.8
-    bit_depth: int = 8
-    noise_std: float = 0.0
-    blur_std: float = 0.0
-    dark_speckles: bool = False
-
-    def __post_init__(self) -> None:
-        checks = [
-            ("speckle_size", 1.0 <= self.speckle_size <= 200.0, "between 1 and 200 pixel"),
-            ("density", 0.0 < self.density <= 5.0, "in (0, 5]"),
-            ("contrast", 0.0 < self.contrast <= 1.0, "in (0, 1]"),
-            ("bit_depth", 0 <= int(self.bit_depth) <= 16, "0 (float) or 1..16"),
-            ("noise_std", self.noise_std >= 0.0, ">= 0 grey levels"),
-            ("blur_std", self.blur_std >= 0.0, ">= 0 pixel"),
-        ]
-        for name, ok, expected in checks:
-            if not ok:
-                raise ParameterError(
-                    f"speckle parameter {name}={getattr(self, name)!r} is out of range; expected "
-                    f"{expected}"
-                )
-
-    @property
-    def full_scale(self) -> float:
-        """Largest grey level (``2**bit_depth - 1``, or 1.0 for floating point output)."""
-        return float(2 ** int(self.bit_depth) - 1) if self.bit_depth else 1.0
 
 
 # --------------------------------------------------------------------------------------------

@@ -8,7 +8,6 @@ displacement of every reference pixel; ``jointwear datasets speckle`` is its com
 from __future__ import annotations
 
 import dataclasses
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -16,56 +15,19 @@ import xarray as xr
 
 from jointwear._version import source_attribute
 from jointwear.datasets import speckle as sp
+from jointwear.datasets._speckle_params import (
+    BIT_DEPTH_MAX,
+    DEFAULT_FRAMES,
+    DEFAULT_SEED,
+    FIELDS,
+    MIN_FRAMES,
+    PNG_BIT_DEPTH_MIN,
+    SpeckleMotion,
+)
 from jointwear.errors import BadInputError, ParameterError
 from jointwear.io import atomic_path, save
 
 __all__ = ["FIELDS", "SpeckleMotion", "write_speckle_set"]
-
-#: Displacement fields of a speckle data set.
-FIELDS = ("rigid", "affine", "rotation", "sinusoidal")
-
-
-@dataclass(frozen=True)
-class SpeckleMotion:
-    """The displacement field of the last frame of a speckle data set (pixel units).
-
-    ``rigid``: translation (``u``, ``v``) [pixel] and rotation ``theta_deg`` [degree] about the
-    image centre (+x towards +y); ``rotation``: the rotation alone; ``affine``: normal strain
-    exx = ``strain``, eyy = -strain/2 with that rotation and translation; ``sinusoidal``: u of
-    ``amplitude`` [pixel] varying along x with ``wavelength`` [pixel].
-    """
-
-    field: str = "rigid"
-    u: float = 1.5
-    v: float = -0.7
-    theta_deg: float = 0.0
-    strain: float = 0.01
-    amplitude: float = 2.0
-    wavelength: float = 128.0
-
-    def __post_init__(self) -> None:
-        if self.field not in FIELDS:
-            raise ParameterError(f"field {self.field!r}: expected one of {', '.join(FIELDS)}")
-
-    def at(self, shape: tuple[int, int], scale: float = 1.0) -> sp.Field:
-        """The field on a reference image of ``shape`` (height, width), its amplitudes scaled
-        by ``scale`` (the sinusoid's wavelength is not)."""
-        h, w = shape
-        centre = ((w - 1) / 2, (h - 1) / 2)
-        u, v, theta = self.u * scale, self.v * scale, self.theta_deg * scale
-        if self.field == "rigid":
-            return sp.RigidField((u, v), theta, centre)
-        if self.field == "rotation":
-            return sp.rotation(theta, centre)
-        if self.field == "affine":
-            return sp.AffineField.from_strain(
-                exx=self.strain * scale,
-                eyy=-0.5 * self.strain * scale,
-                rotation_deg=theta,
-                translation=(u, v),
-                center=centre,
-            )
-        return sp.SinusoidalField((self.amplitude * scale, 0.0), self.wavelength)
 
 
 def write_speckle_set(
@@ -73,9 +35,9 @@ def write_speckle_set(
     shape: tuple[int, int],
     motion: SpeckleMotion | None = None,
     *,
-    frames: int = 1,
+    frames: int = DEFAULT_FRAMES,
     params: sp.SpeckleParams | None = None,
-    seed: int = 0,
+    seed: int = DEFAULT_SEED,
 ) -> list[str]:
     """Render and write a speckle data set to the folder ``out``; return the image names.
 
@@ -97,12 +59,15 @@ def write_speckle_set(
     seed : int
         Seed of the pattern and the noise.
     """
-    if frames < 1:
-        raise ParameterError(f"frames={frames}: expected >= 1")
+    if frames < MIN_FRAMES:
+        raise ParameterError(f"frames={frames}: expected >= {MIN_FRAMES}")
     motion = SpeckleMotion() if motion is None else motion
     params = sp.SpeckleParams() if params is None else params
-    if not 1 <= params.bit_depth <= 16:
-        raise ParameterError(f"bit_depth={params.bit_depth}: expected 1..16 (PNG output)")
+    if not PNG_BIT_DEPTH_MIN <= params.bit_depth <= BIT_DEPTH_MAX:
+        raise ParameterError(
+            f"bit_depth={params.bit_depth}: expected {PNG_BIT_DEPTH_MIN}..{BIT_DEPTH_MAX} "
+            "(PNG output)"
+        )
     fields = [motion.at(shape, (k + 1) / frames) for k in range(frames)]
     images = sp.speckle_sequence(shape, [None, *fields], params=params, seed=seed)
     out = Path(out)

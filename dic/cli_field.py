@@ -10,6 +10,10 @@ import typer
 
 from jointwear._cli import Overwrite
 from jointwear.dic import _cli_options as opt
+from jointwear.dic.field._params import FieldParams
+
+#: the library's defaults (every option's default and help are read from them)
+_P = FieldParams
 
 
 def _refuse_misapplied(p: dict) -> None:
@@ -61,33 +65,35 @@ def field_cmd(
         str | None,
         typer.Option("--roi", help="x0,y0,x1,y1 (pixels), a polygon .toml or a mask image (left)."),
     ] = None,
-    subset: opt.SubsetOpt = opt.DEFAULTS.subset_size,
-    step: opt.StepOpt = opt.DEFAULTS.step,
+    subset: opt.SubsetOpt = _P.subset_size,
+    step: opt.StepOpt = _P.step,
     strain_window: Annotated[
         int | None,
         typer.Option(
             "--strain-window",
-            help="Strain fit window (grid points, odd; 0: none). Default 5 (0 with --points).",
+            help="Strain fit window (grid points, odd; 0: none). "
+            f"Default {_P.strain_window} (0 with --points).",
         ),
     ] = None,
     points: opt.PointsOpt = None,
     frame: Annotated[
         str | None,
         typer.Option(
-            "--frame", help="Stereo output frame: world or plane (best fit). Default world."
+            "--frame",
+            help=f"Stereo output frame: world or plane (best fit). Default {_P.frame}.",
         ),
     ] = None,
     fps: opt.FpsOpt = None,
-    zncc_min: opt.ZnccMinOpt = opt.DEFAULTS.zncc_min,
+    zncc_min: opt.ZnccMinOpt = _P.zncc_min,
     epipolar_max: Annotated[
         float | None,
         typer.Option(
             "--epipolar-max",
             help="Stereo: flag pairs whose rays miss by more (pixels, RMS reprojection). "
-            "Default 1.",
+            f"Default {_P.epipolar_max_px:g}.",
         ),
     ] = None,
-    search_radius: opt.SearchRadiusOpt = opt.DEFAULTS.search_radius,
+    search_radius: opt.SearchRadiusOpt = _P.search_radius,
     origin: opt.OriginOpt = "measured",
     out: opt.OutOpt = Path("field.nc"),
     csv: Annotated[
@@ -95,7 +101,7 @@ def field_cmd(
         typer.Option("--csv", help="Also write CSV (one file per image, VIC-3D-like)."),
     ] = None,
     plot: opt.PlotOpt = None,
-    threads: opt.ThreadsOpt = opt.DEFAULTS.threads,
+    threads: opt.ThreadsOpt = _P.threads,
     allow_empty: opt.AllowEmptyOpt = False,
     overwrite: Overwrite = False,
 ) -> None:
@@ -103,7 +109,6 @@ def field_cmd(
     --left/--right/--calibration); still images need no --fps."""
     from jointwear.dic._flag_report import check_flags
     from jointwear.dic.field._files import measure_field_files
-    from jointwear.dic.field._measure import FieldParams
 
     _refuse_misapplied(ctx.params)
     given = dict(frame=frame, epipolar_max_px=epipolar_max, strain_window=strain_window)

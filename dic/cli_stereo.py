@@ -10,6 +10,8 @@ import typer
 from jointwear._cli import FigureOut, Overwrite, Scheduler
 from jointwear.dic import _cli_options as opt
 from jointwear.dic.calibration._defaults import (
+    BOARD_KIND,
+    BOARD_SQUARES,
     CHARUCO_DICTIONARY,
     MAX_RMS_PX,
     MAX_VIEW_RMS_PX,
@@ -103,10 +105,10 @@ def calibrate_cmd(
     overwrite: Overwrite = False,
     board: Annotated[
         Literal["chessboard", "charuco"], typer.Option(help="chessboard or charuco.")
-    ] = "chessboard",
+    ] = BOARD_KIND,
     squares: Annotated[
         tuple[int, int], typer.Option(help="Squares along x and y (not inner corners).")
-    ] = (10, 7),
+    ] = BOARD_SQUARES,
     square: Annotated[
         float | None,
         typer.Option(help="Side of one board square, in --unit (required)."),

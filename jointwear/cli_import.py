@@ -8,6 +8,7 @@ from typing import Annotated
 
 import typer
 
+from jointwear import _import_defaults as D
 from jointwear._cli import AngleDirection, AngleZero, Overwrite
 
 app = typer.Typer(
@@ -92,14 +93,16 @@ def motion(
     velocity_unit: Annotated[
         str | None, typer.Option("--velocity-unit", help="Unit of the velocity columns, e.g. mm/s.")
     ] = None,
-    time_unit: Annotated[str, typer.Option("--time-unit", help="Unit of the time column.")] = "s",
+    time_unit: Annotated[
+        str, typer.Option("--time-unit", help="Unit of the time column.")
+    ] = D.TIME_UNIT,
     time_column: Annotated[
         str, typer.Option("--time-column", help="Name of the time column.")
-    ] = "time",
+    ] = D.TIME_COLUMN,
     velocity_columns: Annotated[
         str,
         typer.Option("--velocity-columns", help="Velocity column names x,y[,z] (bearing frame)."),
-    ] = "vx,vy,vz",
+    ] = ",".join(D.VELOCITY_COLUMNS),
     tool: _Tool = None,
 ) -> None:
     """Import a follower motion history: time and velocity columns with stated units."""
@@ -142,11 +145,11 @@ def wearmap(
     ] = None,
     columns: Annotated[
         str, typer.Option("--columns", help="Names of the theta, z and depth columns.")
-    ] = "theta,z,wear_depth",
+    ] = ",".join(D.WEAR_MAP_COLUMNS),
     z_mid_width: Annotated[
         float,
         typer.Option("--z-mid-width", help="z of the bearing mid-width in the file [z unit]."),
-    ] = 0.0,
+    ] = D.Z_MID_WIDTH,
     cycles: Annotated[
         float | None, typer.Option("--cycles", help="Crank cycles the map belongs to.")
     ] = None,

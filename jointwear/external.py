@@ -29,6 +29,7 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
+from jointwear import _import_defaults as D
 from jointwear import conventions
 from jointwear.errors import BadInputError, ParameterError
 
@@ -213,9 +214,9 @@ def import_motion(
     *,
     velocity_unit: str,
     data_origin: str,
-    time_unit: str = "s",
-    time_column: str = "time",
-    velocity_columns: Sequence[str] = ("vx", "vy", "vz"),
+    time_unit: str = D.TIME_UNIT,
+    time_column: str = D.TIME_COLUMN,
+    velocity_columns: Sequence[str] = D.VELOCITY_COLUMNS,
     position_columns: Sequence[str] | None = None,
     position_unit: str | None = None,
     tool: str | None = None,
@@ -292,8 +293,8 @@ def import_wear_map(
     angle_zero: str,
     angle_direction: str,
     data_origin: str,
-    columns: Sequence[str] = ("theta", "z", "wear_depth"),
-    z_mid_width: float = 0.0,
+    columns: Sequence[str] = D.WEAR_MAP_COLUMNS,
+    z_mid_width: float = D.Z_MID_WIDTH,
     z_reversed: bool = False,
     cycles: float | None = None,
     tool: str | None = None,

@@ -21,6 +21,7 @@ from jointwear.metrology.choices import (
     PRESETS,
     REFERENCES,
     VALUE_KINDS,
+    WEAR_SHAPES,
     Z_SOURCES,
 )
 from jointwear.metrology.choices import PLAUSIBILITY as _LIM
@@ -40,7 +41,7 @@ Preset = choices("Preset", PRESETS, "Reader preset.")
 Layout = choices("Layout", LAYOUTS, "Multi-layer layout.")
 Decimal = choices("Decimal", [("point", "."), ("comma", ",")], "Decimal separator.")
 FilterKind = choices("FilterKind", [("gaussian", "gaussian"), ("rc2", "2rc")], "Profile filter.")
-Shape = choices("Shape", ("auto", "cylinder", "circle", "form"), "Unworn reference shape.")
+Shape = choices("Shape", WEAR_SHAPES, "Unworn reference shape.")
 Reference = choices("Reference", tuple(REFERENCES), "ISO reference.")
 ValueKind = choices("ValueKind", ("auto", *VALUE_KINDS), "Meaning of the value column(s).")
 

@@ -16,6 +16,9 @@ __all__ = [
     "PRESETS",
     "REFERENCES",
     "PLAUSIBILITY",
+    "WEAR_SHAPES",
+    "WEAR_SHAPE",
+    "UNWORN_THRESHOLD",
 ]
 
 #: Units an angle column may have (``index`` = sample number over one full turn).
@@ -51,3 +54,9 @@ PLAUSIBILITY: dict[str, float] = {
     "points_tolerance": 0.01,  # relative: stated angular step vs the step of the angles
     "filter_ratio": 0.1,  # high-band / mid-band amplitude above which a filter claim is false
 }
+
+#: Unworn reference shapes of :func:`~jointwear.metrology.wear_map`, and its default.
+WEAR_SHAPES = ("auto", "cylinder", "circle", "form")
+WEAR_SHAPE = "auto"
+#: Unworn points of a wear map lie within this many robust standard deviations [1].
+UNWORN_THRESHOLD = 3.0

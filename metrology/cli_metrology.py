@@ -11,7 +11,7 @@ from jointwear._cli import AngleDirection, AngleZero, FigureOut, Overwrite
 from jointwear._version import source_attribute
 from jointwear.metrology import _cli_options as opt
 from jointwear.metrology._cli_options import FilterKind, Shape
-from jointwear.metrology.choices import REFERENCES
+from jointwear.metrology.choices import REFERENCES, UNWORN_THRESHOLD, WEAR_SHAPE
 
 _SOURCE = source_attribute("metrology")
 
@@ -229,10 +229,10 @@ def wearmap_cmd(
             help="Unworn reference: auto (cylinder with --before, else form), cylinder, circle "
             "(per layer) or form (centre per layer, taper and lobing smooth in z).",
         ),
-    ] = Shape.auto,
+    ] = Shape(WEAR_SHAPE),
     threshold: Annotated[
         float, typer.Option("--threshold", help="Unworn = within this many robust std devs.")
-    ] = 3.0,
+    ] = UNWORN_THRESHOLD,
     radius_mm: Annotated[
         float | None, typer.Option("--radius-mm", help="Bore radius for the volume [mm].")
     ] = None,

@@ -78,6 +78,7 @@ from jointwear.metrology._wear_setup import (
     registered_offset,
 )
 from jointwear.metrology.baseline import FormBasis, correlation_length, noise_sigma
+from jointwear.metrology.choices import UNWORN_THRESHOLD, WEAR_SHAPE, WEAR_SHAPES
 from jointwear.metrology.form import SCAN_VARIABLES, scan_variable
 from jointwear.metrology.wear_quantities import derived_quantities
 
@@ -137,8 +138,8 @@ def wear_map(
     *,
     angle_offset_deg: float = 0.0,
     register: bool = False,
-    shape: str = "auto",
-    threshold: float = 3.0,
+    shape: str = WEAR_SHAPE,
+    threshold: float = UNWORN_THRESHOLD,
     unworn: np.ndarray | xr.DataArray | None = None,
     surface: str = "bore",
     radius: float | None = None,
@@ -327,9 +328,9 @@ def _refuse_form_tails(q, tail, limit: float = 0.3) -> None:
 
 def _options(shape, before, margin_deg, surface, threshold) -> tuple[str, float]:
     """Checked options: (reference shape, margin around worn regions [degree])."""
-    if shape not in ("auto", "cylinder", "circle", "form"):
+    if shape not in WEAR_SHAPES:
         raise BadInputError(
-            f"wear_map: shape must be 'auto', 'cylinder', 'circle' or 'form', got {shape!r}"
+            f"wear_map: shape must be one of {', '.join(map(repr, WEAR_SHAPES))}, got {shape!r}"
         )
     if shape == "auto":
         shape = "cylinder" if before is not None else "form"

@@ -7,11 +7,16 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from pathlib import Path
-
-import xarray as xr
+from typing import TYPE_CHECKING
 
 from jointwear.errors import BadInputError, ParameterError, SimulationError
 from jointwear.sim.parameters import SimParameters
+
+if TYPE_CHECKING:  # light: the CLI reads DEFAULT_CRANK_CYCLES without the numerical stack
+    import xarray as xr
+
+#: Crank cycles a cycle run simulates unless told.
+DEFAULT_CRANK_CYCLES = 1.0
 
 __all__ = ["cycle_parameters", "simulate_cycles_to_file"]
 
@@ -50,7 +55,7 @@ def simulate_cycles_to_file(
     out: str | Path,
     params: SimParameters,
     *,
-    cycles: float = 1.0,
+    cycles: float = DEFAULT_CRANK_CYCLES,
     params_file: str | Path | None = None,
     wear: str | Path | None = None,
     wear_cycles: float | None = None,

@@ -9,6 +9,7 @@ import typer
 
 from jointwear._cli import NetcdfOut, Overwrite
 from jointwear.sim._cli_options import Base, Progress
+from jointwear.sim._cycle_file import DEFAULT_CRANK_CYCLES
 from jointwear.sim.parameters import DEFAULT_PARAMETER_SET
 
 __all__ = ["register"]
@@ -19,7 +20,7 @@ def cycle(
     overwrite: Overwrite = False,
     cycles: Annotated[
         float, typer.Option("--cycles", help="Crank cycles to simulate (fractions allowed).")
-    ] = 1.0,
+    ] = DEFAULT_CRANK_CYCLES,
     params: Annotated[
         Path | None,
         typer.Option("--params", help="TOML file overriding the parameter set (SI units)."),

@@ -17,6 +17,7 @@ from jointwear.sim._cli_options import (
     check_lost_runs,
 )
 from jointwear.sim.parameters import DEFAULT_PARAMETER_SET
+from jointwear.sim.sweep._verify_spec import default_study
 
 __all__ = ["register"]
 
@@ -27,8 +28,7 @@ def verify(
         Path | None,
         typer.Argument(
             help="Study spec (TOML with a \\[verify] table; see docs/sim-wear.md). Without "
-            "it: the default study (4 dN levels N/80 x 1, 2, 4, 8; 4 replicates each; 4 "
-            "runs on the grid refined 2x)."
+            f"it: the default study ({default_study()})."
         ),
     ] = None,
     cycles: Annotated[

@@ -10,7 +10,7 @@ import typer
 from jointwear._cli import Overwrite
 from jointwear.sim._cli_options import Base, Progress, WearParams
 from jointwear.sim.parameters import DEFAULT_PARAMETER_SET, JointParameters
-from jointwear.sim.wear._settings import DEFAULT_CYCLES, WearSettings
+from jointwear.sim.wear._settings import CALIBRATION_RTOL, DEFAULT_CYCLES, WearSettings
 
 __all__ = ["register"]
 
@@ -169,7 +169,7 @@ def calibrate(
     ] = True,
     rtol: Annotated[
         float, typer.Option("--rtol", help="Relative tolerance of the re-simulated match.")
-    ] = 0.02,
+    ] = CALIBRATION_RTOL,
 ) -> None:
     """Estimate the wear coefficient kw from measured wear depth, volume, cylindricity or a map.
 

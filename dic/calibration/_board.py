@@ -11,6 +11,8 @@ import numpy as np
 
 from jointwear.dic.calibration._camera import Camera, StereoCalibration, _check_enough_views
 from jointwear.dic.calibration._defaults import (
+    BOARD_KIND,
+    BOARD_SQUARES,
     CHARUCO_DICTIONARY,
     MAX_RMS_PX,
     MAX_VIEW_RMS_PX,
@@ -46,9 +48,9 @@ class CalibrationBoard:
         board; None: not assessed.
     """
 
-    kind: Literal["chessboard", "charuco"] = "chessboard"
-    squares_x: int = 10
-    squares_y: int = 7
+    kind: Literal["chessboard", "charuco"] = BOARD_KIND
+    squares_x: int = BOARD_SQUARES[0]
+    squares_y: int = BOARD_SQUARES[1]
     square_size: float = 0.01
     marker_size: float = 0.0075
     dictionary: str = CHARUCO_DICTIONARY

@@ -11,3 +11,6 @@ MAX_VIEW_RMS_PX = 1.0
 VIDEO_EVERY = 10
 #: ArUco dictionary of a ChArUco board
 CHARUCO_DICTIONARY = "DICT_5X5_100"
+#: board kind and its squares along x and y (not inner corners)
+BOARD_KIND = "chessboard"
+BOARD_SQUARES = (10, 7)

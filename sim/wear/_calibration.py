@@ -24,7 +24,7 @@ import xarray as xr
 from jointwear import conventions
 from jointwear.errors import BadInputError
 from jointwear.sim.wear._loop import simulate_wear
-from jointwear.sim.wear._settings import WearSettings
+from jointwear.sim.wear._settings import CALIBRATION_RTOL, WearSettings
 from jointwear.sim.wear._settings import check_kw as _check_kw
 
 __all__ = [
@@ -212,7 +212,7 @@ def calibrate_kw(
     quantity: Literal["max_depth", "volume", "cylindricity", "map"] | None = None,
     cycles: float | None = None,
     resimulate: Callable[[float], xr.Dataset] | None = None,
-    rtol: float = 0.02,
+    rtol: float = CALIBRATION_RTOL,
     max_iter: int = 6,
 ) -> KwCalibration:
     """Estimate kw so that the simulated wear matches a measurement.
@@ -624,7 +624,7 @@ def calibration_report(
     cycles: float | None = None,
     vary: tuple[str, tuple[float, float]] | None = None,
     resimulate: bool = True,
-    rtol: float = 0.02,
+    rtol: float = CALIBRATION_RTOL,
 ) -> list[str]:
     """Calibrate kw against measurements and describe the result, line by line.
 

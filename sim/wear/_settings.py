@@ -13,6 +13,7 @@ from jointwear.params import check_fields, checked, non_negative, within
 __all__ = [
     "DEFAULT_KW",
     "DEFAULT_CYCLES",
+    "CALIBRATION_RTOL",
     "KW_RANGE",
     "WearSettings",
     "check_kw",
@@ -24,6 +25,9 @@ DEFAULT_KW: float = 9.0e-16
 
 #: Default target of a wear run [cycles].
 DEFAULT_CYCLES: float = 1e6
+
+#: Relative tolerance of a re-simulated kw calibration's match to the measurement.
+CALIBRATION_RTOL: float = 0.02
 
 #: Accepted range of kw [m²/N]. Above 1e-11 (1e-2 mm³/(N m), beyond severe dry wear) the bore of
 #: the study would wear through in hours; below 1e-20 nothing measurable wears in any lifetime.

@@ -1,0 +1,144 @@
+"""The parameters of a synthetic speckle data set, one source for the library and ``jointwear
+datasets speckle`` (light: the CLI reads these defaults and limits without importing numpy).
+
+:class:`SpeckleParams` is public as ``jointwear.datasets.speckle.SpeckleParams``,
+:class:`SpeckleMotion` and :data:`FIELDS` as ``jointwear.datasets.speckle_set.…``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+from jointwear.errors import ParameterError
+
+if TYPE_CHECKING:
+    from jointwear.datasets.speckle import Field
+
+__all__ = [
+    "BIT_DEPTH_MAX",
+    "DEFAULT_FRAMES",
+    "DEFAULT_SEED",
+    "FIELDS",
+    "MIN_FRAMES",
+    "PNG_BIT_DEPTH_MIN",
+    "SpeckleMotion",
+    "SpeckleParams",
+]
+
+#: Deepest grey scale of an image [bit]; a PNG needs at least PNG_BIT_DEPTH_MIN (0, floating
+#: point grey levels, is an array only).
+BIT_DEPTH_MAX = 16
+PNG_BIT_DEPTH_MIN = 1
+
+#: Displacement fields of a speckle data set.
+FIELDS = ("rigid", "affine", "rotation", "sinusoidal")
+
+#: Deformed frames of a data set: the default and the fewest.
+DEFAULT_FRAMES = MIN_FRAMES = 1
+#: Seed of the pattern and the noise.
+DEFAULT_SEED = 0
+
+
+@dataclass(frozen=True)
+class SpeckleParams:
+    """Pattern and camera parameters of a synthetic speckle image.
+
+    Parameters
+    ----------
+    speckle_size : float
+        Nominal speckle diameter [pixel]; each blob is a Gaussian of standard deviation
+        ``speckle_size / 4``.
+    density : float
+        Expected fraction of the area covered by speckles (number of blobs = ``density * area /
+        (pi * (speckle_size / 2)**2)``), in (0, 5].
+    contrast : float
+        Difference between the brightest and darkest intensity as a fraction of full scale,
+        in (0, 1].
+    bit_depth : int
+        Bits per pixel of the output (1..16); 0 returns floating point grey levels unrounded.
+    noise_std : float
+        Standard deviation of additive Gaussian noise [grey levels of the output scale].
+    blur_std : float
+        Standard deviation of a Gaussian point-spread function in the image plane [pixel].
+    dark_speckles : bool
+        Dark speckles on a bright background (default False: bright on dark).
+    """
+
+    speckle_size: float = 5.0
+    density: float = 0.6
+    contrast: float = 0.8
+    bit_depth: int = 8
+    noise_std: float = 0.0
+    blur_std: float = 0.0
+    dark_speckles: bool = False
+
+    def __post_init__(self) -> None:
+        checks = [
+            ("speckle_size", 1.0 <= self.speckle_size <= 200.0, "between 1 and 200 pixel"),
+            ("density", 0.0 < self.density <= 5.0, "in (0, 5]"),
+            ("contrast", 0.0 < self.contrast <= 1.0, "in (0, 1]"),
+            (
+                "bit_depth",
+                0 <= int(self.bit_depth) <= BIT_DEPTH_MAX,
+                f"0 (float) or 1..{BIT_DEPTH_MAX}",
+            ),
+            ("noise_std", self.noise_std >= 0.0, ">= 0 grey levels"),
+            ("blur_std", self.blur_std >= 0.0, ">= 0 pixel"),
+        ]
+        for name, ok, expected in checks:
+            if not ok:
+                raise ParameterError(
+                    f"speckle parameter {name}={getattr(self, name)!r} is out of range; expected "
+                    f"{expected}"
+                )
+
+    @property
+    def full_scale(self) -> float:
+        """Largest grey level (``2**bit_depth - 1``, or 1.0 for floating point output)."""
+        return float(2 ** int(self.bit_depth) - 1) if self.bit_depth else 1.0
+
+
+@dataclass(frozen=True)
+class SpeckleMotion:
+    """The displacement field of the last frame of a speckle data set (pixel units).
+
+    ``rigid``: translation (``u``, ``v``) [pixel] and rotation ``theta_deg`` [degree] about the
+    image centre (+x towards +y); ``rotation``: the rotation alone; ``affine``: normal strain
+    exx = ``strain``, eyy = -strain/2 with that rotation and translation; ``sinusoidal``: u of
+    ``amplitude`` [pixel] varying along x with ``wavelength`` [pixel].
+    """
+
+    field: str = "rigid"
+    u: float = 1.5
+    v: float = -0.7
+    theta_deg: float = 0.0
+    strain: float = 0.01
+    amplitude: float = 2.0
+    wavelength: float = 128.0
+
+    def __post_init__(self) -> None:
+        if self.field not in FIELDS:
+            raise ParameterError(f"field {self.field!r}: expected one of {', '.join(FIELDS)}")
+
+    def at(self, shape: tuple[int, int], scale: float = 1.0) -> Field:
+        """The field on a reference image of ``shape`` (height, width), its amplitudes scaled
+        by ``scale`` (the sinusoid's wavelength is not)."""
+        from jointwear.datasets import speckle as sp
+
+        h, w = shape
+        centre = ((w - 1) / 2, (h - 1) / 2)
+        u, v, theta = self.u * scale, self.v * scale, self.theta_deg * scale
+        if self.field == "rigid":
+            return sp.RigidField((u, v), theta, centre)
+        if self.field == "rotation":
+            return sp.rotation(theta, centre)
+        if self.field == "affine":
+            return sp.AffineField.from_strain(
+                exx=self.strain * scale,
+                eyy=-0.5 * self.strain * scale,
+                rotation_deg=theta,
+                translation=(u, v),
+                center=centre,
+            )
+        return sp.SinusoidalField((self.amplitude * scale, 0.0), self.wavelength)
