@@ -9,15 +9,7 @@ import typer
 
 from jointwear._cli import FigureOut, Overwrite, Scheduler
 from jointwear.dic import _cli_options as opt
-from jointwear.dic.calibration._defaults import (
-    BOARD_KIND,
-    BOARD_SQUARES,
-    CHARUCO_DICTIONARY,
-    MAX_RMS_PX,
-    MAX_VIEW_RMS_PX,
-    MIN_VIEWS,
-    VIDEO_EVERY,
-)
+from jointwear.dic.calibration import _defaults as defaults
 
 
 def _board(board, squares, square, unit, square_u, square_mm, marker, marker_mm, dictionary):
@@ -61,7 +53,7 @@ def _board(board, squares, square, unit, square_u, square_mm, marker, marker_mm,
         squares[1],
         square * scale,
         marker_m,
-        dictionary or CHARUCO_DICTIONARY,
+        dictionary or defaults.CHARUCO_DICTIONARY,
         length_unit=length_unit,
         square_size_u=None if square_u is None else square_u * scale,
     )
@@ -105,10 +97,10 @@ def calibrate_cmd(
     overwrite: Overwrite = False,
     board: Annotated[
         Literal["chessboard", "charuco"], typer.Option(help="chessboard or charuco.")
-    ] = BOARD_KIND,
+    ] = defaults.BOARD_KIND,
     squares: Annotated[
         tuple[int, int], typer.Option(help="Squares along x and y (not inner corners).")
-    ] = BOARD_SQUARES,
+    ] = defaults.BOARD_SQUARES,
     square: Annotated[
         float | None,
         typer.Option(help="Side of one board square, in --unit (required)."),
@@ -131,24 +123,26 @@ def calibrate_cmd(
     marker_mm: Annotated[float | None, typer.Option(hidden=True)] = None,
     dictionary: Annotated[
         str | None,
-        typer.Option(help=f"ChArUco ArUco dictionary (default {CHARUCO_DICTIONARY})."),
+        typer.Option(help=f"ChArUco ArUco dictionary (default {defaults.CHARUCO_DICTIONARY})."),
     ] = None,
     world_view: Annotated[
         int | None,
         typer.Option(help="Index of the view whose board pose becomes the world frame."),
     ] = None,
-    min_views: Annotated[int, typer.Option(min=1, help="Fewest usable views.")] = MIN_VIEWS,
+    min_views: Annotated[
+        int, typer.Option(min=1, help="Fewest usable views.")
+    ] = defaults.MIN_VIEWS,
     every: Annotated[
         int | None,
-        typer.Option(min=1, help=f"Videos: use every N-th frame (default {VIDEO_EVERY})."),
+        typer.Option(min=1, help=f"Videos: use every N-th frame (default {defaults.VIDEO_EVERY})."),
     ] = None,
     max_rms: Annotated[
         float, typer.Option(help="Largest acceptable stereo reprojection RMS (px).")
-    ] = MAX_RMS_PX,
+    ] = defaults.MAX_RMS_PX,
     max_view_rms: Annotated[
         float,
         typer.Option(help="Views above this per-camera reprojection RMS (px) are dropped."),
-    ] = MAX_VIEW_RMS_PX,
+    ] = defaults.MAX_VIEW_RMS_PX,
     accept_poor: Annotated[
         bool,
         typer.Option(
@@ -186,7 +180,7 @@ def calibrate_cmd(
             right,
             out,
             b,
-            every=VIDEO_EVERY if every is None else every,
+            every=defaults.VIDEO_EVERY if every is None else every,
             parameters=params,
             min_views=min_views,
             world_view=world_view,

@@ -13,7 +13,6 @@ by :func:`jointwear.io.encode_attrs`), atomically. The library keeps returning t
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -108,21 +107,13 @@ def _fill_value(values: np.ndarray) -> Any:
     return values.dtype.type(np.nan) if values.dtype.kind in "fc" else None
 
 
-def write_record(
-    record: Record,
-    path: str | Path,
-    *,
-    inputs: Iterable[str | Path] = (),
-    parameters: Any = None,
-    command: str | None = None,
-    source: str | None = None,
-    title: str | None = None,
-    parents: Iterable[Mapping[str, Any]] = (),
-) -> Path:
+def write_record(record: Record, path: str | Path, **provenance: Any) -> Path:
     """Write ``record`` to netCDF-4 atomically, as :func:`jointwear.io.save` writes its Dataset.
 
-    Parameters are those of :func:`jointwear.io.save` (``parents`` as provenance dicts); the
-    record is not checked against the data contract (build it with code whose Dataset is).
+    ``provenance`` are the keywords of :func:`jointwear.io.save` (``inputs``, ``parameters``,
+    ``command``, ``source``, ``title``; ``parents`` as provenance dicts), given to
+    :func:`jointwear.io.file_attrs`. The record is not checked against the data contract (build
+    it with code whose Dataset is).
 
     Returns
     -------
@@ -134,15 +125,7 @@ def write_record(
     from jointwear.io import atomic_path, encode_attrs, file_attrs
 
     path = Path(path)
-    attrs = file_attrs(
-        record.attrs,
-        inputs=inputs,
-        parameters=parameters,
-        command=command,
-        source=source,
-        title=title,
-        parents=parents,
-    )
+    attrs = file_attrs(record.attrs, **provenance)
     variables = record.variables
     dims = record.dims
     with atomic_path(path) as tmp:
