@@ -8,6 +8,7 @@ import numbers
 from dataclasses import dataclass
 from typing import Literal
 
+from jointwear.dic.subset._params import CorrelationParams
 from jointwear.errors import ParameterError
 
 __all__ = ["FieldParams"]
@@ -44,18 +45,18 @@ class FieldParams:
         As :class:`jointwear.dic.CorrelationParams`.
     """
 
-    subset_size: int = 31
-    step: int = 10
+    subset_size: int = CorrelationParams.subset_size
+    step: int = CorrelationParams.step
     strain_window: int = 5
     frame: Literal["world", "plane"] = "world"
-    zncc_min: float = 0.8
+    zncc_min: float = CorrelationParams.zncc_min
     epipolar_max_px: float = 1.0
     consistency_max_px: float = 0.02
-    interpolation: Literal["cubic", "quintic"] = "quintic"
-    tolerance: float = 1e-3
-    max_iterations: int = 40
-    search_radius: int = 48
-    threads: int = 0
+    interpolation: Literal["cubic", "quintic"] = CorrelationParams.interpolation
+    tolerance: float = CorrelationParams.tolerance
+    max_iterations: int = CorrelationParams.max_iterations
+    search_radius: int = CorrelationParams.search_radius
+    threads: int = CorrelationParams.threads
 
     def __post_init__(self) -> None:
         w = self.strain_window
@@ -75,8 +76,6 @@ class FieldParams:
             raise ParameterError(f"epipolar_max_px={self.epipolar_max_px!r}: expected > 0 pixel")
 
     def correlation(self):
-        from jointwear.dic.subset._correlator import CorrelationParams
-
         return CorrelationParams(
             subset_size=self.subset_size,
             step=self.step,
