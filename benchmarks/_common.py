@@ -14,6 +14,17 @@ from typing import Any
 RESULTS = Path(__file__).resolve().parent / "results"
 
 
+def _load_average() -> float | None:
+    try:
+        return os.getloadavg()[0]
+    except OSError:
+        return None
+
+
+#: the 1-minute load average when the benchmark started (this module is imported first)
+_LOAD_AT_START = _load_average()
+
+
 def machine() -> dict[str, Any]:
     """Describe the machine the figures were measured on."""
     cpu = platform.processor() or platform.machine()
@@ -25,16 +36,13 @@ def machine() -> dict[str, Any]:
                     break
     except OSError:
         pass
-    try:
-        load = os.getloadavg()[0]
-    except OSError:
-        load = None
     return {
         "cpu": cpu,
         "cores": os.cpu_count(),
         "python": platform.python_version(),
         "platform": platform.platform(),
-        "load_average_1min_at_start": load,
+        "load_average_1min_at_start": _LOAD_AT_START,
+        "load_average_1min_at_end": _load_average(),
     }
 
 
