@@ -22,6 +22,15 @@ from jointwear._compile_notice import announce_compilation
 from jointwear._version import __version__
 from jointwear.errors import EXIT_BAD_INPUT, EXIT_USAGE, JointwearError
 
+#: BLAS thread pools of the command's process: one thread each unless the user set them. The
+#: parallel work is in numba kernels and worker processes; idle OpenBLAS pools (numpy's and
+#: scipy's) cost about 0.2-0.3 CPU s per command just to start and spin (benchmarks/
+#: bench_startup.py), and on a shared 2-core machine they compete with the numba threads.
+#: Set before numpy is first imported (nothing above imports it).
+BLAS_THREAD_VARIABLES = ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
+for _name in BLAS_THREAD_VARIABLES:
+    os.environ.setdefault(_name, "1")
+
 app = typer.Typer(
     name="jointwear",
     help="Validate wear simulations of joints with clearance against test-rig measurements.",

@@ -108,3 +108,31 @@ def test_dic_correlate_of_a_pair_imports_neither_xarray_nor_pandas(tmp_path):
     assert (field["flag"].values == 0).all()
     np.testing.assert_allclose(field["u"].values, 1.7, atol=0.02)
     np.testing.assert_allclose(field["v"].values, -0.4, atol=0.02)
+
+
+@pytest.mark.parametrize("user", [None, "2"])
+def test_the_command_runs_blas_single_threaded_unless_the_user_says(tmp_path, user):
+    """Idle OpenBLAS pools cost ~0.25 CPU s per command (bench_startup): the CLI sets one BLAS
+    thread before numpy is imported; a value the user exported is kept."""
+    import os
+
+    from jointwear.cli import BLAS_THREAD_VARIABLES
+
+    env = {k: v for k, v in os.environ.items() if k not in BLAS_THREAD_VARIABLES}
+    if user is not None:
+        env["OPENBLAS_NUM_THREADS"] = user
+    code = (
+        "import sys\nimport jointwear.cli\n"
+        "print('numpy' in sys.modules)\n"
+        "import os\nprint(os.environ['OPENBLAS_NUM_THREADS'], os.environ['MKL_NUM_THREADS'])"
+    )
+    out = subprocess.run(
+        [sys.executable, "-c", code],
+        capture_output=True,
+        text=True,
+        cwd=tmp_path,
+        env=env,
+        check=True,
+    ).stdout.split("\n")
+    assert out[0] == "False"  # set before numpy (and its BLAS) is loaded
+    assert out[1] == f"{user or '1'} 1"
