@@ -649,6 +649,6 @@ class SubsetCorrelator:
             sigma=res.sigma,
         )
 
-    def to_dataset(self, res: MatchResult, *, time: float | None = None) -> xr.Dataset:
+    def to_dataset(self, res: MatchResult) -> xr.Dataset:
         """Package a :class:`MatchResult` as an xarray Dataset (grid ``(y, x)`` or ``point``)."""
         return self.to_record(res).to_dataset()

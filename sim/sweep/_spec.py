@@ -396,10 +396,7 @@ def read_spec(spec: str | Path | Mapping[str, Any]) -> SweepSpec:
         from jointwear.params import read_toml
 
         where_file = f"sweep spec '{spec}': "
-        try:
-            data = read_toml(spec)
-        except ParameterError:
-            raise
+        data = read_toml(spec)
         try:
             return read_spec(data)
         except ParameterError as exc:
