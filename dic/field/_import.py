@@ -31,6 +31,7 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
+from jointwear.dic.subset._params import check_image_origin
 from jointwear.errors import BadInputError, ParameterError
 
 __all__ = ["read_field", "FIELD_FORMATS"]
@@ -192,10 +193,7 @@ def read_field(
     """
     if format not in FIELD_FORMATS:
         raise ParameterError(f"format={format!r}: expected one of {', '.join(FIELD_FORMATS)}")
-    if data_origin not in ("measured", "synthetic"):
-        raise ParameterError(
-            f"data_origin={data_origin!r}: say what the images were, 'measured' or 'synthetic'"
-        )
+    check_image_origin(data_origin)
     paths = _files(files)
     cx, cy, pos_c, disp_c, disp2_c, sig_c, q_c = _COLUMNS[format]
     tables = [_table(p, format) for p in paths]

@@ -50,6 +50,7 @@ import xarray as xr
 
 from jointwear.dic.field._params import FieldParams
 from jointwear.dic.icgn import _flags
+from jointwear.dic.subset._params import check_image_origin
 from jointwear.errors import BadInputError, ParameterError
 
 __all__ = ["FieldParams", "measure_field", "FIELD_FLAG_MEANINGS"]
@@ -316,8 +317,7 @@ def measure_field(
     from jointwear.dic.subset._correlator import SubsetCorrelator
 
     prm = _field_params(params, options)
-    if data_origin not in ("measured", "synthetic"):
-        raise ParameterError(f"data_origin={data_origin!r}: expected 'measured' or 'synthetic'")
+    check_image_origin(data_origin)
     calibration, L, lnames, Rr, rnames = _read_images(left, right, calibration)
     t = _time_base(times, frame_rate, len(L))
     cp = prm.correlation()

@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from jointwear.dic.subset._params import UPDATE_ZNCC, CorrelationParams
+from jointwear.dic.subset._params import UPDATE_ZNCC, CorrelationParams, check_image_origin
 from jointwear.errors import BadInputError, ParameterError
 
 if TYPE_CHECKING:
@@ -159,11 +159,7 @@ def correlate_files(
         check_writable(plot, what="figure")
     if points is not None and roi is not None:
         raise ParameterError("give either points= or roi=, not both")
-    if data_origin not in ("measured", "synthetic"):
-        raise ParameterError(
-            f"data_origin={data_origin!r} (--origin): say what the images are, 'measured' "
-            "(camera images) or 'synthetic' (generated)"
-        )
+    check_image_origin(data_origin)
     if isinstance(points, (str, Path)):
         points = read_points_file(Path(points))
     t0 = time.perf_counter()

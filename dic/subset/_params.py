@@ -20,6 +20,8 @@ __all__ = [
     "set_threads",
     "check_image",
     "check_pair",
+    "IMAGE_ORIGINS",
+    "check_image_origin",
 ]
 
 #: smallest subset side [pixel] (odd) and grid step [pixel] the correlation accepts
@@ -28,6 +30,9 @@ MIN_STEP = 1
 
 #: default median ZNCC below which an incremental sequence moves its reference forward
 UPDATE_ZNCC = 0.9
+
+#: what DIC images can be (the results' ``data_origin``): camera images or generated ones
+IMAGE_ORIGINS = ("measured", "synthetic")
 
 _SHAPES = {"affine": False, "first": False, "quadratic": True, "second": True}
 
@@ -164,6 +169,17 @@ def check_pair(reference: np.ndarray, deformed: np.ndarray, what: str = "deforme
             "images of one sequence must come from the same camera setting - convert both to the "
             "same type (e.g. .astype(np.float64)) if that is intended"
         )
+
+
+def check_image_origin(data_origin: str) -> str:
+    """``data_origin`` if it is one of :data:`IMAGE_ORIGINS`, else a ParameterError naming
+    ``data_origin`` (``--origin``) and the two choices."""
+    if data_origin not in IMAGE_ORIGINS:
+        raise ParameterError(
+            f"data_origin={data_origin!r} (--origin): say what the images are, 'measured' "
+            "(camera images) or 'synthetic' (generated)"
+        )
+    return data_origin
 
 
 def _integral_invalid(valid: np.ndarray) -> np.ndarray:
