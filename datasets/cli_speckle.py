@@ -22,8 +22,6 @@ from jointwear.datasets._speckle_params import (
     SpeckleParams,
 )
 
-_Motion, _Params = SpeckleMotion, SpeckleParams
-
 
 def speckle_cmd(
     out: Annotated[Path, typer.Argument(help="Output folder.")],
@@ -32,21 +30,25 @@ def speckle_cmd(
     field: Annotated[
         Literal["rigid", "affine", "rotation", "sinusoidal"],
         typer.Option("--field", help="rigid, affine, rotation or sinusoidal."),
-    ] = _Motion.field,
-    u: Annotated[float, typer.Option("--u", help="Translation along x (pixels).")] = _Motion.u,
-    v: Annotated[float, typer.Option("--v", help="Translation along y (pixels).")] = _Motion.v,
+    ] = SpeckleMotion.field,
+    u: Annotated[
+        float, typer.Option("--u", help="Translation along x (pixels).")
+    ] = SpeckleMotion.u,
+    v: Annotated[
+        float, typer.Option("--v", help="Translation along y (pixels).")
+    ] = SpeckleMotion.v,
     theta_deg: Annotated[
         float, typer.Option("--theta-deg", help="Rotation (degrees), +x towards +y.")
-    ] = _Motion.theta_deg,
+    ] = SpeckleMotion.theta_deg,
     strain: Annotated[
         float, typer.Option("--strain", help="Affine: normal strain exx = -eyy/2.")
-    ] = _Motion.strain,
+    ] = SpeckleMotion.strain,
     amplitude: Annotated[
         float, typer.Option("--amplitude", help="Sinusoidal: amplitude of u (pixels).")
-    ] = _Motion.amplitude,
+    ] = SpeckleMotion.amplitude,
     wavelength: Annotated[
         float, typer.Option("--wavelength", help="Sinusoidal: wavelength (pixels).")
-    ] = _Motion.wavelength,
+    ] = SpeckleMotion.wavelength,
     frames: Annotated[
         int,
         typer.Option(
@@ -55,17 +57,19 @@ def speckle_cmd(
     ] = DEFAULT_FRAMES,
     speckle_size: Annotated[
         float, typer.Option("--speckle-size", help="Speckle diameter (pixels).")
-    ] = _Params.speckle_size,
-    density: Annotated[float, typer.Option("--density", help="Area fraction.")] = _Params.density,
+    ] = SpeckleParams.speckle_size,
+    density: Annotated[
+        float, typer.Option("--density", help="Area fraction.")
+    ] = SpeckleParams.density,
     contrast: Annotated[
         float, typer.Option("--contrast", help="0..1 of full scale.")
-    ] = _Params.contrast,
+    ] = SpeckleParams.contrast,
     noise: Annotated[
         float, typer.Option("--noise", help="Noise std (grey levels).")
-    ] = _Params.noise_std,
+    ] = SpeckleParams.noise_std,
     blur: Annotated[
         float, typer.Option("--blur", help="Gaussian PSF std (pixels).")
-    ] = _Params.blur_std,
+    ] = SpeckleParams.blur_std,
     bit_depth: Annotated[
         int,
         typer.Option(
@@ -74,7 +78,7 @@ def speckle_cmd(
             max=BIT_DEPTH_MAX,
             help=f"8 or up to {BIT_DEPTH_MAX}.",
         ),
-    ] = _Params.bit_depth,
+    ] = SpeckleParams.bit_depth,
     seed: Annotated[int, typer.Option("--seed", help="Random seed.")] = DEFAULT_SEED,
 ) -> None:
     """Write reference/deformed speckle PNGs and the exact displacement (truth.nc)."""
