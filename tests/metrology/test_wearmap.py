@@ -141,6 +141,21 @@ def test_a_file_without_scan_values_is_refused_naming_the_file(tmp_path, capsys)
     assert code == 3
     assert "wear.nc" in err and "neither 'radius' nor 'radial_deviation'" in err
     assert not (tmp_path / "o.nc").exists()
+    # the advice followed (a scan: radius over (z, theta)) reads the wear
+    worn = dev.copy(data={"radius": R + WEAR})
+    save(worn, bad, source="test")
+    args = [
+        "metrology",
+        "wearmap",
+        str(bad),
+        "--before",
+        str(good),
+        "--out",
+        str(tmp_path / "o.nc"),
+    ]
+    assert main(args) == 0
+    depth = xr.open_dataset(tmp_path / "o.nc")["wear_depth"]
+    np.testing.assert_allclose(float(depth.max()), WEAR.max(), rtol=0.02)
 
 
 def test_exact_centring_with_large_set_up_offsets():
