@@ -380,28 +380,35 @@ def _iterate(
     return zncc, it, FLAG_NOT_CONVERGED
 
 
-@njit(cache=True, nogil=True)
-def _iterate_affine(
-    f, gx, gy, fn, Hinv, jf, js, def_coef, def_invalid, order, xc, yc, half, p, max_iter, tol,
-    max_shift, border, w,
-):  # fmt: skip
-    """:func:`_iterate` with the affine warp (6 parameters)."""
-    return _iterate(
+def _specialise(name: str, quadratic: bool, doc: str, **jit_options):
+    """Compile :func:`_iterate` for one warp order (``quadratic`` frozen as a constant) under
+    ``name``, which also names its numba cache files; one source for both specialisations."""
+
+    def iterate(
         f, gx, gy, fn, Hinv, jf, js, def_coef, def_invalid, order, xc, yc, half, p, max_iter,
-        tol, max_shift, border, w, False,
-    )  # fmt: skip
+        tol, max_shift, border, w,
+    ):  # fmt: skip
+        return _iterate(
+            f, gx, gy, fn, Hinv, jf, js, def_coef, def_invalid, order, xc, yc, half, p,
+            max_iter, tol, max_shift, border, w, quadratic,
+        )  # fmt: skip
+
+    iterate.__name__ = iterate.__qualname__ = name
+    iterate.__doc__ = doc
+    return njit(cache=True, **jit_options)(iterate)
 
 
-@njit(cache=True, fastmath=_FM)
-def _iterate_quadratic(
-    f, gx, gy, fn, Hinv, jf, js, def_coef, def_invalid, order, xc, yc, half, p, max_iter, tol,
-    max_shift, border, w,
-):  # fmt: skip
-    """:func:`_iterate` with the second-order warp (12 parameters)."""
-    return _iterate(
-        f, gx, gy, fn, Hinv, jf, js, def_coef, def_invalid, order, xc, yc, half, p, max_iter,
-        tol, max_shift, border, w, True,
-    )  # fmt: skip
+#: :func:`_iterate` with the affine warp (6 parameters).
+_iterate_affine = _specialise(
+    "_iterate_affine", False, ":func:`_iterate` with the affine warp (6 parameters).", nogil=True
+)
+#: :func:`_iterate` with the second-order warp (12 parameters).
+_iterate_quadratic = _specialise(
+    "_iterate_quadratic",
+    True,
+    ":func:`_iterate` with the second-order warp (12 parameters).",
+    fastmath=_FM,
+)
 
 
 @njit(cache=True)
