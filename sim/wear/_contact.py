@@ -26,7 +26,7 @@ import numpy as np
 from scipy.optimize import brentq
 
 from jointwear.errors import ParameterError, SimulationError
-from jointwear.params import to_jsonable
+from jointwear.params import check_fields, positive, to_jsonable
 from jointwear.sim.wearmap import BearingGrid
 
 __all__ = ["CycleWear", "ContactModel", "ConstantContact", "WinklerContact", "DynamicContact"]
@@ -76,13 +76,6 @@ class ContactModel(Protocol):
         ...
 
 
-def _positive(name: str, value: float) -> float:
-    value = float(value)
-    if not (np.isfinite(value) and value > 0):
-        raise ParameterError(f"{name} must be a positive finite number, got {value!r}")
-    return value
-
-
 @dataclass(frozen=True)
 class ConstantContact:
     """Prescribed, profile-independent contact: pressure ``p`` and sliding ``s`` per cycle.
@@ -99,14 +92,14 @@ class ConstantContact:
 
     grid: BearingGrid = field(default_factory=BearingGrid)
     pressure: float | np.ndarray = 1.0e6
-    sliding: float = 0.02
+    sliding: float = positive(0.02)
 
     def __post_init__(self) -> None:
         p = np.broadcast_to(np.asarray(self.pressure, dtype=float), self.grid.shape).copy()
         if not np.all(np.isfinite(p)) or np.any(p < 0):
             raise ParameterError("pressure must be finite and >= 0 [Pa] at every point")
         object.__setattr__(self, "pressure", p)
-        _positive("sliding", self.sliding)
+        check_fields(self, "ConstantContact")
 
     def describe(self) -> dict[str, Any]:
         return {
@@ -164,9 +157,9 @@ class WinklerContact:
     grid: BearingGrid = field(default_factory=BearingGrid)
     load: float | tuple[float, ...] = 20.0
     load_angle_deg: float | tuple[float, ...] = 90.0
-    clearance: float = 0.5e-3
-    foundation_modulus: float = 1.0e11
-    sliding: float = 0.02
+    clearance: float = positive(0.5e-3)
+    foundation_modulus: float = positive(1.0e11)
+    sliding: float = positive(0.02)
     tilt: float = 0.0
     n_steps: int = 1
 
@@ -184,9 +177,7 @@ class WinklerContact:
         object.__setattr__(self, "load", tuple(np.broadcast_to(load, n).tolist()))
         object.__setattr__(self, "load_angle_deg", tuple(np.broadcast_to(angle, n).tolist()))
         object.__setattr__(self, "n_steps", n)
-        _positive("clearance", self.clearance)
-        _positive("foundation_modulus", self.foundation_modulus)
-        _positive("sliding", self.sliding)
+        check_fields(self, "WinklerContact")
         if not np.isfinite(self.tilt):
             raise ParameterError("tilt must be finite [rad]")
 

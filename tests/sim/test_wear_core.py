@@ -261,6 +261,21 @@ def test_bad_kw_is_refused(kw, match):
         WearSettings(kw=kw)
 
 
+@pytest.mark.parametrize(
+    ("model", "name", "value"),
+    [
+        ("ConstantContact", "sliding", 0.0),
+        ("WinklerContact", "sliding", float("inf")),
+        ("WinklerContact", "clearance", -1e-4),
+        ("WinklerContact", "foundation_modulus", float("nan")),
+    ],
+)
+def test_contact_models_refuse_a_non_positive_length_or_modulus(model, name, value):
+    cls = {"ConstantContact": ConstantContact, "WinklerContact": WinklerContact}[model]
+    with pytest.raises(ParameterError, match=rf"{model}\.{name} must be a positive finite number"):
+        cls(GRID, **{name: value})
+
+
 def test_bad_settings_and_targets():
     with pytest.raises(ParameterError, match="scheme must be .adaptive., .fixed. or .schedule."):
         WearSettings(scheme="implicit")
