@@ -41,6 +41,27 @@ def _keywords(fn) -> dict:
     return {k: p.default for k, p in inspect.signature(fn).parameters.items()}
 
 
+def _same(lib: dict, *names: str) -> dict:
+    """Options named as the library's: ``name -> (lib[name], None)`` (every name of ``lib``
+    when none are given)."""
+    return {n: (lib[n], None) for n in (names or lib)}
+
+
+def _renamed(lib: dict, **cli_to_lib: str) -> dict:
+    """Options named otherwise: ``cli name -> (lib[library name], None)``."""
+    return {cli: (lib[name], None) for cli, name in cli_to_lib.items()}
+
+
+def _scaled(lib: dict, **cli_to_lib: tuple[str, float]) -> dict:
+    """Options in other units: ``cli name -> (lib[library name], CLI units per library unit)``."""
+    return {cli: (lib[name], per) for cli, (name, per) in cli_to_lib.items()}
+
+
+def _stated(*names: str) -> dict:
+    """Options whose default is None: the library's default applies, and the help states it."""
+    return dict.fromkeys(names, (None, None))
+
+
 def _check(fn, mapping: dict, without: set[str]) -> dict[str, Any]:
     """Every option of ``fn`` is in ``mapping`` (name -> (library default, CLI units per library
     unit)) or in ``without``; each mapped CLI default, converted the way the command converts it,
@@ -64,16 +85,8 @@ def test_speckle_defaults_and_limits_are_the_librarys(tmp_path):
     from jointwear.datasets.speckle_set import FIELDS, SpeckleMotion, write_speckle_set
 
     p, m, kw = _fields(SpeckleParams), _fields(SpeckleMotion), _keywords(write_speckle_set)
-    mapping = {name: (m[name], None) for name in m} | {
-        "speckle_size": (p["speckle_size"], None),
-        "density": (p["density"], None),
-        "contrast": (p["contrast"], None),
-        "noise": (p["noise_std"], None),
-        "blur": (p["blur_std"], None),
-        "bit_depth": (p["bit_depth"], None),
-        "frames": (kw["frames"], None),
-        "seed": (kw["seed"], None),
-    }
+    mapping = _same(m) | _same(p, "speckle_size", "density", "contrast", "bit_depth")
+    mapping |= _renamed(p, noise="noise_std", blur="blur_std") | _same(kw, "frames", "seed")
     params = _check(speckle_cmd, mapping, {"out", "overwrite", "size"})
     assert _choices(params["field"]) == FIELDS
     # the limits: the first value outside the CLI's range is the first the library refuses
@@ -94,28 +107,20 @@ def test_instruments_defaults_are_the_librarys():
     from jointwear.datasets.simulated_wear import wear_from_simulation
 
     g, w, s = _keywords(generate), _keywords(write), _keywords(wear_from_simulation)
-    mapping = {
-        "layers": (g["n_layers"], None),
-        "points": (g["n_points"], None),
-        "spacing_mm": (g["layer_spacing"], 1e3),
-        "eccentricity_um": (g["eccentricity"], 1e6),
-        "tilt": (g["tilt"], None),
-        "wear_um": (g["wear_depth"], 1e6),
-        "noise_um": (g["noise"], 1e6),
-        "quantisation_nm": (g["quantisation"], 1e9),
-        "angle_zero": (g["convention"][0], None),
-        "angle_direction": (g["convention"][1], None),
-        "seed": (g["seed"], None),
-        "noise_seed": (g["noise_seed"], None),
-        "layout": (w["layout"], None),
-        "value": (w["value"], None),
-        "units": (w["units"], None),
-        "angle": (w["angle"], None),
-        "decimal": (w["decimal"], None),
-        "wear_scale": (s["scale"], None),
-        "wear_rotation_deg": (s["rotation_deg"], None),
-        "radius_mm": (None, None),  # the default depends on --wear-from: the help states it
-    }
+    mapping = _renamed(g, layers="n_layers", points="n_points") | _same(g, "tilt", "seed")
+    mapping |= _scaled(
+        g,
+        spacing_mm=("layer_spacing", 1e3),
+        eccentricity_um=("eccentricity", 1e6),
+        wear_um=("wear_depth", 1e6),
+        noise_um=("noise", 1e6),
+        quantisation_nm=("quantisation", 1e9),
+    )
+    zero, direction = g["convention"]
+    mapping |= {"angle_zero": (zero, None), "angle_direction": (direction, None)}
+    mapping |= _same(g, "noise_seed") | _same(w, "layout", "value", "units", "angle", "decimal")
+    mapping |= _renamed(s, wear_scale="scale", wear_rotation_deg="rotation_deg")
+    mapping |= _stated("radius_mm")  # the default depends on --wear-from
     params = _check(
         instruments_cmd, mapping, {"out", "overwrite", "delimiter", "wear_from", "truth"}
     )
@@ -131,15 +136,9 @@ def test_rig_defaults_are_the_librarys():
 
     c, kw = _fields(RigConfig), _keywords(generate_rig)
     same = ("duration", "fps", "width", "height", "exposure", "seed", "board_legacy")
-    mapping = {name: (c[name], None) for name in same} | {
-        "z_amplitude_mm": (c["z_amplitude"], 1e3),
-        "noise": (c["noise_sigma"], None),
-        "blur": (c["blur_sigma_px"], None),
-        "board": (c["board_kind"], None),
-        "codec": (kw["codec"], None),
-        "video": (kw["video"], None),
-        "images": (kw["images"], None),
-    }
+    mapping = _same(c, *same) | _scaled(c, z_amplitude_mm=("z_amplitude", 1e3))
+    mapping |= _renamed(c, noise="noise_sigma", blur="blur_sigma_px", board="board_kind")
+    mapping |= _same(kw, "codec", "video", "images")
     params = _check(rig, mapping, {"out", "overwrite", "drop", "duplicate", "motion"})
     assert set(_choices(params["codec"])) == set(CODECS)
     size = c["board_square_size"] * 1e3
@@ -155,13 +154,8 @@ def test_field_defaults_help_and_limits_are_the_librarys():
     from jointwear.dic.field._files import measure_field_files
 
     f = _fields(FieldParams)
-    mapping = {n: (f[n], None) for n in ("step", "zncc_min", "search_radius", "threads")} | {
-        "subset": (f["subset_size"], None),
-        # None: the library's default applies (0 with --points); the help states it
-        "strain_window": (None, None),
-        "frame": (None, None),
-        "epipolar_max": (None, None),
-    }
+    mapping = _same(f, "step", "zncc_min", "search_radius", "threads")
+    mapping |= _renamed(f, subset="subset_size") | _stated("strain_window", "frame", "epipolar_max")
     mapping["origin"] = (_keywords(measure_field_files)["data_origin"], None)
     without = {"images", "left", "right", "calibration", "roi", "points", "fps"}
     without |= {"out", "csv", "plot", "allow_empty", "overwrite"}
@@ -214,8 +208,8 @@ def test_wearmap_defaults_are_the_librarys():
     from jointwear.metrology.wearmap import wear_map
 
     kw = _keywords(wear_map)
-    mapping = {n: (kw[n], None) for n in ("angle_offset_deg", "register", "shape", "threshold")}
-    mapping["radius_mm"] = (kw["radius"], None)
+    mapping = _same(kw, "angle_offset_deg", "register", "shape", "threshold")
+    mapping |= _renamed(kw, radius_mm="radius")
     params = _check(wearmap_cmd, mapping, {"worn", "before", "out", "overwrite", "plot"})
     # every choice the command offers is one the library takes; another shape is refused
     from jointwear.errors import BadInputError
@@ -237,15 +231,9 @@ def test_calibrate_defaults_are_the_librarys():
         _keywords(calibrate_stereo),
         _keywords(calibrate_files),
     )
-    mapping = {n: (kw[n], None) for n in ("min_views", "max_rms", "max_view_rms", "world_view")}
-    mapping |= {
-        "board": (b["kind"], None),
-        "squares": ((b["squares_x"], b["squares_y"]), None),
-        "accept_poor": (kw["accept_poor"], None),
-        # None: the library's default applies; the help states it
-        "dictionary": (None, None),
-        "every": (None, None),
-    }
+    mapping = _same(kw, "min_views", "max_rms", "max_view_rms", "world_view", "accept_poor")
+    mapping |= _renamed(b, board="kind") | _stated("dictionary", "every")
+    mapping["squares"] = ((b["squares_x"], b["squares_y"]), None)
     without = {"left", "right", "out", "overwrite", "square", "unit", "square_u", "square_mm"}
     without |= {"marker", "marker_mm"}
     params = _check(calibrate_cmd, mapping, without)
@@ -262,15 +250,12 @@ def test_cycle_and_calibrate_kw_defaults_are_the_librarys():
     from jointwear.sim.wear._calibration import calibration_report
 
     kw = _keywords(simulate_cycles_to_file)
-    mapping = {n: (kw[n], None) for n in ("cycles", "wear", "wear_cycles")}
-    mapping["base"] = (DEFAULT_PARAMETER_SET, None)
+    mapping = _same(kw, "cycles", "wear", "wear_cycles") | {"base": (DEFAULT_PARAMETER_SET, None)}
     _check(cycle, mapping, {"out", "overwrite", "params", "progress"})
 
     report = _keywords(calibration_report)
     assert report["rtol"] == _keywords(calibrate_kw)["rtol"]
-    mapping = {n: (report[n], None) for n in ("resimulate", "rtol", "cycles")}
-    mapping["measured_map"] = (report["measured_map"], None)
-    mapping["vary"] = (report["vary"], None)
+    mapping = _same(report, "resimulate", "rtol", "cycles", "measured_map", "vary")
     without = {"simulated", "max_depth_um", "volume_mm3", "cylindricity_um"}
     _check(calibrate, mapping, without)
 
@@ -280,7 +265,7 @@ def test_import_defaults_are_the_librarys():
     from jointwear.external import import_motion, import_wear_map
 
     kw = _keywords(import_motion)
-    mapping = {n: (kw[n], None) for n in ("time_unit", "time_column", "tool")}
+    mapping = _same(kw, "time_unit", "time_column", "tool")
     params = _check(
         motion, mapping, {"file", "out", "overwrite", "origin", "velocity_unit", "velocity_columns"}
     )
@@ -288,10 +273,10 @@ def test_import_defaults_are_the_librarys():
     assert tuple(_names(columns, "--velocity-columns", (2, 3))) == kw["velocity_columns"]
 
     kw = _keywords(import_wear_map)
-    mapping = {n: (kw[n], None) for n in ("z_mid_width", "cycles", "tool")}
+    mapping = _same(kw, "z_mid_width", "cycles", "tool")
     required = ("theta_unit", "z_unit", "depth_unit", "angle_zero", "angle_direction")
     assert all(kw[n] is inspect.Parameter.empty for n in required)
-    mapping |= {n: (None, None) for n in required}  # None: the command asks for them
+    mapping |= dict.fromkeys(required, (None, None))  # None: the command asks for them
     params = _check(wearmap, mapping, {"file", "out", "overwrite", "origin", "columns"})
     assert tuple(_names(params["columns"].default, "--columns", (3, 3))) == kw["columns"]
 
@@ -321,12 +306,8 @@ def test_compare_defaults_and_help_are_the_librarys():
     from jointwear.errors import BadInputError
 
     kw = _keywords(compare_files)
-    mapping = {n: (kw[n], None) for n in ("table", "criteria", "cycles", "variables")}
-    mapping |= {
-        "method": (kw["motion_method"], None),
-        "period": (kw["period_s"], None),
-        "axes": (None, None),  # None: DEFAULT_AXES, the help states them
-    }
+    mapping = _same(kw, "table", "criteria", "cycles", "variables")
+    mapping |= _renamed(kw, method="motion_method", period="period_s") | _stated("axes")
     without = {"sim", "meas", "out", "overwrite", "sim_extra", "meas_extra", "ensemble"}
     params = _check(compare_cmd, mapping, without | {"verification", "strict"})
     assert kw["axes"] == DEFAULT_AXES
