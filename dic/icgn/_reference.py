@@ -9,7 +9,13 @@ import numpy as np
 from numba import njit
 
 from jointwear.dic.icgn._flags import FLAG_INVALID_PIXELS, FLAG_NO_TEXTURE, FLAG_OK, FLAG_OUTSIDE
-from jointwear.dic.icgn._interp import PAD, interp_value, node_filters, node_row_sums
+from jointwear.dic.icgn._interp import (
+    PAD,
+    _node_gradients,
+    interp_value,
+    node_filters,
+    node_row_sums,
+)
 
 
 @njit(cache=True)
@@ -151,14 +157,37 @@ def subset_std(img, invalid, centres, half, border):
     return out
 
 
+@njit(cache=True, inline="always")
+def _node_derivative(coef, x, y, val, der, r):
+    """The interpolant's exact derivative ``(d/dx, d/dy)`` at the pixel node (x, y), summed
+    as :func:`~jointwear.dic.icgn._interp._node_gradients` sums it (the same numbers)."""
+    sx = 0.0
+    sy = 0.0
+    for p in range(2 * r + 1):
+        vv, vd = node_row_sums(coef[y + PAD - r + p], x + PAD - r, val, der)
+        sx += val[p] * vd
+        sy += der[p] * vv
+    return sx, sy
+
+
 @njit(cache=True)
 def subset_kappa(coef, order, gx, gy, centres, half, out):
     """Per subset, ``kappa = sum |g_c|^2 / sum g_c . g_s``: central-difference node gradients
     ``gx``, ``gy`` against the interpolant's exact node derivative ``g_s`` (from the padded
-    coefficients), over the subset square around each centre (1 where undefined)."""
+    coefficients), over the subset square around each centre (1 where undefined).
+
+    Where the subsets together cover more nodes than the image has (a dense grid: every node
+    lies in many subsets), ``g_s`` is computed once per node for the whole image; otherwise
+    (scattered points) per subset node. Both give the same numbers.
+    """
     val, der = node_filters(order)
     r = val.shape[0] // 2
     h, w = gx.shape
+    dense = centres.shape[0] * (2 * half + 1) ** 2 >= h * w
+    exact_x = np.empty((h, w) if dense else (1, 1))
+    exact_y = np.empty_like(exact_x)
+    if dense:
+        _node_gradients(coef, order, exact_x, exact_y)
     for i in range(centres.shape[0]):
         out[i] = 1.0
         xc = centres[i, 0]
@@ -171,12 +200,11 @@ def subset_kappa(coef, order, gx, gy, centres, half, out):
         b = 0.0
         for y in range(max(jc - half, 0), min(jc + half + 1, h)):
             for x in range(max(ic - half, 0), min(ic + half + 1, w)):
-                sx = 0.0
-                sy = 0.0
-                for p in range(2 * r + 1):
-                    vv, vd = node_row_sums(coef[y + PAD - r + p], x + PAD - r, val, der)
-                    sx += val[p] * vd
-                    sy += der[p] * vv
+                if dense:
+                    sx = exact_x[y, x]
+                    sy = exact_y[y, x]
+                else:
+                    sx, sy = _node_derivative(coef, x, y, val, der, r)
                 a += gx[y, x] * gx[y, x] + gy[y, x] * gy[y, x]
                 b += gx[y, x] * sx + gy[y, x] * sy
         if b > 0.0 and math.isfinite(a / b):
