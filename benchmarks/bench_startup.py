@@ -167,10 +167,16 @@ def _throughput(work: Path, env: dict, repeat: int) -> dict:
         cli.append(n / _run(args, work, env)[1])
         lib.append(library())
     ratios = [c / x for c, x in zip(cli, lib, strict=True)]
+    # what the process adds to the call (start, imports, kernels, reading, writing): the ratio
+    # falls when the call gets faster even if this stays the same
+    added = [n / c - n / x for c, x in zip(cli, lib, strict=True)]
     return {
         "points": n,
         "cli_poi_per_s_whole_process": round(statistics.median(cli)),
         "library_poi_per_s_correlate_call": round(statistics.median(lib)),
+        "cli_wall_s_median": round(n / statistics.median(cli), 3),
+        "library_wall_s_median": round(n / statistics.median(lib), 3),
+        "cli_added_wall_s_median": round(statistics.median(added), 3),
         "ratio": round(statistics.median(ratios), 3),
         "ratio_min": round(min(ratios), 3),
         "target_ratio": 0.7,
