@@ -60,6 +60,7 @@ def main() -> None:
         "updates_accepted": int(ds.attrs["n_updates"]),
         "updates_rejected": int(ds.attrs["n_rejected"]),
         "dn_sequence": ds["update_dn"].values.astype(int).tolist(),
+        "dn_max": int(ds["update_dn"].values.max()),
         "max_wear_depth_um": final(ds, "max_wear_depth") * 1e6,
         "worn_volume_mm3": final(ds, "worn_volume") * 1e9,
         "archard_volume_mm3": final(ds, "archard_volume") * 1e9,
