@@ -26,6 +26,7 @@ __all__ = [
     "SubsetOpt",
     "ThreadsOpt",
     "ZnccMinOpt",
+    "correlation_keywords",
     "refuse_given",
 ]
 
@@ -81,3 +82,18 @@ def refuse_given(given, applies_to: str) -> None:
     for value, flag in given:
         if value is not None:
             raise typer.BadParameter(f"{flag} applies to {applies_to}")
+
+
+def correlation_keywords(
+    subset: int, step: int, zncc_min: float, search_radius: int, threads: int
+) -> dict[str, int | float]:
+    """The options every subset-DIC command shares, as the library's keywords: the one place
+    that maps the CLI's names onto :class:`~jointwear.dic.CorrelationParams` fields (``--subset``
+    is ``subset_size``)."""
+    return {
+        "subset_size": subset,
+        "step": step,
+        "zncc_min": zncc_min,
+        "search_radius": search_radius,
+        "threads": threads,
+    }

@@ -169,15 +169,11 @@ def correlate_cmd(
 
     _refuse_misapplied(ctx.params, is_sequence_input(deformed))
     params = CorrelationParams(
-        subset_size=subset,
-        step=step,
+        **opt.correlation_keywords(subset, step, zncc_min, search_radius, threads),
         shape=shape,
         interpolation=interpolation,
-        search_radius=search_radius,
-        zncc_min=zncc_min,
         tolerance=tolerance,
         max_iterations=max_iterations,
-        threads=threads,
     )
     ds, elapsed = correlate_files(
         reference,

@@ -115,11 +115,7 @@ def field_cmd(
     if points is not None and strain_window is None:
         given["strain_window"] = 0  # scattered points: no grid to fit strain on
     params = FieldParams(
-        subset_size=subset,
-        step=step,
-        zncc_min=zncc_min,
-        search_radius=search_radius,
-        threads=threads,
+        **opt.correlation_keywords(subset, step, zncc_min, search_radius, threads),
         **{k: v for k, v in given.items() if v is not None},
     )
     ds, elapsed, files = measure_field_files(
