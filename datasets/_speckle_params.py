@@ -17,11 +17,14 @@ if TYPE_CHECKING:
 
 __all__ = [
     "BIT_DEPTH_MAX",
+    "CONTRAST_RANGE",
     "DEFAULT_FRAMES",
+    "DENSITY_RANGE",
     "DEFAULT_SEED",
     "FIELDS",
     "MIN_FRAMES",
     "PNG_BIT_DEPTH_MIN",
+    "SPECKLE_SIZE_RANGE",
     "SpeckleMotion",
     "SpeckleParams",
 ]
@@ -31,6 +34,12 @@ __all__ = [
 BIT_DEPTH_MAX = 16
 PNG_BIT_DEPTH_MIN = 1
 
+#: What :class:`SpeckleParams` accepts, as its errors and ``datasets speckle --help`` say it:
+#: speckle diameter [pixel] from..to (both included); area fraction and contrast in (0, max].
+SPECKLE_SIZE_RANGE = (1.0, 200.0)
+DENSITY_RANGE = (0.0, 5.0)
+CONTRAST_RANGE = (0.0, 1.0)
+
 #: Displacement fields of a speckle data set.
 FIELDS = ("rigid", "affine", "rotation", "sinusoidal")
 
@@ -38,6 +47,11 @@ FIELDS = ("rigid", "affine", "rotation", "sinusoidal")
 DEFAULT_FRAMES = MIN_FRAMES = 1
 #: Seed of the pattern and the noise.
 DEFAULT_SEED = 0
+
+
+def _open(bounds: tuple[float, float]) -> str:
+    """``"in (lo, hi]"``: the interval of a density or contrast, written once."""
+    return f"in ({bounds[0]:g}, {bounds[1]:g}]"
 
 
 @dataclass(frozen=True)
@@ -74,10 +88,19 @@ class SpeckleParams:
     dark_speckles: bool = False
 
     def __post_init__(self) -> None:
+        size_min, size_max = SPECKLE_SIZE_RANGE
         checks = [
-            ("speckle_size", 1.0 <= self.speckle_size <= 200.0, "between 1 and 200 pixel"),
-            ("density", 0.0 < self.density <= 5.0, "in (0, 5]"),
-            ("contrast", 0.0 < self.contrast <= 1.0, "in (0, 1]"),
+            (
+                "speckle_size",
+                size_min <= self.speckle_size <= size_max,
+                f"between {size_min:g} and {size_max:g} pixel",
+            ),
+            ("density", DENSITY_RANGE[0] < self.density <= DENSITY_RANGE[1], _open(DENSITY_RANGE)),
+            (
+                "contrast",
+                CONTRAST_RANGE[0] < self.contrast <= CONTRAST_RANGE[1],
+                _open(CONTRAST_RANGE),
+            ),
             (
                 "bit_depth",
                 0 <= int(self.bit_depth) <= BIT_DEPTH_MAX,

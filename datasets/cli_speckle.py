@@ -14,10 +14,13 @@ import typer
 from jointwear._cli import Overwrite
 from jointwear.datasets._speckle_params import (
     BIT_DEPTH_MAX,
+    CONTRAST_RANGE,
     DEFAULT_FRAMES,
     DEFAULT_SEED,
+    DENSITY_RANGE,
     MIN_FRAMES,
     PNG_BIT_DEPTH_MIN,
+    SPECKLE_SIZE_RANGE,
     SpeckleMotion,
     SpeckleParams,
 )
@@ -56,13 +59,24 @@ def speckle_cmd(
         ),
     ] = DEFAULT_FRAMES,
     speckle_size: Annotated[
-        float, typer.Option("--speckle-size", help="Speckle diameter (pixels).")
+        float,
+        typer.Option(
+            "--speckle-size",
+            help="Speckle diameter (pixels), {:g} to {:g}.".format(*SPECKLE_SIZE_RANGE),
+        ),
     ] = SpeckleParams.speckle_size,
     density: Annotated[
-        float, typer.Option("--density", help="Area fraction.")
+        float,
+        typer.Option(
+            "--density",
+            help="Area fraction covered by speckles, in ({:g}, {:g}].".format(*DENSITY_RANGE),
+        ),
     ] = SpeckleParams.density,
     contrast: Annotated[
-        float, typer.Option("--contrast", help="0..1 of full scale.")
+        float,
+        typer.Option(
+            "--contrast", help="Fraction of full scale, in ({:g}, {:g}].".format(*CONTRAST_RANGE)
+        ),
     ] = SpeckleParams.contrast,
     noise: Annotated[
         float, typer.Option("--noise", help="Noise std (grey levels).")

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import dataclasses
 import inspect
+import re
 import subprocess
 import sys
 import typing
@@ -99,6 +100,24 @@ def test_speckle_defaults_and_limits_are_the_librarys(tmp_path):
     with pytest.raises(ParameterError, match="frames"):
         write_speckle_set(tmp_path, (8, 8), frames=params["frames"].min - 1)
     assert not any(tmp_path.iterdir())
+    # the ranges the help states are the ones the library takes: "lo to hi" both included,
+    # "(lo, hi]" the lower edge excluded
+    stated = {
+        "speckle_size": ("to", params["speckle_size"].help),
+        "density": ("(", params["density"].help),
+        "contrast": ("(", params["contrast"].help),
+    }
+    for name, (kind, text) in stated.items():
+        if kind == "to":
+            lo, hi = (float(v) for v in re.search(r"([\d.]+) to ([\d.]+)", text).groups())
+        else:
+            lo, hi = (float(v) for v in re.search(r"\(([\d.]+), ([\d.]+)\]", text).groups())
+        SpeckleParams(**{name: hi})
+        if kind == "to":
+            SpeckleParams(**{name: lo})
+        for outside in [lo - 0.5, hi + 0.5] if kind == "to" else [lo, hi * 1.01]:
+            with pytest.raises(ParameterError, match=name):
+                SpeckleParams(**{name: outside})
 
 
 def test_instruments_defaults_are_the_librarys():
