@@ -176,18 +176,31 @@ def subset_kappa(coef, order, gx, gy, centres, half, out):
     ``gx``, ``gy`` against the interpolant's exact node derivative ``g_s`` (from the padded
     coefficients), over the subset square around each centre (1 where undefined).
 
-    Where the subsets together cover more nodes than the image has (a dense grid: every node
-    lies in many subsets), ``g_s`` is computed once per node for the whole image; otherwise
+    Where the subsets together cover more nodes than the box around them has (a dense grid:
+    every node lies in many subsets), ``g_s`` is computed once per node of that box; otherwise
     (scattered points) per subset node. Both give the same numbers.
     """
     val, der = node_filters(order)
     r = val.shape[0] // 2
     h, w = gx.shape
-    dense = centres.shape[0] * (2 * half + 1) ** 2 >= h * w
-    exact_x = np.empty((h, w) if dense else (1, 1))
+    # the box [x0, x1) x [y0, y1) the subset squares cover
+    x0, y0, x1, y1 = w, h, 0, 0
+    for i in range(centres.shape[0]):
+        xc = centres[i, 0]
+        yc = centres[i, 1]
+        if math.isfinite(xc) and math.isfinite(yc):
+            ic = int(round(xc))
+            jc = int(round(yc))
+            x0 = min(x0, max(ic - half, 0))
+            y0 = min(y0, max(jc - half, 0))
+            x1 = max(x1, min(ic + half + 1, w))
+            y1 = max(y1, min(jc + half + 1, h))
+    box = max(x1 - x0, 0) * max(y1 - y0, 0)
+    dense = box > 0 and centres.shape[0] * (2 * half + 1) ** 2 > box
+    exact_x = np.empty((y1 - y0, x1 - x0) if dense else (1, 1))
     exact_y = np.empty_like(exact_x)
-    if dense:
-        _node_gradients(coef, order, exact_x, exact_y)
+    if dense:  # the box's nodes, from its rows and columns of the padded coefficients
+        _node_gradients(coef[y0 : y1 + 2 * PAD, x0 : x1 + 2 * PAD], order, exact_x, exact_y)
     for i in range(centres.shape[0]):
         out[i] = 1.0
         xc = centres[i, 0]
@@ -201,8 +214,8 @@ def subset_kappa(coef, order, gx, gy, centres, half, out):
         for y in range(max(jc - half, 0), min(jc + half + 1, h)):
             for x in range(max(ic - half, 0), min(ic + half + 1, w)):
                 if dense:
-                    sx = exact_x[y, x]
-                    sy = exact_y[y, x]
+                    sx = exact_x[y - y0, x - x0]
+                    sy = exact_y[y - y0, x - x0]
                 else:
                     sx, sy = _node_derivative(coef, x, y, val, der, r)
                 a += gx[y, x] * gx[y, x] + gy[y, x] * gy[y, x]
