@@ -27,6 +27,7 @@ __all__ = [
     "SPECKLE_SIZE_RANGE",
     "SpeckleMotion",
     "SpeckleParams",
+    "open_interval",
 ]
 
 #: Deepest grey scale of an image [bit]; a PNG needs at least PNG_BIT_DEPTH_MIN (0, floating
@@ -49,8 +50,9 @@ DEFAULT_FRAMES = MIN_FRAMES = 1
 DEFAULT_SEED = 0
 
 
-def _open(bounds: tuple[float, float]) -> str:
-    """``"in (lo, hi]"``: the interval of a density or contrast, written once."""
+def open_interval(bounds: tuple[float, float]) -> str:
+    """``"in (lo, hi]"``: the interval of a density or contrast, as the errors and the CLI
+    help write it."""
     return f"in ({bounds[0]:g}, {bounds[1]:g}]"
 
 
@@ -95,11 +97,15 @@ class SpeckleParams:
                 size_min <= self.speckle_size <= size_max,
                 f"between {size_min:g} and {size_max:g} pixel",
             ),
-            ("density", DENSITY_RANGE[0] < self.density <= DENSITY_RANGE[1], _open(DENSITY_RANGE)),
+            (
+                "density",
+                DENSITY_RANGE[0] < self.density <= DENSITY_RANGE[1],
+                open_interval(DENSITY_RANGE),
+            ),
             (
                 "contrast",
                 CONTRAST_RANGE[0] < self.contrast <= CONTRAST_RANGE[1],
-                _open(CONTRAST_RANGE),
+                open_interval(CONTRAST_RANGE),
             ),
             (
                 "bit_depth",

@@ -23,6 +23,7 @@ from jointwear.datasets._speckle_params import (
     SPECKLE_SIZE_RANGE,
     SpeckleMotion,
     SpeckleParams,
+    open_interval,
 )
 
 
@@ -69,13 +70,13 @@ def speckle_cmd(
         float,
         typer.Option(
             "--density",
-            help="Area fraction covered by speckles, in ({:g}, {:g}].".format(*DENSITY_RANGE),
+            help=f"Area fraction covered by speckles, {open_interval(DENSITY_RANGE)}.",
         ),
     ] = SpeckleParams.density,
     contrast: Annotated[
         float,
         typer.Option(
-            "--contrast", help="Fraction of full scale, in ({:g}, {:g}].".format(*CONTRAST_RANGE)
+            "--contrast", help=f"Fraction of full scale, {open_interval(CONTRAST_RANGE)}."
         ),
     ] = SpeckleParams.contrast,
     noise: Annotated[
