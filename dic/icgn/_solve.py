@@ -398,11 +398,9 @@ def _specialise(name: str, quadratic: bool, doc: str, **jit_options):
     return njit(cache=True, **jit_options)(iterate)
 
 
-#: :func:`_iterate` with the affine warp (6 parameters).
 _iterate_affine = _specialise(
     "_iterate_affine", False, ":func:`_iterate` with the affine warp (6 parameters).", nogil=True
 )
-#: :func:`_iterate` with the second-order warp (12 parameters).
 _iterate_quadratic = _specialise(
     "_iterate_quadratic",
     True,
