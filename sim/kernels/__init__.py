@@ -1,6 +1,10 @@
 """numba kernels of the simulator (four-bar, slider-crank), one module per piece of physics.
 
-* ``_layout``: indices into the parameter vectors, the diagnostics row and the info array;
+* ``_layout``: indices into the parameter vectors, the diagnostics row, the info array and the context;
+* ``_jit``: how the evaluation kernels are compiled (cached, without numba's runtime: they
+  allocate nothing);
+* ``_context``: the evaluation context, with the scratch arrays the kernels work in, made once
+  per integration;
 * ``_geometry``: follower rotation, bore/journal nodes, contact search, layer axes, a force
   added to a contact wrench;
 * ``_friction``: smoothed Coulomb friction (eq. 12);

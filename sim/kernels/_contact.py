@@ -6,9 +6,6 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
-from numba import njit
-
 from jointwear.sim.kernels._friction import _apply_friction
 from jointwear.sim.kernels._geometry import (
     W_NORMAL,
@@ -21,7 +18,13 @@ from jointwear.sim.kernels._geometry import (
     _search,
     _seg,
 )
+from jointwear.sim.kernels._jit import inline_kernel, kernel
 from jointwear.sim.kernels._layout import (
+    C_BUF,
+    C_GEO,
+    C_LAYER,
+    C_NODE,
+    C_WSC,
     CA,
     CE,
     GRADED,
@@ -54,14 +57,14 @@ from jointwear.sim.kernels._layout import (
 )
 
 
-@njit(cache=True)
+@kernel
 def ln_factor(rate, vimp, ce):
     """Lankarani-Nikravesh damping factor 1 + 3(1-ce^2) rate / (4 vimp), clamped at 0."""
     f = 1.0 + 3.0 * (1.0 - ce * ce) * rate / (4.0 * vimp)
     return f if f > 0.0 else 0.0
 
 
-@njit(cache=True)
+@kernel
 def _stiffness(P, IP, h):
     if IP[KVARY] == 0:
         return P[K0]
@@ -73,7 +76,7 @@ def _stiffness(P, IP, h):
     return P[KFAC] * math.sqrt(P[RJ] * rbt / den)
 
 
-@njit(cache=True, inline="always")
+@inline_kernel
 def _damped(fel, rate, vm, vfloor, ce):
     """Eq. 6: elastic force fel times the L-N factor; vm <= 0 (no impact remembered) uses the
     current approach rate, at least vfloor, as impact velocity."""
@@ -82,7 +85,7 @@ def _damped(fel, rate, vm, vfloor, ce):
     return fel * ln_factor(rate, vm, ce)
 
 
-@njit(cache=True)
+@kernel
 def _slices(J0, u, V0, W, ctx, wrench, acc, hstep):
     """Grid-independent radial contact: axial slices with the penetration linear in between.
 
@@ -99,8 +102,8 @@ def _slices(J0, u, V0, W, ctx, wrench, acc, hstep):
     Nl = IP[NL]
     Nd = IP[ND]
     nexp = P[NEXP]
-    # one scratch block per call: bound, in-plane axis point, reach, results per layer
-    scr = np.empty((Nl, 8))
+    # the context's scratch block: bound, in-plane axis point, reach, results per layer
+    scr = ctx[C_LAYER]
     dest = scr[:, 0]
     axs = scr[:, 1]
     ays = scr[:, 2]
@@ -109,8 +112,8 @@ def _slices(J0, u, V0, W, ctx, wrench, acc, hstep):
     kk = scr[:, 5]
     fel = scr[:, 6]
     reach = scr[:, 7]  # 1 = the journal spans this layer, 2 = and it was searched
-    geo = np.empty((Nl, 3, 6))  # the three nodes around the deepest: point (3), normal (3)
-    sm = np.empty(Nl, dtype=np.int64)
+    geo = ctx[C_GEO]  # the three nodes around the deepest: point (3), normal (3)
+    sm = ctx[C_NODE]
     for n in range(Nl):
         fel[n] = 0.0
         ok, axs[n], ays[n], dest[n] = _layer_axis(n, J0, u, P, HMIN, ZL)
@@ -172,7 +175,7 @@ def _slices(J0, u, V0, W, ctx, wrench, acc, hstep):
     have0 = False
     f0x, f0y, f0z = 0.0, 0.0, 0.0
     proj = IP[WPROJ]
-    wsc = np.empty((Nl if (acc and proj == WPROJ_CONSERVING) else 0, 3))
+    wsc = ctx[C_WSC]  # written and read with acc and the conserving projection only
     for n in range(Nl):
         if fel[n] <= 0.0 or reach[n] != 2.0:
             son[n] = 0
@@ -210,7 +213,7 @@ def _slices(J0, u, V0, W, ctx, wrench, acc, hstep):
                 wsc[n, 1] = fw * vt
                 wsc[n, 2] = vt
             elif fw > 0.0:
-                _spread(n, sm[n], fw, vt, hstep, J0, u, P, H, ZL, Nd, AREA, WW)
+                _spread(n, sm[n], fw, vt, hstep, J0, u, P, H, ZL, Nd, AREA, WW, ctx[C_BUF])
             acc_out[0] += fn * vt * hstep
             acc_out[2] += fn * hstep
         nslice += 1
@@ -223,11 +226,11 @@ def _slices(J0, u, V0, W, ctx, wrench, acc, hstep):
         elif f0x * hx + f0y * hy + f0z * hz < 0.0:
             two = True
     if acc and proj == WPROJ_CONSERVING:
-        _spread_regions(wsc, sm, son, hstep, J0, u, P, H, ZL, Nd, AREA, WW)
+        _spread_regions(wsc, sm, son, hstep, J0, u, P, H, ZL, Nd, AREA, WW, ctx[C_BUF])
     return energy, fnsum, pen, kdeep, nslice, two, clen
 
 
-@njit(cache=True)
+@kernel
 def _wear_force(n, fn, sd, kk, fel, WL, proj, P):
     """Force of layer n whose pressure, spread over the layer's slice area, gives its wear work.
 
@@ -247,13 +250,14 @@ def _wear_force(n, fn, sd, kk, fel, WL, proj, P):
     return fn * kk[n] * sd[n] ** P[NEXP] * WL[n] / fel[n]
 
 
-@njit(cache=True)
-def _spread_regions(wsc, sm, son, hstep, J0, u, P, H, ZL, Nd, AREA, WW):
+@kernel
+def _spread_regions(wsc, sm, son, hstep, J0, u, P, H, ZL, Nd, AREA, WW, buf):
     """Spread the local wear forces, scaled per contact region to its normal work.
 
     ``wsc[n]`` = (F_n |v_t|, local wear force x |v_t|, |v_t|) of contacting layer n. In each
     run of adjacent contacting layers the local forces keep their shape and are scaled so that
     their work equals the region's F_n |v_t| (the worn volume stays kw times the normal work).
+    ``buf`` is scratch for :func:`_spread`.
     """
     Nl = son.shape[0] - 2
     n = 0
@@ -274,11 +278,11 @@ def _spread_regions(wsc, sm, son, hstep, J0, u, P, H, ZL, Nd, AREA, WW):
             else:  # no layer of the region penetrates at its node: lumped
                 fw = wsc[k, 0] / wsc[k, 2] if wsc[k, 2] > 0.0 else 0.0
             if fw > 0.0:
-                _spread(k, sm[k], fw, wsc[k, 2], hstep, J0, u, P, H, ZL, Nd, AREA, WW)
+                _spread(k, sm[k], fw, wsc[k, 2], hstep, J0, u, P, H, ZL, Nd, AREA, WW, buf)
         n = end
 
 
-@njit(cache=True)
+@kernel
 def _penetrating_run(n, ms, J0, u, P, H, ZL, Nd, buf):
     """Contiguous run of penetrating nodes of layer n around node ms.
 
@@ -306,12 +310,12 @@ def _penetrating_run(n, ms, J0, u, P, H, ZL, Nd, buf):
     return lo, hi
 
 
-@njit(cache=True)
-def _spread(n, ms, fn, vt, hstep, J0, u, P, H, ZL, Nd, AREA, WW):
+@kernel
+def _spread(n, ms, fn, vt, hstep, J0, u, P, H, ZL, Nd, AREA, WW, buf):
     """Spread a layer's normal force over its contiguous penetrating nodes, weights sqrt(delta),
-    adding p |v_t| dt to WW[0] and |v_t| dt to WW[1]; every node is evaluated once."""
+    adding p |v_t| dt to WW[0] and |v_t| dt to WW[1]; every node is evaluated once. ``buf``
+    (at least ``2 (Nd // 2) + 1``) is scratch for :func:`_penetrating_run`."""
     half = Nd // 2
-    buf = np.empty(2 * half + 1)
     lo, hi = _penetrating_run(n, ms, J0, u, P, H, ZL, Nd, buf)
     wsum = 0.0
     for mm in range(lo, hi + 1):
@@ -329,7 +333,7 @@ def _spread(n, ms, fn, vt, hstep, J0, u, P, H, ZL, Nd, AREA, WW):
         WW[1, n, ms % Nd] += vt * hstep
 
 
-@njit(cache=True)
+@kernel
 def _per_point(J0, u, V0, W, ctx, wrench, acc, hstep):
     """The study's literal form: a full L-N force at every penetrating node (grid-dependent).
 
@@ -350,7 +354,7 @@ def _per_point(J0, u, V0, W, ctx, wrench, acc, hstep):
     two = False
     fn0x, fn0y, fn0z = 0.0, 0.0, 0.0
     have0 = False
-    buf = np.empty(2 * (Nd // 2) + 1)
+    buf = ctx[C_BUF]
     for n in range(Nl):
         son[n] = 0
         ok, ax, ay, dest = _layer_axis(n, J0, u, P, HMIN, ZL)
@@ -411,7 +415,7 @@ def _per_point(J0, u, V0, W, ctx, wrench, acc, hstep):
     return energy, fnsum, pen_rad, kdeep, nslice, two, wcontact
 
 
-@njit(cache=True, inline="always")
+@inline_kernel
 def _end_faces(J0, u, V0, W, ctx, wrench, acc, hstep):
     """Axial stops: the journal's shoulders against the bearing end faces.
 
@@ -462,7 +466,7 @@ def _end_faces(J0, u, V0, W, ctx, wrench, acc, hstep):
     return energy, pen_ax, fax
 
 
-@njit(cache=True, inline="always")
+@inline_kernel
 def _contact(J0, u, V0, W, ctx, wrench, acc, hstep):
     """Contact of the journal with the bore and the end faces, in the bearing frame.
 
@@ -501,7 +505,7 @@ def _contact(J0, u, V0, W, ctx, wrench, acc, hstep):
     return energy, fnsum, pen_rad, pen_ax, mode, kdeep, nslice, fax
 
 
-@njit(cache=True)
+@kernel
 def _latch_impacts(vimp, srate, son, Nl, vfloor, per_layer):
     """Impact velocity of eq. 6, latched once per impact at its onset, per contact region.
 

@@ -6,10 +6,9 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
-from numba import njit
-
+from jointwear.sim.kernels._context import joint_arrays
 from jointwear.sim.kernels._geometry import body_rotation
+from jointwear.sim.kernels._jit import kernel
 from jointwear.sim.kernels._joint import (
     clearance_joint,
     ideal_joint_info,
@@ -55,7 +54,7 @@ from jointwear.sim.kernels._layout import (
 from jointwear.sim.kernels._slider_crank import eval_slider_crank
 
 
-@njit(cache=True)
+@kernel
 def _eval_clearance(t, y, ctx, dy, acc, hstep, diag):
     """Right-hand side of the clearance model; optionally accumulates wear work / fills diag."""
     P, IP = ctx[0], ctx[1]
@@ -66,16 +65,12 @@ def _eval_clearance(t, y, ctx, dy, acc, hstep, diag):
     Bx, By = l1 * c1, l1 * s1
     vBx, vBy = -l1 * w1 * s1, l1 * w1 * c1
     Ccx, Ccy = Bx + l2 * c2, By + l2 * s2
-    R = np.empty((3, 3))
+    R, Rb, Og, Cj, ug, FM, J0, u, V0, W, wrench = joint_arrays(ctx)
     ob0, ob1, ob2, wgx, wgy, wgz = body_rotation(y, R)  # the follower
     dz = P[JOFF]
     Cfx = l4 + l3 * R[0, 1] + dz * R[0, 2]
     Cfy = l3 * R[1, 1] + dz * R[1, 2]
     Cfz = l3 * R[2, 1] + dz * R[2, 2]
-    Rb = np.empty((3, 3))
-    Og = np.empty(3)
-    Cj = np.empty(3)
-    ug = np.empty(3)
     on_coupler = IP[ON_COUPLER] == 1
     # the follower is the spatial body, the coupler the planar one
     joint_frames(not on_coupler, R, Cfx, Cfy, Cfz, c2, s2, -s2, c2, Ccx, Ccy, dz, Rb, Og, Cj, ug)
@@ -93,11 +88,8 @@ def _eval_clearance(t, y, ctx, dy, acc, hstep, diag):
     else:
         V0g = (vcx - vfx, vcy - vfy, vcz - vfz)
         Wg = (-wgx, -wgy, w2 - wgz)
-    FM = np.empty(6)
-    J0 = np.empty(3)
-    u = np.empty(3)
-    energy, fnsum, pen_rad, pen_ax, mode, kdeep, nslice, fax, wrench = clearance_joint(
-        Rb, Og, Cj, ug, V0g, Wg, ctx, acc, hstep, FM, J0, u
+    energy, fnsum, pen_rad, pen_ax, mode, kdeep, nslice, fax = clearance_joint(
+        Rb, Og, Cj, ug, V0g, Wg, ctx, acc, hstep, FM, J0, u, V0, W, wrench
     )
     # wrench on the bearing, global: force F, moment M about Og
     Fx, Fy, Fz, Mx, My, Mz = FM[0], FM[1], FM[2], FM[3], FM[4], FM[5]
@@ -180,7 +172,7 @@ def _eval_clearance(t, y, ctx, dy, acc, hstep, diag):
         diag[D_TH2DOT] = w2
 
 
-@njit(cache=True)
+@kernel
 def _eval_ideal(t, y, P, IP, dy, diag):
     """Planar four-bar with ideal joint C: loop-closure constraints, Baumgarte-stabilised."""
     th1, th2, th3, w1, w2, w3 = y[0], y[1], y[2], y[3], y[4], y[5]
@@ -247,7 +239,7 @@ def _eval_ideal(t, y, P, IP, dy, diag):
         diag[D_TH2DOT] = w2
 
 
-@njit(cache=True)
+@kernel
 def _eval(t, y, ctx, dy, acc, hstep, diag):
     """Right-hand side dy of the mechanism (``IP[MECH]``) and joint model; ``ctx`` as in
     :func:`~jointwear.sim.kernels._contact._contact`.

@@ -6,13 +6,12 @@ from __future__ import annotations
 
 import math
 
-from numba import njit
-
 from jointwear.sim.kernels._geometry import W_FRICTION, _add_force
+from jointwear.sim.kernels._jit import inline_kernel, kernel
 from jointwear.sim.kernels._layout import MUD, MUS, VD, VS
 
 
-@njit(cache=True)
+@kernel
 def friction_coefficient(v, mus, mud, vs, vd):
     """Eq. 12: smoothed Coulomb friction coefficient at sliding speed v >= 0 [m/s]."""
     if v < vs:
@@ -22,7 +21,7 @@ def friction_coefficient(v, mus, mud, vs, vd):
     return mud
 
 
-@njit(cache=True, inline="always")
+@inline_kernel
 def _apply_friction(wrench, px, py, pz, tx, ty, tz, fn, muon, P):
     """Add the friction of eq. 12 at a contact to ``wrench``; return the sliding speed |v_t|.
 

@@ -6,12 +6,11 @@ from __future__ import annotations
 
 import math
 
-from numba import njit
-
+from jointwear.sim.kernels._jit import inline_kernel, kernel
 from jointwear.sim.kernels._layout import DPHI, LJ, RB, RJ
 
 
-@njit(cache=True)
+@kernel
 def _quat_matrix(q0, q1, q2, q3, R):
     n = math.sqrt(q0 * q0 + q1 * q1 + q2 * q2 + q3 * q3)
     w, x, y, z = q0 / n, q1 / n, q2 / n, q3 / n
@@ -26,7 +25,7 @@ def _quat_matrix(q0, q1, q2, q3, R):
     R[2, 2] = 1 - 2 * (x * x + y * y)
 
 
-@njit(cache=True, inline="always")
+@inline_kernel
 def body_rotation(y, R):
     """Fill ``R`` from the quaternion y[4:8]; return the body's angular velocity y[8:11] in its
     own axes and in global axes (the rotating body of the clearance-model states)."""
@@ -38,7 +37,7 @@ def body_rotation(y, R):
     return ob0, ob1, ob2, wgx, wgy, wgz
 
 
-@njit(cache=True)
+@kernel
 def _node(n, m, J0, u, P, H, ZL, Nd):
     """Signed penetration of bearing point (n, m) by the journal and its geometry (bearing frame).
 
@@ -60,7 +59,7 @@ def _node(n, m, J0, u, P, H, ZL, Nd):
     return P[RJ] - dist, Dx, Dy, Dz, dx / dist, dy / dist, dz / dist, s
 
 
-@njit(cache=True)
+@kernel
 def _dl(t, P):
     """Penetration of a node tuple from :func:`_node`, -1 beyond the journal's ends."""
     if abs(t[7]) > 0.5 * P[LJ]:
@@ -68,13 +67,13 @@ def _dl(t, P):
     return t[0]
 
 
-@njit(cache=True)
+@kernel
 def _node_delta(n, m, J0, u, P, H, ZL, Nd):
     """Penetration of bearing point (n, m), -1 beyond the journal's ends."""
     return _dl(_node(n, m, J0, u, P, H, ZL, Nd), P)
 
 
-@njit(cache=True)
+@kernel
 def _cross_acc(ax, ay, az, bx, by, bz, out, k, s):
     out[k] += s * (ay * bz - az * by)
     out[k + 1] += s * (az * bx - ax * bz)
@@ -86,7 +85,7 @@ def _cross_acc(ax, ay, az, bx, by, bz, out, k, s):
 W_NORMAL, W_FRICTION = 6, 9
 
 
-@njit(cache=True, inline="always")
+@inline_kernel
 def _add_force(wrench, px, py, pz, dx, dy, dz, s, part):
     """Add the force s (dx, dy, dz) acting at (px, py, pz) to a contact wrench: to the resultant,
     to its ``part`` (:data:`W_NORMAL` or :data:`W_FRICTION`) and its moment to the moment slots."""
@@ -105,7 +104,7 @@ _GL_T = (0.5 - 0.5 * math.sqrt(0.6), 0.5, 0.5 + 0.5 * math.sqrt(0.6))
 _GL_W = (5.0 / 18.0, 8.0 / 18.0, 5.0 / 18.0)
 
 
-@njit(cache=True)
+@kernel
 def _seg(a, b, nexp):
     """Integrals over an axial interval where the penetration runs linearly from a to b.
 
@@ -148,7 +147,7 @@ def _seg(a, b, nexp):
     return j0, j1, g, frac
 
 
-@njit(cache=True)
+@kernel
 def _search(n, m0, J0, u, P, H, ZL, Nd):
     """Deepest node of layer n near node m0: (ms, delta at ms-1, ms, ms+1, their node tuples)."""
     # climb from the node facing the eccentricity to the nearest local maximum of the
@@ -192,7 +191,7 @@ def _search(n, m0, J0, u, P, H, ZL, Nd):
     return ms, dm, d0, dp, nm, n0, npp
 
 
-@njit(cache=True)
+@kernel
 def _layer_axis(n, J0, u, P, HMIN, ZL):
     """Journal axis point in layer n's plane and a bound of the layer's penetration.
 
@@ -209,7 +208,7 @@ def _layer_axis(n, J0, u, P, HMIN, ZL):
     return True, ax, ay, dest
 
 
-@njit(cache=True)
+@kernel
 def _facing_node(ax, ay, P, Nd):
     """Index of the bore node facing the journal axis point (ax, ay) (eq. 2 angles)."""
     phi0 = math.atan2(ay, -ax)
@@ -218,7 +217,7 @@ def _facing_node(ax, ay, P, Nd):
     return int(round(phi0 / P[DPHI])) % Nd
 
 
-@njit(cache=True, inline="always")
+@inline_kernel
 def _rel_velocity(V0, W, px, py, pz):
     """Velocity of the journal relative to the bearing at the point (px, py, pz)."""
     return (

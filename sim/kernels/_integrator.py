@@ -10,7 +10,9 @@ import numpy as np
 from numba import njit
 
 from jointwear.sim.kernels._contact import _latch_impacts
+from jointwear.sim.kernels._context import make_context
 from jointwear.sim.kernels._equations import _eval
+from jointwear.sim.kernels._jit import inline_kernel
 from jointwear.sim.kernels._layout import (
     I_BAD,
     I_CONTACT,
@@ -18,7 +20,6 @@ from jointwear.sim.kernels._layout import (
     IDEAL,
     LATCH,
     ND_DIAG,
-    NINFO,
     NL,
     VFLOOR,
 )
@@ -56,7 +57,7 @@ _E = np.array(
 )
 
 
-@njit(cache=True, inline="always")
+@inline_kernel
 def _combine(Ks, coef, s, i):
     """sum_j coef[j] Ks[j, i] over the stages j < s with a non-zero coefficient, in order."""
     a = 0.0
@@ -102,10 +103,8 @@ def integrate(
     """
     n = y.shape[0]
     Nl = IP[NL]
-    srate = np.zeros(Nl + 2)
-    son = np.zeros(Nl + 2, dtype=np.int64)
-    info = np.zeros(NINFO)
-    ctx = (P, IP, H, HMIN, ZL, WL, AREA, vimp, srate, son, info, WW, acc_out)
+    ctx = make_context(P, IP, H, HMIN, ZL, WL, AREA, vimp, WW, acc_out)
+    srate, son, info = ctx[8], ctx[9], ctx[10]
     Ks = np.empty((7, n))  # the seven stage derivatives (the seventh is the next first: FSAL)
     yt = np.empty(n)
     y1 = np.empty(n)

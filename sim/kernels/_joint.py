@@ -14,10 +14,8 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
-from numba import njit
-
 from jointwear.sim.kernels._contact import _contact
+from jointwear.sim.kernels._jit import inline_kernel, kernel
 from jointwear.sim.kernels._layout import (
     CTILT,
     D_AXIS,
@@ -53,7 +51,7 @@ __all__ = [
 ]
 
 
-@njit(cache=True, inline="always")
+@inline_kernel
 def joint_frames(on_spatial, R, sx, sy, sz, xx, xy, yx, yy, qx, qy, qz, Rb, Og, Cj, ug):
     """Fill the bearing frame ``Rb``, bearing centre ``Og``, journal centre ``Cj`` and journal
     axis ``ug`` (global) of a joint between a spatial body and a planar one.
@@ -80,28 +78,28 @@ def joint_frames(on_spatial, R, sx, sy, sz, xx, xy, yx, yy, qx, qy, qz, Rb, Og, 
         ug[0], ug[1], ug[2] = R[0, 2], R[1, 2], R[2, 2]
 
 
-@njit(cache=True)
-def clearance_joint(Rb, Og, Cj, ug, V0g, Wg, ctx, acc, hstep, FM, J0, u):
+@kernel
+def clearance_joint(Rb, Og, Cj, ug, V0g, Wg, ctx, acc, hstep, FM, J0, u, V0, W, wrench):
     """The clearance joint's side of the mechanism interface: contact wrench from the two poses.
 
     A mechanism gives the bearing frame ``Rb`` (columns: the bearing's axes, global), the bearing
     centre ``Og``, the journal centre ``Cj`` and axis ``ug`` (global), and the journal body's
     velocity at ``Og`` and angular velocity relative to the bearing body, ``V0g`` and ``Wg``
     (global); ``ctx`` as in :func:`_contact`. Fills ``FM`` with the wrench on the bearing (force,
-    moment about ``Og``; global), ``J0`` and ``u`` with the journal centre and axis in the
-    bearing frame, and returns (elastic energy, normal force sum, max radial penetration, max
-    axial penetration, mode, stiffness at the deepest slice, contacting slices, axial force,
-    wrench in the bearing frame).
+    moment about ``Og``; global), ``J0``, ``u``, ``V0`` and ``W`` with the journal centre and
+    axis, the relative velocity and angular velocity in the bearing frame, and ``wrench`` with
+    the contact wrench in the bearing frame (12, as :func:`_contact` adds to it); returns
+    (elastic energy, normal force sum, max radial penetration, max axial penetration, mode,
+    stiffness at the deepest slice, contacting slices, axial force). The out arrays are the
+    context's scratch arrays (:func:`._context.joint_arrays`).
     """
     info = ctx[10]
-    V0 = np.empty(3)
-    W = np.empty(3)
     for i in range(3):
         J0[i] = Rb[0, i] * (Cj[0] - Og[0]) + Rb[1, i] * (Cj[1] - Og[1]) + Rb[2, i] * (Cj[2] - Og[2])
         u[i] = Rb[0, i] * ug[0] + Rb[1, i] * ug[1] + Rb[2, i] * ug[2]
         V0[i] = Rb[0, i] * V0g[0] + Rb[1, i] * V0g[1] + Rb[2, i] * V0g[2]
         W[i] = Rb[0, i] * Wg[0] + Rb[1, i] * Wg[1] + Rb[2, i] * Wg[2]
-    wrench = np.zeros(12)
+    wrench[:] = 0.0
     info[I_BAD] = 0.0
     if u[2] < 0.5:
         info[I_BAD] = 1.0
@@ -118,10 +116,10 @@ def clearance_joint(Rb, Og, Cj, ug, V0g, Wg, ctx, acc, hstep, FM, J0, u):
     FM[3] = Rb[0, 0] * wrench[3] + Rb[0, 1] * wrench[4] + Rb[0, 2] * wrench[5]
     FM[4] = Rb[1, 0] * wrench[3] + Rb[1, 1] * wrench[4] + Rb[1, 2] * wrench[5]
     FM[5] = Rb[2, 0] * wrench[3] + Rb[2, 1] * wrench[4] + Rb[2, 2] * wrench[5]
-    return energy, fnsum, pen_rad, pen_ax, mode, kdeep, nslice, fax, wrench
+    return energy, fnsum, pen_rad, pen_ax, mode, kdeep, nslice, fax
 
 
-@njit(cache=True)
+@kernel
 def record_joint(diag, y, Og, Cj, FM, J0, u, wrench, pen_rad, pen_ax, mode, kdeep, nslice, fax):
     """Write the clearance joint's slots of the diagnostics row, the same for every mechanism.
 
@@ -152,7 +150,7 @@ def record_joint(diag, y, Og, Cj, FM, J0, u, wrench, pen_rad, pen_ax, mode, kdee
         diag[D_QUAT + i] = y[4 + i] / n
 
 
-@njit(cache=True)
+@kernel
 def record_ideal_joint(diag, bx, by, jx, jy, joff, Fx, Fy, angle):
     """Write the joint's slots of the diagnostics row for the ideal (planar) joint.
 
@@ -172,7 +170,7 @@ def record_ideal_joint(diag, bx, by, jx, jy, joff, Fx, Fy, angle):
     diag[D_QUAT], diag[D_QUAT + 3] = math.cos(a), math.sin(a)
 
 
-@njit(cache=True)
+@kernel
 def ideal_joint_info(info):
     """Set the per-evaluation ``info`` of the ideal joint: no contact, no penetration, valid."""
     info[I_PEN] = -1.0

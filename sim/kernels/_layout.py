@@ -106,6 +106,27 @@ I_PEN, I_CONTACT, I_BAD = 0, 1, 2
 NINFO = 4
 
 
+# ---- evaluation context (ctx), made by _context.make_context --------------------------------
+# slots 0-12 (P, IP, H, HMIN, ZL, WL, AREA, vimp, srate, son, info, WW, acc_out): see
+# _contact._contact; then the scratch arrays of the evaluation kernels, which allocate nothing
+C_VEC = 13  # (N_VEC, 12) vectors of the joint, rows V_*
+C_MAT = 14  # (2, 3, 3): the rotating body's rotation (body -> global) and the bearing frame
+C_LAYER = 15  # (Nl, 8) per-layer results of the slice contact
+C_GEO = 16  # (Nl, 3, 6) the three nodes around each layer's deepest: point, normal
+C_NODE = 17  # (Nl,) int: each layer's deepest node
+C_WSC = 18  # (Nl, 3) per-layer work of the conserving wear projection
+C_BUF = 19  # (Nd + 1,) penetrations of a layer's penetrating run of nodes
+
+
+# rows of ctx[C_VEC]: bearing centre, journal centre, journal axis (global); wrench on the
+# bearing (global: force, moment); journal centre and axis, relative velocity and angular
+# velocity (bearing frame); the contact wrench (12, bearing frame)
+V_OG, V_CJ, V_UG, V_FM, V_J0, V_U, V_V0, V_W, V_WRENCH = 0, 1, 2, 3, 4, 5, 6, 7, 8
+
+
+N_VEC = 9
+
+
 # contact modes
 MODE_FREE, MODE_POINT, MODE_LINE, MODE_TWO, MODE_AXIAL, MODE_AXIAL_RADIAL, MODE_IDEAL = (
     0,

@@ -27,11 +27,10 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
-from numba import njit
-
 from jointwear.sim.kernels import _layout as kn
+from jointwear.sim.kernels._context import joint_arrays
 from jointwear.sim.kernels._geometry import body_rotation
+from jointwear.sim.kernels._jit import kernel
 from jointwear.sim.kernels._joint import (
     clearance_joint,
     ideal_joint_info,
@@ -53,12 +52,12 @@ D_ROD_OMEGA = 19
 D_ROD_ANGLE, D_DRIVER_TORQUE = 22, 23
 
 
-@njit(cache=True)
+@kernel
 def _cross(a0, a1, a2, b0, b1, b2):
     return a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
 
 
-@njit(cache=True)
+@kernel
 def _eval_slider_clearance(t, y, ctx, dy, acc, hstep, diag):
     """Right-hand side of the slider-crank with the clearance joint; fills ``diag`` if sized."""
     P, IP = ctx[0], ctx[1]
@@ -70,7 +69,7 @@ def _eval_slider_clearance(t, y, ctx, dy, acc, hstep, diag):
     c1, s1 = math.cos(th1), math.sin(th1)
     Bx, By = l1 * c1, l1 * s1
     vBx, vBy = -l1 * w1 * s1, l1 * w1 * c1
-    R = np.empty((3, 3))
+    R, Rb, Og, Cj, ug, FM, J0, u, V0, W, wrench = joint_arrays(ctx)
     ob0, ob1, ob2, wgx, wgy, wgz = body_rotation(y, R)  # the rod
     # rod pivot P (position, velocity, acceleration without the slider's unknown xdd)
     if case_b:
@@ -86,10 +85,6 @@ def _eval_slider_clearance(t, y, ctx, dy, acc, hstep, diag):
         Ox, Oy = Bx, By  # crank pin
     else:
         Ox, Oy = xs, 0.0  # slider pin
-    Rb = np.empty((3, 3))
-    Og = np.empty(3)
-    Cj = np.empty(3)
-    ug = np.empty(3)
     # the rod is the spatial body; the other is the crank (x along A -> B) or the slider
     xx, xy, yx, yy = (c1, s1, -s1, c1) if case_b else (1.0, 0.0, 0.0, 1.0)
     joint_frames(on_rod, R, Jx, Jy, Jz, xx, xy, yx, yy, Ox, Oy, joff, Rb, Og, Cj, ug)
@@ -108,11 +103,8 @@ def _eval_slider_clearance(t, y, ctx, dy, acc, hstep, diag):
     else:
         V0g = (vrx - vox, vry - voy, vrz)
         Wg = (wgx, wgy, wgz - woz)
-    FM = np.empty(6)
-    J0 = np.empty(3)
-    u = np.empty(3)
-    energy, fnsum, pen_rad, pen_ax, mode, kdeep, nslice, fax, wrench = clearance_joint(
-        Rb, Og, Cj, ug, V0g, Wg, ctx, acc, hstep, FM, J0, u
+    energy, fnsum, pen_rad, pen_ax, mode, kdeep, nslice, fax = clearance_joint(
+        Rb, Og, Cj, ug, V0g, Wg, ctx, acc, hstep, FM, J0, u, V0, W, wrench
     )
     sr = 1.0 if on_rod else -1.0  # sign of the bearing wrench acting on the rod
     Frx, Fry, Frz = sr * FM[0], sr * FM[1], sr * FM[2]
@@ -208,7 +200,7 @@ def _eval_slider_clearance(t, y, ctx, dy, acc, hstep, diag):
     diag[kn.D_ENERGY] = T + V + energy
 
 
-@njit(cache=True)
+@kernel
 def _eval_slider_ideal(t, y, ctx, dy, diag):
     """Ideal joints: the crank at constant speed; joint reactions and driver torque (Newton-Euler).
 
@@ -270,7 +262,7 @@ def _eval_slider_ideal(t, y, ctx, dy, diag):
     diag[kn.D_ENERGY] = T + g * (0.5 * m1 * Byf + mr * (Byf + h * sp))
 
 
-@njit(cache=True)
+@kernel
 def eval_slider_crank(t, y, ctx, dy, acc, hstep, diag):
     """Right-hand side of the slider-crank (clearance or ideal model, ``IP[IDEAL]``)."""
     if ctx[1][kn.IDEAL] == 1:

@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import math
 
-from numba import njit
+from jointwear.sim.kernels._jit import inline_kernel
 
 
-@njit(cache=True, inline="always")
+@inline_kernel
 def _tilt_spring(u, W, k, c, wrench):
     """Rotational spring-damper resisting the journal's tilt, in the bearing frame.
 

@@ -17,7 +17,7 @@ from jointwear.params import replace_nested
 from jointwear.sim import PARAMETER_SETS, run_cycles
 from jointwear.sim.dynamics import _layers, _pack, point_area
 from jointwear.sim.kernels._contact import _contact, _latch_impacts, _stiffness
-from jointwear.sim.kernels._layout import NINFO
+from jointwear.sim.kernels._context import make_context
 
 BASE = PARAMETER_SETS["zhang2023"]
 EDGE_PEN = 1.0e-6  # penetration at the bearing edge z = +wb/2 [m]
@@ -46,21 +46,7 @@ def _press(params, length=CONTACT_LENGTH):
     area = point_area(params)
     ww = np.zeros((2, nl, nd))
     acc = np.zeros(3)
-    ctx = (
-        P,
-        IP,
-        h,
-        h.min(axis=1).copy(),
-        zl,
-        wl,
-        area,
-        np.zeros(nl + 2),
-        np.zeros(nl + 2),
-        np.zeros(nl + 2, dtype=np.int64),
-        np.zeros(NINFO),
-        ww,
-        acc,
-    )
+    ctx = make_context(P, IP, h, h.min(axis=1).copy(), zl, wl, area, np.zeros(nl + 2), ww, acc)
     wrench = np.zeros(12)
     _contact(J0, u, V0, W, ctx, wrench, True, 1.0)
     return ww[0], area, float(np.linalg.norm(wrench[6:9])), J0, u, float(acc[0])
