@@ -46,28 +46,12 @@ def make_context(P, IP, H, HMIN, ZL, WL, AREA, vimp, WW, acc_out):
     per-evaluation info start at zero.
     """
     Nl, Nd = IP[NL], IP[ND]
-    return (
-        P,
-        IP,
-        H,
-        HMIN,
-        ZL,
-        WL,
-        AREA,
-        vimp,
-        np.zeros(Nl + 2),
-        np.zeros(Nl + 2, dtype=np.int64),
-        np.zeros(NINFO),
-        WW,
-        acc_out,
-        np.empty((N_VEC, 12)),
-        np.empty((2, 3, 3)),
-        np.empty((Nl, 8)),
-        np.empty((Nl, 3, 6)),
-        np.empty(Nl, dtype=np.int64),
-        np.empty((Nl, 3)),
-        np.empty(Nd + 1),
-    )
+    inputs = (P, IP, H, HMIN, ZL, WL, AREA, vimp)
+    rates_and_info = (np.zeros(Nl + 2), np.zeros(Nl + 2, dtype=np.int64), np.zeros(NINFO))
+    joint = (np.empty((N_VEC, 12)), np.empty((2, 3, 3)))
+    layers = (np.empty((Nl, 8)), np.empty((Nl, 3, 6)), np.empty(Nl, dtype=np.int64))
+    wear = (np.empty((Nl, 3)), np.empty(Nd + 1))
+    return inputs + rates_and_info + (WW, acc_out) + joint + layers + wear
 
 
 @inline_kernel
