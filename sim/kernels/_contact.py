@@ -163,9 +163,12 @@ def _slices(J0, u, V0, W, ctx, wrench, acc, hstep):
         j0, j1, g, frac = _seg(a, bb, nexp)
         # the interval's share of the bearing width (written as 1/(Nl-1) for equal spacing)
         lam = (ZL[n] - ZL[n + 1]) / P[WB] if IP[GRADED] else 1.0 / (Nl - 1)
-        fel[n] += lam * kk[n] * j0
-        fel[n + 1] += lam * kk[n + 1] * j1
-        energy += lam * 0.5 * (kk[n] + kk[n + 1]) * g
+        # a layer beyond the journal's end was not searched: the interval has the other's K
+        k0 = kk[n] if reach[n] == 2.0 else kk[n + 1]
+        k1 = kk[n + 1] if reach[n + 1] == 2.0 else kk[n]
+        fel[n] += lam * k0 * j0
+        fel[n + 1] += lam * k1 * j1
+        energy += lam * 0.5 * (k0 + k1) * g
         clen += lam * frac
     fnsum = 0.0
     kdeep = 0.0
