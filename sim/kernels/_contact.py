@@ -473,7 +473,8 @@ def _end_faces(J0, u, V0, W, ctx, wrench, acc, hstep):
 def _contact(J0, u, V0, W, ctx, wrench, acc, hstep):
     """Contact of the journal with the bore and the end faces, in the bearing frame.
 
-    ``ctx`` = (P, IP, H, HMIN, ZL, WL, AREA, vimp, srate, son, info, WW, acc_out). With
+    ``ctx`` = (P, IP, H, HMIN, ZL, WL, AREA, vimp, srate, son, info, WW, acc_out, then the
+    scratch arrays of :func:`._context.make_context`). With
     ``acc``, adds to ``WW[0]`` the wear work p |v_t| dt and to ``WW[1]`` the sliding distance
     |v_t| dt of every contacting bearing point. Adds to ``wrench`` (12: force on the bearing,
     moment about the bearing centre, normal part of the force, friction part of the force)
