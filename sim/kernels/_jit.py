@@ -5,8 +5,9 @@ search and forces, the impact latch) is compiled without the numba runtime (NRT)
 function may not allocate an array (numba refuses to compile one that does) and returns none,
 so it needs no reference counts. With the runtime, numba counted a reference up and down with
 an atomic operation for every array handed down the call chain (the evaluation context alone
-holds 20); that took about three quarters of an integration step's time, and a step cost twice
-what it does now (``benchmarks/results/sim_cycle.json``).
+holds 20). Without it a step takes half the time (``benchmarks/results/sim_cycle.json``: 0.110
+-> 0.054 s CPU per crank cycle, results equal to the bit); a ``perf`` profile had put the two
+counting functions at about three quarters of the compiled code's samples.
 
 The scratch arrays the kernels work in are allocated once per integration, by
 :func:`._context.make_context`; :func:`._integrator.integrate` and ``make_context`` keep the

@@ -1,6 +1,6 @@
 """The evaluation kernels run without numba's runtime (``sim/kernels/_jit.py``).
 
-Counting array references took about three quarters of an integration step; the kernels an
+Counting array references took half of an integration step's time; the kernels an
 integration step calls are compiled without the runtime, so they can neither allocate nor count.
 A kernel decorated with plain ``numba.njit`` would silently bring the cost back: this test names
 it.
