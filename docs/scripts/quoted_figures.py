@@ -10,6 +10,16 @@ value to the quoted unit, e.g. ``<!-- fig: sim_cycle.json:figures/x_s *1e3 -->``
 quoted in milliseconds. The figure is the last number before the marker; it agrees when it
 equals the JSON value rounded to the digits the figure shows (half a unit of its last digit).
 
+A range's ends are the least or the largest of several values: a path step ``*`` takes every
+key (or item) at that level, ``(a|b|c)`` the keys named, and ``min`` or ``max`` after the path
+says which end is quoted::
+
+    8 <!-- fig: sim_rigs.json:figures/rigs/(default|friction_0)/cpu_s min -->–21 s
+    <!-- fig: sim_rigs.json:figures/rigs/(default|friction_0)/cpu_s max -->
+
+A path that names several values without ``min`` or ``max`` is reported, as is ``min``/``max``
+on a path that names one.
+
 Usage: ``python docs/scripts/quoted_figures.py`` prints every marked figure with its JSON value
 and exits 1 when one disagrees or its marker names no value.
 """
@@ -27,7 +37,8 @@ ROOT = Path(__file__).resolve().parents[2]
 RESULTS = ROOT / "benchmarks" / "results"
 
 MARKER = re.compile(
-    r"<!--\s*fig:\s*(?P<file>[\w.-]+\.json):(?P<path>[^*>]+?)\s*(?:\*\s*(?P<factor>[-+0-9.eE]+)\s*)?-->"
+    r"<!--\s*fig:\s*(?P<file>[\w.-]+\.json):(?P<path>[^>]+?)(?:\s+(?P<end>min|max))?"
+    r"\s*(?:\*\s*(?P<factor>[-+0-9.eE]+)\s*)?-->"
 )
 # a number as docs write it: 1.71, 0.10, 2,909, 1e-16, −0.5 (unicode minus)
 NUMBER = re.compile(r"[-−]?(?:\d{1,3}(?:,\d{3})+|\d+)(?:\.\d+)?(?:[eE][-−+]?\d+)?")
@@ -54,16 +65,33 @@ def documents(root: Path = ROOT) -> list[Path]:
     return [root / "README.md", *sorted((root / "docs").glob("*.md"))]
 
 
+def _child(data: object, key: str) -> object:
+    if isinstance(data, list):
+        return data[int(key)]
+    if isinstance(data, dict):
+        return data[key]
+    raise KeyError(key)
+
+
 def lookup(data: object, path: str) -> object:
     """The value at ``path`` (keys joined by ``/``, list indices as integers)."""
     for key in path.split("/"):
-        if isinstance(data, list):
-            data = data[int(key)]
-        elif isinstance(data, dict):
-            data = data[key]
-        else:
-            raise KeyError(key)
+        data = _child(data, key)
     return data
+
+
+def select(data: object, path: str) -> list[object]:
+    """Every value ``path`` names: as :func:`lookup`, with ``*`` for every key or item of a
+    level and ``(a|b)`` for the keys named."""
+    found = [data]
+    for key in path.split("/"):
+        if key == "*":
+            found = [v for d in found for v in (d if isinstance(d, list) else d.values())]
+        elif key.startswith("(") and key.endswith(")"):
+            found = [_child(d, k) for d in found for k in key[1:-1].split("|")]
+        else:
+            found = [_child(d, key) for d in found]
+    return found
 
 
 def _as_float(text: str) -> float:
@@ -83,13 +111,28 @@ def agrees(quoted: str, value: float) -> bool:
     return abs(q - value) <= _decimals_unit(quoted) * (1 + 1e-9) + 1e-12 * abs(value)
 
 
+class _Selection(ValueError):
+    """A marker's path and its ``min``/``max`` do not go together."""
+
+
+def _end(values: list[float], end: str | None) -> float:
+    """The value a marker names: the only one, or the least/largest with ``min``/``max``."""
+    if end is None:
+        if len(values) != 1:
+            raise _Selection(f"the path names {len(values)} values: add min or max")
+        return values[0]
+    if len(values) < 2:
+        raise _Selection(f"{end} of a path that names {len(values)} value(s)")
+    return min(values) if end == "min" else max(values)
+
+
 def check_text(text: str, doc: str, results: Path = RESULTS) -> list[Figure]:
     """Every marked figure of ``text`` with its JSON value and the problem, if any."""
     cache: dict[str, object] = {}
     figures = []
     for m in MARKER.finditer(text):
         line = text.count("\n", 0, m.start()) + 1
-        source = f"{m['file']}:{m['path'].strip()}"
+        source = f"{m['file']}:{m['path'].strip()}" + (f" {m['end']}" if m["end"] else "")
         before = text[: m.start()]
         start = max(before.rfind("-->"), before.rfind("\n\n"))
         numbers = list(NUMBER.finditer(before, max(start, 0)))
@@ -100,14 +143,17 @@ def check_text(text: str, doc: str, results: Path = RESULTS) -> list[Figure]:
         try:
             if m["file"] not in cache:
                 cache[m["file"]] = json.loads((results / m["file"]).read_text(encoding="utf-8"))
-            raw = lookup(cache[m["file"]], m["path"].strip())
-            value = float(raw) * (float(m["factor"]) if m["factor"] else 1.0)
+            values = [float(v) for v in select(cache[m["file"]], m["path"].strip())]
+            value = _end(values, m["end"]) * (float(m["factor"]) if m["factor"] else 1.0)
         except FileNotFoundError:
             figures.append(
                 Figure(doc, line, quoted, source, None, f"no file benchmarks/results/{m['file']}")
             )
             continue
-        except (KeyError, IndexError, ValueError, TypeError):
+        except _Selection as e:
+            figures.append(Figure(doc, line, quoted, source, None, str(e)))
+            continue
+        except (KeyError, IndexError, ValueError, TypeError, AttributeError):
             figures.append(Figure(doc, line, quoted, source, None, "no numeric value at that path"))
             continue
         problem = None if agrees(quoted, value) else f"quoted {quoted}, the results say {value:.6g}"

@@ -39,7 +39,20 @@ def test_every_marked_figure_agrees_with_its_benchmark():
 @pytest.fixture
 def results(tmp_path):
     (tmp_path / "bench.json").write_text(
-        json.dumps({"figures": {"ratio": 1.7067, "runs": [0.1, 0.25], "a.b c": 2.0}})
+        json.dumps(
+            {
+                "figures": {
+                    "ratio": 1.7067,
+                    "runs": [0.1, 0.25],
+                    "a.b c": 2.0,
+                    "rigs": {
+                        "slow": {"cpu_s": 27.7},
+                        "mid": {"cpu_s": 20.5},
+                        "fast": {"cpu_s": 8.2},
+                    },
+                }
+            }
+        )
     )
     return tmp_path
 
@@ -77,3 +90,47 @@ def test_paths_indices_factors_and_keys_with_dots(results):
 def test_a_broken_marker_is_reported(results, text, problem):
     figures = qf.check_text(text, "doc.md", results)
     assert any(f.problem and problem in f.problem for f in figures), figures
+
+
+@pytest.mark.parametrize(
+    ("text", "ok"),
+    [
+        ("8 <!-- fig: bench.json:figures/rigs/*/cpu_s min -->", True),
+        ("28 <!-- fig: bench.json:figures/rigs/*/cpu_s max -->", True),
+        ("21 <!-- fig: bench.json:figures/rigs/(fast|mid)/cpu_s max -->", True),
+        ("28 <!-- fig: bench.json:figures/rigs/(fast|mid)/cpu_s max -->", False),
+        ("8.2 <!-- fig: bench.json:figures/rigs/(fast|mid)/cpu_s min -->", True),
+        ("20.5 <!-- fig: bench.json:figures/rigs/(fast|mid)/cpu_s min -->", False),
+        ("250 <!-- fig: bench.json:figures/runs/* max *1e3 -->", True),
+    ],
+)
+def test_a_range_end_is_the_least_or_largest_of_the_values_named(results, text, ok):
+    (fig,) = qf.check_text(text, "doc.md", results)
+    assert fig.ok is ok, fig.problem
+
+
+def test_each_end_of_a_range_has_its_own_marker(results):
+    text = (
+        "finish in 8 <!-- fig: bench.json:figures/rigs/*/cpu_s min -->–28 s"
+        " <!-- fig: bench.json:figures/rigs/*/cpu_s max --> CPU"
+    )
+    figures = qf.check_text(text, "doc.md", results)
+    assert [(f.quoted, f.ok) for f in figures] == [("8", True), ("28", True)]
+    swapped = text.replace(" min -->", " MAX -->").replace(" max -->", " min -->")
+    swapped = swapped.replace(" MAX -->", " max -->")
+    assert [f.ok for f in qf.check_text(swapped, "doc.md", results)] == [False, False]
+
+
+@pytest.mark.parametrize(
+    ("text", "problem"),
+    [
+        ("8 <!-- fig: bench.json:figures/rigs/*/cpu_s -->", "names 3 values: add min or max"),
+        ("1.71 <!-- fig: bench.json:figures/ratio max -->", "max of a path that names 1"),
+        ("8 <!-- fig: bench.json:figures/rigs/(fast|none)/cpu_s min -->", "no numeric value"),
+    ],
+)
+def test_a_selection_without_its_end_or_an_end_without_a_selection_is_reported(
+    results, text, problem
+):
+    (fig,) = qf.check_text(text, "doc.md", results)
+    assert fig.problem and problem in fig.problem, fig.problem
