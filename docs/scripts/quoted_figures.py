@@ -11,8 +11,9 @@ quoted in milliseconds. The figure is the last number before the marker; it agre
 equals the JSON value rounded to the digits the figure shows (half a unit of its last digit).
 
 A range's ends are the least or the largest of several values: a path step ``*`` takes every
-key (or item) at that level, ``(a|b|c)`` the keys named, and ``min`` or ``max`` after the path
-says which end is quoted::
+key (or item) at that level, ``(a|b|c)`` the keys named, ``[key=value,key^=text,key$=text]``
+the items of a list of records whose fields equal (begin with, end with) the texts given, and
+``min`` or ``max`` after the path says which end is quoted::
 
     8 <!-- fig: sim_rigs.json:figures/rigs/(default|friction_0)/cpu_s min -->–21 s
     <!-- fig: sim_rigs.json:figures/rigs/(default|friction_0)/cpu_s max -->
@@ -80,12 +81,35 @@ def lookup(data: object, path: str) -> object:
     return data
 
 
+def _matches(record: object, conditions: str) -> bool:
+    """``record`` (a dict) has every field of ``conditions`` (``key=value`` equal, ``key^=text``
+    beginning with, ``key$=text`` ending with)."""
+    if not isinstance(record, dict):
+        return False
+    for condition in conditions.split(","):
+        key, op, want = condition.partition("=")
+        if not op:
+            raise KeyError(condition)
+        if key.endswith("^"):
+            if not str(record.get(key[:-1], "")).startswith(want):
+                return False
+        elif key.endswith("$"):
+            if not str(record.get(key[:-1], "")).endswith(want):
+                return False
+        elif str(record.get(key)) != want:
+            return False
+    return True
+
+
 def select(data: object, path: str) -> list[object]:
     """Every value ``path`` names: as :func:`lookup`, with ``*`` for every key or item of a
-    level and ``(a|b)`` for the keys named."""
+    level, ``(a|b)`` for the keys named and ``[key=value,key^=prefix]`` for the records of a
+    list that match."""
     found = [data]
     for key in path.split("/"):
-        if key == "*":
+        if key.startswith("[") and key.endswith("]"):
+            found = [r for d in found for r in d if _matches(r, key[1:-1])]
+        elif key == "*":
             found = [v for d in found for v in (d if isinstance(d, list) else d.values())]
         elif key.startswith("(") and key.endswith(")"):
             found = [_child(d, k) for d in found for k in key[1:-1].split("|")]
@@ -117,6 +141,8 @@ class _Selection(ValueError):
 
 def _end(values: list[float], end: str | None) -> float:
     """The value a marker names: the only one, or the least/largest with ``min``/``max``."""
+    if not values:
+        raise _Selection("the path names no value")
     if end is None:
         if len(values) != 1:
             raise _Selection(f"the path names {len(values)} values: add min or max")

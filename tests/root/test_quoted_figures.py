@@ -50,6 +50,12 @@ def results(tmp_path):
                         "mid": {"cpu_s": 20.5},
                         "fast": {"cpu_s": 8.2},
                     },
+                    "metrics": [
+                        {"quantity": "c_4e5", "metric": "S", "value": 5.88e-6},
+                        {"quantity": "c_4e5 [z = 0, +z]", "metric": "S", "value": 22.11e-6},
+                        {"quantity": "c_4e5 [z = 0, +z]", "metric": "U", "value": 1.0},
+                        {"quantity": "c_12e6", "metric": "S", "value": 40.0e-6},
+                    ],
                 }
             }
         )
@@ -102,6 +108,19 @@ def test_a_broken_marker_is_reported(results, text, problem):
         ("8.2 <!-- fig: bench.json:figures/rigs/(fast|mid)/cpu_s min -->", True),
         ("20.5 <!-- fig: bench.json:figures/rigs/(fast|mid)/cpu_s min -->", False),
         ("250 <!-- fig: bench.json:figures/runs/* max *1e3 -->", True),
+        (
+            "5.9 <!-- fig: bench.json:figures/metrics/[quantity^=c_4e5,metric=S]/value min *1e6 -->",
+            True,
+        ),
+        (
+            "22.1 <!-- fig: bench.json:figures/metrics/[quantity^=c_4e5,metric=S]/value max *1e6 -->",
+            True,
+        ),
+        (
+            "40.0 <!-- fig: bench.json:figures/metrics/[quantity^=c_4e5,metric=S]/value max *1e6 -->",
+            False,
+        ),
+        ("5.9 <!-- fig: bench.json:figures/metrics/[quantity=c_4e5,metric=S]/value *1e6 -->", True),
     ],
 )
 def test_a_range_end_is_the_least_or_largest_of_the_values_named(results, text, ok):
@@ -127,6 +146,8 @@ def test_each_end_of_a_range_has_its_own_marker(results):
         ("8 <!-- fig: bench.json:figures/rigs/*/cpu_s -->", "names 3 values: add min or max"),
         ("1.71 <!-- fig: bench.json:figures/ratio max -->", "max of a path that names 1"),
         ("8 <!-- fig: bench.json:figures/rigs/(fast|none)/cpu_s min -->", "no numeric value"),
+        ("8 <!-- fig: bench.json:figures/metrics/[metric=V]/value min -->", "names no value"),
+        ("8 <!-- fig: bench.json:figures/metrics/[metric]/value min -->", "no numeric value"),
     ],
 )
 def test_a_selection_without_its_end_or_an_end_without_a_selection_is_reported(
