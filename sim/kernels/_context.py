@@ -26,8 +26,6 @@ from jointwear.sim.kernels._layout import (
     V_OG,
     V_U,
     V_UG,
-    V_V0,
-    V_W,
     V_WRENCH,
 )
 
@@ -58,8 +56,8 @@ def make_context(P, IP, H, HMIN, ZL, WL, AREA, vimp, WW, acc_out):
 def joint_arrays(ctx):
     """The scratch arrays of a mechanism's right-hand side and its clearance joint: the rotating
     body's rotation ``R``, the bearing frame ``Rb``, ``Og``, ``Cj``, ``ug``, ``FM``, ``J0``,
-    ``u``, ``V0``, ``W`` and the contact ``wrench`` (as :func:`._joint.clearance_joint` names
-    them). Their contents are undefined until written."""
+    ``u`` and the contact ``wrench`` (as :func:`._joint.clearance_joint` names them). Their
+    contents are undefined until written."""
     vec, mat = ctx[C_VEC], ctx[C_MAT]
     return (
         mat[0],
@@ -70,7 +68,5 @@ def joint_arrays(ctx):
         vec[V_FM],
         vec[V_J0],
         vec[V_U],
-        vec[V_V0],
-        vec[V_W],
         vec[V_WRENCH],
     )

@@ -65,7 +65,7 @@ def _eval_clearance(t, y, ctx, dy, acc, hstep, diag):
     Bx, By = l1 * c1, l1 * s1
     vBx, vBy = -l1 * w1 * s1, l1 * w1 * c1
     Ccx, Ccy = Bx + l2 * c2, By + l2 * s2
-    R, Rb, Og, Cj, ug, FM, J0, u, V0, W, wrench = joint_arrays(ctx)
+    R, Rb, Og, Cj, ug, FM, J0, u, wrench = joint_arrays(ctx)
     ob0, ob1, ob2, wgx, wgy, wgz = body_rotation(y, R)  # the follower
     dz = P[JOFF]
     Cfx = l4 + l3 * R[0, 1] + dz * R[0, 2]
@@ -89,7 +89,7 @@ def _eval_clearance(t, y, ctx, dy, acc, hstep, diag):
         V0g = (vcx - vfx, vcy - vfy, vcz - vfz)
         Wg = (-wgx, -wgy, w2 - wgz)
     energy, fnsum, pen_rad, pen_ax, mode, kdeep, nslice, fax = clearance_joint(
-        Rb, Og, Cj, ug, V0g, Wg, ctx, acc, hstep, FM, J0, u, V0, W, wrench
+        Rb, Og, Cj, ug, V0g, Wg, ctx, acc, hstep, FM, J0, u, wrench
     )
     # wrench on the bearing, global: force F, moment M about Og
     Fx, Fy, Fz, Mx, My, Mz = FM[0], FM[1], FM[2], FM[3], FM[4], FM[5]

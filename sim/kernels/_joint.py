@@ -17,6 +17,7 @@ import math
 from jointwear.sim.kernels._contact import _contact
 from jointwear.sim.kernels._jit import inline_kernel, kernel
 from jointwear.sim.kernels._layout import (
+    C_VEC,
     CTILT,
     D_AXIS,
     D_BEAR_POS,
@@ -39,6 +40,8 @@ from jointwear.sim.kernels._layout import (
     I_PEN,
     KTILT,
     MODE_IDEAL,
+    V_V0,
+    V_W,
 )
 from jointwear.sim.kernels._tilt import _tilt_spring
 
@@ -79,21 +82,23 @@ def joint_frames(on_spatial, R, sx, sy, sz, xx, xy, yx, yy, qx, qy, qz, Rb, Og, 
 
 
 @kernel
-def clearance_joint(Rb, Og, Cj, ug, V0g, Wg, ctx, acc, hstep, FM, J0, u, V0, W, wrench):
+def clearance_joint(Rb, Og, Cj, ug, V0g, Wg, ctx, acc, hstep, FM, J0, u, wrench):
     """The clearance joint's side of the mechanism interface: contact wrench from the two poses.
 
     A mechanism gives the bearing frame ``Rb`` (columns: the bearing's axes, global), the bearing
     centre ``Og``, the journal centre ``Cj`` and axis ``ug`` (global), and the journal body's
     velocity at ``Og`` and angular velocity relative to the bearing body, ``V0g`` and ``Wg``
     (global); ``ctx`` as in :func:`_contact`. Fills ``FM`` with the wrench on the bearing (force,
-    moment about ``Og``; global), ``J0``, ``u``, ``V0`` and ``W`` with the journal centre and
-    axis, the relative velocity and angular velocity in the bearing frame, and ``wrench`` with
-    the contact wrench in the bearing frame (12, as :func:`_contact` adds to it); returns
-    (elastic energy, normal force sum, max radial penetration, max axial penetration, mode,
-    stiffness at the deepest slice, contacting slices, axial force). The out arrays are the
-    context's scratch arrays (:func:`._context.joint_arrays`).
+    moment about ``Og``; global), ``J0`` and ``u`` with the journal centre and axis in the
+    bearing frame, and ``wrench`` with the contact wrench in the bearing frame (12, as
+    :func:`_contact` adds to it); returns (elastic energy, normal force sum, max radial
+    penetration, max axial penetration, mode, stiffness at the deepest slice, contacting slices,
+    axial force). The out arrays are the context's scratch arrays
+    (:func:`._context.joint_arrays`); the relative velocity and angular velocity in the bearing
+    frame, which only the contact reads, are the context's too.
     """
     info = ctx[10]
+    V0, W = ctx[C_VEC][V_V0], ctx[C_VEC][V_W]
     for i in range(3):
         J0[i] = Rb[0, i] * (Cj[0] - Og[0]) + Rb[1, i] * (Cj[1] - Og[1]) + Rb[2, i] * (Cj[2] - Og[2])
         u[i] = Rb[0, i] * ug[0] + Rb[1, i] * ug[1] + Rb[2, i] * ug[2]

@@ -69,7 +69,7 @@ def _eval_slider_clearance(t, y, ctx, dy, acc, hstep, diag):
     c1, s1 = math.cos(th1), math.sin(th1)
     Bx, By = l1 * c1, l1 * s1
     vBx, vBy = -l1 * w1 * s1, l1 * w1 * c1
-    R, Rb, Og, Cj, ug, FM, J0, u, V0, W, wrench = joint_arrays(ctx)
+    R, Rb, Og, Cj, ug, FM, J0, u, wrench = joint_arrays(ctx)
     ob0, ob1, ob2, wgx, wgy, wgz = body_rotation(y, R)  # the rod
     # rod pivot P (position, velocity, acceleration without the slider's unknown xdd)
     if case_b:
@@ -104,7 +104,7 @@ def _eval_slider_clearance(t, y, ctx, dy, acc, hstep, diag):
         V0g = (vrx - vox, vry - voy, vrz)
         Wg = (wgx, wgy, wgz - woz)
     energy, fnsum, pen_rad, pen_ax, mode, kdeep, nslice, fax = clearance_joint(
-        Rb, Og, Cj, ug, V0g, Wg, ctx, acc, hstep, FM, J0, u, V0, W, wrench
+        Rb, Og, Cj, ug, V0g, Wg, ctx, acc, hstep, FM, J0, u, wrench
     )
     sr = 1.0 if on_rod else -1.0  # sign of the bearing wrench acting on the rod
     Frx, Fry, Frz = sr * FM[0], sr * FM[1], sr * FM[2]

@@ -9,11 +9,19 @@ it.
 from __future__ import annotations
 
 import importlib
+import math
 import pkgutil
 
+import numpy as np
 from numba.core.registry import CPUDispatcher
 
 import jointwear.sim.kernels as kernels
+from jointwear.params import replace_nested
+from jointwear.sim import PARAMETER_SETS
+from jointwear.sim.dynamics import _layers, _pack, point_area
+from jointwear.sim.kernels._contact import _contact
+from jointwear.sim.kernels._context import make_context
+from jointwear.sim.kernels._layout import C_GEO, C_LAYER, C_NODE, C_VEC, C_WSC
 
 #: Kernels that keep the runtime: they allocate (the integration's arrays and its context) or,
 #: like the closed-form kinematics, also serve the Python API with arrays.
@@ -39,17 +47,6 @@ def _aligned_journal_past_the_edge(junk):
     """One contact evaluation of a journal parallel to the bore, pressed 1 µm into every layer
     it spans and shifted 1.5 mm along -z, so that its end lies between the two +z layers; the
     context's scratch arrays are filled with ``junk`` first."""
-    import math
-
-    import numpy as np
-
-    from jointwear.params import replace_nested
-    from jointwear.sim import PARAMETER_SETS
-    from jointwear.sim.dynamics import _layers, _pack, point_area
-    from jointwear.sim.kernels._contact import _contact
-    from jointwear.sim.kernels._context import make_context
-    from jointwear.sim.kernels._layout import C_GEO, C_LAYER, C_NODE, C_VEC, C_WSC
-
     p = replace_nested(
         PARAMETER_SETS["zhang2023"],
         **{"joint.n_layers": 10, "joint.n_points": 100, "joint.axial_grading": 0.0},
@@ -78,8 +75,6 @@ def _aligned_journal_past_the_edge(junk):
 def test_a_contact_never_reads_what_the_scratch_arrays_held():
     """The scratch arrays are reused from one evaluation to the next: nothing may read a slot
     this evaluation did not write (here the stiffness of a layer beyond the journal's end)."""
-    import numpy as np
-
     first = _aligned_journal_past_the_edge(0.0)
     second = _aligned_journal_past_the_edge(1e30)
     for a, b in zip(first, second, strict=True):
