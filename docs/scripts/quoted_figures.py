@@ -74,11 +74,8 @@ def _child(data: object, key: str) -> object:
     raise KeyError(key)
 
 
-def lookup(data: object, path: str) -> object:
-    """The value at ``path`` (keys joined by ``/``, list indices as integers)."""
-    for key in path.split("/"):
-        data = _child(data, key)
-    return data
+#: Field tests of a record filter: ``key^=text`` begins with, ``key$=text`` ends with.
+_FIELD_TESTS = {"^": str.startswith, "$": str.endswith}
 
 
 def _matches(record: object, conditions: str) -> bool:
@@ -90,11 +87,9 @@ def _matches(record: object, conditions: str) -> bool:
         key, op, want = condition.partition("=")
         if not op:
             raise KeyError(condition)
-        if key.endswith("^"):
-            if not str(record.get(key[:-1], "")).startswith(want):
-                return False
-        elif key.endswith("$"):
-            if not str(record.get(key[:-1], "")).endswith(want):
+        test = _FIELD_TESTS.get(key[-1:])
+        if test is not None:
+            if not test(str(record.get(key[:-1], "")), want):
                 return False
         elif str(record.get(key)) != want:
             return False
@@ -102,9 +97,9 @@ def _matches(record: object, conditions: str) -> bool:
 
 
 def select(data: object, path: str) -> list[object]:
-    """Every value ``path`` names: as :func:`lookup`, with ``*`` for every key or item of a
-    level, ``(a|b)`` for the keys named and ``[key=value,key^=prefix]`` for the records of a
-    list that match."""
+    """Every value ``path`` names (keys joined by ``/``, list indices as integers), with ``*``
+    for every key or item of a level, ``(a|b)`` for the keys named and
+    ``[key=value,key^=text,key$=text]`` for the records of a list that match."""
     found = [data]
     for key in path.split("/"):
         if key.startswith("[") and key.endswith("]"):
