@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Literal, get_args
 
 from jointwear.errors import BadInputError
 from jointwear.params import check_fields, positive
@@ -28,7 +29,8 @@ CODECS: dict[str, tuple[str, str, bool]] = {
 DEFAULT_CODEC = "ffv1"
 
 #: Calibration boards the rig renders.
-BOARD_KINDS = ("chessboard", "charuco")
+BoardKind = Literal["chessboard", "charuco"]
+BOARD_KINDS = get_args(BoardKind)
 
 
 @dataclass(frozen=True)
@@ -38,6 +40,75 @@ class RigConfig:
     The defaults describe a rig like the study's: two 1280 x 1024 cameras 1.0 m from the
     mechanism plane, 0.30 m apart (toe-in towards ``look_at``), a 0.42 m x 0.34 m field of view
     (0.33 mm per pixel) covering the follower and joint C, 50 frames/s.
+
+    Parameters
+    ----------
+    width, height : int
+        Image size [pixel], at least 64.
+    fov_width : float
+        Width of the field of view in the mechanism plane [m].
+    distance : float
+        Distance of the cameras from the mechanism plane [m].
+    baseline : float
+        Distance between the two cameras [m].
+    look_at : tuple of float
+        Point both cameras aim at [m], mechanism frame.
+    distortion : tuple of float
+        Lens distortion (k1, k2, p1, p2, k3), OpenCV's model.
+    principal_offset_px : tuple of float
+        Principal point's offset from the image centre [pixel].
+    fps : float
+        Frame rate [1/s].
+    duration : float
+        Recorded time [s].
+    crank_speed_rpm : float
+        Crank speed [rev/min].
+    crank_angle0_deg : float
+        Crank angle of the first frame [degree].
+    z_amplitude : float
+        Out-of-plane amplitude of joint C [m].
+    z_phase_deg : float
+        Phase of that out-of-plane motion against the crank [degree].
+    journal_size : float
+        Side of the journal's speckled plate [m].
+    journal_z, crank_z : float
+        Out-of-plane offsets of the journal's and the crank's plates [m].
+    follower_width : float
+        Width of the follower's speckled strip [m].
+    speckle_size : float or None
+        Speckle size on the parts [m]; None: 4 pixel footprints.
+    noise_sigma : float
+        Sensor noise [grey levels].
+    blur_sigma_px : float
+        Optical blur sigma [pixel].
+    exposure : float
+        Brightness gain.
+    exposure_time : float
+        Exposure time [s] over which ``motion_blur_samples`` sub-frames are averaged.
+    motion_blur_samples : int
+        Sub-frames per frame (1: no motion blur).
+    background : float
+        Background grey level [0..255].
+    seed : int
+        Random seed of the speckle and the noise.
+    drop_frames : tuple of int
+        Frame indices to drop: frames the camera lost.
+    duplicate_frames : tuple of int
+        Frame indices to duplicate: frames the camera wrote twice.
+    board_squares : tuple of int
+        Calibration board squares along x and y.
+    board_square_size : float
+        Side of a board square [m].
+    board_views : int
+        Calibration views rendered.
+    board_kind : str
+        Calibration board: chessboard or charuco.
+    board_marker_size : float
+        Side of a ChArUco marker [m].
+    board_dictionary : str
+        ArUco dictionary of the ChArUco markers.
+    board_legacy : bool
+        ChArUco in the layout of OpenCV < 4.6 (boards printed from it).
     """
 
     width: int = 1280
@@ -71,7 +142,7 @@ class RigConfig:
     board_squares: tuple[int, int] = (10, 8)
     board_square_size: float = 0.025
     board_views: int = 12
-    board_kind: str = "chessboard"
+    board_kind: BoardKind = "chessboard"
     board_marker_size: float = 0.01875
     board_dictionary: str = "DICT_5X5_100"
     board_legacy: bool = False

@@ -8,7 +8,7 @@ datasets speckle`` (light: the CLI reads these defaults and limits without impor
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Literal, get_args
 
 from jointwear.errors import ParameterError
 
@@ -42,7 +42,8 @@ DENSITY_RANGE = (0.0, 5.0)
 CONTRAST_RANGE = (0.0, 1.0)
 
 #: Displacement fields of a speckle data set.
-FIELDS = ("rigid", "affine", "rotation", "sinusoidal")
+FieldName = Literal["rigid", "affine", "rotation", "sinusoidal"]
+FIELDS = get_args(FieldName)
 
 #: Deformed frames of a data set: the default and the fewest.
 DEFAULT_FRAMES = MIN_FRAMES = 1
@@ -132,13 +133,30 @@ class SpeckleParams:
 class SpeckleMotion:
     """The displacement field of the last frame of a speckle data set (pixel units).
 
-    ``rigid``: translation (``u``, ``v``) [pixel] and rotation ``theta_deg`` [degree] about the
-    image centre (+x towards +y); ``rotation``: the rotation alone; ``affine``: normal strain
-    exx = ``strain``, eyy = -strain/2 with that rotation and translation; ``sinusoidal``: u of
-    ``amplitude`` [pixel] varying along x with ``wavelength`` [pixel].
+    ``rigid``: translation (``u``, ``v``) and rotation ``theta_deg`` about the image centre;
+    ``rotation``: the rotation alone; ``affine``: normal strain exx = ``strain``,
+    eyy = -strain/2 with that rotation and translation; ``sinusoidal``: u of ``amplitude``
+    varying along x with ``wavelength``.
+
+    Parameters
+    ----------
+    field : str
+        rigid, affine, rotation or sinusoidal.
+    u : float
+        Translation along x [pixel].
+    v : float
+        Translation along y [pixel].
+    theta_deg : float
+        Rotation [degree], +x towards +y.
+    strain : float
+        Affine: normal strain exx = -eyy/2.
+    amplitude : float
+        Sinusoidal: amplitude of u [pixel].
+    wavelength : float
+        Sinusoidal: wavelength [pixel].
     """
 
-    field: str = "rigid"
+    field: FieldName = "rigid"
     u: float = 1.5
     v: float = -0.7
     theta_deg: float = 0.0

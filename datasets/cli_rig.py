@@ -8,6 +8,7 @@ from typing import Annotated, Literal
 import typer
 
 from jointwear._cli import Overwrite
+from jointwear._cli_dataclass import Opt, options_from
 from jointwear.datasets._rig_config import DEFAULT_CODEC, RigConfig
 
 #: the library's defaults (every option's default is read from them)
@@ -18,40 +19,33 @@ _BOARD = (
 )
 
 
+@options_from(
+    "cfg",
+    RigConfig,
+    "duration",
+    "fps",
+    "width",
+    "height",
+    Opt("z_amplitude", unit="mm"),
+    Opt("noise_sigma", "--noise"),
+    Opt("blur_sigma_px", "--blur"),
+    "exposure",
+    Opt("drop_frames", "--drop"),
+    Opt("duplicate_frames", "--duplicate"),
+    "seed",
+    Opt("board_kind", "--board", help=f"Calibration board: chessboard, or charuco ({_BOARD})."),
+    "board_legacy",
+)
 def rig(
     out: Annotated[Path, typer.Option("--out", "-o", help="Output folder.")],
     overwrite: Overwrite = False,
-    duration: Annotated[float, typer.Option(help="Recorded time (s).")] = _C.duration,
-    fps: Annotated[float, typer.Option(help="Frame rate (1/s).")] = _C.fps,
-    width: Annotated[int, typer.Option(help="Image width (px).")] = _C.width,
-    height: Annotated[int, typer.Option(help="Image height (px).")] = _C.height,
-    z_amplitude_mm: Annotated[
-        float, typer.Option(help="Out-of-plane amplitude of joint C (mm).")
-    ] = _C.z_amplitude * 1e3,
-    noise: Annotated[float, typer.Option(help="Sensor noise (grey levels).")] = _C.noise_sigma,
-    blur: Annotated[float, typer.Option(help="Optical blur sigma (px).")] = _C.blur_sigma_px,
-    exposure: Annotated[float, typer.Option(help="Brightness gain.")] = _C.exposure,
+    cfg: RigConfig = _C(),
     codec: Annotated[
         Literal["ffv1", "png", "grey", "mjpg", "mp4v"],
         typer.Option(help="ffv1, png or grey (lossless), mjpg or mp4v (lossy)."),
     ] = DEFAULT_CODEC,
     video: Annotated[bool, typer.Option(help="Write videos.")] = True,
     images: Annotated[bool, typer.Option(help="Write image folders.")] = True,
-    drop: Annotated[
-        list[int] | None, typer.Option(help="Frame index to drop (repeatable).")
-    ] = None,
-    duplicate: Annotated[
-        list[int] | None, typer.Option(help="Frame index to duplicate (repeatable).")
-    ] = None,
-    seed: Annotated[int, typer.Option(help="Random seed.")] = _C.seed,
-    board: Annotated[
-        Literal["chessboard", "charuco"],
-        typer.Option(help=f"Calibration board: chessboard, or charuco ({_BOARD})."),
-    ] = _C.board_kind,
-    board_legacy: Annotated[
-        bool,
-        typer.Option(help="ChArUco in the layout of OpenCV < 4.6 (boards printed from it)."),
-    ] = _C.board_legacy,
     motion: Annotated[
         Path | None,
         typer.Option(
@@ -63,21 +57,6 @@ def rig(
     """Render what the rig's two cameras would record, board images and the ground truth."""
     from jointwear.datasets.rig import generate_rig
 
-    cfg = RigConfig(
-        width=width,
-        height=height,
-        fps=fps,
-        duration=duration,
-        z_amplitude=z_amplitude_mm / 1e3,
-        noise_sigma=noise,
-        blur_sigma_px=blur,
-        exposure=exposure,
-        seed=seed,
-        drop_frames=tuple(drop or ()),
-        duplicate_frames=tuple(duplicate or ()),
-        board_kind=board,
-        board_legacy=board_legacy,
-    )
     motion_ds = None
     if motion is not None:
         from jointwear import io

@@ -1,5 +1,6 @@
-"""Options shared by the ``jointwear dic`` commands, declared once; their defaults are the
-library's (:class:`jointwear.dic.CorrelationParams`), so the CLI and the library agree."""
+"""Options shared by the ``jointwear dic`` commands, declared once; the correlation options'
+defaults are the library's (:class:`jointwear.dic.CorrelationParams`), so the CLI and the
+library agree."""
 
 from __future__ import annotations
 
@@ -9,41 +10,33 @@ from typing import Annotated
 import typer
 
 from jointwear._cli import NetcdfOut
-from jointwear.dic.subset._params import MIN_STEP, MIN_SUBSET, CorrelationParams
+from jointwear._cli_dataclass import Opt
+from jointwear.dic.subset._params import MIN_STEP, MIN_SUBSET
 
 __all__ = [
+    "CORRELATION",
     "AllowEmptyOpt",
     "CalibrationOpt",
     "CalibrationOutOpt",
-    "DEFAULTS",
     "FpsOpt",
     "OriginOpt",
     "OutOpt",
     "PlotOpt",
     "PointsOpt",
-    "SearchRadiusOpt",
-    "StepOpt",
-    "SubsetOpt",
-    "ThreadsOpt",
-    "ZnccMinOpt",
-    "correlation_keywords",
     "refuse_given",
 ]
 
-#: the library's correlation defaults (the options below show them)
-DEFAULTS = CorrelationParams()
-
-# the limits are the library's (a value below them is a usage error naming the flag; an even
-# subset is refused by CorrelationParams with the odd size to use)
-SubsetOpt = Annotated[
-    int, typer.Option("--subset", min=MIN_SUBSET, help="Subset size (pixels), odd.")
-]
-StepOpt = Annotated[int, typer.Option("--step", min=MIN_STEP, help="Grid step (pixels).")]
-ZnccMinOpt = Annotated[float, typer.Option("--zncc-min", help="Flag matches below this ZNCC.")]
-SearchRadiusOpt = Annotated[
-    int, typer.Option("--search-radius", help="Seed search half-width (pixels).")
-]
-ThreadsOpt = Annotated[int, typer.Option("--threads", min=0, help="numba threads (0: auto).")]
+#: The subset-correlation options of every dic command, as fields of
+#: :class:`~jointwear.dic.CorrelationParams` or :class:`~jointwear.dic.FieldParams` (which name
+#: them alike): their defaults are the dataclass's, and a value below a limit is a usage error
+#: naming the flag (an even subset is refused by the library with the odd size to use).
+CORRELATION = (
+    Opt("subset_size", "--subset", help="Subset size (pixels), odd.", min=MIN_SUBSET),
+    Opt("step", help="Grid step (pixels).", min=MIN_STEP),
+    Opt("zncc_min", help="Flag matches below this ZNCC."),
+    Opt("search_radius", help="Seed search half-width (pixels)."),
+    Opt("threads", help="numba threads (0: auto).", min=0),
+)
 OutOpt = NetcdfOut
 CalibrationOpt = Annotated[
     Path | None, typer.Option("--calibration", "-c", help="Stereo calibration (.nc).")
@@ -82,18 +75,3 @@ def refuse_given(given, applies_to: str) -> None:
     for value, flag in given:
         if value is not None:
             raise typer.BadParameter(f"{flag} applies to {applies_to}")
-
-
-def correlation_keywords(
-    subset: int, step: int, zncc_min: float, search_radius: int, threads: int
-) -> dict[str, int | float]:
-    """The options every subset-DIC command shares, as the library's keywords: the one place
-    that maps the CLI's names onto :class:`~jointwear.dic.CorrelationParams` fields (``--subset``
-    is ``subset_size``)."""
-    return {
-        "subset_size": subset,
-        "step": step,
-        "zncc_min": zncc_min,
-        "search_radius": search_radius,
-        "threads": threads,
-    }

@@ -8,6 +8,7 @@ from typing import Annotated, Literal
 import typer
 
 from jointwear._cli import Overwrite
+from jointwear._cli_dataclass import Opt, options_from
 from jointwear.dic import _cli_options as opt
 from jointwear.dic.subset._params import UPDATE_ZNCC, CorrelationParams
 from jointwear.errors import BadInputError
@@ -85,6 +86,15 @@ def _summary(ds, out: Path, elapsed: float, plot: Path | None, mode, update_zncc
     return msg
 
 
+@options_from(
+    "params",
+    CorrelationParams,
+    *opt.CORRELATION,
+    Opt("shape", help="Shape function: affine or quadratic."),
+    Opt("interpolation", help="B-spline: quintic or cubic."),
+    Opt("tolerance", help="IC-GN convergence: last update norm (pixels)."),
+    "max_iterations",
+)
 def correlate_cmd(
     ctx: typer.Context,
     reference: Annotated[
@@ -107,30 +117,12 @@ def correlate_cmd(
     roi: Annotated[
         str | None, typer.Option("--roi", help="Region x_min,y_min,x_max,y_max (pixels).")
     ] = None,
-    subset: opt.SubsetOpt = opt.DEFAULTS.subset_size,
-    step: opt.StepOpt = opt.DEFAULTS.step,
-    shape: Annotated[
-        Literal["affine", "quadratic"],
-        typer.Option("--shape", help="Shape function: affine or quadratic."),
-    ] = opt.DEFAULTS.shape,
-    interpolation: Annotated[
-        Literal["quintic", "cubic"],
-        typer.Option("--interpolation", help="B-spline: quintic or cubic."),
-    ] = opt.DEFAULTS.interpolation,
-    search_radius: opt.SearchRadiusOpt = opt.DEFAULTS.search_radius,
+    params: CorrelationParams = CorrelationParams(),
     seed: Annotated[
         list[str] | None,
         typer.Option("--seed", help="Seed point x,y (pixels) (repeatable)."),
     ] = None,
-    zncc_min: opt.ZnccMinOpt = opt.DEFAULTS.zncc_min,
     points: opt.PointsOpt = None,
-    tolerance: Annotated[
-        float,
-        typer.Option("--tolerance", help="IC-GN convergence: last update norm (pixels)."),
-    ] = opt.DEFAULTS.tolerance,
-    max_iterations: Annotated[
-        int, typer.Option("--max-iterations", help="IC-GN iteration limit per point.")
-    ] = opt.DEFAULTS.max_iterations,
     update_zncc: Annotated[
         float,
         typer.Option(
@@ -159,7 +151,6 @@ def correlate_cmd(
         typer.Option("--fps", "--frame-rate", help="Sequences: frame rate (1/s)."),
     ] = None,
     plot: opt.PlotOpt = None,
-    threads: opt.ThreadsOpt = opt.DEFAULTS.threads,
     allow_empty: opt.AllowEmptyOpt = False,
     origin: opt.OriginOpt = "measured",
 ) -> None:
@@ -168,13 +159,6 @@ def correlate_cmd(
     from jointwear.dic.subset._files import correlate_files, is_sequence_input
 
     _refuse_misapplied(ctx.params, is_sequence_input(deformed))
-    params = CorrelationParams(
-        **opt.correlation_keywords(subset, step, zncc_min, search_radius, threads),
-        shape=shape,
-        interpolation=interpolation,
-        tolerance=tolerance,
-        max_iterations=max_iterations,
-    )
     ds, elapsed = correlate_files(
         reference,
         deformed,

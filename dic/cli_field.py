@@ -3,12 +3,14 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 from typing import Annotated
 
 import typer
 
 from jointwear._cli import Overwrite
+from jointwear._cli_dataclass import options_from
 from jointwear.dic import _cli_options as opt
 from jointwear.dic.field._params import FieldParams
 
@@ -43,6 +45,7 @@ def _refuse_misapplied(p: dict) -> None:
         )
 
 
+@options_from("params", FieldParams, *opt.CORRELATION)
 def field_cmd(
     ctx: typer.Context,
     images: Annotated[
@@ -65,8 +68,7 @@ def field_cmd(
         str | None,
         typer.Option("--roi", help="x0,y0,x1,y1 (pixels), a polygon .toml or a mask image (left)."),
     ] = None,
-    subset: opt.SubsetOpt = _P.subset_size,
-    step: opt.StepOpt = _P.step,
+    params: FieldParams = _P(),
     strain_window: Annotated[
         int | None,
         typer.Option(
@@ -84,7 +86,6 @@ def field_cmd(
         ),
     ] = None,
     fps: opt.FpsOpt = None,
-    zncc_min: opt.ZnccMinOpt = _P.zncc_min,
     epipolar_max: Annotated[
         float | None,
         typer.Option(
@@ -93,7 +94,6 @@ def field_cmd(
             f"Default {_P.epipolar_max_px:g}.",
         ),
     ] = None,
-    search_radius: opt.SearchRadiusOpt = _P.search_radius,
     origin: opt.OriginOpt = "measured",
     out: opt.OutOpt = Path("field.nc"),
     csv: Annotated[
@@ -101,7 +101,6 @@ def field_cmd(
         typer.Option("--csv", help="Also write CSV (one file per image, VIC-3D-like)."),
     ] = None,
     plot: opt.PlotOpt = None,
-    threads: opt.ThreadsOpt = _P.threads,
     allow_empty: opt.AllowEmptyOpt = False,
     overwrite: Overwrite = False,
 ) -> None:
@@ -114,10 +113,7 @@ def field_cmd(
     given = dict(frame=frame, epipolar_max_px=epipolar_max, strain_window=strain_window)
     if points is not None and strain_window is None:
         given["strain_window"] = 0  # scattered points: no grid to fit strain on
-    params = FieldParams(
-        **opt.correlation_keywords(subset, step, zncc_min, search_radius, threads),
-        **{k: v for k, v in given.items() if v is not None},
-    )
+    params = replace(params, **{k: v for k, v in given.items() if v is not None})
     ds, elapsed, files = measure_field_files(
         images,
         out,

@@ -87,7 +87,7 @@ def test_speckle_defaults_and_limits_are_the_librarys(tmp_path):
 
     p, m, kw = _fields(SpeckleParams), _fields(SpeckleMotion), _keywords(write_speckle_set)
     mapping = _same(m) | _same(p, "speckle_size", "density", "contrast", "bit_depth")
-    mapping |= _renamed(p, noise="noise_std", blur="blur_std") | _same(kw, "frames", "seed")
+    mapping |= _same(p, "noise_std", "blur_std") | _same(kw, "frames", "seed")
     params = _check(speckle_cmd, mapping, {"out", "overwrite", "size"})
     assert _choices(params["field"]) == FIELDS
     # the limits: the first value outside the CLI's range is the first the library refuses
@@ -156,15 +156,15 @@ def test_rig_defaults_are_the_librarys():
     c, kw = _fields(RigConfig), _keywords(generate_rig)
     same = ("duration", "fps", "width", "height", "exposure", "seed", "board_legacy")
     mapping = _same(c, *same) | _scaled(c, z_amplitude_mm=("z_amplitude", 1e3))
-    mapping |= _renamed(c, noise="noise_sigma", blur="blur_sigma_px", board="board_kind")
+    mapping |= _same(c, "noise_sigma", "blur_sigma_px", "board_kind")
     mapping |= _same(kw, "codec", "video", "images")
-    params = _check(rig, mapping, {"out", "overwrite", "drop", "duplicate", "motion"})
+    params = _check(rig, mapping, {"out", "overwrite", "drop_frames", "duplicate_frames", "motion"})
     assert set(_choices(params["codec"])) == set(CODECS)
     size = c["board_square_size"] * 1e3
     assert f"{c['board_squares'][0]} x {c['board_squares'][1]} squares of {size:g} mm" in (
-        params["board"].help
+        params["board_kind"].help
     )
-    assert c["board_dictionary"] in params["board"].help
+    assert c["board_dictionary"] in params["board_kind"].help
 
 
 def test_field_defaults_help_and_limits_are_the_librarys():
@@ -173,8 +173,8 @@ def test_field_defaults_help_and_limits_are_the_librarys():
     from jointwear.dic.field._files import measure_field_files
 
     f = _fields(FieldParams)
-    mapping = _same(f, "step", "zncc_min", "search_radius", "threads")
-    mapping |= _renamed(f, subset="subset_size") | _stated("strain_window", "frame", "epipolar_max")
+    mapping = _same(f, "subset_size", "step", "zncc_min", "search_radius", "threads")
+    mapping |= _stated("strain_window", "frame", "epipolar_max")
     mapping["origin"] = (_keywords(measure_field_files)["data_origin"], None)
     without = {"images", "left", "right", "calibration", "roi", "points", "fps"}
     without |= {"out", "csv", "plot", "allow_empty", "overwrite"}
@@ -182,7 +182,7 @@ def test_field_defaults_help_and_limits_are_the_librarys():
     assert f"Default {f['strain_window']} (0 with --points)" in params["strain_window"].help
     assert f"Default {f['frame']}." in params["frame"].help
     assert f"Default {f['epipolar_max_px']:g}." in params["epipolar_max"].help
-    smallest = params["subset"].min
+    smallest = params["subset_size"].min
     CorrelationParams(subset_size=smallest)
     with pytest.raises(ParameterError):
         CorrelationParams(subset_size=smallest - 2)  # the next odd size below the CLI's limit
