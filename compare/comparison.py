@@ -33,7 +33,7 @@ from jointwear.compare.origin import side_origin
 from jointwear.compare.reported import reported_metrics, split_reported
 from jointwear.compare.sources import Sources
 from jointwear.compare.study import band_study_uncertainty, is_study
-from jointwear.compare.verification import GCI, numerical_uncertainty
+from jointwear.compare.verification import GCI, LeastSquaresStudy, numerical_uncertainty
 from jointwear.errors import BadInputError
 
 __all__ = [
@@ -339,11 +339,13 @@ def _sensitivity(
     return pd.DataFrame(rows, columns=SENSITIVITY_COLUMNS)
 
 
-def _verification(verification) -> tuple[Mapping[str, GCI], list[xr.Dataset]]:
-    """(GCI per quantity of older 1-D refinement data, sim verify studies) of ``verification``."""
+def _verification(
+    verification,
+) -> tuple[Mapping[str, GCI | LeastSquaresStudy], list[xr.Dataset]]:
+    """(u_num per quantity of 1-D refinement data, sim verify studies) of ``verification``."""
     studies: list[xr.Dataset] = []
     if verification is None:
-        gci: Mapping[str, GCI] = {}
+        gci: Mapping[str, GCI | LeastSquaresStudy] = {}
     elif isinstance(verification, xr.Dataset) or not isinstance(verification, Mapping):
         # a Dataset is a Mapping too: test it first. sim verify studies (contract) apart from
         # the older 1-D refinement datasets (GCI)
@@ -428,7 +430,10 @@ def compare(
     variables: Sequence[str] | None = None,
     axes: Sequence[str] | None = DEFAULT_AXES,
     ensemble: xr.Dataset | Sequence[xr.Dataset] | Ensemble | None = None,
-    verification: xr.Dataset | Sequence[xr.Dataset] | Mapping[str, GCI] | None = None,
+    verification: xr.Dataset
+    | Sequence[xr.Dataset]
+    | Mapping[str, GCI | LeastSquaresStudy]
+    | None = None,
 ) -> Comparison:
     """Compare simulation and measurement: wear maps and/or motion, detected from the variables.
 
@@ -458,9 +463,10 @@ def compare(
         the u_input of each compared quantity (:mod:`jointwear.compare.ensemble`).
     verification : Dataset(s) or mapping of GCI, optional
         Verification studies for u_num: a ``jointwear sim verify`` study (its stored wear maps
-        give u_num of every band quantity, :mod:`jointwear.compare.study`), or older 1-D
-        refinement datasets (quantities over a refinement parameter, GCI,
-        :mod:`jointwear.compare.verification`).
+        give u_num of every band quantity, :mod:`jointwear.compare.study`), or 1-D
+        refinement datasets (quantities over a refinement parameter: the GCI of three
+        solutions, Eça & Hoekstra's least squares of four or more,
+        :func:`jointwear.compare.verification.refinement_study`).
 
     Returns
     -------

@@ -32,7 +32,8 @@ u_num: a verification study of ``jointwear sim verify`` (``jointwear_file =
 "verification_study"``, run to the quantity's cycles: the quantity on every stored run's map
 through :func:`jointwear.refinement.study_uncertainty`), a verification dataset with a variable
 of the quantity's own name, or one that keeps a wear map per refinement level (``wear_depth`` over ``(h, [cycles,] z, theta)``: the quantity
-is computed on each level, then the GCI of :mod:`jointwear.compare.verification`); else the
+is computed on each level, then the GCI of three levels, least squares of four or more,
+:func:`jointwear.compare.verification.refinement_study`); else the
 criteria's ``wear_u_num_rel`` (not for angles); else not assessed. u_input: an ensemble that
 keeps its wear maps (the quantity per member, the spread of
 :func:`jointwear.compare.ensemble.spread`; for angles the wrapped deviations, and only from an
@@ -73,7 +74,7 @@ from jointwear.compare._reported_quantities import (
 from jointwear.compare.align import _prepare_map
 from jointwear.compare.criteria import Criteria
 from jointwear.compare.ensemble import Ensemble, not_a_distribution, spread
-from jointwear.compare.verification import _formal_order, gci
+from jointwear.compare.verification import _formal_order, refinement_study
 from jointwear.errors import BadInputError
 from jointwear.reported import is_reported
 
@@ -284,7 +285,7 @@ def _u_num(
             values = ref + mt.wrap_angle_deg(values - ref)
         dim = ds[name].dims[0] if name in ds.data_vars else _level_dim(ds)
         order, note = _formal_order(ds, str(dim))
-        g = gci(
+        g = refinement_study(
             h, values, quantity=name, formal_order=order, formal_order_note=note, refined=str(dim)
         )
         if not g.assessed:

@@ -25,7 +25,7 @@ from jointwear.compare.budget import Component, combine
 from jointwear.compare.criteria import Criteria
 from jointwear.compare.ensemble import Ensemble, spread
 from jointwear.compare.study import StudyResult, study_component
-from jointwear.compare.verification import GCI
+from jointwear.compare.verification import GCI, LeastSquaresStudy
 
 __all__ = ["Sources", "SIM_U_COVERS"]
 
@@ -44,7 +44,8 @@ class Sources:
     ensemble : Ensemble or None
         Ensembles of simulations for u_input.
     gci : mapping
-        Quantity name -> :class:`~jointwear.compare.verification.GCI` from verification data.
+        Quantity name -> :class:`~jointwear.compare.verification.GCI` or
+        :class:`~jointwear.compare.verification.LeastSquaresStudy` from 1-D refinement data.
     compared_cycles : float or None
         Wear cycles of the compared simulation.
     field_values : mapping
@@ -57,7 +58,7 @@ class Sources:
 
     criteria: Criteria
     ensemble: Ensemble | None = None
-    gci: Mapping[str, GCI] = field(default_factory=dict)
+    gci: Mapping[str, GCI | LeastSquaresStudy] = field(default_factory=dict)
     compared_cycles: float | None = None
     field_values: Mapping[str, Sequence[tuple[int, np.ndarray]]] = field(default_factory=dict)
     studies: Mapping[str, StudyResult] = field(default_factory=dict)
@@ -115,7 +116,7 @@ class Sources:
         )
 
     @staticmethod
-    def _verification_component(g: GCI, s: float) -> Component:
+    def _verification_component(g: GCI | LeastSquaresStudy, s: float) -> Component:
         covers = frozenset({f"refinement of {g.refined}"} | g.covers)
         if not g.assessed:
             return Component(None, f"verification study: {g.reason}", covers)

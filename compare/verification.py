@@ -24,6 +24,13 @@ The formal order comes from the refinement coordinate's (or the dataset's) ``for
 attribute; without one it is taken as 1 (the explicit update of the wear in cycles is first
 order; a lower cap only makes the uncertainty larger) and the description says so.
 
+With **four or more** solutions :func:`refinement_study` (and so :func:`numerical_uncertainty`)
+takes Eça & Hoekstra's least-squares procedure instead (:func:`jointwear.refinement.eca_hoekstra`,
+deterministic solutions): it fits every level, so a quantity whose solutions scatter or
+oscillate with refinement - the RMS of a motion with impacts, over solver tolerances - gets an
+uncertainty that covers the scatter (the data-range branch, ``Fs = 3``) instead of none. The
+GCI's refusals stand for three solutions, which cannot tell scatter from a trend.
+
 The GCI is an expanded (about 95 %) uncertainty; ASME V&V 20 (section 2-4) takes the standard
 numerical uncertainty as ``u_num = GCI / 1.15``. Two solutions cannot show that the sequence
 converges and an oscillating or diverging one has no order: those are *not assessed*, with the
@@ -46,13 +53,21 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import xarray as xr
 
 from jointwear.errors import BadInputError
 
-__all__ = ["GCI", "gci", "numerical_uncertainty", "GCI_TO_STANDARD"]
+__all__ = [
+    "GCI",
+    "GCI_TO_STANDARD",
+    "LeastSquaresStudy",
+    "gci",
+    "numerical_uncertainty",
+    "refinement_study",
+]
 
 #: V&V 20: standard numerical uncertainty = GCI / 1.15 (GCI with Fs = 1.25 taken as a 95 % bound)
 GCI_TO_STANDARD = 1.15
@@ -116,10 +131,7 @@ class GCI:
     @property
     def covers(self) -> frozenset[str]:
         """Error sources the study accounts for (beyond the refinement of ``refined`` itself)."""
-        name = self.refined.lower()
-        if any(key in name for key in UPDATE_INTERVAL_NAMES):
-            return frozenset({"wear-update interval"})
-        return frozenset()
+        return _covers(self.refined)
 
     def describe(self) -> str:
         """One line for the report: the method and its figures, or why it was not assessed."""
@@ -139,6 +151,106 @@ class GCI:
             f"GCI_fine = {self.gci_fine:.3g} -> u_num = GCI/{GCI_TO_STANDARD:g} = "
             f"{self.u_num_rel:.3g}·|S| (coarse to fine: {seq})"
         )
+
+
+def _covers(refined: str) -> frozenset[str]:
+    name = refined.lower()
+    if any(key in name for key in UPDATE_INTERVAL_NAMES):
+        return frozenset({"wear-update interval"})
+    return frozenset()
+
+
+@dataclass(frozen=True)
+class LeastSquaresStudy:
+    """Numerical uncertainty of one quantity from four or more deterministic solutions.
+
+    The result of Eça & Hoekstra's least-squares procedure
+    (:func:`jointwear.refinement.eca_hoekstra`), read like a :class:`GCI` (``assessed``,
+    ``reason``, ``values`` finest first, ``u_num_rel``, ``covers``, ``describe``).
+
+    Attributes
+    ----------
+    fit : RefinementFit
+        The procedure's result (absolute uncertainties, k = 1).
+    refined : str
+        Name of the refinement parameter.
+    """
+
+    fit: Any
+    refined: str = "h"
+
+    @property
+    def quantity(self) -> str:
+        return self.fit.quantity
+
+    @property
+    def assessed(self) -> bool:
+        return bool(self.fit.assessed) and math.isfinite(self.u_num_rel)
+
+    @property
+    def reason(self) -> str:
+        if self.fit.assessed and not math.isfinite(self.u_num_rel):
+            return "the finest solution is 0: a relative uncertainty is undefined"
+        return self.fit.reason if not self.fit.assessed else ""
+
+    @property
+    def h(self) -> tuple[float, ...]:
+        return self.fit.h
+
+    @property
+    def values(self) -> tuple[float, ...]:
+        return self.fit.means
+
+    @property
+    def u_num_rel(self) -> float:
+        """Standard numerical uncertainty of the finest solution relative to it [1]."""
+        value = abs(self.fit.value)
+        return self.fit.u_num / value if value > 0 else float("nan")
+
+    @property
+    def covers(self) -> frozenset[str]:
+        return _covers(self.refined)
+
+    def describe(self) -> str:
+        return (
+            f"least squares over {len(self.fit.h)} levels of {self.refined} "
+            f"(Eça & Hoekstra 2014): {self.fit.describe()}; u_num = {self.u_num_rel:.3g}·|S|"
+            if self.assessed
+            else self.fit.describe()
+        )
+
+
+def refinement_study(
+    h: Sequence[float],
+    values: Sequence[float],
+    *,
+    quantity: str = "quantity",
+    formal_order: float = 1.0,
+    formal_order_note: str = "stated",
+    refined: str = "h",
+) -> GCI | LeastSquaresStudy:
+    """Numerical uncertainty of the finest of deterministic solutions over a refinement ``h``.
+
+    The GCI (:func:`gci`) of three solutions; with four or more finite ones, Eça & Hoekstra's
+    least squares (:func:`jointwear.refinement.eca_hoekstra`), which fits them all and covers
+    their scatter. Parameters as :func:`gci`.
+    """
+    from jointwear.refinement import eca_hoekstra
+
+    h_arr = np.asarray(h, dtype=float)
+    f_arr = np.asarray(values, dtype=float)
+    ok = np.isfinite(f_arr) if f_arr.shape == h_arr.shape else np.zeros(0, bool)
+    if ok.sum() < 4:
+        return gci(
+            h,
+            values,
+            quantity=quantity,
+            formal_order=formal_order,
+            formal_order_note=formal_order_note,
+            refined=refined,
+        )
+    fit = eca_hoekstra(h_arr[ok], f_arr[ok], formal_order=formal_order, quantity=quantity)
+    return LeastSquaresStudy(fit, refined)
 
 
 def _not_assessed(quantity, reason, h, f, ratio=float("nan"), e_a=float("nan"), fs=1.25) -> GCI:
@@ -320,8 +432,11 @@ def _formal_order(ds: xr.Dataset, dim: str) -> tuple[float, str]:
 
 def numerical_uncertainty(
     studies: xr.Dataset | Sequence[xr.Dataset],
-) -> Mapping[str, GCI]:
-    """GCI of every 1-D quantity of one or more verification datasets.
+) -> Mapping[str, GCI | LeastSquaresStudy]:
+    """Numerical uncertainty of every 1-D quantity of one or more verification datasets.
+
+    The GCI of three solutions, Eça & Hoekstra's least squares of four or more
+    (:func:`refinement_study`).
 
     Parameters
     ----------
@@ -333,10 +448,10 @@ def numerical_uncertainty(
     Returns
     -------
     dict
-        Quantity name -> :class:`GCI`.
+        Quantity name -> :class:`GCI` or :class:`LeastSquaresStudy`.
     """
     items = [studies] if isinstance(studies, xr.Dataset) else list(studies)
-    out: dict[str, GCI] = {}
+    out: dict[str, GCI | LeastSquaresStudy] = {}
     for ds in items:
         for name, var in ds.data_vars.items():
             if var.ndim != 1 or var.dtype.kind not in "fiu":
@@ -348,7 +463,7 @@ def numerical_uncertainty(
                     "values (the refinement parameter h of each solution)"
                 )
             order, note = _formal_order(ds, str(dim))
-            out[str(name)] = gci(
+            out[str(name)] = refinement_study(
                 np.asarray(ds[dim].values, dtype=float),
                 np.asarray(var.values, dtype=float),
                 quantity=str(name),
