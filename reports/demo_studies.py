@@ -112,7 +112,9 @@ MOTION_RTOLS = (1e-4, 5e-5, 3e-5, 2e-5, 1e-5, 5e-6, 3e-6, 2e-6)
 
 def _rms_window(motion: xr.Dataset, duration: float) -> dict[str, float]:
     """RMS of each in-plane follower velocity component over the first ``duration`` seconds
-    (the stereo footage's window, the samples the comparison uses); 0: the whole record."""
+    (the stereo footage's length; 0: the whole record), on the simulation's own samples. The
+    comparison takes the RMS at the footage's frames, shifted by the crank-angle alignment,
+    and this study's u_num relative to it (``u_num_rel·|S|``)."""
     t = np.asarray(motion["time"].values, dtype=float)
     window = t <= t[0] + duration if duration > 0 else np.ones(t.shape, bool)
     v = motion["follower_velocity"]
@@ -128,8 +130,8 @@ def motion_verification(params: Any, size: DemoSize, main: xr.Dataset) -> xr.Dat
     """Numerical uncertainty of the simulated in-plane follower velocity RMS: the solver tolerance.
 
     The motion is repeated with ``solver.rtol`` = :data:`MOTION_RTOLS` (the main run uses the
-    default, the finest level); the RMS of each in-plane component over the compared window
-    (the footage's ``size.rig_duration``) is the studied quantity. With impacts the RMS does not
+    default, the finest level); the RMS of each in-plane component over the footage's length
+    ``size.rig_duration`` is the studied quantity. With impacts the RMS does not
     converge smoothly with the tolerance (it scatters by about 1e-4 of itself down to rtol =
     1e-9), so :func:`jointwear.compare.compare` takes Eça & Hoekstra's least squares over the nine
     levels (:func:`jointwear.compare.verification.refinement_study`), whose data-range branch
