@@ -27,6 +27,7 @@ __all__ = [
     "SPECKLE_SIZE_RANGE",
     "SpeckleMotion",
     "SpeckleParams",
+    "closed_interval",
     "open_interval",
 ]
 
@@ -49,6 +50,12 @@ FIELDS = get_args(FieldName)
 DEFAULT_FRAMES = MIN_FRAMES = 1
 #: Seed of the pattern and the noise.
 DEFAULT_SEED = 0
+
+
+def closed_interval(bounds: tuple[float, float]) -> str:
+    """``"1 to 200"``: the interval of a speckle size (both ends included), as the errors and
+    the CLI help write it."""
+    return f"{bounds[0]:g} to {bounds[1]:g}"
 
 
 def open_interval(bounds: tuple[float, float]) -> str:
@@ -96,7 +103,7 @@ class SpeckleParams:
             (
                 "speckle_size",
                 size_min <= self.speckle_size <= size_max,
-                f"between {size_min:g} and {size_max:g} pixel",
+                f"{closed_interval(SPECKLE_SIZE_RANGE)} pixel",
             ),
             (
                 "density",

@@ -24,6 +24,7 @@ from jointwear.datasets._speckle_params import (
     SPECKLE_SIZE_RANGE,
     SpeckleMotion,
     SpeckleParams,
+    closed_interval,
     open_interval,
 )
 
@@ -33,7 +34,7 @@ from jointwear.datasets._speckle_params import (
     SpeckleParams,
     Opt(
         "speckle_size",
-        help="Speckle diameter (pixels), {:g} to {:g}.".format(*SPECKLE_SIZE_RANGE),
+        help=f"Speckle diameter (pixels), {closed_interval(SPECKLE_SIZE_RANGE)}.",
     ),
     Opt("density", help=f"Area fraction covered by speckles, {open_interval(DENSITY_RANGE)}."),
     Opt("contrast", help=f"Fraction of full scale, {open_interval(CONTRAST_RANGE)}."),

@@ -145,5 +145,5 @@ def test_library_refusal_names_the_flag(capsys, tmp_path):
     assert "--subset 8" in err and "use 9" in err and "subset_size" not in err
     code = main(["datasets", "speckle", str(tmp_path / "s"), "--speckle-size", "300"])
     err = capsys.readouterr().err
-    assert code == 3 and "--speckle-size 300" in err and "between 1 and 200" in err
+    assert code == 3 and "--speckle-size 300" in err and "expected 1 to 200 pixel" in err
     assert not (tmp_path / "s").exists()
