@@ -221,36 +221,35 @@ class LeastSquaresStudy:
 
 
 def refinement_study(
-    h: Sequence[float],
-    values: Sequence[float],
-    *,
-    quantity: str = "quantity",
-    formal_order: float = 1.0,
-    formal_order_note: str = "stated",
-    refined: str = "h",
+    h: Sequence[float], values: Sequence[float], **options: Any
 ) -> GCI | LeastSquaresStudy:
     """Numerical uncertainty of the finest of deterministic solutions over a refinement ``h``.
 
     The GCI (:func:`gci`) of three solutions; with four or more finite ones, Eça & Hoekstra's
     least squares (:func:`jointwear.refinement.eca_hoekstra`), which fits them all and covers
-    their scatter. Parameters as :func:`gci`.
+    their scatter.
+
+    Parameters
+    ----------
+    h, values : sequence of float
+        As :func:`gci`.
+    **options
+        ``quantity``, ``formal_order``, ``formal_order_note``, ``refined``: as :func:`gci`,
+        with its defaults.
     """
     from jointwear.refinement import eca_hoekstra
 
+    unknown = set(options) - set(gci.__kwdefaults__ or {})
+    if unknown:
+        raise TypeError(f"refinement_study: unknown options {sorted(unknown)}")
     h_arr = np.asarray(h, dtype=float)
     f_arr = np.asarray(values, dtype=float)
     ok = np.isfinite(f_arr) if f_arr.shape == h_arr.shape else np.zeros(0, bool)
     if ok.sum() < 4:
-        return gci(
-            h,
-            values,
-            quantity=quantity,
-            formal_order=formal_order,
-            formal_order_note=formal_order_note,
-            refined=refined,
-        )
-    fit = eca_hoekstra(h_arr[ok], f_arr[ok], formal_order=formal_order, quantity=quantity)
-    return LeastSquaresStudy(fit, refined)
+        return gci(h, values, **options)
+    o = {**(gci.__kwdefaults__ or {}), **options}
+    fit = eca_hoekstra(h_arr[ok], f_arr[ok], formal_order=o["formal_order"], quantity=o["quantity"])
+    return LeastSquaresStudy(fit, o["refined"])
 
 
 def _not_assessed(quantity, reason, h, f, ratio=float("nan"), e_a=float("nan"), fs=1.25) -> GCI:

@@ -106,3 +106,9 @@ def test_three_levels_go_to_the_gci_four_to_least_squares(levels):
     else:
         assert g.assessed and 0 < g.u_num_rel < 1e-2
         assert "least squares over 4 levels" in g.describe()
+
+
+def test_a_misspelt_option_is_refused_at_any_number_of_levels():
+    for n in (3, 5):
+        with pytest.raises(TypeError, match="refine"):
+            refinement_study(np.arange(1.0, n + 1), np.ones(n), refine="solver_rtol")
