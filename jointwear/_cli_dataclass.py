@@ -128,7 +128,8 @@ def _expanded(cls: type, specs: tuple[str | Opt, ...]) -> list[tuple[Opt, inspec
             raise TypeError(f"{cls.__name__}.{spec.field} has no default to show")
         kind, repeatable = _option_type(hints[spec.field])
         if spec.unit:  # shown rounded; the command maps it back to the exact field default
-            kind, default = float, float(f"{default / spec.factor:.12g}")
+            kind = float if default is not None else float | None
+            default = None if default is None else float(f"{default / spec.factor:.12g}")
         help_text = spec.help or helps.get(spec.field)
         if help_text is None:
             raise TypeError(

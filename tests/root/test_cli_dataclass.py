@@ -38,8 +38,19 @@ class _Rig:
     quiet: bool = False
 
     def __post_init__(self) -> None:
-        if self.gap <= 0:
+        if self.gap is not None and self.gap <= 0:
             raise ValueError(f"gap={self.gap!r}: expected > 0 m")
+
+
+@dataclass(frozen=True)
+class _Bore:
+    """Parameters
+    ----------
+    radius : float or None
+        Bore radius [m]; None: from the file.
+    """
+
+    radius: float | None = None
 
 
 def _app(*fields):
@@ -105,6 +116,21 @@ def test_a_spec_that_names_no_field_fails_at_declaration(fields, message):
 def test_an_option_that_clashes_with_a_parameter_fails_at_declaration():
     with pytest.raises(TypeError, match="clash"):
         _app(Opt("gap", name="name"))
+
+
+def test_a_length_whose_default_is_none_stays_none_unless_given():
+    seen = []
+
+    @options_from("bore", _Bore, Opt("radius", unit="mm"))
+    def cmd(bore: _Bore = _Bore()) -> None:
+        seen.append(bore)
+
+    app = typer.Typer(add_completion=False)
+    app.command()(cmd)
+    app.command("other")(lambda: None)
+    assert CliRunner().invoke(app, ["cmd"]).exit_code == 0
+    assert CliRunner().invoke(app, ["cmd", "--radius-mm", "8"]).exit_code == 0
+    assert seen[0].radius is None and seen[1].radius == pytest.approx(8e-3, rel=1e-15)
 
 
 def test_undocumented_field_needs_a_help():
