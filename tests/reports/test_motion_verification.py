@@ -112,3 +112,24 @@ def test_a_misspelt_option_is_refused_at_any_number_of_levels():
     for n in (3, 5):
         with pytest.raises(TypeError, match="refine"):
             refinement_study(np.arange(1.0, n + 1), np.ones(n), refine="solver_rtol")
+
+
+def test_a_failing_tolerance_is_left_out_not_fatal(monkeypatch):
+    import jointwear.sim as sim
+    from jointwear.errors import SimulationError
+
+    real = sim.run_cycles
+
+    def flaky(params, **kw):
+        if params.solver.rtol == MOTION_RTOLS[0]:
+            raise SimulationError("step size collapsed")
+        return real(params, **kw)
+
+    monkeypatch.setattr(sim, "run_cycles", flaky)
+    params = _params(FULL)
+    main = real(params, cycles=FULL.motion_cycles).dataset
+    study = motion_verification(params, FULL, main)
+    x = study["follower_velocity_x_rms"].values
+    assert np.isnan(x[0]) and np.isfinite(x[1:]).all()
+    g = refinement_study(study["solver_rtol"].values, x, refined="solver_rtol")
+    assert g.assessed and len(g.h) == 8
