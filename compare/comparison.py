@@ -339,6 +339,11 @@ def _sensitivity(
     return pd.DataFrame(rows, columns=SENSITIVITY_COLUMNS)
 
 
+#: What ``compare(verification=...)`` takes: sim verify studies or 1-D refinement datasets, or
+#: their u_num per quantity.
+Verification = xr.Dataset | Sequence[xr.Dataset] | Mapping[str, GCI | LeastSquaresStudy]
+
+
 def _verification(
     verification,
 ) -> tuple[Mapping[str, GCI | LeastSquaresStudy], list[xr.Dataset]]:
@@ -430,10 +435,7 @@ def compare(
     variables: Sequence[str] | None = None,
     axes: Sequence[str] | None = DEFAULT_AXES,
     ensemble: xr.Dataset | Sequence[xr.Dataset] | Ensemble | None = None,
-    verification: xr.Dataset
-    | Sequence[xr.Dataset]
-    | Mapping[str, GCI | LeastSquaresStudy]
-    | None = None,
+    verification: Verification | None = None,
 ) -> Comparison:
     """Compare simulation and measurement: wear maps and/or motion, detected from the variables.
 
