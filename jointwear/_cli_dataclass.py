@@ -4,7 +4,7 @@ help text and limits, in the library and on the command line.
 A command that takes a parameter set declares it as one parameter annotated with the
 dataclass, and :func:`options_from` expands that parameter into one option per field::
 
-    @options_from("params", CorrelationParams, "subset_size:--subset", "step", "shape")
+    @options_from("params", CorrelationParams, Opt("subset_size", "--subset"), "step", "shape")
     def correlate_cmd(reference: Path, params: CorrelationParams) -> None: ...
 
 - the option's **default** is the field's default (the help shows it from there);
@@ -73,14 +73,6 @@ class Opt:
     min: float | None = None
     max: float | None = None
 
-    @classmethod
-    def parse(cls, spec: str | Opt) -> Opt:
-        """``"field"`` or ``"field:--flag"`` (or an :class:`Opt`) as an :class:`Opt`."""
-        if isinstance(spec, Opt):
-            return spec
-        field, _, flag = spec.partition(":")
-        return cls(field, flag or None)
-
     @property
     def param_name(self) -> str:
         if self.name:
@@ -115,19 +107,41 @@ def _option_type(hint: Any) -> tuple[Any, bool]:
     return hint, False
 
 
-def _expanded(cls: type, specs: tuple[str | Opt, ...]) -> list[tuple[Opt, inspect.Parameter, bool]]:
+@dataclass(frozen=True)
+class _Expanded:
+    """One offered field: how it is offered, the command's parameter, the field's own default,
+    and whether the option repeats (a ``tuple[T, ...]`` field)."""
+
+    spec: Opt
+    parameter: inspect.Parameter
+    field_default: Any
+    repeatable: bool
+
+    def to_field(self, value: Any) -> Any:
+        """The option's value as the field's: a repeatable option's list as a tuple, a length
+        in its unit in metres (the shown, rounded default as the field's exact default)."""
+        if self.repeatable:
+            return tuple(value or ())
+        if self.spec.unit and value is not None:
+            if value == self.parameter.default:
+                return self.field_default
+            return value * self.spec.factor
+        return value
+
+
+def _expanded(cls: type, specs: tuple[str | Opt, ...]) -> list[_Expanded]:
     hints = typing.get_type_hints(cls)
     fields = {f.name: f for f in dataclasses.fields(cls)}
     helps = field_help(cls)
     out = []
-    for spec in map(Opt.parse, specs):
+    for spec in (s if isinstance(s, Opt) else Opt(s) for s in specs):
         if spec.field not in fields:
             raise TypeError(f"{cls.__name__} has no field {spec.field!r}")
-        default = fields[spec.field].default
+        field_default = default = fields[spec.field].default
         if default is dataclasses.MISSING:
             raise TypeError(f"{cls.__name__}.{spec.field} has no default to show")
         kind, repeatable = _option_type(hints[spec.field])
-        if spec.unit:  # shown rounded; the command maps it back to the exact field default
+        if spec.unit:  # shown rounded; to_field maps it back to the exact field default
             kind = float if default is not None else float | None
             default = None if default is None else float(f"{default / spec.factor:.12g}")
         help_text = spec.help or helps.get(spec.field)
@@ -150,20 +164,8 @@ def _expanded(cls: type, specs: tuple[str | Opt, ...]) -> list[tuple[Opt, inspec
             default=None if repeatable else default,
             annotation=Annotated[kind, option],
         )
-        out.append((spec, parameter, repeatable))
+        out.append(_Expanded(spec, parameter, field_default, repeatable))
     return out
-
-
-def _to_field(cls: type, spec: Opt, option: inspect.Parameter, value: Any, repeatable: bool):
-    """An option's value as the field's: a repeatable option's list as a tuple, a length in
-    its unit in metres (the shown default as the field's exact default)."""
-    if repeatable:
-        return tuple(value or ())
-    if spec.unit and value is not None:
-        if value == option.default:
-            return next(f.default for f in dataclasses.fields(cls) if f.name == spec.field)
-        return value * spec.factor
-    return value
 
 
 def options_from(param: str, cls: type, *fields: str | Opt) -> Callable[[F], F]:
@@ -176,7 +178,7 @@ def options_from(param: str, cls: type, *fields: str | Opt) -> Callable[[F], F]:
     cls : type
         The frozen parameter dataclass.
     *fields : str or Opt
-        The fields offered, in help order: a name, ``"name:--flag"`` or an :class:`Opt`. The
+        The fields offered, in help order: a field's name or an :class:`Opt`. The
         other fields keep their defaults; none given: every field, by its own name.
 
     Returns
@@ -193,20 +195,20 @@ def options_from(param: str, cls: type, *fields: str | Opt) -> Callable[[F], F]:
         expanded = _expanded(cls, fields or tuple(f.name for f in dataclasses.fields(cls)))
         hints = typing.get_type_hints(func, include_extras=True)
         taken = set(signature.parameters) - {param}
-        clash = taken & {p.name for _, p, _ in expanded}
+        clash = taken & {e.parameter.name for e in expanded}
         if clash:
             raise TypeError(f"{func.__name__}: options {sorted(clash)} clash with parameters")
         params: list[inspect.Parameter] = []
         for p in signature.parameters.values():
             if p.name == param:
-                params.extend(q for _, q, _ in expanded)
+                params.extend(e.parameter for e in expanded)
             else:
                 kind = inspect.Parameter.KEYWORD_ONLY
                 params.append(p.replace(kind=kind, annotation=hints.get(p.name, p.annotation)))
 
         @functools.wraps(func)
         def command(**kwargs: Any) -> Any:
-            values = {s.field: _to_field(cls, s, q, kwargs.pop(q.name), r) for s, q, r in expanded}
+            values = {e.spec.field: e.to_field(kwargs.pop(e.parameter.name)) for e in expanded}
             kwargs[param] = cls(**values)
             return func(**kwargs)
 
