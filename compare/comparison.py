@@ -353,7 +353,7 @@ def _verification(
         gci: Mapping[str, GCI | LeastSquaresStudy] = {}
     elif isinstance(verification, xr.Dataset) or not isinstance(verification, Mapping):
         # a Dataset is a Mapping too: test it first. sim verify studies (contract) apart from
-        # the older 1-D refinement datasets (GCI)
+        # the 1-D refinement datasets (GCI or least squares, by their number of levels)
         items = [verification] if isinstance(verification, xr.Dataset) else list(verification)
         studies = [ds for ds in items if is_study(ds)]
         older = [ds for ds in items if not is_study(ds)]
@@ -463,7 +463,7 @@ def compare(
     ensemble : Dataset, sequence of Datasets or Ensemble, optional
         Ensembles of simulations over uncertain inputs (``run`` dimension); their spread is
         the u_input of each compared quantity (:mod:`jointwear.compare.ensemble`).
-    verification : Dataset(s) or mapping of GCI, optional
+    verification : Dataset(s) or mapping of GCI / LeastSquaresStudy, optional
         Verification studies for u_num: a ``jointwear sim verify`` study (its stored wear maps
         give u_num of every band quantity, :mod:`jointwear.compare.study`), or 1-D
         refinement datasets (quantities over a refinement parameter: the GCI of three
