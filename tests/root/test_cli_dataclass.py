@@ -173,3 +173,17 @@ def test_library_refusal_names_the_flag(capsys, tmp_path):
     err = capsys.readouterr().err
     assert code == 3 and "--speckle-size 300" in err and "expected 1 to 200 pixel" in err
     assert not (tmp_path / "s").exists()
+
+
+def test_the_refusals_suggested_values_are_taken(capsys, tmp_path):
+    # the fixes the two refusals above suggest, applied as given, run
+    speckle = tmp_path / "s"
+    args = ["datasets", "speckle", str(speckle), "--size", "96x96", "--speckle-size", "200"]
+    assert main(args) == 0
+    assert main(["datasets", "speckle", str(speckle), "--size", "96x96", "--overwrite"]) == 0
+    out = tmp_path / "f.nc"
+    ref, deformed = speckle / "reference.png", speckle / "deformed.png"
+    args = ["dic", "correlate", str(ref), str(deformed), "--subset", "9", "--step", "16"]
+    code = main([*args, "--out", str(out)])
+    capsys.readouterr()
+    assert code == 0 and out.exists()
