@@ -105,8 +105,9 @@ def wear_verification(
 #: levels, for Eça & Hoekstra's least squares, which covers the scatter of a motion with impacts
 #: over the tolerance (three would go to the GCI, which refuses it). Checked against the RMS at
 #: rtol 1e-8..1e-9 from 40 initial crank angles, both components: 2 u_num covers 96 % of the 80
-#: cases with these nine levels, 83 % with five (1e-4, 3e-5, 1e-5, 3e-6, 1e-6);
-#: tests/reports/test_motion_verification.py repeats it on 20 angles (100 % and 88 %).
+#: cases with these nine levels, 82 % with five (1e-4, 3e-5, 1e-5, 3e-6, 1e-6)
+#: (benchmarks/bench_motion_verification.py); tests/reports/test_motion_verification.py repeats
+#: it on 20 angles (100 % and 88 %).
 MOTION_RTOLS = (1e-4, 5e-5, 3e-5, 2e-5, 1e-5, 5e-6, 3e-6, 2e-6)
 
 
