@@ -177,8 +177,9 @@ def import_field_cmd(
         parameters={"format": format, "length_unit": length_unit, "fps": fps},
         source=source_attribute(f"dic.import-field from {format}"),
     )
-    ok = ds.flag.values[-1] == 0
-    typer.echo(f"{out}: {len(paths)} images, {ok.sum()}/{ok.size} points with data")
+    from jointwear.dic.field._import import import_summary
+
+    typer.echo(f"{out}: {len(paths)} images, {import_summary(ds)}")
 
 
 def register_import(app: typer.Typer) -> None:

@@ -8,18 +8,28 @@ reference), in the given order or a glob pattern's frame-number order:
     ``x``, ``y`` [pixel] (subset centre, reference image); ``X``, ``Y``, ``Z`` (reference
     position) and ``U``, ``V``, ``W`` (displacement) in the calibration's length unit, or ``u``,
     ``v`` [pixel] in a 2D export; ``sigma`` (VIC-3D's matching confidence [pixel]; -1 or empty
-    marks a point without data).
+    marks a point the tool did not solve); ``flag`` (jointwear's own CSV export: the flag's name).
 ``"dice"``
     DICe's solution text files (``DICe_solution_*.txt``): ``***`` comment lines, then a
     comma-separated header row. Used columns: ``COORDINATE_X``, ``COORDINATE_Y`` [pixel];
     ``MODEL_COORDINATES_X/Y/Z`` and ``MODEL_DISPLACEMENT_X/Y/Z`` (stereo, length unit of the
-    calibration) or ``DISPLACEMENT_X/Y`` [pixel] (2D); ``SIGMA`` (-1: failed) and ``GAMMA``.
+    calibration) or ``DISPLACEMENT_X/Y`` [pixel] (2D); DICe's failure markers ``MATCH``,
+    ``SIGMA`` and ``GAMMA`` (-1 on a subset DICe did not solve, whose displacement columns then
+    hold 0); ``STATUS_FLAG`` is kept as ``foreign_status`` (its codes also mark how a solved
+    subset was initialised, so it does not decide failure).
 
 Nothing is guessed: a stereo file's length unit must be stated (``length_unit``: ``"mm"``,
 ``"m"``, ``"um"``, ``"in"`` or metres per unit); the points must be the same in every file (same
 ``x``, ``y``); the foreign tools' ``sigma`` is a matching confidence in pixels, not a
 displacement uncertainty, so ``displacement_u`` is NaN ("not assessed") and the foreign value
-is kept as ``foreign_sigma``. Points without data are flagged (``flag`` 6, ``not_reached``).
+is kept as ``foreign_sigma``.
+
+Failure stays failure: a row the source marks failed (DICe ``MATCH``, ``SIGMA`` or ``GAMMA``
+negative; VIC-3D ``sigma`` negative; a jointwear CSV's ``flag`` other than ``ok``) is flagged
+``failed_in_source`` (or, from a jointwear CSV, with its own flag) and NaN in every component,
+whatever numbers the row holds (DICe writes zeros); a row with an empty or non-finite
+component is flagged ``not_reached``. The columns that decided are named in the
+``flag`` variable's ``comment``.
 """
 
 from __future__ import annotations
@@ -31,13 +41,26 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
+from jointwear.dic.field._measure import FIELD_FLAG_MEANINGS
+from jointwear.dic.icgn._flags import FLAG_NOT_REACHED
 from jointwear.dic.subset._params import check_image_origin
 from jointwear.errors import BadInputError, ParameterError
 
-__all__ = ["read_field", "FIELD_FORMATS"]
+__all__ = ["read_field", "FIELD_FORMATS", "import_summary"]
 
 FIELD_FORMATS = ("vic3d-csv", "dice")
 _UNITS = {"m": 1.0, "mm": 1e-3, "um": 1e-6, "µm": 1e-6, "cm": 1e-2, "in": 0.0254}
+
+#: flags of an imported field: the field's own (a jointwear CSV's names map back to them) and
+#: ``failed_in_source`` (the source's own failure marker)
+IMPORT_FLAG_MEANINGS = (*FIELD_FLAG_MEANINGS.split(), "failed_in_source")
+FLAG_FAILED_IN_SOURCE = len(IMPORT_FLAG_MEANINGS) - 1
+#: format -> columns whose negative value marks a row the source did not solve
+_FAILURE_COLUMNS = {"vic3d-csv": ("sigma",), "dice": ("MATCH", "SIGMA", "GAMMA")}
+#: format -> the source's status column kept as ``foreign_status`` (not a failure test)
+_STATUS_COLUMN = {"vic3d-csv": None, "dice": "STATUS_FLAG"}
+#: text columns: jointwear's own CSV names its flag
+_TEXT_COLUMNS = ("flag",)
 
 #: format -> (x, y, position XYZ, displacement XYZ, 2D displacement, sigma, quality)
 _COLUMNS = {
@@ -90,15 +113,15 @@ def _table(path: Path, fmt: str) -> dict[str, np.ndarray]:
     cols: dict[str, np.ndarray] = {}
     body = rows[1:]
     for j, name in enumerate(head):
+        if name in _TEXT_COLUMNS:
+            cols[name] = np.array([r[j].strip() if j < len(r) else "" for r in body])
+            continue
         vals = []
         for k, r in enumerate(body):
             v = r[j].strip() if j < len(r) else ""
             try:
                 vals.append(float(v) if v else np.nan)
             except ValueError:
-                if name in ("flag",):
-                    vals.append(np.nan)
-                    continue
                 raise BadInputError(
                     f"{fmt} file '{path}' row {k + 2}, column '{name}': {v!r} is not a number"
                 ) from None
@@ -128,6 +151,32 @@ def _files(files) -> list[Path]:
     return out
 
 
+def _source_flags(tables: list[dict], fmt: str, shape: tuple[int, int]) -> tuple[np.ndarray, str]:
+    """The source's own verdict on every row and the columns that gave it.
+
+    Returns the flag (0 where the source did not mark the row failed; ``failed_in_source``
+    where a failure column is negative; a jointwear CSV's own flag by its name, an unknown name
+    ``failed_in_source``) and a sentence naming the tests applied.
+    """
+    flag = np.zeros(shape, np.int8)
+    used = []
+    for c in _FAILURE_COLUMNS[fmt]:
+        if any(c in t for t in tables):
+            for k, t in enumerate(tables):
+                if c in t:
+                    flag[k][t[c] < 0] = FLAG_FAILED_IN_SOURCE  # NaN < 0 is False
+            used.append(f"{c} < 0")
+    if any("flag" in t for t in tables):
+        value = {name: v for v, name in enumerate(IMPORT_FLAG_MEANINGS)}
+        for k, t in enumerate(tables):
+            if "flag" in t:
+                own = np.array([value.get(f, FLAG_FAILED_IN_SOURCE) if f else 0 for f in t["flag"]])
+                flag[k] = np.where(own != 0, own, flag[k])
+        used.append("the flag column's name other than ok")
+    tests = ", ".join(used) if used else "none (the files have no failure column)"
+    return flag, f"failed in the source by: {tests}; an empty or non-finite component: not_reached"
+
+
 def _field_variables(disp, sig, flag, unit: str, format: str, sig_c: str) -> dict:
     """Displacement (uncertainty not assessed), the foreign sigma and the flag of an import."""
     data = {
@@ -150,7 +199,7 @@ def _field_variables(disp, sig, flag, unit: str, format: str, sig_c: str) -> dic
             },
         ),
         "foreign_sigma": xr.DataArray(
-            np.where(sig >= 0, sig, np.nan),
+            np.where((sig >= 0) & (flag == 0), sig, np.nan),
             dims=("time", "point"),
             attrs={"units": "pixel", "long_name": f"{sig_c} column of the {format} files"},
         ),
@@ -159,9 +208,9 @@ def _field_variables(disp, sig, flag, unit: str, format: str, sig_c: str) -> dic
             dims=("time", "point"),
             attrs={
                 "units": "1",
-                "long_name": "field quality flag (imported: ok or not_reached = no data)",
-                "flag_values": np.array([0, 6], np.int8),
-                "flag_meanings": "ok not_reached",
+                "long_name": "field quality flag (imported: the source's failures kept)",
+                "flag_values": np.arange(len(IMPORT_FLAG_MEANINGS), dtype=np.int8),
+                "flag_meanings": " ".join(IMPORT_FLAG_MEANINGS),
             },
         ),
     }
@@ -239,14 +288,22 @@ def read_field(
             sig[k] = tab[sig_c]
         if q_c and q_c in tab:
             qual[k] = tab[q_c]
-    missing = ~np.isfinite(disp).all(axis=-1)
-    if sig_c in first:
-        missing |= ~(sig >= 0)
-    flag = np.where(missing, 6, 0).astype(np.int8)
+    flag, decided = _source_flags(tables, format, (n_t, n))
+    no_data = ~np.isfinite(disp).all(axis=-1) & (flag == 0)
+    flag[no_data] = FLAG_NOT_REACHED
+    missing = flag != 0
     disp[missing] = np.nan
+    qual[missing] = np.nan
     axes = ["x", "y", "z"] if stereo else ["x", "y"]
     unit = "m" if stereo else "pixel"
     data = _field_variables(disp, sig, flag, unit, format, sig_c)
+    data["flag"].attrs["comment"] = decided
+    status_c = _STATUS_COLUMN[format]
+    if status_c and status_c in first:
+        status = np.array([t.get(status_c, np.full(n, np.nan)) for t in tables])
+        data["foreign_status"] = xr.DataArray(
+            status, dims=("time", "point"), attrs={"units": "1", "long_name": f"{status_c} column"}
+        )
     if q_c and np.isfinite(qual).any():
         data["foreign_quality"] = xr.DataArray(
             qual, dims=("time", "point"), attrs={"units": "1", "long_name": f"{q_c} column"}
@@ -283,3 +340,13 @@ def read_field(
     if stereo:
         ds.attrs["length_unit_of_the_files_m"] = scale
     return ds
+
+
+def import_summary(ds: xr.Dataset) -> str:
+    """'119/123 points with data in the last image (4 failed in the source)': the count of
+    points with data and of each failure in the last image."""
+    flag = ds.flag.values[-1]
+    names = str(ds.flag.attrs["flag_meanings"]).split()
+    text = f"{int((flag == 0).sum())}/{flag.size} points with data in the last image"
+    counts = [f"{int((flag == v).sum())} {names[v]}" for v in np.unique(flag[flag != 0])]
+    return text + (f" ({', '.join(counts)})" if counts else "")
