@@ -38,6 +38,8 @@ def _spell(key: str, value: object) -> str:
     if isinstance(value, (tuple, list)):
         if key == "ignore_header":
             return " ".join(f"ignore_header={v}" for v in value)
+        if key == "columns":  # one comma-joined word: the same in Python and on the command line
+            return f"{key}='{','.join(str(v) for v in value)}'"
         return f"{key}=({','.join(str(v) for v in value)})"
     if isinstance(value, bool):
         return f"{key}={value}"

@@ -1,15 +1,21 @@
 """Text as labs write it, made plain before sniffing: end-of-file marks, quoted CSV, thousands
-separators, concatenated per-layer blocks; formats that are not supported are named.
+marks, concatenated per-layer blocks; formats that are not supported are named.
 
 * a trailing Ctrl-Z (DOS end-of-file mark, often after CRLF line ends) is dropped;
 * JSON and angles in degrees-minutes-seconds are refused as unsupported formats (no delimiter
   advice can make them readable);
 * quoted CSV (``"0.5","8.0012"``, also with a decimal comma inside the quotes) is unquoted
   with :mod:`csv` and re-joined with tabs;
-* thousands separators (``8,001.234``, ``8.001,234``, ``8'001.234``) are removed when the file
-  shows both separators in one number (unambiguous), or when ``thousands=`` is given;
+* the field delimiter is decided first, from the data lines (:func:`sniff_delimiter`); a
+  thousands mark (``8,001.234``, ``8.001,234``, ``8'001.234``, ``8 001,234``) is then looked
+  for *within* the fields (:func:`sniff_thousands`): accepted only when it is not the delimiter,
+  one number shows it next to the decimal mark, and every value of each column holding it is
+  grouped by it; or given (``thousands=``, :func:`thousands_mark` reads its names);
 * a file of several blocks, each a layer with its own header lines (``Layer 2``, ``Height:
   1 mm``, the column names again), is split into blocks (:func:`split_blocks`).
+
+:func:`sniff_delimiter`, :func:`sniff_thousands`, :func:`fields` and :data:`MISSING` are the
+sniffer's parts that other importers reuse (lines in, decisions out; nothing read from disk).
 """
 
 from __future__ import annotations
@@ -17,16 +23,231 @@ from __future__ import annotations
 import csv
 import io
 import re
+from collections.abc import Sequence
 
 from jointwear.metrology.readers.advice import Refusal
 
-__all__ = ["normalise", "split_blocks"]
+__all__ = [
+    "DELIMITERS",
+    "MISSING",
+    "THOUSANDS_NAMES",
+    "fields",
+    "is_missing",
+    "normalise",
+    "sniff_delimiter",
+    "sniff_thousands",
+    "split_blocks",
+    "thousands_mark",
+]
 
 _DMS = re.compile(r"\d+\s*°\s*\d+\s*['′]|\d+d\s*\d+m\s*\d+(\.\d+)?s", re.I)
 
+#: Spellings of a thousands mark (``thousands=`` / ``--thousands``) -> the character.
+THOUSANDS_NAMES: dict[str, str] = {
+    ",": ",",
+    "comma": ",",
+    ".": ".",
+    "point": ".",
+    "dot": ".",
+    "period": ".",
+    "'": "'",
+    "apostrophe": "'",
+    "quote": "'",
+    " ": " ",
+    "space": " ",
+}
+#: The name a suggestion uses for each mark (one the shell passes as it is).
+THOUSANDS_WORD = {",": "comma", ".": "point", "'": "apostrophe", " ": "space"}
+#: Field delimiters in the order they are tried (``" "``: any run of whitespace).
+DELIMITERS = ("\t", ";", ",", " ")
+#: Cells that mean "no value here" (a missing point), compared lower-cased.
+MISSING = frozenset(
+    (
+        "",
+        "-",
+        "--",
+        "---",
+        "----",
+        "*",
+        "**",
+        "***",
+        "nan",
+        "-nan",
+        "+nan",
+        "na",
+        "n/a",
+        "#n/a",
+        "null",
+        "none",
+        "?",
+        "invalid",
+        "void",
+        "missing",
+        "#value!",
+    )
+)
+_LOOSE = re.compile(
+    r"^[-+]?(?:\d{1,3}(?:[,.'\u00a0\u202f ]\d{3})+|\d+)?(?:[.,]\d*)?(?:[eE][-+]?\d+)?$"
+)
 
-def normalise(text: str, path: str, thousands: str | None) -> tuple[str, dict[str, str]]:
-    """(plain text, notes on what was changed) or a refusal for an unsupported format."""
+
+def is_missing(cell: str) -> bool:
+    """True for a cell that marks a missing point (:data:`MISSING`: ``---``, ``NaN``, empty…)."""
+    return cell.strip().lower() in MISSING
+
+
+def thousands_mark(name: str | None) -> str | None:
+    """The character of a thousands mark given by name (``comma``, ``point``, ``apostrophe``,
+    ``space``) or as itself; None stays None; anything else is refused."""
+    if name is None:
+        return None
+    key = name if name == " " else str(name).strip().lower()
+    if key not in THOUSANDS_NAMES:
+        raise Refusal(
+            f"thousands={name!r} (--thousands) is not a thousands mark; use comma, point, "
+            "apostrophe or space"
+        )
+    return THOUSANDS_NAMES[key]
+
+
+def fields(line: str, delimiter: str | None) -> list[str]:
+    """The stripped fields of ``line`` split at ``delimiter`` (``" "``: any whitespace run;
+    None: the whole line is one field); a trailing delimiter adds no field."""
+    if delimiter is None:
+        return [line.strip()]
+    if delimiter == " ":
+        return line.split()
+    toks = [t.strip() for t in line.strip().split(delimiter)]
+    return toks[:-1] if len(toks) > 1 and toks[-1] == "" else toks
+
+
+def _numberish(tok: str) -> bool:
+    """A number under some decimal/thousands reading, or a missing-value mark."""
+    return is_missing(tok) or (any(c.isdigit() for c in tok) and bool(_LOOSE.match(tok)))
+
+
+def sniff_delimiter(lines: Sequence[str]) -> str | None:
+    """The field delimiter of lines of numbers, decided before any decimal or thousands mark.
+
+    Parameters
+    ----------
+    lines : sequence of str
+        Data lines (a table's rows; header lines left out).
+
+    Returns
+    -------
+    str or None
+        The first of tab, ``;``, ``,``, ``" "`` (whitespace) that splits at least 90 % of the
+        lines into the same number (>= 2) of fields that are each a number under some reading
+        (decimal point or comma, grouped thousands) or a missing-value mark, with at least one
+        number per line; None when none does (one column, or not a table).
+    """
+    rows = [ln for ln in lines if ln.strip()]
+    if not rows:
+        return None
+    for d in DELIMITERS:
+        counts: dict[int, int] = {}
+        for ln in rows:
+            toks = fields(ln, d)
+            if len(toks) >= 2 and all(map(_numberish, toks)) and not all(map(is_missing, toks)):
+                counts[len(toks)] = counts.get(len(toks), 0) + 1
+        if counts and max(counts.values()) >= 0.9 * len(rows):
+            return d
+    return None
+
+
+def _grouped(sep: str, dec: str | None) -> re.Pattern:
+    """A number whose integer part is grouped by ``sep`` (or has at most 3 digits)."""
+    d = "[.,]" if dec is None else re.escape(dec)
+    s = re.escape(sep)
+    return re.compile(rf"^[-+]?\d{{1,3}}(?:{s}\d{{3}})*(?:{d}\d*)?(?:[eE][-+]?\d+)?$")
+
+
+def _plain(dec: str) -> re.Pattern:
+    d = re.escape(dec)
+    return re.compile(rf"^[-+]?(?:\d+(?:{d}\d*)?|{d}\d+)(?:[eE][-+]?\d+)?$")
+
+
+def sniff_thousands(lines: Sequence[str], delimiter: str | None) -> str | None:
+    """A thousands mark that the table shows unambiguously, else None.
+
+    Parameters
+    ----------
+    lines : sequence of str
+        Data lines.
+    delimiter : str or None
+        Their field delimiter (:func:`sniff_delimiter`); None for one column.
+
+    Returns
+    -------
+    str or None
+        ``sep`` when, within the fields, (1) neither ``sep`` nor the decimal mark is the
+        delimiter, (2) at least one number holds ``sep`` and the decimal mark
+        (``8,001.234``), and (3) every value of every column holding ``sep`` is grouped by it
+        (``999.5`` yes; ``1234.5`` or ``0.458`` with ``sep='.'`` no) and every other column
+        reads with the decimal mark alone.
+    """
+    table = [fields(ln, delimiter) for ln in lines if ln.strip()]
+    if not table:
+        return None
+    width = max(map(len, table))
+    cols = [[r[j] for r in table if j < len(r) and not is_missing(r[j])] for j in range(width)]
+    for sep, dec in ((",", "."), (".", ","), ("'", "."), ("'", ","), (" ", ","), (" ", ".")):
+        if delimiter in (sep, dec) or (delimiter is None and sep == " "):
+            continue
+        both = re.compile(rf"^[-+]?\d{{1,3}}(?:{re.escape(sep)}\d{{3}})+{re.escape(dec)}\d+")
+        if not any(both.match(v) for col in cols for v in col):
+            continue
+        grouped, plain = _grouped(sep, dec), _plain(dec)
+        if all(
+            all(map((grouped if any(sep in v for v in col) else plain).match, col)) for col in cols
+        ):
+            return sep
+    return None
+
+
+def _remove_thousands(
+    text: str, path: str, given: str | None, delimiter: str | None
+) -> tuple[str, str | None]:
+    """``text`` with the thousands mark removed inside the fields of its data lines, and a note
+    (None when there is none). A given mark that is the delimiter is refused."""
+    sep = thousands_mark(given)
+    lines = text.splitlines()
+    data = [i for i, ln in enumerate(lines) if _is_data(ln)]
+    sample = [lines[i] for i in data[:400]]
+    delim = delimiter or sniff_delimiter(sample)
+    if sep is None:
+        sep = sniff_thousands(sample, delim)
+        if sep is None:
+            return text, None
+        how = "one number shows it next to the decimal mark, every value of its column grouped"
+    else:
+        how = "given"
+        if sep == delim:
+            raise Refusal(
+                f"'{path}': thousands={THOUSANDS_WORD[sep]!r} (--thousands) is the field "
+                "delimiter of the table; a thousands mark cannot also separate the fields - drop "
+                "the option, or pass delimiter=... if the fields are separated otherwise"
+            )
+    pat = _grouped(sep, None)
+    for i in data:
+        toks = [
+            t.replace(sep, "") if sep in t and pat.match(t) else t for t in fields(lines[i], delim)
+        ]
+        lines[i] = (delim or " ").join(toks)
+    end = "\n" if text.endswith(("\n", "\r")) else ""
+    note = f"thousands mark {THOUSANDS_WORD[sep]!r} removed within the fields ({how})"
+    return "\n".join(lines) + end, note
+
+
+def normalise(
+    text: str, path: str, thousands: str | None, delimiter: str | None = None
+) -> tuple[str, dict[str, str]]:
+    """(plain text, notes on what was changed) or a refusal for an unsupported format.
+
+    ``thousands`` is the thousands mark given (None: sniffed, :func:`sniff_thousands`),
+    ``delimiter`` the field delimiter given (None: sniffed, :func:`sniff_delimiter`).
+    """
     notes: dict[str, str] = {}
     stripped = text.rstrip("\r\n\t ")
     if stripped.endswith("\x1a"):
@@ -49,35 +270,16 @@ def normalise(text: str, path: str, thousands: str | None) -> tuple[str, dict[st
     if sum(ln.count('"') >= 2 for ln in body) > len(body) // 2:
         text = _unquote(text)
         notes["quoted"] = "quoted CSV fields unquoted (csv module) and re-joined with tabs"
-    sep = thousands or _thousands(text)
-    if sep is not None:
-        dec = "," if sep == "." else "."
-        pat = re.compile(
-            rf"(?<![\d{re.escape(sep)}])(\d{{1,3}}(?:{re.escape(sep)}\d{{3}})+)(?=[{re.escape(dec)}\s;\t]|$)"
-        )
-        text = "\n".join(
-            pat.sub(lambda m: m.group(1).replace(sep, ""), ln) if _is_data(ln) else ln
-            for ln in text.splitlines()
-        )
-        notes["thousands"] = (
-            f"thousands separator {sep!r} removed ({'given' if thousands else 'seen next to the decimal separator in one number'})"
-        )
+        delimiter = "\t"
+    text, note = _remove_thousands(text, path, thousands, delimiter)
+    if note:
+        notes["thousands"] = note
     return text, notes
 
 
 def _is_data(line: str) -> bool:
     s = line.strip()
     return bool(s) and bool(re.match(r"^[-+]?\d", s)) and not re.search(r"[A-DF-Za-df-z]", s)
-
-
-def _thousands(text: str) -> str | None:
-    """A thousands separator shown unambiguously: a number holding both separators."""
-    lines = [ln for ln in text[:65536].splitlines()[:400] if _is_data(ln)]
-    for sep, dec in ((",", "."), (".", ","), ("'", "."), ("'", ",")):
-        pat = re.compile(rf"\b\d{{1,3}}(?:{re.escape(sep)}\d{{3}})+{re.escape(dec)}\d+")
-        if sum(bool(pat.search(ln)) for ln in lines) >= max(1, len(lines) // 10):
-            return sep
-    return None
 
 
 def _unquote(text: str) -> str:

@@ -269,7 +269,9 @@ def _text_format(
         delimiter=delimiter,
         decimal=decimal,
         header_lines=header_lines,
-        columns=tuple(columns) if columns is not None else None,
+        columns=(columns.split(",") if isinstance(columns, str) else tuple(columns))
+        if columns is not None
+        else None,
         units=units,
         z_units=z_units,
         sheet=sheet,

@@ -14,7 +14,7 @@ import pandas as pd
 from jointwear.errors import BadInputError
 from jointwear.metrology.readers.claims import drop_ignored
 from jointwear.metrology.readers.columns import COLUMN_KINDS, _guess_columns, _kind_from_name
-from jointwear.metrology.readers.pretext import normalise, split_blocks
+from jointwear.metrology.readers.pretext import normalise, split_blocks, thousands_mark
 from jointwear.metrology.readers.source import _read_text
 from jointwear.metrology.readers.units import _LENGTH_KINDS, UNITS, _file_units, unit_factor
 
@@ -53,8 +53,9 @@ class TextFormat:
         Decimal separator.
     header_lines : int, optional
         Number of lines before the numeric table (metadata and column names).
-    columns : tuple of str, optional
-        Meaning of each column, from :data:`COLUMN_KINDS`; for a wide file the value columns
+    columns : tuple of str or str, optional
+        Meaning of each column, from :data:`COLUMN_KINDS` (or one comma-joined string, as the
+        command line and the refusals spell it: ``"angle_deg,deviation"``); for a wide file the value columns
         are all ``"radius"`` or ``"deviation"``.
     units : str, optional
         Unit of the length columns: ``"um"``, ``"mm"``, ``"m"``, ``"inch"``; for files that do
@@ -69,8 +70,9 @@ class TextFormat:
     ignore_header : tuple of str
         Header claims to drop (names of :data:`~.claims.CLAIMS`: ``units``, ``nominal_radius``,
         ``points``, ``filter``, ``layers``, ``layer_spacing``, ``z``) when the header is wrong.
-    thousands : {",", ".", "'", " "}, optional
-        Thousands separator (``8,001.234``); sniffed only where unambiguous.
+    thousands : {"comma", "point", "apostrophe", "space"}, optional
+        Thousands mark (``8,001.234``; also given as the character itself); sniffed only where
+        unambiguous (:func:`~.pretext.sniff_thousands`).
     """
 
     delimiter: str | None = None
@@ -97,7 +99,8 @@ class TextFormat:
         if self.decimal not in (None, ".", ","):
             raise BadInputError(f"decimal {self.decimal!r} must be '.' or ','")
         if self.columns is not None:
-            cols = tuple(str(c).strip().lower() for c in self.columns)
+            given = self.columns.split(",") if isinstance(self.columns, str) else self.columns
+            cols = tuple(str(c).strip().lower() for c in given)
             bad = [c for c in cols if c not in COLUMN_KINDS]
             if bad:
                 raise BadInputError(
@@ -109,8 +112,7 @@ class TextFormat:
             unit_factor(self.units, where="option units (--units)")
         if self.z_units is not None:
             unit_factor(self.z_units, where="option z_units (--z-units)")
-        if self.thousands not in (None, ",", ".", "'", " "):
-            raise BadInputError(f"thousands {self.thousands!r} must be ',', '.', \"'\" or ' '")
+        object.__setattr__(self, "thousands", thousands_mark(self.thousands))
         if self.thousands is not None and self.thousands == self.decimal:
             raise BadInputError("thousands and decimal separators must differ")
         object.__setattr__(self, "ignore_header", tuple(self.ignore_header))
@@ -343,7 +345,7 @@ def parse_file(path: str | Path, fmt: TextFormat = TextFormat()) -> ParsedFile:
     """
     path = Path(path)
     text = _read_text(path, fmt.encoding, fmt.sheet)
-    text, pre = normalise(text, str(path), fmt.thousands)
+    text, pre = normalise(text, str(path), fmt.thousands, fmt.delimiter)
     return _parse_text(path, text, fmt, pre)
 
 
@@ -352,7 +354,7 @@ def parse_blocks(path: str | Path, fmt: TextFormat = TextFormat()) -> list[Parse
     header lines) gives one :class:`ParsedFile` per block (line numbers are the file's)."""
     path = Path(path)
     text = _read_text(path, fmt.encoding, fmt.sheet)
-    text, pre = normalise(text, str(path), fmt.thousands)
+    text, pre = normalise(text, str(path), fmt.thousands, fmt.delimiter)
     blocks = split_blocks(text) if fmt.header_lines is None else None
     if not blocks:
         return [_parse_text(path, text, fmt, pre)]

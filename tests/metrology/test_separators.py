@@ -1,0 +1,165 @@
+"""Issue 38 item 1: the field delimiter is decided before the decimal and thousands marks, and a
+thousands mark is taken only where every value of its column is grouped by it. Comma CSVs with
+three decimals (the commonest export there is) used to read 1000 x wrong with exit 0."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from jointwear.errors import BadInputError
+from jointwear.metrology.readers import read_scan
+from jointwear.metrology.readers.pretext import (
+    fields,
+    sniff_delimiter,
+    sniff_thousands,
+    thousands_mark,
+)
+
+CONV = ("-x", "clockwise")  # canonical: theta comes back as written
+
+
+def _dev_um(n, k):
+    t = np.radians(np.arange(n) * 360.0 / n)
+    return 0.3 * np.cos(2 * t + 0.1 * k) + 0.2 * np.sin(5 * t) + 0.158
+
+
+def _cell(v, decimals, dec):
+    return f"{v:.{decimals}f}".replace(".", dec)
+
+
+@pytest.mark.parametrize(
+    ("delim", "dec"), [(",", "."), (";", "."), (";", ","), ("\t", "."), ("\t", ",")]
+)
+@pytest.mark.parametrize("decimals", [1, 2, 3, 4, 5, 6])
+def test_wide_files_read_right_at_every_number_of_decimals(tmp_path, delim, dec, decimals):
+    n = 3600  # angles 0.000 ... 359.900 written with `decimals` decimals (>= 1)
+    th = np.arange(n) * 360.0 / n
+    dev = [_dev_um(n, k) for k in range(3)]
+    lines = ["Units: um", delim.join(["Angle (deg)"] + [f"Dev z={k} mm" for k in range(3)])]
+    for i in range(n):
+        cells = [_cell(th[i], max(decimals, 1), dec)] + [_cell(d[i], decimals, dec) for d in dev]
+        lines.append(delim.join(cells))
+    f = tmp_path / "wide.csv"
+    f.write_text("\n".join(lines) + "\n")
+    ds = read_scan(f, convention=CONV)
+    want = np.round(np.array(dev), decimals) * 1e-6
+    np.testing.assert_allclose(ds["radial_deviation"].values, want, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(ds["theta"].values, th, atol=1e-9)
+    np.testing.assert_allclose(np.diff(ds["z"].values), 1e-3, rtol=1e-9)
+    assert "thousands" not in ds.attrs["reader_guesses"]["wide.csv"]
+
+
+@pytest.mark.parametrize(("delim", "dec"), [(",", "."), (";", ","), ("\t", ".")])
+@pytest.mark.parametrize("decimals", [2, 3, 4])
+def test_long_files_with_angles_above_100_and_z_to_12_mm(tmp_path, delim, dec, decimals):
+    n = 720
+    th = np.arange(n) * 360.0 / n
+    zs = np.linspace(0.0, 12.0, 5)  # 0.000 ... 12.000 mm
+    dev = [_dev_um(n, k) for k in range(zs.size)]
+    lines = ["Units: um", "Z unit: mm", delim.join(["z", "angle", "dev"])]
+    for k, z in enumerate(zs):
+        lines += [
+            delim.join([_cell(z, 3, dec), _cell(th[i], decimals, dec), _cell(dev[k][i], 3, dec)])
+            for i in range(n)
+        ]
+    f = tmp_path / "long.csv"
+    f.write_text("\n".join(lines) + "\n")
+    ds = read_scan(f, convention=CONV, angle_unit="deg")
+    np.testing.assert_allclose(
+        ds["radial_deviation"].values, np.round(dev, 3) * 1e-6, rtol=0, atol=1e-12
+    )
+    np.testing.assert_allclose(ds["theta"].values, th, atol=1e-9)
+    np.testing.assert_allclose(ds["z"].values, (zs - 6.0) * 1e-3, atol=1e-12)
+
+
+def test_the_issue_file_reads_ront_0_625_um_not_625(tmp_path, run_import):
+    """`Angle (deg),Dev z=0 mm,Dev z=1 mm` / `0.0,0.458,0.508` under `Units: um`."""
+    import xarray as xr
+
+    from jointwear.metrology import assess
+
+    n = 720
+    th = np.arange(n) * 0.5
+    t = np.radians(th)
+    a = 0.3125 * np.cos(2 * t) + 0.1455  # p-p 0.625 um; the first row is 0.458
+    b = 0.3125 * np.cos(3 * t) + 0.1955  # first row 0.508
+    f = tmp_path / "issue.csv"
+    f.write_text(
+        "Units: um\nAngle (deg),Dev z=0 mm,Dev z=1 mm\n"
+        + "".join(f"{x:.1f},{u:.3f},{v:.3f}\n" for x, u, v in zip(th, a, b, strict=True))
+    )
+    assert f.read_text().splitlines()[2] == "0.0,0.458,0.508"
+    out = tmp_path / "issue.nc"
+    assert run_import(f, out) == 0
+    ds = xr.load_dataset(out)
+    form = assess(ds)
+    np.testing.assert_allclose(form["RONt_LS"].values, [0.625e-6, 0.625e-6], atol=0.002e-6)
+
+
+def test_a_thousands_mark_needs_every_value_of_its_column_grouped(tmp_path):
+    n = 360
+    th = np.arange(n) * 1.0
+    r = 8000.0 + 1.5 * np.cos(3 * np.radians(th))
+    tab = "Units: um\n" + "".join(f"{a:.3f}\t{v:,.4f}\n" for a, v in zip(th, r, strict=True))
+    f = tmp_path / "tab.txt"
+    f.write_text(tab)
+    ds = read_scan(f, convention=CONV, angle_unit="deg")
+    np.testing.assert_allclose(ds["radius"].values[0], np.round(r, 4) * 1e-6, rtol=1e-12)
+    assert "thousands mark 'comma'" in ds.attrs["reader_guesses"]["tab.txt"]["thousands"]
+    # semicolons, decimal comma, space thousands (the mark --help lists: 'space')
+    g = tmp_path / "space.txt"
+    g.write_text(
+        "Units: um\n"
+        + "".join(
+            f"{a:.3f};{v:,.4f}\n".replace(",", " ").replace(".", ",")
+            for a, v in zip(th, r, strict=True)
+        )
+    )
+    ds = read_scan(g, convention=CONV, angle_unit="deg")
+    np.testing.assert_allclose(ds["radius"].values[0], np.round(r, 4) * 1e-6, rtol=1e-12)
+    ds = read_scan(g, convention=CONV, angle_unit="deg", thousands="space")
+    np.testing.assert_allclose(ds["radius"].values[0], np.round(r, 4) * 1e-6, rtol=1e-12)
+
+
+def test_sniffer_parts_decide_the_delimiter_first():
+    assert sniff_delimiter(["0.0,0.458,0.508", "0.5,0.457,0.507"]) == ","
+    assert sniff_thousands(["0.0,0.458,0.508", "0.5,0.457,0.507"], ",") is None
+    assert sniff_delimiter(["0,000;8.001,234", "1,000;8.000,999"]) == ";"
+    assert sniff_thousands(["0,000;8.001,234", "1,000;8.000,999"], ";") == "."
+    # a column in which a value of 4+ digits is not grouped: no thousands mark
+    assert sniff_thousands(["1\t8,001.5", "2\t8002.5"], "\t") is None
+    # the delimiter is never the thousands mark, even if one number looks grouped
+    assert sniff_thousands(["0.0,8,001.234", "0.5,8,001.235"], ",") is None
+    assert sniff_delimiter(["0.000 100.00 -0.282", "0.000 100.50 -0.281"]) == " "
+    assert sniff_delimiter(["1.5", "2.5"]) is None
+    assert fields("1,2,", ",") == ["1", "2"]
+    assert [thousands_mark(w) for w in ("space", "comma", "point", "apostrophe", "'")] == [
+        " ",
+        ",",
+        ".",
+        "'",
+        "'",
+    ]
+    with pytest.raises(BadInputError, match="comma, point, apostrophe or space"):
+        thousands_mark("underscore")
+
+
+def test_a_given_thousands_mark_that_is_the_delimiter_is_refused(tmp_path):
+    f = tmp_path / "c.csv"
+    f.write_text("Units: um\n" + "".join(f"{a:.1f},{0.1 * a:.3f}\n" for a in range(360)))
+    with pytest.raises(BadInputError, match="is the field delimiter"):
+        read_scan(f, convention=CONV, thousands="comma")
+
+
+def test_comma_thousands_in_a_comma_csv_is_not_read_as_two_layers(tmp_path):
+    """`0.0,8,001.234`: the comma is the delimiter, so it cannot be a thousands mark; the file
+    is not read (a third column of 001.234 is not a layer of radii)."""
+    r = 8000.0 + 1.5 * np.cos(3 * np.radians(np.arange(360.0)))
+    f = tmp_path / "amb.csv"
+    f.write_text(
+        "Units: um\nAngle (deg),Radius\n"
+        + "".join(f"{a:.1f},{v:,.3f}\n" for a, v in zip(range(360), r, strict=True))
+    )
+    with pytest.raises(BadInputError):
+        read_scan(f, convention=CONV)
