@@ -13,7 +13,9 @@ import jointwear.compare.metrics as mt
 import jointwear.compare.verdicts as vd
 
 METRIC_COLUMNS = ["quantity", "metric", "value", "units", "long_name", "definition", "basis"]
-DECISION_COLUMNS = ["quantity", "criterion", "value", "state", "basis", "reason", "passed", "key"]
+DECISION_COLUMNS = [
+    "quantity", "criterion", "value", "state", "basis", "reason", "passed", "key", "resolution",
+]  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -27,10 +29,17 @@ class Uncertainty:
     basis : str
         How it was obtained ("stated by the simulation file", "ensemble of 16 runs", "GCI ...",
         "user-stated 15 % of |S|"), or why it is unknown.
+    relative : float
+        Share of the variance ``value**2`` that is applied relative to the simulated value
+        ``S`` (a user-stated ``rel·|S|``, a verification study's relative u_num, a reduced
+        ensemble's relative spread): it scales with ``S**2`` when the model predicts another
+        value, the rest is fixed [1, in 0..1]. The resolution of a criterion
+        (:func:`jointwear.compare.metrics.detectable_error`) uses it.
     """
 
     value: float | None
     basis: str
+    relative: float = 0.0
 
     @property
     def known(self) -> bool:
@@ -90,8 +99,10 @@ def decision(
     basis: str,
     reason: str = "",
     key: str = "",
+    resolution: str = "",
 ) -> dict[str, Any]:
-    """One row of the decision card (``key``: the metrics-table quantity it judges)."""
+    """One row of the decision card (``key``: the metrics-table quantity it judges;
+    ``resolution``: the errors the criterion detects, :func:`resolution_text`)."""
     vd.state_code(state)  # refuse unknown states
     return {
         "quantity": quantity,
@@ -102,6 +113,7 @@ def decision(
         "reason": reason,
         "passed": state == vd.PASS,
         "key": key or quantity,
+        "resolution": resolution,
     }
 
 
@@ -157,6 +169,9 @@ class Discrepancy:
         Value of a pass or a fail, from the :class:`~jointwear.compare.metrics.VV20` result.
     criterion_note : str
         Added to the criterion's text (e.g. how an angle error is wrapped).
+    relative : bool
+        True (a magnitude): the resolution is stated as relative errors ``(S - D) / |D|``;
+        False (an angle): as the absolute error ``|E| > U_val``.
     """
 
     s: float
@@ -168,6 +183,7 @@ class Discrepancy:
     not_assessed_text: str
     result_text: Callable[[Any], str]
     criterion_note: str = ""
+    relative: bool = True
 
 
 def scalar_discrepancy(s: float, d: float, units: str, relative_error_max: float) -> Discrepancy:
@@ -192,6 +208,40 @@ def scalar_discrepancy(s: float, d: float, units: str, relative_error_max: float
         not_assessed_text=f"E = {fmt(s - d, units)} (S = {fmt(s, units)}, D = {fmt(d, units)}){screen}",
         result_text=lambda res: f"|E| = {fmt(abs(res.E), units)}, U_val = {fmt(res.U_val, units)}",
     )
+
+
+def _percent(e: float) -> str:
+    return f"{e * 100:+.0f} %".replace("-", "−")
+
+
+def resolution_text(low: float, high: float) -> str:
+    """``"detects errors outside −24 %…+40 %"``: what a V&V 20 criterion can detect."""
+    if not (np.isfinite(low) or np.isfinite(high)):
+        return "detects no error of S (U_val grows with S faster than |E|, and exceeds |D|)"
+    if not np.isfinite(high):
+        return f"detects under-predictions below {_percent(low)}, no over-prediction"
+    if not np.isfinite(low):
+        return f"detects over-predictions above {_percent(high)}, no under-prediction to S = 0"
+    return f"detects errors outside {_percent(low)}…{_percent(high)}"
+
+
+def _resolution(rows: Rows, quantity: str, error: Discrepancy, budget: Budget, res: Any) -> str:
+    """The detectable errors of a decided criterion: metric rows and the card's text."""
+    if not error.relative:
+        return f"detects |E| > {fmt(res.U_val, error.units)}"
+    known = [u for _, u in budget.parts()]
+    u_rel = float(np.sqrt(sum(float(u.value) ** 2 * u.relative for u in known)))
+    u_fix = float(np.sqrt(sum(float(u.value) ** 2 * (1.0 - u.relative) for u in known)))
+    low, high = mt.detectable_error(error.d, error.s, u_fixed=u_fix, u_relative=u_rel, k=budget.k)
+    how = (
+        f"|E| = U_val solved for S = D (1 + e); {u_rel / res.u_val:.0%} of u_val applied relative "
+        "to S"
+        if res.u_val > 0
+        else ""
+    )
+    rows.add(quantity, "detectable_error_low", low, error.units, how)
+    rows.add(quantity, "detectable_error_high", high, error.units, how)
+    return resolution_text(low, high)
 
 
 def vv20_decision(
@@ -258,5 +308,6 @@ def vv20_decision(
             vd.PASS if res.passed else vd.FAIL,
             "V&V 20",
             key=quantity,
+            resolution=_resolution(rows, quantity, error, budget, res),
         )
     )

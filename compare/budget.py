@@ -100,11 +100,15 @@ class Component:
     covers : frozenset of str
         The error sources it accounts for (e.g. ``{"wear-update interval", "cycle-to-cycle
         variability"}``); two components that share one are not both added.
+    relative : bool
+        True when ``value`` is applied relative to the simulated value (``rel·|S|``): it
+        scales with ``S`` (:attr:`jointwear.compare._decide.Uncertainty.relative`).
     """
 
     value: float | None
     source: str
     covers: frozenset[str]
+    relative: bool = False
 
     @property
     def known(self) -> bool:
@@ -138,11 +142,13 @@ def combine(term: str, components: Iterable[Component], *, missing: str = "") ->
     if not used:
         reasons = [line[len("not assessed: ") :] for line in lines if line.startswith("not ")]
         return unknown("; ".join([*(reasons or []), *([missing] if missing else [])]) or missing)
-    total = math.sqrt(sum(float(c.value) ** 2 for c in used))
+    var = sum(float(c.value) ** 2 for c in used)
+    total = math.sqrt(var)
+    share = sum(float(c.value) ** 2 for c in used if c.relative) / var if var > 0 else 0.0
     if len(used) == 1 and not lines:
-        return Uncertainty(total, used[0].source)
+        return Uncertainty(total, used[0].source, share)
     shown = [f"{c.source} = {c.value:.3g}" for c in used]
     basis = f"{term} = quadrature sum of: " + "; ".join(shown)
     if lines:
         basis += " | " + "; ".join(lines)
-    return Uncertainty(total, basis)
+    return Uncertainty(total, basis, share)

@@ -122,6 +122,16 @@ class Comparison:
         """``"12 criteria: 3 pass, 1 fail, ..."``."""
         return vd.summary_line(self.states)
 
+    def resolution(self) -> str:
+        """``"this comparison detects maximum wear depth errors outside −24 %…+40 %; ..."``:
+        the resolution of every decided V&V 20 criterion ('' when none is decided)."""
+        decided = self.states.isin([vd.PASS, vd.FAIL])
+        rows = self.decisions[decided & (self.decisions.resolution.astype(str) != "")]
+        parts = [
+            f"{r.quantity}: {str(r.resolution).removeprefix('detects ')}" for r in rows.itertuples()
+        ]
+        return "this comparison detects " + "; ".join(parts) if parts else ""
+
     def value(self, quantity: str, metric: str) -> float:
         """One number of the metrics table."""
         rows = self.metrics[(self.metrics.quantity == quantity) & (self.metrics.metric == metric)]

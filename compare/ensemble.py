@@ -246,7 +246,7 @@ def spread(
         Square root of the summed variances; not assessed when an ensemble has fewer than two
         finished runs.
     """
-    var = 0.0
+    var = var_rel = 0.0
     parts = []
     for label, values, cycles in per_ensemble:
         v = np.asarray(values, dtype=float)
@@ -276,6 +276,7 @@ def spread(
             if mean == 0:
                 return unknown(f"{label}: zero mean at {cycles:g} cycles, cannot be scaled")
             sd = sd / abs(mean) * abs(s)
+            var_rel += sd**2
             note += (
                 f", run for {cycles:g} cycles: relative spread {sd / abs(s):.3g} applied to the "
                 f"compared value at {compared_cycles:g} cycles"
@@ -283,5 +284,7 @@ def spread(
         var += sd**2
         parts.append(note)
     return Uncertainty(
-        float(np.sqrt(var)), "ensemble (V&V 20 input uncertainty): " + "; ".join(parts)
+        float(np.sqrt(var)),
+        "ensemble (V&V 20 input uncertainty): " + "; ".join(parts),
+        var_rel / var if var > 0 else 0.0,
     )

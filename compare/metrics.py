@@ -36,6 +36,7 @@ __all__ = [
     "area_validation_metric",
     "VV20",
     "vv20",
+    "detectable_error",
     "wrap_angle_deg",
     "max_location",
     "worn_volume",
@@ -132,6 +133,20 @@ DEFINITIONS: dict[str, tuple[str, str, str]] = {
         "same",
     ),
     "U_val": ("expanded validation uncertainty", "U_val = k u_val (ASME V&V 20)", "same"),
+    "detectable_error_low": (
+        "smallest detectable under-prediction",
+        "the relative error (S - D) / |D| < 0 at which |E| = U_val, with the budget's parts that "
+        "are applied relative to S scaled to S = D (1 + error): a model that under-predicts by "
+        "less passes; -inf = no under-prediction down to S = 0 is detectable (resolution)",
+        "1",
+    ),
+    "detectable_error_high": (
+        "smallest detectable over-prediction",
+        "the relative error (S - D) / |D| > 0 at which |E| = U_val, scaled as for "
+        "detectable_error_low: a model that over-predicts by less passes; inf = no "
+        "over-prediction is detectable (resolution)",
+        "1",
+    ),
 }
 
 
@@ -340,6 +355,63 @@ def vv20(
         big_u,
         bool(abs(e) <= big_u),
     )
+
+
+def detectable_error(
+    d: float, s: float, *, u_fixed: float, u_relative: float, k: float
+) -> tuple[float, float]:
+    """The resolution of a V&V 20 criterion: the relative errors at which ``|E| = U_val``.
+
+    The budget is ``u_val(S')**2 = u_fixed**2 + (b |S'|)**2`` with ``b = u_relative / |S|``:
+    the part ``u_relative`` of the compared budget is applied relative to the simulated value
+    ``s`` (a user-stated ``rel·|S|``, a relative verification u_num), so a model predicting
+    ``S' = D (1 + e)`` carries ``b |D (1 + e)|``; the rest (``u_D``, an ensemble's spread, the
+    simulation's own ``_u``) is fixed. With ``alpha = k u_fixed / |D|`` and ``beta = k b``,
+    ``|E| = U_val`` is ``e**2 = alpha**2 + beta**2 (1 + e)**2``, a quadratic in ``e``.
+
+    Parameters
+    ----------
+    d, s : float
+        Measured and simulated value [units of the quantity].
+    u_fixed, u_relative : float
+        The fixed and the relative-to-S parts of u_val at ``s`` (standard uncertainties,
+        ``u_val**2 = u_fixed**2 + u_relative**2``) [units of the quantity].
+    k : float
+        Coverage factor [1].
+
+    Returns
+    -------
+    (float, float)
+        ``(low, high)`` relative errors ``(S' - D) / |D|`` [1]: errors in ``(low, high)`` pass,
+        errors outside fail. ``low`` is ``-inf`` when no under-prediction down to ``S' = 0`` is
+        detectable, ``high`` ``inf`` when no over-prediction is (``beta >= 1``); NaN when
+        ``d`` is 0 or a value is not finite.
+
+    Examples
+    --------
+    A fixed budget is symmetric, ``±k u_val / |D|``:
+
+    >>> [round(e, 4) for e in detectable_error(10.0, 10.0, u_fixed=1.0, u_relative=0.0, k=2.0)]
+    [-0.2, 0.2]
+
+    u_input = 20 % of S: over-predictions carry more uncertainty, the band is asymmetric:
+
+    >>> [round(e, 4) for e in detectable_error(10.0, 10.0, u_fixed=0.0, u_relative=2.0, k=2.0)]
+    [-0.2857, 0.6667]
+    """
+    values = (d, s, u_fixed, u_relative, k)
+    if not all(np.isfinite(v) for v in values) or d == 0:
+        return float("nan"), float("nan")
+    alpha = k * u_fixed / abs(d)
+    beta = k * u_relative / abs(s) if s != 0 else 0.0
+    # (1 - beta^2) e^2 - 2 beta^2 e - (alpha^2 + beta^2) = 0
+    roots = np.roots([1.0 - beta**2, -2.0 * beta**2, -(alpha**2 + beta**2)])
+    real = [float(r.real) for r in np.atleast_1d(roots) if abs(r.imag) <= 1e-12 * (1 + abs(r))]
+    low = max((r for r in real if -1.0 <= r < 0.0), default=-math.inf)
+    high = min((r for r in real if r > 0.0), default=math.inf)
+    if alpha == 0 and beta == 0:
+        low = high = 0.0
+    return low, high
 
 
 def wrap_angle_deg(angle_deg: float | np.ndarray) -> float | np.ndarray:

@@ -51,6 +51,8 @@ def card_lines(c: Comparison) -> list[str]:
         )
         if row.reason:
             out.append(f"{'':<{width}}    why: {row.reason}")
+        if row.resolution and row.state in (vd.PASS, vd.FAIL):
+            out.append(f"{'':<{width}}    resolution: {row.resolution}")
     return out
 
 
@@ -71,7 +73,7 @@ def alignment_lines(c: Comparison) -> list[str]:
 
 def outcome_lines(c: Comparison) -> list[str]:
     """The summary line and, when something is undecided, what and why in one line each."""
-    lines = [c.summary()]
+    lines = [c.summary(), *([c.resolution()] if c.resolution() else [])]
     na, nc = c.quantities(vd.NOT_ASSESSED), c.quantities(vd.NOT_COMPARABLE)
     if na:
         lines.append(

@@ -113,6 +113,7 @@ def circular_discrepancy(s: float, d: float, max_error_deg: float) -> Discrepanc
             f"|E| = {abs(e):.1f} degree, U_val = {res.U_val:.1f} degree ({shown})"
         ),
         criterion_note=", E wrapped to (-180, 180] degree",
+        relative=False,
     )
 
 
@@ -293,7 +294,9 @@ def _u_num(
         return Uncertainty(g.u_num_rel * abs(g.values[0]), "verification: " + g.describe())
     if criteria.wear_u_num_rel is not None and not angle:
         rel = criteria.wear_u_num_rel
-        return Uncertainty(rel * abs(s), f"user-stated {rel:.3g}·|S| (criteria wear_u_num_rel)")
+        return Uncertainty(
+            rel * abs(s), f"user-stated {rel:.3g}·|S| (criteria wear_u_num_rel)", 1.0
+        )
     if skipped:
         return skipped[0]
     return unknown(
@@ -337,7 +340,9 @@ def _u_input(
         return spread(parts, s, compared_cycles=None if angle else cycles)
     if criteria.wear_u_input_rel is not None and not angle:
         rel = criteria.wear_u_input_rel
-        return Uncertainty(rel * abs(s), f"user-stated {rel:.3g}·|S| (criteria wear_u_input_rel)")
+        return Uncertainty(
+            rel * abs(s), f"user-stated {rel:.3g}·|S| (criteria wear_u_input_rel)", 1.0
+        )
     return unknown(
         "no ensemble that keeps its wear maps (--ensemble from jointwear sim sweep with maps)"
         + ("" if angle else " and the criteria state no wear_u_input_rel")

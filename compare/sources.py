@@ -101,7 +101,7 @@ class Sources:
         rel = getattr(self.criteria, f"{family}_u_num_rel")
         if rel is not None:
             return Uncertainty(
-                rel * abs(s), f"user-stated {rel:.3g}·|S| (criteria {family}_u_num_rel)"
+                rel * abs(s), f"user-stated {rel:.3g}·|S| (criteria {family}_u_num_rel)", 1.0
             )
         if comps:
             return combine("u_num", comps)
@@ -120,7 +120,9 @@ class Sources:
         covers = frozenset({f"refinement of {g.refined}"} | g.covers)
         if not g.assessed:
             return Component(None, f"verification study: {g.reason}", covers)
-        return Component(g.u_num_rel * abs(s), "verification: " + g.describe(), covers)
+        return Component(
+            g.u_num_rel * abs(s), "verification: " + g.describe(), covers, relative=True
+        )
 
     def u_input(self, quantity: str, s: float, family: str) -> Uncertainty:
         """Input standard uncertainty of a simulated value ``s``."""
@@ -148,7 +150,7 @@ class Sources:
         rel = getattr(self.criteria, f"{family}_u_input_rel")
         if rel is not None:
             return Uncertainty(
-                rel * abs(s), f"user-stated {rel:.3g}·|S| (criteria {family}_u_input_rel)"
+                rel * abs(s), f"user-stated {rel:.3g}·|S| (criteria {family}_u_input_rel)", 1.0
             )
         if self.ensemble is not None:
             return unknown(

@@ -72,6 +72,7 @@ def to_dataset(c: Comparison) -> xr.Dataset:
                 "basis": row.basis,
                 "reason": row.reason,
                 "key": row.key,
+                "resolution": row.resolution,
                 "flag_values": vd.FLAG_VALUES,
                 "flag_meanings": vd.FLAG_MEANINGS,
             },
@@ -97,6 +98,7 @@ def to_dataset(c: Comparison) -> xr.Dataset:
             "n_not_assessed": n[vd.NOT_ASSESSED],
             "n_not_comparable": n[vd.NOT_COMPARABLE],
             "verdict_summary": c.summary(),
+            "resolution_summary": c.resolution(),
             "notes": "\n".join(c.notes),
             "partial": "\n".join(c.partial),
             "criteria": json_dumps(c.criteria),
@@ -149,6 +151,7 @@ def load_comparison(source: str | Path | xr.Dataset) -> Comparison:
                     "reason": var.attrs.get("reason", ""),
                     "passed": state == vd.PASS,
                     "key": var.attrs.get("key", var.attrs.get("quantity", str(name))),
+                    "resolution": var.attrs.get("resolution", ""),
                 }
             )
     wear_dims = ({"z", "theta"}, {"z_sim", "theta_sim"}, {"run", "z", "theta"})

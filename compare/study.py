@@ -151,4 +151,4 @@ def study_component(res: StudyResult, s: float, compared_cycles: float | None) -
             f"; run for {res.cycles:g} cycles: relative u_num {u / abs(s):.3g} applied to the "
             f"compared value at {compared_cycles:g} cycles"
         )
-    return Component(u, note, covers)
+    return Component(u, note, covers, relative=not same)
