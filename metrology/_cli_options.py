@@ -199,6 +199,14 @@ MinFormNm = Annotated[
         f"Smallest plausible peak-to-valley of deviations [nm] ({_LIM['min_form'] * 1e9:g}).",
     ),
 ]
+FormFraction = Annotated[
+    float | None,
+    _opt(
+        "--form-fraction",
+        "Largest plausible peak-to-valley of deviations relative to the header's nominal "
+        f"radius (default {_LIM['form_fraction']:g}).",
+    ),
+]
 
 
 # --- assess ---------------------------------------------------------------------------------

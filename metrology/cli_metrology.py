@@ -78,6 +78,7 @@ def import_cmd(
     max_deviation_mm: opt.MaxDeviationMm = None,
     nominal_tolerance: opt.NominalTolerance = None,
     min_form_nm: opt.MinFormNm = None,
+    form_fraction: opt.FormFraction = None,
 ) -> None:
     """Import roundness/cylindricity text exports into contract netCDF files."""
     from jointwear.metrology.readers.importing import import_scans
@@ -106,6 +107,7 @@ def import_cmd(
         max_deviation=_si(max_deviation_mm, 1e-3),
         nominal_tolerance=nominal_tolerance,
         min_form=_si(min_form_nm, 1e-9),
+        form_fraction=form_fraction,
     )
     if instrument is not None:
         options["instrument"] = instrument

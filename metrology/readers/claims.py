@@ -7,7 +7,8 @@ overridable):
 
 * the length unit against the magnitude of the values: a radius must make a bore of plausible
   size (``radius_min`` .. ``radius_max``), a deviation must stay within a gauge's range
-  (``max_deviation``) and within ``deviation_fraction`` of a stated nominal radius;
+  (``max_deviation``) and within ``deviation_fraction`` of a stated nominal radius, and their
+  form (peak-to-valley) within ``form_fraction`` (1 %) of a stated nominal radius;
 * the nominal radius against the measured radius (``nominal_tolerance``);
 * the points per revolution against the rows of a layer and its angular step;
 * a stated Gaussian filter against the spectrum (a profile filtered at k_c UPR holds almost
@@ -254,6 +255,8 @@ def check_magnitude(
             _unit_fixes(stated_by_file, larger),
             "if the trace really is that flat, lower the limit with min_form=<m>",
         )
+    if nominal is not None:
+        _check_form(v, f, unit, unit_source, stated_by_file, nominal, limits, where)
     if dmax > limit:
         smaller = [
             u for u in ("mm", "um") if unit_factor(u) < f and dmax / f * unit_factor(u) <= limit
@@ -265,6 +268,41 @@ def check_magnitude(
             "if the deviations really are that large, raise the limit with max_deviation=<m> "
             "(or pass value='radius' if the column holds radii)",
         )
+
+
+def _check_form(
+    v: np.ndarray,
+    f: float,
+    unit: str,
+    unit_source: str,
+    stated_by_file: bool,
+    nominal: tuple[str, float],
+    limits: dict[str, float],
+    where: str,
+) -> None:
+    """Refuse deviations whose form (peak-to-valley of the 0.5-99.5 % range) exceeds
+    ``form_fraction`` (1 %) of the stated radius: a precision bore's form is far smaller (a
+    sub-micrometre form written in um under ``Units: mm`` reads 1000 x too large)."""
+    lo, hi = np.percentile(v, [0.5, 99.5])
+    form = float(hi - lo) * f
+    limit = limits["form_fraction"] * nominal[1]
+    if form <= limit:
+        return
+    others = [
+        u for u in ("um", "mm", "inch") if unit_factor(u) < f and form / f * unit_factor(u) <= limit
+    ][:1]
+    written = form / f
+    sym = {"um": "µm", "inch": "in"}
+    readings = "".join(f"; read in {u} it is {written:.4g} {sym.get(u, u)}" for u in others)
+    raise _wrong_deviation_unit(
+        f"{where}: the values are read in {unit!r} ({unit_source}) as radial deviations with "
+        f"a form (peak-to-valley) of {written:.4g} {sym.get(unit, unit)}, "
+        f"{form / nominal[1]:.2%} of the header's nominal radius {_fmt(nominal[1])} "
+        f"({nominal[0]}), where a precision bore's form stays below "
+        f"{limits['form_fraction']:.0%} of its radius (form_fraction){readings}",
+        _unit_fixes(stated_by_file, others),
+        "if the form really is that large, raise the limit with form_fraction=<value>",
+    )
 
 
 def _unit_fixes(stated_by_file: bool, units: list[str]) -> list[tuple[dict, str]]:

@@ -107,6 +107,7 @@ def read_scan(
     max_deviation: float | None = None,
     nominal_tolerance: float | None = None,
     min_form: float | None = None,
+    form_fraction: float | None = None,
 ) -> xr.Dataset:
     """Read a roundness / cylindricity scan from text exports into a contract Dataset.
 
@@ -154,11 +155,12 @@ def read_scan(
         ``points``, ``filter``, ``layers``, ``z_extent``, ``layer_spacing``, ``z``); recorded.
     z_source : str
         Where z comes from (:data:`~jointwear.metrology.choices.Z_SOURCES`; ``auto``: the one there is).
-    radius_range, max_deviation, nominal_tolerance, min_form : optional
+    radius_range, max_deviation, nominal_tolerance, min_form, form_fraction : optional
         Plausibility limits of the header cross-checks (:data:`~jointwear.metrology.choices.PLAUSIBILITY`): bore
         radius (min, max) [m] (0.5 mm to 2 m), largest |radial deviation| [m] (1 mm), relative
         tolerance against a stated nominal radius (0.05), smallest peak-to-valley of a
-        deviation trace [m] (10 nm).
+        deviation trace [m] (10 nm), largest peak-to-valley of deviations relative to the
+        stated nominal radius (0.01).
 
     Returns
     -------
@@ -193,7 +195,7 @@ def read_scan(
         thousands,
     )
     files, folder = _collect_files(paths, pattern)
-    limits = _limits(radius_range, max_deviation, nominal_tolerance, min_form)
+    limits = _limits(radius_range, max_deviation, nominal_tolerance, min_form, form_fraction)
     parsed = [pf for f in files for pf in parse_blocks(f, base)]
     layers, metadata, notes = _read_layers(
         parsed, len(files), expected_points, allow_partial, value, angle_unit, arc, limits
@@ -240,7 +242,9 @@ def _checked(convention, value: str, layout: str) -> AngleConvention:
     return conv
 
 
-def _limits(radius_range, max_deviation, nominal_tolerance, min_form) -> dict[str, float]:
+def _limits(
+    radius_range, max_deviation, nominal_tolerance, min_form, form_fraction
+) -> dict[str, float]:
     """The plausibility limits with the options given."""
     rmin, rmax = (None, None) if radius_range is None else radius_range
     return plausibility(
@@ -249,6 +253,7 @@ def _limits(radius_range, max_deviation, nominal_tolerance, min_form) -> dict[st
         max_deviation=max_deviation,
         nominal_tolerance=nominal_tolerance,
         min_form=min_form,
+        form_fraction=form_fraction,
     )
 
 

@@ -4,6 +4,8 @@ three decimals (the commonest export there is) used to read 1000 x wrong with ex
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 
@@ -163,3 +165,53 @@ def test_comma_thousands_in_a_comma_csv_is_not_read_as_two_layers(tmp_path):
     )
     with pytest.raises(BadInputError):
         read_scan(f, convention=CONV)
+
+
+# --- issue 38 item 2: a unit claim against the form the numbers make on the stated radius ----
+
+
+def _small_form(tmp_path, unit_line, nominal_line, form=0.625):
+    """A deviation trace of peak-to-valley ``form`` as written (in the file's unit)."""
+    n = 720
+    th = np.arange(n) * 0.5
+    dev = 0.5 * form * np.cos(2 * np.radians(th))
+    f = tmp_path / "small.txt"
+    f.write_text(
+        f"{unit_line}\n{nominal_line}\nAngle (deg)\tDeviation\n"
+        + "".join(f"{a:.1f}\t{v:.4f}\n" for a, v in zip(th, dev, strict=True))
+    )
+    return f, dev
+
+
+def test_a_sub_um_form_under_a_mm_header_is_refused_naming_both_readings(tmp_path, run_import):
+    f, dev = _small_form(tmp_path, "Units: mm", "Nominal diameter: 25 mm")
+    with pytest.raises(BadInputError) as exc:
+        read_scan(f, convention=CONV)
+    msg = str(exc.value)
+    assert re.search(r"form \(peak-to-valley\) of 0\.6\d* mm.*read in um it is 0\.6\d* µm", msg)
+    assert "form_fraction" in msg
+    assert "12.5 mm" in msg
+    assert exc.value.suggestions == ({"ignore_header": ("units",), "units": "um"},)
+    ds = read_scan(f, convention=CONV, **exc.value.suggestions[0])
+    np.testing.assert_allclose(ds["radial_deviation"].values[0], np.round(dev, 4) * 1e-6)
+    # the command line names the flags, and they run as printed
+    out = tmp_path / "o.nc"
+    assert run_import(f, out) == 3
+    assert run_import(f, out, "--ignore-header", "units", "--units", "um") == 0
+
+
+def test_a_form_within_one_percent_of_the_radius_passes(tmp_path):
+    # 0.1 mm form on a 12.5 mm radius (0.8 %): a plausible worn bore in mm
+    f, dev = _small_form(tmp_path, "Units: mm", "Nominal radius: 12.5 mm", form=0.1)
+    ds = read_scan(f, convention=CONV)
+    np.testing.assert_allclose(ds["radial_deviation"].values[0], np.round(dev, 4) * 1e-3)
+    # the same in um with the nominal stated is of course fine
+    g, dev = _small_form(tmp_path, "Units: um", "Nominal radius: 12.5 mm")
+    ds = read_scan(g, convention=CONV)
+    np.testing.assert_allclose(ds["radial_deviation"].values[0], np.round(dev, 4) * 1e-6)
+    # 0.2 mm (1.6 %) is refused, and form_fraction widens the rule
+    h, dev = _small_form(tmp_path, "Units: mm", "Nominal radius: 12.5 mm", form=0.2)
+    with pytest.raises(BadInputError, match="form_fraction"):
+        read_scan(h, convention=CONV)
+    ds = read_scan(h, convention=CONV, form_fraction=0.02)
+    np.testing.assert_allclose(ds["radial_deviation"].values[0], np.round(dev, 4) * 1e-3)
