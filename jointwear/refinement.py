@@ -797,4 +797,7 @@ def describe_study(study: xr.Dataset) -> str:
             f"refinement {float(row['u_refinement']):.2g}, grid {float(row['u_grid']):.2g}; "
             f"{row['branch'].values})"
         )
+    if "run_warnings_summary" in study.attrs:  # the runs' own warnings and what they mean
+        lines.append(f"run warnings: {study.attrs['run_warnings_summary']}")
+        lines.append(f"  for u_num: {study.attrs['run_warnings_verdict']}")
     return "\n".join(lines)

@@ -43,6 +43,16 @@ def verify(
             f"default the {DEFAULT_PARAMETER_SET} set.",
         ),
     ] = None,
+    seed: Annotated[
+        int | None,
+        typer.Option(
+            "--seed",
+            min=0,
+            help="Draw the replicates' start phases from this seed (default: phases 0, 1, "
+            "2, ... cycles, or the spec's phases); a second seed measures how much u_num "
+            "depends on them.",
+        ),
+    ] = None,
     workers: Workers = None,
     scheduler: Scheduler = None,
     resume: Resume = False,
@@ -85,6 +95,7 @@ def verify(
             params,
             cycles=cycles,
             spec=spec,
+            seed=seed,
             workers=workers,
             scheduler=scheduler,
             band=band,

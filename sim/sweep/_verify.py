@@ -32,6 +32,7 @@ import xarray as xr
 
 from jointwear.errors import BadInputError, ParameterError
 from jointwear.sim.sweep._verify_spec import VerifySpec
+from jointwear.sim.sweep._verify_warnings import KINDS, warning_variables
 
 __all__ = [
     "VerifySpec",
@@ -62,6 +63,8 @@ _KEYS = {
     "grid": "refinement factor of the next grid (n_layers and n_points times it), >= 2",
     "grid_replicates": "runs at the next grid (default: replicates)",
     "formal_order": "formal order of the ΔN update (1: explicit Euler)",
+    "phases": "start phase of each replicate [cycles] (default 0, 1, 2, ...)",
+    "seed": "draw the replicates' start phases from this seed instead",
 }
 
 
@@ -115,13 +118,14 @@ def _run_table(spec: VerifySpec, sim: Any, wear: Any) -> tuple[np.ndarray, list[
     """Values of every run (rows, :data:`_COLUMNS`) and its place (kind, level, replicate)."""
     nl, nd = sim.joint.n_layers, sim.joint.n_points
     s0 = float(wear.initial_settle_cycles)
+    phase = spec.start_phases()
     rows, where = [], []
     for i, dn in enumerate(spec.levels):
         for r in range(spec.replicates):
-            rows.append((dn, s0 + r, nl, nd))
+            rows.append((dn, s0 + phase[r], nl, nd))
             where.append(("level", i, r))
     for r in range(spec.grid_replicates):
-        rows.append((spec.levels[0], s0 + r, nl * spec.grid, nd * spec.grid))
+        rows.append((spec.levels[0], s0 + phase[r], nl * spec.grid, nd * spec.grid))
         where.append(("grid", 0, r))
     return np.asarray(rows, dtype=float), where
 
@@ -177,6 +181,7 @@ def verify_wear(
     levels: Sequence[int] | None = None,
     replicates: int | None = None,
     grid: int | None = None,
+    seed: int | None = None,
     band: tuple[float, float] | None = None,
     wear: Any = None,
     workers: int | None = None,
@@ -197,6 +202,9 @@ def verify_wear(
         The study (``[verify]`` table, docs/sim-wear.md); default :meth:`VerifySpec.default`.
     levels, replicates, grid : optional
         Override the spec's ΔN levels [cycles], replicates per level, grid refinement factor.
+    seed : int, optional
+        Draw the replicates' start phases from this seed (overrides the spec's ``phases`` and
+        ``seed``; :class:`VerifySpec`).
     band : (z_min, z_max), optional
         Axial band [m] whose maximum depth, volume and cylindricity are added as quantities
         (:func:`study_dataset`).
@@ -245,6 +253,8 @@ def verify_wear(
         for k, v in (("levels", levels), ("replicates", replicates), ("grid", grid))
         if v is not None
     }
+    if seed is not None:
+        changes.update(seed=seed, phases=None)
     if replicates is not None and "grid_replicates" not in changes:
         changes["grid_replicates"] = replicates
     if changes:
@@ -496,6 +506,14 @@ def study_dataset(
     ds["run_error"] = xr.Variable(
         "run", errors.astype(str), {"units": "1", "long_name": "error of a failed run"}
     )
+    ds = ds.assign_coords(
+        warning_kind=xr.Variable(
+            "warning_kind", np.array(KINDS), {"units": "1", "long_name": "kind of run warning"}
+        )
+    )
+    warn_vars, warn_attrs = warning_variables(where, results, spec)
+    for name, (dims, arr, attrs) in warn_vars.items():
+        ds[name] = xr.Variable(dims, arr, attrs)
     ds.attrs.update(
         {
             "title": "jointwear verification study: u_num from replicates, ΔN levels and a grid run",
@@ -514,6 +532,7 @@ def study_dataset(
             "n_ok": int(np.sum(status == 0)),
             "n_failed": int(np.sum(status == 1)),
             "n_not_run": int(np.sum(status == 2)),
+            **warn_attrs,
             "method": "Eça & Hoekstra (2014) least squares on replicate means "
             "(jointwear.refinement); grid term: Roache two-grid, Fs = 3, assumed order 1; "
             f"u_refinement = U_phi / {COVERAGE_K:g}",

@@ -6,6 +6,8 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import math
+import random
 from dataclasses import dataclass
 from typing import Any
 
@@ -45,6 +47,14 @@ class VerifySpec:
         Runs at the next grid, at the finest ΔN.
     formal_order : float
         Formal order of the update in ΔN (explicit Euler: 1).
+    phases : tuple of float, optional
+        Start phase of each replicate [crank cycles]: added to ``wear.initial_settle_cycles``,
+        so replicate ``r`` starts measuring that much later in the motion; one per replicate
+        (the grid runs take the first ``grid_replicates``). Default ``(0, 1, 2, ...)``.
+    seed : int, optional
+        Draw the phases instead, uniformly in ``[0, n)`` cycles (``n`` = the larger of
+        ``replicates`` and ``grid_replicates``), from this seed: a second study with another
+        seed measures how much u_num depends on the phases. Not with ``phases``.
     """
 
     cycles: float
@@ -53,6 +63,8 @@ class VerifySpec:
     grid: int = DEFAULT_GRID_FACTOR
     grid_replicates: int = DEFAULT_REPLICATES
     formal_order: float = 1.0
+    phases: tuple[float, ...] | None = None
+    seed: int | None = None
 
     def __post_init__(self) -> None:
         c = self.cycles
@@ -82,6 +94,43 @@ class VerifySpec:
         fo = self.formal_order
         if isinstance(fo, bool) or not isinstance(fo, (int, float)) or not fo > 0:
             raise ParameterError(f"formal_order must be > 0, got {fo!r}")
+        object.__setattr__(self, "phases", self._checked_phases())
+
+    def _checked_phases(self) -> tuple[float, ...] | None:
+        """``phases`` as floats, checked against the replicates and ``seed``."""
+        if self.seed is not None:
+            _whole(self.seed, "seed", 0)
+            if self.phases is not None:
+                raise ParameterError(
+                    "give either phases (the start phases themselves) or seed (draw them), not both"
+                )
+        if self.phases is None:
+            return None
+        try:
+            phases = tuple(float(p) for p in self.phases)
+        except (TypeError, ValueError):
+            raise ParameterError(
+                f"phases = {self.phases!r}: expected a list of start phases [cycles]"
+            ) from None
+        need = max(self.replicates, self.grid_replicates)
+        if len(phases) < need:
+            raise ParameterError(
+                f"phases = {list(phases)}: {need} replicates need {need} start phases, one each"
+            )
+        if any(not math.isfinite(p) or p < 0 for p in phases):
+            raise ParameterError(f"phases = {list(phases)}: every phase must be >= 0 [cycles]")
+        return phases
+
+    def start_phases(self) -> tuple[float, ...]:
+        """The start phase of every replicate [crank cycles] (``phases``, drawn from ``seed``,
+        or ``0, 1, 2, ...``), as many as the larger of ``replicates`` and ``grid_replicates``."""
+        n = max(self.replicates, self.grid_replicates)
+        if self.phases is not None:
+            return self.phases[:n]
+        if self.seed is None:
+            return tuple(float(r) for r in range(n))
+        draw = random.Random(self.seed)
+        return tuple(round(draw.uniform(0.0, n), 6) for _ in range(n))
 
     @classmethod
     def default(cls, cycles: float, **changes: Any) -> VerifySpec:
@@ -93,7 +142,10 @@ class VerifySpec:
 
     def describe(self) -> dict[str, Any]:
         """JSON-ready record (provenance, digest)."""
-        return json.loads(json.dumps(dataclasses.asdict(self)))
+        record = dataclasses.asdict(self)
+        if self.phases is None and self.seed is None:  # the record of studies before phases
+            del record["phases"], record["seed"]
+        return json.loads(json.dumps(record))
 
 
 def _whole(v: Any, name: str, lo: int) -> int:

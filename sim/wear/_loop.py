@@ -32,8 +32,11 @@ The next interval is ``dN * 0.9 tol_eff / eta`` (at most doubled, at least 0.2x)
 run always finishes; its accuracy (expanded, k = 2) is reported per point (``wear_depth_u``), for
 the maximum depth and the volume, and ``accuracy_status`` says whether ``tol`` could be held.
 ``scheme="schedule"`` replays a list of intervals (:func:`halved_schedule` for convergence
-checks). Accepted updates that changed the rate field by more than
-:data:`UNRESOLVED_RATE_CHANGE` set the ``convergence_warning`` attribute.
+checks). Accepted updates whose rate-field change exceeds both :data:`UNRESOLVED_RATE_CHANGE`
+(noise removed) and the detection limit of the run's own rate noise set the
+``convergence_warning`` attribute (:func:`unresolved_updates`); the fixed and schedule schemes,
+which measure one cycle per update, measure that noise with one more cycle on the final
+profile (:meth:`WearRun.step`).
 
 kw
 --
@@ -84,8 +87,9 @@ __all__ = [
 
 _log = logging.getLogger("jointwear.sim.wear")
 
-#: Relative change of the wear-rate field over one accepted update above which the result is
-#: flagged as not converged in dN (``convergence_warning`` attribute).
+#: Relative change of the wear-rate field over one accepted update (its noise removed) above
+#: which the result is flagged as not converged in dN (``convergence_warning`` attribute), when
+#: the change also exceeds the detection limit of the run's rate noise (:func:`unresolved_updates`).
 UNRESOLVED_RATE_CHANGE: float = 0.5
 
 #: Columns of the update history.
@@ -172,6 +176,8 @@ class WearRun:
             "worst_detection": 0.0,
             "history": [],  # tuples, columns HISTORY
             "snapshots": [],  # (cycles, h, normal_work, depth_u, volume_u)
+            # single-cycle rate noise on the final profile (fixed/schedule schemes), NaN: not yet
+            "probe_noise": math.nan,
         }
         self._set_target(cycles, snapshots)
         if self.checkpoint is not None:
@@ -283,6 +289,8 @@ class WearRun:
             checkpoint=path,
             on_update=on_update,
         )
+        if isinstance(state, dict):  # checkpoints written before the noise probe existed
+            state.setdefault("probe_noise", math.nan)
         if not isinstance(state, dict) or set(state) != set(run._s):
             raise BadInputError(
                 f"checkpoint '{path}' does not hold a wear-run state this version understands; "
@@ -424,6 +432,10 @@ class WearRun:
             if dn < dn_wanted and nxt >= dn:  # clipped to a stop: do not lose the proposal
                 nxt = max(nxt, min(dn_wanted, st.dn_max))
             s["dn_next"] = nxt
+        if s["done"] >= self.target and not adaptive:
+            s["probe_noise"], n_probe, pen = self._probe_noise(h_new, new, state_new)
+            s["cycles_simulated"] += n_probe
+            s["max_penetration"] = _max_known(s["max_penetration"], pen)
         if s["done"] in self._stops:
             b: ctl.ErrorBudget = s["budget"]
             s["snapshots"] = [
@@ -434,6 +446,33 @@ class WearRun:
         self._save()
         self._notify(dn, eta, new.n, accepted=True)
         return s["done"] < self.target
+
+    def _probe_noise(
+        self, h: np.ndarray, last: ctl.RateSample, state: Any
+    ) -> tuple[float, float, float]:
+        """The single-cycle rate noise on the final profile (fixed and schedule schemes).
+
+        Those schemes measure one cycle per update, so a run knows nothing of its own
+        cycle-to-cycle variability; one more cycle on the final profile, continuing from
+        ``state`` (which is left as it was: the run's result and any continuation do not
+        change), paired with the last measured cycle, estimates it.
+
+        Returns (relative noise of one cycle's rate field [1], cycles simulated, largest
+        penetration [m]).
+        """
+        res: CycleWear = self.contact.run(h, cycles=1.0, state=state)
+        rate = self.settings.kw * np.asarray(res.wear_work, dtype=float) / res.cycles
+        pair = ctl.sample_rates(
+            [last.rate, rate], [last.work_rate, res.normal_work / res.cycles], self.grid.point_area
+        )
+        return pair.rel_noise, res.cycles, getattr(res, "max_penetration", math.nan)
+
+    def rate_noise(self) -> float:
+        """The run's relative single-cycle rate noise [1]: the adaptive scheme's last estimate,
+        or the fixed/schedule schemes' probe on the final profile (NaN: not measured yet)."""
+        if self.settings.scheme == "adaptive":
+            return self._sigma(self._s["noise_hist"])
+        return float(self._s.get("probe_noise", math.nan))
 
     def _save(self) -> None:
         if self.checkpoint is not None:
@@ -484,23 +523,39 @@ class WearRun:
     def convergence_warning(self) -> str | None:
         """A message if an accepted update changed the wear-rate field too much, else None.
 
-        A rate change beyond :data:`UNRESOLVED_RATE_CHANGE` (noise removed) means the update
-        interval was too large for the profile feedback: the explicit update overshoots and the
-        result is not converged in dN (the adaptive scheme rejects such updates).
+        A rate change beyond :data:`UNRESOLVED_RATE_CHANGE` (noise removed) that the run's
+        own rate noise cannot explain (:func:`unresolved_updates`) means the update interval
+        was too large for the profile feedback: the explicit update overshoots and the result
+        is not converged in dN (the adaptive scheme rejects such updates).
         """
         hist = self.history()
         acc = hist[hist[:, 3] == 1]
         if not len(acc):
             return None
-        eta = np.sqrt(np.maximum(acc[:, 2] ** 2 - acc[:, 5] ** 2, 0.0))
-        worst = int(np.argmax(eta))
-        if eta[worst] <= UNRESOLVED_RATE_CHANGE:
+        adaptive = self.settings.scheme == "adaptive"
+        sigma = self.rate_noise()
+        noise = (
+            acc[:, 5]
+            if adaptive
+            else np.full(len(acc), ctl.change_noise(sigma, 1, 1))  # one cycle per measurement
+        )
+        flagged, eta = unresolved_updates(acc[:, 2], noise)
+        if not flagged.any():
             return None
+        worst = int(np.argmax(np.where(flagged, eta, -1.0)))
+        if adaptive or np.isfinite(sigma):
+            known = (
+                f" (its rate noise alone explains changes up to {100 * ctl.DETECTION_SIGMAS * noise[worst]:.0f} %, "
+                f"from {100 * sigma:.0f} % per cycle)"
+            )
+        else:
+            known = " (the run's rate noise was not measured: the run did not finish)"
         return (
-            f"the wear-rate field changed by {100 * eta[worst]:.0f} % over the update of "
-            f"{int(acc[worst, 1])} cycles starting at {int(acc[worst, 0])} cycles: the update "
-            "interval is too large to resolve the profile feedback and the result is not "
-            "converged; use the adaptive scheme or a smaller dN"
+            f"the wear-rate field changed by {100 * acc[worst, 2]:.0f} % over the update of "
+            f"{int(acc[worst, 1])} cycles starting at {int(acc[worst, 0])} cycles{known}, in "
+            f"{int(flagged.sum())} of {len(acc)} updates: the update interval is too large to "
+            "resolve the profile feedback and the result is not converged; use the adaptive "
+            "scheme or a smaller dN"
         )
 
     def history(self) -> np.ndarray:
@@ -556,7 +611,7 @@ class WearRun:
             "cycles_target": self.target,
             "cycles_done": s["done"],
             "cycles_simulated": s["cycles_simulated"],
-            "rate_noise": self._sigma(s["noise_hist"]),
+            "rate_noise": self.rate_noise(),
             "status": "complete" if complete else "partial",
             "accuracy_status": status,
             "wear_note": "Archard dh = kw p ds per point; explicit cycle updates of dN cycles, "
@@ -579,6 +634,31 @@ def _max_known(a: float, b: float) -> float:
     if math.isnan(a) or math.isnan(b):
         return math.nan
     return max(a, b)
+
+
+def unresolved_updates(eta_raw: np.ndarray, noise: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Which updates' rate changes mean "not converged in dN", judged against their noise.
+
+    Parameters
+    ----------
+    eta_raw : ndarray
+        Measured relative change of the wear-rate field over each update [1].
+    noise : ndarray
+        Standard deviation of that change caused by the cycle-to-cycle noise alone [1]
+        (0: a deterministic contact model; NaN counts as 0).
+
+    Returns
+    -------
+    (flagged, eta_sys)
+        ``flagged``: the change exceeds the detection limit ``DETECTION_SIGMAS * noise`` (a
+        change within the noise is not non-convergence) and its systematic part
+        ``eta_sys = sqrt(eta_raw^2 - noise^2)`` exceeds :data:`UNRESOLVED_RATE_CHANGE`.
+    """
+    eta_raw = np.asarray(eta_raw, dtype=float)
+    noise = np.nan_to_num(np.asarray(noise, dtype=float), nan=0.0)
+    eta_sys = np.sqrt(np.maximum(eta_raw**2 - noise**2, 0.0))
+    flagged = (eta_sys > UNRESOLVED_RATE_CHANGE) & (eta_raw > ctl.DETECTION_SIGMAS * noise)
+    return flagged, eta_sys
 
 
 def _noise_limited(tol_eff: float, tol: float) -> bool:

@@ -27,13 +27,15 @@ SMALL = replace_nested(PARAMETER_SETS["zhang2023"], **{"joint.n_layers": 12, "jo
 class Manufactured:
     """An executor computing manufactured wear runs (exact answer known)."""
 
-    def __init__(self, seed: int, *, d0=20e-6, c_dn=2.0, noise=0.004):
+    def __init__(self, seed: int, *, d0=20e-6, c_dn=2.0, noise=0.004, warn=None):
         rng = np.random.default_rng(seed)
+        self.warn = warn  # (dn, settle) -> tuple of "kind: message", the runs' warnings
         self.seed, self.d0, self.c_dn, self.noise = seed, d0, c_dn, noise
         self.z0 = rng.uniform(-2e-3, 2e-3)
         self.th0 = rng.uniform(0, 360)
         self.wz, self.wth = 2.5e-3, 25.0  # bump widths [m], [deg]
         self.calls: list[int] = []
+        self.settles: list[float] = []
 
     @property
     def exact_volume(self) -> float:
@@ -64,7 +66,11 @@ class Manufactured:
             "max_wear_z": float(z[k[0]]),
         }
         self.calls.append(task.index)
-        return RunResult(task.index, "ok", out, {"wear_depth": h}, "", 0.0, "manufactured")
+        self.settles.append(wear.initial_settle_cycles)
+        warned = self.warn(wear.dn, wear.initial_settle_cycles) if self.warn else ()
+        return RunResult(
+            task.index, "ok", out, {"wear_depth": h}, "", 0.0, "manufactured", warnings=warned
+        )
 
     def __call__(self, tasks, *, workers, scheduler, on_result, on_lost, on_start):
         on_start("manufactured")
@@ -272,3 +278,105 @@ def test_report_figure_plots_the_study(manufactured):
     titles = [ax.get_title() for ax in fig.axes]
     assert any(t.startswith("max_wear_depth") for t in titles)
     assert any(t.startswith("worn_volume") for t in titles)
+
+
+CONV = (
+    "convergence_warning: the wear-rate field changed by 73 % over the update of 5000 cycles "
+    "starting at 0 cycles: ... not converged; use the adaptive scheme or a smaller dN"
+)
+
+
+def test_runs_warnings_are_in_the_file_the_summary_and_info(manufactured, tmp_path, capsys):
+    """Two of the finest level's runs and one grid run warn "not converged": the file holds each
+    run's warnings, the counts per level, the text once, and the verdict says u_num may
+    understate the error; the CLI output and ``jointwear info`` show it."""
+    from jointwear import io
+
+    manufactured(5, warn=lambda dn, settle: (CONV,) if dn == 100 and settle < 4 else ())
+    out = tmp_path / "study.nc"
+    assert main(["sim", "verify", "--cycles", "8000", "--out", str(out), "--workers", "0"]) == 0
+    text = capsys.readouterr().out
+    ds = io.load(out)
+    counts = ds["level_warning_count"].sel(warning_kind="convergence_warning").values
+    assert list(counts) == [2, 0, 0, 0]
+    assert int(ds["grid_warning_count"].sel(warning_kind="convergence_warning")) == 2
+    assert int(ds["level_warning_count"].sel(warning_kind="contact_validity_warning").sum()) == 0
+    warned = [w for w in ds["run_warnings"].values if w]
+    assert len(warned) == 4 and all("convergence_warning" in w for w in warned)
+    summary = ds.attrs["run_warnings_summary"]
+    assert "in 4 of 20 runs" in summary and "ΔN 100: 2 of 4" in summary
+    assert summary.count("changed by 73 %") == 1  # the text once
+    assert "may understate" in ds.attrs["run_warnings_verdict"]
+    for shown in (text, None):
+        if shown is None:
+            assert main(["info", str(out)]) == 0
+            shown = capsys.readouterr().out
+        assert "run warnings: convergence_warning in 4 of 20 runs" in shown
+        assert "for u_num: convergence_warning: the finest level" in shown
+
+
+def test_coarse_level_warnings_and_validity_are_interpreted(manufactured):
+    def warn(dn, settle):
+        if dn == 800:
+            return (CONV, "contact_validity_warning: penetration 0.3 of the clearance")
+        return ()
+
+    manufactured(6, warn=warn)
+    ds = verify_wear(SMALL, cycles=8000, workers=0)
+    verdict = ds.attrs["run_warnings_verdict"]
+    assert "coarser levels (ΔN = 800)" in verdict and "finest level is converged" in verdict
+    assert "model-form error is not in it" in verdict
+    manufactured(6)
+    quiet = verify_wear(SMALL, cycles=8000, workers=0)
+    assert quiet.attrs["run_warnings_summary"] == "none"
+    assert int(quiet["level_warning_count"].sum()) == 0
+
+
+def test_seed_draws_the_start_phases(manufactured, tmp_path):
+    m = manufactured(7)
+    verify_wear(SMALL, cycles=8000, workers=0)
+    base = sorted(set(m.settles))
+    assert base == [2.0, 3.0, 4.0, 5.0]  # wear.initial_settle_cycles 2 + (0, 1, 2, 3)
+    m = manufactured(7)
+    ds = verify_wear(SMALL, cycles=8000, workers=0, seed=11)
+    drawn = sorted(set(m.settles))
+    assert len(drawn) == 4 and drawn != base
+    assert all(2.0 <= s < 6.0 for s in drawn)
+    assert sorted(ds["initial_settle_cycles"].values) == drawn
+    assert json_spec(ds)["seed"] == 11
+    m = manufactured(7)
+    verify_wear(SMALL, cycles=8000, workers=0, seed=11)
+    assert sorted(set(m.settles)) == drawn  # the same seed, the same phases
+    m = manufactured(7)
+    spec = VerifySpec.default(8000, phases=(0.25, 0.5, 1.5, 3.0))
+    verify_wear(SMALL, spec=spec, workers=0)
+    assert sorted(set(m.settles)) == [2.25, 2.5, 3.5, 5.0]
+
+
+def json_spec(ds):
+    import json
+
+    return json.loads(ds.attrs["study_spec"])
+
+
+@pytest.mark.parametrize(
+    ("table", "match"),
+    [
+        ({"verify": {"cycles": 1000, "phases": [0, 1]}}, "4 replicates need 4 start phases"),
+        ({"verify": {"cycles": 1000, "phases": [0, 1, -1, 2]}}, "must be >= 0"),
+        ({"verify": {"cycles": 1000, "phases": [0, 1, 2, 3], "seed": 1}}, "not both"),
+        ({"verify": {"cycles": 1000, "seed": -1}}, "seed must be >= 0"),
+    ],
+)
+def test_phase_refusals(table, match):
+    with pytest.raises(ParameterError, match=match):
+        read_verify_spec(table, cycles=None)
+
+
+def test_cli_seed(manufactured, tmp_path, capsys):
+    m = manufactured(8)
+    out = tmp_path / "s.nc"
+    args = ["sim", "verify", "--cycles", "8000", "--out", str(out), "--workers", "0"]
+    assert main([*args, "--seed", "3"]) == 0
+    assert len(set(m.settles)) == 4 and sorted(set(m.settles)) != [2.0, 3.0, 4.0, 5.0]
+    assert main([*args, "--seed", "-2", "--overwrite"]) == 2
