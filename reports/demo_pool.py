@@ -20,6 +20,8 @@ from collections.abc import Callable, Iterator
 from concurrent.futures import Executor, Future, ProcessPoolExecutor
 from typing import Any
 
+from jointwear._worker_threads import limit_worker_threads, numba_threads_launched
+
 __all__ = ["InlineExecutor", "MAX_WORKERS", "available_cores", "run_part", "worker_pool"]
 
 #: At most this many worker processes (each holds a simulation's memory, a few hundred MB).
@@ -47,14 +49,12 @@ def available_cores() -> int:
 
 
 def _init_worker() -> None:
-    """One thread per worker process for BLAS (one part or run per core); Ctrl-C is the demo
+    """One thread per worker process for numba and BLAS (one part or run per core); Ctrl-C is the demo
     process's to handle (it stops the workers), and SIGTERM ends a worker at once (the
     command line's handler, inherited by a fork, would turn it into an exception)."""
     import signal
 
-    from jointwear.sim.sweep._exec import WORKER_ENV
-
-    os.environ.update(WORKER_ENV)
+    limit_worker_threads()  # numba's API where numba is imported (a fork), else the environment
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
 
@@ -81,7 +81,12 @@ def worker_pool(workers: int, cpu: list[float] | None = None) -> Iterator[Execut
         return
     # fork only a process with one thread (a fork copies no other thread, whatever lock it
     # held); otherwise the workers start afresh and import what they need
-    fork = "fork" in multiprocessing.get_all_start_methods() and threading.active_count() == 1
+    # (numba's thread pool is a thread too: a process that started it is not forked)
+    fork = (
+        "fork" in multiprocessing.get_all_start_methods()
+        and threading.active_count() == 1
+        and not numba_threads_launched()
+    )
     context = multiprocessing.get_context("fork" if fork else "spawn")
     pool = ProcessPoolExecutor(workers, mp_context=context, initializer=_init_worker)
     try:

@@ -17,20 +17,13 @@ from concurrent import futures as cf
 from typing import Any
 
 from jointwear._dask import connect_scheduler
+from jointwear._worker_threads import WORKER_ENV
 from jointwear.sim.sweep._run import RunResult, RunTask, evaluate_run
 
 __all__ = ["execute", "WORKER_ENV", "LOOPBACK"]
 
 #: Address every socket of a local cluster listens on (no other machine can reach it).
 LOOPBACK = "127.0.0.1"
-
-#: Environment of local workers: one thread each for numba and BLAS (one run per core).
-WORKER_ENV = {
-    "NUMBA_NUM_THREADS": "1",
-    "OMP_NUM_THREADS": "1",
-    "OPENBLAS_NUM_THREADS": "1",
-    "MKL_NUM_THREADS": "1",
-}
 
 
 def _serial(tasks: Sequence[RunTask], on_result: Callable[[RunResult], None]) -> str:

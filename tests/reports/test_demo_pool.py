@@ -170,3 +170,81 @@ def test_a_cancelled_compared_run_cancels_the_wear_part():
     assert not first.done() and not pool.wear.done()
     assert held[0].cancel()  # the demo is stopped: its pool cancels the queued task
     assert first.cancelled() and pool.wear.cancelled()
+
+
+#: A parent that compiled a kernel (and later started numba's threads) opens the demo's pool;
+#: each worker starts numba's threads as the DIC does and compiles a kernel of its own.
+_POOL_AFTER_COMPILE = """
+import os
+
+
+def part():
+    import numba
+
+    first = numba.get_num_threads()
+    numba.set_num_threads(numba.config.NUMBA_NUM_THREADS)  # as dic's set_threads does
+
+    @numba.njit
+    def twice(x):
+        return 2 * x
+
+    return first, numba.config.NUMBA_NUM_THREADS, twice(21), os.environ["NUMBA_NUM_THREADS"]
+
+
+if __name__ == "__main__":
+    import numba
+
+    from jointwear.reports.demo_pool import worker_pool
+
+    @numba.njit
+    def one(x):
+        return x + 1
+
+    one(1)  # a compile in the parent before the pool
+    for _ in range(2):
+        with worker_pool(2) as pool:
+            got = [pool.submit(part).result() for _ in range(3)]
+            print(pool._mp_context.get_start_method(), *got[0])
+        numba.get_num_threads()  # the parent's numba threads run: the next pool is spawned
+"""
+
+
+def test_a_pool_opened_after_a_compile_compiles_in_its_workers(tmp_path):
+    """The race of #37: a forked worker used to set NUMBA_NUM_THREADS=1 under the numba it
+    inherited (2 threads); the next compile after its threads started raised RuntimeError."""
+    import subprocess
+    import sys
+
+    script = tmp_path / "pool_after_compile.py"
+    script.write_text(_POOL_AFTER_COMPILE)
+    env = {**os.environ, "NUMBA_NUM_THREADS": "2", "NUMBA_CACHE_DIR": str(tmp_path / "cache")}
+    run = subprocess.run(
+        [sys.executable, str(script)], env=env, capture_output=True, text=True, timeout=300
+    )
+    assert run.returncode == 0, run.stderr[-2000:]
+    forked, spawned = (line.split() for line in run.stdout.splitlines())
+    # forked: numba's API set one thread; the environment keeps the value numba read
+    assert forked == ["fork", "1", "2", "42", "2"]
+    # spawned: the environment said one thread before the worker imported numba
+    assert spawned == ["spawn", "1", "1", "42", "1"]
+
+
+@pytest.mark.slow
+def test_the_demo_runs_its_pool_on_an_empty_kernel_cache(tmp_path):
+    """The README's first command on a fresh install: every kernel compiled for first use, in
+    the parent and in two forked workers (the quick size, so that CI can afford it)."""
+    import subprocess
+    import sys
+
+    env = {**os.environ, "NUMBA_NUM_THREADS": "2", "NUMBA_CACHE_DIR": str(tmp_path / "cache")}
+    code = (
+        "import sys\nfrom jointwear.reports.demo import run_demo\n"
+        f"run_demo({str(tmp_path / 'demo')!r}, quick=True, workers=2)\n"
+    )
+    run = subprocess.run(
+        [sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=900
+    )
+    assert run.returncode == 0, run.stderr[-3000:]
+    assert "[1/2] simulating and measuring in 2 worker processes" in run.stderr
+    assert any((tmp_path / "cache").rglob("*.nbi"))  # the kernels were compiled, not loaded
+    assert (tmp_path / "demo" / "report.html").is_file()
