@@ -31,8 +31,11 @@ oscillate with refinement - the RMS of a motion with impacts, over solver tolera
 uncertainty that covers the scatter (the data-range branch, ``Fs = 3``) instead of none. The
 GCI's refusals stand for three solutions, which cannot tell scatter from a trend.
 
-The GCI is an expanded (about 95 %) uncertainty; ASME V&V 20 (section 2-4) takes the standard
-numerical uncertainty as ``u_num = GCI / 1.15``. Two solutions cannot show that the sequence
+The GCI is an expanded (about 95 %) uncertainty; it is converted to the standard numerical
+uncertainty by the project's one rule for such bounds, ``u_num = GCI / 2``
+(:data:`jointwear.refinement.COVERAGE_K`, k = 2 of the GUM for about 95 %; the same factor as
+Eça & Hoekstra's ``U_phi``, so three and four levels of the same data agree; ASME V&V 20's
+alternative GCI / 1.15 is not used, see there). Two solutions cannot show that the sequence
 converges and an oscillating or diverging one has no order: those are *not assessed*, with the
 reason, never a number.
 
@@ -59,6 +62,7 @@ import numpy as np
 import xarray as xr
 
 from jointwear.errors import BadInputError
+from jointwear.refinement import COVERAGE_K
 
 __all__ = [
     "GCI",
@@ -69,8 +73,8 @@ __all__ = [
     "refinement_study",
 ]
 
-#: V&V 20: standard numerical uncertainty = GCI / 1.15 (GCI with Fs = 1.25 taken as a 95 % bound)
-GCI_TO_STANDARD = 1.15
+#: standard numerical uncertainty = GCI / GCI_TO_STANDARD: the one rule for a ~95 % bound
+GCI_TO_STANDARD = COVERAGE_K
 
 
 @dataclass(frozen=True)
@@ -106,7 +110,8 @@ class GCI:
     gci_fine : float
         Relative GCI of the finest solution [1] (NaN when not assessed).
     u_num_rel : float
-        Relative standard numerical uncertainty ``GCI / 1.15`` [1] (NaN when not assessed).
+        Relative standard numerical uncertainty ``GCI / 2`` (:data:`GCI_TO_STANDARD`) [1]
+        (NaN when not assessed).
     safety_factor : float
         ``Fs`` used.
     """

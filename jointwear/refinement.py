@@ -33,7 +33,8 @@ step by step in their Appendix A), for ``n_g >= 4`` levels sorted finest first:
    ``U_phi = 3 U_s / Delta_phi (eps + U_s + |phi_1 - phi_fit(h_1)|)``.
 
 ``U_phi`` is meant to bound the error with about 95 % coverage; the standard uncertainty of the
-refinement is ``u_refinement = U_phi / 2`` (k = 2). The statistical part is the standard error of
+refinement is ``u_refinement = U_phi / 2`` (k = 2, :data:`COVERAGE_K`: the project's one rule for
+every numerical-uncertainty bound, also the GCI of :mod:`jointwear.compare.verification`). The statistical part is the standard error of
 the finest level's mean, ``u_stat = s_1``; a grid term ``u_grid`` is added by the caller (a run at
 the next grid, :func:`study_uncertainty`) and ``u_num^2 = u_stat^2 + u_refinement^2 + u_grid^2``
 (k = 1). Identical solutions at every level mean that the refinement parameter is inert (it does
@@ -72,7 +73,13 @@ __all__ = [
     "P_HIGH_FACTOR",
 ]
 
-#: Coverage factor of Eça & Hoekstra's U_phi (about 95 %): u_refinement = U_phi / COVERAGE_K.
+#: The one rule converting a numerical-uncertainty *bound* to a standard uncertainty: a bound
+#: meant to cover the error with about 95 % (Eça & Hoekstra's U_phi, Roache's GCI with its Fs,
+#: the two-grid term) is an expanded uncertainty with k = 2 (JCGM 100:2008, the GUM, 6.3.3 and
+#: G.1.3: about 95 % for a normal distribution; Eça & Hoekstra 2014 build U_phi as such a 95 %
+#: bound, as Roache's GCI). ASME V&V 20-2009 2-4.1 also offers GCI / 1.15 for Fs = 1.25; it is
+#: not used: two factors for the same bound made four levels (U_phi / 2) give a u_num 1.74x
+#: smaller than three (GCI / 1.15) of the same data, and it says nothing for Fs = 3.
 COVERAGE_K = 2.0
 #: Lower bound of a credible observed order (Eça & Hoekstra 2014, sec. 4).
 P_LOW = 0.5

@@ -138,6 +138,7 @@ def _context(c: Comparison, page: _Page) -> dict[str, Any]:
         "card_class": verdict_class,
         "verdict": verdict,
         "summary": c.summary(),
+        "resolution": c.resolution(),
         "n_passed": n_pass,
         "n_decisions": n,
         "failed": list(dict.fromkeys(c.failed())),

@@ -110,7 +110,7 @@ def test_gci_order_capped_at_formal_order_and_safety_factor():
     # the case: changes of 1 % and 0.01 % (p ~ 6.6) no longer give u_num ~ 1e-6
     steep = gci(h, [1.01, 1.0001, 1.0])
     assert steep.order > 6 and steep.safety_factor == 3.0
-    assert steep.u_num_rel == pytest.approx(3.0 * 1e-4 / 1.0 / 1.15, rel=1e-6)
+    assert steep.u_num_rel == pytest.approx(3.0 * 1e-4 / 1.0 / 2.0, rel=1e-6)
     # p = 0.3 < 0.5: not credible -> Fs = 3 with the observed (lower) order
     f = 1 + 0.1 * h**0.3
     low = gci(h, f)

@@ -28,7 +28,26 @@ def test_gci_recovers_order_and_extrapolated_value():
     assert g.extrapolated == pytest.approx(10.0, rel=1e-12)
     e_a = 0.9 / 10.3
     assert g.gci_fine == pytest.approx(1.25 * e_a / 3.0, rel=1e-12)
-    assert g.u_num_rel == pytest.approx(g.gci_fine / 1.15)
+    assert g.u_num_rel == pytest.approx(g.gci_fine / 2)
+
+
+def test_one_rule_for_a_numerical_uncertainty_bound():
+    """GCI and Eça & Hoekstra's U_phi are both ~95 % bounds: one k (= 2) converts both, so three
+    and four levels of the same exactly first-order data give the same u_num (they differed by
+    2 / 1.15 = 1.74x when the GCI was divided by 1.15 and U_phi by 2)."""
+    from jointwear.compare.verification import GCI_TO_STANDARD, refinement_study
+    from jointwear.refinement import COVERAGE_K
+
+    assert GCI_TO_STANDARD == COVERAGE_K == 2.0
+    h = np.array([1.0, 2.0, 4.0, 8.0])
+    f = 1.0 + 0.1 * h
+    three = refinement_study(h[:3], f[:3], quantity="q")
+    four = refinement_study(h, f, quantity="q")
+    assert type(three).__name__ == "GCI" and type(four).__name__ == "LeastSquaresStudy"
+    # by hand: e_a = 0.1 / 1.1, p = 1, Fs = 1.25: GCI = 1.25 e_a, u_num = GCI / 2
+    assert three.u_num_rel == pytest.approx(1.25 * 0.1 / 1.1 / 2, rel=1e-9)
+    assert four.u_num_rel == pytest.approx(three.u_num_rel, rel=1e-6)
+    assert "GCI/2" in three.describe()
 
 
 def test_gci_non_constant_ratio():
