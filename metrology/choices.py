@@ -53,7 +53,8 @@ PLAUSIBILITY: dict[str, float] = {
     "form_fraction": 0.01,  # deviation peak-to-valley (0.5-99.5 %) at most 1 % of the radius
     "spacing_tolerance": 0.01,  # relative: stated layer spacing vs the layers found
     "points_tolerance": 0.01,  # relative: stated angular step vs the step of the angles
-    "filter_ratio": 0.1,  # high-band / mid-band amplitude above which a filter claim is false
+    "filter_energy": 1e-4,  # energy above 3 k_c / energy of harmonics >= 2 (a Gaussian k_c
+    # filter leaves 2^-18 = 3.8e-6 of what was there), beyond the export's rounding floor
 }
 
 #: Unworn reference shapes of :func:`~jointwear.metrology.wear_map`, and its default.

@@ -521,3 +521,44 @@ def test_cli_speaks_the_suggested_flags_and_they_work(tmp_path, capsys):
     assert main(["metrology", "import", str(f), "--out", str(out), *conv, *flags]) == 0
     ds = io.load(out)
     np.testing.assert_allclose(ds["radius"].values[0], np.round(r_mm, 7) * 1e-3, rtol=1e-12)
+
+
+def _trace(rng, n, rich):
+    """A deviation trace [um]: smooth (form to 12 UPR) or rich (harmonics to n/2, 1/k
+    amplitudes, and 20 nm probe noise)."""
+    ks = np.arange(2, 13) if not rich else np.arange(2, n // 2)
+    amp = rng.uniform(0.05, 1.0, ks.size) / (1 if not rich else np.sqrt(ks))
+    spec = np.zeros(n // 2 + 1, complex)
+    spec[ks] = amp * np.exp(1j * rng.uniform(0, 2 * np.pi, ks.size)) * n / 2
+    v = np.fft.irfft(spec, n)
+    return v + (0.02 * rng.standard_normal(n) if rich else 0.0)
+
+
+@pytest.mark.parametrize("seed", range(2))
+def test_truly_filtered_traces_are_never_refused_and_unfiltered_rich_ones_are(tmp_path, seed):
+    """Issue 38: two medians of |rfft| that were both the rounding floor refused a smooth,
+    truly filtered trace ("0.84 x above 150 UPR"). 52 generated filtered traces (smooth and
+    rich, cut-offs 15-500 UPR, 1-6 decimals written) all pass; every unfiltered rich one is
+    refused."""
+    from jointwear.metrology.filters import filter_profile
+
+    rng = np.random.default_rng(seed)
+    refused = 0
+    for i in range(26):
+        n = int(rng.choice([3600, 7200]))
+        kc = float(rng.choice([15, 50, 150, 500] if n > 4000 else [15, 50, 150]))
+        rich = bool(i % 2)
+        raw = _trace(rng, n, rich)
+        decimals = int(rng.integers(1, 7))
+        th = np.arange(n) * 360.0 / n
+        head = f"Units: um\nFilter: Gaussian {kc:g} UPR\nAngle (deg)\tDeviation\n"
+        filt = filter_profile(raw * 1e-6, kc) * 1e6
+        g = _write(tmp_path / f"f{i}.txt", _rows(th, filt, fv=f"{{:.{decimals}f}}"), head)
+        ds = read_scan(g, convention=CONV)  # a truly filtered trace: never refused
+        assert "consistent" in ds.attrs["reader_guesses"][g.name]["filter"]
+        if rich and decimals >= 3:  # written finely enough to show the unfiltered band
+            f = _write(tmp_path / f"r{i}.txt", _rows(th, raw, fv=f"{{:.{decimals}f}}"), head)
+            with pytest.raises(Refusal, match="not filtered as stated"):
+                read_scan(f, convention=CONV)
+            refused += 1
+    assert refused >= 3
