@@ -56,13 +56,34 @@ class FlagReport:
         )
 
 
+def _values(ds: xr.Dataset | Record, name: str, k: int | None, where: np.ndarray) -> np.ndarray:
+    """The ``where`` points' values of variable ``name`` in image ``k``."""
+    values = ds[name].values if k is None or "time" not in ds[name].dims else ds[name].values[k]
+    return np.asarray(values, float).reshape(where.shape)[where]
+
+
 def _median(ds: xr.Dataset | Record, name: str, k: int | None, where: np.ndarray) -> float | None:
     if name not in ds:
         return None
-    values = ds[name].values if k is None or "time" not in ds[name].dims else ds[name].values[k]
-    values = np.asarray(values, float).reshape(where.shape)[where]
+    values = _values(ds, name, k, where)
     values = values[np.isfinite(values)]
     return float(np.median(values)) if values.size else None
+
+
+def _ran_out(ds: xr.Dataset | Record, k: int | None, where: np.ndarray) -> str | None:
+    """'the iterations ran out ...' when most of the ``where`` points stopped at the limit."""
+    limit = ds.attrs.get("dic_max_iterations")
+    if limit is None or "iterations" not in ds:
+        return None
+    it = _values(ds, "iterations", k, where)
+    stopped = int((it >= int(limit)).sum())
+    if stopped <= it.size / 2:
+        return None
+    return (
+        f"the iterations ran out: {stopped} of these {it.size} points stopped at "
+        f"--max-iterations {int(limit)} before the update fell below --tolerance; raise "
+        "--max-iterations (or give better guesses: --seed, a smaller motion between images)"
+    )
 
 
 def _hint(meaning: str, ds: xr.Dataset | Record, k: int | None, where: np.ndarray) -> str:
@@ -90,6 +111,8 @@ def _hint(meaning: str, ds: xr.Dataset | Record, k: int | None, where: np.ndarra
             "or, for a sequence, an incremental reference helps; lower --zncc-min only for a "
             "pattern known to be poor"
         )
+    if meaning == "not_converged" and (ran_out := _ran_out(ds, k, where)):
+        return ran_out
     if meaning in ("not_converged", "not_reached", "diverged"):
         return (
             "the motion was not found from the guesses: it may exceed --search-radius, or the "

@@ -67,11 +67,15 @@ def _summary(ds, out: Path, elapsed: float, plot: Path | None, mode, update_zncc
     """The command's report line; ``ds`` a Dataset or a Record (read through ``.values``)."""
     import numpy as np
 
-    ok = ds["flag"].values == 0
-    zncc = ds["zncc"].values[ok]
-    zncc = zncc[np.isfinite(zncc)]
-    median = float(np.median(zncc)) if zncc.size else float("nan")
-    msg = f"{out}: {ok.sum()}/{ok.size} points ok, median ZNCC {median:.4f}, {elapsed:.2f} s"
+    flag, zncc = ds["flag"].values, ds["zncc"].values
+    later = ""
+    if "time" in ds["flag"].dims:  # a sequence: the reference frame matches itself (ZNCC 1)
+        flag, zncc = flag[1:], zncc[1:]
+        later = f" in the {len(flag)} later frame{'s' if len(flag) > 1 else ''}"
+    ok = flag == 0
+    zncc = zncc[ok & np.isfinite(zncc)]
+    median = f"{np.median(zncc):.4f}" if zncc.size else "- (no point ok)"
+    msg = f"{out}: {ok.sum()}/{ok.size} points ok{later}, median ZNCC {median}, {elapsed:.2f} s"
     if plot is not None:
         msg += f"; figure {plot}"
     if mode == "incremental":

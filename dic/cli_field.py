@@ -38,6 +38,14 @@ def _refuse_misapplied(p: dict) -> None:
         )
     if p["points"] is not None and p["roi"] is not None:
         raise typer.BadParameter("give either --points or --roi, not both")
+    entries = [*(p["images"] or ()), *(p["left"] or ()), *(p["right"] or ())]
+    if len(entries) > 1 + stereo and all(Path(e).is_file() for e in entries):
+        opt.refuse_given(
+            ((p["fps"], "--fps"),),
+            "a filmed sequence (a folder, quoted pattern or video), not to still images given "
+            "one by one (their time axis is the image index); omit --fps, or give the frames "
+            "as a folder or quoted pattern",
+        )
     if p["points"] is not None and p["strain_window"]:
         raise typer.BadParameter(
             "--strain-window: scattered --points have no grid to fit strain over; drop "

@@ -94,6 +94,15 @@ def _frames(source, what: str) -> tuple[list[np.ndarray], list[str]]:
     return frames, [str(k) for k in range(len(frames))]
 
 
+def _median_or(values: np.ndarray, default: float) -> float:
+    """Median of the latest frame's finite ``values`` (T, N) that has any, else ``default``."""
+    for row in values[::-1]:
+        finite = row[np.isfinite(row)]
+        if finite.size:
+            return float(np.median(finite))
+    return default
+
+
 def _track(corr, img, guess, search_centre=(0.0, 0.0)):
     """Match ``img`` from per-point guesses; where points fail (a region moved or lies at a
     depth the guesses do not reach), search afresh from seeds and keep, point by point, the
@@ -186,10 +195,7 @@ def _match_images(corr, L, Rr, calibration, centres, epipolar_max_px=1.0):
                 )  # fmt: skip
             else:
                 g = np.where(np.isfinite(PR[k - 1]).all(axis=1)[:, None], PR[k - 1], np.nan)
-                centre = (
-                    float(np.nanmedian(PR[k - 1, :, 0])),
-                    float(np.nanmedian(PR[k - 1, :, 6])),
-                )
+                centre = (_median_or(PR[:k, :, 0], 0.0), _median_or(PR[:k, :, 6], 0.0))
                 res = _track(corr, Rr[k], g, centre)
             PR[k], SR[k], Z[k, 1], F[k, 1] = res.params, res.sigma, res.zncc, res.flag
     ok_img = F == _flags.FLAG_OK
@@ -342,6 +348,7 @@ def measure_field(
             "dic_subset_size_pixel": int(cp.subset_size),
             "dic_step_pixel": int(cp.step) if points is None else "points given",
             "dic_zncc_min": float(cp.zncc_min),
+            "dic_max_iterations": int(cp.max_iterations),
             "dic_shape_function": "affine",
             "dic_interpolation": f"{cp.interpolation} B-spline (prefiltered)",
             "dic_criterion": "ZNSSD (IC-GN), image gradients by central differences",
@@ -536,7 +543,7 @@ def _field_dataset(m: _Matches, flag, lr, calibration, prm: FieldParams, cp, wit
     c = m.grid.centres
     sub_x, sub_y = m.subset_centres()
     Z = m.Z
-    zncc = np.nanmin(np.where(np.isfinite(Z), Z, np.nan), axis=1) if m.stereo else Z[:, 0]
+    zncc = np.fmin.reduce(np.where(np.isfinite(Z), Z, np.nan), axis=1) if m.stereo else Z[:, 0]
     coords = _coordinates(m, with_grid)
     data: dict[str, xr.DataArray] = {}
     attrs: dict = {}

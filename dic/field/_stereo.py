@@ -80,6 +80,16 @@ def _point_cov(calibration, X, sl, sr):
 MISFIT_FACTOR = 2.0
 
 
+#: the gate a refusal suggests keeps this share [%] of the reference pair's points
+RECOVER_PERCENTILE = 95
+
+
+def _round_up(value: float) -> float:
+    """``value`` rounded up to two significant digits (a gate that keeps what it measured)."""
+    digits = 1 - int(np.floor(np.log10(value)))
+    return float(np.ceil(value * 10.0**digits) / 10.0**digits)
+
+
 def check_calibration_fits(calibration, uv_left, uv_right, ok, epipolar_max_px) -> dict:
     """Measure how well the calibration fits the reference pair's matches, once, up front.
 
@@ -100,6 +110,7 @@ def check_calibration_fits(calibration, uv_left, uv_right, ok, epipolar_max_px) 
     med_epi, med_rep = float(np.nanmedian(np.abs(epi))), float(np.nanmedian(rep))
     if med_rep > MISFIT_FACTOR * epipolar_max_px:
         share = float(np.mean(rep > epipolar_max_px))
+        keeps = _round_up(float(np.nanpercentile(rep, RECOVER_PERCENTILE)))
         raise BadInputError(
             f"the calibration ({calibration.source}) does not fit these images: over the "
             f"{int(ok.sum())} points matched in the reference pair, median epipolar error "
@@ -107,8 +118,10 @@ def check_calibration_fits(calibration, uv_left, uv_right, ok, epipolar_max_px) 
             f"against epipolar_max_px={epipolar_max_px:g} (CLI --epipolar-max, pixel, RMS "
             f"reprojection): {share:.0%} of the points would be flagged epipolar_mismatch. "
             "Use the calibration of these cameras and check which images are the left and "
-            "which the right camera's; only for a calibration known to be coarse raise the "
-            f"gate above {med_rep:.2f} pixel (the positions then carry that misfit)"
+            "which the right camera's; only for a calibration known to be coarse, "
+            f"--epipolar-max {keeps:g} keeps {RECOVER_PERCENTILE}% of these points (the "
+            f"{RECOVER_PERCENTILE}th percentile of their residual; the positions then carry "
+            "that misfit)"
         )
     return {"dic_median_epipolar_error_pixel": med_epi, "dic_median_reprojection_pixel": med_rep}
 

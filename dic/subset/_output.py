@@ -140,6 +140,7 @@ def result_record(
         "dic_shape_function": params.shape,
         "dic_interpolation": f"{params.interpolation} B-spline (prefiltered)",
         "dic_tolerance_pixel": float(params.tolerance),
+        "dic_max_iterations": int(params.max_iterations),
         "dic_zncc_min": float(params.zncc_min),
         "displacement_convention": (
             "Lagrangian: the subset centred at (x, y) of the reference moved by (u, v); x to "

@@ -192,6 +192,8 @@ def pair(tmp_path_factory):
         # stereo options on a 2D field
         ("field", ["--frame", "plane"], "--frame"),
         ("field", ["--epipolar-max", "2"], "--epipolar-max"),
+        # a frame rate on still images given one by one
+        ("field", ["--fps", "10"], "--fps"),
     ],
 )
 def test_flags_that_cannot_apply_to_the_input_are_usage_errors(pair, command, extra, named, capsys):

@@ -119,6 +119,9 @@ def test_cli_2d_field_with_a_frame_rate_and_a_mask(affine, tmp_path):
     cv2.imwrite(str(tmp_path / "mask.png"), mask)
     out = tmp_path / "f.nc"
     args = ["dic", "field", *names, "--roi", str(tmp_path / "mask.png"), "--subset", "21"]
+    assert main([*args, "--step", "10", "--fps", "50", "--out", str(out)]) == 2  # stills
+    # the refusal's fix: the frames as a quoted pattern take a frame rate
+    args[2 : 2 + len(names)] = [str(tmp_path / "img_*.png")]
     assert main([*args, "--step", "10", "--fps", "50", "--out", str(out)]) == 0
     ds = io.load(out)
     np.testing.assert_allclose(ds.time.values, [0, 0.02, 0.04])

@@ -5,6 +5,7 @@ point exits 1 unless --allow-empty; a mostly flagged image names its dominant fl
 from __future__ import annotations
 
 import cv2
+import numpy as np
 import pytest
 
 from jointwear import io
@@ -65,6 +66,20 @@ def test_the_fix_the_refusal_names_reads_the_input_or_says_so(rig, capsys):
     assert 2.0 < ds.attrs["dic_median_reprojection_pixel"] < 4.0
 
 
+def test_the_gate_the_refusal_names_keeps_the_points_run_as_printed(rig, capsys):
+    """The suggested --epipolar-max is measured on the images (95th percentile of the residual),
+    not the median (which by construction leaves half the points flagged)."""
+    tmp, roi = rig
+    assert main(_field(tmp, roi, "off.nc")) == 3
+    err = " ".join(capsys.readouterr().err.split())
+    value = err.split("--epipolar-max ")[-1].split(" ")[0]
+    median = float(err.split("median RMS reprojection residual ")[1].split(" pixel")[0])
+    assert float(value) > median
+    assert main(_field(tmp, roi, "off.nc", "--epipolar-max", value)) == 0
+    ok = io.load(tmp / "f.nc").flag.values[0] == 0
+    assert ok.mean() >= 0.9
+
+
 def _unrelated_pair(tmp):
     a = sp.speckle_sequence((120, 140), [None], seed=1)[0]
     b = sp.speckle_sequence((120, 140), [None], seed=2)[0]
@@ -94,3 +109,23 @@ def test_correlate_says_why_most_points_failed(tmp_path, capsys):
     code = main([*args, "--out", str(tmp_path / "c.nc")])
     err = capsys.readouterr().err
     assert code == 1 and "no valid point" in err and "mostly" in err
+
+
+def test_a_starved_run_counts_later_frames_only_and_names_max_iterations(tmp_path, capsys):
+    """Two iterations cannot reach a 3.4-pixel shift: the summary counts only the later frames
+    (the reference matches itself at ZNCC 1) and the warning names --max-iterations."""
+    frames = sp.speckle_sequence(
+        (200, 200), [None, sp.RigidField((3.4, -2.3)), sp.RigidField((6.7, -4.6))], seed=3
+    )
+    for k, f in enumerate(frames):
+        cv2.imwrite(str(tmp_path / f"f_{k}.png"), f)
+    args = ["dic", "correlate", str(tmp_path / "f_*.png"), "--out", str(tmp_path / "s.nc")]
+    code = main([*args, "--max-iterations", "2"])
+    out, err = capsys.readouterr()
+    assert code == 1
+    assert "0/512 points ok in the 2 later frames" in out and "1.0000" not in out
+    assert "ran out" in err and "--max-iterations 2" in err and "raise --max-iterations" in err
+    assert main([*args, "--overwrite"]) == 0  # the default limit, as the fix says
+    ds = io.load(tmp_path / "s.nc")
+    assert (ds.flag.values[1:] == 0).mean() > 0.9
+    assert np.nanmax(np.abs(ds.u.values[2] - 6.7)) < 0.05

@@ -214,3 +214,35 @@ def test_subsets_straddling_a_depth_step_are_flagged_left_right_inconsistent():
     loose = sc.measure(pairs, subset_size=25, step=12, strain_window=0, consistency_max_px=1e9)
     Q = loose.position.values[loose.flag.values[0] == 0]
     assert np.abs(Q[:, 2] - step(Q[:, 0], Q[:, 1])).max() > 100e-6  # what the flag prevents
+
+
+def test_points_beyond_the_specimen_leak_no_numpy_warning(scene, tmp_path, capsys):
+    """A ROI reaching past the specimen: points that fail in both cameras (no ZNCC at all)
+    are flagged without numpy's 'All-NaN slice encountered' on stderr."""
+    import warnings
+
+    import cv2
+
+    from jointwear.cli import main
+
+    sc, pairs, _ = scene
+    for k, (lft, rgt) in enumerate(pairs[:2]):
+        cv2.imwrite(str(tmp_path / f"s_{k}_0.png"), lft)
+        cv2.imwrite(str(tmp_path / f"s_{k}_1.png"), rgt)
+    sc.calibration.save(tmp_path / "cal.nc")
+    x0, y0, x1, y1 = sc.roi_left()
+    h, w = pairs[0][0].shape
+    roi = f"{max(x0 - 80, 0):.0f},{max(y0 - 80, 0):.0f},{min(x1 + 80, w):.0f},{min(y1 + 80, h):.0f}"
+    args = ["dic", "field", "--left", str(tmp_path / "s_*_0.png"), "--right"]
+    args += [str(tmp_path / "s_*_1.png"), "--calibration", str(tmp_path / "cal.nc")]
+    args += ["--roi", roi, "--subset", "25", "--step", "24", "--out", str(tmp_path / "f.nc")]
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        assert main([*args, "--allow-empty"]) == 0
+    assert not [str(c.message) for c in caught]
+    assert "Warning" not in capsys.readouterr().err
+    from jointwear import io
+
+    ds = io.load(tmp_path / "f.nc")
+    both = np.isnan(ds.zncc.values[1])
+    assert both.any() and (ds.flag.values[1][both] != 0).all()
