@@ -17,14 +17,13 @@ import xarray as xr
 from jointwear import conventions
 from jointwear.params import to_jsonable
 from jointwear.sim.kernels import _layout as kn
+from jointwear.sim.mechanisms import mechanism_of
 from jointwear.sim.parameters import SimParameters
-from jointwear.sim.slider_crank import SliderCrankParameters
 from jointwear.sim.wearmap import layer_positions
 
 __all__ = [
     "AXIS",
     "CONTACT_MODES",
-    "is_slider_crank",
     "variable",
     "vector",
     "body_motion",
@@ -48,11 +47,6 @@ CONTACT_MODES: dict[int, str] = {
     kn.MODE_AXIAL_RADIAL: "axial_and_radial",
     kn.MODE_IDEAL: "ideal_joint",
 }
-
-
-def is_slider_crank(params: SimParameters) -> bool:
-    """Whether ``params`` describe the slider-crank (``mechanism.kind``)."""
-    return isinstance(params.mechanism, SliderCrankParameters)
 
 
 def variable(dims: str | tuple[str, ...], values: np.ndarray, units: str, long_name: str, **attrs):
@@ -168,9 +162,9 @@ def dataset(
     ``t_rel`` is the time since the start of the run [s], which began at ``t0`` [s] of
     simulated time.
     """
-    slider = is_slider_crank(params)
+    mech = mechanism_of(params)
     data = dict(mechanism_variables)
-    data.update(joint_variables(diag, "B" if slider and _crank_rod(params) else "C"))
+    data.update(joint_variables(diag, mech.joint(params)))
     time = xr.DataArray(
         t_rel,
         dims="time",
@@ -187,8 +181,7 @@ def dataset(
         {k: xr.Variable(d, np.asarray(val), attrs=a) for k, (d, val, a) in data.items()},
         coords={"time": time, "axis": axis_c},
     )
-    mech = "slider-crank" if slider else "four-bar"
-    ds.attrs["title"] = f"jointwear {mech} simulation with a 3D revolute clearance joint"
+    ds.attrs["title"] = f"jointwear {mech.title} simulation with a 3D revolute clearance joint"
     ds.attrs["data_origin"] = "simulated"
     ds.attrs["source"] = "jointwear (sim.dynamics)"
     ds.attrs["parameter_set"] = params.name
@@ -202,15 +195,9 @@ def dataset(
     ds.attrs["impact_latch"] = params.contact.impact_latch
     ds.attrs["contact_stiffness_model"] = params.contact.stiffness
     ds.attrs["bearing_on"] = params.mechanism.bearing_on
-    if slider:
-        ds.attrs["clearance_at"] = params.mechanism.clearance_at
-        ds.attrs["planar"] = int(params.mechanism.planar)
+    ds.attrs.update(mech.attrs(params))
     ds.attrs["parameters_json"] = json.dumps(to_jsonable(params))
     return ds
-
-
-def _crank_rod(params: SimParameters) -> bool:
-    return params.mechanism.clearance_at == "crank_rod"
 
 
 def layers(params: SimParameters) -> tuple[np.ndarray, np.ndarray]:

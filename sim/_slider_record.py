@@ -37,7 +37,6 @@ def pack_mechanism(params: SimParameters, P: np.ndarray, IP: np.ndarray) -> None
     P[kn.GRAV] = m.gravity
     P[kn.JOFF] = m.joint_offset
     P[kn.OMEGA] = m.crank_speed
-    IP[kn.MECH] = kn.MECH_SLIDER_CRANK
     IP[kn.DRIVER] = 1
     IP[ks.SC_CASE] = 1 if m.clearance_at == "crank_rod" else 0
     IP[ks.SC_BEARING_ROD] = 1 if m.bearing_on == "rod" else 0

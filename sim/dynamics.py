@@ -19,12 +19,12 @@ import xarray as xr
 
 from jointwear import conventions
 from jointwear.errors import BadInputError, ParameterError, SimulationError
-from jointwear.sim import _four_bar_record, _slider_record
-from jointwear.sim._record import CONTACT_MODES, add_maps, dataset, is_slider_crank
+from jointwear.sim._record import CONTACT_MODES, add_maps, dataset
 from jointwear.sim._record import layers as _layers
 from jointwear.sim.contact import contact_constant
 from jointwear.sim.kernels import _layout as kn
 from jointwear.sim.kernels._integrator import integrate
+from jointwear.sim.mechanisms import mechanism_of
 from jointwear.sim.parameters import SimParameters
 from jointwear.sim.validity import contact_validity
 
@@ -115,7 +115,7 @@ class CycleResult:
 
 def _side(params: SimParameters):
     """The module with the mechanism's own packing, angle flags and record variables."""
-    return _slider_record if is_slider_crank(params) else _four_bar_record
+    return mechanism_of(params).record_module()
 
 
 def _pack(params: SimParameters) -> tuple[np.ndarray, np.ndarray]:
@@ -124,6 +124,7 @@ def _pack(params: SimParameters) -> tuple[np.ndarray, np.ndarray]:
     P = np.zeros(kn.NP)
     IP = np.zeros(kn.NIP, dtype=np.int64)
     _side(params).pack_mechanism(params, P, IP)
+    IP[kn.MECH] = mechanism_of(params).kernel_flag
     P[kn.RJ], P[kn.LJ], P[kn.RB], P[kn.WB] = (
         j.journal_radius,
         j.journal_length,
@@ -157,7 +158,7 @@ def _pack(params: SimParameters) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _mechanism(params: SimParameters) -> str:
-    return "slider_crank" if is_slider_crank(params) else "four_bar"
+    return mechanism_of(params).name
 
 
 def initial_state(params: SimParameters) -> SimState:

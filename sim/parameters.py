@@ -335,10 +335,17 @@ def parameters_from_tables(
         raise ParameterError(
             f"{where}: unknown table(s)/name(s) {', '.join(unknown)}; known: {', '.join(merged)}"
         )
-    kind = (
-        data.get("mechanism", {}).get("kind") if isinstance(data.get("mechanism"), dict) else None
-    )
-    base_kind = getattr(base_params.mechanism, "kind", "four_bar")
+    from jointwear.sim.mechanisms import check_applicable, foreign_keys, mechanism_of
+
+    table = data.get("mechanism") if isinstance(data.get("mechanism"), dict) else {}
+    kind = table.get("kind")
+    base_kind = mechanism_of(base_params).name
+    foreign = [f"mechanism.{k}" for k in table if k not in merged["mechanism"]]
+    if foreign and foreign_keys(base_params, foreign):
+        raise ParameterError(
+            f"{where}: unknown parameter(s) {', '.join(foreign)} for the base set {base!r}"
+            f"{foreign_keys(base_params, foreign)}; choose the mechanism with --base"
+        )
     if kind is not None and kind != base_kind:
         raise ParameterError(
             f"{where}: mechanism.kind = {kind!r} does not match the base "
@@ -357,6 +364,14 @@ def parameters_from_tables(
         merged["mechanism"] = from_mapping(
             type(base_params.mechanism), merged["mechanism"], where="mechanism"
         )
-        return from_mapping(SimParameters, merged)
+        params = from_mapping(SimParameters, merged)
     except ParameterError as exc:
         raise ParameterError(f"{where}: {exc}") from None
+    given = {
+        f"{name}.{key}": value
+        for name, tab in data.items()
+        if isinstance(tab, dict)
+        for key, value in tab.items()
+    }
+    check_applicable(params, given, base_params, where=where)
+    return params

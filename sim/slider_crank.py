@@ -75,7 +75,9 @@ class SliderCrankParameters(CrankDriven):
         9.81 m/s2 along -y (jointwear choice; negligible at the benchmark speed).
     joint_offset : float
         0 m: the clearance joint in the links' plane (jointwear choice; a non-zero value moves
-        the joint centre along +z, so the contact forces tilt the rod out of plane).
+        the joint centre along +z, so the contact forces tilt the rod out of plane: only with
+        ``planar = false``, and a non-zero value with ``planar = true`` is refused,
+        :mod:`jointwear.sim.mechanisms`).
     crank_speed_rpm : float
         5000 rpm, counter-clockwise [F04/F08, not verified].
     initial_crank_angle_deg : float

@@ -369,7 +369,7 @@ def apply_values(sim_params: Any, wear_settings: Any, values: Mapping[str, float
     ParameterError
         A value the parameter dataclasses refuse (their message names the field).
     """
-    from jointwear.params import replace_nested
+    from jointwear.sim.mechanisms import replace_checked
 
     numeric = numeric_fields(sim_params, wear_settings)
     sim_changes: dict[str, Any] = {}
@@ -389,7 +389,7 @@ def apply_values(sim_params: Any, wear_settings: Any, values: Mapping[str, float
         journal = sim_changes.get("joint.journal_radius", sim_params.joint.journal_radius)
         sim_changes["joint.bearing_radius"] = float(journal) + clearance
     try:
-        p = replace_nested(sim_params, **sim_changes) if sim_changes else sim_params
+        p = replace_checked(sim_params, sim_changes) if sim_changes else sim_params
         w = dataclasses.replace(wear_settings, **wear_changes) if wear_changes else wear_settings
     except (TypeError, ValueError) as exc:
         if isinstance(exc, ParameterError):

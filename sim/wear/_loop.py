@@ -806,7 +806,7 @@ def apply_overrides(
     ParameterError
         An unknown name (the message lists the known ones) or an invalid value.
     """
-    from jointwear.params import replace_nested
+    from jointwear.sim.mechanisms import replace_checked
 
     if not overrides:
         return params, settings
@@ -833,5 +833,5 @@ def apply_overrides(
                 f"override(s) {', '.join(bad)} must be dotted names such as "
                 "'mechanism.joint_offset' or 'wear.kw'"
             )
-        params = replace_nested(params, **sim)
+        params = replace_checked(params, sim, where="overrides")
     return params, settings
