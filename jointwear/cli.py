@@ -218,4 +218,15 @@ def main(argv: list[str] | None = None) -> int:
                 typer.echo(line, err=True)
             except OSError:
                 pass
+        _redeliver(argv)
     return 0
+
+
+def _redeliver(argv: list[str] | None) -> None:
+    """Called in-process (``main([...])``: a test, a user's script), the caller's own handler
+    gets the Ctrl-C or SIGTERM the command stopped on, so that the caller stops too (pytest
+    ends the session) instead of running on; the ``jointwear`` script exits 130 or 143."""
+    signum = _STATE["signal"]
+    if argv is not None and signum is not None:
+        _STATE["signal"] = None
+        signal.raise_signal(signum)
