@@ -1,7 +1,10 @@
 """Alignment of simulation and measurement in xarray, and validation metrics (``jointwear.compare``)."""
 
-from jointwear._lazy import lazy_api
+import lazy_loader
 
-# Public names come from the modules below; they are imported on first use (PEP 562) so that
-# the command line starts fast.
-__getattr__, __dir__ = lazy_api(__name__, ["jointwear.compare._api"])
+# The public names: the __all__ of these modules (module -> None) or the names listed. They are
+# imported on first use so that the command line starts fast; ``python docs/scripts/lazy_stubs.py``
+# writes them into __init__.pyi, which lazy_loader reads.
+_EXPORTS = {"_api": None}
+
+__getattr__, __dir__, __all__ = lazy_loader.attach_stub(__name__, __file__)

@@ -1,9 +1,10 @@
 """Digital image correlation (``jointwear.dic``): 2D subset DIC, stereo DIC, footage tracking."""
 
-from jointwear._lazy import lazy_api
+import lazy_loader
 
-# Public names come from the modules below; they are imported on first use (PEP 562) so that
-# the command line starts fast.
-__getattr__, __dir__ = lazy_api(
-    __name__, ["jointwear.dic._api2d", "jointwear.dic._api3d", "jointwear.dic._api_field"]
-)
+# The public names: the __all__ of these modules (module -> None) or the names listed. They are
+# imported on first use so that the command line starts fast; ``python docs/scripts/lazy_stubs.py``
+# writes them into __init__.pyi, which lazy_loader reads.
+_EXPORTS = {"_api2d": None, "_api3d": None, "_api_field": None}
+
+__getattr__, __dir__, __all__ = lazy_loader.attach_stub(__name__, __file__)

@@ -1,92 +1,47 @@
-"""Lazy re-export of a subpackage's public API (PEP 562).
+"""Import hooks of the start-up: :func:`after_import` prepares a heavy dependency when (and only
+if) it is imported.
 
-A subpackage's ``__init__`` re-exports the names listed in ``__all__`` of its ``_api*``
-modules, but imports them only on first use, so that ``jointwear --help`` and the CLI groups
-start without loading numba, scipy or xarray.
+Subpackages serve their public names lazily with ``lazy_loader.attach_stub`` (their
+``__init__.pyi`` lists every name; ``docs/scripts/lazy_stubs.py`` writes it).
+:func:`lazy_api` is the former in-house loader's signature over ``lazy_loader.attach``, kept for
+a package not yet given an ``_EXPORTS`` table and a stub; it reads the API modules' ``__all__``
+from their source, so nothing is imported until a name is used.
 """
 
 from __future__ import annotations
 
-import importlib
+import ast
 import importlib.abc
 import importlib.machinery
+import importlib.util
 import sys
-import types
 from collections.abc import Callable, Sequence
+from pathlib import Path
 from typing import Any
 
-__all__ = ["lazy_api", "after_import", "stub_text"]
+import lazy_loader
+
+__all__ = ["lazy_api", "after_import"]
 
 
 def lazy_api(
     package: str, api_modules: Sequence[str]
 ) -> tuple[Callable[[str], Any], Callable[[], list[str]]]:
-    """Return ``(__getattr__, __dir__)`` for ``package`` re-exporting ``api_modules``.
-
-    Parameters
-    ----------
-    package : str
-        The subpackage's ``__name__``.
-    api_modules : sequence of str
-        Fully qualified names of the modules whose ``__all__`` is the public API.
-    """
-
-    def _load() -> dict[str, Any]:
-        # Import the API modules and bind every public name in the package namespace, as a
-        # star-import would. Binding after the imports matters: importing a submodule sets a
-        # package attribute of the same name (e.g. module ``assess`` vs function ``assess``),
-        # and the public function must win.
-        modules = [importlib.import_module(name) for name in api_modules]
-        names = [n for m in modules for n in m.__all__]
-        public = {n: getattr(m, n) for m in modules for n in m.__all__}
-        namespace = vars(sys.modules[package])
-        namespace.update(public)
-        namespace["__all__"] = names
-        return namespace
-
-    loading = False
-
-    def __getattr__(name: str) -> Any:
-        # Private names are submodules (``from jointwear.dic import _api2d``): answering
-        # AttributeError lets the import system load them without pulling in the whole API,
-        # and so does any lookup made while the API modules themselves are being imported.
-        nonlocal loading
-        if (name == "__all__" or not name.startswith("_")) and not loading:
-            loading = True
-            try:
-                namespace = _load()
-            finally:
-                loading = False
-            if name in namespace:
-                return namespace[name]
-        raise AttributeError(f"module {package!r} has no attribute {name!r}")
-
-    def __dir__() -> list[str]:
-        return sorted(set(__getattr__("__all__")))
-
-    # The import system binds a freshly imported submodule on its package with ``setattr``
-    # (``import jointwear.metrology.assess`` sets ``jointwear.metrology.assess`` to the module).
-    # When the submodule exports a public name equal to its own name, bind that object
-    # instead, so that ``from jointwear.metrology import assess`` gives the function whatever
-    # was imported first.
-    sys.modules[package].__class__ = _ShadowingModule
-    return __getattr__, __dir__
-
-
-class _ShadowingModule(types.ModuleType):
-    """A package whose public names win over same-named submodules bound by the import system."""
-
-    def __setattr__(self, name: str, value: Any) -> None:
-        if (
-            isinstance(value, types.ModuleType)
-            and not name.startswith("_")
-            and value.__name__ == f"{self.__name__}.{name}"
-            # the module's own __all__ only: a lazy subpackage computes its __all__ on first
-            # use, and binding it must not load it
-            and name in vars(value).get("__all__", ())
-        ):
-            value = getattr(value, name)
-        super().__setattr__(name, value)
+    """Return ``(__getattr__, __dir__)`` for ``package`` re-exporting ``api_modules``' ``__all__``
+    (fully qualified module names), and set the package's ``__all__``."""
+    attrs = {}
+    for name in api_modules:
+        spec = importlib.util.find_spec(name)
+        tree = ast.parse(Path(spec.origin).read_text(encoding="utf-8"))
+        names = next(
+            ast.literal_eval(node.value)
+            for node in tree.body
+            if isinstance(node, ast.Assign) and getattr(node.targets[0], "id", "") == "__all__"
+        )
+        attrs[name.removeprefix(package + ".")] = list(names)
+    getattr_, dir_, all_ = lazy_loader.attach(package, submod_attrs=attrs)
+    sys.modules[package].__all__ = all_
+    return getattr_, dir_
 
 
 def after_import(name: str, callback: Callable[[], None]) -> None:
@@ -125,19 +80,3 @@ class _AfterImport(importlib.abc.MetaPathFinder):
 
         loader.exec_module = exec_then_notify  # type: ignore[method-assign]
         return spec
-
-
-def stub_text(package: str, api_modules: Sequence[str]) -> str:
-    """The ``__init__.pyi`` of a package built with :func:`lazy_api`: one star-import per API
-    module, which in a stub re-exports exactly that module's ``__all__`` (PEP 484), so that type
-    checkers and editors see what ``__getattr__`` serves (``tests/root/test_lazy_api.py`` checks
-    every stub against its package)."""
-    lines = [
-        f'"""Static view of {package}\'s lazily loaded public API (generated by',
-        '``jointwear._lazy.stub_text``; do not edit)."""',
-        "",
-        "# In a stub, a star-import re-exports exactly the names in the module's __all__.",
-        *(f"from {name} import *  # noqa: F403" for name in sorted(api_modules)),
-        "",
-    ]
-    return "\n".join(lines)

@@ -8,8 +8,11 @@ wear run (:func:`verify_wear`, ``jointwear sim verify``) built on them. The modu
 the public names are importable from here and from :mod:`jointwear.sim`, loaded on first use.
 """
 
-from jointwear._lazy import lazy_api
+import lazy_loader
 
-__getattr__, __dir__ = lazy_api(
-    __name__, ["jointwear.sim.sweep._driver", "jointwear.sim.sweep._verify"]
-)
+# The public names: the __all__ of these modules (module -> None) or the names listed. They are
+# imported on first use so that the command line starts fast; ``python docs/scripts/lazy_stubs.py``
+# writes them into __init__.pyi, which lazy_loader reads.
+_EXPORTS = {"_driver": None, "_verify": None}
+
+__getattr__, __dir__, __all__ = lazy_loader.attach_stub(__name__, __file__)

@@ -8,9 +8,11 @@ kw against measured wear. The modules are private; the public names are importab
 and from :mod:`jointwear.sim`, loaded on first use.
 """
 
-from jointwear._lazy import lazy_api
+import lazy_loader
 
-__getattr__, __dir__ = lazy_api(
-    __name__,
-    ["jointwear.sim.wear._loop", "jointwear.sim.wear._contact", "jointwear.sim.wear._calibration"],
-)
+# The public names: the __all__ of these modules (module -> None) or the names listed. They are
+# imported on first use so that the command line starts fast; ``python docs/scripts/lazy_stubs.py``
+# writes them into __init__.pyi, which lazy_loader reads.
+_EXPORTS = {"_loop": None, "_contact": None, "_calibration": None}
+
+__getattr__, __dir__, __all__ = lazy_loader.attach_stub(__name__, __file__)
