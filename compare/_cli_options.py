@@ -14,6 +14,7 @@ import typer
 from jointwear.compare._choices import DEFAULT_AXES, MOTION_VARIABLES
 
 __all__ = [
+    "AllowOtherRigOpt",
     "AxisOpt",
     "CriteriaOpt",
     "CyclesOpt",
@@ -73,6 +74,14 @@ VerificationOpt = Annotated[
         help="Verification study: a 'jointwear sim verify' study.nc (u_num of each wear "
         "criterion on the measured band, Eça-Hoekstra), or older 1-D refinement data "
         "(GCI, order capped at the formal order).",
+    ),
+]
+AllowOtherRigOpt = Annotated[
+    bool,
+    typer.Option(
+        "--allow-other-rig",
+        help="Use a --verification study or an --ensemble whose recorded rig parameters "
+        "differ from the simulation's (labelled in the notes); refused by default.",
     ),
 ]
 StrictOpt = Annotated[

@@ -13,6 +13,7 @@ import jointwear.compare.verdicts as vd
 from jointwear.compare._decide import (
     Rows,
     decision,
+    fmt,
     scalar_discrepancy,
     threshold_state,
     vv20_decision,
@@ -193,6 +194,30 @@ def _stated(al: xr.Dataset, s: np.ndarray, d: np.ndarray) -> dict[str, tuple]:
     return out
 
 
+def _calibration(name: str, meas: float, al: xr.Dataset, d: np.ndarray, criteria) -> list:
+    """The user-stated calibration terms of the instrument, ``(u, basis)``, for u_D of ``name``
+    (measured value ``meas``; ``d`` the measured map on the band)."""
+    out = []
+    gain = criteria.gain_u_rel
+    if gain is not None:
+        out.append((gain * abs(meas), f"user-stated instrument gain u {gain:.3g}·|D| (gain_u_rel)"))
+    probe = criteria.probe_u_m
+    radius = al.attrs.get("bearing_radius_m")
+    if probe is not None and name == "max_wear_depth":
+        out.append((probe, f"user-stated radial offset u {fmt(probe, 'm')} (probe_u_m)"))
+    elif probe is not None and name == "worn_volume" and radius:
+        z, th = np.asarray(al["z"].values), np.asarray(al["theta"].values)
+        area = mt.worn_volume(np.where(np.isfinite(d), 1.0, np.nan), z, th, float(radius))
+        out.append(
+            (
+                probe * area,
+                f"user-stated radial offset u {fmt(probe, 'm')} (probe_u_m) over the band's "
+                f"area {area * 1e6:.3g} mm²",
+            )
+        )
+    return out
+
+
 def wear_metrics(al: xr.Dataset, rows: Rows, decisions: list[dict[str, Any]], src: Sources) -> str:
     """Metric rows and decisions of the aligned wear maps ``al``; returns the domain statement.
 
@@ -299,6 +324,7 @@ def wear_metrics(al: xr.Dataset, rows: Rows, decisions: list[dict[str, Any]], sr
             meas_u=ud,
             sim_note=us_note,
             meas_note=f"stated by the measurement: {ud_note}" if ud_note else "",
+            calibration=_calibration(name, meas, al, d, criteria),
         )
         vv20_decision(
             rows,

@@ -44,6 +44,7 @@ def compare_cmd(
     axes: opt.AxisOpt = None,
     ensemble: opt.EnsembleOpt = None,
     verification: opt.VerificationOpt = None,
+    allow_other_rig: opt.AllowOtherRigOpt = False,
     strict: opt.StrictOpt = False,
 ) -> None:
     """Compare simulation and measurement (wear maps and/or motion, detected from variables).
@@ -72,6 +73,7 @@ def compare_cmd(
         axes=axes or DEFAULT_AXES,
         ensemble=ensemble or [],
         verification=verification or [],
+        allow_other_rig=allow_other_rig,
         warn=oc.echo_warning,
     )
     lines = [oc.origin_line(result), *oc.card_lines(result), *oc.alignment_lines(result)]

@@ -433,6 +433,24 @@ def _add_motion_ensemble(ens, axes, m_sel, motion, kwargs, field_values) -> None
         motion[f"{n}_sim_ensemble"] = band
 
 
+def _rig_notes(
+    sim: xr.Dataset | None, studies: Sequence[xr.Dataset], ens: Ensemble | None, allow: bool
+) -> list[str]:
+    """Each study and ensemble checked against the simulation's rig
+    (:func:`jointwear.compare.rig.check_rig`): the notes; refused when another rig is not
+    allowed."""
+    from jointwear.compare.rig import check_rig
+
+    notes = []
+    for i, study in enumerate(studies):
+        name = str(study.attrs.get("title", f"verification study {i + 1}"))
+        notes.append(check_rig(sim, study, f"verification study {name!r}", allow_other_rig=allow))
+    for i, ds in enumerate(ens.datasets if ens is not None else ()):
+        what = f"ensemble {ens.names[i]!r}"
+        notes.append(check_rig(sim, ds, what, allow_other_rig=allow, varied=ens.parameters(i)))
+    return [n for n in notes if n]
+
+
 def compare(
     sim: xr.Dataset | Sequence[xr.Dataset],
     meas: xr.Dataset | Sequence[xr.Dataset],
@@ -446,6 +464,7 @@ def compare(
     axes: Sequence[str] | None = DEFAULT_AXES,
     ensemble: xr.Dataset | Sequence[xr.Dataset] | Ensemble | None = None,
     verification: Verification | None = None,
+    allow_other_rig: bool = False,
 ) -> Comparison:
     """Compare simulation and measurement: wear maps and/or motion, detected from the variables.
 
@@ -479,6 +498,10 @@ def compare(
         refinement datasets (quantities over a refinement parameter: the GCI of three
         solutions, Eça & Hoekstra's least squares of four or more,
         :func:`jointwear.compare.verification.refinement_study`).
+    allow_other_rig : bool
+        Use a verification study or an ensemble whose recorded rig parameters differ from the
+        simulation's (labelled in the notes); by default that is refused
+        (:mod:`jointwear.compare.rig`).
 
     Returns
     -------
@@ -488,7 +511,8 @@ def compare(
     Raises
     ------
     BadInputError
-        Nothing to compare, inputs that cannot be aligned, or a malformed ensemble.
+        Nothing to compare, inputs that cannot be aligned, a malformed ensemble, or a study or
+        an ensemble of another rig (without ``allow_other_rig``).
     ConventionError
         A wear map does not state its angle convention.
 
@@ -524,7 +548,7 @@ def compare(
     m_wear, m_motion = _split(meass_maps)
     rows = Rows()
     decisions: list[dict[str, Any]] = []
-    notes: list[str] = []
+    notes = _rig_notes(s_wear if s_wear is not None else s_motion, studies, ens, allow_other_rig)
     partial = _partial_inputs(sims, meass)
     wear = motion = None
     field_values: dict[str, list[tuple[int, np.ndarray]]] = {}

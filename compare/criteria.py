@@ -91,6 +91,17 @@ class Criteria:
         User-stated relative numerical standard uncertainty, used where neither the simulation
         (``<name>_u``) nor a verification study (``--verification``) gives one [1].
         None (default) = not stated.
+    gain_u_rel : float or None
+        User-stated relative standard uncertainty of the measuring instrument's gain
+        (magnification calibration) [1]; a ``[measurement]`` table may state it. A gain error
+        scales the whole measured map, so it adds ``gain_u_rel·|D|`` to u_D of every wear
+        quantity, in quadrature with the map's own u. None (default) = not stated.
+    probe_u_m : float or None
+        User-stated standard uncertainty of a radial offset common to the whole measured wear
+        map (stylus/probe radius calibration, an offset between the before- and after-wear
+        scans) [m]; a ``[measurement]`` table may state it. It adds to u_D of the maximum depth
+        as itself and of the worn volume as itself times the band's area; the cylindricity
+        removes a uniform offset (no term). None (default) = not stated.
     """
 
     k: float = checked(2.0, _coverage_factor)
@@ -106,15 +117,35 @@ class Criteria:
     motion_u_input_rel: float | None = checked(None, _stated)
     wear_u_num_rel: float | None = checked(None, _stated)
     motion_u_num_rel: float | None = checked(None, _stated)
+    gain_u_rel: float | None = checked(None, _stated)
+    probe_u_m: float | None = checked(None, _stated)
 
     def __post_init__(self) -> None:
         check_fields(self, "criteria")
 
 
+#: the keys a ``[measurement]`` table may state (the instrument's calibration terms of u_D)
+MEASUREMENT_KEYS = ("gain_u_rel", "probe_u_m")
+
+
 def load_criteria(path: str | Path | None) -> Criteria:
-    """Criteria from a TOML file (keys of :class:`Criteria`, optionally in a ``[criteria]`` table)."""
+    """Criteria from a TOML file (keys of :class:`Criteria`, optionally in a ``[criteria]``
+    table; the instrument's calibration terms, ``gain_u_rel`` and ``probe_u_m``, also in a
+    ``[measurement]`` table)."""
     if path is None:
         return Criteria()
     data = read_toml(path)
-    data = data.get("criteria", data)
-    return from_mapping(Criteria, data, where="criteria")
+    measurement = dict(data.get("measurement", {}) or {})
+    data = dict(data.get("criteria", {k: v for k, v in data.items() if k != "measurement"}))
+    other = sorted(set(measurement) - set(MEASUREMENT_KEYS))
+    if other:
+        raise ParameterError(
+            f"measurement.{other[0]}: unknown key; the [measurement] table states "
+            f"{' and '.join(MEASUREMENT_KEYS)}"
+        )
+    twice = sorted(set(measurement) & set(data))
+    if twice:
+        raise ParameterError(
+            f"{twice[0]} is stated both in [criteria] and in [measurement]: state it once"
+        )
+    return from_mapping(Criteria, {**data, **measurement}, where="criteria")

@@ -172,20 +172,34 @@ class Sources:
         meas_u: float | None,
         sim_note: str = "",
         meas_note: str = "",
+        calibration: Sequence[tuple[float, str]] = (),
     ) -> Budget:
         """The V&V 20 budget of a simulated value ``s``: :meth:`u_num` (the simulation's own
         standard uncertainty ``sim_u``), :meth:`u_input`, :meth:`u_d` (the measurement's
-        ``meas_u``) and the criteria's coverage factor."""
+        ``meas_u``, with the instrument's ``calibration`` terms) and the criteria's coverage
+        factor."""
         return Budget(
             self.u_num(quantity, s, sim_u, family, sim_note),
             self.u_input(quantity, s, family),
-            self.u_d(meas_u, meas_note),
+            self.u_d(meas_u, meas_note, calibration),
             self.criteria.k,
         )
 
     @staticmethod
-    def u_d(stated: float | None, note: str = "") -> Uncertainty:
-        """Measurement standard uncertainty, from the measurement file only (``note``: how)."""
-        if stated is not None and np.isfinite(stated):
-            return Uncertainty(float(stated), note or "stated by the measurement file (<name>_u)")
-        return unknown("the measurement states no uncertainty (<name>_u)")
+    def u_d(
+        stated: float | None, note: str = "", calibration: Sequence[tuple[float, str]] = ()
+    ) -> Uncertainty:
+        """Measurement standard uncertainty: the measurement file's own (``note``: how), with
+        the user-stated calibration terms ``(u, basis)`` of the instrument added in quadrature.
+
+        A calibration term alone does not make u_D known: it does not cover the measurement's
+        noise, form and alignment, which only the file can state.
+        """
+        if stated is None or not np.isfinite(stated):
+            return unknown("the measurement states no uncertainty (<name>_u)")
+        own = note or "stated by the measurement file (<name>_u)"
+        if not calibration:
+            return Uncertainty(float(stated), own)
+        comps = [Component(float(stated), own, frozenset({"measurement file"}))]
+        comps += [Component(u, basis, frozenset({basis})) for u, basis in calibration]
+        return combine("u_D", comps)

@@ -220,6 +220,7 @@ def compare_files(
     axes: Sequence[str] | None = DEFAULT_AXES,
     ensemble: Sequence[str | Path] = (),
     verification: Sequence[str | Path] = (),
+    allow_other_rig: bool = False,
     warn: Callable[[str], None] | None = None,
 ) -> Comparison:
     """Compare files: load simulation and measurement, :func:`compare` them, save the result.
@@ -241,6 +242,8 @@ def compare_files(
         Ensembles of simulations (``run`` dimension): their spread is the input uncertainty.
     verification : sequence of path
         Verification studies or refinement data (numerical uncertainty).
+    allow_other_rig : bool
+        Use a study or an ensemble of another rig, labelled (default: refused, exit 3).
     warn : callable, optional
         Receives the warning text for a file from another tool (the CLI prints it on stderr).
 
@@ -271,6 +274,7 @@ def compare_files(
         axes=axes,
         ensemble=as_ensemble(ens, [Path(p).name for p in ensemble]) if ens else None,
         verification=vers or None,
+        allow_other_rig=allow_other_rig,
     )
     save_comparison(
         result,

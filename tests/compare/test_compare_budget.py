@@ -161,3 +161,47 @@ def test_u_d_from_the_maps_per_point_and_derived_u_with_k():
     narrow = compare(sim, meas.isel(z=slice(2, 14)), criteria=crit)
     basis = narrow.metrics.set_index(["quantity", "metric"]).loc[("worn_volume", "u_D"), "basis"]
     assert "fully correlated" in basis
+
+
+def test_instrument_calibration_terms_raise_u_d(tmp_path):
+    """[measurement] gain_u_rel and probe_u_m enter u_D in quadrature with the map's own u."""
+    from jointwear.compare import load_criteria
+
+    sim, meas = syn.sim_wear(), syn.meas_wear(n_layers=16, u=0.4e-6)
+    base = Criteria(wear_u_num_rel=0.01, wear_u_input_rel=0.05)
+    plain = compare(sim, meas, criteria=base)
+    toml = tmp_path / "criteria.toml"
+    toml.write_text(
+        "[criteria]\nwear_u_num_rel = 0.01\nwear_u_input_rel = 0.05\n"
+        "[measurement]\ngain_u_rel = 0.02\nprobe_u_m = 0.5e-6\n"
+    )
+    crit = load_criteria(toml)
+    assert (crit.gain_u_rel, crit.probe_u_m) == (0.02, 0.5e-6)
+    cal = compare(sim, meas, criteria=crit)
+    d = cal.value("max_wear_depth", "value_meas")
+    own = plain.value("max_wear_depth", "u_D")
+    assert cal.value("max_wear_depth", "u_D") == pytest.approx(
+        np.sqrt(own**2 + (0.02 * d) ** 2 + 0.5e-6**2)
+    )
+    # the volume: the offset over the band's area, R 2 pi (z_max - z_min) for a full band
+    lo, hi = (float(v) for v in np.ravel(cal.wear.attrs["z_overlap_m"]))
+    area = syn.RADIUS * 2 * np.pi * (hi - lo)
+    v, own_v = cal.value("worn_volume", "value_meas"), plain.value("worn_volume", "u_D")
+    assert cal.value("worn_volume", "u_D") == pytest.approx(
+        np.sqrt(own_v**2 + (0.02 * v) ** 2 + (0.5e-6 * area) ** 2)
+    )
+    # the cylindricity removes a uniform offset: the gain only
+    c, own_c = cal.value("cylindricity", "value_meas"), plain.value("cylindricity", "u_D")
+    assert cal.value("cylindricity", "u_D") == pytest.approx(np.hypot(own_c, 0.02 * c))
+    basis = cal.metrics.set_index(["quantity", "metric"]).loc[("max_wear_depth", "u_D"), "basis"]
+    assert "gain_u_rel" in basis and "probe_u_m" in basis
+    # a calibration term alone does not make an unstated u_D known
+    bare = compare(sim, syn.meas_wear(n_layers=16), criteria=crit)
+    assert bare.state("maximum wear depth") == "not_assessed"
+    # a misspelt key and a key stated twice are refused, naming it
+    toml.write_text("[measurement]\ngain_u = 0.02\n")
+    with pytest.raises(ParameterError, match=r"measurement\.gain_u"):
+        load_criteria(toml)
+    toml.write_text("[criteria]\ngain_u_rel = 0.01\n[measurement]\ngain_u_rel = 0.02\n")
+    with pytest.raises(ParameterError, match="both"):
+        load_criteria(toml)

@@ -173,7 +173,9 @@ def test_field_defaults_help_and_limits_are_the_librarys():
     from jointwear.dic.field._files import measure_field_files
 
     f = _fields(FieldParams)
-    mapping = _same(f, "subset_size", "step", "zncc_min", "search_radius", "threads")
+    mapping = _same(
+        f, "subset_size", "step", "zncc_min", "search_radius", "threads", "u_outlier_factor"
+    )
     mapping |= _stated("strain_window", "frame", "epipolar_max")
     mapping["origin"] = (_keywords(measure_field_files)["data_origin"], None)
     without = {"images", "left", "right", "calibration", "roi", "points", "fps"}
@@ -325,7 +327,7 @@ def test_compare_defaults_and_help_are_the_librarys():
     from jointwear.errors import BadInputError
 
     kw = _keywords(compare_files)
-    mapping = _same(kw, "table", "criteria", "cycles", "variables")
+    mapping = _same(kw, "table", "criteria", "cycles", "variables", "allow_other_rig")
     mapping |= _renamed(kw, method="motion_method", period="period_s") | _stated("axes")
     without = {"sim", "meas", "out", "overwrite", "sim_extra", "meas_extra", "ensemble"}
     params = _check(compare_cmd, mapping, without | {"verification", "strict"})
