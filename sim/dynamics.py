@@ -26,7 +26,7 @@ from jointwear.sim.kernels import _layout as kn
 from jointwear.sim.kernels._integrator import integrate
 from jointwear.sim.mechanisms import mechanism_of
 from jointwear.sim.parameters import SimParameters
-from jointwear.sim.validity import contact_validity
+from jointwear.sim.validity import contact_validity, penetration_stop_advice
 
 __all__ = [
     "SimState",
@@ -410,11 +410,15 @@ def run_cycles(
         if status != 0:
             partial = _record(params, t_rel[:i_out], diag[:i_out], t0) if record else None
             theta = math.degrees(y[0]) % 360.0
+            advice = (
+                penetration_stop_advice(params)
+                if status == 2
+                else "tighten solver tolerances, reduce the time step or check the parameters"
+            )
             raise SimulationError(
                 f"simulation stopped at t = {t:.6g} s (crank angle {theta:.2f} deg): "
-                f"{_STATUS.get(status, 'unknown failure')}; the record up to there is in "
-                ".partial - tighten solver tolerances, reduce the time step or check the "
-                "parameters",
+                f"{_STATUS.get(status, 'unknown failure')}; {advice}; the record up to there "
+                "is in .partial",
                 partial=partial,
             )
         if progress is not None:

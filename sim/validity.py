@@ -22,7 +22,14 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
-__all__ = ["CONTACT_LIMITS", "POLYMER_MODULUS", "ContactLimit", "contact_validity"]
+__all__ = [
+    "CONTACT_LIMITS",
+    "POLYMER_MODULUS",
+    "ContactLimit",
+    "contact_validity",
+    "hertz_deflections",
+    "penetration_stop_advice",
+]
 
 
 @dataclass(frozen=True)
@@ -152,3 +159,111 @@ def contact_validity(
     if warning:
         attrs["contact_validity_warning"] = warning
     return {"status": status, "checks": checks, "warning": warning, "attrs": attrs}
+
+
+def hertz_deflections(params: Any, load: float) -> tuple[float, float, float]:
+    """The contact's deflections under a joint load, with its stiffness.
+
+    Parameters
+    ----------
+    params : SimParameters
+    load : float
+        Joint force [N].
+
+    Returns
+    -------
+    (static, sudden, K)
+        ``static = (F / K)^(1/n)`` [m], the line-contact deflection under ``F`` (K of eq. 7,
+        ``n = contact.exponent``); ``sudden = ((n + 1) F / K)^(1/n)`` [m], the peak deflection
+        when ``F`` is applied at once (energy: ``F d = K d^(n+1) / (n+1)``), what a journal
+        crossing the clearance and landing under load reaches without any approach speed;
+        ``K`` [N/m^n].
+    """
+    from jointwear.sim.contact import contact_constant
+
+    n = params.contact.exponent
+    k = contact_constant(params)[1]
+    return (load / k) ** (1 / n), ((n + 1) * load / k) ** (1 / n), k
+
+
+def _joint_load(params: Any) -> float:
+    """The ideal joint's largest reaction over one crank cycle [N] (its own short run)."""
+    import dataclasses
+
+    from jointwear.sim.dynamics import run_cycles
+
+    ideal = dataclasses.replace(params, joint=dataclasses.replace(params.joint, model="ideal"))
+    ds = run_cycles(ideal, cycles=1.0).dataset
+    return float(ds["contact_force"].max())
+
+
+def penetration_stop_advice(params: Any) -> str:
+    """Why a run stopped on ``contact.max_penetration_fraction``: the physics, compared.
+
+    The joint's load (the ideal joint's largest reaction over a cycle) deflects the contact by
+    the Hertz deflection of eq. 7's K; when that deflection, applied suddenly, reaches the stop
+    (``max_penetration_fraction`` x the radial clearance), the clearance is too small for this
+    load and contact stiffness (physically the joint runs closed, elastically preloaded, which
+    an impact model of a clearance joint does not describe) and no solver setting changes it.
+    The message names the parameters that do: the clearance, the materials, the speed.
+    """
+    j, c = params.joint, params.contact
+    clearance = j.radial_clearance
+    stop = c.max_penetration_fraction * clearance
+    try:
+        load = _joint_load(params)
+    except Exception as exc:  # noqa: BLE001 - advice must never hide the stop itself
+        return (
+            f"the joint's load could not be estimated for a comparison with the clearance "
+            f"({exc}); check the clearance, the materials and the speed, then the solver"
+        )
+    static, sudden, k = hertz_deflections(params, load)
+    soft = min(c.journal_modulus, c.bearing_modulus)
+    compared = (
+        f"the ideal joint carries up to {load:.4g} N, which deflects this contact (K = "
+        f"{k:.3g} N/m^{c.exponent:g} of eq. 7, E = {c.journal_modulus / 1e9:.3g} / "
+        f"{c.bearing_modulus / 1e9:.3g} GPa) by {1e6 * static:.3g} um statically and "
+        f"{1e6 * sudden:.3g} um when applied at once, against a radial clearance of "
+        f"{1e6 * clearance:.3g} um and the stop at {1e6 * stop:.3g} um"
+    )
+    levers = (
+        "what changes it is the physics: a larger clearance (joint.bearing_radius - "
+        "joint.journal_radius), a stiffer pair (contact.journal_modulus, "
+        f"contact.bearing_modulus; the softer here is {soft / 1e9:.3g} GPa), or a lower "
+        "mechanism.crank_speed_rpm (the inertial load grows with its square); for a joint "
+        "without play use joint.model = 'ideal'"
+    )
+    if sudden >= 0.5 * stop:
+        from jointwear.sim.parameters import ContactParameters
+
+        usual = ContactParameters.max_penetration_fraction * clearance
+        if c.max_penetration_fraction < ContactParameters.max_penetration_fraction and (
+            sudden < 0.5 * usual
+        ):
+            return (
+                f"physical cause: the stop itself is set below the contact's deflection under "
+                f"the joint's load (contact.max_penetration_fraction = "
+                f"{c.max_penetration_fraction:g}, default {ContactParameters.max_penetration_fraction:g}) - "
+                f"{compared}; raise contact.max_penetration_fraction"
+            )
+        if soft < POLYMER_MODULUS:
+            cause = (
+                f"the soft pair ({soft / 1e9:.3g} GPa) deflects under the joint's load by "
+                "about the clearance or more"
+            )
+        elif sudden < clearance:
+            cause = "the clearance is too small for this load and contact stiffness"
+        else:
+            cause = "the contact's elastic deflection under the load exceeds the clearance"
+        return (
+            f"physical cause: {cause} - {compared}; impacts add to that, so the journal does "
+            "not fly within a clearance but presses through it (the joint runs closed, "
+            "elastically preloaded), which the clearance-joint contact model does not describe; "
+            f"tightening the solver does not help: {levers}"
+        )
+    return (
+        f"{compared}: the load alone reaches {100 * sudden / stop:.0f} % of the stop, so the "
+        "stop comes from an impact faster than the load explains or from the integration; "
+        "check contact.restitution and the speed, then tighten solver.rtol or "
+        f"solver.onset_penetration; otherwise {levers}"
+    )

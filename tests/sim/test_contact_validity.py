@@ -113,3 +113,73 @@ def test_cycle_command_prints_and_records_the_breach(tmp_path, capsys):
     assert main(["sim", "cycle", "--cycles", "1", "--out", str(out), "--params", str(params)]) == 0
     assert "left its validity range" in capsys.readouterr().err
     assert io.load(out).attrs["contact_validity_status"] == "exceeded"
+
+
+SC = PARAMETER_SETS["slider_crank"]
+
+
+@pytest.mark.parametrize(
+    ("changes", "cause"),
+    [
+        # 10-um clearance at 5000 rpm: stops within about 40 us
+        (
+            {"joint.bearing_radius": SC.joint.journal_radius + 10e-6},
+            "the clearance is too small for this load",
+        ),
+        # a PTFE bearing: stops at about 0.3 ms
+        (PTFE, "the soft pair (0.5 GPa)"),
+    ],
+)
+def test_a_physical_penetration_stop_names_its_cause_and_levers(changes, cause):
+    """The stop compares the Hertz deflection under the ideal joint's load (2.72 kN, closed
+    forms below) with the clearance and names the physical parameters, not the solver's."""
+    from jointwear.errors import SimulationError
+    from jointwear.sim.contact import contact_constant
+
+    p = replace_nested(SC, **changes)
+    with pytest.raises(SimulationError) as exc:
+        run_cycles(p, cycles=1.0, record=False)
+    msg = str(exc.value)
+    assert "physical cause: " + cause in msg
+    for lever in ("joint.bearing_radius", "contact.bearing_modulus", "crank_speed_rpm"):
+        assert lever in msg
+    assert "tightening the solver does not help" in msg
+    assert "tighten solver tolerances" not in msg
+    # the numbers quoted are the closed forms: d = (F/K)^(2/3), sudden ((n+1) F/K)^(2/3)
+    ideal = run_cycles(replace_nested(p, **{"joint.model": "ideal"}), cycles=1.0).dataset
+    f = float(ideal["contact_force"].max())
+    k = contact_constant(p)[1]
+    assert f"{f:.4g} N" in msg
+    assert f"by {1e6 * (f / k) ** (2 / 3):.3g} um statically" in msg
+    assert f"{1e6 * (2.5 * f / k) ** (2 / 3):.3g} um when applied at once" in msg
+
+
+def test_the_printed_levers_run():
+    """A lever the 10-um message names, applied: a tenth of the speed runs the cycle."""
+    p = replace_nested(
+        SC,
+        **{
+            "joint.bearing_radius": SC.joint.journal_radius + 10e-6,
+            "mechanism.crank_speed_rpm": 500.0,
+        },
+    )
+    assert run_cycles(p, cycles=1.0, record=False).max_penetration < 5e-6
+
+
+def test_an_unexplained_stop_keeps_the_numerical_advice():
+    """On the default four-bar the ideal joint's load deflects the contact by a few um against a
+    250-um stop: a stop there would not be explained by the load, and the advice says so."""
+    from jointwear.sim.validity import penetration_stop_advice
+
+    text = penetration_stop_advice(BASE)  # the default four-bar: 63 um peaks of 500 um
+    assert "physical cause" not in text and "solver.rtol" in text
+
+
+def test_a_stop_set_below_the_loads_deflection_names_the_setting():
+    from jointwear.sim.validity import penetration_stop_advice
+
+    low = replace_nested(BASE, **{"contact.max_penetration_fraction": 0.01})
+    text = penetration_stop_advice(low)
+    assert (
+        "the stop itself is set below" in text and "raise contact.max_penetration_fraction" in text
+    )
