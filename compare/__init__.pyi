@@ -42,3 +42,6 @@ from ._api import (
     worn_volume as worn_volume,
     wrap_angle_deg as wrap_angle_deg,
 )
+from ._wear import (
+    band_label as band_label,
+)

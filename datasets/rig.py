@@ -52,7 +52,7 @@ from jointwear.datasets._rig_motion import (  # noqa: F401 (L1, L2, L4 re-export
     _truth_state,
     fourbar_pose,
 )
-from jointwear.dic.calibration._camera import Camera, StereoCalibration
+from jointwear.dic import Camera, StereoCalibration
 from jointwear.errors import BadInputError
 from jointwear.outputs import write_image
 

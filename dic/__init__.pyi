@@ -19,7 +19,6 @@ from ._api3d import (
     BodySpec as BodySpec,
     calibrate_stereo as calibrate_stereo,
     CalibrationBoard as CalibrationBoard,
-    Camera as Camera,
     cardan_to_matrix as cardan_to_matrix,
     epipolar_distance as epipolar_distance,
     fit_rigid as fit_rigid,
@@ -32,7 +31,6 @@ from ._api3d import (
     read_opencv_calibration as read_opencv_calibration,
     read_vic3d_calibration as read_vic3d_calibration,
     stereo_noise_floor as stereo_noise_floor,
-    StereoCalibration as StereoCalibration,
     time_derivative as time_derivative,
     track_footage as track_footage,
     TrackConfig as TrackConfig,
@@ -44,4 +42,8 @@ from ._api_field import (
     plot_field as plot_field,
     read_field as read_field,
     write_field_csv as write_field_csv,
+)
+from .calibration._camera import (
+    Camera as Camera,
+    StereoCalibration as StereoCalibration,
 )

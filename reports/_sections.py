@@ -177,7 +177,7 @@ def _verdict(c: Comparison, counts: dict[str, int]) -> tuple[str, str]:
     if n == 0:
         return "NO DECISION: nothing was compared", "undecided"
     if c.wear is not None and any(str(t).startswith("validation domain") for t in c.notes):
-        from jointwear.compare._wear import band_label
+        from jointwear.compare import band_label
 
         # the wear is judged on the measured band only; the rest of the simulation is not
         synthetic += f"; wear judged {band_label(c.wear)}, outside it extrapolated"
@@ -239,6 +239,7 @@ def _sensitivity_rows(c: Comparison) -> list[dict[str, str]]:
                 "S1": f"{float(r.S1):.2f}" if np.isfinite(float(r.S1)) else "–",
                 "ST": f"{float(r.ST):.2f}" if np.isfinite(float(r.ST)) else "–",
                 "method": str(r.method),
+                "estimator": str(getattr(r, "estimator", "S1")),
             }
         )
     return rows

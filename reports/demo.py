@@ -141,7 +141,7 @@ def _compared_study_run(
     finest level, :func:`~jointwear.reports.demo_studies.is_compared_run`), simulated once: the
     study gets its result, ``sim_wear.nc`` its whole wear map; then the roundness scans."""
     from jointwear.errors import SimulationError
-    from jointwear.sim.sweep._run import evaluate_run
+    from jointwear.sim.sweep import evaluate_run
 
     if not is_compared_run(task, params, size):
         raise SimulationError("demo: the study's run 0 is not the compared wear run")

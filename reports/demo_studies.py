@@ -7,6 +7,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import xarray as xr
 
+from jointwear.datasets.reference_study import ENSEMBLE_INPUTS
 from jointwear.errors import JointwearError
 
 if TYPE_CHECKING:
@@ -181,17 +182,6 @@ def motion_verification(params: Any, size: DemoSize, main: xr.Dataset) -> xr.Dat
     )
 
 
-#: The demo's uncertain model inputs: dotted parameter name -> (relative standard deviation,
-#: what it stands for). The wear coefficient has to be calibrated (the reference study's value
-#: cannot be used as printed), the radial clearance and the friction coefficient are not
-#: measured on the rig.
-ENSEMBLE_INPUTS: dict[str, tuple[float, str]] = {
-    "wear.kw": (0.15, "Archard wear coefficient, calibrated to about 15 %"),
-    "joint.bearing_radius": (0.004, "bore radius (radial clearance 0.5 mm +- 32 µm)"),
-    "friction.dynamic_coefficient": (0.2, "dynamic friction coefficient, +- 20 %"),
-}
-
-
 def ensemble_spec(params: Any, size: Any, *, kw: float | None = None) -> dict[str, Any]:
     """The demo's sweep spec (``jointwear sim sweep`` format): LHS over :data:`ENSEMBLE_INPUTS`.
 
@@ -300,7 +290,7 @@ def is_compared_run(task: Any, params: Any, size: DemoSize) -> bool:
     """True if the study run ``task`` is the demo's compared wear run: the same parameters,
     wear settings (:func:`main_wear_settings`), cycles and snapshots, so that one simulation
     serves both (replicate 0 of the finest level)."""
-    from jointwear.sim.sweep._params import apply_values
+    from jointwear.sim.sweep import apply_values
 
     sim, wear = apply_values(task.sim_params, task.wear_settings, task.values)
     return (

@@ -13,7 +13,7 @@ models are then compared with each measurement, each with its own uncertainties:
 * the right model's map turned by 180 degree (a wrong angle zero).
 
 u_input of each candidate is the spread of a Latin-hypercube ensemble around *its own* nominal
-inputs (:data:`jointwear.reports.demo_studies.ENSEMBLE_INPUTS`; an input whose nominal value is
+inputs (:data:`jointwear.datasets.reference_study.ENSEMBLE_INPUTS`; an input whose nominal value is
 0, friction 0, is not varied), u_D comes from the measured map. Every measurement replicate has
 its own instrument noise; every right-model replicate its own update tolerance.
 

@@ -2,7 +2,8 @@
 
 ``python docs/scripts/lazy_stubs.py`` (``--check`` lists the stubs that are out of date and exits
 1). Such a package's ``__init__.py`` declares what it exports in ``_EXPORTS`` (module, relative
-to the package -> ``None`` for the names in that module's ``__all__``, or a tuple of names) and
+to the package -> ``None`` for the names in that module's ``__all__``, or a tuple of names,
+in which ``"*"`` stands for that ``__all__``) and
 calls ``lazy_loader.attach_stub(__name__, __file__)``, which reads the stub at import time and
 imports a name's module on first use (the script imports the listed modules to read their
 ``__all__``; the package's own ``__init__`` only reads its stub). The stub lists every public name explicitly, as
@@ -55,7 +56,7 @@ def _names(package: str, module: str, wanted: tuple[str, ...] | None) -> dict[st
     replacing the function by the module (a function's or class's own module, else the module
     the listing module imports it from, by name or by a star-import of its ``__all__``)."""
     listing = importlib.import_module(f"{package}.{module}")
-    names = list(listing.__all__) if wanted is None else list(wanted)
+    names = [n for w in wanted or ("*",) for n in (listing.__all__ if w == "*" else [w])]
     imported, stars = {}, []
     for node in ast.parse(Path(listing.__file__).read_text()).body:
         if isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
@@ -93,9 +94,15 @@ def _names(package: str, module: str, wanted: tuple[str, ...] | None) -> dict[st
 def stub_text(package: str, exports: dict[str, tuple[str, ...] | None]) -> str:
     """The ``__init__.pyi`` of ``package`` exporting ``exports`` (see the module docstring)."""
     where: dict[str, str] = {}
-    for module, wanted in exports.items():
+    # names listed one by one come after whole modules' __all__: an entry that names an object
+    # the package exports already says where to load it from (a lighter module than the list)
+    for module, wanted in sorted(exports.items(), key=lambda kv: kv[1] is not None):
         for name, origin in _names(package, module, wanted).items():
-            if name in where:
+            if name in where and (
+                wanted is None
+                or getattr(importlib.import_module(f"{package}.{origin}"), name)
+                is not getattr(importlib.import_module(f"{package}.{where[name]}"), name)
+            ):
                 raise ValueError(f"{package}: {name} exported twice")
             where[name] = origin
     by_module: dict[str, list[str]] = {}

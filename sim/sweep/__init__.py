@@ -13,6 +13,13 @@ import lazy_loader
 # The public names: the __all__ of these modules (module -> None) or the names listed. They are
 # imported on first use so that the command line starts fast; ``python docs/scripts/lazy_stubs.py``
 # writes them into __init__.pyi, which lazy_loader reads.
-_EXPORTS = {"_driver": None, "_verify": None}
+_EXPORTS = {
+    "_driver": ("*", "Execution", "assemble", "run_and_save"),
+    "_verify": None,
+    # the machinery of a sweep the calibration and the demo reuse
+    "_run": ("evaluate_run", "RunTask"),
+    "_params": ("apply_values", "parse_parameter", "parameter_units"),
+    "_spec": ("Design", "read_spec", "spec_digest"),
+}
 
 __getattr__, __dir__, __all__ = lazy_loader.attach_stub(__name__, __file__)

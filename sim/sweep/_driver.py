@@ -53,7 +53,7 @@ def _base(
 ) -> tuple[Any, Any, dict[str, Any], list]:
     """(SimParameters, WearSettings, JSON record, input files) of the base of every run."""
     from jointwear.params import from_mapping, read_toml, to_jsonable
-    from jointwear.sim.wear._settings import WearSettings
+    from jointwear.sim.wear import WearSettings
 
     if spec.run == "function":
         if params is not None:

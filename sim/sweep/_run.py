@@ -91,8 +91,7 @@ def _wear(
         wear_outputs,
     )
     from jointwear.sim.sweep._params import apply_values
-    from jointwear.sim.wear._contact import DynamicContact
-    from jointwear.sim.wear._loop import WearRun
+    from jointwear.sim.wear import DynamicContact, WearRun
 
     spec = task.spec
     params, settings = apply_values(task.sim_params, task.wear_settings, task.values)
