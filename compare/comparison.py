@@ -31,6 +31,7 @@ from jointwear.compare.criteria import Criteria, load_criteria
 from jointwear.compare.ensemble import WEAR_QUANTITIES, Ensemble, as_ensemble
 from jointwear.compare.origin import side_origin
 from jointwear.compare.reported import reported_metrics, split_reported
+from jointwear.compare.sensitivity import SENSITIVITY_COLUMNS, sensitivity_table
 from jointwear.compare.sources import Sources
 from jointwear.compare.study import band_study_uncertainty, is_study
 from jointwear.compare.verification import GCI, LeastSquaresStudy, numerical_uncertainty
@@ -72,7 +73,9 @@ class Comparison:
         Parts that were not compared (a side without wear maps or motion).
     sensitivity : DataFrame
         Which inputs dominate each quantity: the ensemble's Sobol indices (S1, ST), else
-        squared standardised regression coefficients (S1 column; method says which).
+        squared standardised regression coefficients in the S1 column; ``estimator`` names which
+        (``S1`` or ``SRC²``) and ``method`` how far an SRC² is a variance share
+        (:mod:`jointwear.compare.sensitivity`).
     """
 
     wear: xr.Dataset | None
@@ -84,9 +87,7 @@ class Comparison:
     data_origin: Mapping[str, str] = field(default_factory=dict)
     partial: tuple[str, ...] = ()
     sensitivity: pd.DataFrame = field(
-        default_factory=lambda: pd.DataFrame(
-            columns=["quantity", "parameter", "S1", "ST", "method"]
-        )
+        default_factory=lambda: pd.DataFrame(columns=SENSITIVITY_COLUMNS)
     )
 
     @property
@@ -286,67 +287,6 @@ def _ensemble_motion(
                     },
                 )
     return values, bands
-
-
-SENSITIVITY_COLUMNS = ["quantity", "parameter", "S1", "ST", "method"]
-
-
-def _regression(
-    ens: Ensemble, q: str, field_values: Mapping[str, Sequence[tuple[int, np.ndarray]]]
-) -> list[dict[str, object]]:
-    """Squared standardised regression coefficients of ``q`` on the inputs of a random ensemble.
-
-    For a model close to linear in its inputs, SRC² is the share of the output variance each
-    input explains (their sum is the R² of the fit, stated in the method). Used only when the
-    ensemble has no Sobol indices; needs more runs than inputs + 1.
-    """
-    found = list(field_values.get(q, ())) or ens.scalar(q)
-    rows: list[dict[str, object]] = []
-    for i, y in found[:1]:
-        ds = ens.datasets[i]
-        names = [p for p in ens.parameters(i) if p in ds.coords and ds[p].dims == ("run",)]
-        x = (
-            np.column_stack([np.asarray(ds[p].values, dtype=float) for p in names])
-            if names
-            else None
-        )
-        if x is None:
-            continue
-        ok = np.isfinite(y) & np.all(np.isfinite(x), axis=1)
-        sd = x[ok].std(axis=0, ddof=1) if ok.sum() > 1 else np.zeros(len(names))
-        if ok.sum() <= len(names) + 1 or np.any(sd == 0) or np.std(y[ok]) == 0:
-            continue
-        xs = (x[ok] - x[ok].mean(axis=0)) / sd
-        ys = (y[ok] - y[ok].mean()) / y[ok].std(ddof=1)
-        beta, *_ = np.linalg.lstsq(np.column_stack([np.ones(ok.sum()), xs]), ys, rcond=None)
-        r2 = 1.0 - float(
-            np.sum((ys - np.column_stack([np.ones(ok.sum()), xs]) @ beta) ** 2)
-        ) / float(np.sum(ys**2))
-        method = f"SRC² (linear fit over {int(ok.sum())} runs, R² = {r2:.2f})"
-        for p, b in zip(names, beta[1:], strict=True):
-            rows.append(
-                {
-                    "quantity": q,
-                    "parameter": p,
-                    "S1": float(b**2),
-                    "ST": float("nan"),
-                    "method": method,
-                }
-            )
-    return rows
-
-
-def _sensitivity(
-    ens: Ensemble | None,
-    quantities: Sequence[str],
-    field_values: Mapping[str, Sequence[tuple[int, np.ndarray]]],
-) -> pd.DataFrame:
-    rows: list[dict[str, object]] = []
-    if ens is not None:
-        for q in quantities:
-            sobol = [{"quantity": q, **r, "method": "Sobol (SALib)"} for r in ens.sensitivity(q)]
-            rows += sobol or _regression(ens, q, field_values)
-    return pd.DataFrame(rows, columns=SENSITIVITY_COLUMNS)
 
 
 #: What ``compare(verification=...)`` takes: sim verify studies or 1-D refinement datasets, or
@@ -603,5 +543,5 @@ def compare(
         criteria=criteria,
         data_origin={"simulation": side_origin(sims), "measurement": side_origin(meass)},
         partial=tuple(partial),
-        sensitivity=_sensitivity(ens, compared, field_values),
+        sensitivity=sensitivity_table(ens, compared, field_values),
     )

@@ -18,6 +18,7 @@ from jointwear.compare._choices import ALIGN_METHOD
 from jointwear.compare._decide import DECISION_COLUMNS, METRIC_COLUMNS
 from jointwear.compare.comparison import DEFAULT_AXES, Comparison
 from jointwear.compare.criteria import Criteria
+from jointwear.compare.sensitivity import SENSITIVITY_COLUMNS
 from jointwear.errors import ParameterError
 from jointwear.params import from_mapping, to_jsonable
 
@@ -85,6 +86,7 @@ def to_dataset(c: Comparison) -> xr.Dataset:
                 "S1": row.S1,
                 "ST": row.ST,
                 "method": row.method,
+                "estimator": row.estimator,
             }
         )
     n = vd.counts(c.states)
@@ -181,7 +183,10 @@ def load_comparison(source: str | Path | xr.Dataset) -> Comparison:
             "measurement": str(ds.attrs.get("data_origin_measurement", "not stated")),
         },
         partial=partial,
-        sensitivity=pd.DataFrame(sens, columns=["quantity", "parameter", "S1", "ST", "method"]),
+        sensitivity=pd.DataFrame(
+            [{"estimator": "SRC²" if "SRC" in s.get("method", "") else "S1", **s} for s in sens],
+            columns=SENSITIVITY_COLUMNS,
+        ),
     )
 
 
