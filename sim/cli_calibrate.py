@@ -1,0 +1,125 @@
+"""``jointwear sim calibrate`` (Bayesian calibration) and ``jointwear sim predict`` (the posterior
+ensemble of real simulations)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from jointwear._cli import Overwrite
+from jointwear.sim._cli_options import (
+    Base,
+    Progress,
+    Resume,
+    Scheduler,
+    WearParams,
+    Workers,
+    check_executor,
+    check_lost_runs,
+)
+from jointwear.sim.parameters import DEFAULT_PARAMETER_SET
+
+__all__ = ["register"]
+
+#: default ensemble size of ``sim predict`` (posterior samples simulated)
+PREDICT_SAMPLES = 16
+
+
+def calibrate_cmd(
+    spec: Annotated[Path, typer.Argument(help="Calibration spec (TOML; see docs/calibration.md).")],
+    out: Annotated[Path, typer.Option("--out", help="Posterior file (netCDF).")],
+    params: WearParams = None,
+    base: Base = DEFAULT_PARAMETER_SET,
+    workers: Workers = None,
+    scheduler: Scheduler = None,
+    resume: Resume = False,
+    verification: Annotated[
+        Path | None,
+        typer.Option(
+            "--verification",
+            help="A 'jointwear sim verify' study: u_num of each map quantity on its band "
+            "(else the spec's u_num_rel).",
+        ),
+    ] = None,
+    progress: Progress = None,
+    overwrite: Overwrite = False,
+) -> None:
+    """Calibrate uncertain inputs on measured data: emulator over the prior, posterior by MCMC.
+
+    The training runs (a Latin hypercube over the prior) go through the sweep driver and are
+    kept in OUT's folder as <out>.design-<cycles>.nc (--resume reuses them). Refused (exit 3):
+    an emulator error above the spec's fraction of the data's u, an unconverged chain, a
+    datum outside its posterior predictive interval.
+    """
+    from jointwear.progress import progress_bar, run_counter
+    from jointwear.sim.calibrate import calibrate
+
+    check_executor(workers, scheduler)
+    with progress_bar("training runs", total=None, enabled=progress) as bar:
+        ds = calibrate(
+            spec,
+            out=out,
+            params=params,
+            base=base,
+            workers=workers,
+            scheduler=scheduler,
+            resume=resume,
+            verification=[verification] if verification else [],
+            on_progress=run_counter(bar, "training runs"),
+        )
+    typer.echo(f"{out}: posterior of {', '.join(ds['parameter'].values.tolist())}")
+    for line in ds.attrs["identifiability"].splitlines():
+        typer.echo(f"  {line}")
+    typer.echo(
+        f"  sampler: {ds.attrs['sampler']}; acceptance {ds.attrs['acceptance_fraction']:.2f}"
+    )
+    for i, label in enumerate(ds["datum"].values):
+        typer.echo(
+            f"  {label}: measured {float(ds['measured'][i]):.4g}, predictive "
+            f"{float(ds['ppc_lo'][i]):.4g} .. {float(ds['ppc_hi'][i]):.4g}"
+        )
+
+
+def predict_cmd(
+    posterior: Annotated[Path, typer.Argument(help="Posterior file of 'jointwear sim calibrate'.")],
+    cycles: Annotated[float, typer.Option("--cycles", help="Crank cycles to simulate.")],
+    out: Annotated[Path, typer.Option("--out", help="Prediction ensemble (netCDF).")],
+    samples: Annotated[
+        int, typer.Option("--samples", min=2, help="Posterior samples simulated.")
+    ] = PREDICT_SAMPLES,
+    workers: Workers = None,
+    scheduler: Scheduler = None,
+    resume: Resume = False,
+    progress: Progress = None,
+    overwrite: Overwrite = False,
+) -> None:
+    """Run the simulator at posterior samples: the ensemble 'jointwear compare' takes as the
+    simulation (mean map compared, spread = input uncertainty)."""
+    from jointwear.progress import progress_bar, run_counter
+    from jointwear.sim.calibrate import predict
+
+    check_executor(workers, scheduler)
+    with progress_bar("prediction", total=None, enabled=progress) as bar:
+        ds = predict(
+            posterior,
+            cycles=cycles,
+            out=out,
+            samples=samples,
+            workers=workers,
+            scheduler=scheduler,
+            resume=resume,
+            on_progress=run_counter(bar, "prediction"),
+        )
+    typer.echo(
+        f"{out}: {ds.attrs['n_runs']} runs at posterior samples, {cycles:g} cycles: "
+        f"{ds.attrs['n_ok']} ok, {ds.attrs['n_failed']} failed, {ds.attrs['n_not_run']} not run"
+    )
+    check_lost_runs(ds, f" (see 'error' in {out})")
+
+
+def register(app: typer.Typer) -> None:
+    """Add ``jointwear sim calibrate`` and ``jointwear sim predict`` to the ``sim`` group."""
+    app.command("calibrate")(calibrate_cmd)
+    app.command("predict")(predict_cmd)
