@@ -207,6 +207,14 @@ FormFraction = Annotated[
         f"radius (default {_LIM['form_fraction']:g}).",
     ),
 ]
+MaxMissing = Annotated[
+    float | None,
+    _opt(
+        "--max-missing",
+        "Largest share of a layer's points that may be missing ('---', 'NaN', empty cells) "
+        f"(default {_LIM['max_missing']:g}).",
+    ),
+]
 
 
 # --- assess ---------------------------------------------------------------------------------

@@ -50,6 +50,7 @@ PLAUSIBILITY: dict[str, float] = {
     "min_form": 10e-9,  # [m] smallest peak-to-valley of a deviation trace (below any probe noise)
     "nominal_tolerance": 0.05,  # relative: measured radius within 5 % of the stated nominal
     "deviation_fraction": 0.05,  # |deviation| at most 5 % of the stated nominal radius
+    "max_missing": 0.05,  # share of a layer's points that may be missing (NaN)
     "form_fraction": 0.01,  # deviation peak-to-valley (0.5-99.5 %) at most 1 % of the radius
     "spacing_tolerance": 0.01,  # relative: stated layer spacing vs the layers found
     "points_tolerance": 0.01,  # relative: stated angular step vs the step of the angles

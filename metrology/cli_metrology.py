@@ -79,6 +79,7 @@ def import_cmd(
     nominal_tolerance: opt.NominalTolerance = None,
     min_form_nm: opt.MinFormNm = None,
     form_fraction: opt.FormFraction = None,
+    max_missing: opt.MaxMissing = None,
 ) -> None:
     """Import roundness/cylindricity text exports into contract netCDF files."""
     from jointwear.metrology.readers.importing import import_scans
@@ -108,6 +109,7 @@ def import_cmd(
         nominal_tolerance=nominal_tolerance,
         min_form=_si(min_form_nm, 1e-9),
         form_fraction=form_fraction,
+        max_missing=max_missing,
     )
     if instrument is not None:
         options["instrument"] = instrument
@@ -120,6 +122,11 @@ def import_cmd(
             f"{target}: {var} {ds.sizes['z']} layers x {ds.sizes['theta']} points "
             f"(instrument 0 deg along {angle_zero}, {ds.attrs['instrument_angle_direction']})"
         )
+        if ds.attrs.get("missing_points"):
+            typer.echo(
+                f"  note: {ds.attrs['missing_points']} point(s) missing in the file (read as "
+                "NaN; fits skip them)"
+            )
         if ds.attrs.get("z_unconfirmed"):
             typer.echo(f"  note: {ds.attrs['z_unconfirmed']}")
 
@@ -241,26 +248,59 @@ def wearmap_cmd(
     plot: Annotated[
         Path | None, typer.Option("--plot", help="Also save a wear-map figure (PNG).")
     ] = None,
+    unworn: Annotated[
+        str | None,
+        typer.Option(
+            "--unworn",
+            help="Theta arcs known to be unworn, START:END[,START:END...] [degree, canonical "
+            "convention; START > END wraps through 0]: skips the search for unworn points.",
+        ),
+    ] = None,
+    unworn_z_mm: Annotated[
+        str | None,
+        typer.Option(
+            "--unworn-z-mm",
+            help="z ranges known to be unworn, START:END[,...] [mm]; with --unworn both hold.",
+        ),
+    ] = None,
 ) -> None:
     """Wear depth over (z, theta) from a worn scan and a before-scan or fitted reference."""
     from jointwear import io
     from jointwear.metrology.readers.importing import output_paths
     from jointwear.metrology.wearmap import wear_map
 
+    arcs = _ranges(unworn, "--unworn", 1.0)
+    z_ranges = _ranges(unworn_z_mm, "--unworn-z-mm", 1e-3)
     targets = output_paths(worn, out, "_wear.nc")
     ref = io.load(before) if before is not None else None
     for path, target in zip(worn, targets, strict=True):
         io.check_writable(target)
         w = io.load(path)
-        ds = wear_map(
-            w,
-            ref,
-            angle_offset_deg=angle_offset_deg,
-            register=register,
-            shape=str(shape),
-            threshold=threshold,
-            radius=radius_mm * 1e-3 if radius_mm else None,
-        )
+        try:
+            ds = wear_map(
+                w,
+                ref,
+                angle_offset_deg=angle_offset_deg,
+                register=register,
+                shape=str(shape),
+                threshold=threshold,
+                radius=radius_mm * 1e-3 if radius_mm else None,
+                unworn=arcs,
+                unworn_z=z_ranges,
+            )
+        except Exception as exc:
+            given = {
+                "--before": before,
+                "--out": target,
+                "--angle-offset-deg": angle_offset_deg or None,
+                "--register": register or None,
+                "--shape": shape if str(shape) != WEAR_SHAPE else None,
+                "--threshold": threshold if threshold != UNWORN_THRESHOLD else None,
+                "--radius-mm": radius_mm,
+                "--unworn-z-mm": unworn_z_mm,
+            }
+            _rethrow_with_command(exc, path, given)
+            raise
         inputs = [path] + ([before] if before is not None else [])
         io.save(
             ds,
@@ -273,6 +313,8 @@ def wearmap_cmd(
                 "register": register,
                 "shape": str(shape),
                 "threshold": threshold,
+                "unworn": unworn,
+                "unworn_z_mm": unworn_z_mm,
             },
         )
         typer.echo(f"{target}: {_wear_summary(ds)}")
@@ -321,6 +363,51 @@ def _save_form(result, target: Path, scan_path: Path, scan, params: dict) -> Non
     result.attrs["source"] = _SOURCE
     io.save(result, target, inputs=[scan_path], parameters=params, source=_SOURCE, parents=[scan])
     typer.echo(f"wrote {target}")
+
+
+def _ranges(text: str | None, flag: str, scale: float) -> list[tuple[float, float]] | None:
+    """``START:END[,START:END...]`` as (start, end) pairs times ``scale`` (None stays None)."""
+    if text is None:
+        return None
+    try:
+        pairs = [tuple(float(v) * scale for v in part.split(":")) for part in text.split(",")]
+    except ValueError:
+        pairs = [()]
+    if not pairs or any(len(p) != 2 for p in pairs):
+        raise typer.BadParameter(
+            f"{text!r}: expected START:END pairs joined by commas, e.g. 200:330 or 330:30,150:200",
+            param_hint=flag,
+        )
+    return pairs
+
+
+def _rethrow_with_command(exc, path: Path, given: dict) -> None:
+    """A wear map refused with unworn arcs: the message ends with the command to run (the
+    options ``given`` that are not None, flags as True)."""
+    import shlex
+
+    from jointwear.errors import BadInputError
+    from jointwear.metrology._wear_unseen import WearMapRefusal, format_arcs
+
+    if not isinstance(exc, WearMapRefusal):
+        return
+    cmd = ["jointwear", "metrology", "wearmap", str(path)]
+    for flag, value in given.items():
+        if value is True:
+            cmd.append(flag)
+        elif value is not None:
+            cmd += [flag, f"{value:g}" if isinstance(value, float) else str(value)]
+    if exc.unworn_arcs:
+        fix = (
+            "if the bore is known to be unworn at theta "
+            f"{format_arcs(exc.unworn_arcs)} degree (canonical convention; the arcs the data "
+            "find least worn), run: " + shlex.join([*cmd, "--unworn", format_arcs(exc.unworn_arcs)])
+        )
+    else:
+        fix = "give the theta arcs known to be unworn: " + shlex.join(
+            [*cmd, "--unworn", "START:END"]
+        )
+    raise BadInputError(f"{exc.reason}; {fix}") from None
 
 
 def _wear_summary(ds) -> str:

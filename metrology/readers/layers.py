@@ -156,6 +156,18 @@ def _check_layers(
                 f"{where}: layer {k + 1} has only {lay.value.size} point(s); a roundness trace "
                 "needs at least 4 (the file looks truncated - re-export it)"
             )
+        share = float(np.isnan(lay.value).mean())
+        if share > limits["max_missing"]:
+            text, sugg = advise(
+                [({"max_missing": "<value>"}, f"at least {share:.3g}, to read it with them")]
+            )
+            raise Refusal(
+                f"{where}: layer {k + 1} has {int(np.isnan(lay.value).sum())} of "
+                f"{lay.value.size} points missing ({share:.1%}), more than max_missing = "
+                f"{limits['max_missing']:g} of a layer (its form would rest on what is left); "
+                f"re-export the layer, or {text}",
+                sugg,
+            )
     if pts is not None and layered:
         for lay in out:
             check_points(pts, lay.value.size, {"deg": lay.theta_deg}, arc, True, where, limits)

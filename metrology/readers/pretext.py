@@ -34,6 +34,7 @@ __all__ = [
     "fields",
     "is_missing",
     "normalise",
+    "numeric_line",
     "sniff_delimiter",
     "sniff_thousands",
     "split_blocks",
@@ -277,9 +278,21 @@ def normalise(
     return text, notes
 
 
+_TOKENS = re.compile(r"[\t;,]|\s+")
+_NUMBER_START = re.compile(r"^[-+]?(?:\d|[.,]\d)[^A-DF-Za-df-z]*$")
+
+
+def numeric_line(line: str) -> bool:
+    """A line of the table: every field (split at tab, ``;``, ``,`` or whitespace) a number
+    (starting with a digit; no letter but an exponent's ``e``) or a missing-value mark
+    (:data:`MISSING`), at least one of them a number."""
+    toks = [t for t in _TOKENS.split(line.strip()) if t]
+    numbers = [bool(_NUMBER_START.match(t)) for t in toks]
+    return any(numbers) and all(n or is_missing(t) for n, t in zip(numbers, toks, strict=True))
+
+
 def _is_data(line: str) -> bool:
-    s = line.strip()
-    return bool(s) and bool(re.match(r"^[-+]?\d", s)) and not re.search(r"[A-DF-Za-df-z]", s)
+    return numeric_line(line)
 
 
 def _unquote(text: str) -> str:
@@ -303,12 +316,7 @@ _BLOCK_KEY = re.compile(r"^\W*(layer|plane|trace|block|section|z|height|level|po
 
 
 def _numeric(line: str) -> bool:
-    s = line.strip()
-    return (
-        bool(s)
-        and bool(re.match(r"^[-+]?(?:\d|[.,]\d)", s))
-        and not re.search(r"[A-DF-Za-df-z]", s)
-    )
+    return numeric_line(line)
 
 
 _FIRST_NUMBER = re.compile(r"^[ \t]*[-+]?(?:\d|[.,]\d)", re.M)

@@ -108,6 +108,7 @@ def read_scan(
     nominal_tolerance: float | None = None,
     min_form: float | None = None,
     form_fraction: float | None = None,
+    max_missing: float | None = None,
 ) -> xr.Dataset:
     """Read a roundness / cylindricity scan from text exports into a contract Dataset.
 
@@ -161,6 +162,9 @@ def read_scan(
         tolerance against a stated nominal radius (0.05), smallest peak-to-valley of a
         deviation trace [m] (10 nm), largest peak-to-valley of deviations relative to the
         stated nominal radius (0.01).
+    max_missing : float, optional
+        Largest share of a layer's points that may be missing (``---``, ``NaN``, empty cells:
+        read as NaN points, counted in ``missing_points``); default 0.05.
 
     Returns
     -------
@@ -195,7 +199,9 @@ def read_scan(
         thousands,
     )
     files, folder = _collect_files(paths, pattern)
-    limits = _limits(radius_range, max_deviation, nominal_tolerance, min_form, form_fraction)
+    limits = _limits(
+        radius_range, max_deviation, nominal_tolerance, min_form, form_fraction, max_missing
+    )
     parsed = [pf for f in files for pf in parse_blocks(f, base)]
     layers, metadata, notes = _read_layers(
         parsed, len(files), expected_points, allow_partial, value, angle_unit, arc, limits
@@ -243,7 +249,7 @@ def _checked(convention, value: str, layout: str) -> AngleConvention:
 
 
 def _limits(
-    radius_range, max_deviation, nominal_tolerance, min_form, form_fraction
+    radius_range, max_deviation, nominal_tolerance, min_form, form_fraction, max_missing
 ) -> dict[str, float]:
     """The plausibility limits with the options given."""
     rmin, rmax = (None, None) if radius_range is None else radius_range
@@ -254,6 +260,7 @@ def _limits(
         nominal_tolerance=nominal_tolerance,
         min_form=min_form,
         form_fraction=form_fraction,
+        max_missing=max_missing,
     )
 
 
@@ -404,4 +411,6 @@ def _record_reading(ds: xr.Dataset, first, notes: dict, unconfirmed: str | None)
         ds.attrs["instrument_units"] = first.units
     if unconfirmed:
         ds.attrs["z_unconfirmed"] = unconfirmed
+    var = "radius" if "radius" in ds else "radial_deviation"
+    ds.attrs["missing_points"] = int(ds[var].isnull().sum())  # NaN points (missing cells)
     return ds

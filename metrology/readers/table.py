@@ -14,7 +14,14 @@ import pandas as pd
 from jointwear.errors import BadInputError
 from jointwear.metrology.readers.claims import drop_ignored
 from jointwear.metrology.readers.columns import COLUMN_KINDS, _guess_columns, _kind_from_name
-from jointwear.metrology.readers.pretext import normalise, split_blocks, thousands_mark
+from jointwear.metrology.readers.pretext import (
+    MISSING,
+    is_missing,
+    normalise,
+    numeric_line,
+    split_blocks,
+    thousands_mark,
+)
 from jointwear.metrology.readers.source import _read_text
 from jointwear.metrology.readers.units import _LENGTH_KINDS, UNITS, _file_units, unit_factor
 
@@ -167,7 +174,8 @@ def _score(lines: Sequence[str], delim: str, dec: str) -> tuple[int, float] | No
         toks = _split(ln, delim)
         if delim != " " and toks and toks[-1] == "":
             toks = toks[:-1]  # trailing delimiter
-        if toks and all(_is_num(t, dec) for t in toks):
+        nums = [_is_num(t, dec) for t in toks]
+        if any(nums) and all(n or is_missing(t) for n, t in zip(nums, toks, strict=True)):
             counts[len(toks)] = counts.get(len(toks), 0) + 1
     if not counts:
         return None
@@ -177,10 +185,7 @@ def _score(lines: Sequence[str], delim: str, dec: str) -> tuple[int, float] | No
 
 
 def _numeric_line(line: str) -> bool:
-    s = line.strip()
-    if not s:
-        return False
-    return bool(re.match(r"^[-+]?(?:\d|[.,]\d)", s)) and not re.search(r"[A-DF-Za-df-z]", s)
+    return numeric_line(line)
 
 
 def sniff(
@@ -367,6 +372,60 @@ def parse_blocks(path: str | Path, fmt: TextFormat = TextFormat()) -> list[Parse
     return out
 
 
+def _modal_width(lines: Sequence[str], body_idx: Sequence[int], delim: str) -> int:
+    """The number of fields of most of the first 200 table lines (a first line whose last cell
+    is missing, ``0.5<TAB>``, does not set the width)."""
+    counts: dict[int, int] = {}
+    for i in list(body_idx[:200]):
+        toks = _split(lines[i], delim)
+        if delim != " " and toks and toks[-1] == "":
+            toks = toks[:-1]
+        counts[len(toks)] = counts.get(len(toks), 0) + 1
+    return max(counts.items(), key=lambda kv: (kv[1], kv[0]))[0]
+
+
+#: Cells pandas reads as missing besides its defaults (every case of :data:`MISSING`).
+_NA_CELLS = sorted({v for m in MISSING if m for v in (m, m.upper(), m.title())})
+_PLACED = ("radius", "deviation", "value", "ignore")
+
+
+def _short_rows(
+    path: str, lines: Sequence[str], line_numbers: np.ndarray, data: np.ndarray, fmt, ncol: int
+) -> None:
+    """A row with a missing cell must still have every field (an empty cell between
+    delimiters); fewer fields is a cut line, which pandas would pad with NaN: refused."""
+    for r in np.flatnonzero(np.any(np.isnan(data), axis=1)):
+        ln = lines[line_numbers[r] - 1]
+        raw = ln.split() if fmt.delimiter == " " else ln.strip("\r\n ").split(fmt.delimiter)
+        if len(raw) < ncol:
+            more = " (the file looks truncated - re-export it)" if r == data.shape[0] - 1 else ""
+            raise BadInputError(
+                f"'{path}' line {line_numbers[r]}: expected {ncol} fields, found {len(raw)} in "
+                f"{ln.strip()[:60]!r}{more}; a missing value is written as an empty field or a "
+                "mark such as '---' or 'NaN' - fix or delete the line"
+            )
+
+
+def _missing(
+    path: str, data: np.ndarray, cols: Sequence[str], line_numbers: np.ndarray, guessed: dict
+) -> None:
+    """Missing cells (:data:`MISSING`) of value columns are points without a value (NaN,
+    counted in ``guessed["missing"]``); a missing angle, z or coordinate cannot be placed."""
+    nan = np.isnan(data)
+    if not nan.any():
+        return
+    for j, c in enumerate(cols):
+        if c not in _PLACED and nan[:, j].any():
+            r = int(np.flatnonzero(nan[:, j])[0])
+            raise BadInputError(
+                f"'{path}' line {line_numbers[r]}: the {c} (column {j + 1}) is missing; a point "
+                "without its position cannot be placed - delete the line or re-export it"
+            )
+    count = int(nan[:, [j for j, c in enumerate(cols) if c in _PLACED[:3]]].sum())
+    if count:
+        guessed["missing"] = f"{count} missing value(s) (e.g. '---', 'NaN', empty) read as NaN"
+
+
 def _parse_text(path: Path, text: str, fmt: TextFormat, pre: dict[str, str]) -> ParsedFile:
     fmt, guessed = sniff(text, fmt, path=str(path))
     guessed.update(pre)
@@ -378,10 +437,7 @@ def _parse_text(path: Path, text: str, fmt: TextFormat, pre: dict[str, str]) -> 
     else:
         body_idx = range(hl, len(lines))
     line_numbers = np.asarray(body_idx, dtype=np.int64) + 1
-    first = _split(lines[body_idx[0]], fmt.delimiter or " ")
-    if fmt.delimiter != " " and first and first[-1] == "":
-        first = first[:-1]
-    ncol = len(first)
+    ncol = _modal_width(lines, body_idx, fmt.delimiter or " ")
     body = "\n".join(tail) if isinstance(body_idx, range) else "\n".join(lines[i] for i in body_idx)
     sep = r"\s+" if fmt.delimiter == " " else fmt.delimiter
     try:
@@ -395,6 +451,7 @@ def _parse_text(path: Path, text: str, fmt: TextFormat, pre: dict[str, str]) -> 
             skip_blank_lines=False,
             na_filter=True,
             keep_default_na=True,
+            na_values=_NA_CELLS,
             usecols=range(ncol),
             skipinitialspace=True,
         )
@@ -402,15 +459,14 @@ def _parse_text(path: Path, text: str, fmt: TextFormat, pre: dict[str, str]) -> 
     except (ValueError, pd.errors.ParserError):
         _bad_line(str(path), lines, line_numbers, fmt, ncol)
         raise  # pragma: no cover - _bad_line always raises
-    if data.shape[0] != len(body_idx) or not np.all(np.isfinite(data)):
+    if data.shape[0] != len(body_idx) or np.any(np.isinf(data)):
         bad = (
-            np.flatnonzero(~np.all(np.isfinite(data), axis=1))
-            if data.shape[0] == len(body_idx)
-            else []
+            np.flatnonzero(np.any(np.isinf(data), axis=1)) if data.shape[0] == len(body_idx) else []
         )
         if len(bad):
             _bad_line(str(path), lines, line_numbers[bad[0] :], fmt, ncol)
         _bad_line(str(path), lines, line_numbers, fmt, ncol)
+    _short_rows(str(path), lines, line_numbers, data, fmt, ncol)
     # a short last line is read as NaN-padded by pandas; caught above. Extra fields:
     last = _split(lines[body_idx[-1]], fmt.delimiter or " ")
     if fmt.delimiter != " " and last and last[-1] == "":
@@ -436,6 +492,7 @@ def _parse_text(path: Path, text: str, fmt: TextFormat, pre: dict[str, str]) -> 
     else:
         cols, name_units = _guess_columns(data, names)
         guessed["columns"] = ",".join(cols)
+    _missing(str(path), data, cols, line_numbers, guessed)
     if "units" in fmt.ignore_header:
         name_units = {k: u for k, u in name_units.items() if cols[int(k)] not in _LENGTH_KINDS}
         guessed["ignored_header"] = "units (header and column names; ignore_header)"

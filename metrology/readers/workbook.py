@@ -37,6 +37,24 @@ def _has_numbers(ws) -> bool:
     return False
 
 
+def _blank_cells_missing(rows: list[list[str]]) -> list[list[str]]:
+    """Rows of numbers padded to the table's width: a blank cell at the end of a row of the
+    table is a missing value (a worksheet has no cut lines), not a shorter row."""
+    from collections import Counter
+
+    from jointwear.metrology.readers.pretext import numeric_line
+
+    numeric = [bool(r) and numeric_line("\t".join(r)) for r in rows]
+    widths = Counter(len(r) for r, n in zip(rows, numeric, strict=True) if n)
+    if not widths:
+        return rows
+    width = widths.most_common(1)[0][0]
+    return [
+        r + [""] * (width - len(r)) if n and len(r) < width else r
+        for r, n in zip(rows, numeric, strict=True)
+    ]
+
+
 def workbook_text(path: Path, sheet: str | None = None) -> str:
     """Tab-separated text of one worksheet of ``path``.
 
@@ -100,10 +118,10 @@ def workbook_text(path: Path, sheet: str | None = None) -> str:
             cells = [_cell(v) for v in row]
             while cells and cells[-1] == "":
                 cells.pop()
-            rows.append("\t".join(cells))
+            rows.append(cells)
     finally:
         wb.close()
-    text = "\n".join(rows).rstrip("\n") + "\n"
+    text = "\n".join("\t".join(r) for r in _blank_cells_missing(rows)).rstrip("\n") + "\n"
     if not text.strip():
         raise BadInputError(f"'{path}': the sheet is empty")
     return text

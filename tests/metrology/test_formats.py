@@ -65,14 +65,21 @@ def test_talyrond_style_workbook_reads_every_digit(tmp_path):
     assert main(args + ["--sheet", "Trace"]) == 0 and out.exists()
 
 
-def test_workbook_with_a_missing_cell_names_the_row(tmp_path):
+def test_workbook_with_a_blank_value_cell_reads_a_missing_point(tmp_path):
+    """A blank cell (a formula never calculated, a deleted cell) is a missing value (issue 38:
+    NaN, counted); a blank angle cannot be placed and names the row."""
     th, r = _trace(360)
     rows = [("Units", "um"), ("Angle (deg)", "Deviation (um)")]
     rows += [(a, v - 8000.0) for a, v in zip(th.tolist(), r.tolist(), strict=True)]
-    rows[50] = (rows[50][0], None)  # a formula never calculated / a deleted cell
+    rows[50] = (rows[50][0], None)
     f = _workbook(tmp_path / "gap.xlsx", {"Sheet1": rows})
-    with pytest.raises(BadInputError, match=r"gap.xlsx' line 51: expected 2 fields, found 1"):
-        read_scan(f, convention=CONV)
+    ds = read_scan(f, convention=CONV)
+    assert ds.attrs["missing_points"] == 1
+    assert int(np.isnan(ds["radial_deviation"].values[0]).sum()) == 1
+    rows[50] = (None, rows[51][1])
+    g = _workbook(tmp_path / "gap2.xlsx", {"Sheet1": rows})
+    with pytest.raises(BadInputError, match=r"gap2.xlsx' line 51: the angle_deg .* is missing"):
+        read_scan(g, convention=CONV)
 
 
 def test_damaged_workbook_and_old_xls_are_refused(tmp_path):

@@ -132,7 +132,7 @@ BAD = {
     ),
     "nan": (
         "Units: um\n0.0\t1.0\n1.0\t2.0\n2.0\tnan\n3.0\t1.0\n",
-        r"line 4: 'nan' is not a measured value",
+        r"layer 1 has 1 of 4 points missing \(25.0%\), more than max_missing",
     ),
     "text": (
         "Units: um\n0.0\t1.0\n1.0\t2.0\n2.0\t2.5\n3.0\tabc\n",

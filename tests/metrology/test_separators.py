@@ -215,3 +215,71 @@ def test_a_form_within_one_percent_of_the_radius_passes(tmp_path):
         read_scan(h, convention=CONV)
     ds = read_scan(h, convention=CONV, form_fraction=0.02)
     np.testing.assert_allclose(ds["radial_deviation"].values[0], np.round(dev, 4) * 1e-3)
+
+
+# --- issue 38 item 4: missing values are NaN points, counted; too many refused ---------------
+
+
+@pytest.mark.parametrize("mark", ["---", "NaN", "nan", "", "-", "*", "n/a", "#N/A", "invalid"])
+@pytest.mark.parametrize("delim", [",", ";", "\t"])
+def test_missing_cells_are_nan_points_counted(tmp_path, mark, delim, run_import):
+    import xarray as xr
+
+    from jointwear.metrology import assess
+
+    n = 360
+    th = np.arange(n) * 1.0
+    dev = 0.3 * np.cos(2 * np.radians(th))
+    gone = [10, 100, 250]
+    rows = [
+        delim.join([f"{a:.1f}", mark if i in gone else f"{v:.4f}"])
+        for i, (a, v) in enumerate(zip(th, dev, strict=True))
+    ]
+    f = tmp_path / "miss.csv"
+    f.write_text(f"Units: um\nAngle (deg){delim}Deviation\n" + "\n".join(rows) + "\n")
+    ds = read_scan(f, convention=CONV)
+    v = ds["radial_deviation"].values[0]
+    assert np.flatnonzero(np.isnan(v)).tolist() == gone
+    want = np.round(dev, 4) * 1e-6
+    want[gone] = np.nan
+    np.testing.assert_allclose(v, want, rtol=0, atol=1e-12)
+    assert ds.attrs["missing_points"] == 3
+    assert "3 missing" in ds.attrs["reader_guesses"]["miss.csv"]["missing"]
+    # the fit skips them: the LS roundness is that of the 357 points left (limaçon, lstsq)
+    ok = np.isfinite(want)
+    t = np.radians(ds["theta"].values[ok])
+    a = np.column_stack([np.ones(t.size), np.cos(t), np.sin(t)])
+    res = want[ok] - a @ np.linalg.lstsq(a, want[ok], rcond=None)[0]
+    np.testing.assert_allclose(assess(ds)["RONt_LS"].values[0], np.ptp(res), rtol=1e-9)
+    out = tmp_path / "miss.nc"
+    assert run_import(f, out) == 0
+    assert xr.load_dataset(out).attrs["missing_points"] == 3
+
+
+def test_a_layer_with_too_many_missing_points_is_refused_naming_the_flag(tmp_path, run_import):
+    n = 100
+    rows = [f"{i * 3.6:.1f}\t{'---' if i % 10 == 0 else f'{np.cos(i / 9):.4f}'}" for i in range(n)]
+    f = tmp_path / "holes.txt"
+    f.write_text("Units: um\nAngle (deg)\tDeviation\n" + "\n".join(rows) + "\n")
+    with pytest.raises(BadInputError, match=r"10 of 100 points missing.*max_missing") as exc:
+        read_scan(f, convention=CONV)
+    assert exc.value.suggestions == ({"max_missing": "<value>"},)
+    assert read_scan(f, convention=CONV, max_missing=0.1).attrs["missing_points"] == 10
+    out = tmp_path / "h.nc"
+    assert run_import(f, out) == 3
+    assert run_import(f, out, "--max-missing", "0.1") == 0
+
+
+def test_a_missing_angle_or_a_cut_row_is_refused_not_a_missing_point(tmp_path):
+    rows = [f"{i:.1f}\t{np.cos(i / 9):.4f}" for i in range(360)]
+    rows[50] = "---\t0.5"
+    f = tmp_path / "angle.txt"
+    f.write_text("Units: um\nAngle (deg)\tDeviation\n" + "\n".join(rows) + "\n")
+    with pytest.raises(BadInputError, match=r"line 53: the angle_deg \(column 1\) is missing"):
+        read_scan(f, convention=CONV)
+    rows = [f"{i:.1f};{np.cos(i / 9):.4f};{np.sin(i / 9):.4f}" for i in range(360)]
+    rows[50] = "50.0;0.5"  # a field short: not an empty cell
+    g = tmp_path / "cut.txt"
+    g.write_text("Units: um\nAngle (deg);Dev z=0 mm;Dev z=1 mm\n" + "\n".join(rows) + "\n")
+    with pytest.raises(BadInputError, match=r"line 53: expected 3 fields, found 2"):
+        read_scan(g, convention=CONV)
