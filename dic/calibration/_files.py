@@ -14,7 +14,7 @@ __all__ = ["board_views", "calibrate_files", "rejected_path"]
 
 
 def _video_frames(path: Path, every: int, what: str) -> list:
-    from jointwear.dic.footage._video import open_frames
+    from jointwear.dic.footage import open_frames
 
     src = open_frames(path, what=what)
     return [img for i, _, img in src.frames() if i % every == 0]
@@ -23,7 +23,7 @@ def _video_frames(path: Path, every: int, what: str) -> list:
 def board_views(left: Path, right: Path, every: int = VIDEO_EVERY):
     """(left images, right images, view names or None) of two folders / patterns or videos
     (videos: every ``every``-th frame, named ``<video>#<frame>``)."""
-    from jointwear.dic.footage._video import is_image_sequence, list_image_sequence
+    from jointwear.dic.footage import is_image_sequence, list_image_sequence
 
     if is_image_sequence(left):  # a folder, or a pattern like 'cal/*_0.tif'
         lefts = list_image_sequence(left, what="left calibration")[0]

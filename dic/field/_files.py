@@ -20,7 +20,7 @@ def image_list(values: Sequence[str] | None, what: str):
     pattern of the later images (the first image is the reference)."""
     if not values:
         return None
-    from jointwear.dic.footage._video import is_image_sequence, list_image_sequence
+    from jointwear.dic.footage import is_image_sequence, list_image_sequence
 
     if len(values) == 1 and is_image_sequence(values[0]):
         return values[0]
@@ -41,7 +41,7 @@ def image_list(values: Sequence[str] | None, what: str):
 
 
 def _input_files(values: Sequence[str] | None) -> list[Path]:
-    from jointwear.dic.footage._video import is_image_sequence, list_image_sequence
+    from jointwear.dic.footage import is_image_sequence, list_image_sequence
 
     out: list[Path] = []
     for v in values or []:
@@ -96,7 +96,7 @@ def measure_field_files(
     from jointwear._version import source_attribute
     from jointwear.dic.field._io import save_field_plot, write_field_csv
     from jointwear.dic.field._measure import measure_field
-    from jointwear.dic.subset._files import read_points_file
+    from jointwear.dic.subset import read_points_file
     from jointwear.io import check_writable, save
 
     params = params or FieldParams()
@@ -108,7 +108,7 @@ def measure_field_files(
     t0 = time.perf_counter()
     common = dict(roi=roi, points=pts, frame_rate=frame_rate, data_origin=data_origin)
     if left or right:
-        from jointwear.dic.calibration._importers import read_calibration
+        from jointwear.dic.calibration import read_calibration
 
         cal = read_calibration(calibration)
         left_images, right_images = image_list(left, "--left"), image_list(right, "--right")

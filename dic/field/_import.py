@@ -42,8 +42,8 @@ import numpy as np
 import xarray as xr
 
 from jointwear.dic.field._measure import FIELD_FLAG_MEANINGS
-from jointwear.dic.icgn._flags import FLAG_NOT_REACHED
-from jointwear.dic.subset._params import check_image_origin
+from jointwear.dic.icgn import FLAG_NOT_REACHED
+from jointwear.dic.subset import check_image_origin
 from jointwear.errors import BadInputError, ParameterError
 
 __all__ = ["read_field", "FIELD_FORMATS", "import_summary"]
@@ -86,7 +86,7 @@ _COLUMNS = {
 
 
 def _scale(length_unit) -> float:
-    from jointwear.dic.calibration._importers import metres_per_unit
+    from jointwear.dic.calibration import metres_per_unit
 
     s = metres_per_unit(length_unit, _UNITS)
     if s is None:

@@ -116,7 +116,7 @@ def read_roi(spec, shape: tuple[int, int]) -> tuple[np.ndarray, str]:
         if path.suffix.lower() == ".toml":
             poly = _read_polygon(path)
             return _polygon_mask(poly, shape), f"polygon from '{path.name}' ({len(poly)} vertices)"
-        from jointwear.dic.subset._sequence import read_image
+        from jointwear.dic.subset import read_image
 
         img = read_image(path)
         if img.shape != (h, w):

@@ -101,7 +101,7 @@ def check_calibration_fits(calibration, uv_left, uv_right, ok, epipolar_max_px) 
     the median reprojection residual exceeds ``MISFIT_FACTOR`` times the gate: most points
     would be flagged ``epipolar_mismatch`` and the positions of the rest carry the misfit.
     """
-    from jointwear.dic.calibration._stereo import epipolar_distance, triangulate
+    from jointwear.dic.calibration import epipolar_distance, triangulate
 
     if not ok.any():
         return {}
@@ -155,7 +155,7 @@ def stereo_geometry(calibration, sub_x, sub_y, DL, SR, DR, flag, prm):
     displacements (T, N, 3) [m] in the output frame, their standard uncertainties, and the
     dataset's stereo variables, coordinates and attributes.
     """
-    from jointwear.dic.calibration._stereo import triangulate
+    from jointwear.dic.calibration import triangulate
     from jointwear.dic.field._measure import variable
 
     n_t, _, n = sub_x.shape

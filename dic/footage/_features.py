@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from jointwear.dic.calibration._stereo import epipolar_distance
+from jointwear.dic.calibration import epipolar_distance
 
 #: candidates per feature in the epipolar-guided matching
 _K_CANDIDATES = 8

@@ -51,7 +51,7 @@ def track_files(
     **options
         Passed to :func:`track_footage` (``fps``, ``max_frames``, ``resume``, ``scheduler``).
     """
-    from jointwear.dic.calibration._importers import read_calibration
+    from jointwear.dic.calibration import read_calibration
     from jointwear.dic.footage._track import track_footage
 
     cal = read_calibration(calibration) if calibration is not None else None

@@ -8,7 +8,7 @@ from typing import Any
 
 import numpy as np
 
-from jointwear.dic.calibration._stereo import epipolar_distance, triangulate
+from jointwear.dic.calibration import epipolar_distance, triangulate
 from jointwear.dic.footage._config import FRAME_FLAGS, BodySpec, TrackConfig
 from jointwear.dic.footage._features import (
     MatchReport,

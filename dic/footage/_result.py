@@ -269,7 +269,7 @@ def _noise_attrs(st, calibration) -> dict[str, float]:
     sig_med = float(np.median(st.sigma_px))
     attrs = {f"{name}_match_sigma_px": sig_med}
     if calibration is not None:
-        from jointwear.dic.calibration._stereo import stereo_noise_floor
+        from jointwear.dic.calibration import stereo_noise_floor
 
         floor = stereo_noise_floor(calibration, np.nanmean(st.ref3d, axis=0), sig_med)
         attrs[f"{name}_noise_floor_z_per_point_m"] = floor

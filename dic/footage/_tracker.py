@@ -11,7 +11,7 @@ from jointwear.dic.footage._features import (
     _sift_homography,
     affine_guess,
 )
-from jointwear.dic.icgn._interp import prefilter_region
+from jointwear.dic.icgn import prefilter_region
 
 
 # ---------------------------------------------------------------------------------------------

@@ -46,7 +46,7 @@ if TYPE_CHECKING:
     import xarray as xr
 
     from jointwear._netcdf import Record
-    from jointwear.dic.icgn._interp import SplineImage
+    from jointwear.dic.icgn import SplineImage
 
 __all__ = [
     "CorrelationParams",
@@ -126,7 +126,7 @@ class SubsetCorrelator:
                 )
             base = CorrelationParams(**{**asdict(base), **options})
         self.params = base
-        from jointwear.dic.icgn._interp import prefilter
+        from jointwear.dic.icgn import prefilter
 
         self.reference_raw = check_image(reference, "reference image")
         self.ref = prefilter(self.reference_raw, base.interpolation)
@@ -248,7 +248,7 @@ class SubsetCorrelator:
 
     # ------------------------------------------------------------------ matching
     def _prepare_deformed(self, deformed) -> tuple[SplineImage, np.ndarray, np.ndarray]:
-        from jointwear.dic.icgn._interp import SplineImage, prefilter
+        from jointwear.dic.icgn import SplineImage, prefilter
 
         if isinstance(deformed, SplineImage):
             spl = deformed
@@ -499,7 +499,7 @@ class SubsetCorrelator:
         uncertainty exceeds the scatter by 1.2-1.3 on 3-4 px speckle).
         """
         if getattr(self, "_kappa", None) is None:
-            from jointwear.dic.icgn._reference import subset_kappa
+            from jointwear.dic.icgn import subset_kappa
 
             r = self.ref
             k = np.ones(self.n_points)

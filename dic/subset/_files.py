@@ -58,14 +58,14 @@ def read_points_file(path: Path):
 
 def is_sequence_input(deformed: str | Path | None) -> bool:
     """True when ``deformed`` (None, a folder, pattern or video) makes the input a sequence."""
-    from jointwear.dic.footage._video import is_image_sequence
+    from jointwear.dic.footage import is_image_sequence
 
     return deformed is None or (not Path(deformed).is_file() and is_image_sequence(str(deformed)))
 
 
 def _read_sequence(reference: Path, deformed: Path | None):
     """(frames, fps) and the input files of a sequence."""
-    from jointwear.dic.footage._video import is_image_sequence, list_image_sequence
+    from jointwear.dic.footage import is_image_sequence, list_image_sequence
     from jointwear.dic.subset._sequence import read_frames, read_image
 
     if deformed is not None:  # a reference named unlike the frames, then the frames

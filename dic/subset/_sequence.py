@@ -25,7 +25,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from jointwear.dic.footage._video import check_frame_names  # noqa: F401 (re-exported)
+from jointwear.dic.footage import check_frame_names  # noqa: F401 (re-exported)
 from jointwear.dic.subset._params import UPDATE_ZNCC
 from jointwear.errors import BadInputError, ParameterError
 
@@ -89,7 +89,7 @@ def read_frames(
             )
         return [np.asarray(f) for f in source[sel]], None
     if isinstance(source, (str, Path)):
-        from jointwear.dic.footage._video import is_image_sequence, list_image_sequence
+        from jointwear.dic.footage import is_image_sequence, list_image_sequence
 
         path = Path(source)
         if is_image_sequence(source):
