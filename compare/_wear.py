@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -218,21 +219,171 @@ def _calibration(name: str, meas: float, al: xr.Dataset, d: np.ndarray, criteria
     return out
 
 
+@dataclass(frozen=True)
+class WearCase:
+    """What every wear criterion reads: the aligned maps on the band and what was derived.
+
+    Attributes
+    ----------
+    al : Dataset
+        The aligned maps (:func:`jointwear.compare.align.align_wear_maps`).
+    s, d : ndarray
+        Simulated and measured wear depth on the band, ``(z, theta)`` [m].
+    rows, decisions, src
+        The metrics table, the decision card and the uncertainty sources of the comparison.
+    band : str
+        The band's label (:func:`band_label`).
+    peak_nc, whole_nc : str
+        Why the maximum / the whole-map criteria are not comparable ('' when they are).
+    sim_max, meas_max : (float, float, float)
+        Value [m], z [m] and angle [degree] of each maximum (:func:`metrics.max_location`).
+    """
+
+    al: xr.Dataset
+    s: np.ndarray
+    d: np.ndarray
+    rows: Rows
+    decisions: list[dict[str, Any]]
+    src: Sources
+    band: str
+    peak_nc: str
+    whole_nc: str
+    sim_max: tuple[float, float, float]
+    meas_max: tuple[float, float, float]
+
+    @property
+    def z(self) -> np.ndarray:
+        return np.asarray(self.al["z"].values)
+
+    @property
+    def criteria(self):
+        return self.src.criteria
+
+
+def shape_criterion(c: WearCase) -> None:
+    """Wear map shape: NRMSE and Pearson r against their thresholds."""
+    criteria, nr, r = c.criteria, mt.nrmse(c.s, c.d), mt.pearson_r(c.s, c.d)
+    ok_shape = bool(nr <= criteria.wear_nrmse_max and r >= criteria.wear_r_min)
+    c.decisions.append(
+        decision(
+            f"wear map shape {c.band}",
+            f"NRMSE <= {criteria.wear_nrmse_max:g} and r >= {criteria.wear_r_min:g}",
+            f"NRMSE = {nr:.3g}, r = {r:.3g}",
+            vd.NOT_COMPARABLE
+            if c.whole_nc
+            else threshold_state(ok_shape, bool(np.isfinite(nr) and np.isfinite(r))),
+            "threshold",
+            c.whole_nc,
+            key="wear_depth",
+        )
+    )
+
+
+def angle_criterion(c: WearCase) -> None:
+    """Angle of the maximum wear against ``max_angle_error_deg``."""
+    ts, td = c.sim_max[2], c.meas_max[2]
+    ang = float(mt.wrap_angle_deg(ts - td))
+    c.decisions.append(
+        decision(
+            f"angle of maximum wear {c.band}",
+            f"|error| <= {c.criteria.max_angle_error_deg:g} degree",
+            f"{ang:+.1f} degree (sim {ts:.1f}, meas {td:.1f})",
+            vd.NOT_COMPARABLE
+            if c.peak_nc
+            else threshold_state(abs(ang) <= c.criteria.max_angle_error_deg),
+            "threshold",
+            c.peak_nc,
+            key="wear_depth",
+        )
+    )
+
+
+def axial_criterion(c: WearCase) -> None:
+    """Axial position of the maximum wear against ``max_z_error_m``."""
+    zs, zd, z = c.sim_max[1], c.meas_max[1], c.z
+    z_nc = c.peak_nc
+    edge_s, edge_d = _edge_max(c.s), _edge_max(c.d)
+    if not z_nc and z.size > 1 and edge_s != 0 and edge_s == edge_d:
+        z_nc = (
+            f"both maxima {c.band} lie on its edge layer z = "
+            f"{z[0 if edge_s < 0 else -1] * 1e3:+.2f} mm: the wear grows towards the edge on both "
+            "sides and the band cannot show where either maximum is"
+        )
+    c.decisions.append(
+        decision(
+            f"axial position of maximum wear {c.band}",
+            f"|error| <= {c.criteria.max_z_error_m * 1e3:g} mm",
+            f"{(zs - zd) * 1e3:+.2f} mm (sim {zs * 1e3:+.2f}, meas {zd * 1e3:+.2f})",
+            vd.NOT_COMPARABLE
+            if z_nc
+            else threshold_state(abs(zs - zd) <= c.criteria.max_z_error_m + 1e-12),
+            "threshold",
+            z_nc,
+            key="wear_depth",
+        )
+    )
+
+
+#: the V&V 20 band quantities: card label and units
+_LABELS = {
+    "max_wear_depth": ("maximum wear depth", "m"),
+    "worn_volume": ("worn volume", "m3"),
+    "cylindricity": ("cylindricity of the wear (LSCY)", "m"),
+}
+
+
+def vv20_band_criterion(name: str):
+    """The V&V 20 decision of the band quantity ``name`` (a key of :func:`sim_quantities`)."""
+
+    def decide(c: WearCase) -> None:
+        sim_q = sim_quantities(c.al)
+        if name not in sim_q:
+            return
+        meas_q = sim_quantities(c.al, "wear_depth_meas")
+        value = sim_q[name] if name != "max_wear_depth" else c.sim_max[0]
+        meas = meas_q[name] if name != "max_wear_depth" else c.meas_max[0]
+        (us, us_note), (ud, ud_note) = (_stated(c.al, c.s, c.d)[name][k] for k in ("sim", "meas"))
+        budget = c.src.budget(
+            name,
+            value,
+            "wear",
+            sim_u=us,
+            meas_u=ud,
+            sim_note=us_note,
+            meas_note=f"stated by the measurement: {ud_note}" if ud_note else "",
+            calibration=_calibration(name, meas, c.al, c.d, c.criteria),
+        )
+        label, units = _LABELS[name]
+        vv20_decision(
+            c.rows,
+            c.decisions,
+            name,
+            f"{label} {c.band}",
+            scalar_discrepancy(value, meas, units, c.criteria.relative_error_max),
+            budget,
+            not_comparable=c.peak_nc if name == "max_wear_depth" else c.whole_nc,
+        )
+
+    return decide
+
+
 def wear_metrics(al: xr.Dataset, rows: Rows, decisions: list[dict[str, Any]], src: Sources) -> str:
     """Metric rows and decisions of the aligned wear maps ``al``; returns the domain statement.
 
     Every criterion is decided on the band the measurement covers and labelled so; what lies
     outside is the validation-domain statement (returned), never a verdict. With
     ``criteria.strict_coverage`` the old rule applies: a simulated maximum outside the band, or
-    more than ``max_volume_outside`` of the volume, makes the criteria *not comparable*.
+    more than ``max_volume_outside`` of the volume, makes the criteria *not comparable*. The
+    criteria decided are the wear rows of :data:`jointwear.compare.registry.CRITERIA`, in order.
     """
+    from jointwear.compare.registry import criteria_of
+
     criteria = src.criteria
     s = np.asarray(al["wear_depth_sim"].values)
     d = np.asarray(al["wear_depth_meas"].values)
     z = np.asarray(al["z"].values)
     th = np.asarray(al["theta"].values)
     q = "wear_depth"
-    band = band_label(al)
     if criteria.strict_coverage:
         peak_nc, whole_nc = coverage(al, criteria.max_volume_outside)
     else:
@@ -241,100 +392,19 @@ def wear_metrics(al: xr.Dataset, rows: Rows, decisions: list[dict[str, Any]], sr
     frac = float(al.attrs.get("volume_fraction_compared", np.nan))
     rows.add(q, "volume_fraction_compared", frac, "m")
     rows.add(q, "rmse", mt.rmse(s, d), "m")
-    nr = mt.nrmse(s, d)
-    rows.add(q, "nrmse", nr, "m")
-    r = mt.pearson_r(s, d)
-    rows.add(q, "pearson_r", r, "m")
+    rows.add(q, "nrmse", mt.nrmse(s, d), "m")
+    rows.add(q, "pearson_r", mt.pearson_r(s, d), "m")
     rows.add(q, "mean_error", float(np.nanmean(s - d)), "m")
     rows.add(q, "max_abs_error", float(np.nanmax(np.abs(s - d))), "m")
     rows.add(q, "area_validation_metric", mt.area_validation_metric(s, d), "m")
-    vs, zs, ts = mt.max_location(s, z, th)
-    vd_, zd, td = mt.max_location(d, z, th)
-    ang = float(mt.wrap_angle_deg(ts - td))
-    rows.add(q, "max_angle_error", ang, "m")
-    rows.add(q, "max_z_error", zs - zd, "m")
-    z_nc = peak_nc
-    edge_s, edge_d = _edge_max(s), _edge_max(d)
-    if not z_nc and z.size > 1 and edge_s != 0 and edge_s == edge_d:
-        z_nc = (
-            f"both maxima {band} lie on its edge layer z = {z[0 if edge_s < 0 else -1] * 1e3:+.2f} "
-            "mm: the wear grows towards the edge on both sides and the band cannot show where "
-            "either maximum is"
-        )
-    ok_shape = bool(nr <= criteria.wear_nrmse_max and r >= criteria.wear_r_min)
-    decisions.append(
-        decision(
-            f"wear map shape {band}",
-            f"NRMSE <= {criteria.wear_nrmse_max:g} and r >= {criteria.wear_r_min:g}",
-            f"NRMSE = {nr:.3g}, r = {r:.3g}",
-            vd.NOT_COMPARABLE
-            if whole_nc
-            else threshold_state(ok_shape, bool(np.isfinite(nr) and np.isfinite(r))),
-            "threshold",
-            whole_nc,
-            key="wear_depth",
-        )
+    sim_max, meas_max = mt.max_location(s, z, th), mt.max_location(d, z, th)
+    rows.add(q, "max_angle_error", float(mt.wrap_angle_deg(sim_max[2] - meas_max[2])), "m")
+    rows.add(q, "max_z_error", sim_max[1] - meas_max[1], "m")
+    case = WearCase(
+        al, s, d, rows, decisions, src, band_label(al), peak_nc, whole_nc, sim_max, meas_max
     )
-    decisions.append(
-        decision(
-            f"angle of maximum wear {band}",
-            f"|error| <= {criteria.max_angle_error_deg:g} degree",
-            f"{ang:+.1f} degree (sim {ts:.1f}, meas {td:.1f})",
-            vd.NOT_COMPARABLE
-            if peak_nc
-            else threshold_state(abs(ang) <= criteria.max_angle_error_deg),
-            "threshold",
-            peak_nc,
-            key="wear_depth",
-        )
-    )
-    decisions.append(
-        decision(
-            f"axial position of maximum wear {band}",
-            f"|error| <= {criteria.max_z_error_m * 1e3:g} mm",
-            f"{(zs - zd) * 1e3:+.2f} mm (sim {zs * 1e3:+.2f}, meas {zd * 1e3:+.2f})",
-            vd.NOT_COMPARABLE
-            if z_nc
-            else threshold_state(abs(zs - zd) <= criteria.max_z_error_m + 1e-12),
-            "threshold",
-            z_nc,
-            key="wear_depth",
-        )
-    )
-    stated = _stated(al, s, d)
-    sim_q = sim_quantities(al)
-    meas_q = sim_quantities(al, "wear_depth_meas")
-    labels = {
-        "max_wear_depth": "maximum wear depth",
-        "worn_volume": "worn volume",
-        "cylindricity": "cylindricity of the wear (LSCY)",
-    }
-    units = {"max_wear_depth": "m", "worn_volume": "m3", "cylindricity": "m"}
-    for name in ("max_wear_depth", "worn_volume", "cylindricity"):
-        if name not in sim_q:
-            continue
-        value = sim_q[name] if name != "max_wear_depth" else vs
-        meas = meas_q[name] if name != "max_wear_depth" else vd_
-        (us, us_note), (ud, ud_note) = stated[name]["sim"], stated[name]["meas"]
-        budget = src.budget(
-            name,
-            value,
-            "wear",
-            sim_u=us,
-            meas_u=ud,
-            sim_note=us_note,
-            meas_note=f"stated by the measurement: {ud_note}" if ud_note else "",
-            calibration=_calibration(name, meas, al, d, criteria),
-        )
-        vv20_decision(
-            rows,
-            decisions,
-            name,
-            f"{labels[name]} {band}",
-            scalar_discrepancy(value, meas, units[name], criteria.relative_error_max),
-            budget,
-            not_comparable=peak_nc if name == "max_wear_depth" else whole_nc,
-        )
+    for entry in criteria_of("wear"):
+        entry.decide(case)
     cs, cd = al.attrs.get("cylindricity_stated_sim_m"), al.attrs.get("cylindricity_stated_meas_m")
     if cs is not None and cd is not None:
         rows.add("cylindricity_stated", "value_sim", float(cs), "m")

@@ -92,3 +92,16 @@ def test_not_assessed_criteria_state_no_resolution():
     c = compare(syn.sim_wear(), syn.meas_wear(n_layers=16))
     assert not np.any(c.metrics.metric == "detectable_error_low")
     assert c.resolution() == ""
+
+
+def test_the_criteria_table_decides_the_wear_card_in_its_order():
+    """compare.registry.CRITERIA is what decides: its wear rows, in order, are the card's."""
+    from jointwear.compare.registry import CRITERIA, criteria_of
+
+    c = _decided(1.0)
+    wear = criteria_of("wear")
+    assert [e.basis for e in wear] == list(c.decisions.basis)
+    assert [e.name for e in wear if e.basis == "V&V 20"] == [
+        k for k, b in zip(c.decisions.key, c.decisions.basis, strict=True) if b == "V&V 20"
+    ]
+    assert all(callable(e.decide) for e in CRITERIA)
