@@ -131,7 +131,8 @@ def _table(path: Path, fmt: str) -> dict[str, np.ndarray]:
 
 def _files(files) -> list[Path]:
     if isinstance(files, (str, Path)):
-        from jointwear.dic.footage._video import _GLOB_CHARS, _natural_key
+        from jointwear.filenames import GLOB_CHARS as _GLOB_CHARS
+        from jointwear.filenames import natural_key as _natural_key
 
         p = Path(files)
         if p.is_file():

@@ -12,6 +12,8 @@ from pathlib import Path
 import numpy as np
 
 from jointwear.errors import BadInputError
+from jointwear.filenames import GLOB_CHARS as _GLOB_CHARS
+from jointwear.filenames import natural_key as _natural_key
 
 __all__ = [
     "FrameSource",
@@ -269,13 +271,6 @@ def prefetch(items: Iterable, depth: int = 3) -> Iterator:
     finally:
         stop.set()
         thread.join(timeout=5.0)
-
-
-def _natural_key(p: Path):
-    return [int(s) if s.isdigit() else s for s in re.split(r"(\d+)", p.name)]
-
-
-_GLOB_CHARS = re.compile(r"[*?\[]")
 
 
 def is_image_sequence(path: str | Path) -> bool:
