@@ -159,6 +159,23 @@ ZSource = Annotated[
         f"Where z comes from: {', '.join(Z_SOURCES)} (auto refuses when two sources disagree).",
     ),
 ]
+Heights = Annotated[
+    Path | None,
+    _opt(
+        "--heights",
+        "File of layer file, height lines (any delimiter; unit in its first line, e.g. "
+        "'file,height_mm', else --z-units); a folder's manifest/heights/index.csv is found "
+        "without it.",
+    ),
+]
+ZMm = Annotated[
+    str | None,
+    _opt(
+        "--z-mm",
+        "Height of each layer [mm], comma-separated in file/column order, e.g. 0,1.5,4 (uneven "
+        "z; overrides every other source).",
+    ),
+]
 ExpectedPoints = Annotated[int | None, _opt("--expected-points", "Points every layer must have.")]
 AllowPartial = Annotated[bool, _opt("--allow-partial", "Accept incomplete layers (NaN).")]
 Resample = Annotated[bool, _opt("--resample", "Interpolate layers onto one uniform grid.")]

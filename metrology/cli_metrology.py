@@ -40,6 +40,18 @@ def _si(value: float | None, scale: float) -> float | None:
     return value * scale if value is not None else None
 
 
+def _z_list(z_mm: str | None) -> tuple[float, ...] | None:
+    """``--z-mm 0,1.5,4`` as heights in metres (None when not given)."""
+    if z_mm is None:
+        return None
+    try:
+        return tuple(float(v) * 1e-3 for v in z_mm.replace(" ", "").split(",") if v)
+    except ValueError:
+        raise typer.BadParameter(
+            f"--z-mm {z_mm!r}: expected comma-separated numbers in mm, e.g. 0,1.5,4"
+        ) from None
+
+
 def _text(value) -> str | None:
     """A choice option's value as the library's string (None stays None)."""
     return str(value) if value is not None else None
@@ -80,6 +92,8 @@ def import_cmd(
     min_form_nm: opt.MinFormNm = None,
     form_fraction: opt.FormFraction = None,
     max_missing: opt.MaxMissing = None,
+    heights: opt.Heights = None,
+    z_mm: opt.ZMm = None,
 ) -> None:
     """Import roundness/cylindricity text exports into contract netCDF files."""
     from jointwear.metrology.readers.importing import import_scans
@@ -110,6 +124,8 @@ def import_cmd(
         min_form=_si(min_form_nm, 1e-9),
         form_fraction=form_fraction,
         max_missing=max_missing,
+        heights=str(heights) if heights is not None else None,
+        z=_z_list(z_mm),
     )
     if instrument is not None:
         options["instrument"] = instrument

@@ -64,13 +64,23 @@ def _z_from_meta(meta: dict[str, str], z_units: str | None, where: str) -> float
     return None
 
 
-_MANIFESTS = ("manifest.csv", "manifest.txt", "manifest.json", "layers.csv", "layers.txt")
+#: Names (stems) of a folder's heights file: per-layer file, z (never read as a layer).
+MANIFEST_STEMS = ("manifest", "layers", "heights", "height", "index", "z", "levels")
+_MANIFESTS = tuple(f"{stem}.{ext}" for stem in MANIFEST_STEMS for ext in ("csv", "txt", "json"))
+_Z_UNIT_IN_NAME = re.compile(
+    r"(?:z|height|h|pos|position|level)[_ ]?(mm|um|µm|m|in|inch)\b|[\[(]\s*([^\])]+)\s*[\])]",
+    re.I,
+)
 
 
-def _read_manifest(folder: Path, z_units: str | None) -> tuple[Path, dict[str, float]] | None:
-    """(manifest path, {file: z [m]}) of a folder, or None; every listed file must exist."""
-    for name in _MANIFESTS:
-        p = folder / name
+def _read_manifest(
+    folder: Path, z_units: str | None, heights: Path | None = None
+) -> tuple[Path, dict[str, float]] | None:
+    """(heights file, {file: z [m]}): the ``heights`` file given, else the first of
+    :data:`_MANIFESTS` in ``folder``, else None; every listed file must exist in ``folder``."""
+    if heights is not None and not Path(heights).is_file():
+        raise BadInputError(f"heights='{heights}' (--heights) is not a file")
+    for p in [Path(heights)] if heights is not None else [folder / n for n in _MANIFESTS]:
         if not p.exists():
             continue
         lines_of: dict[str, int] = {}
@@ -103,11 +113,9 @@ def _read_manifest(folder: Path, z_units: str | None) -> tuple[Path, dict[str, f
                     lines_of[toks[0]] = i
                 except ValueError:
                     if not vals:
-                        m = re.search(r"[\[(]\s*([^\])]+)\s*[\])]", st) or re.search(
-                            r"z[_ ]?(mm|um|µm|m|in|inch)\b", st, re.I
-                        )
+                        m = _Z_UNIT_IN_NAME.search(st)
                         if m:
-                            unit = m.group(1)
+                            unit = m.group(1) or m.group(2)
                         continue  # header line
                     raise BadInputError(f"'{p}' line {i}: z {toks[1]!r} is not a number") from None
             if (

@@ -52,6 +52,7 @@ from jointwear.metrology.choices import LAYOUTS, VALUE_KINDS
 from jointwear.metrology.readers.advice import plausibility
 from jointwear.metrology.readers.claims import check_layers
 from jointwear.metrology.readers.dataset import _as_convention, _assemble
+from jointwear.metrology.readers.heights import MANIFEST_STEMS
 from jointwear.metrology.readers.layers import _Layer, _layers_from_file
 from jointwear.metrology.readers.table import TextFormat, parse_blocks
 from jointwear.metrology.readers.zsource import assign_z, layer_numbers_from_meta
@@ -109,6 +110,7 @@ def read_scan(
     min_form: float | None = None,
     form_fraction: float | None = None,
     max_missing: float | None = None,
+    heights: str | Path | None = None,
 ) -> xr.Dataset:
     """Read a roundness / cylindricity scan from text exports into a contract Dataset.
 
@@ -138,6 +140,10 @@ def read_scan(
         Unit of z (long-file column, header keyword, file names, manifest) when not stated.
     z : sequence of float, optional
         Instrument height of each layer [m], in file/column order (overrides everything else).
+    heights : path, optional
+        A file of (layer file, z) lines in any delimiter, the unit in its first line
+        (``file,height_mm``) or ``z_units``; a folder's ``manifest``, ``heights``, ``index``,
+        ``layers`` (``.csv``/``.txt``/``.json``) is found without it.
     layer_spacing : float, optional
         Distance between consecutive layers [m] when the files do not say.
     z_mid : float or "centre"
@@ -198,7 +204,7 @@ def read_scan(
         ignore_header,
         thousands,
     )
-    files, folder = _collect_files(paths, pattern)
+    files, folder = _collect_files(paths, pattern, heights)
     limits = _limits(
         radius_range, max_deviation, nominal_tolerance, min_form, form_fraction, max_missing
     )
@@ -217,6 +223,7 @@ def read_scan(
         z_units=z_units,
         z_source=z_source,
         where=f"'{folder or files[0]}'",
+        heights=None if heights is None else Path(heights),
     )
     notes["z_from"] = zsrc
     where = f"'{files[0] if len(files) == 1 else folder}'"
@@ -294,8 +301,9 @@ def _text_format(
     return replace(base, **over) if over else base
 
 
-def _collect_files(paths, pattern: str) -> tuple[list[Path], Path | None]:
-    """(the files to read, the folder they came from or None for one file)."""
+def _collect_files(paths, pattern: str, heights=None) -> tuple[list[Path], Path | None]:
+    """(the files to read, the folder they came from or None for one file); a folder's heights
+    file (:data:`~.heights.MANIFEST_STEMS`, or ``heights``) is not a layer."""
     if not isinstance(paths, (str, Path)):
         files = [Path(f) for f in paths]
         if not files:
@@ -312,7 +320,8 @@ def _collect_files(paths, pattern: str) -> tuple[list[Path], Path | None]:
             for f in p.glob(pattern)
             if f.is_file()
             and not f.name.startswith(".")
-            and f.stem.lower() not in ("manifest", "layers")
+            and f.stem.lower() not in MANIFEST_STEMS
+            and (heights is None or f.resolve() != Path(heights).resolve())
         ),
         key=_natural_key,
     )

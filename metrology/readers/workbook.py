@@ -8,10 +8,16 @@ and the same refusals as any text export. "Line" in messages is the worksheet ro
 from __future__ import annotations
 
 import datetime as _dt
+import re
 import zipfile
 from pathlib import Path
 
+import numpy as np
+
 from jointwear.errors import BadInputError
+from jointwear.metrology.readers.pretext import numeric_line
+
+_NUM = r"[-+]?(?:\d+(?:[.,]\d*)?|[.,]\d+)"
 
 __all__ = ["workbook_text"]
 
@@ -37,12 +43,57 @@ def _has_numbers(ws) -> bool:
     return False
 
 
+_LAYER_HEAD = re.compile(
+    rf"^(?:(?:layer|plane|trace|level|section)\s*(?:no\.?|#)?\s*(\d+))?[\s,;:-]*"
+    rf"(?:(?:z|height|h)\s*[=:]?\s*({_NUM})\s*(mm|um|µm|μm|m|in|inch)?)?\s*$",
+    re.I,
+)
+
+
+def _merged_layer_heads(rows: list[list[str]]) -> list[list[str]] | None:
+    """A sheet whose layers stand side by side under merged header cells (``Layer 2  z = 1.0
+    mm`` over an angle and a value column each) as one long table: a z column (or a layer
+    number column when the cells give no z), then each group's columns, layer after layer.
+    None when the sheet has no such header row."""
+    for h, row in enumerate(rows[:40]):
+        cells = [(j, c) for j, c in enumerate(row) if c]
+        if len(cells) < 2:
+            continue
+        found = [(j, _LAYER_HEAD.match(c)) for j, c in cells]
+        if not all(m and (m.group(1) or m.group(2)) for _, m in found):
+            continue
+        pos = [j for j, _ in found]
+        steps = set(np.diff(pos).tolist())
+        if len(steps) != 1 or min(steps) < 2:
+            continue
+        width = steps.pop()
+        p0 = pos[0]
+        body = rows[h + 1 :]
+        names = body[0] if body and not numeric_line("\t".join(body[0])) else None
+        data = body[1:] if names is not None else body
+        zs = [m.group(2) for _, m in found]
+        units = {m.group(3) for _, m in found if m.group(3)}
+        if all(zs):
+            head = [f"z [{units.pop()}]" if len(units) == 1 else "z"]
+            keys = [z.replace(",", ".") for z in zs]
+        else:
+            head, keys = ["Layer"], [m.group(1) or str(k + 1) for k, (_, m) in enumerate(found)]
+        group = (names or [])[p0 : p0 + width]
+        out = rows[:h] + ([head + group] if names is not None else [])
+        for g, key in enumerate(keys):
+            lo = p0 + g * width
+            for r in data:
+                part = (r[lo : lo + width] + [""] * width)[:width]
+                if any(part):
+                    out.append([key, *part])
+        return out
+    return None
+
+
 def _blank_cells_missing(rows: list[list[str]]) -> list[list[str]]:
     """Rows of numbers padded to the table's width: a blank cell at the end of a row of the
     table is a missing value (a worksheet has no cut lines), not a shorter row."""
     from collections import Counter
-
-    from jointwear.metrology.readers.pretext import numeric_line
 
     numeric = [bool(r) and numeric_line("\t".join(r)) for r in rows]
     widths = Counter(len(r) for r, n in zip(rows, numeric, strict=True) if n)
@@ -121,7 +172,8 @@ def workbook_text(path: Path, sheet: str | None = None) -> str:
             rows.append(cells)
     finally:
         wb.close()
-    text = "\n".join("\t".join(r) for r in _blank_cells_missing(rows)).rstrip("\n") + "\n"
+    rows = _merged_layer_heads(rows) or _blank_cells_missing(rows)
+    text = "\n".join("\t".join(r) for r in rows).rstrip("\n") + "\n"
     if not text.strip():
         raise BadInputError(f"'{path}': the sheet is empty")
     return text

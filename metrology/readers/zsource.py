@@ -109,13 +109,20 @@ def assign_z(
     z_units: str | None,
     z_source: str,
     where: str,
+    heights: Path | None = None,
 ) -> str:
-    """Set ``z`` [m] of every layer; returns how (for ``reader_guesses``)."""
+    """Set ``z`` [m] of every layer; returns how (for ``reader_guesses``). ``heights``: a file
+    of (layer file, z) lines, as a folder's ``manifest.csv``."""
     if z_source not in Z_SOURCES:
         raise BadInputError(f"z_source {z_source!r} is not known; use {', '.join(Z_SOURCES)}")
     meta = parsed[0].metadata
+    if heights is not None and layout != "folder":
+        raise BadInputError(
+            f"{where}: heights='{heights}' (--heights) gives the z of per-layer files, but this "
+            f"scan is one {layout} file; drop the option"
+        )
     src, unit_used, spacing_used = _find_z(
-        layers, parsed, layout, folder, z, layer_spacing, z_units, z_source, where, meta
+        layers, parsed, layout, folder, z, layer_spacing, z_units, z_source, where, meta, heights
     )
     if layer_spacing is not None and not spacing_used and len(layers) > 1:
         zs = np.sort([lay.z for lay in layers])
@@ -138,7 +145,9 @@ def assign_z(
     return src
 
 
-def _find_z(layers, parsed, layout, folder, z, layer_spacing, z_units, z_source, where, meta):
+def _find_z(
+    layers, parsed, layout, folder, z, layer_spacing, z_units, z_source, where, meta, heights
+):
     """(source, z unit option used, spacing option used)."""
     auto = z_source == "auto"
     if z is not None or z_source == "option":
@@ -157,11 +166,11 @@ def _find_z(layers, parsed, layout, folder, z, layer_spacing, z_units, z_source,
         named = bool(col) and str(col[0]) in parsed[0].column_units
         return "z column", not named and z_units is not None, False
     numbers = [lay.index for lay in layers]
-    heights = layout == "blocks" and all(
+    block_heights = layout == "blocks" and all(
         _z_from_meta(pf.metadata, pf.z_units, f"'{pf.path}'") is not None for pf in parsed
     )
     if all(v is not None for v in numbers) and (
-        (auto and not heights) or z_source in ("numbers", "spacing")
+        (auto and not block_heights) or z_source in ("numbers", "spacing")
     ):
         listed = ", ".join(f"{v:g}" for v in numbers[:4]) + (", ..." if len(numbers) > 4 else "")
         sp = _numbered_spacing(layer_spacing, meta, z_units, where, f"numbered ({listed})")
@@ -173,7 +182,9 @@ def _find_z(layers, parsed, layout, folder, z, layer_spacing, z_units, z_source,
             sp[1] == "layer_spacing",
         )
     if layout in ("folder", "blocks"):
-        return _z_per_part(layers, parsed, folder, layer_spacing, z_units, z_source, where, meta)
+        return _z_per_part(
+            layers, parsed, folder, layer_spacing, z_units, z_source, where, meta, heights
+        )
     if layout == "wide":
         return _z_wide(layers, parsed[0], layer_spacing, z_units, z_source, where, meta)
     if len(layers) == 1:
@@ -182,11 +193,13 @@ def _find_z(layers, parsed, layout, folder, z, layer_spacing, z_units, z_source,
     raise BadInputError(f"{where}: cannot tell the z of the {len(layers)} layers; pass z=[...]")
 
 
-def _z_per_part(layers, parsed, folder, layer_spacing, z_units, z_source, where, meta):
+def _z_per_part(layers, parsed, folder, layer_spacing, z_units, z_source, where, meta, heights):
     """z of per-layer files (or blocks): manifest, header keyword, file names, spacing."""
     blocks = len({pf.path for pf in parsed}) == 1 and len(parsed) > 1
+    if folder is None and heights is not None:
+        folder = Path(parsed[0].path).parent
     if folder is not None and z_source in ("auto", "manifest"):
-        found = _read_manifest(folder, z_units)
+        found = _read_manifest(folder, z_units, heights)
         if found:
             manifest = found[1]
             for lay in layers:
@@ -197,7 +210,7 @@ def _z_per_part(layers, parsed, folder, layer_spacing, z_units, z_source, where,
                         f"manifest '{found[0]}' has no entry for '{name}'; add a line '{name}, <z>'"
                     )
                 lay.z = manifest[key]
-            return "manifest", z_units is not None, False
+            return f"heights file '{found[0].name}'", z_units is not None, False
         if z_source == "manifest":
             raise BadInputError(f"z_source='manifest' but '{folder}' holds no manifest.csv")
     zh = [_z_from_meta(pf.metadata, pf.z_units, f"'{pf.path}'") for pf in parsed]

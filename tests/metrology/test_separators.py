@@ -283,3 +283,86 @@ def test_a_missing_angle_or_a_cut_row_is_refused_not_a_missing_point(tmp_path):
     g.write_text("Units: um\nAngle (deg);Dev z=0 mm;Dev z=1 mm\n" + "\n".join(rows) + "\n")
     with pytest.raises(BadInputError, match=r"line 53: expected 3 fields, found 2"):
         read_scan(g, convention=CONV)
+
+
+# --- issue 38 item 5: heights from an index file, uneven z on the command line --------------
+
+
+def _layer_folder(d, zs_mm):
+    d.mkdir()
+    n = 360
+    th = np.arange(n) * 1.0
+    for k in range(len(zs_mm)):
+        dev = 0.3 * np.cos(2 * np.radians(th)) + 0.1 * k
+        (d / f"trace{k + 1}.txt").write_text(
+            "Units: um\nAngle (deg)\tDeviation\n"
+            + "".join(f"{a:.1f}\t{v:.4f}\n" for a, v in zip(th, dev, strict=True))
+        )
+    return d
+
+
+@pytest.mark.parametrize(
+    ("name", "head", "sep", "extra"),
+    [
+        ("heights.txt", "", " ", ("--z-units", "mm")),  # file, height; no unit: --z-units
+        ("index.csv", "file,height_mm\n", ",", ()),
+        ("manifest.txt", "file;z [mm]\n", ";", ()),
+    ],
+)
+def test_heights_from_an_index_file_in_the_folder(tmp_path, run_import, name, head, sep, extra):
+    import xarray as xr
+
+    zs = [0.0, 1.5, 4.0]  # uneven
+    d = _layer_folder(tmp_path / "scan", zs)
+    (d / name).write_text(head + "".join(f"trace{k + 1}.txt{sep}{z:g}\n" for k, z in enumerate(zs)))
+    out = tmp_path / "o.nc"
+    assert run_import(d, out, *extra) == 0
+    ds = xr.load_dataset(out)
+    np.testing.assert_allclose(ds["z"].values, (np.array(zs) - 2.0) * 1e-3, atol=1e-12)
+    assert ds.sizes["z"] == 3  # the heights file is not read as a layer
+
+
+def test_heights_file_given_and_z_mm_on_the_command_line(tmp_path, run_import):
+    import xarray as xr
+
+    zs = [0.0, 1.5, 4.0]
+    d = _layer_folder(tmp_path / "scan", zs)
+    hf = tmp_path / "my_z.tsv"
+    hf.write_text("name\theight_mm\n" + "".join(f"trace{k + 1}\t{z:g}\n" for k, z in enumerate(zs)))
+    out = tmp_path / "o.nc"
+    assert run_import(d, out, "--heights", str(hf)) == 0
+    np.testing.assert_allclose(xr.load_dataset(out)["z"].values, [-2e-3, -0.5e-3, 2e-3])
+    out2 = tmp_path / "o2.nc"
+    assert run_import(d, out2, "--z-mm", "0,1.5,4") == 0
+    np.testing.assert_allclose(xr.load_dataset(out2)["z"].values, [-2e-3, -0.5e-3, 2e-3])
+    assert run_import(d, tmp_path / "o3.nc", "--z-mm", "0,1.5") == 3  # one per layer
+    assert run_import(d, tmp_path / "o4.nc", "--z-mm", "0;x") == 2
+
+
+@pytest.mark.parametrize("with_z", [True, False])
+def test_excel_merged_layer_headers_read_as_layers_with_their_z(tmp_path, with_z):
+    openpyxl = pytest.importorskip("openpyxl")
+    zs = [0.0, 1.5, 4.0]
+    wb = openpyxl.Workbook()
+    ws = wb.active
+    ws.append(["Units", "um"])
+    heads = [f"Layer {k + 1}" + (f"  z = {z:.1f} mm" if with_z else "") for k, z in enumerate(zs)]
+    ws.append([c for h in heads for c in (h, None)])
+    for k in range(3):
+        ws.merge_cells(start_row=2, start_column=2 * k + 1, end_row=2, end_column=2 * k + 2)
+    ws.append(["Angle (deg)", "Deviation (um)"] * 3)
+    th = np.arange(360) * 1.0
+    dev = np.array([0.3 * np.cos(2 * np.radians(th)) + 0.1 * k for k in range(3)])
+    for i in range(360):
+        ws.append([c for k in range(3) for c in (th[i], float(dev[k, i]))])
+    f = tmp_path / "merged.xlsx"
+    wb.save(f)
+    if with_z:
+        ds = read_scan(f, convention=CONV)
+        np.testing.assert_allclose(ds["z"].values, [-2e-3, -0.5e-3, 2e-3], atol=1e-12)
+    else:  # layer numbers: z needs the spacing, and the refusal says so
+        with pytest.raises(BadInputError, match="layer_spacing"):
+            read_scan(f, convention=CONV)
+        ds = read_scan(f, convention=CONV, layer_spacing=1e-3)
+        np.testing.assert_allclose(ds["z"].values, [-1e-3, 0, 1e-3], atol=1e-12)
+    np.testing.assert_allclose(ds["radial_deviation"].values, dev * 1e-6, atol=1e-15)
