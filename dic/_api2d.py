@@ -75,6 +75,7 @@ def correlate(
     max_iterations: int = 40,
     border: int = 4,
     threads: int = 0,
+    u_outlier_factor: float = CorrelationParams.u_outlier_factor,
 ) -> xr.Dataset:
     """Subset DIC between two images (ZNSSD criterion, IC-GN on B-spline interpolation).
 
@@ -115,6 +116,9 @@ def correlate(
         less exact.
     threads : int
         numba threads (0: min(2, available)).
+    u_outlier_factor : float
+        Matches whose uncertainty exceeds this multiple of the median are flagged
+        ``uncertainty_outlier`` (0: no test; see :class:`CorrelationParams`).
 
     Returns
     -------
@@ -153,6 +157,7 @@ def correlate(
         max_iterations=max_iterations,
         border=border,
         threads=threads,
+        u_outlier_factor=u_outlier_factor,
     )
     corr = SubsetCorrelator(reference, points=points, roi=roi, params=params)
     return corr.correlate(deformed, initial_guess=initial_guess, seed_points=seed_points)

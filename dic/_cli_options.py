@@ -36,6 +36,11 @@ CORRELATION = (
     Opt("zncc_min", help="Flag matches below this ZNCC."),
     Opt("search_radius", help="Seed search half-width (pixels)."),
     Opt("threads", help="numba threads (0: auto).", min=0),
+    Opt(
+        "u_outlier_factor",
+        help="Flag matches whose uncertainty exceeds this multiple of the image's median (0: off).",
+        min=0,
+    ),
 )
 OutOpt = NetcdfOut
 CalibrationOpt = Annotated[

@@ -60,7 +60,9 @@ FLAG_ROI_EDGE = 9
 FLAG_LEFT_RIGHT = 10
 FIELD_FLAG_MEANINGS = (
     _flags.FLAG_MEANINGS + " epipolar_mismatch subset_crosses_roi_edge left_right_inconsistent"
+    " uncertainty_outlier"
 )
+assert FIELD_FLAG_MEANINGS.split().index("uncertainty_outlier") == _flags.FLAG_U_OUTLIER
 
 
 def _frames(source, what: str) -> tuple[list[np.ndarray], list[str]]:
@@ -198,6 +200,10 @@ def _match_images(corr, L, Rr, calibration, centres, epipolar_max_px=1.0):
                 centre = (_median_or(PR[:k, :, 0], 0.0), _median_or(PR[:k, :, 6], 0.0))
                 res = _track(corr, Rr[k], g, centre)
             PR[k], SR[k], Z[k, 1], F[k, 1] = res.params, res.sigma, res.zncc, res.flag
+    factor = corr.params.u_outlier_factor
+    F[1:, 0] = _flags.flag_uncertainty_outliers(F[1:, 0], SL[1:], factor)
+    if stereo:
+        F[:, 1] = _flags.flag_uncertainty_outliers(F[:, 1], SR, factor)
     ok_img = F == _flags.FLAG_OK
     PL[~ok_img[:, 0]] = np.nan
     SL[~ok_img[:, 0]] = np.nan
@@ -349,6 +355,7 @@ def measure_field(
             "dic_step_pixel": int(cp.step) if points is None else "points given",
             "dic_zncc_min": float(cp.zncc_min),
             "dic_max_iterations": int(cp.max_iterations),
+            "dic_u_outlier_factor": float(cp.u_outlier_factor),
             "dic_shape_function": "affine",
             "dic_interpolation": f"{cp.interpolation} B-spline (prefiltered)",
             "dic_criterion": "ZNSSD (IC-GN), image gradients by central differences",
@@ -587,7 +594,8 @@ def _field_dataset(m: _Matches, flag, lr, calibration, prm: FieldParams, cp, wit
     data["zncc"] = variable(zncc, ("time", "point"), "1", "lowest ZNCC of the point's matches")
     data["flag"] = variable(
         flag, ("time", "point"), "1", "field quality flag",
-        flag_values=np.arange(11, dtype=np.int8), flag_meanings=FIELD_FLAG_MEANINGS,
+        flag_values=np.arange(len(FIELD_FLAG_MEANINGS.split()), dtype=np.int8),
+        flag_meanings=FIELD_FLAG_MEANINGS,
     )  # fmt: skip
     if m.stereo:
         data["left_right_deviation"] = variable(

@@ -50,8 +50,12 @@ def result_dataset(
 def result_record(
     centres, P, zncc, iterations, flag, params: CorrelationParams, grid=None, sigma=None
 ) -> Record:
-    """Per-point arrays -> :class:`~jointwear._netcdf.Record` of :func:`result_dataset`."""
+    """Per-point arrays -> :class:`~jointwear._netcdf.Record` of :func:`result_dataset`;
+    matches whose uncertainty is ``params.u_outlier_factor`` times their image's median are
+    flagged ``uncertainty_outlier`` (:func:`~jointwear.dic.icgn._flags.flag_uncertainty_outliers`)."""
     P = np.asarray(P, float)
+    if sigma is not None:
+        flag = _flags.flag_uncertainty_outliers(flag, sigma, params.u_outlier_factor)
     ok = np.asarray(flag) == _flags.FLAG_OK
     lead = P.shape[:-2]
     lead_dims = ("time",) if len(lead) == 1 else ()
@@ -113,8 +117,8 @@ def result_record(
         {
             "units": "1",
             "long_name": "correlation quality flag",
-            "flag_values": _flags.FLAG_VALUES,
-            "flag_meanings": _flags.FLAG_MEANINGS,
+            "flag_values": _flags.OUTPUT_FLAG_VALUES,
+            "flag_meanings": _flags.OUTPUT_FLAG_MEANINGS,
         },
     )
     if sigma is not None:
@@ -141,6 +145,7 @@ def result_record(
         "dic_interpolation": f"{params.interpolation} B-spline (prefiltered)",
         "dic_tolerance_pixel": float(params.tolerance),
         "dic_max_iterations": int(params.max_iterations),
+        "dic_u_outlier_factor": float(params.u_outlier_factor),
         "dic_zncc_min": float(params.zncc_min),
         "displacement_convention": (
             "Lagrangian: the subset centred at (x, y) of the reference moved by (u, v); x to "
