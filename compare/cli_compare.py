@@ -46,6 +46,15 @@ def compare_cmd(
     verification: opt.VerificationOpt = None,
     allow_other_rig: opt.AllowOtherRigOpt = False,
     strict: opt.StrictOpt = False,
+    calibration_check: Annotated[
+        bool,
+        typer.Option(
+            "--calibration-check",
+            help="Compare with the data a posterior prediction was calibrated on: every row "
+            "labelled 'calibration check, not validation', a pass never counted as validation "
+            "(without it such data are refused).",
+        ),
+    ] = False,
 ) -> None:
     """Compare simulation and measurement (wear maps and/or motion, detected from variables).
 
@@ -75,6 +84,7 @@ def compare_cmd(
         verification=verification or [],
         allow_other_rig=allow_other_rig,
         warn=oc.echo_warning,
+        calibration_check=calibration_check,
     )
     lines = [oc.origin_line(result), *oc.card_lines(result), *oc.alignment_lines(result)]
     lines += [f"metrics: {out}", *oc.outcome_lines(result)]

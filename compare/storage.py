@@ -227,6 +227,7 @@ def compare_files(
     verification: Sequence[str | Path] = (),
     allow_other_rig: bool = False,
     warn: Callable[[str], None] | None = None,
+    calibration_check: bool = False,
 ) -> Comparison:
     """Compare files: load simulation and measurement, :func:`compare` them, save the result.
 
@@ -251,11 +252,16 @@ def compare_files(
         Use a study or an ensemble of another rig, labelled (default: refused, exit 3).
     warn : callable, optional
         Receives the warning text for a file from another tool (the CLI prints it on stderr).
+    calibration_check : bool
+        Compare with data a posterior prediction was calibrated on, labelled as a calibration
+        check and never counted as validation (else such data are refused:
+        :mod:`jointwear.compare.calibration_use`).
 
     Returns
     -------
     Comparison
     """
+    from jointwear.compare import calibration_use
     from jointwear.compare.comparison import compare
     from jointwear.compare.criteria import load_criteria
     from jointwear.compare.ensemble import as_ensemble
@@ -267,6 +273,9 @@ def compare_files(
     sims = [load_for_comparison(p, role="simulated", warn=warn) for p in sim]
     meass = [load_for_comparison(p, role="measured", warn=warn) for p in meas]
     ens = [io.load(p) for p in ensemble]
+    sims, ens, ens_names, used = calibration_use.prepare(
+        sims, sim, meas, ens, [Path(p).name for p in ensemble], calibration_check
+    )
     vers = [io.load(p, validate=False) for p in verification]
     result = compare(
         sims,
@@ -277,10 +286,12 @@ def compare_files(
         motion_method=motion_method,
         variables=variables or None,
         axes=axes,
-        ensemble=as_ensemble(ens, [Path(p).name for p in ensemble]) if ens else None,
+        ensemble=as_ensemble(ens, ens_names) if ens else None,
         verification=vers or None,
         allow_other_rig=allow_other_rig,
     )
+    if used:
+        result = calibration_use.as_calibration_check(result, used)
     save_comparison(
         result,
         out,

@@ -125,7 +125,11 @@ def predict(
         RunTask(i, design.run_values(names, i), int(seeds[i]), spec, sim, wear)
         for i in range(samples)
     ]
+    from jointwear.params import to_jsonable
+
     record = {
+        "parameters": to_jsonable(sim),
+        "wear": to_jsonable(wear),
         "spec": spec.describe(),
         "posterior": file_record(posterior),
         "samples": picks.tolist(),

@@ -327,7 +327,9 @@ def test_compare_defaults_and_help_are_the_librarys():
     from jointwear.errors import BadInputError
 
     kw = _keywords(compare_files)
-    mapping = _same(kw, "table", "criteria", "cycles", "variables", "allow_other_rig")
+    mapping = _same(
+        kw, "table", "criteria", "cycles", "variables", "allow_other_rig", "calibration_check"
+    )
     mapping |= _renamed(kw, method="motion_method", period="period_s") | _stated("axes")
     without = {"sim", "meas", "out", "overwrite", "sim_extra", "meas_extra", "ensemble"}
     params = _check(compare_cmd, mapping, without | {"verification", "strict"})
