@@ -81,12 +81,12 @@ from jointwear.dic.footage._tracker import (  # noqa: F401 (re-exported)
 )
 from jointwear.dic.footage._video import (
     FrameSource,
+    check_frame_names,
     check_stereo_pair,
     list_image_sequence,
     open_frames,
     prefetch,
 )
-from jointwear.dic.subset._sequence import check_frame_names
 from jointwear.errors import BadInputError
 
 __all__ = [

@@ -213,9 +213,8 @@ def calibrate(
     """
     from jointwear import io
     from jointwear._version import source_attribute
+    from jointwear.sim.sweep import parameter_units, read_spec
     from jointwear.sim.sweep._driver import _base, run_sweep
-    from jointwear.sim.sweep._params import parameter_units
-    from jointwear.sim.sweep._spec import read_spec
 
     spec_file = [Path(spec)] if isinstance(spec, (str, Path)) else []
     spec = spec if isinstance(spec, CalibrationSpec) else read_calibration_spec(spec)

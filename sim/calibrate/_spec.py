@@ -248,7 +248,7 @@ def read_calibration_spec(spec: str | Path | Mapping[str, Any]) -> CalibrationSp
 
 
 def _parse(data: Mapping[str, Any], folder: Path | None) -> CalibrationSpec:
-    from jointwear.sim.sweep._params import parse_parameter
+    from jointwear.sim.sweep import parse_parameter
 
     unknown = sorted(set(data) - {"calibrate", "parameters"})
     if unknown:
