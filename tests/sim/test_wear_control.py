@@ -268,3 +268,35 @@ def test_unresolved_updates_threshold(eta, noise, flagged):
 
     got, _ = unresolved_updates(np.array([eta]), np.array([noise]))
     assert bool(got[0]) is flagged
+
+
+class OutlierContact(SteadyNoisyContact):
+    """5 % noise per cycle, and every 25th cycle a very different one (the load elsewhere): the
+    heavy tail of the dynamics' cycle-to-cycle variability."""
+
+    def __init__(self):
+        super().__init__(noise=0.05, seed=9)
+
+    def describe(self):
+        return {"model": "outlier"}
+
+    def run(self, wear_depth, *, cycles, state, progress=None):
+        k = 0 if state is None else state[1]
+        res = super().run(wear_depth, cycles=cycles, state=None if state is None else state[0])
+        if k % 25 == 24:
+            res.wear_work = np.roll(res.wear_work, self.grid.n_points // 2, axis=1) * 3
+            res.normal_work = float(np.sum(res.wear_work * res.point_area))
+        res.state = (res.state, k + 1)
+        return res
+
+
+def test_isolated_outlier_cycles_are_noted_not_called_non_convergence():
+    ds = simulate_wear(
+        contact=OutlierContact(),
+        cycles=8000,
+        snapshots=[],
+        settings=WearSettings(kw=KW, scheme="fixed", dn=100),
+    )
+    assert np.sum(ds["update_rate_change"].values > 1.0) >= 2  # the outliers are there
+    assert "convergence_warning" not in ds.attrs
+    assert "isolated outliers" in ds.attrs["rate_change_outliers"]
