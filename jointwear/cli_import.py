@@ -38,6 +38,34 @@ _Tool = Annotated[
     str | None, typer.Option("--tool", help="The program that wrote the file, e.g. 'Adams 2024'.")
 ]
 
+_Delimiter = Annotated[
+    str | None,
+    typer.Option("--delimiter", help="CSV field delimiter: tab, semicolon, comma or whitespace."),
+]
+_Decimal = Annotated[
+    str | None, typer.Option("--decimal", help="CSV decimal mark: point or comma.")
+]
+_U = Annotated[
+    str | None,
+    typer.Option(
+        "--u",
+        metavar="VALUE[unit]",
+        help="Uncertainty of every point, e.g. 0.5um (default unit: the data's).",
+    ),
+]
+_UColumn = Annotated[
+    str | None,
+    typer.Option("--u-column", help="Column(s) of the table holding each row's uncertainty."),
+]
+_UK = Annotated[
+    float | None,
+    typer.Option("--u-k", help="Coverage factor of --u/--u-column: 1 standard, 2 expanded (95 %)."),
+]
+_UCovers = Annotated[
+    str | None,
+    typer.Option("--u-covers", help="What the uncertainty covers, e.g. 'probe noise'."),
+]
+
 _CF_SUFFIXES = (".nc", ".nc4", ".cdf")
 """File endings read as CF netCDF; any other file is read as a CSV table."""
 
@@ -77,11 +105,43 @@ def _needed(table: str, never: str, *given: tuple[str, str | None]) -> list[str]
     return [value for _, value in given if value is not None]
 
 
-def _save(ds, out: Path, source: Path) -> None:
+def _stated(value: str | None, column: str | None, k: float | None, covers: str | None, count: int):
+    """The uncertainty the options state (None when none is), or a refusal naming them."""
+    from jointwear.import_uncertainty import StatedUncertainty
+
+    if value is None and column is None:
+        if k is not None or covers:
+            from jointwear.errors import ParameterError
+
+            raise ParameterError(
+                "--u-k/--u-covers: give the uncertainty itself with --u or --u-column"
+            )
+        return None
+    columns = None if column is None else tuple(_names(column, "--u-column", (1, count)))
+    return StatedUncertainty(value=value, columns=columns, k=k, covers=covers)
+
+
+def _csv_only(file: Path, name: str, *given: object) -> None:
+    """The --u options state a CSV table's uncertainty; a CF file states its own."""
+    if any(v is not None for v in given):
+        from jointwear.errors import ParameterError
+
+        raise ParameterError(
+            f"--u/--u-column/--u-k/--u-covers describe a CSV table; the CF file '{file}' states "
+            f"its uncertainty as the variable {name}_u (units, coverage_factor, comment): add it "
+            "there, or drop those options"
+        )
+
+
+def _save(ds, out: Path, source: Path, name: str, example: str) -> None:
     from jointwear import io
+    from jointwear.import_uncertainty import NO_UNCERTAINTY_NOTE
 
     io.save(ds, out, inputs=[source], parameters={"external": True, **ds.attrs})
-    typer.echo(f"wrote {out} ({ds.attrs['data_origin']}, from {source.name})")
+    read_as = f"; {ds.attrs['read_as']}" if ds.attrs.get("read_as") else ""
+    typer.echo(f"wrote {out} ({ds.attrs['data_origin']}, from {source.name}{read_as})")
+    if f"{name}_u" not in ds:
+        typer.echo("note: " + NO_UNCERTAINTY_NOTE.format(what=name, example=example), err=True)
 
 
 @app.command("motion")
@@ -104,12 +164,19 @@ def motion(
         typer.Option("--velocity-columns", help="Velocity column names x,y[,z] (bearing frame)."),
     ] = ",".join(D.VELOCITY_COLUMNS),
     tool: _Tool = None,
+    delimiter: _Delimiter = None,
+    decimal: _Decimal = None,
+    u: _U = None,
+    u_column: _UColumn = None,
+    u_k: _UK = None,
+    u_covers: _UCovers = None,
 ) -> None:
     """Import a follower motion history: time and velocity columns with stated units."""
     from jointwear import external
 
     data_origin = origin.value if origin else None
     if file.suffix.lower() in _CF_SUFFIXES:
+        _csv_only(file, "follower_velocity", u, u_column, u_k, u_covers)
         ds = _from_cf(file, "follower_velocity", data_origin=data_origin, tool=tool)
     else:
         csv_origin, unit = _needed(
@@ -126,8 +193,11 @@ def motion(
             velocity_columns=_names(velocity_columns, "--velocity-columns", (2, 3)),
             data_origin=csv_origin,
             tool=tool,
+            delimiter=delimiter,
+            decimal=decimal,
+            uncertainty=_stated(u, u_column, u_k, u_covers, 3),
         )
-    _save(ds, out, file)
+    _save(ds, out, file, "follower_velocity", "2mm/s")
 
 
 @app.command("wearmap")
@@ -154,12 +224,19 @@ def wearmap(
         float | None, typer.Option("--cycles", help="Crank cycles the map belongs to.")
     ] = None,
     tool: _Tool = None,
+    delimiter: _Delimiter = None,
+    decimal: _Decimal = None,
+    u: _U = None,
+    u_column: _UColumn = None,
+    u_k: _UK = None,
+    u_covers: _UCovers = None,
 ) -> None:
     """Import a wear map (depth positive where material was removed) with stated units and angle convention."""
     from jointwear import external
 
     data_origin = origin.value if origin else None
     if file.suffix.lower() in _CF_SUFFIXES:
+        _csv_only(file, "wear_depth", u, u_column, u_k, u_covers)
         ds = _from_cf(
             file,
             "wear_depth",
@@ -191,8 +268,11 @@ def wearmap(
             z_mid_width=z_mid_width,
             cycles=cycles,
             tool=tool,
+            delimiter=delimiter,
+            decimal=decimal,
+            uncertainty=_stated(u, u_column, u_k, u_covers, 1),
         )
-    _save(ds, out, file)
+    _save(ds, out, file, "wear_depth", "0.5um")
 
 
 @app.command("reported")

@@ -22,6 +22,7 @@ import csv
 import re
 from collections.abc import Callable, Sequence
 from functools import cache
+from io import StringIO
 from pathlib import Path
 from typing import Any
 
@@ -32,6 +33,7 @@ import xarray as xr
 from jointwear import _import_defaults as D
 from jointwear import conventions
 from jointwear.errors import BadInputError, ParameterError
+from jointwear.import_uncertainty import StatedUncertainty, attach_uncertainty
 
 __all__ = [
     "DATA_ORIGINS",
@@ -41,6 +43,7 @@ __all__ = [
     "import_wear_map",
     "import_cf",
     "load_for_comparison",
+    "StatedUncertainty",
 ]
 
 #: What the numbers of a file are (global attribute ``data_origin``).
@@ -116,8 +119,23 @@ def to_si(values: Any, unit: str, *, kind: str, option: str) -> np.ndarray:
     return np.asarray(values, dtype=float) * factor
 
 
-def read_table(path: str | Path) -> pd.DataFrame:
+def read_table(
+    path: str | Path, *, delimiter: str | None = None, decimal: str | None = None
+) -> pd.DataFrame:
     """Read a CSV/TSV/whitespace table with a header row; ``#`` starts a comment line.
+
+    The field delimiter and the decimal mark are the metrology readers' decisions
+    (:func:`jointwear.metrology.readers.table.sniff` on the data rows, the thousands mark
+    :func:`jointwear.metrology.readers.pretext.sniff_thousands`), so a semicolon table with
+    decimal commas (``0,25;1,5``) reads as numbers; what was sniffed is in ``table.attrs``.
+
+    Parameters
+    ----------
+    path : path
+    delimiter : {"tab", "semicolon", "comma", "whitespace"} or the character, optional
+        Field delimiter (``--delimiter``); sniffed when not given.
+    decimal : {".", ","} (or "point", "comma"), optional
+        Decimal mark (``--decimal``); sniffed when not given.
 
     Raises
     ------
@@ -128,18 +146,22 @@ def read_table(path: str | Path) -> pd.DataFrame:
     if not path.is_file():
         raise BadInputError(f"'{path}' does not exist or is not a file")
     try:
-        table = pd.read_csv(
-            path,
-            sep=None,
-            engine="python",
-            comment="#",
-            skipinitialspace=True,
-            encoding="utf-8-sig",
-        )
+        text = path.read_text(encoding="utf-8-sig")
     except UnicodeDecodeError:
         raise BadInputError(
             f"'{path}' is not UTF-8 text; export it as CSV (UTF-8) from the tool that wrote it"
         ) from None
+    lines = [ln for ln in text.splitlines() if ln.strip() and not ln.lstrip().startswith("#")]
+    sep, dec, thousands, how = _format(lines, path, delimiter, decimal)
+    try:
+        table = pd.read_csv(
+            StringIO("\n".join(lines)),
+            sep=sep,
+            engine="python",
+            decimal=dec,
+            thousands=thousands,
+            skipinitialspace=True,
+        )
     except (pd.errors.ParserError, pd.errors.EmptyDataError, csv.Error) as exc:
         raise BadInputError(
             f"'{path}' could not be read as a table with a header row: {exc}"
@@ -150,7 +172,52 @@ def read_table(path: str | Path) -> pd.DataFrame:
             f"numbers, found {table.shape[1]} column(s) and {len(table)} row(s)"
         )
     table.columns = [str(c).strip() for c in table.columns]
+    table.attrs["read_as"] = how
     return table
+
+
+#: ``--decimal`` spellings -> the mark
+_DECIMALS = {".": ".", "point": ".", "dot": ".", ",": ",", "comma": ","}
+
+
+def _format(
+    lines: list[str], path: Path, delimiter: str | None, decimal: str | None
+) -> tuple[str | None, str, str | None, str]:
+    """(pandas ``sep``, decimal mark, thousands mark, what was read how) of a table's lines
+    (the header row first): the metrology readers' sniffer on its data rows."""
+    from jointwear.metrology.readers.pretext import sniff_thousands
+    from jointwear.metrology.readers.table import TextFormat, sniff
+
+    if decimal is not None and str(decimal).strip().lower() not in _DECIMALS:
+        raise ParameterError(f"--decimal {decimal!r}: use point or comma")
+    dec = None if decimal is None else _DECIMALS[str(decimal).strip().lower()]
+    try:
+        fmt = TextFormat(delimiter=delimiter, decimal=dec, header_lines=0)
+    except BadInputError as exc:
+        raise ParameterError(f"--delimiter {delimiter!r}: {exc}") from None
+    data = lines[1:51]
+    if not data or (fmt.delimiter is not None and fmt.decimal is not None):
+        found, guessed = fmt, {}
+    else:
+        try:
+            found, guessed = sniff("\n".join(data), fmt, path=str(path))
+        except BadInputError:  # a column of text: the table is read as it was before
+            found, guessed = fmt, {}
+    if found.delimiter is None:  # not decided: csv's sniffer (any delimiter), decimal point
+        return None, found.decimal or ".", None, "delimiter sniffed by csv, decimal point"
+    thousands = None
+    if found.decimal is not None:
+        thousands = sniff_thousands(data, found.delimiter)
+        thousands = None if thousands == found.decimal else thousands
+    sep = r"\s+" if found.delimiter == " " else found.delimiter
+    names = {"\t": "tab", ";": "semicolon", ",": "comma", " ": "whitespace"}
+    how = (
+        f"delimiter {names[found.delimiter]} ({'sniffed' if 'delimiter' in guessed else 'given'}), "
+        f"decimal {'comma' if found.decimal == ',' else 'point'} "
+        f"({'sniffed' if 'decimal' in guessed else 'given'})"
+        + (f", thousands mark {thousands!r} (sniffed)" if thousands else "")
+    )
+    return sep, found.decimal or ".", thousands, how
 
 
 def _column(table: pd.DataFrame, name: str, path: Path, option: str) -> np.ndarray:
@@ -166,9 +233,14 @@ def _column(table: pd.DataFrame, name: str, path: Path, option: str) -> np.ndarr
     bad = np.flatnonzero(~np.isfinite(values))
     if bad.size:
         row = int(bad[0])
+        hint = (
+            "; the file writes decimal commas: give --decimal comma (and --delimiter)"
+            if "," in str(column.iloc[row])
+            else ""
+        )
         raise BadInputError(
             f"'{path}', column {name!r}: value {column.iloc[row]!r} in data row {row + 1} is not a "
-            f"finite number ({bad.size} such value(s)); fix or remove those rows"
+            f"finite number ({bad.size} such value(s)); fix or remove those rows{hint}"
         )
     return values
 
@@ -220,6 +292,9 @@ def import_motion(
     position_columns: Sequence[str] | None = None,
     position_unit: str | None = None,
     tool: str | None = None,
+    delimiter: str | None = None,
+    decimal: str | None = None,
+    uncertainty: StatedUncertainty | None = None,
 ) -> xr.Dataset:
     """Import a follower motion history (CSV table) from another simulator or instrument.
 
@@ -242,12 +317,19 @@ def import_motion(
         Follower position columns and their unit, if the file has them.
     tool : str, optional
         The program that wrote the file (e.g. ``"Adams 2024"``), recorded in ``source``.
+    delimiter, decimal : str, optional
+        Field delimiter and decimal mark (:func:`read_table`); sniffed when not given.
+    uncertainty : StatedUncertainty, optional
+        The velocity's uncertainty as the user states it (``--u`` or ``--u-column``, in the
+        velocity unit unless it says its own), stored as ``follower_velocity_u``. None: not
+        stated, and V&V 20 criteria on these data are *not assessed*.
 
     Returns
     -------
     Dataset
-        ``follower_velocity(time, axis)`` [m s-1] (and ``follower_position`` [m]), ``time`` [s]
-        from 0, ``data_origin`` and ``external = "yes"`` in the attributes.
+        ``follower_velocity(time, axis)`` [m s-1] (and ``follower_position`` [m],
+        ``follower_velocity_u``), ``time`` [s] from 0, ``data_origin`` and
+        ``external = "yes"`` in the attributes.
     """
     path = Path(path)
     _check_origin(data_origin)
@@ -255,7 +337,7 @@ def import_motion(
         raise ParameterError(
             f"--velocity-columns: give 2 or 3 column names (x, y[, z]), got {list(velocity_columns)}"
         )
-    table = read_table(path)
+    table = read_table(path, delimiter=delimiter, decimal=decimal)
     t = to_si(
         _column(table, time_column, path, "--time-column"),
         time_unit,
@@ -281,6 +363,20 @@ def import_motion(
         position = _vector(table, position_columns, path, "--position", position_unit, "length")
         ds["follower_position"] = (("time", "axis"), position)
     ds = conventions.annotate(ds)
+    if uncertainty is not None:
+        columns = uncertainty.columns or ()
+        values = None
+        if columns:
+            if len(columns) not in (1, len(axes)):
+                raise ParameterError(
+                    f"--u-column: give one column, or one per velocity component "
+                    f"({len(axes)}), got {len(columns)}"
+                )
+            values = _vector(table, columns, path, "--u", velocity_unit, "velocity")
+        ds = attach_uncertainty(
+            ds, "follower_velocity", uncertainty, unit=velocity_unit, kind="velocity", values=values
+        )
+    ds.attrs["read_as"] = table.attrs.get("read_as", "")
     return _stamp(ds, path, data_origin, tool, "follower motion")
 
 
@@ -298,6 +394,9 @@ def import_wear_map(
     z_reversed: bool = False,
     cycles: float | None = None,
     tool: str | None = None,
+    delimiter: str | None = None,
+    decimal: str | None = None,
+    uncertainty: StatedUncertainty | None = None,
 ) -> xr.Dataset:
     """Import a wear map given as a long table (one row per bearing point: theta, z, depth).
 
@@ -324,18 +423,24 @@ def import_wear_map(
         Crank cycles the map belongs to; adds a ``cycles`` dimension of length 1.
     tool : str, optional
         The program that wrote the file.
+    delimiter, decimal : str, optional
+        Field delimiter and decimal mark (:func:`read_table`); sniffed when not given.
+    uncertainty : StatedUncertainty, optional
+        The depth's uncertainty as the user states it (``--u`` or ``--u-column``, in the depth
+        unit unless it says its own), stored as ``wear_depth_u``. None: not stated, and V&V 20
+        criteria on these data are *not assessed*.
 
     Returns
     -------
     Dataset
-        ``wear_depth(z, theta)`` [m] on the canonical angle convention.
+        ``wear_depth(z, theta)`` [m] (and ``wear_depth_u``) on the canonical angle convention.
     """
     path = Path(path)
     _check_origin(data_origin)
     if len(columns) != 3:
         raise ParameterError(f"--columns: give three names (theta, z, depth), got {list(columns)}")
     convention = conventions.AngleConvention(angle_zero, angle_direction)
-    table = read_table(path)
+    table = read_table(path, delimiter=delimiter, decimal=decimal)
     theta = to_si(
         _column(table, columns[0], path, "--columns"),
         theta_unit,
@@ -354,6 +459,15 @@ def import_wear_map(
     theta_keys = np.round(theta, 9)
     z_keys = np.round(z, 12)
     frame = pd.DataFrame({"z": z_keys, "theta": theta_keys, "depth": depth})
+    if uncertainty is not None and uncertainty.columns:
+        if len(uncertainty.columns) != 1:
+            raise ParameterError("--u-column: a wear map takes one column of uncertainties")
+        frame["u"] = to_si(
+            _column(table, uncertainty.columns[0], path, "--u-column"),
+            depth_unit,
+            kind="length",
+            option="--depth-unit",
+        )
     duplicated = frame.duplicated(["z", "theta"])
     if duplicated.any():
         row = int(np.flatnonzero(duplicated.to_numpy())[0])
@@ -377,10 +491,23 @@ def import_wear_map(
             "theta": conventions.theta_coord(grid.columns.to_numpy(), convention),
         },
     )
+    if uncertainty is not None:
+        values = None
+        if uncertainty.columns:
+            values = frame.pivot(index="z", columns="theta", values="u").to_numpy()
+        ds = attach_uncertainty(
+            conventions.annotate(ds),
+            "wear_depth",
+            uncertainty,
+            unit=depth_unit,
+            kind="length",
+            values=values,
+        )
     ds = conventions.to_canonical(ds)
     if cycles is not None:
         ds = ds.expand_dims(cycles=[float(cycles)])
     ds = conventions.annotate(ds)
+    ds.attrs["read_as"] = table.attrs.get("read_as", "")
     return _stamp(ds, path, data_origin, tool, "wear map")
 
 
@@ -433,18 +560,21 @@ def import_cf(
     known = {**conventions.COORDINATES, **conventions.VARIABLES}
     kinds = {"m": "length", "m s-1": "velocity", "s": "time", "degree": "angle", "N": "force"}
     for name in list(ds.variables):
-        if name not in known or known[name][0] not in kinds:
+        base = name[:-2] if name.endswith("_u") and name[:-2] in known else name
+        if base not in known or known[base][0] not in kinds:
             continue
         unit = ds[name].attrs.get("units")
         if unit is None:
             raise BadInputError(
-                f"'{path}': variable {name!r} has no units attribute; add it (CF requires it)"
+                f"'{path}': variable {name!r} has no 'units' attribute; add it (CF requires it)"
             )
         values = to_si(
-            ds[name].values, str(unit), kind=kinds[known[name][0]], option=f"{name}:units"
+            ds[name].values, str(unit), kind=kinds[known[base][0]], option=f"{name}:units"
         )
         ds[name] = ds[name].copy(data=values)
-        ds[name].attrs["units"] = known[name][0]
+        ds[name].attrs["units"] = known[base][0]
+        if base != name:  # an uncertainty of a contract variable: it says what it is
+            ds[name].attrs.setdefault("long_name", f"standard uncertainty of {known[base][1]}")
     if "theta" in ds.coords:
         attrs = ds.coords["theta"].attrs
         zero = angle_zero or attrs.get("angle_zero")
@@ -467,6 +597,11 @@ def import_cf(
             theta=conventions.theta_coord(theta, conventions.AngleConvention(zero, direction))
         ).sortby("theta")
         ds = conventions.to_canonical(ds)
+    if "z" in ds.coords and "z_zero" in ds["z"].attrs and "z_direction" not in ds["z"].attrs:
+        ds["z"].attrs.update(
+            z_direction="+z",
+            z_note="the file did not state which way z grows; taken as +z of the bearing frame",
+        )
     if "z" in ds.coords and "z_zero" not in ds.coords["z"].attrs:
         ds["z"].attrs.update(
             z_zero="bearing mid-width",
@@ -474,8 +609,28 @@ def import_cf(
             z_note="the file did not state where z = 0 lies; taken as the bearing mid-width on import",
         )
     ds = conventions.annotate(ds)
+    _check_cf_attributes(ds, path)
     ds.attrs.pop("provenance", None)
     return _stamp(ds, path, origin, tool or ds.attrs.get("source"), "dataset")
+
+
+def _check_cf_attributes(ds: xr.Dataset, path: Path) -> None:
+    """Every variable of a CF file states ``units`` and ``long_name`` (the data contract); a
+    missing one is refused naming the file, the variable and the attribute."""
+    missing = [
+        (name, key)
+        for name, var in ds.data_vars.items()
+        for key in ("units", "long_name")
+        if key not in var.attrs
+    ]
+    if missing:
+        listed = "; ".join(f"variable {n!r} has no {k!r} attribute" for n, k in missing)
+        name, key = missing[0]
+        raise BadInputError(
+            f"'{path}' (the input): {listed}. Add it to the file (e.g. ncatted -a "
+            f"{key},{name},c,c,'...' {path.name}) or remove the variable; jointwear does not "
+            "write a variable whose meaning or unit nobody stated"
+        )
 
 
 def load_for_comparison(

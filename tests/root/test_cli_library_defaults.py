@@ -285,20 +285,26 @@ def test_import_defaults_are_the_librarys():
     from jointwear.cli_import import _names, motion, wearmap
     from jointwear.external import import_motion, import_wear_map
 
+    # the stated uncertainty's options make one StatedUncertainty (uncertainty=None: not stated)
+    stated = {"u", "u_column", "u_k", "u_covers"}
     kw = _keywords(import_motion)
-    mapping = _same(kw, "time_unit", "time_column", "tool")
+    assert kw["uncertainty"] is None
+    mapping = _same(kw, "time_unit", "time_column", "tool", "delimiter", "decimal")
     params = _check(
-        motion, mapping, {"file", "out", "overwrite", "origin", "velocity_unit", "velocity_columns"}
+        motion,
+        mapping,
+        {"file", "out", "overwrite", "origin", "velocity_unit", "velocity_columns", *stated},
     )
     columns = params["velocity_columns"].default
     assert tuple(_names(columns, "--velocity-columns", (2, 3))) == kw["velocity_columns"]
 
     kw = _keywords(import_wear_map)
-    mapping = _same(kw, "z_mid_width", "cycles", "tool")
+    assert kw["uncertainty"] is None
+    mapping = _same(kw, "z_mid_width", "cycles", "tool", "delimiter", "decimal")
     required = ("theta_unit", "z_unit", "depth_unit", "angle_zero", "angle_direction")
     assert all(kw[n] is inspect.Parameter.empty for n in required)
     mapping |= dict.fromkeys(required, (None, None))  # None: the command asks for them
-    params = _check(wearmap, mapping, {"file", "out", "overwrite", "origin", "columns"})
+    params = _check(wearmap, mapping, {"file", "out", "overwrite", "origin", "columns", *stated})
     assert tuple(_names(params["columns"].default, "--columns", (3, 3))) == kw["columns"]
 
 
