@@ -56,7 +56,9 @@ def _length_unit(value: str | None) -> str | None:
     try:
         unit_factor(value)
     except BadInputError:
-        raise typer.BadParameter(f"unit {value!r} is not known; use um, mm, m or inch") from None
+        raise typer.BadParameter(
+            f"unit {value!r} is not known; use um, mm, m, inch or uin (micro-inch)"
+        ) from None
     return value
 
 
@@ -83,8 +85,8 @@ Units = Annotated[
     str | None,
     _opt(
         "--units",
-        "Length unit of files that do not state it: um, mm, m or inch (a unit the file "
-        "contradicts is an error).",
+        "Length unit of files that do not state it: um, mm, m, inch or uin (micro-inch); a "
+        "unit the file contradicts is an error, one it names but nobody knows is replaced.",
         callback=_length_unit,
     ),
 ]

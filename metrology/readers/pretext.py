@@ -38,6 +38,7 @@ __all__ = [
     "sniff_delimiter",
     "sniff_thousands",
     "split_blocks",
+    "thousands_hint",
     "thousands_mark",
 ]
 
@@ -204,6 +205,19 @@ def sniff_thousands(lines: Sequence[str], delimiter: str | None) -> str | None:
             all(map((grouped if any(sep in v for v in col) else plain).match, col)) for col in cols
         ):
             return sep
+    return None
+
+
+def thousands_hint(cells: Sequence[str], delimiter: str | None) -> str | None:
+    """The word (``comma``, ``point``, ``apostrophe``, ``space``) of a thousands mark that some
+    cell is grouped by (``8,001``, ``8 001,5``) and that is not the delimiter, else None: the
+    ``thousands=`` a refusal of those cells can offer."""
+    for sep in (" ", "'", ",", "."):
+        if sep == delimiter or (sep == " " and delimiter in (None, " ")):
+            continue
+        pat = re.compile(rf"^[-+]?\d{{1,3}}(?:{re.escape(sep)}\d{{3}})+(?:[.,]\d+)?$")
+        if any(pat.match(c.strip()) for c in cells):
+            return THOUSANDS_WORD[sep]
     return None
 
 

@@ -12,14 +12,18 @@ import numpy as np
 import pandas as pd
 
 from jointwear.errors import BadInputError
+from jointwear.metrology.readers.advice import Refusal
 from jointwear.metrology.readers.claims import drop_ignored
 from jointwear.metrology.readers.columns import COLUMN_KINDS, _guess_columns, _kind_from_name
 from jointwear.metrology.readers.pretext import (
     MISSING,
+    fields,
     is_missing,
     normalise,
     numeric_line,
+    sniff_delimiter,
     split_blocks,
+    thousands_hint,
     thousands_mark,
 )
 from jointwear.metrology.readers.source import _read_text
@@ -255,10 +259,18 @@ def sniff(
         if best is None:
             bad = data_sample[0]
             line_no = lines.index(bad) + 1 if bad in lines else header_lines + 1
-            raise BadInputError(
+            d = fmt.delimiter or sniff_delimiter(data_sample)
+            hint = thousands_hint([c for ln in data_sample for c in fields(ln, d)], d)
+            fix = (
+                f"pass thousands='{hint}' if its numbers are grouped in thousands, else "
+                if hint and fmt.thousands is None
+                else "pass "
+            )
+            raise Refusal(
                 f"'{path}' line {line_no}: cannot split {bad.strip()[:60]!r} into numbers with "
                 "any delimiter (tab, ';', ',', whitespace) and decimal separator ('.', ','); "
-                "pass delimiter=... and decimal=..., or fix the line"
+                f"{fix}delimiter=... and decimal=..., or fix the line",
+                ({"thousands": hint},) if hint and fmt.thousands is None else (),
             )
         _, d, c = best
         if delim is None:
@@ -331,10 +343,17 @@ def _bad_line(
                         f"'{path}' line {ln_no}: {t!r} is not a measured value; remove the line "
                         "or re-export without missing points"
                     )
-                raise BadInputError(
+                hint = thousands_hint([t], fmt.delimiter) if fmt.thousands is None else None
+                raise Refusal(
                     f"'{path}' line {ln_no}: {t!r} is not a number (expected decimal "
                     f"separator {fmt.decimal!r}, delimiter {_DELIMS.get(fmt.delimiter or ' ')}); "
-                    "fix the line or pass delimiter=/decimal="
+                    + (
+                        f"pass thousands='{hint}' if it is grouped in thousands, or "
+                        if hint
+                        else ""
+                    )
+                    + "fix the line or pass delimiter=/decimal=",
+                    ({"thousands": hint},) if hint else (),
                 )
     raise BadInputError(f"'{path}': the table could not be parsed; pass delimiter= and decimal=")
 

@@ -366,3 +366,71 @@ def test_excel_merged_layer_headers_read_as_layers_with_their_z(tmp_path, with_z
         ds = read_scan(f, convention=CONV, layer_spacing=1e-3)
         np.testing.assert_allclose(ds["z"].values, [-1e-3, 0, 1e-3], atol=1e-12)
     np.testing.assert_allclose(ds["radial_deviation"].values, dev * 1e-6, atol=1e-15)
+
+
+# --- issue 38 item 6: micro-inch, --units over an unknown header unit, --thousands named ------
+
+
+@pytest.mark.parametrize("name", ["uin", "µin", "μin", "microinch"])
+def test_micro_inch_is_a_unit(tmp_path, name):
+    th = np.arange(360) * 1.0
+    dev = 20.0 * np.cos(2 * np.radians(th))  # 20 uin = 0.508 um
+    f = tmp_path / "uin.txt"
+    f.write_text(
+        f"Units: {name}\nAngle (deg)\tDeviation\n"
+        + "".join(f"{a:.1f}\t{v:.3f}\n" for a, v in zip(th, dev, strict=True))
+    )
+    ds = read_scan(f, convention=CONV)
+    np.testing.assert_allclose(
+        ds["radial_deviation"].values[0], np.round(dev, 3) * 25.4e-9, rtol=1e-12
+    )
+
+
+def test_units_option_replaces_a_header_unit_nobody_knows(tmp_path, run_import):
+    th = np.arange(360) * 1.0
+    f = tmp_path / "odd.txt"
+    f.write_text(
+        "Units: Mikron*\nAngle (deg)\tDeviation\n"
+        + "".join(f"{a:.1f}\t{np.cos(np.radians(2 * a)):.4f}\n" for a in th)
+    )
+    with pytest.raises(BadInputError, match=r"line 1: unit 'Mikron\*' is not known") as exc:
+        read_scan(f, convention=CONV)
+    assert exc.value.suggestions == ({"units": "<unit>"},)
+    ds = read_scan(f, convention=CONV, units="um")
+    assert "Mikron" in ds.attrs["reader_guesses"]["odd.txt"]["unknown_unit"]
+    np.testing.assert_allclose(ds["radial_deviation"].values[0].max(), 1e-6)
+    out = tmp_path / "o.nc"
+    assert run_import(f, out) == 3
+    assert run_import(f, out, "--units", "um") == 0
+    # a known header unit is still never overridden silently
+    g = tmp_path / "mm.txt"
+    g.write_text(f.read_text().replace("Mikron*", "um"))
+    with pytest.raises(BadInputError, match="contradicts the file"):
+        read_scan(g, convention=CONV, units="mm")
+
+
+def test_refusals_name_thousands_where_it_helps(tmp_path, run_import):
+    """Grouped integers (`8'001'000` nm) show no decimal mark, so the mark is not sniffed; the
+    refusal names --thousands, and the flag as printed reads the file."""
+    th = np.arange(360) * 1.0
+    r = 8000 + np.cos(np.radians(3 * th))
+    f = tmp_path / "ap.txt"
+    f.write_text(
+        "Units: nm\n"
+        + "".join(
+            f"{a:.1f}\t{int(v * 1000):,}\n".replace(",", "'") for a, v in zip(th, r, strict=True)
+        )
+    )
+    with pytest.raises(BadInputError, match="thousands='apostrophe'") as exc:
+        read_scan(f, convention=CONV)
+    assert exc.value.suggestions == ({"thousands": "apostrophe"},)
+    ds = read_scan(f, convention=CONV, **exc.value.suggestions[0])
+    np.testing.assert_allclose(ds["radius"].values[0], np.floor(r * 1000) * 1e-9, rtol=1e-12)
+    assert run_import(f, tmp_path / "o.nc", "--thousands", "apostrophe") == 0
+    # space-grouped integers in a semicolon file: --thousands space, the spelling --help lists
+    g = tmp_path / "sp.txt"
+    g.write_text(g_text := f.read_text().replace("'", " ").replace("\t", ";"))
+    assert "8 000 999" in g_text or "8 001 000" in g_text
+    with pytest.raises(BadInputError, match="thousands='space'"):
+        read_scan(g, convention=CONV)
+    assert run_import(g, tmp_path / "o2.nc", "--thousands", "space") == 0
