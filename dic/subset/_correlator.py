@@ -273,12 +273,12 @@ class SubsetCorrelator:
         return self.params.min_texture * self.image_std
 
     def _solver_options(self) -> tuple:
-        """IC-GN options in the kernels' order: half, quadratic, max_iter, tol, min_std,
-        max_shift, border, zncc_min, order."""
+        """IC-GN options in the kernels' order: half, second order (the shape function's
+        kernel branch), max_iter, tol, min_std, max_shift, border, zncc_min, order."""
         p = self.params
         return (
             int(p.half),
-            bool(p.quadratic),
+            bool(p.shape_function.second_order),
             int(p.max_iterations),
             float(p.tolerance),
             float(self._min_subset_std),
@@ -300,8 +300,10 @@ class SubsetCorrelator:
         """
         from jointwear.dic.icgn import _match as _icgn
 
-        if self.params.quadratic:
-            raise ParameterError("preload_references: only the affine shape function")
+        if not self.params.shape_function.preload:
+            raise ParameterError(
+                f"preload_references: not for the {self.params.shape} shape function (affine only)"
+            )
         n, m = self.n_points, self.params.subset_size**2
         F, GX, GY = np.empty((n, m)), np.empty((n, m)), np.empty((n, m))
         HINV, JF, JS = np.empty((n, 6, 6)), np.empty((n, 6)), np.empty((n, 6))

@@ -20,21 +20,6 @@ if TYPE_CHECKING:
 __all__ = ["result_dataset", "result_record"]
 
 
-_GRAD_NAMES = [
-    ("u", 0, "pixel", "displacement along x (image columns, right)"),
-    ("du_dx", 1, "1", "displacement gradient du/dx"),
-    ("du_dy", 2, "1", "displacement gradient du/dy"),
-    ("v", 6, "pixel", "displacement along y (image rows, down)"),
-    ("dv_dx", 7, "1", "displacement gradient dv/dx"),
-    ("dv_dy", 8, "1", "displacement gradient dv/dy"),
-]
-_SECOND = [  # d2u_dx2 .. d2v_dy2: shape parameters 3-5 (u) and 9-11 (v)
-    (f"d2{c}_{d}", first + k, "pixel-1", f"second derivative d2{c}/{d}")
-    for c, first in (("u", 3), ("v", 9))
-    for k, d in enumerate(("dx2", "dxdy", "dy2"))
-]
-
-
 def result_dataset(
     centres, P, zncc, iterations, flag, params: CorrelationParams, grid=None, sigma=None
 ) -> xr.Dataset:
@@ -87,8 +72,7 @@ def result_record(
             ),
         }
     data = {}
-    names = _GRAD_NAMES + (_SECOND if params.quadratic else [])
-    for name, k, units, long in names:
+    for name, k, units, long in params.shape_function.outputs:
         vals = np.where(ok, P[..., k], np.nan).reshape(shape)
         data[name] = Variable(dims, vals, {"units": units, "long_name": long})
     data["zncc"] = Variable(

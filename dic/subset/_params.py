@@ -12,6 +12,8 @@ from jointwear.errors import BadInputError, ParameterError
 if TYPE_CHECKING:  # numpy is imported by the checks that use it: the CLI's option
     import numpy as np  # declarations read this module without it
 
+    from jointwear.dic.icgn._shapes import ShapeFunction
+
 __all__ = [
     "CorrelationParams",
     "MIN_STEP",
@@ -34,8 +36,6 @@ UPDATE_ZNCC = 0.9
 #: what DIC images can be (the results' ``data_origin``): camera images or generated ones
 IMAGE_ORIGINS = ("measured", "synthetic")
 
-_SHAPES = {"affine": False, "first": False, "quadratic": True, "second": True}
-
 
 @dataclass(frozen=True)
 class CorrelationParams:
@@ -48,7 +48,9 @@ class CorrelationParams:
     step : int
         Grid spacing of the points of interest [pixel] (grids only).
     shape : str
-        Subset shape function: ``"affine"`` (first order) or ``"quadratic"`` (second order).
+        Subset shape function, a name of the table
+        :data:`~jointwear.dic.icgn._shapes.SHAPE_FUNCTIONS`: ``"affine"`` (first order) or
+        ``"quadratic"`` (second order).
     interpolation : str
         ``"cubic"`` or ``"quintic"`` B-spline on prefiltered coefficients.
     max_iterations : int
@@ -101,10 +103,7 @@ class CorrelationParams:
             )
         if not isinstance(self.step, numbers.Integral) or self.step < MIN_STEP:
             raise ParameterError(f"step={self.step!r}: expected an integer >= {MIN_STEP} pixel")
-        if self.shape not in _SHAPES:
-            raise ParameterError(
-                f"shape={self.shape!r}: expected 'affine' (first order) or 'quadratic' (second order)"
-            )
+        self.shape_function  # noqa: B018 - a name not in the table is refused, naming them
         if self.interpolation not in ("cubic", "quintic"):
             raise ParameterError(
                 f"interpolation={self.interpolation!r}: expected 'cubic' or 'quintic' (B-spline)"
@@ -130,8 +129,11 @@ class CorrelationParams:
         return self.subset_size // 2
 
     @property
-    def quadratic(self) -> bool:
-        return _SHAPES[self.shape]
+    def shape_function(self) -> ShapeFunction:
+        """The shape's record in :data:`~jointwear.dic.icgn._shapes.SHAPE_FUNCTIONS`."""
+        from jointwear.dic.icgn._shapes import shape_function
+
+        return shape_function(self.shape)
 
 
 def set_threads(threads: int = 0) -> int:

@@ -383,10 +383,9 @@ class _SequenceTracker:
         ds = result_dataset(
             base.centres, self.P, self.Z, self.It, self.Fl, prm, base.grid, sigma=self.S
         )
-        if reference == "incremental" and prm.quadratic:
-            for name in ("d2u_dx2", "d2u_dxdy", "d2u_dy2", "d2v_dx2", "d2v_dxdy", "d2v_dy2"):
-                later = ref_frame > 0
-                ds[name].values[later] = np.nan
+        if reference == "incremental":
+            for name in prm.shape_function.not_incremental:
+                ds[name].values[ref_frame > 0] = np.nan
         ds = ds.assign_coords(
             time=("time", t, {"units": "s", "long_name": "elapsed time since the first frame"}),
             frame=("time", np.arange(len(t)), {"long_name": "frame index"}),
