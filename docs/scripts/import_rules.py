@@ -20,20 +20,19 @@ sibling) so that a new violation fails.
 from __future__ import annotations
 
 import ast
+import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
 
-#: folder -> import package (pyproject's package-dir)
+#: top-level folder -> import package (pyproject's package-dir)
 FOLDERS = {
-    "jointwear": "jointwear",
-    "sim": "jointwear.sim",
-    "dic": "jointwear.dic",
-    "metrology": "jointwear.metrology",
-    "compare": "jointwear.compare",
-    "reports": "jointwear.reports",
-    "datasets": "jointwear.datasets",
+    folder: package
+    for package, folder in tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"][
+        "setuptools"
+    ]["package-dir"].items()
+    if "/" not in folder
 }
 
 #: top-level package -> the packages it may import (besides itself and the root), from
