@@ -51,6 +51,9 @@ def summarise(path: str | Path, *, validate: bool = True) -> str:
         from jointwear.refinement import describe_study
 
         lines.append(describe_study(ds))
+    if ds.attrs.get("jointwear_file") == "posterior":  # jointwear sim calibrate
+        lines.append("calibration (posterior/prior sd; 'NOT informed': the data do not fix it):")
+        lines.extend("  " + t for t in str(ds.attrs.get("identifiability", "")).splitlines())
     if "history" in ds.attrs:
         lines.append("history:")
         lines.extend("  " + h for h in str(ds.attrs["history"]).splitlines())

@@ -91,6 +91,11 @@ def test_calibration_of_the_linear_model_matches_the_closed_form(tmp_path):
     prov = io.parse_provenance(back)
     assert prov["parameters"]["calibration"]["values"][0]["source"] == "closed-form test"
     assert 0.05 < float(back["ppc_p_below"][0]) < 0.95
+    # jointwear info says which parameter the data do not inform
+    from jointwear.summary import summarise
+
+    info = summarise(tmp_path / "post.nc")
+    assert "x1: posterior" in info and "NOT informed by the data" in info
 
 
 def test_emulator_error_is_what_was_planted():
