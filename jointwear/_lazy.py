@@ -3,45 +3,18 @@ if) it is imported.
 
 Subpackages serve their public names lazily with ``lazy_loader.attach_stub`` (their
 ``__init__.pyi`` lists every name; ``docs/scripts/lazy_stubs.py`` writes it).
-:func:`lazy_api` is the former in-house loader's signature over ``lazy_loader.attach``, kept for
-a package not yet given an ``_EXPORTS`` table and a stub; it reads the API modules' ``__all__``
-from their source, so nothing is imported until a name is used.
 """
 
 from __future__ import annotations
 
-import ast
 import importlib.abc
 import importlib.machinery
 import importlib.util
 import sys
-from collections.abc import Callable, Sequence
-from pathlib import Path
+from collections.abc import Callable
 from typing import Any
 
-import lazy_loader
-
-__all__ = ["lazy_api", "after_import"]
-
-
-def lazy_api(
-    package: str, api_modules: Sequence[str]
-) -> tuple[Callable[[str], Any], Callable[[], list[str]]]:
-    """Return ``(__getattr__, __dir__)`` for ``package`` re-exporting ``api_modules``' ``__all__``
-    (fully qualified module names), and set the package's ``__all__``."""
-    attrs = {}
-    for name in api_modules:
-        spec = importlib.util.find_spec(name)
-        tree = ast.parse(Path(spec.origin).read_text(encoding="utf-8"))
-        names = next(
-            ast.literal_eval(node.value)
-            for node in tree.body
-            if isinstance(node, ast.Assign) and getattr(node.targets[0], "id", "") == "__all__"
-        )
-        attrs[name.removeprefix(package + ".")] = list(names)
-    getattr_, dir_, all_ = lazy_loader.attach(package, submod_attrs=attrs)
-    sys.modules[package].__all__ = all_
-    return getattr_, dir_
+__all__ = ["after_import"]
 
 
 def after_import(name: str, callback: Callable[[], None]) -> None:

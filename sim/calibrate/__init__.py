@@ -10,13 +10,11 @@ diagnostics, identifiability and the posterior predictive check (:func:`calibrat
 modules are private; the public names are importable from here, loaded on first use.
 """
 
-from jointwear._lazy import lazy_api
+import lazy_loader
 
-__getattr__, __dir__ = lazy_api(
-    __name__,
-    [
-        "jointwear.sim.calibrate._run",
-        "jointwear.sim.calibrate._spec",
-        "jointwear.sim.calibrate._predict",
-    ],
-)
+# The public names: the __all__ of these modules. They are imported on first use so that the
+# command line starts fast; ``python docs/scripts/lazy_stubs.py`` writes them into __init__.pyi,
+# which lazy_loader reads.
+_EXPORTS = {"_run": None, "_spec": None, "_predict": None}
+
+__getattr__, __dir__, __all__ = lazy_loader.attach_stub(__name__, __file__)

@@ -13,6 +13,7 @@ PACKAGES = [
     "jointwear.sim",
     "jointwear.sim.wear",
     "jointwear.sim.sweep",
+    "jointwear.sim.calibrate",
     "jointwear.dic",
     "jointwear.dic.icgn",
     "jointwear.dic.calibration",
