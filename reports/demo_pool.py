@@ -22,7 +22,14 @@ from typing import Any
 
 from jointwear._worker_threads import limit_worker_threads, numba_threads_launched
 
-__all__ = ["InlineExecutor", "MAX_WORKERS", "available_cores", "run_part", "worker_pool"]
+__all__ = [
+    "InlineExecutor",
+    "MAX_WORKERS",
+    "available_cores",
+    "quiet_wear_log",
+    "run_part",
+    "worker_pool",
+]
 
 #: At most this many worker processes (each holds a simulation's memory, a few hundred MB).
 MAX_WORKERS = 4
@@ -55,8 +62,20 @@ def _init_worker() -> None:
     import signal
 
     limit_worker_threads()  # numba's API where numba is imported (a fork), else the environment
+    quiet_wear_log()  # a spawned worker: as the demo's own process
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
+
+
+def quiet_wear_log() -> None:
+    """The wear runs' accuracy warnings are not printed by the demo (nothing in it can be
+    changed; its wear line states the accuracy, noise included, and the files keep the
+    warning in ``accuracy_warning``)."""
+    import logging
+
+    log = logging.getLogger("jointwear.sim.wear")
+    if not any(isinstance(h, logging.NullHandler) for h in log.handlers):
+        log.addHandler(logging.NullHandler())
 
 
 def process_cpu(pid: int) -> float | None:
