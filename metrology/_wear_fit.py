@@ -261,19 +261,21 @@ def _exclude_tails(
     points). While a zone of 1, 2, 4 or 8 bands (``step_deg`` wide, on every layer) next to the
     worn region has a mean above ``z_crit`` standard errors, the next band leaves the unworn
     set and the reference is refitted. Where that would leave fewer than ``min_fraction`` of
-    the points and the zone's mean exceeds 1.5 ``z_crit`` standard errors, the tails reach
-    around the bore: refused (a BadInputError naming the explicit unworn mask). What stays
-    below the test is in the uncertainty: the larger of the "unworn selection" term (the change
-    when a further 10-30 degree is left out) and the undetected tail (:func:`undetected_tail`).
-    Returns (mask, description).
+    the points, the tails reach around the bore: the test stops there and returns the tail it
+    still measures (mean + 2 standard errors), whose consequence the map carries in its u
+    (:mod:`._wear_unseen`: decided by consequence, not refused for its presence; a 1-nm tail
+    against 7 um of wear used to refuse the map). What stays below the test is in the
+    uncertainty: the larger of the "unworn selection" term (the change when a further 10-30
+    degree is left out) and the undetected tail (:func:`undetected_tail`).
+    Returns (mask, description, remaining tail [m] or None when the test did not stop early).
     """
     nz, nt = shape
     win = max(1, int(round(step_deg * nt / 360.0)))
     # the worn region: most of a step-wide window not unworn (not each isolated noise outlier)
     region = _smooth_theta((~mask).reshape(shape).astype(float), win) > 0.5
     if not region.any() or region.all():
-        return mask, "none found (no worn region)"
-    n_bands, note = 0, ""
+        return mask, "none found (no worn region)", None
+    n_bands, note, remaining = 0, "", None
     while True:
         grown = ~_dilate(~region, theta_deg, step_deg)
         new = mask & ~(grown & ~region).ravel()
@@ -293,20 +295,20 @@ def _exclude_tails(
                 break
         if not found:
             break
-        if new.sum() < min_fraction * mask.size:
-            if tbar <= 1.5 * z_crit * se:  # a refusal needs stronger evidence: stop here
-                break
-            raise BadInputError(
-                f"wear_map: the wear's faint tails reach around the bore (the unworn points "
-                f"next to the worn region still hold {tbar * 1e9:.2g} ± {se * 1e9:.2g} nm of "
-                f"wear with only {new.mean():.0%} of the points left): the reference fitted on "
-                "what is left would absorb them and the volume would read low; pass an explicit "
-                "unworn mask (unworn=...) of points known to be unworn"
+        if new.sum() < min_fraction * mask.size:  # the tails reach around the bore
+            remaining = tbar + 2.0 * se
+            note += (
+                f"; the tails reach around the bore: stopped with {mask.mean():.0%} of the "
+                f"points left, their remaining wear ({tbar * 1e9:.2g} ± {se * 1e9:.2g} nm) is "
+                "carried in the u"
             )
+            break
         mask, region, n_bands = new, grown, n_bands + 1
-    return mask, (
+    return (
+        mask,
         f"{n_bands} band(s) of {step_deg:g} degree next to the worn region held wear above "
-        f"{z_crit:g} standard errors and were left out of the unworn set ({note})"
+        f"{z_crit:g} standard errors and were left out of the unworn set ({note})",
+        remaining,
     )
 
 

@@ -202,13 +202,17 @@ def tail_term(q: dict, wear: np.ndarray, wts, dv: float, shift):
     return {name: b / np.sqrt(3.0) for name, b in bound.items()}, np.abs(shift) / np.sqrt(3.0)
 
 
-def reference_bias_terms(q: dict, u: np.ndarray, selection, tail, note: str) -> np.ndarray:
+def reference_bias_terms(
+    q: dict, u: np.ndarray, selection, tail, note: str, unseen=None
+) -> np.ndarray:
     """Add to ``q`` the uncertainty of the reference's bias by faint wear tails and return the
     widened per-point u. ``selection`` (:func:`selection_term`) and ``tail``
     (:func:`tail_term`) are two estimates of that one effect (leaving the tails out changes
-    the map by about what they bias it): the larger of the two counts, not their sum. Either
-    may be None (not assessed); ``note`` describes the tail."""
-    per_point = [t[1] for t in (selection, tail) if t is not None]
+    the map by about what they bias it), and so is ``unseen`` (the wear up to a level the
+    selection cannot see on the unworn points: (per quantity, per point, level [m]),
+    :mod:`._wear_unseen`): the largest counts, not their sum. Each may be None (not assessed;
+    ``unseen``: not needed); ``note`` describes the tail."""
+    per_point = [t[1] for t in (selection, tail, unseen) if t is not None]
     for name, (v, uu, comment) in list(q.items()):
         parts, terms = [], []
         if selection is not None and np.isfinite(selection[0][name]):
@@ -221,25 +225,42 @@ def reference_bias_terms(q: dict, u: np.ndarray, selection, tail, note: str) -> 
                 f"undetected wear tail ({tail[0][name]:.3g}: bound/sqrt(3), rectangular; {note})"
             )
             terms.append(tail[0][name])
+        if unseen is not None and np.isfinite(unseen[0][name]):
+            parts.append(
+                f"unseen wear ({unseen[0][name]:.3g}: bound/sqrt(3), rectangular, of wear up to "
+                f"{unseen[2] * 1e9:.2g} nm on every unworn point; wear spread round the bore)"
+            )
+            terms.append(unseen[0][name])
         du = max(terms, default=0.0)
         text = "; " + " and ".join(parts)
-        if len(terms) == 2:
-            text += " (one effect: the larger counted)"
+        if len(terms) >= 2:
+            text += f" (one effect: the {'larger' if len(terms) == 2 else 'largest'} counted)"
         q[name] = (v, float(np.hypot(uu, du)) if np.isfinite(uu) else uu, comment + text)
     if per_point:
         u = np.hypot(u, np.maximum.reduce(per_point))
     return u
 
 
-def refuse_inseparable_difference(s2: float, noise: float, tau: float) -> None:
-    """Refuse a difference of scans whose unworn points hold smooth structure, not noise."""
+def refuse_inseparable_difference(s2: float, noise: float, tau: float, arcs=()) -> None:
+    """Refuse a difference of scans whose unworn points hold smooth structure, not noise
+    (``arcs``: the theta arcs [degree] the data find least worn, for the fix)."""
+    from jointwear.metrology._wear_unseen import WearMapRefusal, format_arcs
+
     if np.sqrt(s2) > max(1.5 * noise, 1e-9) and tau > 20.0:
-        raise BadInputError(
+        fix = (
+            f"if the bore is known to be unworn at theta {format_arcs(arcs)} degree (canonical), "
+            f"pass them as unworn (CLI --unworn {format_arcs(arcs)})"
+            if arcs
+            else "give the theta arcs known to be unworn (CLI --unworn THETA1:THETA2)"
+        )
+        raise WearMapRefusal(
             f"wear_map: the difference of the scans leaves {np.sqrt(s2) * 1e9:.3g} nm RMS of "
             f"smooth structure (correlation length {tau:.0f} samples) on the points taken as "
             f"unworn, against {noise * 1e9:.3g} nm of noise: wear spread around most of the "
             "bore (or a change of form between the scans) cannot be separated from the change "
-            "of set-up; pass an explicit unworn mask (unworn=...) of points known to be unworn"
+            "of set-up",
+            fix,
+            arcs,
         )
 
 

@@ -77,6 +77,16 @@ from jointwear.metrology._wear_setup import (
     register_angle,
     registered_offset,
 )
+from jointwear.metrology._wear_unseen import (
+    STRUCTURE_SHARE,
+    exposed,
+    refuse_by_consequence,
+    smooth_structure,
+    unseen_bound,
+    unseen_level,
+    unseen_term,
+    unworn_arcs,
+)
 from jointwear.metrology.baseline import FormBasis, correlation_length, noise_sigma
 from jointwear.metrology.choices import UNWORN_THRESHOLD, WEAR_SHAPE, WEAR_SHAPES
 from jointwear.metrology.form import SCAN_VARIABLES, scan_variable
@@ -141,6 +151,7 @@ def wear_map(
     shape: str = WEAR_SHAPE,
     threshold: float = UNWORN_THRESHOLD,
     unworn: np.ndarray | xr.DataArray | None = None,
+    unworn_z=None,
     surface: str = "bore",
     radius: float | None = None,
     margin_deg: float | None = None,
@@ -175,8 +186,13 @@ def wear_map(
         Highest lobing harmonic and degree in z of the form model (``shape="form"``).
     threshold : float
         Unworn points lie within ``threshold`` robust standard deviations of the reference.
-    unworn : bool array (z, theta), optional
-        Explicit unworn mask (canonical theta order of the worn scan); skips the iteration.
+    unworn : bool array (z, theta) or sequence of (start, end), optional
+        Explicit unworn mask (canonical theta order of the worn scan), or the theta arcs
+        [degree, canonical convention; start > end wraps through 0] whose points are unworn
+        (CLI ``--unworn 200:330``); skips the iteration.
+    unworn_z : sequence of (start, end), optional
+        z ranges [m] whose points are unworn (with ``unworn`` arcs: both must hold; CLI
+        ``--unworn-z-mm``).
     surface : {"bore", "shaft"}
         A bore's radius grows with wear, a shaft's shrinks; wear depth is positive for material
         removed in both.
@@ -208,7 +224,7 @@ def wear_map(
     rw = np.asarray(w.values, dtype=float)
     sign = 1.0 if surface == "bore" else -1.0
     X = FormBasis(z, th, harmonics, axial_degree) if shape == "form" else _basis(z, th, shape)
-    mask_in = _mask_in(unworn, rw.shape)
+    mask_in = _mask_in(unworn, rw.shape, z, th, unworn_z)
     method = _method(shape, X, before is not None)
     fit_args = (threshold, mask_in, max_iter, margin_deg)
     offset = float(angle_offset_deg)
@@ -244,17 +260,33 @@ def wear_map(
         X, fit, alt, _ = _reference(d, X, shape, z, th, harmonics, *fit_args, rbz is not None)
         resid, mask, var_fit, s2, n_iter = fit
     tails = _tails_note(mask_in is not None, margin_deg)
+    remaining = None
     if mask_in is None and rbz is not None:
-        fit, tails = _without_tails(d, X, mask, rw.shape, th, threshold, margin_deg)
+        fit, tails, remaining = _without_tails(d, X, mask, rw.shape, th, threshold, margin_deg)
         resid, mask, var_fit, s2, _ = fit
     radius = _volume_radius(radius, wname, rw, worn, w)
     terms = ("selection", "tail") if rbz is not None else ("tail",)
     terms = terms if mask_in is None else ()
-    q, u, tau, noise, tail = _quantities(d, X, fit, alt, z, th, radius, terms, fit_args)
+    structure = 0.0
+    if terms and rbz is not None:
+        r2 = resid.reshape(rw.shape)
+        structure = smooth_structure(
+            s2, noise_sigma(r2), correlation_length(r2, mask.reshape(rw.shape))
+        )
+        noisy = structure > STRUCTURE_SHARE * noise_sigma(r2)
+        if remaining is not None or noisy or exposed(mask.reshape(rw.shape)).any():
+            terms += ("unseen",)  # wear spread round the bore: decided by consequence
+            remaining = (remaining, structure if noisy else 0.0)
+    q, u, tau, noise, tail, unseen = _quantities(
+        d, X, fit, alt, z, th, radius, terms, fit_args, remaining
+    )
     mask2 = mask.reshape(rw.shape)
     wear = resid.reshape(rw.shape)
     if rbz is not None:
-        refuse_inseparable_difference(s2, noise, tau)
+        arcs = unworn_arcs(mask2, th) if mask_in is None else ()
+        refuse_inseparable_difference(s2, noise, tau, arcs)
+        if unseen is not None:
+            refuse_by_consequence(q, *unseen, float(mask.mean()), arcs)
     else:
         _refuse_inseparable(q, d, X, fit, noise, threshold, rw.shape)
         _refuse_form_tails(q, tail)
@@ -266,7 +298,7 @@ def wear_map(
     )
     attrs = {
         "wear_reference": method,
-        "unworn_selection": "explicit mask"
+        "unworn_selection": _explicit_note(unworn, unworn_z)
         if mask_in is not None
         else f"iterative: |residual - median| <= {threshold} x 1.4826 MAD ({n_iter} rounds)",
         "n_unworn_points": int(mask.sum()),
@@ -343,10 +375,61 @@ def _options(shape, before, margin_deg, surface, threshold) -> tuple[str, float]
     return shape, margin_deg
 
 
-def _mask_in(unworn, shape: tuple[int, int]) -> np.ndarray | None:
-    """The explicit unworn mask, flattened (None if not given)."""
-    if unworn is None:
+def _explicit_note(unworn, unworn_z) -> str:
+    """The ``unworn_selection`` attribute of an explicit mask."""
+    if unworn is not None and np.ndim(unworn) == 2 and np.shape(unworn)[1] == 2:
+        arcs = ", ".join(f"{a:g}..{b:g}" for a, b in np.asarray(unworn, dtype=float))
+        text = f"explicit: theta {arcs} degree (canonical)"
+    elif unworn is not None and np.shape(unworn) == (2,):
+        text = f"explicit: theta {float(unworn[0]):g}..{float(unworn[1]):g} degree (canonical)"
+    else:
+        text = "explicit mask" if unworn is not None else "explicit: all theta"
+    if unworn_z is not None:
+        zs = ", ".join(f"{a * 1e3:g}..{b * 1e3:g}" for a, b in np.asarray(unworn_z, dtype=float))
+        text += f", z {zs} mm"
+    return text
+
+
+def _in_arcs(values: np.ndarray, ranges, what: str, period: float | None) -> np.ndarray:
+    """Which ``values`` lie in any of the closed ``ranges`` (lo, hi); with a ``period`` an arc
+    with lo > hi wraps through 0 [degree]."""
+    inside = np.zeros(values.shape, dtype=bool)
+    for r in ranges:
+        try:
+            lo, hi = (float(x) for x in r)
+        except (TypeError, ValueError):
+            raise BadInputError(f"wear_map: {what} must be (start, end) pairs, got {r!r}") from None
+        if not (np.isfinite(lo) and np.isfinite(hi)) or lo == hi:
+            raise BadInputError(f"wear_map: {what} {lo:g}:{hi:g} is empty; give start:end")
+        if period is None:
+            inside |= (values >= min(lo, hi)) & (values <= max(lo, hi))
+            continue
+        span = (hi - lo) % period or period
+        inside |= (values - lo) % period <= span + 1e-9
+    return inside
+
+
+def _mask_in(unworn, shape: tuple[int, int], z=None, th=None, unworn_z=None) -> np.ndarray | None:
+    """The explicit unworn mask, flattened (None if not given): a bool array (z, theta), or
+    theta arcs [degree, canonical] and/or z ranges ``unworn_z`` [m] (both must hold)."""
+    if unworn is None and unworn_z is None:
         return None
+    if unworn is not None and np.shape(unworn) == (2,):  # one arc
+        unworn = [tuple(unworn)]
+    as_arcs = unworn is None or (np.ndim(unworn) == 2 and np.shape(unworn)[1] == 2)
+    as_arcs = as_arcs and not (unworn is not None and np.shape(unworn) == shape)
+    if as_arcs:
+        mask_in = np.ones(shape, dtype=bool)
+        if unworn is not None:
+            mask_in &= _in_arcs(th, unworn, "unworn theta arc", 360.0)[None, :]
+        if unworn_z is not None:
+            mask_in &= _in_arcs(z, unworn_z, "unworn z range", None)[:, None]
+        if not mask_in.any():
+            raise BadInputError(
+                "wear_map: the unworn arcs/z ranges hold no point of the worn scan "
+                f"(theta {th.min():g}..{th.max():g} degree, z {z.min():g}..{z.max():g} m)"
+            )
+        return mask_in.ravel()
     mask_in = np.asarray(unworn, dtype=bool)
     if mask_in.shape != shape:
         raise BadInputError(
@@ -395,10 +478,11 @@ def _centring_note(exact: bool, X, r0_w, with_before: bool) -> str:
 
 
 def _without_tails(d, X, mask, shape, th, threshold, margin_deg):
-    """The robust fit after the faint-tail test (:func:`_exclude_tails`), and its note."""
-    mask, tails = _exclude_tails(d, X, mask, shape, th, 2.0, 5.0)
+    """The robust fit after the faint-tail test (:func:`_exclude_tails`), its note and the
+    tail it still measures where the tails reach around the bore [m] (else None)."""
+    mask, tails, remaining = _exclude_tails(d, X, mask, shape, th, 2.0, 5.0)
     fit = _robust_reference(d, X, threshold, mask, 1, "wear_map", shape, th, margin_deg)
-    return fit, tails
+    return fit, tails, remaining
 
 
 def _tails_note(explicit: bool, margin_deg: float) -> str:
@@ -411,11 +495,14 @@ def _tails_note(explicit: bool, margin_deg: float) -> str:
     )
 
 
-def _quantities(d, X, fit, alt, z, th, radius, terms, fit_args):
+def _quantities(d, X, fit, alt, z, th, radius, terms, fit_args, remaining=None):
     """Derived quantities with their u, the per-point u, the residual's correlation length
-    [samples], the instrument noise [m] (successive differences of the map) and the undetected
+    [samples], the instrument noise [m] (successive differences of the map), the undetected
     tail (volume change [m^3], description, u of the volume without it [m^3]; None if not
-    assessed). ``terms``: which of the "selection" and "tail" terms to add to the u."""
+    assessed) and the unseen wear's (bound of each quantity, level [m]) or None.
+    ``terms``: which of the "selection", "tail" and "unseen" terms to add to the u;
+    ``remaining``: (the tail the band test still measures where it stopped [m] or None, the
+    RMS smooth structure of the unworn points [m] or 0) for the "unseen" term."""
     resid, mask, var_fit, s2, _ = fit
     threshold, _, _, margin = fit_args
     shape = (z.size, th.size)
@@ -437,10 +524,10 @@ def _quantities(d, X, fit, alt, z, th, radius, terms, fit_args):
         other = alt[0].reshape(shape)
         _model_order_term(q, other, wts, z, th, "form-model order")
         u = np.hypot(u, wear - other)  # each depth's dependence on the model order
-    tail = None
+    tail = unseen = None
     if mask2.all() or not terms:
-        return q, u, tau, noise_sigma(wear), tail
-    selection = tail_u = None
+        return q, u, tau, noise_sigma(wear), tail, unseen
+    selection = tail_u = unseen_u = None
     note = "not assessed"
     if "selection" in terms:
         selection = selection_term(q, wear, d, X, mask2, wts, z, th, threshold, margin)
@@ -448,8 +535,15 @@ def _quantities(d, X, fit, alt, z, th, radius, terms, fit_args):
         dv, shift, note = undetected_tail(d, X, mask, shape, th, wts)
         tail = (dv, note, q["worn_volume"][1])
         tail_u = tail_term(q, wear, wts, dv, shift)
-    u = reference_bias_terms(q, u, selection, tail_u, note)
-    return q, u, tau, noise_sigma(wear), tail
+    if "unseen" in terms:
+        tail_left, structure = remaining
+        level = unseen_level(wear, mask2, th, threshold, tail_left, structure)
+        where = mask2 if tail_left is not None or structure else exposed(mask2)
+        bound, per_point = unseen_bound(X, G, where * level, z, th, wts, wear)
+        unseen = (bound, level)
+        unseen_u = (*unseen_term(bound, per_point), level)
+    u = reference_bias_terms(q, u, selection, tail_u, note, unseen_u)
+    return q, u, tau, noise_sigma(wear), tail, unseen
 
 
 def _attr_radius(orig: xr.Dataset | xr.DataArray, da: xr.DataArray) -> float | None:

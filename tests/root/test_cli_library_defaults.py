@@ -229,8 +229,8 @@ def test_wearmap_defaults_are_the_librarys():
     from jointwear.metrology.wearmap import wear_map
 
     kw = _keywords(wear_map)
-    mapping = _same(kw, "angle_offset_deg", "register", "shape", "threshold")
-    mapping |= _renamed(kw, radius_mm="radius")
+    mapping = _same(kw, "angle_offset_deg", "register", "shape", "threshold", "unworn")
+    mapping |= _renamed(kw, radius_mm="radius", unworn_z_mm="unworn_z")
     params = _check(wearmap_cmd, mapping, {"worn", "before", "out", "overwrite", "plot"})
     # every choice the command offers is one the library takes; another shape is refused
     from jointwear.errors import BadInputError
