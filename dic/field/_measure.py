@@ -50,7 +50,7 @@ import xarray as xr
 
 from jointwear.dic.field._params import FieldParams
 from jointwear.dic.icgn import _flags
-from jointwear.dic.subset._params import check_image_origin
+from jointwear.dic.subset import check_image_origin
 from jointwear.errors import BadInputError, ParameterError
 
 __all__ = ["FieldParams", "measure_field", "FIELD_FLAG_MEANINGS"]
@@ -69,13 +69,12 @@ def _frames(source, what: str) -> tuple[list[np.ndarray], list[str]]:
     """Images of one camera (first = reference) and their names."""
     from pathlib import Path
 
-    from jointwear.dic.subset._correlator import check_image
-    from jointwear.dic.subset._sequence import read_frames, read_image
+    from jointwear.dic.subset import check_image, read_frames, read_image
 
     if isinstance(source, np.ndarray) and source.ndim == 2:
         return [check_image(source, f"{what} image 0")], ["0"]
     if isinstance(source, (str, Path)):
-        from jointwear.dic.footage._video import is_image_sequence, list_image_sequence
+        from jointwear.dic.footage import is_image_sequence, list_image_sequence
 
         if is_image_sequence(source):
             files, _ = list_image_sequence(source, what=f"{what} images")
@@ -137,7 +136,7 @@ def left_right_deviation(corr_params, right_img, left_img, centres, rx, ry, subs
     surface sees different things in the two views: its forward and backward matches disagree
     by tenths of a pixel while the ZNCC can stay above 0.8. Also returns the backward match's
     standard uncertainty (RMS over x and y times sqrt(2)) [pixel]."""
-    from jointwear.dic.subset._correlator import SubsetCorrelator
+    from jointwear.dic.subset import SubsetCorrelator
 
     rc = np.column_stack([rx, ry])
     dev = np.full(len(centres), np.nan)
@@ -326,7 +325,7 @@ def measure_field(
     1.300, -0.700 pixel
     """
     from jointwear.dic.field._roi import grid_points, read_roi
-    from jointwear.dic.subset._correlator import SubsetCorrelator
+    from jointwear.dic.subset import SubsetCorrelator
 
     prm = _field_params(params, options)
     check_image_origin(data_origin)
@@ -389,7 +388,7 @@ def _field_params(params: FieldParams | None, options: dict) -> FieldParams:
 def _read_images(left, right, calibration):
     """The calibration (read if a path) and the checked images of both cameras with their
     names: ``calibration, L, lnames, Rr, rnames`` (``Rr`` empty in 2D)."""
-    from jointwear.dic.subset._correlator import check_pair
+    from jointwear.dic.subset import check_pair
 
     stereo = right is not None
     if stereo and calibration is None:
@@ -403,7 +402,7 @@ def _read_images(left, right, calibration):
             "(--right) for a stereo field, or drop the calibration for a 2D field"
         )
     if stereo and not hasattr(calibration, "left"):
-        from jointwear.dic.calibration._importers import read_calibration
+        from jointwear.dic.calibration import read_calibration
 
         calibration = read_calibration(calibration)
     L, lnames = _frames(left, "left" if stereo else "")

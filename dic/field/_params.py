@@ -8,7 +8,7 @@ import numbers
 from dataclasses import dataclass
 from typing import Literal
 
-from jointwear.dic.subset._params import CorrelationParams
+from jointwear.dic.subset import CorrelationParams
 from jointwear.errors import ParameterError
 
 __all__ = ["FieldParams"]

@@ -11,6 +11,7 @@ _EXPORTS = {
     "_interp": ("SplineImage", "prefilter", "prefilter_region"),
     "_reference": ("subset_kappa",),
     "_flags": ("FLAG_NOT_REACHED",),
+    "_shapes": ("ShapeFunction", "shape_function"),
 }
 
 __getattr__, __dir__, __all__ = lazy_loader.attach_stub(__name__, __file__)

@@ -15,3 +15,7 @@ from ._interp import (
 from ._reference import (
     subset_kappa as subset_kappa,
 )
+from ._shapes import (
+    shape_function as shape_function,
+    ShapeFunction as ShapeFunction,
+)

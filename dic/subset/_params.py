@@ -12,7 +12,7 @@ from jointwear.errors import BadInputError, ParameterError
 if TYPE_CHECKING:  # numpy is imported by the checks that use it: the CLI's option
     import numpy as np  # declarations read this module without it
 
-    from jointwear.dic.icgn._shapes import ShapeFunction
+    from jointwear.dic.icgn import ShapeFunction
 
 __all__ = [
     "CorrelationParams",
@@ -131,7 +131,7 @@ class CorrelationParams:
     @property
     def shape_function(self) -> ShapeFunction:
         """The shape's record in :data:`~jointwear.dic.icgn._shapes.SHAPE_FUNCTIONS`."""
-        from jointwear.dic.icgn._shapes import shape_function
+        from jointwear.dic.icgn import shape_function
 
         return shape_function(self.shape)
 
