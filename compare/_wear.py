@@ -128,6 +128,14 @@ def _cell_u(al: xr.Dataset, name: str, u: np.ndarray, basis: str) -> tuple[np.nd
     return cell, f"{basis}; its independent part averaged over the cell: {al[rname].attrs['basis']}"
 
 
+def _simulated_edge(al: xr.Dataset, side: int) -> float | None:
+    """z [m] of the whole simulated map's first (``side`` -1) or last (+1) layer, or None."""
+    if "z_sim" not in al.coords or al["z_sim"].size == 0:
+        return None
+    z_sim = np.asarray(al["z_sim"].values, dtype=float)
+    return float(z_sim.min() if side < 0 else z_sim.max())
+
+
 def _edge_max(f: np.ndarray) -> int:
     """-1 / +1 when the maximum of ``f`` lies on the first / last layer of the band, else 0."""
     i = int(np.unravel_index(np.nanargmax(f), f.shape)[0])
@@ -304,11 +312,22 @@ def axial_criterion(c: WearCase) -> None:
     z_nc = c.peak_nc
     edge_s, edge_d = _edge_max(c.s), _edge_max(c.d)
     if not z_nc and z.size > 1 and edge_s != 0 and edge_s == edge_d:
-        z_nc = (
-            f"both maxima {c.band} lie on its edge layer z = "
-            f"{z[0 if edge_s < 0 else -1] * 1e3:+.2f} mm: the wear grows towards the edge on both "
-            "sides and the band cannot show where either maximum is"
-        )
+        edge = float(z[0 if edge_s < 0 else -1])
+        face = _simulated_edge(c.al, edge_s)
+        # on the simulated map's own edge (the bearing face), nothing lies beyond: both maxima
+        # are located there and the criterion is decided; inside it, the band cannot tell
+        if face is None or abs(edge - face) > 1e-6:
+            beyond = (
+                f"; a measured map reaching z = {face * 1e3:+.2f} mm (the simulated map's edge, "
+                "the bearing face) would decide it"
+                if face is not None
+                else ""
+            )
+            z_nc = (
+                f"both maxima {c.band} lie on its edge layer z = {edge * 1e3:+.2f} mm: the wear "
+                f"grows towards the edge on both sides and the band cannot show where either "
+                f"maximum is{beyond}"
+            )
     c.decisions.append(
         decision(
             f"axial position of maximum wear {c.band}",
