@@ -42,6 +42,18 @@ def _stated(where: str, name: str, value: Any) -> Any:
     return value
 
 
+def _rate(where: str, name: str, value: Any) -> Any:
+    if _fraction(where, name, value) == 0:
+        raise ParameterError(f"{where}.{name} = 0 would never fail a model; state a rate in (0, 1)")
+    return value
+
+
+def _count(where: str, name: str, value: Any) -> Any:
+    if not (isinstance(value, int) and not isinstance(value, bool) and value >= 1):
+        raise ParameterError(f"{where}.{name} must be an integer >= 1, got {value!r}")
+    return value
+
+
 def _true_or_false(where: str, name: str, value: Any) -> Any:
     if not isinstance(value, bool):
         raise ParameterError(f"{where}.{name} must be true or false, got {value!r}")
@@ -96,6 +108,12 @@ class Criteria:
         (magnification calibration) [1]; a ``[measurement]`` table may state it. A gain error
         scales the whole measured map, so it adds ``gain_u_rel·|D|`` to u_D of every wear
         quantity, in quadrature with the map's own u. None (default) = not stated.
+    field_false_fail_rate : float
+        The rate at which a right model fails a field criterion (wear field, axial
+        distribution): the Mahalanobis distance is decided against chi² at ``1 -`` it [1].
+    field_bins_z, field_bins_theta : int
+        Bins of the band in z and theta whose mean depths are the wear field's features (at
+        most the grid's layers and angles) [1].
     probe_u_m : float or None
         User-stated standard uncertainty of a radial offset common to the whole measured wear
         map (stylus/probe radius calibration, an offset between the before- and after-wear
@@ -119,6 +137,9 @@ class Criteria:
     motion_u_num_rel: float | None = checked(None, _stated)
     gain_u_rel: float | None = checked(None, _stated)
     probe_u_m: float | None = checked(None, _stated)
+    field_false_fail_rate: float = checked(0.05, _rate)
+    field_bins_z: int = checked(4, _count)
+    field_bins_theta: int = checked(12, _count)
 
     def __post_init__(self) -> None:
         check_fields(self, "criteria")

@@ -133,6 +133,24 @@ DEFINITIONS: dict[str, tuple[str, str, str]] = {
         "same",
     ),
     "U_val": ("expanded validation uncertainty", "U_val = k u_val (ASME V&V 20)", "same"),
+    "mahalanobis_d2": (
+        "Mahalanobis distance squared",
+        "D² = eᵀ C⁺ e of the feature difference e = f(S) - f(D), C = C_input + C_num + C_D, over "
+        "the principal components of C (Hills & Leslie 2003; Rebba & Mahadevan 2006)",
+        "1",
+    ),
+    "mahalanobis_dof": ("degrees of freedom of D²", "number of principal components kept", "1"),
+    "mahalanobis_threshold": (
+        "threshold of D²",
+        "chi² quantile at 1 - the stated false-fail rate, with the degrees of freedom",
+        "1",
+    ),
+    "mahalanobis_p": ("p-value of D²", "P(chi²(K) > D²) under the right-model hypothesis", "1"),
+    "detectable_scale_error": (
+        "smallest detectable common scale error of the field",
+        "sqrt(threshold / sᵀ C⁺ s): a field S (1 + e) fails when |e| exceeds it (resolution)",
+        "1",
+    ),
     "detectable_error_low": (
         "smallest detectable under-prediction",
         "the relative error (S - D) / |D| < 0 at which |E| = U_val, with the budget's parts that "

@@ -36,7 +36,8 @@ class Criterion:
         ``"module:function"`` deciding it; a function name ending in ``()`` is a factory called
         with ``argument``.
     basis : str
-        What decides it: ``"threshold"``, ``"V&V 20"`` or ``"field"``.
+        What decides it: ``"threshold"``, ``"V&V 20"`` or ``"field"`` (a Mahalanobis distance,
+        :mod:`jointwear.compare._field`).
     resolution : str
         How its resolution (the smallest error it detects) is stated.
     argument : str
@@ -64,6 +65,7 @@ def _resolve(decider: str, argument: str) -> Callable[[Any], None]:
 
 
 _WEAR = "jointwear.compare._wear"
+_FIELD = "jointwear.compare._field"
 _VV20 = "detectable relative errors, both ways (detectable_error_low/high)"
 
 #: the criteria table, in the order of the decision card
@@ -80,6 +82,10 @@ CRITERIA: tuple[Criterion, ...] = (
               "worn_volume"),
     Criterion("cylindricity", "wear", f"{_WEAR}:vv20_band_criterion()", "V&V 20", _VV20,
               "cylindricity"),
+    Criterion("wear_field", "wear", f"{_FIELD}:field_criterion", "field",
+              "D² threshold and the smallest common scale error (detectable_scale_error)"),
+    Criterion("axial_distribution", "wear", f"{_FIELD}:axial_criterion_field", "field",
+              "D² threshold (scale-free: shares per layer)"),
 )  # fmt: skip
 
 

@@ -133,7 +133,7 @@ def test_no_threshold_pass_without_uncertainties():
     assert len(vv) == 3 and (vv.state == "not_assessed").all()
     assert vv.value.str.contains("screening only").all()
     assert not c.any_failed and c.summary().count("pass") == 1  # the shape/location ones only
-    assert "3 not assessed" in c.summary()
+    assert "5 not assessed" in c.summary()  # and the two field criteria (no u at all)
 
 
 def test_u_d_from_the_maps_per_point_and_derived_u_with_k():
