@@ -378,33 +378,20 @@ def run_cycles(
     n_chunks = max(1, math.ceil(cycles * 50 - 1e-9), math.ceil(duration / 0.01 - 1e-9))
     pen_limit = params.contact.max_penetration_fraction * params.joint.radial_clearance
     nacc_total = 0
+    inputs = (P, IP, h, hmin, zl, wl, area, vimp, ww, acc)
+    solver = (
+        _side(params).ANGLE_FLAGS[model],
+        float(s.rtol),
+        float(s.atol),
+        float(s.max_step),
+        float(s.min_step),
+        float(s.onset_penetration),
+        float(pen_limit),
+    )
     for k in range(n_chunks):
         t_chunk = t0 + duration * (k + 1) / n_chunks if k < n_chunks - 1 else t_end
         status, t, hstep, i_out, nacc, _nrej = integrate(
-            t,
-            y,
-            hstep,
-            t_chunk,
-            t_out,
-            i_out,
-            diag,
-            P,
-            IP,
-            h,
-            hmin,
-            zl,
-            wl,
-            area,
-            vimp,
-            ww,
-            acc,
-            _side(params).ANGLE_FLAGS[model],
-            s.rtol,
-            s.atol,
-            s.max_step,
-            s.min_step,
-            s.onset_penetration,
-            pen_limit,
+            t, y, hstep, t_chunk, (t_out, diag), i_out, inputs, solver
         )
         nacc_total += nacc
         if status != 0:

@@ -20,11 +20,24 @@ from jointwear.sim.kernels._geometry import (
 )
 from jointwear.sim.kernels._jit import inline_kernel, kernel
 from jointwear.sim.kernels._layout import (
+    C_ACC,
+    C_AREA,
     C_BUF,
     C_GEO,
+    C_H,
+    C_HMIN,
+    C_INFO,
+    C_IP,
     C_LAYER,
     C_NODE,
+    C_P,
+    C_SON,
+    C_SRATE,
+    C_VIMP,
+    C_WL,
     C_WSC,
+    C_WW,
+    C_ZL,
     CA,
     CE,
     GRADED,
@@ -85,6 +98,26 @@ def _damped(fel, rate, vm, vfloor, ce):
     return fel * ln_factor(rate, vm, ce)
 
 
+@inline_kernel
+def _inputs(ctx):
+    """The context's inputs and memory by name: (P, IP, H, HMIN, ZL, WL, AREA, vimp, srate,
+    son, WW, acc_out) (:func:`._context.make_context`)."""
+    return (
+        ctx[C_P],
+        ctx[C_IP],
+        ctx[C_H],
+        ctx[C_HMIN],
+        ctx[C_ZL],
+        ctx[C_WL],
+        ctx[C_AREA],
+        ctx[C_VIMP],
+        ctx[C_SRATE],
+        ctx[C_SON],
+        ctx[C_WW],
+        ctx[C_ACC],
+    )
+
+
 @kernel
 def _slices(J0, u, V0, W, ctx, wrench, acc, hstep):
     """Grid-independent radial contact: axial slices with the penetration linear in between.
@@ -97,8 +130,7 @@ def _slices(J0, u, V0, W, ctx, wrench, acc, hstep):
     Returns (energy, normal force sum, max penetration, K at the deepest layer, contacting
     layers, opposite-sides flag, contact length fraction).
     """
-    P, IP, H, HMIN, ZL, WL, AREA = ctx[0], ctx[1], ctx[2], ctx[3], ctx[4], ctx[5], ctx[6]
-    vimp, srate, son, WW, acc_out = ctx[7], ctx[8], ctx[9], ctx[11], ctx[12]
+    P, IP, H, HMIN, ZL, WL, AREA, vimp, srate, son, WW, acc_out = _inputs(ctx)
     Nl = IP[NL]
     Nd = IP[ND]
     nexp = P[NEXP]
@@ -342,8 +374,7 @@ def _per_point(J0, u, V0, W, ctx, wrench, acc, hstep):
 
     Returns the same tuple as :func:`_slices`.
     """
-    P, IP, H, HMIN, ZL, WL, AREA = ctx[0], ctx[1], ctx[2], ctx[3], ctx[4], ctx[5], ctx[6]
-    vimp, srate, son, WW, acc_out = ctx[7], ctx[8], ctx[9], ctx[11], ctx[12]
+    P, IP, H, HMIN, ZL, WL, AREA, vimp, srate, son, WW, acc_out = _inputs(ctx)
     Nl = IP[NL]
     Nd = IP[ND]
     nexp = P[NEXP]
@@ -424,7 +455,14 @@ def _end_faces(J0, u, V0, W, ctx, wrench, acc, hstep):
 
     Returns (elastic energy, max axial penetration, axial normal force sum).
     """
-    P, IP, vimp, srate, son, acc_out = ctx[0], ctx[1], ctx[7], ctx[8], ctx[9], ctx[12]
+    P, IP, vimp, srate, son, acc_out = (
+        ctx[C_P],
+        ctx[C_IP],
+        ctx[C_VIMP],
+        ctx[C_SRATE],
+        ctx[C_SON],
+        ctx[C_ACC],
+    )
     Nl = IP[NL]
     nexp = P[NEXP]
     energy = 0.0
@@ -482,8 +520,8 @@ def _contact(J0, u, V0, W, ctx, wrench, acc, hstep):
     penetration, mode, stiffness at the deepest slice, number of contacting slices, axial
     force magnitude).
     """
-    IP = ctx[1]
-    info = ctx[10]
+    IP = ctx[C_IP]
+    info = ctx[C_INFO]
     if IP[PER_POINT] == 1:
         energy, fnsum, pen_rad, kdeep, nslice, two, wcontact = _per_point(
             J0, u, V0, W, ctx, wrench, acc, hstep

@@ -2,8 +2,8 @@
 scratch arrays that let the evaluation kernels allocate nothing (:mod:`._jit`).
 
 ``ctx`` is a tuple of arrays: the packed parameters, the bore profile and layer geometry, the
-impact and wear-work memory (slots 0-12, listed in :func:`._contact._contact`), then the
-scratch arrays (slots ``C_*`` of :mod:`._layout`). It is made once per integration; the
+impact and wear-work memory, then the scratch arrays; every slot is read by its name ``C_*`` of
+:mod:`._layout` (``ctx[C_IP]``, never a bare number). It is made once per integration; the
 scratch arrays hold nothing from one evaluation to the next.
 """
 

@@ -18,6 +18,9 @@ from jointwear.sim.kernels._joint import (
 )
 from jointwear.sim.kernels._layout import (
     BAUM,
+    C_INFO,
+    C_IP,
+    C_P,
     D_COUP_POS,
     D_COUP_VEL,
     D_CRANK_POS,
@@ -57,7 +60,7 @@ from jointwear.sim.kernels._slider_crank import eval_slider_crank
 @kernel
 def _eval_clearance(t, y, ctx, dy, acc, hstep, diag):
     """Right-hand side of the clearance model; optionally accumulates wear work / fills diag."""
-    P, IP = ctx[0], ctx[1]
+    P, IP = ctx[C_P], ctx[C_IP]
     th1, th2, w1, w2 = y[0], y[1], y[2], y[3]
     c1, s1 = math.cos(th1), math.sin(th1)
     c2, s2 = math.cos(th2), math.sin(th2)
@@ -248,10 +251,10 @@ def _eval(t, y, ctx, dy, acc, hstep, diag):
     integrators specialised on a function argument or a closure (they compile again in every
     process), so the mechanisms are told apart by an integer.
     """
-    if ctx[1][MECH] == MECH_SLIDER_CRANK:
+    if ctx[C_IP][MECH] == MECH_SLIDER_CRANK:
         eval_slider_crank(t, y, ctx, dy, acc, hstep, diag)
-    elif ctx[1][IDEAL] == 1:
-        _eval_ideal(t, y, ctx[0], ctx[1], dy, diag)
-        ideal_joint_info(ctx[10])
+    elif ctx[C_IP][IDEAL] == 1:
+        _eval_ideal(t, y, ctx[C_P], ctx[C_IP], dy, diag)
+        ideal_joint_info(ctx[C_INFO])
     else:
         _eval_clearance(t, y, ctx, dy, acc, hstep, diag)

@@ -14,6 +14,9 @@ from jointwear.sim.kernels._context import make_context
 from jointwear.sim.kernels._equations import _eval
 from jointwear.sim.kernels._jit import inline_kernel
 from jointwear.sim.kernels._layout import (
+    C_INFO,
+    C_SON,
+    C_SRATE,
     I_BAD,
     I_CONTACT,
     I_PEN,
@@ -68,43 +71,28 @@ def _combine(Ks, coef, s, i):
 
 
 @njit(cache=True)
-def integrate(
-    t,
-    y,
-    hstep,
-    t_end,
-    t_out,
-    i_out,
-    diag_out,
-    P,
-    IP,
-    H,
-    HMIN,
-    ZL,
-    WL,
-    AREA,
-    vimp,
-    WW,
-    acc_out,
-    ANG,
-    rtol,
-    atol,
-    hmax,
-    hmin,
-    onset,
-    pen_limit,
-):
+def integrate(t, y, hstep, t_end, record, i_out, inputs, solver):
     """Advance ``y`` from ``t`` to ``t_end`` with adaptive DOPRI5; record diagnostics.
+
+    Parameters, grouped: ``record`` = (``t_out``, ``diag_out``), the output times and the
+    diagnostics rows written there from row ``i_out`` on; ``inputs`` = (``P``, ``IP``, ``H``,
+    ``HMIN``, ``ZL``, ``WL``, ``AREA``, ``vimp``, ``WW``, ``acc_out``), what the evaluation
+    context reads and adds to (:func:`._context.make_context`); ``solver`` = (``ANG``, ``rtol``,
+    ``atol``, ``hmax``, ``hmin``, ``onset``, ``pen_limit``): the components under absolute
+    tolerance only, the tolerances, step bounds, deepest allowed onset and the penetration stop.
 
     Returns (status, t, hstep, i_out, n_accepted, n_rejected). status: 0 done, 1 step-size
     collapse, 2 penetration beyond ``pen_limit``, 3 non-finite state, 4 journal axis flipped.
     ``acc_out``: normal work, axial normal work, normal impulse (accumulated) and the largest
     penetration at the end of an accepted step (bore or end faces, kept as a maximum).
     """
+    t_out, diag_out = record
+    P, IP, H, HMIN, ZL, WL, AREA, vimp, WW, acc_out = inputs
+    ANG, rtol, atol, hmax, hmin, onset, pen_limit = solver
     n = y.shape[0]
     Nl = IP[NL]
     ctx = make_context(P, IP, H, HMIN, ZL, WL, AREA, vimp, WW, acc_out)
-    srate, son, info = ctx[8], ctx[9], ctx[10]
+    srate, son, info = ctx[C_SRATE], ctx[C_SON], ctx[C_INFO]
     Ks = np.empty((7, n))  # the seven stage derivatives (the seventh is the next first: FSAL)
     yt = np.empty(n)
     y1 = np.empty(n)

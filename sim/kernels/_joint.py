@@ -17,6 +17,8 @@ import math
 from jointwear.sim.kernels._contact import _contact
 from jointwear.sim.kernels._jit import inline_kernel, kernel
 from jointwear.sim.kernels._layout import (
+    C_INFO,
+    C_P,
     C_VEC,
     CTILT,
     D_AXIS,
@@ -97,7 +99,7 @@ def clearance_joint(Rb, Og, Cj, ug, V0g, Wg, ctx, acc, hstep, FM, J0, u, wrench)
     (:func:`._context.joint_arrays`); the relative velocity and angular velocity in the bearing
     frame, which only the contact reads, are the context's too.
     """
-    info = ctx[10]
+    info = ctx[C_INFO]
     V0, W = ctx[C_VEC][V_V0], ctx[C_VEC][V_W]
     for i in range(3):
         J0[i] = Rb[0, i] * (Cj[0] - Og[0]) + Rb[1, i] * (Cj[1] - Og[1]) + Rb[2, i] * (Cj[2] - Og[2])
@@ -112,7 +114,7 @@ def clearance_joint(Rb, Og, Cj, ug, V0g, Wg, ctx, acc, hstep, FM, J0, u, wrench)
     energy, fnsum, pen_rad, pen_ax, mode, kdeep, nslice, fax = _contact(
         J0, u, V0, W, ctx, wrench, acc, hstep
     )
-    P = ctx[0]
+    P = ctx[C_P]
     if P[KTILT] != 0.0 or P[CTILT] != 0.0:
         energy += _tilt_spring(u, W, P[KTILT], P[CTILT], wrench)
     FM[0] = Rb[0, 0] * wrench[0] + Rb[0, 1] * wrench[1] + Rb[0, 2] * wrench[2]

@@ -107,8 +107,14 @@ NINFO = 4
 
 
 # ---- evaluation context (ctx), made by _context.make_context --------------------------------
-# slots 0-12 (P, IP, H, HMIN, ZL, WL, AREA, vimp, srate, son, info, WW, acc_out): see
-# _contact._contact; then the scratch arrays of the evaluation kernels, which allocate nothing
+# the inputs and memory every evaluation reads or adds to (_context.make_context):
+C_P, C_IP = 0, 1  # packed float and integer parameters
+C_H, C_HMIN = 2, 3  # (Nl, Nd) wear depth; (Nl,) its least value per layer
+C_ZL, C_WL, C_AREA = 4, 5, 6  # layer positions, their width shares, (Nl, Nd) point areas
+C_VIMP, C_SRATE, C_SON = 7, 8, 9  # (Nl + 2) latched impact velocity, approach rate, contact flag
+C_INFO = 10  # (NINFO,) per-evaluation info, slots I_*
+C_WW, C_ACC = 11, 12  # (2, Nl, Nd) wear work and sliding distance; accumulated totals
+# then the scratch arrays of the evaluation kernels, which allocate nothing
 C_VEC = 13  # (N_VEC, 12) vectors of the joint, rows V_*
 C_MAT = 14  # (2, 3, 3): the rotating body's rotation (body -> global) and the bearing frame
 C_LAYER = 15  # (Nl, 8) per-layer results of the slice contact

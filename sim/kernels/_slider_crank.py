@@ -60,7 +60,7 @@ def _cross(a0, a1, a2, b0, b1, b2):
 @kernel
 def _eval_slider_clearance(t, y, ctx, dy, acc, hstep, diag):
     """Right-hand side of the slider-crank with the clearance joint; fills ``diag`` if sized."""
-    P, IP = ctx[0], ctx[1]
+    P, IP = ctx[kn.C_P], ctx[kn.C_IP]
     th1, xs, w1, vs = y[0], y[1], y[2], y[3]
     l1, l2, joff = P[kn.L1], P[kn.L2], P[kn.JOFF]
     m1, mr, ms, g = P[kn.M1], P[kn.M2], P[kn.M3], P[kn.GRAV]
@@ -208,11 +208,11 @@ def _eval_slider_ideal(t, y, ctx, dy, diag):
     torque. Rod: m a_G = F_B + F_C + m g and I phi_dd = (B - G) x F_B + (C - G) x F_C; slider x:
     m_s x_dd = -F_Cx; crank about A: 0 = tau - (B x F_B)_z - m1 g (L1/2) cos theta.
     """
-    P, IP = ctx[0], ctx[1]
+    P, IP = ctx[kn.C_P], ctx[kn.C_IP]
     th1, w1 = y[0], y[1]
     dy[0] = w1
     dy[1] = 0.0
-    ideal_joint_info(ctx[10])
+    ideal_joint_info(ctx[kn.C_INFO])
     if diag.shape[0] == 0:
         return
     l1, l2, joff = P[kn.L1], P[kn.L2], P[kn.JOFF]
@@ -265,7 +265,7 @@ def _eval_slider_ideal(t, y, ctx, dy, diag):
 @kernel
 def eval_slider_crank(t, y, ctx, dy, acc, hstep, diag):
     """Right-hand side of the slider-crank (clearance or ideal model, ``IP[IDEAL]``)."""
-    if ctx[1][kn.IDEAL] == 1:
+    if ctx[kn.C_IP][kn.IDEAL] == 1:
         _eval_slider_ideal(t, y, ctx, dy, diag)
     else:
         _eval_slider_clearance(t, y, ctx, dy, acc, hstep, diag)
