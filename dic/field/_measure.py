@@ -48,8 +48,8 @@ from dataclasses import asdict, dataclass
 import numpy as np
 import xarray as xr
 
+from jointwear.dic import icgn as _flags
 from jointwear.dic.field._params import FieldParams
-from jointwear.dic.icgn import _flags
 from jointwear.dic.subset import check_image_origin
 from jointwear.errors import BadInputError, ParameterError
 

@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-from jointwear.dic.icgn import _flags
+from jointwear.dic import icgn as _flags
 from jointwear.errors import BadInputError
 
 __all__ = ["plane_guess", "best_fit_plane", "stereo_geometry"]

@@ -10,7 +10,32 @@ import lazy_loader
 _EXPORTS = {
     "_interp": ("SplineImage", "prefilter", "prefilter_region"),
     "_reference": ("subset_kappa",),
-    "_flags": ("FLAG_NOT_REACHED",),
+    # the quality flags (dic.subset, dic.field use them as ``icgn.FLAG_OK``, ...)
+    "_flags": (
+        "AFFINE_INDEX",
+        "FLAG_DIVERGED",
+        "FLAG_INVALID_PIXELS",
+        "FLAG_LOW_CORRELATION",
+        "FLAG_MEANINGS",
+        "FLAG_NOT_CONVERGED",
+        "FLAG_NOT_REACHED",
+        "FLAG_NO_TEXTURE",
+        "FLAG_OK",
+        "FLAG_OUTSIDE",
+        "FLAG_U_OUTLIER",
+        "OUTPUT_FLAG_MEANINGS",
+        "OUTPUT_FLAG_VALUES",
+        "flag_uncertainty_outliers",
+    ),
+    # the matching kernels the subset correlator drives
+    "_match": (
+        "affine_references",
+        "icgn_affine_loaded",
+        "icgn_many",
+        "icgn_serial",
+        "rg_propagate",
+        "subset_std",
+    ),
     "_shapes": ("ShapeFunction", "shape_function"),
 }
 

@@ -31,7 +31,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-import jointwear.dic.icgn._flags as _flags
+from jointwear.dic import icgn as _flags
 from jointwear.dic.subset._output import result_dataset, result_record
 from jointwear.dic.subset._params import (
     CorrelationParams,
@@ -232,7 +232,7 @@ class SubsetCorrelator:
 
     def _texture_and_usable(self) -> tuple[np.ndarray, np.ndarray]:
         """Intensity std of every reference subset, and which points can be seeds."""
-        from jointwear.dic.icgn import _match as _icgn
+        from jointwear.dic import icgn as _icgn
 
         if self._texture is None:
             tex = _icgn.subset_std(
@@ -298,7 +298,7 @@ class SubsetCorrelator:
         thousands of points, not for dense fields. Affine shape only; the kernel then runs on
         one thread without holding the GIL, so several correlators can work in threads.
         """
-        from jointwear.dic.icgn import _match as _icgn
+        from jointwear.dic import icgn as _icgn
 
         if not self.params.shape_function.preload:
             raise ParameterError(
@@ -316,7 +316,7 @@ class SubsetCorrelator:
         self._loaded = (F, GX, GY, HINV, JF, JS, FN, FLAG0)
 
     def _run_many(self, dspl, dinv, P, active, st, serial=False):
-        from jointwear.dic.icgn import _match as _icgn
+        from jointwear.dic import icgn as _icgn
 
         ref, dfm = self._kernel_args(dspl, dinv)
         out = (st.zncc, st.iterations, st.flag, st.sigma)
@@ -328,7 +328,7 @@ class SubsetCorrelator:
         kernel(ref, dfm, opts, self.centres, P, active, out)
 
     def _propagate(self, dspl, dinv, st, done, group, n_groups):
-        from jointwear.dic.icgn import _match as _icgn
+        from jointwear.dic import icgn as _icgn
 
         ref, dfm = self._kernel_args(dspl, dinv)
         _icgn.rg_propagate(

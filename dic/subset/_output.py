@@ -9,8 +9,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-import jointwear.dic.icgn._flags as _flags
 from jointwear._netcdf import Record, Variable
+from jointwear.dic import icgn as _flags
 
 if TYPE_CHECKING:
     import xarray as xr

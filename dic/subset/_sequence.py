@@ -269,7 +269,7 @@ class _SequenceTracker:
     ``It``, flags ``Fl`` and the reference frame of every frame."""
 
     def __init__(self, base, first: np.ndarray, frame_list: list, seeds0: np.ndarray | None):
-        from jointwear.dic.icgn import _flags as _icgn
+        from jointwear.dic import icgn as _icgn
 
         self.base, self.frame_list, self.seeds0 = base, frame_list, seeds0
         n_t, n = len(frame_list), base.n_points
@@ -320,7 +320,7 @@ class _SequenceTracker:
 
     def move_reference(self, new_m):
         """The reference becomes frame ``new_m``: subsets centred at the tracked positions."""
-        from jointwear.dic.icgn import _flags as _icgn
+        from jointwear.dic import icgn as _icgn
         from jointwear.dic.subset._correlator import SubsetCorrelator
 
         base = self.base
@@ -335,7 +335,7 @@ class _SequenceTracker:
 
     def track(self, reference, update_zncc, update_every, progress) -> None:
         """Follow the subsets through every frame (see the module docstring)."""
-        from jointwear.dic.icgn import _flags as _icgn
+        from jointwear.dic import icgn as _icgn
         from jointwear.progress import progress_bar
 
         P, S, Fl, tracked = self.P, self.S, self.Fl, self.tracked

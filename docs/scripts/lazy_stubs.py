@@ -105,6 +105,22 @@ def stub_text(package: str, exports: dict[str, tuple[str, ...] | None]) -> str:
             ):
                 raise ValueError(f"{package}: {name} exported twice")
             where[name] = origin
+    return _format(package, where)
+
+
+def _listed(stub: Path) -> dict[str, str]:
+    """Name -> module of an existing stub (empty if there is none)."""
+    if not stub.exists():
+        return {}
+    return {
+        alias.name: node.module
+        for node in ast.parse(stub.read_text()).body
+        if isinstance(node, ast.ImportFrom) and node.module
+        for alias in node.names
+    }
+
+
+def _format(package: str, where: dict[str, str]) -> str:
     by_module: dict[str, list[str]] = {}
     for name, origin in where.items():
         by_module.setdefault(origin, []).append(name)
@@ -154,17 +170,27 @@ def write_stubs(check: bool = False) -> list[Path]:
     """Write (or with ``check``, compare) every stub; return the ones that changed."""
     changed = []
     packages = lazy_packages()
-    for init in packages.values():
-        # a new package's stub must exist (lazy_loader reads it) before the modules are imported
-        if not check and not init.with_suffix(".pyi").exists():
-            init.with_suffix(".pyi").write_text('"""Placeholder: being written."""\n')
-    for name, init in packages.items():
+    before = {
+        n: i.with_suffix(".pyi").read_text() if i.with_suffix(".pyi").exists() else None
+        for n, i in packages.items()
+    }
+    if not check:
+        # lazy_loader reads the stubs when the listing modules are imported below: first serve
+        # what the stubs served and every name _EXPORTS lists one by one (no import needed)
+        for name, init in packages.items():
+            stub = init.with_suffix(".pyi")
+            where = _listed(stub)
+            for module, wanted in _exports(init).items():
+                where.update({n: module for n in wanted or () if n != "*"})
+            stub.write_text(_format(name, where))
+    # subpackages first: a package's listing modules may use its subpackages' new names
+    for name, init in sorted(packages.items(), key=lambda kv: -kv[0].count(".")):
         stub = init.with_suffix(".pyi")
         text = _ruff(stub_text(name, _exports(init)), stub)
-        if not stub.exists() or stub.read_text() != text:
+        if before[name] != text:
             changed.append(stub)
-            if not check:
-                stub.write_text(text)
+        if not check:
+            stub.write_text(text)
     return changed
 
 
