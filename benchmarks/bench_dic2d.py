@@ -7,6 +7,10 @@ output Dataset) and the error against the exact truth, without noise and with 2 
 Gaussian noise. Two numba threads (wall clock, ``poi_per_s``); because the machine is shared,
 the CPU time of one call on one thread is also given (``poi_per_cpu_second_1_thread``), which
 other users of the machine do not distort. Quote medians with the load average.
+
+``--pyvale``: jointwear and pyvale (``pip install pyvale``, not a dependency) side by side in one
+run, CPU time on one thread, min of 3 interleaved repeats, and the CLI process against the
+library call at step 4 (``results/dic2d_pyvale.json``).
 """
 
 from __future__ import annotations
@@ -110,5 +114,142 @@ def main() -> None:
     write_results("dic2d", figures)
 
 
+def _pyvale_cpu(pair, step: int, out: Path) -> tuple[float, object]:
+    """CPU seconds of pyvale's ``calculate_2d`` on one thread (text output in ``out``) and its
+    result: the same pair, 33-pixel subsets, ZNSSD, affine, B-spline, ZNCC gate 0.8."""
+    from pyvale import dic as pdic
+
+    mask = np.zeros(pair.reference.shape, bool)
+    mask[16:-16, 16:-16] = True
+    for old in out.glob("*"):
+        old.unlink()
+    t0 = time.process_time()
+    pdic.calculate_2d(
+        reference=pair.reference, deformed=pair.deformed, roi_mask=mask, seed=[256, 256],
+        subset_size=33, subset_step=step, max_displacement=10, num_threads=1, threshold=0.8,
+        output_basepath=out, print_level=0,
+    )  # fmt: skip
+    cpu = time.process_time() - t0
+    return cpu, pdic.import_2d(
+        data=str(out / "dic_results_*"), layout="column", binary=False, delimiter=","
+    )
+
+
+def _library_cpu(pair, step: int):
+    t0 = time.process_time()
+    ds = _correlate(pair, step, "quintic", threads=1)
+    return time.process_time() - t0, ds
+
+
+def _cli_cpu(ref_png: Path, def_png: Path, out: Path, step: int) -> float:
+    """CPU seconds of the whole ``jointwear dic correlate`` process (start-up included)."""
+    import resource
+    import subprocess
+
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    subprocess.run(
+        [str(Path(sys.executable).parent / "jointwear"), "dic", "correlate", str(ref_png), str(def_png),
+         "--subset", "33", "--step", str(step), "--threads", "1", "--origin", "synthetic",
+         "--out", str(out), "--overwrite"],
+        check=True, capture_output=True,
+    )  # fmt: skip
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    assert out.is_file(), "the CLI wrote no result"
+    return (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+
+
+def _accuracy(u, v, x, y, pair) -> dict:
+    tu, tv = pair.truth(x, y)
+    eu, ev = u - tu, v - tv
+    ok = np.isfinite(eu) & np.isfinite(ev)
+    return {
+        "points_ok": int(ok.sum()),
+        "mean_error_u_px": float(f"{eu[ok].mean():.6f}"),
+        "mean_error_v_px": float(f"{ev[ok].mean():.6f}"),
+        "std_error_u_px": float(f"{eu[ok].std():.6f}"),
+        "std_error_v_px": float(f"{ev[ok].std():.6f}"),
+    }
+
+
+def versus_pyvale(repeat: int = 3) -> None:
+    """jointwear's ``correlate`` and pyvale's ``calculate_2d`` side by side in one run: CPU time
+    of one call on one thread (the machine is shared: CPU time, min of ``repeat`` interleaved
+    repeats), accuracy against the exact truth, and the CLI process against the library call
+    at step 4. Writes ``results/dic2d_pyvale.json``; skipped with a message without pyvale."""
+    import importlib.util
+    import tempfile
+
+    import cv2
+
+    if importlib.util.find_spec("pyvale") is None:
+        print("bench_dic2d --pyvale: pyvale is not installed (pip install pyvale): skipped")
+        return
+    from importlib.metadata import version
+
+    tmp = Path(tempfile.mkdtemp())
+    pairs = {
+        "noise_free": sp.speckle_pair((512, 512), sp.RigidField(SHIFT), seed=1),
+        "noise_2gl": sp.speckle_pair(
+            (512, 512), sp.RigidField(SHIFT), params=sp.SpeckleParams(noise_std=2.0), seed=1
+        ),
+    }
+    figures: dict = {
+        "pyvale_version": version("pyvale"),
+        "image": "512x512, 8 bit, speckle 5 px, shift (3.3, -2.7) px; subset 33, affine, ZNSSD, "
+        "B-spline (jointwear quintic), ZNCC gate 0.8, one thread each, CPU time of the call",
+    }
+    for step in (16, 4):
+        for name, pair in pairs.items():
+            jw, pv = [], []
+            for _ in range(repeat):  # interleaved
+                t, ds = _library_cpu(pair, step)
+                jw.append(t)
+                t, res = _pyvale_cpu(pair, step, tmp)
+                pv.append(t)
+            n_jw = int(ds.flag.size)
+            x, y = np.meshgrid(ds.x.values, ds.y.values)
+            u, v = ds.u.values, ds.v.values
+            px, py = np.asarray(res.ss_x, float).ravel(), np.asarray(res.ss_y, float).ravel()
+            pu, pv_ = np.asarray(res.u_px, float).ravel(), np.asarray(res.v_px, float).ravel()
+            row = {
+                "jointwear": {
+                    "points": n_jw,
+                    "cpu_s_min": round(min(jw), 4),
+                    "poi_per_cpu_s": round(n_jw / min(jw)),
+                    **_accuracy(u.ravel(), v.ravel(), x.ravel(), y.ravel(), pair),
+                },
+                "pyvale": {
+                    "points": int(px.size),
+                    "cpu_s_min": round(min(pv), 4),
+                    "poi_per_cpu_s": round(px.size / min(pv)),
+                    **_accuracy(pu, pv_, px, py, pair),
+                },
+            }
+            row["speed_ratio"] = round(
+                row["jointwear"]["poi_per_cpu_s"] / row["pyvale"]["poi_per_cpu_s"], 2
+            )
+            figures[f"step{step}_{name}"] = row
+            print(f"step {step} {name}: {row}", flush=True)
+    pair = pairs["noise_free"]
+    ref_png, def_png = tmp / "ref.png", tmp / "def.png"
+    cv2.imwrite(str(ref_png), pair.reference)
+    cv2.imwrite(str(def_png), pair.deformed)
+    lib, cli = [], []
+    for _ in range(repeat):
+        lib.append(_library_cpu(pair, 4)[0])
+        (tmp / "cli.nc").unlink(missing_ok=True)
+        cli.append(_cli_cpu(ref_png, def_png, tmp / "cli.nc", 4))
+    figures["step4_cli"] = {
+        "library_cpu_s_min": round(min(lib), 4),
+        "cli_process_cpu_s_min": round(min(cli), 4),
+        "cli_over_library_speed": round(min(lib) / min(cli), 2),
+    }
+    print(figures["step4_cli"])
+    write_results("dic2d_pyvale", figures)
+
+
 if __name__ == "__main__":
-    main()
+    if "--pyvale" in sys.argv:
+        versus_pyvale()
+    else:
+        main()
