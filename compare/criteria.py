@@ -69,12 +69,13 @@ class Criteria:
     k : float
         Coverage factor of the expanded validation uncertainty ``U_val = k u_val`` [1].
     wear_nrmse_max : float
-        Largest acceptable normalised RMSE of the wear map [1].
+        Reference value shown beside the NRMSE of the wear map; not decided [1]: NRMSE (RMSE
+        over the range of D) cannot fail a scaled map (a map whose rms is 0.09 of its range
+        gives NRMSE < 0.25 for a zero prediction), so the shape is decided on r alone.
     wear_r_min : float
-        Smallest acceptable Pearson correlation between the simulated and measured wear maps
-        [1]. Together with ``wear_nrmse_max`` it makes the shape criterion: a low NRMSE alone
-        is also reached by a simulation that predicts almost no wear against a peaky
-        measurement.
+        Smallest acceptable Pearson correlation between the simulated and measured wear maps:
+        the shape criterion [1]. Scale-invariant: it judges the pattern, not its size; its
+        resolution, the turn of the simulated pattern that brings r below it, is stated.
     max_angle_error_deg : float
         Largest acceptable error of the angle of maximum wear [degree].
     max_z_error_m : float

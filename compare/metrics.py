@@ -133,6 +133,12 @@ DEFINITIONS: dict[str, tuple[str, str, str]] = {
         "same",
     ),
     "U_val": ("expanded validation uncertainty", "U_val = k u_val (ASME V&V 20)", "same"),
+    "detectable_turn": (
+        "smallest detectable turn of the wear pattern",
+        "the turn of the simulated map (both ways, the larger) at which its Pearson r with "
+        "itself falls to wear_r_min: the resolution of the shape criterion",
+        "degree",
+    ),
     "mahalanobis_d2": (
         "Mahalanobis distance squared",
         "D² = eᵀ C⁺ e of the feature difference e = f(S) - f(D), C = C_input + C_num + C_D, over "

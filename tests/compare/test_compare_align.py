@@ -251,6 +251,24 @@ def _shape_verdict(c):
     return bool(row.passed.iloc[0]), str(row.criterion.iloc[0])
 
 
+def test_shape_criterion_is_scale_invariant_and_fails_beyond_its_stated_turn():
+    """The shape criterion judges the pattern: any scale passes (as its text says), and a turn
+    of the pattern fails just beyond the resolution it states, passes just below."""
+    meas = syn.meas_wear(n_layers=16)
+    for scale in (0.1, 4.0):
+        sim = syn.sim_wear()
+        sim["wear_depth"] = sim["wear_depth"] * scale
+        c = compare(sim, meas)
+        assert _shape_verdict(c)[0]
+        row = c.decisions[c.decisions.quantity.str.startswith("wear map shape")].iloc[0]
+        assert row.resolution.startswith("scale-invariant")
+    turn = compare(syn.sim_wear(), meas).value("wear_depth", "detectable_turn")
+    assert 5 < turn < 90
+    assert _shape_verdict(compare(syn.sim_wear(rotate_deg=0.8 * turn), meas))[0]
+    assert not _shape_verdict(compare(syn.sim_wear(rotate_deg=1.2 * turn), meas))[0]
+    assert not _shape_verdict(compare(syn.sim_wear(rotate_deg=-1.2 * turn), meas))[0]
+
+
 def test_shape_criterion_needs_correlation_not_only_low_nrmse():
     """A simulation predicting almost no wear must not pass the shape check on NRMSE alone."""
     meas = syn.meas_wear(n_layers=16)  # covers the simulated width: the shape is comparable
@@ -264,7 +282,7 @@ def test_shape_criterion_needs_correlation_not_only_low_nrmse():
         or c.value("wear_depth", "pearson_r") < Criteria().wear_r_min
     )
     passed, criterion = _shape_verdict(c)
-    assert not passed and "r >= 0.5" in criterion
+    assert not passed and "r >= 0.5" in criterion and "scale-invariant" in criterion
     # the same physical field passes, and the threshold on r is what decides
     assert _shape_verdict(compare(syn.sim_wear(), meas))[0]
     r_rot = compare(syn.sim_wear(rotate_deg=60.0), meas).value("wear_depth", "pearson_r")
