@@ -35,6 +35,10 @@ def reference_study_cmd(
             help=f"Coarse grid, {REDUCED.ensemble_runs} ensemble members (about a minute).",
         ),
     ] = False,
+    verbose: Annotated[
+        bool,
+        typer.Option("--verbose", help="Every reading of each undecided verdict, and all notes."),
+    ] = False,
 ) -> None:
     """Decide the reference study's reported values against the default rig (with u_num, u_input).
 
@@ -42,14 +46,33 @@ def reference_study_cmd(
     prints the verdict per reported quantity; exit code 1 when a criterion fails.
     """
     from jointwear.compare.outcome import card_lines, outcome_lines, raise_for_outcome
-    from jointwear.datasets.reference_study import FULL, REDUCED, run_reference_study
+    from jointwear.datasets._study_card import (
+        baseline_quantities,
+        study_card_lines,
+        unstated_fields,
+    )
+    from jointwear.datasets.reference_study import (
+        FULL,
+        REDUCED,
+        reference_file,
+        run_reference_study,
+    )
+    from jointwear.params import read_toml
 
     result = run_reference_study(
         out, REDUCED if reduced else FULL, say=lambda s: typer.echo(s, err=True)
     )
-    for line in [*card_lines(result), *(f"note: {n}" for n in result.notes)]:
-        typer.echo(line)
-    for line in outcome_lines(result):
+    if verbose:
+        lines = [*card_lines(result), *(f"note: {n}" for n in result.notes), *outcome_lines(result)]
+    else:
+        reported = read_toml(reference_file())
+        unstated = unstated_fields(reported)
+        notes = [n for n in result.notes if not (unstated and "does not state" in n)]
+        lines = [
+            *study_card_lines(result, baseline_quantities(reported), unstated),
+            *(f"note: {n}" for n in notes),
+        ]
+    for line in lines:
         typer.echo(line)
     raise_for_outcome(result, where=str(Path(out) / "metrics.nc"))
 

@@ -35,11 +35,34 @@ QUANTITIES = (
 @pytest.fixture(scope="module")
 def study(tmp_path_factory):
     """``jointwear datasets reference-study --reduced``, run once; its saved comparison."""
+    import contextlib
+    import io as _io
+
     out = tmp_path_factory.mktemp("reference") / "study"
-    code = main(["datasets", "reference-study", str(out), "--reduced"])
+    printed = _io.StringIO()
+    with contextlib.redirect_stdout(printed):
+        code = main(["datasets", "reference-study", str(out), "--reduced"])
     result = load_comparison(io.load(out / "metrics.nc"))
     assert code == (1 if result.any_failed else 0)
+    _PRINTED.append(printed.getvalue())
     return out, result
+
+
+_PRINTED: list[str] = []  # what the command printed (its default output)
+
+
+@pytest.mark.slow
+def test_the_default_output_has_at_most_three_lines_per_criterion(study):
+    _, result = study
+    lines = _PRINTED[0].splitlines()
+    card = [ln for ln in lines if not ln.startswith(("unstated:", "to decide them", "note:"))][:-1]
+    blocks: list[list[str]] = []
+    for line in card:
+        (blocks[-1].append(line) if line.startswith(" ") else blocks.append([line]))
+    assert len(blocks) == len(result.decisions) and all(len(b) <= 3 for b in blocks)
+    assert not any("layers centred at z" in ln for ln in lines)  # the readings: --verbose
+    n = len(result.decisions) - 1  # the new bore is the baseline, not a criterion
+    assert lines[-1 - sum(ln.startswith("note:") for ln in lines)].startswith(f"{n} criteria: ")
 
 
 @pytest.mark.slow
