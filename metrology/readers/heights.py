@@ -129,9 +129,12 @@ def _read_manifest(
                 )
             unit = unit or z_units
         if unit is None:
-            raise BadInputError(
-                f"'{p}': the unit of z is not stated (e.g. a first line 'file,z_mm'); add it or "
-                "pass z_units=... (--z-units mm)"
+            from jointwear.metrology.readers.advice import Refusal
+
+            raise Refusal(
+                f"'{p}': the unit of z is not stated (e.g. a first line 'file,z_mm'); add it, "
+                "or pass z_units='<unit>' with the unit of the heights",
+                ({"z_units": "<unit>"},),
             )
         missing = [
             k

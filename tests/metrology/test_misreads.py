@@ -247,7 +247,7 @@ def test_manifest_without_unit_is_not_read_in_metres(tmp_path):
     for k in (1, 2):
         _table(d / f"layer0{k}.txt", np.arange(360) * 1.0, _dev(360), head="Units: um\n")
     (d / "manifest.csv").write_text("layer01.txt,0\nlayer02.txt,2\n")
-    with pytest.raises(BadInputError, match=r"unit of z is not stated.*--z-units"):
+    with pytest.raises(BadInputError, match=r"unit of z is not stated.*z_units="):
         read_scan(d, convention=CONV)
     ds = read_scan(d, convention=CONV, z_units="mm")
     assert float(np.ptp(ds["z"].values)) == pytest.approx(2e-3)
