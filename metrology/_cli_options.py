@@ -19,6 +19,7 @@ from jointwear.metrology.choices import (
     ARCS,
     LAYOUTS,
     PRESETS,
+    READERS,
     REFERENCES,
     VALUE_KINDS,
     WEAR_SHAPES,
@@ -78,7 +79,8 @@ ImportOut = Annotated[
     Path, typer.Option("--out", "-o", help="Output .nc (one scan) or folder (several scans).")
 ]
 PresetOpt = Annotated[
-    Preset, _opt("--preset", "generic or talyrond (values in µm, whole revolutions).")
+    Preset,
+    _opt("--preset", "; ".join(f"{k}: {doc}" for k, (_, doc) in READERS.items()) + "."),
 ]
 LayoutOpt = Annotated[Layout, _opt("--layout", f"{', '.join(LAYOUTS)}.")]
 Units = Annotated[

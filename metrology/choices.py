@@ -14,6 +14,7 @@ __all__ = [
     "LAYOUTS",
     "Z_SOURCES",
     "PRESETS",
+    "READERS",
     "REFERENCES",
     "PLAUSIBILITY",
     "WEAR_SHAPES",
@@ -31,8 +32,22 @@ VALUE_KINDS = ("radius", "deviation")
 LAYOUTS = ("auto", "single", "folder", "long", "wide", "blocks")
 #: Values of ``z_source`` of :func:`~jointwear.metrology.read_scan`.
 Z_SOURCES = ("auto", "option", "column", "numbers", "manifest", "header", "names", "spacing")
-#: Reader presets: the generic reader, or its Talyrond defaults (values in µm, whole turns).
-PRESETS = ("generic", "talyrond")
+#: The reader of each preset: name -> ("module:function", what it reads). One module per
+#: instrument family under ``metrology/readers/``, registered here and nowhere else (the
+#: command line offers these names; :func:`~jointwear.metrology.readers.registry.reader_for`
+#: imports the function when it is used; docs/development.md, "Adding a reader").
+READERS: dict[str, tuple[str, str]] = {
+    "generic": (
+        "jointwear.metrology.readers.scan:read_scan",
+        "every format choice sniffed from the file or given",
+    ),
+    "talyrond": (
+        "jointwear.metrology.readers.talyrond:read_talyrond",
+        "Taylor Hobson Talyrond: values in µm unless stated, whole revolutions",
+    ),
+}
+#: Reader presets (the names of :data:`READERS`).
+PRESETS = tuple(READERS)
 
 #: Reference names accepted (short form -> ISO circle / cylinder names).
 REFERENCES: dict[str, tuple[str, str]] = {

@@ -81,8 +81,10 @@ def import_scans(
         Output ``.nc`` for one scan, else a folder (``<name>.nc`` per scan).
     angle_zero, angle_direction : str
         The instrument's angle convention in the bearing frame (required: never guessed).
-    preset : {"generic", "talyrond"}
-        Reader: :func:`~.scan.read_scan` or :func:`~.talyrond.read_talyrond`.
+    preset : str
+        Reader, by name (:data:`~jointwear.metrology.choices.READERS`: ``generic``
+        :func:`~.scan.read_scan`, ``talyrond`` :func:`~.talyrond.read_talyrond`, or one added
+        with :func:`~.registry.register`).
     batch : bool
         Each entry of each folder in ``paths`` is a separate scan.
     on_saved : callable, optional
@@ -95,7 +97,7 @@ def import_scans(
     list of Path
         The files written.
     """
-    from jointwear.metrology.readers import read_scan, read_talyrond
+    from jointwear.metrology.readers.registry import reader_for
 
     if angle_zero is None or angle_direction is None:
         raise ConventionError(
@@ -104,7 +106,7 @@ def import_scans(
             "(clockwise or counterclockwise seen from +z); text exports rarely state it and "
             "jointwear never guesses it"
         )
-    reader = read_talyrond if preset == "talyrond" else read_scan
+    reader = reader_for(preset)
     items, targets = _scans(paths, batch, out)
     for item, target in zip(items, targets, strict=True):
         io.check_writable(target)
