@@ -48,11 +48,45 @@ def rms_quantities(al: xr.Dataset) -> dict[str, float]:
     return out
 
 
+def _sg_resolution(c_max: float, al: xr.Dataset) -> str:
+    """What C <= c_max can detect, in closed form: a pure amplitude error S = a D has
+    M = a - 1, P = 0; a pure phase shift of a sinusoid P = shift / pi."""
+    text = (
+        f"detects an amplitude error beyond ±{c_max:.0%} (M alone) or a phase error beyond "
+        f"{c_max * 180:.0f} degree of the signal's own period (P alone)"
+    )
+    if al.attrs.get("alignment_method") != "crank_angle":
+        text += "; a constant phase error was removed by the alignment first (motion_alignment)"
+    return text
+
+
+def _shift_rows(al: xr.Dataset, rows: Rows) -> None:
+    """The alignment's time shift as a quantity with its u (a phase error removed by the
+    cross-correlation is a model error: reported, never silently dropped)."""
+    a = al.attrs
+    if "time_shift_s" not in a:
+        return
+    period = float(a.get("period_s", np.nan))
+    how = (
+        "crank angle matched on both sides: a clock offset between the records"
+        if a.get("alignment_method") == "crank_angle"
+        else "removed by cross-correlation before the history criteria: a phase error of the "
+        "model of this size is not judged by them"
+    )
+    rows.add("motion_alignment", "time_shift", float(a["time_shift_s"]), "s", how)
+    u = float(a.get("time_shift_u_s", np.nan))
+    rows.add("motion_alignment", "time_shift_u", u, "s", str(a.get("time_shift_u_basis", "")))
+    rows.add("motion_alignment", "phase_shift", float(a["time_shift_s"]) / period * 360.0,
+             "degree", how)  # fmt: skip
+    rows.add("motion_alignment", "phase_shift_u", u / period * 360.0, "degree")
+
+
 def motion_metrics(
     al: xr.Dataset, rows: Rows, decisions: list[dict[str, Any]], src: Sources
 ) -> None:
     """Metric rows and decisions of the aligned motion ``al``."""
     criteria = src.criteria
+    _shift_rows(al, rows)
     for name, c in components(al):
         s = _column(al, f"{name}_sim", c)
         d = _column(al, f"{name}_meas", c)
@@ -78,6 +112,7 @@ def motion_metrics(
                 f"C = {sg.C:.3g} (M = {sg.M:+.3g}, P = {sg.P:.3g})",
                 threshold_state(sg.C <= criteria.motion_sg_c_max, bool(np.isfinite(sg.C))),
                 "threshold",
+                resolution=_sg_resolution(criteria.motion_sg_c_max, al),
             )
         )
         u = {}

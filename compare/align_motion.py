@@ -190,6 +190,28 @@ def _phase_by_crank_angle(
     return t_sim, shift
 
 
+def shift_uncertainty(method: str, w_time: np.ndarray, t_sim: np.ndarray, period: float):
+    """Standard uncertainty of the alignment's time shift [s] and how it was obtained.
+
+    By crank angle: the scatter of the per-frame shifts (circular standard deviation) over the
+    square root of the frames (the mean's), the frame interval's rounding (interval/√12) added
+    in quadrature. By cross-correlation: the frame interval/√12 (where between two frames the
+    correlation's peak lies is not resolved better than the sampling).
+    """
+    dt = float(np.median(np.diff(w_time))) if w_time.size > 1 else float("nan")
+    rounding = dt / math.sqrt(12.0)
+    if method != "crank_angle":
+        return rounding, f"frame interval {dt * 1e3:.3g} ms / sqrt(12)"
+    ang = 2 * math.pi * (w_time - t_sim) / period
+    r = float(np.hypot(np.mean(np.sin(ang)), np.mean(np.cos(ang))))
+    circ = math.sqrt(max(-2.0 * math.log(max(r, 1e-300)), 0.0)) * period / (2 * math.pi)
+    u = math.hypot(circ / math.sqrt(ang.size), rounding)
+    return u, (
+        f"scatter of the per-frame shifts ({circ * 1e3:.3g} ms) / sqrt({ang.size} frames) and "
+        f"the frame interval {dt * 1e3:.3g} ms / sqrt(12), in quadrature"
+    )
+
+
 def _phase_by_cross_correlation(
     sim: xr.Dataset, meas: xr.Dataset, names: list[str], w: _Window
 ) -> tuple[np.ndarray, float]:
@@ -351,6 +373,7 @@ def align_time_series(
         ``<var>_diff`` (sim - meas), ``<var>_meas_u`` / ``<var>_sim_u`` when given, and
         ``sim_time`` (the simulated instant each sample was taken from). Attributes:
         ``alignment_method``, ``time_shift_s``, ``time_shift_deg`` (crank degrees),
+        ``time_shift_u_s`` (its standard uncertainty, :func:`shift_uncertainty`),
         ``period_s``, ``n_cycles``, ``interpolation``.
     """
     ts = _time(sim, "simulated motion")
@@ -364,6 +387,7 @@ def align_time_series(
     else:
         t_sim, shift = _phase_by_cross_correlation(sim, meas, names, w)
 
+    shift_u, shift_basis = shift_uncertainty(method, w.time, t_sim, period)
     time = xr.DataArray(w.time, dims="time", attrs=dict(meas["time"].attrs))
     time.attrs.setdefault("units", "s")
     time.attrs.setdefault("long_name", conventions.COORDINATES["time"][1])
@@ -397,6 +421,8 @@ def align_time_series(
             "alignment": _ALIGNMENTS[method],
             "time_shift_s": float(shift),
             "time_shift_deg": float(shift / period * 360.0),
+            "time_shift_u_s": float(shift_u),
+            "time_shift_u_basis": shift_basis,
             "period_s": float(period),
             "n_cycles": float(w.n_cycles),
             "interpolation": (

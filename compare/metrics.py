@@ -133,6 +133,14 @@ DEFINITIONS: dict[str, tuple[str, str, str]] = {
         "same",
     ),
     "U_val": ("expanded validation uncertainty", "U_val = k u_val (ASME V&V 20)", "same"),
+    "time_shift": (
+        "time shift of the motion alignment",
+        "measurement time - simulation time of the same instant, modulo the crank period",
+        "same",
+    ),
+    "time_shift_u": ("standard uncertainty of the time shift", "u of time_shift", "same"),
+    "phase_shift": ("phase of the motion alignment", "time_shift / period * 360", "same"),
+    "phase_shift_u": ("standard uncertainty of the phase", "u of phase_shift", "same"),
     "detectable_turn": (
         "smallest detectable turn of the wear pattern",
         "the turn of the simulated map (both ways, the larger) at which its Pearson r with "

@@ -65,8 +65,9 @@ def alignment_lines(c: Comparison) -> list[str]:
         a = c.motion.attrs
         lines.append(
             f"motion aligned by {a['alignment_method'].replace('_', ' ')}: shift "
-            f"{a['time_shift_s'] * 1e3:+.2f} ms ({a['time_shift_deg']:+.1f} degree of crank "
-            f"angle) over {a['n_cycles']:g} cycle(s)"
+            f"{a['time_shift_s'] * 1e3:+.2f} ± {a.get('time_shift_u_s', float('nan')) * 1e3:.2g}"
+            f" ms ({a['time_shift_deg']:+.1f} degree of crank angle) over {a['n_cycles']:g} "
+            "cycle(s)"
         )
     return lines + [f"note: {note}" for note in c.notes]
 

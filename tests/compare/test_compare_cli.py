@@ -150,7 +150,7 @@ def test_compare_cli_motion_variables(files, tmp_path, capsys):
     assert "component(s) z not compared" in text
     assert main([*argv, "--axis", "x", "--axis", "y", "--axis", "z"]) == 0
     assert "follower velocity z history" in capsys.readouterr().out
-    assert "motion aligned by crank angle: shift -111.41 ms (-80.2 degree" in text
+    assert "motion aligned by crank angle: shift -111.41 ± " in text and "(-80.2 degree" in text
     assert main([*argv, "--variable", "journal_offset"]) == 3
     assert "journal_offset are not in both" in capsys.readouterr().err
 
