@@ -95,6 +95,13 @@ def wear_maps_figure(wear: xr.Dataset) -> Any:
     s = np.asarray(wear["wear_depth_sim"].values) * 1e6
     d = np.asarray(wear["wear_depth_meas"].values) * 1e6
     diff = s - d
+    full = "wear_depth_sim_full" in wear
+    if full:
+        th_f = np.asarray(wear["theta_sim"].values, dtype=float)
+        z_f = np.asarray(wear["z_sim"].values, dtype=float) * 1e3
+        s = np.asarray(wear["wear_depth_sim_full"].values) * 1e6
+    # one colour scale for both maps (a reader compares their colours), the difference on its
+    # own diverging scale centred on zero
     vmax = float(np.nanmax([np.nanmax(s), np.nanmax(d)]))
     vmin = float(np.nanmin([np.nanmin(s), np.nanmin(d), 0.0]))
     dmax = float(np.nanmax(np.abs(diff))) or 1.0
@@ -102,17 +109,11 @@ def wear_maps_figure(wear: xr.Dataset) -> Any:
         fig = _figure(10.5, 3.3)
         axes = fig.subplots(1, 3, sharey=True)
         panels = (
-            (s, "simulation", "magma_r", vmin, vmax),
+            (s, "simulation (whole width)" if full else "simulation", "magma_r", vmin, vmax),
             (d, "measurement", "magma_r", vmin, vmax),
             (diff, "simulation − measurement", "RdBu_r", -dmax, dmax),
         )
-        full = "wear_depth_sim_full" in wear
-        if full:
-            th_f = np.asarray(wear["theta_sim"].values, dtype=float)
-            z_f = np.asarray(wear["z_sim"].values, dtype=float) * 1e3
-            s_f = np.asarray(wear["wear_depth_sim_full"].values) * 1e6
-            vmax = float(np.nanmax([vmax, np.nanmax(s_f)]))
-            panels = ((s_f, "simulation (whole width)", "magma_r", vmin, vmax), *panels[1:])
+        meshes = []
         for k, (ax, (field, title, cmap, lo, hi)) in enumerate(zip(axes, panels, strict=True)):
             x, y = (th_f, z_f) if (full and k == 0) else (theta, z_mm)
             mesh = ax.pcolormesh(
@@ -129,7 +130,9 @@ def wear_maps_figure(wear: xr.Dataset) -> Any:
                 ax.set_ylim(z_f.min() - 0.5, z_f.max() + 0.5)
             ax.set_xlabel("θ [degree] (0 along −x, clockwise)")
             ax.set_xticks(np.arange(0, 361, 90))
-            fig.colorbar(mesh, ax=ax, label="wear depth [µm]" if cmap != "RdBu_r" else "Δ [µm]")
+            meshes.append(mesh)
+        fig.colorbar(meshes[1], ax=list(axes[:2]), label="wear depth [µm] (both maps)")
+        fig.colorbar(meshes[2], ax=axes[2], label="Δ [µm]")
         axes[0].set_ylabel("z [mm] (0 at mid-width)")
     return fig
 
@@ -141,6 +144,7 @@ def polar_layers_figure(wear: xr.Dataset, *, max_layers: int = 6) -> Any:
     the last). Zero angle points left (−x), angles grow clockwise, as in the reference study.
     """
     import matplotlib
+    from matplotlib.ticker import MaxNLocator
 
     z = np.asarray(wear["z"].values, dtype=float)
     theta = np.asarray(wear["theta"].values, dtype=float)
@@ -182,8 +186,11 @@ def polar_layers_figure(wear: xr.Dataset, *, max_layers: int = 6) -> Any:
             ax.set_ylim(min(0.0, float(np.nanmin([s[i].min(), d[i].min()]))), top)
             ax.set_title(f"z = {z[i] * 1e3:+.2f} mm (max {top / 1.05:.3g} µm)", pad=10)
             ax.tick_params(labelsize=7)
-            if k == 0:
-                ax.legend(loc="upper left", bbox_to_anchor=(-0.25, 1.18), frameon=False)
+            # three radial labels, between the 0 and 45 degree labels (none of them crowded)
+            ax.yaxis.set_major_locator(MaxNLocator(3))
+            ax.set_rlabel_position(22.5)
+        handles, labels = fig.axes[0].get_legend_handles_labels()
+        fig.legend(handles, labels, loc="outside lower center", ncol=len(labels), frameon=False)
         fig.suptitle("wear depth [µm] per layer", fontsize=9)
     return fig
 
@@ -293,6 +300,28 @@ def _study_series(ds: xr.Dataset) -> list[tuple]:
     return out
 
 
+def _log_x(ax: Any, x: np.ndarray) -> None:
+    """A logarithmic x axis whose labels do not run together: each level's value as a plain
+    number when they span less than two decades and are few (ΔN = 12500 ... 100000), else
+    powers of ten (solver tolerances 1e-4 ... 1e-12)."""
+    from matplotlib.ticker import (
+        LogFormatterSciNotation,
+        LogLocator,
+        NullFormatter,
+        ScalarFormatter,
+    )
+
+    ax.set_xscale("log")
+    levels = np.unique(x)
+    if levels.max() / levels.min() < 100 and levels.size <= 5:
+        ax.xaxis.set_major_formatter(ScalarFormatter())
+        ax.set_xticks(levels)
+    else:
+        ax.xaxis.set_major_locator(LogLocator(base=10, numticks=6))
+        ax.xaxis.set_major_formatter(LogFormatterSciNotation())
+    ax.xaxis.set_minor_formatter(NullFormatter())
+
+
 def verification_figure(datasets: Sequence[xr.Dataset]) -> Any | None:
     """Convergence plots of verification data: every 1-D variable against its dimension.
 
@@ -304,7 +333,6 @@ def verification_figure(datasets: Sequence[xr.Dataset]) -> Any | None:
     when there is nothing to plot.
     """
     import matplotlib
-    from matplotlib.ticker import ScalarFormatter
 
     series = []
     for ds in datasets:
@@ -335,11 +363,7 @@ def verification_figure(datasets: Sequence[xr.Dataset]) -> Any | None:
                 if np.isfinite(u):
                     ax.axhspan(v - u, v + u, color=SIM_COLOUR, alpha=0.12, lw=0)
             if np.all(x > 0):
-                ax.set_xscale("log")
-                ax.xaxis.set_major_formatter(ScalarFormatter())
-                ax.xaxis.set_minor_formatter(ScalarFormatter())
-                ax.set_xticks(np.unique(x))
-                ax.tick_params(axis="x", which="minor", labelbottom=False)
+                _log_x(ax, x)
             if np.all(y > 0) and y.max() / y.min() > 10:
                 ax.set_yscale("log")
             else:
