@@ -90,6 +90,9 @@ def main() -> None:
         t_cmd_inproc, _ = median_time(in_process_command, repeat=3)
         cpu = {
             "import_folder": cpu_time(lambda: read_scan(tmp / "folder", convention=CONV), warmup=1),
+            "import_long_file": cpu_time(
+                lambda: read_scan(tmp / "long.txt", convention=CONV), warmup=1
+            ),
             "cylindricity_MZ": cpu_time(
                 lambda: cylindricity(da, reference="MZ"), repeat=5, warmup=1
             ),

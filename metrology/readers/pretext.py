@@ -227,9 +227,12 @@ def _remove_thousands(
     """``text`` with the thousands mark removed inside the fields of its data lines, and a note
     (None when there is none). A given mark that is the delimiter is refused."""
     sep = thousands_mark(given)
-    lines = text.splitlines()
-    data = [i for i, ln in enumerate(lines) if _is_data(ln)]
-    sample = [lines[i] for i in data[:400]]
+    sample = []
+    for ln in text[:65536].splitlines()[:-1]:  # the first 400 data lines (whole ones) decide
+        if _is_data(ln):
+            sample.append(ln)
+            if len(sample) == 400:
+                break
     delim = delimiter or sniff_delimiter(sample)
     if sep is None:
         sep = sniff_thousands(sample, delim)
@@ -245,7 +248,8 @@ def _remove_thousands(
                 "the option, or pass delimiter=... if the fields are separated otherwise"
             )
     pat = _grouped(sep, None)
-    for i in data:
+    lines = text.splitlines()
+    for i in [i for i, ln in enumerate(lines) if _is_data(ln)]:
         toks = [
             t.replace(sep, "") if sep in t and pat.match(t) else t for t in fields(lines[i], delim)
         ]

@@ -391,6 +391,22 @@ def parse_blocks(path: str | Path, fmt: TextFormat = TextFormat()) -> list[Parse
     return out
 
 
+_BLANK_LINE = re.compile(r"\n[ \t\r\f\v]*\n")
+
+
+def _has_blank_line(text: str, hl: int, tail: Sequence[str]) -> bool:
+    """Whether the table (the lines after the ``hl`` header lines) holds a blank line; a regex
+    over the text instead of a Python loop over its lines (a 13 x 18000 file: 0.1 s)."""
+    pos = 0
+    for _ in range(hl):
+        pos = text.find("\n", pos) + 1
+        if pos == 0:
+            return any(not ln.strip() for ln in tail)  # not \n line ends: the plain way
+    if "\r" in text[:4096].replace("\r\n", ""):
+        return any(not ln.strip() for ln in tail)  # old Mac line ends
+    return bool(_BLANK_LINE.search(text, max(pos - 1, 0))) or (bool(tail) and not tail[0].strip())
+
+
 def _modal_width(lines: Sequence[str], body_idx: Sequence[int], delim: str) -> int:
     """The number of fields of most of the first 200 table lines (a first line whose last cell
     is missing, ``0.5<TAB>``, does not set the width)."""
@@ -451,7 +467,7 @@ def _parse_text(path: Path, text: str, fmt: TextFormat, pre: dict[str, str]) -> 
     lines = text.splitlines()
     hl = fmt.header_lines or 0
     tail = lines[hl:]
-    if any(not ln.strip() for ln in tail):
+    if _has_blank_line(text, hl, tail):
         body_idx = [i for i in range(hl, len(lines)) if lines[i].strip()]
     else:
         body_idx = range(hl, len(lines))
