@@ -74,17 +74,12 @@ def _combine(Ks, coef, s, i):
 def integrate(t, y, hstep, t_end, record, i_out, inputs, solver):
     """Advance ``y`` from ``t`` to ``t_end`` with adaptive DOPRI5; record diagnostics.
 
-    Parameters, grouped: ``record`` = (``t_out``, ``diag_out``), the output times and the
-    diagnostics rows written there from row ``i_out`` on; ``inputs`` = (``P``, ``IP``, ``H``,
-    ``HMIN``, ``ZL``, ``WL``, ``AREA``, ``vimp``, ``WW``, ``acc_out``), what the evaluation
-    context reads and adds to (:func:`._context.make_context`); ``solver`` = (``ANG``, ``rtol``,
-    ``atol``, ``hmax``, ``hmin``, ``onset``, ``pen_limit``): the components under absolute
-    tolerance only, the tolerances, step bounds, deepest allowed onset and the penetration stop.
-
-    Returns (status, t, hstep, i_out, n_accepted, n_rejected). status: 0 done, 1 step-size
-    collapse, 2 penetration beyond ``pen_limit``, 3 non-finite state, 4 journal axis flipped.
-    ``acc_out``: normal work, axial normal work, normal impulse (accumulated) and the largest
-    penetration at the end of an accepted step (bore or end faces, kept as a maximum).
+    ``record`` = (t_out, diag_out): output times, diagnostics rows written from row ``i_out``;
+    ``inputs`` = (P, IP, H, HMIN, ZL, WL, AREA, vimp, WW, acc_out) of :func:`.make_context`;
+    ``solver`` = (ANG, rtol, atol, hmax, hmin, onset, pen_limit). Returns (status, t, hstep,
+    i_out, n_accepted, n_rejected); status 0 done, 1 step-size collapse, 2 penetration beyond
+    ``pen_limit``, 3 non-finite state, 4 journal axis flipped. Adds to ``acc_out`` the normal,
+    axial normal work and normal impulse; keeps there the largest end-of-step penetration.
     """
     t_out, diag_out = record
     P, IP, H, HMIN, ZL, WL, AREA, vimp, WW, acc_out = inputs

@@ -41,6 +41,10 @@ __all__ = [
     "next_interval",
     "COVERAGE",
     "DETECTION_SIGMAS",
+    "UNRESOLVED_RATE_CHANGE",
+    "PERSISTENT_SHARE",
+    "unresolved_updates",
+    "convergence_notes",
 ]
 
 #: Coverage factor of the reported accuracy (expanded uncertainty, about 95 %).
@@ -249,3 +253,79 @@ class ErrorBudget:
     def volume_u(self) -> float:
         """Expanded uncertainty (k = :data:`COVERAGE`) of the worn volume [m³]."""
         return COVERAGE * math.sqrt(self.volume_trunc**2 + self.volume_var)
+
+
+#: Relative change of the wear-rate field over one accepted update (its noise removed) above
+#: which the update is unresolved (:func:`unresolved_updates`), when the change also exceeds the
+#: detection limit of the run's rate noise.
+UNRESOLVED_RATE_CHANGE: float = 0.5
+
+#: Share of the accepted updates that must be unresolved for "not converged in dN": an overshoot
+#: of the profile feedback repeats at every update, an outlier cycle of the dynamics does not.
+PERSISTENT_SHARE: float = 0.25
+
+
+def unresolved_updates(eta_raw: np.ndarray, noise: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Which updates' rate changes the profile feedback, not the noise, must explain.
+
+    Parameters
+    ----------
+    eta_raw : ndarray
+        Measured relative change of the wear-rate field over each update [1].
+    noise : ndarray
+        Standard deviation of that change caused by the cycle-to-cycle noise alone [1]
+        (0: a deterministic contact model; NaN counts as 0).
+
+    Returns
+    -------
+    (flagged, eta_sys)
+        ``flagged``: the change exceeds the detection limit ``DETECTION_SIGMAS * noise`` (a
+        change within the noise is not non-convergence) and its systematic part
+        ``eta_sys = sqrt(eta_raw^2 - noise^2)`` exceeds :data:`UNRESOLVED_RATE_CHANGE`.
+    """
+    eta_raw = np.asarray(eta_raw, dtype=float)
+    noise = np.nan_to_num(np.asarray(noise, dtype=float), nan=0.0)
+    eta_sys = np.sqrt(np.maximum(eta_raw**2 - noise**2, 0.0))
+    flagged = (eta_sys > UNRESOLVED_RATE_CHANGE) & (eta_raw > DETECTION_SIGMAS * noise)
+    return flagged, eta_sys
+
+
+def convergence_notes(
+    accepted: np.ndarray, noise: np.ndarray, sigma: float, *, measured: bool
+) -> tuple[str | None, str | None]:
+    """(convergence warning, outlier note) of a run's accepted updates, each None if none.
+
+    ``accepted``: the accepted rows of the update history (start, dn, rate_change, ...);
+    ``noise``: each change's noise standard deviation [1]; ``sigma``: the relative noise of one
+    cycle [1]; ``measured``: whether the run knows it. Unresolved updates
+    (:func:`unresolved_updates`) in at least :data:`PERSISTENT_SHARE` of the updates mean the
+    interval is too large for the profile feedback (the explicit update overshoots at every
+    update: not converged in dN). Fewer are outliers of the chaotic dynamics (a cycle with
+    another impact sequence, which a two-cycle noise estimate does not foresee): their effect
+    on the result is scatter between runs, which replicates measure (``sim verify``).
+    """
+    flagged, eta = unresolved_updates(accepted[:, 2], noise)
+    if not flagged.any():
+        return None, None
+    worst = int(np.argmax(np.where(flagged, eta, -1.0)))
+    known = (
+        f" (its rate noise alone explains changes up to "
+        f"{100 * DETECTION_SIGMAS * noise[worst]:.0f} %, from {100 * sigma:.0f} % per cycle)"
+        if measured
+        else " (the run's rate noise was not measured: the run did not finish)"
+    )
+    text = (
+        f"the wear-rate field changed by {100 * accepted[worst, 2]:.0f} % over the update of "
+        f"{int(accepted[worst, 1])} cycles starting at {int(accepted[worst, 0])} cycles{known}, "
+        f"in {int(flagged.sum())} of {len(accepted)} updates: "
+    )
+    if flagged.sum() >= PERSISTENT_SHARE * len(accepted):
+        return (
+            text + "the update interval is too large to resolve the profile feedback and the "
+            "result is not converged; use the adaptive scheme or a smaller dN",
+            None,
+        )
+    return None, text + (
+        "isolated outliers of the cycle-to-cycle variability, not a persistent overshoot; "
+        "their effect is scatter between runs"
+    )

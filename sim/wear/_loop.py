@@ -32,9 +32,9 @@ The next interval is ``dN * 0.9 tol_eff / eta`` (at most doubled, at least 0.2x)
 run always finishes; its accuracy (expanded, k = 2) is reported per point (``wear_depth_u``), for
 the maximum depth and the volume, and ``accuracy_status`` says whether ``tol`` could be held.
 ``scheme="schedule"`` replays a list of intervals (:func:`halved_schedule` for convergence
-checks). Accepted updates whose rate-field change exceeds both :data:`UNRESOLVED_RATE_CHANGE`
-(noise removed) and the detection limit of the run's own rate noise set the
-``convergence_warning`` attribute (:func:`unresolved_updates`); the fixed and schedule schemes,
+checks). Accepted updates whose rate-field change exceeds both 50 % (noise removed) and the
+detection limit of the run's own rate noise, in a quarter of the updates or more, set the
+``convergence_warning`` attribute (:func:`._control.convergence_notes`); the fixed and schedule schemes,
 which measure one cycle per update, measure that noise with one more cycle on the final
 profile (:meth:`WearRun.step`).
 
@@ -87,14 +87,6 @@ __all__ = [
 
 _log = logging.getLogger("jointwear.sim.wear")
 
-#: Relative change of the wear-rate field over one accepted update (its noise removed) above
-#: which the result is flagged as not converged in dN (``convergence_warning`` attribute), when
-#: the change also exceeds the detection limit of the run's rate noise (:func:`unresolved_updates`).
-UNRESOLVED_RATE_CHANGE: float = 0.5
-
-#: Share of the accepted updates that must be unresolved for "not converged in dN": an overshoot
-#: of the profile feedback repeats at every update, an outlier cycle of the dynamics does not.
-PERSISTENT_SHARE: float = 0.25
 
 #: Columns of the update history.
 HISTORY = ("start", "dn", "rate_change", "accepted", "cycles_averaged", "rate_change_noise")
@@ -524,72 +516,24 @@ class WearRun:
         pen = float(self._s.get("max_penetration", math.nan))
         return contact_validity(params, pen if pen > -math.inf else math.nan, kw=self.settings.kw)
 
-    def _unresolved(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, float]:
-        """(accepted history rows, flagged, systematic change, noise of the change, sigma)."""
+    def _convergence_notes(self) -> tuple[str | None, str | None]:
         hist = self.history()
         acc = hist[hist[:, 3] == 1]
         adaptive = self.settings.scheme == "adaptive"
         sigma = self.rate_noise()
-        noise = (
-            acc[:, 5]
-            if adaptive
-            else np.full(len(acc), ctl.change_noise(sigma, 1, 1))  # one cycle per measurement
-        )
-        flagged, eta = unresolved_updates(acc[:, 2], noise)
-        return acc, flagged, eta, noise, sigma
-
-    def _describe_unresolved(self, what: str) -> str:
-        acc, flagged, eta, noise, sigma = self._unresolved()
-        worst = int(np.argmax(np.where(flagged, eta, -1.0)))
-        if self.settings.scheme == "adaptive" or np.isfinite(sigma):
-            known = (
-                f" (its rate noise alone explains changes up to "
-                f"{100 * ctl.DETECTION_SIGMAS * noise[worst]:.0f} %, from {100 * sigma:.0f} % "
-                "per cycle)"
-            )
-        else:
-            known = " (the run's rate noise was not measured: the run did not finish)"
-        return (
-            f"the wear-rate field changed by {100 * acc[worst, 2]:.0f} % over the update of "
-            f"{int(acc[worst, 1])} cycles starting at {int(acc[worst, 0])} cycles{known}, in "
-            f"{int(flagged.sum())} of {len(acc)} updates: {what}"
-        )
+        # the adaptive scheme's noise per update; one cycle per measurement otherwise
+        noise = acc[:, 5] if adaptive else np.full(len(acc), ctl.change_noise(sigma, 1, 1))
+        return ctl.convergence_notes(acc, noise, sigma, measured=adaptive or np.isfinite(sigma))
 
     def convergence_warning(self) -> str | None:
-        """A message if accepted updates changed the wear-rate field too much, else None.
-
-        A rate change beyond :data:`UNRESOLVED_RATE_CHANGE` (noise removed) that the run's
-        own rate noise cannot explain (:func:`unresolved_updates`), in at least
-        :data:`PERSISTENT_SHARE` of the accepted updates, means the update interval was too large
-        for the profile feedback: the explicit update overshoots at every update and the result
-        is not converged in dN (the adaptive scheme rejects such updates). Isolated such
-        updates are outliers of the chaotic dynamics (:meth:`rate_outliers`).
-        """
-        acc, flagged, _, _, _ = self._unresolved()
-        if not flagged.any() or flagged.sum() < PERSISTENT_SHARE * len(acc):
-            return None
-        return self._describe_unresolved(
-            "the update interval is too large to resolve the profile feedback and the result "
-            "is not converged; use the adaptive scheme or a smaller dN"
-        )
+        """A message if the update interval did not resolve the profile feedback, else None
+        (:func:`~jointwear.sim.wear._control.convergence_notes`)."""
+        return self._convergence_notes()[0]
 
     def rate_outliers(self) -> str | None:
-        """A note when a few isolated updates changed the rate field beyond its noise, else None.
-
-        Single cycles of the chaotic dynamics are occasionally far from the others (a different
-        sequence of impacts): a run that measures one cycle per update then shows an isolated
-        large change that a Gaussian noise estimate from two cycles does not explain. Fewer
-        than :data:`PERSISTENT_SHARE` of the updates is not an overshoot of the profile
-        feedback, which would repeat at every update; the outlier's effect on the result is
-        cycle-to-cycle scatter, which replicate runs measure (``jointwear sim verify``).
-        """
-        acc, flagged, _, _, _ = self._unresolved()
-        if not flagged.any() or flagged.sum() >= PERSISTENT_SHARE * len(acc):
-            return None
-        return self._describe_unresolved(
-            "isolated outliers of the cycle-to-cycle variability, not a persistent overshoot; "
-            "their effect is scatter between runs"
-        )
+        """A note on isolated updates whose rate change the noise does not explain, else None
+        (:func:`~jointwear.sim.wear._control.convergence_notes`)."""
+        return self._convergence_notes()[1]
 
     def history(self) -> np.ndarray:
         """The update history, one row per update, columns :data:`HISTORY`."""
@@ -665,31 +609,6 @@ def _max_known(a: float, b: float) -> float:
     if math.isnan(a) or math.isnan(b):
         return math.nan
     return max(a, b)
-
-
-def unresolved_updates(eta_raw: np.ndarray, noise: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Which updates' rate changes mean "not converged in dN", judged against their noise.
-
-    Parameters
-    ----------
-    eta_raw : ndarray
-        Measured relative change of the wear-rate field over each update [1].
-    noise : ndarray
-        Standard deviation of that change caused by the cycle-to-cycle noise alone [1]
-        (0: a deterministic contact model; NaN counts as 0).
-
-    Returns
-    -------
-    (flagged, eta_sys)
-        ``flagged``: the change exceeds the detection limit ``DETECTION_SIGMAS * noise`` (a
-        change within the noise is not non-convergence) and its systematic part
-        ``eta_sys = sqrt(eta_raw^2 - noise^2)`` exceeds :data:`UNRESOLVED_RATE_CHANGE`.
-    """
-    eta_raw = np.asarray(eta_raw, dtype=float)
-    noise = np.nan_to_num(np.asarray(noise, dtype=float), nan=0.0)
-    eta_sys = np.sqrt(np.maximum(eta_raw**2 - noise**2, 0.0))
-    flagged = (eta_sys > UNRESOLVED_RATE_CHANGE) & (eta_raw > ctl.DETECTION_SIGMAS * noise)
-    return flagged, eta_sys
 
 
 def _noise_limited(tol_eff: float, tol: float) -> bool:

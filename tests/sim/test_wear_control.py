@@ -264,7 +264,7 @@ def test_a_noisy_run_that_overshoots_is_still_not_converged():
     ],
 )
 def test_unresolved_updates_threshold(eta, noise, flagged):
-    from jointwear.sim.wear._loop import unresolved_updates
+    from jointwear.sim.wear._control import unresolved_updates
 
     got, _ = unresolved_updates(np.array([eta]), np.array([noise]))
     assert bool(got[0]) is flagged
