@@ -510,6 +510,7 @@ def _parse_text(path: Path, text: str, fmt: TextFormat, pre: dict[str, str]) -> 
         _bad_line(str(path), lines, line_numbers[-1:], fmt, ncol)
     if "header_lines" in guessed:
         _no_data_in_header(str(path), lines[:hl], fmt, ncol)
+    _delimiter_in_numbers(str(path), lines, body_idx, hl, fmt, ncol)
     meta, names = _parse_header(lines[:hl], fmt.delimiter or " ", ncol)
     meta = drop_ignored(meta, fmt.ignore_header)
     if fmt.columns is not None:
@@ -610,6 +611,36 @@ def _no_data_in_header(path: str, header: Sequence[str], fmt: TextFormat, ncol: 
             f"'{path}' line {i + 1}: {header[i].strip()[:60]!r} looks like a row of the table "
             f"with {bad!r} where a number belongs; fix or delete the line (or pass "
             "header_lines=... / --header-lines if it really is a header)"
+        )
+
+
+def _delimiter_in_numbers(path, lines, body_idx, hl: int, fmt, ncol: int) -> None:
+    """``Angle,Radius`` over ``0.0,8,001.234``: the comma both separates the fields and groups
+    the thousands, so a column of 3-digit groups after a column of 1-3 digit integers appears
+    that the names do not have. Refused: no option can tell the two commas apart."""
+    if fmt.delimiter != "," or ncol < 3:
+        return
+    names = [ln for ln in lines[:hl] if ln.strip()]
+    if not names or len(_split(names[-1], ",")) >= ncol:
+        return
+    rows = [_split(lines[i], ",") for i in list(body_idx[:200])]
+    groups = [
+        j
+        for j in range(1, ncol)
+        if all(
+            j < len(r)
+            and re.fullmatch(r"\d{3}(?:\.\d+)?", r[j])
+            and re.fullmatch(r"[-+]?\d{1,3}", r[j - 1])
+            for r in rows
+        )
+    ]
+    if groups:
+        raise BadInputError(
+            f"'{path}' line {body_idx[0] + 1}: {lines[body_idx[0]].strip()[:60]!r} has "
+            f"{ncol} fields under {len(_split(names[-1], ','))} column names, and column "
+            f"{groups[0] + 1} holds only 3-digit groups: the comma both separates the fields "
+            "and groups thousands (8,001.234), which no option can tell apart - re-export "
+            "without thousands separators, or with ';' or tab between the fields"
         )
 
 

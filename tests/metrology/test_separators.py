@@ -163,7 +163,7 @@ def test_comma_thousands_in_a_comma_csv_is_not_read_as_two_layers(tmp_path):
         "Units: um\nAngle (deg),Radius\n"
         + "".join(f"{a:.1f},{v:,.3f}\n" for a, v in zip(range(360), r, strict=True))
     )
-    with pytest.raises(BadInputError):
+    with pytest.raises(BadInputError, match=r"both separates the fields and groups thousands"):
         read_scan(f, convention=CONV)
 
 
