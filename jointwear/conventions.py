@@ -19,11 +19,14 @@ from __future__ import annotations
 import json
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
-import xarray as xr
 
 from jointwear.errors import ConventionError
+
+if TYPE_CHECKING:  # xarray is imported where a DataArray is made (jointwear info reads headers)
+    import xarray as xr
 
 __all__ = [
     "AngleConvention",
@@ -243,6 +246,8 @@ def theta_coord(
     values = np.asarray(theta_deg, dtype=float)
     attrs = {"units": "degree", "long_name": COORDINATES["theta"][1]}
     attrs.update(convention.attrs(note))
+    import xarray as xr
+
     return xr.DataArray(values, dims="theta", attrs=attrs, name="theta")
 
 
@@ -256,6 +261,8 @@ def z_coord(z_m: Iterable[float], *, note: str | None = None) -> xr.DataArray:
     }
     if note:
         attrs["z_note"] = note
+    import xarray as xr
+
     return xr.DataArray(np.asarray(z_m, dtype=float), dims="z", attrs=attrs, name="z")
 
 
@@ -371,7 +378,7 @@ def check_convention(obj: xr.DataArray | xr.Dataset, what: str) -> AngleConventi
 
 
 def _attrs(obj: xr.Dataset | Mapping[str, object]) -> Mapping[str, object]:
-    return obj.attrs if isinstance(obj, (xr.Dataset, xr.DataArray)) else obj
+    return obj.attrs if hasattr(obj, "attrs") else obj  # a Dataset, DataArray or Header
 
 
 def is_partial(obj: xr.Dataset | Mapping[str, object]) -> bool:

@@ -29,6 +29,7 @@ if TYPE_CHECKING:  # xarray is imported where a Dataset is read or written (star
 __all__ = [
     "save",
     "load",
+    "load_header",
     "atomic_path",
     "save_figure",
     "figure_format",
@@ -294,34 +295,29 @@ def save(
     return path
 
 
-def load(path: str | Path, *, validate: bool = True) -> xr.Dataset:
-    """Read a jointwear netCDF file fully into memory and check it against the contract.
-
-    Raises
-    ------
-    BadInputError
-        The file does not exist, is not netCDF, or breaks the contract (the message lists
-        every problem).
-    """
-    import xarray as xr
-
-    from jointwear import conventions
-
+def _existing(path: str | Path) -> Path:
     path = Path(path)
     if not path.exists():
         raise BadInputError(f"'{path}' does not exist")
     if path.is_dir():
         raise BadInputError(f"'{path}' is a folder, expected a netCDF (.nc) file")
-    try:
-        with xr.open_dataset(path, engine="netcdf4") as raw:
-            ds = raw.load()
-    except (OSError, ValueError) as exc:
-        raise BadInputError(
-            f"'{path}' could not be read as netCDF ({exc}); is it a jointwear .nc file?"
-        ) from None
-    ds.attrs = decode_attrs(ds.attrs)
-    for name in list(ds.variables):
-        ds[name].attrs = decode_attrs(ds[name].attrs)
+    return path
+
+
+def _not_netcdf(path: Path, exc: Exception) -> BadInputError:
+    return BadInputError(
+        f"'{path}' could not be read as netCDF ({exc}); is it a jointwear .nc file?"
+    )
+
+
+def _checked(ds: Any, path: Path, validate: bool) -> None:
+    """Decode the attributes of ``ds`` (a Dataset or a :class:`~jointwear._header.Header`) in
+    place and check it against the contract (a foreign file is told how it comes in)."""
+    from jointwear import conventions
+
+    ds.attrs.update(decode_attrs(ds.attrs))
+    for var in [*ds.coords.values(), *ds.data_vars.values()]:
+        var.attrs.update(decode_attrs(var.attrs))
     if validate:
         try:
             conventions.validate(ds, require_provenance=True, what=f"'{path}'")
@@ -336,5 +332,45 @@ def load(path: str | Path, *, validate: bool = True) -> xr.Dataset:
                 "convention and units when the file does not state them); in Python, "
                 "jointwear.external.import_cf. See docs/tutorial-own-data.md."
             ) from None
+
+
+def load_header(path: str | Path, *, validate: bool = True) -> Any:
+    """The header of a jointwear netCDF file (names, dimensions, attributes, coordinate
+    values; no data, no xarray), checked against the contract as :func:`load` checks it.
+
+    Returns
+    -------
+    jointwear._header.Header
+        ``attrs``, ``sizes``, ``coords`` and ``data_vars`` as a Dataset has them.
+    """
+    from jointwear._header import read_header
+
+    path = _existing(path)
+    try:
+        header = read_header(path)
+    except (OSError, ValueError, RuntimeError) as exc:
+        raise _not_netcdf(path, exc) from None
+    _checked(header, path, validate)
+    return header
+
+
+def load(path: str | Path, *, validate: bool = True) -> xr.Dataset:
+    """Read a jointwear netCDF file fully into memory and check it against the contract.
+
+    Raises
+    ------
+    BadInputError
+        The file does not exist, is not netCDF, or breaks the contract (the message lists
+        every problem).
+    """
+    import xarray as xr
+
+    path = _existing(path)
+    try:
+        with xr.open_dataset(path, engine="netcdf4") as raw:
+            ds = raw.load()
+    except (OSError, ValueError) as exc:
+        raise _not_netcdf(path, exc) from None
+    _checked(ds, path, validate)
     ds.encoding["source"] = str(path)
     return ds

@@ -23,8 +23,14 @@ def _fmt_range(values: np.ndarray) -> str:
 
 
 def summarise(path: str | Path, *, validate: bool = True) -> str:
-    """Return a text summary of the file at ``path`` (validated against the contract)."""
-    ds = io.load(path, validate=validate)
+    """Return a text summary of the file at ``path`` (validated against the contract).
+
+    Only the file's header is read (:func:`jointwear.io.load_header`, no xarray), except for a
+    verification study, whose summary computes from its data.
+    """
+    ds = io.load_header(path, validate=validate)
+    if ds.attrs.get("jointwear_file") == "verification_study":
+        ds = io.load(path, validate=validate)
     lines = [f"file: {path}"]
     status = describe_status(ds)
     if status:

@@ -136,3 +136,63 @@ def test_the_command_runs_blas_single_threaded_unless_the_user_says(tmp_path, us
     ).stdout.split("\n")
     assert out[0] == "False"  # set before numpy (and its BLAS) is loaded
     assert out[1] == f"{user or '1'} 1"
+
+
+def test_info_reads_the_header_without_xarray_or_pandas(tmp_path):
+    """``jointwear info`` needs names, attributes and coordinates: netCDF4 alone (#37)."""
+    import xarray as xr
+
+    from jointwear import io
+
+    ds = xr.Dataset(
+        {"contact_force": ("time", np.arange(3.0), {"units": "N", "long_name": "force"})},
+        coords={"time": ("time", np.arange(3.0), {"units": "s"})},
+    )
+    io.save(ds, tmp_path / "a.nc", parameters={"a": 1})
+    code = (
+        "from jointwear.cli import main\n"
+        "assert main(['info', 'a.nc']) == 0\n"
+        "import sys\nprint('LOADED', *(m for m in ('xarray', 'pandas') if m in sys.modules))"
+    )
+    out = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, cwd=tmp_path, check=True
+    )
+    assert "contact_force(time) [N]" in out.stdout
+    assert out.stdout.splitlines()[-1] == "LOADED"
+
+
+def test_info_of_the_header_is_the_summary_of_the_whole_file(tmp_path, monkeypatch):
+    """The header's summary is the full load's, word for word (dimension order, coordinates
+    named in a 'coordinates' attribute, decoded attributes, a NaN-padded coordinate refused)."""
+    import xarray as xr
+
+    from jointwear import io
+    from jointwear.summary import summarise
+
+    ds = xr.Dataset(
+        {
+            "wear_depth": (("run", "z"), np.ones((2, 3)), {"units": "m", "long_name": "w"}),
+            "f": ("z", np.arange(3.0), {"units": "N", "long_name": "f", "flags": [1, 2]}),
+        },
+        coords={
+            "z": (
+                "z",
+                [-1e-3, 0.0, 1e-3],
+                {"units": "m", "z_zero": "bearing mid-width", "z_direction": "+z"},
+            ),
+            "label": ("run", ["a", "b"]),
+            "kw": ("run", [1e-13, 2e-13], {"units": "m2 N-1"}),
+        },  # fmt: skip
+    )
+    io.save(ds, tmp_path / "a.nc", parameters={"a": 1})
+    bad = ds.assign_coords(z=("z", [np.nan, 0.0, 1e-3], ds["z"].attrs))
+    io.save(bad, tmp_path / "bad.nc", parameters={"a": 1}, validate=False)
+    header = summarise(tmp_path / "a.nc")
+    monkeypatch.setattr(io, "load_header", io.load)
+    assert header == summarise(tmp_path / "a.nc")
+    assert "dimensions: run=2, z=3" in header and "  label (?): a, b" in header
+    monkeypatch.undo()
+    from jointwear.errors import BadInputError
+
+    with pytest.raises(BadInputError, match="'z' contains NaN"):
+        summarise(tmp_path / "bad.nc")
