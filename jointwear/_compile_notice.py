@@ -20,9 +20,18 @@ __all__ = ["announce_compilation", "NOTICE"]
 
 #: The line printed before the first compilation of a process.
 NOTICE = (
-    "jointwear: compiling numerical kernels for first use "
-    "(once per install; later runs load them from the cache)..."
+    "jointwear: compiling numerical kernels this command uses for the first time (each once "
+    "per install; later runs of any command load it from the cache)..."
 )
+
+
+def _area(event: Any) -> str:
+    """Where a compiled kernel lives: ``jointwear.sim.kernels`` (a package of jointwear, to
+    three levels), else the top module."""
+    dispatcher = (getattr(event, "data", None) or {}).get("dispatcher")
+    module = str(getattr(getattr(dispatcher, "py_func", None), "__module__", None) or "?")
+    parts = module.split(".")
+    return ".".join(parts[:3] if parts[0] == "jointwear" else parts[:1])
 
 
 class _Listener:
@@ -33,6 +42,7 @@ class _Listener:
         self.active = True
         self.count = 0
         self.seconds = 0.0
+        self.areas: dict[str, int] = {}  # kernels compiled per package
         self._started: list[float] = []
 
     def on_start(self, event: Any) -> None:
@@ -53,11 +63,17 @@ class _Listener:
             if not self._started:  # only outermost compiles count towards the time
                 self.seconds += time.perf_counter() - start
         self.count += 1
+        area = _area(event)
+        self.areas[area] = self.areas.get(area, 0) + 1
 
     def summary(self) -> str | None:
         if not self.count:
             return None
-        return f"jointwear: compiled {self.count} kernel(s) in {self.seconds:.0f} s (cached now)"
+        where = ", ".join(f"{a} {n}" for a, n in sorted(self.areas.items(), key=lambda x: -x[1]))
+        return (
+            f"jointwear: compiled {self.count} kernel(s) in {self.seconds:.0f} s ({where}); "
+            "cached now"
+        )
 
 
 def _install(stream: TextIO | None) -> _Listener:
@@ -92,6 +108,7 @@ def announce_compilation(stream: TextIO | None = None) -> Callable[[], str | Non
         if listener is not None:
             listener.stream, listener.active = stream, True
             listener.count, listener.seconds, listener._started = 0, 0.0, []
+            listener.areas = {}
         return _STATE["summary"]
 
     def start() -> None:

@@ -41,7 +41,7 @@ def test_notice_before_the_first_compile_only():
     err = _run(_SCRIPT).stderr
     assert err.count(NOTICE) == 1
     assert err.index(NOTICE) < err.index("compiled")
-    assert "compiled 2 kernel(s)" in err
+    assert "compiled 2 kernel(s)" in err and "(__main__ 2)" in err  # says what it compiled
 
 
 def test_notice_when_numba_was_imported_first():
@@ -99,3 +99,22 @@ def test_compiles_after_the_command_ended_do_not_touch_its_stream():
     done = _run(_CLOSED_STREAM)
     assert done.stdout.strip() == "ok"
     assert NOTICE not in done.stderr
+
+
+def test_the_summary_names_the_packages_it_compiled():
+    from types import SimpleNamespace
+
+    from jointwear._compile_notice import _area
+
+    def event(module):
+        return SimpleNamespace(data={"dispatcher": SimpleNamespace(py_func=_Func(module))})
+
+    assert _area(event("jointwear.sim.kernels._joint")) == "jointwear.sim.kernels"
+    assert _area(event("jointwear.dic.icgn._drive")) == "jointwear.dic.icgn"
+    assert _area(event("numba.np.arraymath")) == "numba"
+    assert _area(SimpleNamespace(data=None)) == "?"
+
+
+class _Func:
+    def __init__(self, module):
+        self.__module__ = module
