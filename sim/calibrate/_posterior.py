@@ -6,7 +6,7 @@ posterior correlation exceeds :data:`TRADE_OFF` in magnitude trade off (the data
 combination, not each).
 
 Posterior predictive check: for every datum, the emulated value at each posterior sample plus a
-draw of the likelihood's noise (u_D, u_num and the emulator's error) gives the predictive
+draw of the likelihood's noise (u_D, u_num and the emulator's error, with their correlation) gives the predictive
 distribution; the measured value must lie in its central ``ppc_level`` interval, otherwise the
 model cannot fit that datum with any parameters the prior allows.
 """
@@ -97,11 +97,12 @@ class Predictive:
 
 
 def predictive_check(
-    y_pred: np.ndarray, sd: np.ndarray, measured: np.ndarray, level: float, seed: int
+    y_pred: np.ndarray, cov: np.ndarray, measured: np.ndarray, level: float, seed: int
 ) -> Predictive:
-    """Predictive draws ``y_pred + N(0, sd²)`` (n, n_d) against the ``measured`` values."""
+    """Predictive draws ``y_pred + N(0, cov)`` ((n, n_d), cov (n, n_d, n_d)) against the data."""
     rng = np.random.default_rng(seed)
-    draws = y_pred + sd * rng.standard_normal(y_pred.shape)
+    chol = np.linalg.cholesky(cov)
+    draws = y_pred + (chol @ rng.standard_normal(y_pred.shape)[..., None])[..., 0]
     a = (1.0 - level) / 2
     lo, hi = np.quantile(draws, a, axis=0), np.quantile(draws, 1 - a, axis=0)
     p = np.mean(draws <= measured, axis=0)

@@ -32,7 +32,7 @@ def _rig(post: xr.Dataset, where: str) -> tuple[Any, Any]:
     """The calibration's base SimParameters and WearSettings, from the posterior file."""
     from jointwear.params import from_mapping
     from jointwear.sim.parameters import DEFAULT_PARAMETER_SET, PARAMETER_SETS
-    from jointwear.sim.wear._settings import WearSettings
+    from jointwear.sim.wear import WearSettings
 
     record = json.loads(str(post.attrs.get("base_parameters", "{}")))
     if "parameters" not in record or "wear" not in record:
@@ -83,9 +83,15 @@ def predict(
     """
     from jointwear import io
     from jointwear.sim.calibrate._data import file_record
-    from jointwear.sim.sweep._driver import Execution, assemble, run_and_save
-    from jointwear.sim.sweep._run import RunTask
-    from jointwear.sim.sweep._spec import Design, read_spec, spec_digest
+    from jointwear.sim.sweep import (
+        Design,
+        Execution,
+        RunTask,
+        assemble,
+        read_spec,
+        run_and_save,
+        spec_digest,
+    )
 
     post = io.load(posterior, validate=False)
     where = str(posterior)

@@ -6,12 +6,14 @@ quantities (:mod:`jointwear.sim.calibrate._data`), trains the emulator
 (:mod:`~jointwear.sim.calibrate._emulator`), and samples the posterior
 (:mod:`~jointwear.sim.calibrate._sampler`) of the Gaussian likelihood
 
-    ln L = -1/2 Σ_i [(y_i - η_i(x))² / σ_i²(x) + ln σ_i²(x)],
-    σ_i² = u_D,i² + u_num,i² + u_emulator,i²,
+    ln L = -1/2 [r(x)ᵀ Σ(x)⁻¹ r(x) + ln det Σ(x)],   r = y - η(x),
+    Σ_ij = δ_ij (u_D,i² + u_emulator,i²) + ρ_ij u_num,i u_num,j,
 
 with u_D the datum's own uncertainty, u_num the numerical uncertainty (a ``sim verify`` study on
-the datum's band, or the stated ``u_num_rel``; the same sources compare uses) and u_emulator the
-emulator's cross-validated error. The emulator is trusted only inside its training range: the
+the datum's band, or the stated ``u_num_rel``; the same sources compare uses; at least the
+training runs' own scatter) and u_emulator the emulator's cross-validated error. ρ_ij is 1 for
+two quantities of the same map (a start phase or an update interval that deepens the maximum
+also adds volume and cylindricity: they are not independent evidence), else 0. The emulator is trusted only inside its training range: the
 posterior is cut there (and refused where it would need more room than an unbounded prior
 allows). It refuses (``CalibrationRefused``, exit 3), naming the figure and the fix: an emulator
 error above ``emulator_max_fraction`` of a datum's u, a chain that did not converge, a datum
@@ -33,6 +35,9 @@ from jointwear.sim.calibrate._data import Band, Datum, band_quantities, file_rec
 from jointwear.sim.calibrate._spec import CalibrationSpec, read_calibration_spec
 
 __all__ = ["calibrate", "CalibrationRefused", "design_path"]
+
+#: the start phase of a wear run, drawn for every training run (not emulated: its scatter)
+PHASE = "mechanism.initial_crank_angle_deg"
 
 
 class CalibrationRefused(BadInputError):
@@ -64,6 +69,10 @@ def _sweep_mapping(spec: CalibrationSpec, cycles: float, outputs: list[str], kee
         d = p.describe()
         d.pop("name")
         params[p.name] = d
+    if spec.run == "wear" and PHASE not in params:
+        # each training run starts at its own crank angle: the runs' scatter about the emulator
+        # is then the cycle-to-cycle variability of one run (a floor of u_num), not hidden
+        params[PHASE] = {"distribution": "uniform", "bounds": [0.0, 360.0]}
     return {"sweep": sweep, "parameters": params}
 
 
@@ -316,10 +325,16 @@ def _sample(spec: CalibrationSpec, data: list[Datum], emu, rel_num, lo, hi):
     priors = [p._scipy() for p in spec.parameters]
     y_d = np.array([d.value for d in data])
     u_d2 = np.array([d.u_d for d in data]) ** 2
+    # u_num (and the runs' scatter) of the quantities of one map move together: a phase or an
+    # update interval that deepens the maximum also adds volume and cylindricity
+    group = np.array([d.band if d.band >= 0 else -1 - i for i, d in enumerate(data)])
+    together = (group[:, None] == group[None, :]).astype(float)
 
-    def noise_sd(y: np.ndarray) -> np.ndarray:
+    def noise_cov(y: np.ndarray) -> np.ndarray:
         u_sim = np.maximum(rel_num * np.abs(y), emu.scatter_sd(y))  # the runs' scatter: a floor
-        return np.sqrt(u_d2 + u_sim**2 + emu.error_sd(y) ** 2)
+        diag = u_d2 + emu.error_sd(y) ** 2
+        cov = together * u_sim[:, :, None] * u_sim[:, None, :]
+        return cov + diag[:, :, None] * np.eye(len(y_d))
 
     def log_prob(x: np.ndarray) -> np.ndarray:
         inside = np.all((x >= lo) & (x <= hi), axis=1)
@@ -329,9 +344,12 @@ def _sample(spec: CalibrationSpec, data: list[Datum], emu, rel_num, lo, hi):
         xi = x[inside]
         lp = sum(p.logpdf(xi[:, k]) for k, p in enumerate(priors))
         y = emu.predict((xi - lo) / (hi - lo))
-        s = noise_sd(y)
-        ll = -0.5 * np.sum(((y - y_d) / s) ** 2 + 2 * np.log(s), axis=1)
-        out[inside] = lp + ll
+        cov = noise_cov(y)
+        r = y - y_d
+        _, logdet = np.linalg.slogdet(cov)
+        out[inside] = lp - 0.5 * (
+            np.sum(r * np.linalg.solve(cov, r[..., None])[..., 0], 1) + logdet
+        )
         return out
 
     rng = np.random.default_rng(spec.seed)
@@ -343,7 +361,7 @@ def _sample(spec: CalibrationSpec, data: list[Datum], emu, rel_num, lo, hi):
     _check_chain(chain, spec)
     ident = identifiability(chain.samples, priors, spec.names)
     y_s = emu.predict((chain.samples - lo) / (hi - lo))
-    ppc = predictive_check(y_s, noise_sd(y_s), y_d, spec.ppc_level, spec.seed)
+    ppc = predictive_check(y_s, noise_cov(y_s), y_d, spec.ppc_level, spec.seed)
     for i in ppc.failed:
         d = data[i]
         raise CalibrationRefused(

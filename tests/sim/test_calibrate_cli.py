@@ -46,7 +46,7 @@ def test_calibrate_predict_compare_end_to_end(tmp_path, capsys):
     measured_maps(tmp_path)
     spec = tmp_path / "spec.toml"
     spec.write_text(
-        '[calibrate]\ndata = ["meas-200.nc"]\ncycles = 200\nsamples = 24\nseed = 1\n'
+        '[calibrate]\ndata = ["meas-200.nc"]\ncycles = 200\nsamples = 40\nseed = 1\n'
         "u_num_rel = 0.02\n"
         '[parameters."wear.kw"]\ndistribution = "uniform"\nbounds = [4.5e-16, 1.8e-15]\n'
     )
