@@ -206,7 +206,7 @@ def _input_part(c, feature: Features, fs: np.ndarray) -> tuple[np.ndarray | None
 
 def _covariance(c, feature: Features) -> tuple[_Parts | None, str]:
     """The total covariance of the features of the compared band, or why it is not assessed."""
-    from jointwear.compare._wear import _u_field
+    from jointwear.compare._wear import _cell_u, _u_field
 
     al, s, d, crit = c.al, c.s, c.d, c.criteria
     fs = feature(s)
@@ -224,9 +224,10 @@ def _covariance(c, feature: Features) -> tuple[_Parts | None, str]:
         notes.append(f"C_num: user-stated {rel:g}·|s| per point")
     else:
         return None, "the simulation states no per-point u and the criteria no wear_u_num_rel"
-    u_meas, _ = _u_field(al, "wear_depth_meas_u")
+    u_meas, basis = _u_field(al, "wear_depth_meas_u")
     if u_meas is None:
         return None, "the measurement states no per-point uncertainty (wear_depth_u)"
+    u_meas, _ = _cell_u(al, "wear_depth_meas_u", u_meas, basis)  # its random part averaged
     parts.append(feature.u_cov(u_meas, d))
     notes.append("C_D: the measurement's per-point u")
     if crit.gain_u_rel is not None and not feature.shares:

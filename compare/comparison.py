@@ -202,6 +202,7 @@ def _ensemble_wear(
     """Per-run compared wear quantities and aligned maps from ensembles that keep ``wear_depth``."""
     values: dict[str, list[tuple[int, np.ndarray]]] = {}
     band = None
+    step = 360.0 / al.sizes["theta"]
     for i, da in ens.field("wear_depth"):
         ds = ens.datasets[i]
         per_run: dict[str, list[float]] = {}
@@ -221,11 +222,15 @@ def _ensemble_wear(
             mds = member.to_dataset(name="wear_depth")
             radius = {k: v for k, v in al.attrs.items() if k == "bearing_radius_m"}
             mds.attrs = {**ds.attrs, **radius}
-            a = align_wear_maps(mds, m_wear, cycles=snap)
+            # on the compared grid: a member run on another grid than the simulation is
+            # averaged over the same cells (else its band could not be used)
+            a = align_wear_maps(mds, m_wear, cycles=snap, theta_step_deg=step)
             q = sim_quantities(a)
             for key, v in q.items():
                 per_run.setdefault(key, [np.nan] * r).append(v)
-            same = a.sizes == al.sizes and np.allclose(a["z"], al["z"])
+            same = a["wear_depth_sim"].shape == al["wear_depth_sim"].shape and np.allclose(
+                a["z"], al["z"]
+            )
             maps.append(np.asarray(a["wear_depth_sim"].values) if same else np.nan)
         for key, vals in per_run.items():
             values.setdefault(key, []).append((i, np.asarray(vals, dtype=float)))
