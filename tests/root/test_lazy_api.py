@@ -118,3 +118,14 @@ def test_the_stub_lists_every_public_name_at_its_module(package):
     for name, module in listed.items():
         defining = importlib.import_module(f"{package}.{module}")
         assert getattr(defining, name) is getattr(pkg, name)
+
+
+def test_every_stub_is_package_data():
+    """lazy_loader reads the stub at import time: an installed package without it cannot start."""
+    import tomllib
+    from pathlib import Path
+
+    config = tomllib.loads((Path(__file__).resolve().parents[2] / "pyproject.toml").read_text())
+    data = config["tool"]["setuptools"]["package-data"]
+    missing = [p for p in PACKAGES if not any(g.endswith(".pyi") for g in data.get(p, []))]
+    assert not missing, f"add '*.pyi' to [tool.setuptools.package-data] of {missing}"
