@@ -131,17 +131,19 @@ def _scalars(q: dict, cyl_before, cyl_after, note: str, noise: float) -> dict:
     return out
 
 
-def _changes(q: dict, other: np.ndarray, wts: np.ndarray, z, th) -> dict:
-    """How much each quantity of ``q`` changes when the map is ``other`` (absolute)."""
+def _changes(wear: np.ndarray, other: np.ndarray, wts: np.ndarray, z, th) -> dict:
+    """How much each quantity changes when the map is ``other`` instead of ``wear``
+    (absolute; both without noise corrections)."""
     zeros = np.zeros_like(other)
-    alt = derived_quantities(other, zeros, 0.0, 1.0, np.zeros(1), np.zeros((1, 1)), wts, z, th)
-    return {name: abs(alt[name][0] - v) for name, (v, _, _) in q.items()}
+    args = (zeros, 0.0, 1.0, np.zeros(1), np.zeros((1, 1)), wts, z, th)
+    mine, alt = derived_quantities(wear, *args), derived_quantities(other, *args)
+    return {name: abs(alt[name][0] - v) for name, (v, _, _) in mine.items()}
 
 
-def _model_order_term(q: dict, other: np.ndarray, wts: np.ndarray, z, th, what: str) -> None:
-    """Add, in quadrature, how much each quantity changes under another defensible choice
-    (the form model's order): a source of uncertainty."""
-    for name, dv in _changes(q, other, wts, z, th).items():
+def _model_order_term(q: dict, wear, other: np.ndarray, wts: np.ndarray, z, th, what: str) -> None:
+    """Add, in quadrature, how much each quantity changes when the map ``wear`` is ``other``
+    under another defensible choice (the form model's order): a source of uncertainty."""
+    for name, dv in _changes(wear, other, wts, z, th).items():
         v, u, comment = q[name]
         if np.isfinite(dv):
             q[name] = (v, float(np.hypot(u, dv)), comment + f"; {what} ({dv:.3g})")
@@ -177,7 +179,7 @@ def selection_term(q, wear, d, X, mask2, wts, z, th, threshold, margin_deg):
             best, change = other, dv
     if best is None:
         return None
-    return _changes(q, best, wts, z, th), np.abs(wear - best)
+    return _changes(wear, best, wts, z, th), np.abs(wear - best)
 
 
 def tail_term(q: dict, wear: np.ndarray, wts, dv: float, shift):
@@ -228,7 +230,8 @@ def reference_bias_terms(
         if unseen is not None and np.isfinite(unseen[0][name]):
             parts.append(
                 f"unseen wear ({unseen[0][name]:.3g}: bound/sqrt(3), rectangular, of wear up to "
-                f"{unseen[2] * 1e9:.2g} nm on every unworn point; wear spread round the bore)"
+                f"{unseen[2] * 1e9:.2g} nm on the unworn points the worn regions' tails can "
+                "reach; wear spread round the bore)"
             )
             terms.append(unseen[0][name])
         du = max(terms, default=0.0)

@@ -5,8 +5,8 @@ is fitted to the difference of the scans on the points taken as unworn. Wear on 
 cannot be told from that change where it lies in the span of the limaçon over them: a uniform
 wear c of the unworn arcs is a radius offset, and wear differing between two arcs is a first
 harmonic. Such wear is not identifiable from the scans; what the data bound is the wear *level*
-the selection would have seen. Where the bore is worn over most of its circumference (the
-longest unworn arc (in a quarter of the layers) is shorter than ``UNSEEN_ARC``: the arcs lie between worn regions, where
+the selection would have seen. Where the bore is worn over most of its circumference (unworn
+arcs shorter than ``UNSEEN_ARC``, in a quarter of the layers, hold more than 1 % of the points: the arcs lie between worn regions, where
 the tails of both overlap; a simulated tilt-stiff rig holds 2-20 nm over all of it) or the band
 test's faint tails reach around it, the map carries the consequence of wear up to that level on
 every unworn point:
@@ -41,8 +41,8 @@ __all__ = [
 #: Largest bound of the unseen wear's change of the volume or the maximum depth, as a fraction
 #: of it, that a map may carry in its u (above it the map is refused) [1].
 UNSEEN_LIMIT = 0.3
-#: Where the longest unworn arc (in at least a quarter of the layers) is shorter than this [degree],
-#: the unseen-wear term is assessed: such arcs lie within reach of the worn regions' tails on
+#: Where unworn arcs (in at least a quarter of the layers) shorter than this [degree] hold more
+#: than 1 % of the points, the unseen-wear term is assessed: such arcs lie within reach of the worn regions' tails on
 #: both sides, and a limaçon fitted on them absorbs smooth wear (a single Gaussian groove
 #: 20 degree wide leaves 150-200 degree; the simulated tilt-stiff rig 60-85 degree).
 UNSEEN_ARC = 120.0

@@ -28,8 +28,11 @@ Uncertainty: ``wear_depth_u`` [m] combines in quadrature the RMS residual of the
 (noise of both scans, unmodelled form and misalignment: how far an unworn point's "wear" scatters
 about 0) with the standard error of the fitted reference at each point; with a before-scan,
 also the dependence on the unworn selection and the largest faint wear tail the band test
-cannot see (:func:`._wear_fit.undetected_tail`). Without one, a map is refused where such a
-tail could change the volume by more than 30 % (the form model absorbs it).
+cannot see (:func:`._wear_fit.undetected_tail`) and, where the bore is worn nearly all round,
+the wear its selection cannot see on the unworn points (:mod:`._wear_unseen`: such a map is
+refused only where that bound exceeds 30 % of the volume or the maximum depth). Without one, a
+map is refused where such a tail could change the volume by more than 30 % (the form model
+absorbs it).
 ``wear_depth_u_random`` [m] states the part of ``wear_depth_u`` that is independent from point
 to point (the instrument noise estimate): it averages down when the map is averaged over cells
 (:func:`jointwear.compare.align_wear_maps`), the rest does not.
@@ -274,7 +277,7 @@ def wear_map(
             s2, noise_sigma(r2), correlation_length(r2, mask.reshape(rw.shape))
         )
         noisy = structure > STRUCTURE_SHARE * noise_sigma(r2)
-        if remaining is not None or noisy or exposed(mask.reshape(rw.shape)).any():
+        if remaining is not None or noisy or exposed(mask.reshape(rw.shape)).mean() > 0.01:
             terms += ("unseen",)  # wear spread round the bore: decided by consequence
             remaining = (remaining, structure if noisy else 0.0)
     q, u, tau, noise, tail, unseen = _quantities(
@@ -518,11 +521,20 @@ def _quantities(d, X, fit, alt, z, th, radius, terms, fit_args, remaining=None):
         cov = block_diag(*cov)
     tau = correlation_length(wear, mask2)
     q = derived_quantities(
-        wear, var_fit.reshape(shape), s2, tau, _design_sum(X, wts), cov, wts, z, th
+        wear,
+        var_fit.reshape(shape),
+        s2,
+        tau,
+        _design_sum(X, wts),
+        cov,
+        wts,
+        z,
+        th,
+        noise_sigma(wear),
     )
     if alt is not None:
         other = alt[0].reshape(shape)
-        _model_order_term(q, other, wts, z, th, "form-model order")
+        _model_order_term(q, wear, other, wts, z, th, "form-model order")
         u = np.hypot(u, wear - other)  # each depth's dependence on the model order
     tail = unseen = None
     if mask2.all() or not terms:
