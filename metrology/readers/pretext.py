@@ -33,6 +33,7 @@ __all__ = [
     "THOUSANDS_NAMES",
     "fields",
     "is_missing",
+    "missing_row",
     "normalise",
     "numeric_line",
     "sniff_delimiter",
@@ -307,6 +308,14 @@ def numeric_line(line: str) -> bool:
     toks = [t for t in _TOKENS.split(line.strip()) if t]
     numbers = [bool(_NUMBER_START.match(t)) for t in toks]
     return any(numbers) and all(n or is_missing(t) for n, t in zip(numbers, toks, strict=True))
+
+
+def missing_row(line: str, like: str) -> bool:
+    """``line`` is a row of missing values only (``NaN``, ``---``) with as many fields as the
+    table row ``like``: a table row, not a header line (a first point missing)."""
+    toks = [t for t in _TOKENS.split(line.strip()) if t]
+    width = len([t for t in _TOKENS.split(like.strip()) if t])
+    return bool(toks) and len(toks) == width and all(map(is_missing, toks))
 
 
 def _is_data(line: str) -> bool:

@@ -19,6 +19,7 @@ from jointwear.metrology.readers.pretext import (
     MISSING,
     fields,
     is_missing,
+    missing_row,
     normalise,
     numeric_line,
     sniff_delimiter,
@@ -219,6 +220,8 @@ def sniff(
                 f"'{path}': no table of numbers found (expected lines like '0.02\\t1.234'); "
                 "is this a roundness export? Pass header_lines=... if the table starts later"
             )
+        while start > 0 and missing_row(lines[start - 1], lines[start]):
+            start -= 1  # rows of missing values only at the top belong to the table
         header_lines = start
         guessed["header_lines"] = str(start)
     else:

@@ -434,3 +434,16 @@ def test_refusals_name_thousands_where_it_helps(tmp_path, run_import):
     with pytest.raises(BadInputError, match="thousands='space'"):
         read_scan(g, convention=CONV)
     assert run_import(g, tmp_path / "o2.nc", "--thousands", "space") == 0
+
+
+def test_a_missing_first_value_of_a_value_only_file_is_not_taken_for_a_header(tmp_path):
+    """`NaN` on the first line of a column of values used to become a header line: one point
+    fewer, every angle of a full turn shifted, exit 0."""
+    v = np.cos(np.radians(2 * np.arange(100) * 3.6))
+    f = tmp_path / "v.txt"
+    f.write_text("Units: um\nNaN\n" + "".join(f"{x:.4f}\n" for x in v[1:]))
+    ds = read_scan(f, convention=CONV, arc="full", max_missing=0.05)
+    assert ds.sizes["theta"] == 100 and ds.attrs["missing_points"] == 1
+    want = np.round(v, 4) * 1e-6
+    want[0] = np.nan
+    np.testing.assert_allclose(ds["radial_deviation"].values[0], want, atol=1e-12)
