@@ -126,6 +126,8 @@ def _write_corpus_file(d, c):
     dress = c.get("dress", "plain")
     if dress == "thousands":  # radii in um written as 8,001.2345
         lines = [re.sub(r"(?<![\d.,])(\d)(\d{3}\.\d+)", r"\1,\2", ln) for ln in lines]
+    elif dress == "comma":  # a plain comma CSV (issue 38: the delimiter decided first)
+        lines = [ln.replace("\t", ",") for ln in lines]
     elif dress == "quoted":
         lines = [",".join(f'"{t}"' for t in ln.split("\t")) for ln in lines]
     text = "\n".join(lines) + "\n"
@@ -236,7 +238,7 @@ def _random_case(rng) -> dict:
         },
         crlf=bool(rng.integers(2)),
         given_truth={k for k in ("units", "value", "angle_unit", "arc") if rng.integers(2)},
-        dress=pick(["plain", "plain", "quoted", "ctrlz", "thousands"]),
+        dress=pick(["plain", "plain", "quoted", "ctrlz", "thousands", "comma"]),
     )
     if case["layout"] == "long" and case["zname"] == "probe":
         case["zname"] = "z"
