@@ -4,7 +4,8 @@ Each command runs in a fresh process (as a user runs it) with a warm numba cache
 its CPU time, user + system (``RUSAGE_CHILDREN``), which other users of a shared machine
 disturb less than the wall time: the minimum and the median of ``--repeat`` runs. Targets
 (issue 23): ``jointwear --help`` <= 0.3 s, ``jointwear info FILE`` <= 0.6 s, ``dic correlate``
-on a 256x256 pair <= 1.0 s. Also the heavy modules each command imported (dask, distributed,
+on a 256x256 pair <= 1.0 s; and each as a multiple of the ``import numpy`` floor
+(``ratio_to_numpy_floor``; issue 37's goals ``goal_ratio``: 4, 5 and 8). Also the heavy modules each command imported (dask, distributed,
 pint, matplotlib, numba, xarray, pandas): ``dic correlate`` of a pair needs none but numba.
 
 Throughput through the command line (item 5): a 1024x1024 pair, 33-pixel subsets, step 4
@@ -183,6 +184,14 @@ def _throughput(work: Path, env: dict, repeat: int) -> dict:
     }
 
 
+#: Issue 37's goals, as multiples of the CPU seconds of ``python -c "import numpy"``.
+GOAL_RATIOS = {
+    "jointwear --help": 4.0,
+    "jointwear dic correlate (256x256, step 8)": 8.0,
+    "jointwear info FILE": 5.0,
+}
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=7)
@@ -230,6 +239,13 @@ def main() -> None:
         one = {**env, **dict.fromkeys(("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"), "1")}
         figures["floor"] = _floor(work, one, repeat)
         print("floor", figures["floor"], flush=True)
+        # each command against the machine's 'import numpy' floor (issue 37's goals), which a
+        # shared machine's load moves less than the CPU seconds themselves
+        numpy_floor = figures["floor"]["python_numpy_cpu_s_min"]
+        for label, row in rows.items():
+            row["ratio_to_numpy_floor"] = round(row["cpu_s_min"] / numpy_floor, 2)
+            if label in GOAL_RATIOS:
+                row["goal_ratio"] = GOAL_RATIOS[label]
         if not a.quick:
             figures["one_megapixel_step4"] = _throughput(work, env, a.repeat_mp)
             print(figures["one_megapixel_step4"], flush=True)
