@@ -11,7 +11,13 @@ import lazy_loader
 _EXPORTS = {
     "_camera": ("Camera", "StereoCalibration"),
     "_importers": ("read_calibration", "metres_per_unit"),
-    "_stereo": ("epipolar_distance", "stereo_noise_floor", "triangulate"),
+    "_stereo": (
+        "epipolar_distance",
+        "stereo_noise_floor",
+        "triangulate",
+        "undistorted_pixels",
+        "project_undistorted",
+    ),
 }
 
 __getattr__, __dir__, __all__ = lazy_loader.attach_stub(__name__, __file__)

@@ -14,6 +14,8 @@ from ._importers import (
 )
 from ._stereo import (
     epipolar_distance as epipolar_distance,
+    project_undistorted as project_undistorted,
     stereo_noise_floor as stereo_noise_floor,
     triangulate as triangulate,
+    undistorted_pixels as undistorted_pixels,
 )

@@ -10,7 +10,8 @@ from jointwear.errors import BadInputError
 __all__ = ["triangulate", "epipolar_distance", "stereo_noise_floor"]
 
 
-def _undistorted_pixels(cam: Camera, uv: np.ndarray) -> np.ndarray:
+def undistorted_pixels(cam: Camera, uv: np.ndarray) -> np.ndarray:
+    """Pixels ``uv`` (N, 2) [px] of ``cam`` with its lens distortion removed (N, 2) [px]."""
     xy = cam.pixels_to_normalized(uv)
     K = cam.matrix
     return np.stack(
@@ -18,7 +19,7 @@ def _undistorted_pixels(cam: Camera, uv: np.ndarray) -> np.ndarray:
     )
 
 
-def _project_undistorted(cam: Camera, X: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def project_undistorted(cam: Camera, X: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Undistorted pixel projection of X (N, 3) and its Jacobian (N, 2, 3)."""
     K = cam.matrix
     Xc = X @ cam.rotation.T + cam.translation
@@ -86,8 +87,8 @@ def triangulate(
     if not ok.any():
         return X, cov, rep
     L, R = calibration.left, calibration.right
-    ul = _undistorted_pixels(L, uvl[ok])
-    ur = _undistorted_pixels(R, uvr[ok])
+    ul = undistorted_pixels(L, uvl[ok])
+    ur = undistorted_pixels(R, uvr[ok])
     H = cv2.triangulatePoints(L.projection_matrix, R.projection_matrix, ul.T, ur.T)
     Xk = np.ascontiguousarray((H[:3] / H[3]).T)
     sig = np.ascontiguousarray(np.broadcast_to(np.asarray(sigma_px, dtype=float), (n,))[ok])
@@ -108,8 +109,8 @@ def epipolar_distance(
 ) -> np.ndarray:
     """Distance of each right point from the epipolar line of its left point [pixel]
     (undistorted right image)."""
-    ul = _undistorted_pixels(calibration.left, np.asarray(uv_left, dtype=float).reshape(-1, 2))
-    ur = _undistorted_pixels(calibration.right, np.asarray(uv_right, dtype=float).reshape(-1, 2))
+    ul = undistorted_pixels(calibration.left, np.asarray(uv_left, dtype=float).reshape(-1, 2))
+    ur = undistorted_pixels(calibration.right, np.asarray(uv_right, dtype=float).reshape(-1, 2))
     F = calibration.fundamental_matrix()
     hl = np.concatenate([ul, np.ones((len(ul), 1))], axis=1)
     hr = np.concatenate([ur, np.ones((len(ur), 1))], axis=1)

@@ -60,7 +60,7 @@ def _point_cov(calibration, X, sl, sr):
     ``cov = G diag(s^2) G^T`` (not the inverse-variance-weighted ``(J^T diag(s^-2) J)^-1``,
     which is the covariance of a weighted triangulation and under-states Y, the coordinate
     both cameras' rows fix, when the images' uncertainties differ)."""
-    from jointwear.dic.calibration._stereo import _project_undistorted
+    from jointwear.dic.calibration import project_undistorted as _project_undistorted
 
     out = np.full((len(X), 3, 3), np.nan)
     ok = np.isfinite(X).all(axis=1) & np.isfinite(sl).all(axis=1) & np.isfinite(sr).all(axis=1)

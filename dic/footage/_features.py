@@ -83,7 +83,7 @@ def epipolar_band(
     """
     import cv2
 
-    from jointwear.dic.calibration._stereo import _undistorted_pixels
+    from jointwear.dic.calibration import undistorted_pixels as _undistorted_pixels
 
     h, w = shape
     gx = np.arange(0, w + _BAND_STEP, _BAND_STEP, dtype=float)
