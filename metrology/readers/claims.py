@@ -32,7 +32,15 @@ import numpy as np
 from jointwear.metrology.readers.advice import Refusal, advise
 from jointwear.metrology.readers.units import unit_factor
 
-__all__ = ["CLAIMS", "claim", "drop_ignored", "check_magnitude", "check_points", "check_filter"]
+__all__ = [
+    "CLAIMS",
+    "claim",
+    "drop_ignored",
+    "check_magnitude",
+    "check_form",
+    "check_points",
+    "check_filter",
+]
 
 _NUMU = r"[-+]?(?:\d+(?:[.,]\d*)?|[.,]\d+)(?:[eE][-+]?\d+)?"
 
@@ -255,8 +263,6 @@ def check_magnitude(
             _unit_fixes(stated_by_file, larger),
             "if the trace really is that flat, lower the limit with min_form=<m>",
         )
-    if nominal is not None:
-        _check_form(v, f, unit, unit_source, stated_by_file, nominal, limits, where)
     if dmax > limit:
         smaller = [
             u for u in ("mm", "um") if unit_factor(u) < f and dmax / f * unit_factor(u) <= limit
@@ -270,21 +276,37 @@ def check_magnitude(
         )
 
 
-def _check_form(
-    v: np.ndarray,
-    f: float,
+def layer_form(theta_deg: np.ndarray, value: np.ndarray) -> float:
+    """Peak-to-valley [value units] of the 0.5-99.5 % range of a layer's residual from its
+    least-squares limaçon (the set-up's eccentricity is no form); NaN points skipped."""
+    ok = np.isfinite(value)
+    t = np.radians(np.asarray(theta_deg, dtype=float)[ok])
+    v = np.asarray(value, dtype=float)[ok]
+    if v.size < 4:
+        return 0.0
+    a = np.column_stack([np.ones_like(t), np.cos(t), np.sin(t)])
+    res = v - a @ np.linalg.lstsq(a, v, rcond=None)[0]
+    lo, hi = np.percentile(res, [0.5, 99.5])
+    return float(hi - lo)
+
+
+def check_form(
+    form: float,
     unit: str,
     unit_source: str,
     stated_by_file: bool,
-    nominal: tuple[str, float],
+    meta: dict[str, str],
     limits: dict[str, float],
     where: str,
 ) -> None:
-    """Refuse deviations whose form (peak-to-valley of the 0.5-99.5 % range) exceeds
-    ``form_fraction`` (1 %) of the stated radius: a precision bore's form is far smaller (a
-    sub-micrometre form written in um under ``Units: mm`` reads 1000 x too large)."""
-    lo, hi = np.percentile(v, [0.5, 99.5])
-    form = float(hi - lo) * f
+    """Refuse deviations whose form ``form`` [m] (the largest :func:`layer_form` of the
+    layers) exceeds ``form_fraction`` (1 %) of the header's nominal radius: a precision bore's
+    form is far smaller (a sub-micrometre form written in um under ``Units: mm`` reads 1000 x
+    too large). Nothing is checked without a stated nominal radius."""
+    nominal = nominal_radius(meta, unit if stated_by_file else None)
+    if nominal is None:
+        return
+    f = unit_factor(unit)
     limit = limits["form_fraction"] * nominal[1]
     if form <= limit:
         return

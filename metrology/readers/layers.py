@@ -10,8 +10,10 @@ from jointwear.errors import BadInputError
 from jointwear.metrology.readers.advice import Refusal, advise, plausibility
 from jointwear.metrology.readers.claims import (
     check_filter,
+    check_form,
     check_magnitude,
     check_points,
+    layer_form,
     stated_filter,
     stated_points,
 )
@@ -168,6 +170,16 @@ def _check_layers(
                 f"re-export the layer, or {text}",
                 sugg,
             )
+    if out and out[0].kind == "deviation" and pf.units:
+        check_form(
+            max(layer_form(lay.theta_deg, lay.value) for lay in out),
+            pf.units,
+            "stated by the file" if "units" in pf.guessed else "units= given",
+            "units" in pf.guessed,
+            pf.metadata,
+            limits,
+            where,
+        )
     if pts is not None and layered:
         for lay in out:
             check_points(pts, lay.value.size, {"deg": lay.theta_deg}, arc, True, where, limits)

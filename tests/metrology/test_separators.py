@@ -447,3 +447,18 @@ def test_a_missing_first_value_of_a_value_only_file_is_not_taken_for_a_header(tm
     want = np.round(v, 4) * 1e-6
     want[0] = np.nan
     np.testing.assert_allclose(ds["radial_deviation"].values[0], want, atol=1e-12)
+
+
+def test_the_form_rule_leaves_out_the_set_up_eccentricity(tmp_path):
+    """Deviations about the spindle hold the set-up's eccentricity (a first harmonic), which
+    is no form: 0.3 mm of it on a 12.5 mm bore (2.4 % p-p) passes, with a 20 um form."""
+    th = np.arange(720) * 0.5
+    t = np.radians(th)
+    dev = 0.15 * np.cos(t - 0.3) + 0.01 * np.cos(3 * t)  # mm
+    f = tmp_path / "ecc.txt"
+    f.write_text(
+        "Units: mm\nNominal radius: 12.5 mm\nAngle (deg)\tDeviation\n"
+        + "".join(f"{a:.1f}\t{v:.6f}\n" for a, v in zip(th, dev, strict=True))
+    )
+    ds = read_scan(f, convention=CONV)
+    np.testing.assert_allclose(ds["radial_deviation"].values[0], np.round(dev, 6) * 1e-3)
