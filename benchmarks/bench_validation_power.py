@@ -12,7 +12,7 @@ Figures: per truth and candidate, the detection probability of each wear criteri
 any-fail rate (the right model's = its false-fail rate); see :mod:`jointwear.reports.power`.
 
 The size (``BENCH_SIZE``: 1e4 cycles on 10 x 36 points, 10 replicates, 4-run ensembles, a
-3-level study) is what the shared 2-core machine allowed; it is written with the results.
+4-level study, two grid runs) is what the shared 2-core machine allowed; it is written with the results.
 Results are written after each truth (a stopped run keeps the truths it finished).
 
 Writes ``benchmarks/results/validation_power.json``.

@@ -80,7 +80,7 @@ class PowerSize:
         The input ensemble of each candidate: LHS members, reduced cycles, fixed updates.
     study : bool
         True: the right model runs the fixed update scheme and has its own ``sim verify``
-        study (three update intervals, two replicates, one grid run); False: its adaptive
+        study (four update intervals, two replicates, two grid runs); False: its adaptive
         update's own ``wear_depth_u`` is its u_num (labelled so).
     truths : tuple of str
         Keys of :data:`TRUTHS`.
@@ -171,8 +171,9 @@ def _ensemble(size: PowerSize, overrides: dict[str, float]) -> xr.Dataset:
     return run_sweep(spec, params=params, wear=WearSettings(scheme="fixed", dn=dn), workers=0)
 
 
-#: the right model's study and fixed update interval: cycles / 8, / 4, / 2 (finest first)
-STUDY_UPDATES = 8
+#: the right model's study and fixed update interval: cycles / 16, / 8, / 4, / 2 (finest
+#: first; Eça & Hoekstra's least squares needs four levels)
+STUDY_UPDATES = 16
 
 
 def _study(size: PowerSize, overrides: dict[str, float]) -> tuple[Any, xr.Dataset | None]:
@@ -184,8 +185,8 @@ def _study(size: PowerSize, overrides: dict[str, float]) -> tuple[Any, xr.Datase
     finest = int(size.cycles // STUDY_UPDATES)
     params, settings = apply_overrides(_params(size, 4), WearSettings(), overrides or None)
     spec = VerifySpec(
-        cycles=size.cycles, levels=(finest, 2 * finest, 4 * finest), replicates=2,
-        grid_replicates=1,
+        cycles=size.cycles, levels=(finest, 2 * finest, 4 * finest, 8 * finest), replicates=2,
+        grid_replicates=2,
     )  # fmt: skip
     study = verify_wear(params, spec=spec, wear=settings, workers=0)
     return WearSettings(scheme="fixed", dn=finest, kw=settings.kw), study
