@@ -170,3 +170,22 @@ def test_a_cf_file_is_refused_naming_its_variable_and_the_missing_attribute(tmp_
     np.testing.assert_allclose(ds["wear_depth_u"].values, 0.25e-6)
     np.testing.assert_allclose(ds["wear_depth"].max(), _depth(1.0).max(), rtol=1e-12)
     assert ds["wear_depth_u"].attrs["long_name"].startswith("standard uncertainty of")
+
+
+def test_a_table_the_sniffer_cannot_decide_is_refused_and_the_suggested_options_read_it(
+    tmp_path, capsys
+):
+    # a column of words beside the numbers: the sniffer cannot decide the decimal mark
+    rows, t, v = _motion_rows(",", ";")
+    rows = [rows[0] + ";note"] + [r + ";ok" for r in rows[1:]]
+    src = tmp_path / "motion.csv"
+    src.write_text("\n".join(rows) + "\n", encoding="utf-8")
+    opts = ["--origin", "measured", "--velocity-unit", "mm/s", "--velocity-columns", "vx,vy"]
+    assert _run("import", "motion", src, *opts, "--out", tmp_path / "a.nc") == 3
+    err = capsys.readouterr().err
+    assert "give --decimal comma (and --delimiter)" in err
+    assert _run("import", "motion", src, *opts, "--decimal", "comma", "--delimiter", "semicolon",
+                "--out", tmp_path / "a.nc") == 0  # fmt: skip
+    np.testing.assert_allclose(
+        io.load(tmp_path / "a.nc")["follower_velocity"].values, v * 1e-3, atol=1e-12
+    )
