@@ -27,14 +27,15 @@ _EXPORTS = {
         "OUTPUT_FLAG_VALUES",
         "flag_uncertainty_outliers",
     ),
-    # the matching kernels the subset correlator drives
+    # the matching kernels the subset correlator drives, in its order: texture, reference
+    # subsets, the solve (preloaded affine, many points, one by one), propagation over the grid
     "_match": (
+        "subset_std",
         "affine_references",
         "icgn_affine_loaded",
         "icgn_many",
         "icgn_serial",
         "rg_propagate",
-        "subset_std",
     ),
     "_shapes": ("ShapeFunction", "shape_function"),
 }
