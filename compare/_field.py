@@ -30,8 +30,8 @@ The covariance, each part stated in the basis:
   ``wear_u_input_rel`` as a common scale error, ``rel² s sᵀ`` (it says nothing of the form: the
   axial distribution then is not assessed);
 * ``C_num``: the simulation's own per-point u (independent between bins, fully correlated within
-  one: an upper bound for a bin mean), else a user-stated relative u_num as a per-point u
-  ``rel·|s|``;
+  one: an upper bound for a bin mean), else a verification study's relative u_num of the
+  maximum depth, else a user-stated relative u_num, as a per-point u ``rel·|s|``;
 * ``C_D``: the measurement's per-point u like the simulation's, with the instrument's stated gain
   (``gain_u_rel² d dᵀ``) and radial offset (``probe_u_m² 1 1ᵀ``, depth features only).
 
@@ -204,6 +204,17 @@ def _input_part(c, feature: Features, fs: np.ndarray) -> tuple[np.ndarray | None
     return None, "no ensemble that keeps its wear maps (--ensemble) and no wear_u_input_rel"
 
 
+def _study_rel(c) -> float | None:
+    """The relative u_num of the maximum depth a verification study gives (None: none)."""
+    if not (c.src.studies or c.src.gci):
+        return None
+    s_max = c.sim_max[0]
+    u = c.src.u_num("max_wear_depth", s_max, None, "wear")
+    if not u.known or s_max == 0 or "user-stated" in u.basis:
+        return None
+    return float(u.value) / abs(s_max)
+
+
 def _covariance(c, feature: Features) -> tuple[_Parts | None, str]:
     """The total covariance of the features of the compared band, or why it is not assessed."""
     from jointwear.compare._wear import _cell_u, _u_field
@@ -219,6 +230,11 @@ def _covariance(c, feature: Features) -> tuple[_Parts | None, str]:
     if u_sim is not None:
         parts.append(feature.u_cov(u_sim, s))
         notes.append("C_num: the simulation's per-point u")
+    elif (study := _study_rel(c)) is not None:
+        parts.append(feature.u_cov(study * np.abs(s), s))
+        notes.append(
+            f"C_num: the verification's u_num of the maximum depth, {study:.3g}·|s| per point"
+        )
     elif rel is not None:
         parts.append(feature.u_cov(rel * np.abs(s), s))
         notes.append(f"C_num: user-stated {rel:g}·|s| per point")
