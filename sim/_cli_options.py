@@ -9,6 +9,7 @@ from typing import Annotated, Any
 import typer
 
 from jointwear._cli import Scheduler
+from jointwear.sim.mechanisms import MECHANISMS
 from jointwear.sim.parameters import DEFAULT_PARAMETER_SET
 
 __all__ = [
@@ -26,8 +27,10 @@ Base = Annotated[
     str,
     typer.Option(
         "--base",
-        help="Named parameter set the --params overrides apply to: the four-bar's "
-        f"{DEFAULT_PARAMETER_SET} or slider_crank.",
+        help="Named parameter set the --params overrides apply to, which chooses the "
+        "mechanism: "
+        + ", ".join(f"{m.parameter_set} ({m.title})" for m in MECHANISMS.values())
+        + f"; default {DEFAULT_PARAMETER_SET}.",
     ),
 ]
 """``--base``: the named parameter set under ``--params`` (default ``DEFAULT_PARAMETER_SET``)."""
