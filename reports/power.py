@@ -36,6 +36,8 @@ from typing import Any
 
 import xarray as xr
 
+from jointwear.errors import JointwearError
+
 __all__ = ["PowerSize", "CI_SIZE", "BENCH_SIZE", "TRUTHS", "WRONG_MODELS", "run_power"]
 
 #: the truth rigs: name -> parameter overrides of the reference set
@@ -192,6 +194,16 @@ def _study(size: PowerSize, overrides: dict[str, float]) -> tuple[Any, xr.Datase
     return WearSettings(scheme="fixed", dn=finest, kw=settings.kw), study
 
 
+def _unworn_arc(truth: xr.Dataset) -> tuple[float, float]:
+    """The 20-degree arc [degree, canonical] around the truth's least-worn angle (mean over z)."""
+    import numpy as np
+
+    depth = truth["wear_depth"].isel(cycles=-1) if "cycles" in truth.dims else truth["wear_depth"]
+    mean = np.asarray(depth.mean("z").values, dtype=float)
+    th = float(truth["theta"].values[int(np.argmin(mean))])
+    return ((th - 10.0) % 360.0, (th + 10.0) % 360.0)
+
+
 def _measure(truth: xr.Dataset, size: PowerSize, seed: int, folder: Path) -> xr.Dataset:
     """Virtual scans of the truth (worn and before wear), imported and made a wear map."""
     from jointwear.datasets import instruments
@@ -223,7 +235,11 @@ def _measure(truth: xr.Dataset, size: PowerSize, seed: int, folder: Path) -> xr.
         path = folder / f"{name}_{seed}"
         instruments.write(scan, path, layout="folder")
         paths.append(read_talyrond(path, convention=convention))
-    wm = wear_map(*paths)
+    try:
+        wm = wear_map(*paths)
+    except JointwearError:  # wear round the whole bore: the user states where it is unworn
+        wm = wear_map(*paths, unworn=[_unworn_arc(truth)])
+        wm.attrs["unworn_stated"] = "the least-worn 20-degree arc of the truth, as a user would"
     wm.attrs["cycles"] = float(size.cycles)
     return wm
 
