@@ -116,9 +116,12 @@ def _save_wear(folder: Path, size: DemoSize, params: Any, wear: xr.Dataset, t0: 
         if wear.attrs.get("accuracy_status") == "not reached"
         else ""
     )
+    # a run of the verification study (fixed updates) states no accuracy of its own: the study's
+    # u_num is the compared run's
+    accuracy = f" ± {u:.1f} µm (k = 2{noise}; " if np.isfinite(u) else " µm (u_num: the study; "
     _say(
         f"  simulated wear: {size.cycles:g} cycles on {size.n_layers} x {size.n_points} points, "
-        f"max depth {float(wear['max_wear_depth'][-1]) * 1e6:.1f} ± {u:.1f} µm (k = 2{noise}; "
+        f"max depth {float(wear['max_wear_depth'][-1]) * 1e6:.1f}{accuracy}"
         f"{time.perf_counter() - t0:.0f} s)"
     )
     return path
