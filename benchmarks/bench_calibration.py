@@ -12,6 +12,8 @@ right) on the early snapshot's band quantities. Figures:
 * U_val of the band's maximum depth relative to D, validating at the later snapshot: "before"
   with the prior's ensemble as u_input (the model at the prior mean), "after" with the
   posterior prediction (``sim predict``), both with the same stated u_num;
+* the wrong model form (tilt stiffness 0 against the tilt-1000 truth) calibrated and validated
+  the same way: refused by the calibration's predictive check, or the criteria that fail;
 * the CPU time of the training design, of one calibration and of one prediction.
 
 Run: ``python benchmarks/bench_calibration.py`` (``--quick``: 3 replicates, CI size; results
@@ -51,10 +53,10 @@ SIZE = {
 TILT, KW_FACTOR, NOISE, U_NUM_REL = 1000.0, 1.15, 0.01, 0.02
 
 
-def base_toml(size: dict[str, Any]) -> str:
+def base_toml(size: dict[str, Any], tilt: float = TILT) -> str:
     return (
         f"[joint]\nn_layers = {size['n_layers']}\nn_points = {size['n_points']}\n"
-        f"tilt_stiffness = {TILT}\n"
+        f"tilt_stiffness = {tilt}\n"
         '[wear]\nscheme = "fixed"\ndn = 100\nsettle_cycles = 0.25\ninitial_settle_cycles = 0.5\n'
     )
 
@@ -100,14 +102,44 @@ def spec_text(early: Path, size: dict[str, Any], kw0: float) -> str:
     )
 
 
-def u_val_ratio(folder: Path, sim: Path, meas: Path, ens: list[Path], cycles: float) -> float:
-    """U_val / |D| of the band's maximum depth from ``jointwear compare``."""
+def compared(folder: Path, sim: Path, meas: Path, ens: list[Path], cycles: float):
+    """``jointwear compare`` of ``sim`` (with the ensembles ``ens``) and ``meas``."""
     from jointwear.compare import compare_files
 
     crit = folder / "criteria.toml"
     crit.write_text(f"wear_u_num_rel = {U_NUM_REL}\n")
-    res = compare_files([sim], [meas], folder / "m.nc", criteria=crit, cycles=cycles, ensemble=ens)
+    return compare_files([sim], [meas], folder / "m.nc", criteria=crit, cycles=cycles, ensemble=ens)
+
+
+def u_val_ratio(folder: Path, sim: Path, meas: Path, ens: list[Path], cycles: float) -> float:
+    """U_val / |D| of the band's maximum depth from ``jointwear compare``."""
+    res = compared(folder, sim, meas, ens, cycles)
     return res.value("max_wear_depth", "U_val") / abs(res.value("max_wear_depth", "value_meas"))
+
+
+def wrong_form(folder: Path, size: dict[str, Any], early: Path, late: Path, kw0: float) -> dict:
+    """The model with tilt stiffness 0 (the wrong form) calibrated and validated the same way."""
+    from jointwear.errors import BadInputError
+    from jointwear.sim.calibrate import calibrate, predict
+
+    wrong = folder / "wrong"
+    wrong.mkdir()
+    for f in (early, late):
+        shutil.copy(f, wrong / f.name)
+    (wrong / "base.toml").write_text(base_toml(size, tilt=0.0))
+    spec = wrong / "spec.toml"
+    spec.write_text(spec_text(early, size, kw0))
+    out: dict[str, Any] = {"joint.tilt_stiffness": 0.0}
+    try:
+        ds = calibrate(spec, out=wrong / "post.nc", params=wrong / "base.toml", workers=0)
+    except BadInputError as exc:  # refused: the wrong form cannot fit the calibration data
+        return out | {"calibration": f"refused: {exc}", "failed": None}
+    out["posterior_kw_mean"] = float(ds["posterior_mean"][0])
+    c2 = size["validation_cycles"]
+    pred = wrong / "prediction.nc"
+    predict(wrong / "post.nc", cycles=c2, out=pred, samples=size["prediction_runs"], workers=0)
+    res = compared(wrong, pred, wrong / late.name, [], c2)
+    return out | {"calibration": "ok", "failed": res.failed(), "summary": res.summary()}
 
 
 def prior_side(folder: Path, size: dict[str, Any], kw0: float) -> tuple[Path, Path]:
@@ -181,6 +213,8 @@ def run(size: dict[str, Any], folder: Path) -> dict[str, Any]:
     predict(folder / "post-0.nc", cycles=c2, out=pred, samples=size["prediction_runs"], workers=0)
     cpu_pred = time.process_time() - t0
     after = u_val_ratio(folder, pred, late, [], c2)
+    early0 = folder / f"truth-0-{size['calibration_cycles']}.nc"
+    wrong = wrong_form(folder, size, early0, late, DEFAULT_KW)
     prior_sd_over_mean = (1.0 / np.sqrt(3)) * 0.5  # uniform ±50 %: sd = width / sqrt(12)
     return {
         "size": size,
@@ -192,6 +226,7 @@ def run(size: dict[str, Any], folder: Path) -> dict[str, Any]:
         "posterior_mean_over_truth_median": float(np.median(means) / kw_true),
         "prior_sd_over_mean": prior_sd_over_mean,
         "u_val_over_d_max_depth": {"before_prior_ensemble": before, "after_posterior": after},
+        "wrong_form": wrong,
         "cpu_s": {
             "training_design_and_first_calibration": design_cpu,
             "calibration_median": float(np.median(cpu_cal)) if cpu_cal else float("nan"),
