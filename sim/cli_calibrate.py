@@ -19,12 +19,10 @@ from jointwear.sim._cli_options import (
     check_executor,
     check_lost_runs,
 )
+from jointwear.sim.calibrate._spec import PREDICT_SAMPLES
 from jointwear.sim.parameters import DEFAULT_PARAMETER_SET
 
 __all__ = ["register"]
-
-#: default ensemble size of ``sim predict`` (posterior samples simulated)
-PREDICT_SAMPLES = 16
 
 
 def calibrate_cmd(

@@ -21,6 +21,7 @@ import numpy as np
 import xarray as xr
 
 from jointwear.errors import BadInputError
+from jointwear.sim.calibrate._spec import PREDICT_SAMPLES
 
 __all__ = ["predict", "PREDICTION_FILE"]
 
@@ -55,7 +56,7 @@ def predict(
     *,
     cycles: float,
     out: str | Path,
-    samples: int = 16,
+    samples: int = PREDICT_SAMPLES,
     workers: int | None = None,
     scheduler: Any = None,
     resume: bool = False,

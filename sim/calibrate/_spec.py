@@ -38,7 +38,16 @@ from typing import Any
 
 from jointwear.errors import ParameterError
 
-__all__ = ["CalibrationSpec", "StatedValue", "read_calibration_spec", "MAP_QUANTITIES"]
+__all__ = [
+    "CalibrationSpec",
+    "StatedValue",
+    "read_calibration_spec",
+    "MAP_QUANTITIES",
+    "PREDICT_SAMPLES",
+]
+
+#: Default number of posterior samples ``sim predict`` simulates (the ensemble's size).
+PREDICT_SAMPLES = 16
 
 #: Quantities of a measured wear map, computed within its band (its z range).
 MAP_QUANTITIES = ("max_wear_depth", "worn_volume", "cylindricity")

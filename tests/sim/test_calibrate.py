@@ -191,3 +191,21 @@ def test_spec_errors_name_the_key(tmp_path):
     with pytest.raises(ParameterError, match="no file nothing.nc"):
         read_calibration_spec(missing)
     assert issubclass(CalibrationRefused, BadInputError)
+
+
+def test_cli_defaults_are_the_librarys():
+    import inspect
+
+    from jointwear.sim.calibrate import calibrate as lib_calibrate
+    from jointwear.sim.calibrate import predict
+    from jointwear.sim.cli_calibrate import calibrate_cmd, predict_cmd
+
+    cli, lib = inspect.signature(predict_cmd).parameters, inspect.signature(predict).parameters
+    for name in ("samples", "workers", "scheduler", "resume"):
+        assert cli[name].default == lib[name].default, name
+    cli, lib = (
+        inspect.signature(calibrate_cmd).parameters,
+        inspect.signature(lib_calibrate).parameters,
+    )
+    for name in ("params", "workers", "scheduler", "resume"):
+        assert cli[name].default == lib[name].default, name
