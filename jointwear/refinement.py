@@ -65,7 +65,6 @@ __all__ = [
     "eca_hoekstra",
     "grid_term",
     "study_uncertainty",
-    "describe_study",
     "location_jump",
     "level_statistics",
     "COVERAGE_K",
@@ -778,33 +777,3 @@ def _unwrap_levels(mean: np.ndarray, h: np.ndarray, period: float) -> np.ndarray
     if not math.isfinite(ref):
         return mean
     return ref + (mean - ref + period / 2) % period - period / 2
-
-
-def describe_study(study: xr.Dataset) -> str:
-    """Text summary of a verification study: one line per quantity with value ± u_num (k = 1),
-    its parts and the branch taken, or why it is not assessed."""
-    lines = [
-        f"verification study: {study.attrs.get('cycles', float('nan')):g} cycles per run, "
-        f"h = ΔN {', '.join(f'{v:g}' for v in np.asarray(study['h'].values))}, "
-        f"{study.sizes.get('replicate', 0)} replicates per level, "
-        f"{study.sizes.get('grid_replicate', 0)} runs on the grid refined "
-        f"{study.attrs.get('grid_ratio', float('nan')):g}x; u_num is a standard uncertainty "
-        "(k = 1)"
-    ]
-    for q in study["quantity"].values:
-        row = study.sel(quantity=q)
-        units = str(row["quantity_units"].values)
-        if int(row["assessed"]) != 1:
-            lines.append(f"  {q}: not assessed - {row['reason'].values}")
-            continue
-        v, u = float(row["value"]), float(row["u_num"])
-        rel = f" ({100 * u / abs(v):.2g} %)" if v and math.isfinite(v) else ""
-        lines.append(
-            f"  {q} = {v:.5g} ± {u:.2g} {units}{rel} (stat {float(row['u_stat']):.2g}, "
-            f"refinement {float(row['u_refinement']):.2g}, grid {float(row['u_grid']):.2g}; "
-            f"{row['branch'].values})"
-        )
-    if "run_warnings_summary" in study.attrs:  # the runs' own warnings and what they mean
-        lines.append(f"run warnings: {study.attrs['run_warnings_summary']}")
-        lines.append(f"  for u_num: {study.attrs['run_warnings_verdict']}")
-    return "\n".join(lines)

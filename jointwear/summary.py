@@ -3,14 +3,19 @@
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from jointwear import io
 from jointwear.conventions import describe_status
 
-__all__ = ["summarise"]
+if TYPE_CHECKING:
+    import xarray as xr
+
+__all__ = ["summarise", "describe_study"]
 
 
 def _fmt_range(values: np.ndarray) -> str:
@@ -54,8 +59,6 @@ def summarise(path: str | Path, *, validate: bool = True) -> str:
             f"  {name}({dims}) [{v.attrs.get('units', '?')}]: {v.attrs.get('long_name', '')}"
         )
     if ds.attrs.get("jointwear_file") == "verification_study":
-        from jointwear.refinement import describe_study
-
         lines.append(describe_study(ds))
     if ds.attrs.get("jointwear_file") == "posterior":  # jointwear sim calibrate
         lines.append("calibration (posterior/prior sd; 'NOT informed': the data do not fix it):")
@@ -76,4 +79,34 @@ def summarise(path: str | Path, *, validate: bool = True) -> str:
         if params:
             text = json.dumps(params, sort_keys=True)
             lines.append("  parameters: " + (text if len(text) < 400 else text[:400] + " ..."))
+    return "\n".join(lines)
+
+
+def describe_study(study: xr.Dataset) -> str:
+    """Text summary of a verification study: one line per quantity with value ± u_num (k = 1),
+    its parts and the branch taken, or why it is not assessed."""
+    lines = [
+        f"verification study: {study.attrs.get('cycles', float('nan')):g} cycles per run, "
+        f"h = ΔN {', '.join(f'{v:g}' for v in np.asarray(study['h'].values))}, "
+        f"{study.sizes.get('replicate', 0)} replicates per level, "
+        f"{study.sizes.get('grid_replicate', 0)} runs on the grid refined "
+        f"{study.attrs.get('grid_ratio', float('nan')):g}x; u_num is a standard uncertainty "
+        "(k = 1)"
+    ]
+    for q in study["quantity"].values:
+        row = study.sel(quantity=q)
+        units = str(row["quantity_units"].values)
+        if int(row["assessed"]) != 1:
+            lines.append(f"  {q}: not assessed - {row['reason'].values}")
+            continue
+        v, u = float(row["value"]), float(row["u_num"])
+        rel = f" ({100 * u / abs(v):.2g} %)" if v and math.isfinite(v) else ""
+        lines.append(
+            f"  {q} = {v:.5g} ± {u:.2g} {units}{rel} (stat {float(row['u_stat']):.2g}, "
+            f"refinement {float(row['u_refinement']):.2g}, grid {float(row['u_grid']):.2g}; "
+            f"{row['branch'].values})"
+        )
+    if "run_warnings_summary" in study.attrs:  # the runs' own warnings and what they mean
+        lines.append(f"run warnings: {study.attrs['run_warnings_summary']}")
+        lines.append(f"  for u_num: {study.attrs['run_warnings_verdict']}")
     return "\n".join(lines)

@@ -279,7 +279,7 @@ def _ensemble_part(folder: Path, size: DemoSize, params: Any, motion_time: np.nd
 def _study(folder: Path, size: DemoSize, params: Any, pool: Executor) -> Path:
     """The verification study of the wear, its runs on ``pool`` (a :class:`_StudyPool`);
     prints its u_num."""
-    from jointwear.refinement import describe_study
+    from jointwear.summary import describe_study
 
     t0 = time.perf_counter()
     path, study = wear_verification(params, size, folder, scheduler=pool)

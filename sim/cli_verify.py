@@ -75,8 +75,8 @@ def verify(
     """
     from jointwear.errors import BadInputError
     from jointwear.progress import progress_bar, run_counter
-    from jointwear.refinement import describe_study
     from jointwear.sim.sweep._verify import verify_wear
+    from jointwear.summary import describe_study
 
     check_executor(workers, scheduler)
     band = None
