@@ -57,8 +57,8 @@ class WearMapRefusal(BadInputError):
 
     Attributes
     ----------
-    reason : str
-        The message without its fix (the command line adds a runnable command).
+    reason, fix : str
+        The message without its fix (the command line adds a runnable command), and the fix.
     unworn_arcs : tuple of (float, float)
         Canonical theta arcs [degree] (start, end; may wrap through 0) that the data find least
         worn: ``unworn=`` mask / CLI ``--unworn``.
@@ -67,6 +67,7 @@ class WearMapRefusal(BadInputError):
     def __init__(self, reason: str, fix: str, unworn_arcs: tuple[tuple[float, float], ...] = ()):
         super().__init__(f"{reason}; {fix}")
         self.reason = reason
+        self.fix = fix
         self.unworn_arcs = tuple(unworn_arcs)
 
 
@@ -93,10 +94,19 @@ def exposed(mask2: np.ndarray, min_arc: float = UNSEEN_ARC) -> np.ndarray:
     return mask2 & ~np.roll(safe, start)[None, :]
 
 
-def unworn_arcs(mask2: np.ndarray, theta_deg: np.ndarray, most: int = 3, min_deg: float = 5.0):
-    """The longest runs of theta (at most ``most``, each >= ``min_deg``) where every layer is
-    unworn, as whole-degree arcs inside the run [degree, canonical]; () if none."""
-    col = np.asarray(mask2, dtype=bool).all(axis=0)
+def unworn_arcs(
+    mask2: np.ndarray, theta_deg: np.ndarray, wear=None, most: int = 3, min_deg: float = 5.0
+):
+    """The longest runs of theta (at most ``most``, each >= ``min_deg``) where at least three
+    quarters of the layers are unworn, as whole-degree arcs inside the run [degree,
+    canonical]; where every column or none is, the runs where the layers' mean ``wear`` [m]
+    (the map, smoothed over 5 degree) lies in its lowest quarter (the reference absorbed the
+    wear: the least worn arcs read lowest); () if none."""
+    col = np.asarray(mask2, dtype=bool).mean(axis=0) >= 0.75
+    if (col.all() or not col.any()) and wear is not None:
+        win = max(1, int(round(5.0 * col.size / 360.0)))
+        mean = _smooth_theta(np.nanmean(wear, axis=0)[None, :], win)[0]
+        col = mean <= np.nanpercentile(mean, 25)
     n = col.size
     if col.all() or not col.any():
         return ()
@@ -196,9 +206,12 @@ def unseen_term(bound: dict, per_point: np.ndarray):
     return {k: v / np.sqrt(3.0) for k, v in bound.items()}, per_point / np.sqrt(3.0)
 
 
-def refuse_by_consequence(q: dict, bound: dict, level: float, share: float, arcs) -> None:
+def refuse_by_consequence(
+    q: dict, bound: dict, level: float, share: float, arcs, explicit: bool = False
+) -> None:
     """Refuse a map whose unseen-wear bound exceeds ``UNSEEN_LIMIT`` of its volume or of its
-    maximum depth (the message names both figures and the arcs an ``unworn`` mask could use)."""
+    maximum depth (the message names both figures and the arcs an ``unworn`` mask could use;
+    ``explicit``: the unworn points were given, and cannot rule the wear out)."""
     for name, what, unit, scale in (
         ("worn_volume", "worn volume", "mm³", 1e9),
         ("max_wear_depth", "maximum depth", "µm", 1e6),
@@ -206,12 +219,16 @@ def refuse_by_consequence(q: dict, bound: dict, level: float, share: float, arcs
         value, b = q[name][0], bound[name]
         if np.isfinite(b) and b > UNSEEN_LIMIT * abs(value):
             fix = (
-                f"if the bore is known to be unworn at theta {format_arcs(arcs)} degree "
+                "the points given as unworn lie within reach of the worn regions' tails (arcs "
+                f"shorter than {UNSEEN_ARC:g} degree) or hold smooth structure, so they cannot "
+                "rule it out: give arcs known to be unworn over a longer span"
+                if explicit
+                else f"if the bore is known to be unworn at theta {format_arcs(arcs)} degree "
                 f"(canonical), pass them as unworn (unworn={[tuple(a) for a in arcs]}; CLI "
                 f"--unworn {format_arcs(arcs)})"
                 if arcs
-                else "pass the theta arcs known to be unworn (unworn=[(THETA1, THETA2)]; CLI "
-                "--unworn THETA1:THETA2) [degree, canonical]"
+                else "give the theta arcs known to be unworn (Python: (start, end) pairs as "
+                "unworn; CLI --unworn THETA1:THETA2) [degree, canonical]"
             )
             raise WearMapRefusal(
                 f"wear_map: wear spread round the bore ({share:.0%} of the points unworn): "

@@ -419,10 +419,8 @@ def _rethrow_with_command(exc, path: Path, given: dict) -> None:
             f"{format_arcs(exc.unworn_arcs)} degree (canonical convention; the arcs the data "
             "find least worn), run: " + shlex.join([*cmd, "--unworn", format_arcs(exc.unworn_arcs)])
         )
-    else:
-        fix = "give the theta arcs known to be unworn: " + shlex.join(
-            [*cmd, "--unworn", "START:END"]
-        )
+    else:  # no arcs to offer (or the arcs given cannot rule the wear out): the library's fix
+        fix = exc.fix
     raise BadInputError(f"{exc.reason}; {fix}") from None
 
 

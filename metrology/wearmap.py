@@ -271,7 +271,7 @@ def wear_map(
     terms = ("selection", "tail") if rbz is not None else ("tail",)
     terms = terms if mask_in is None else ()
     structure = 0.0
-    if terms and rbz is not None:
+    if rbz is not None:  # an explicit mask is tested as well: it may hold wear
         r2 = resid.reshape(rw.shape)
         structure = smooth_structure(
             s2, noise_sigma(r2), correlation_length(r2, mask.reshape(rw.shape))
@@ -286,10 +286,10 @@ def wear_map(
     mask2 = mask.reshape(rw.shape)
     wear = resid.reshape(rw.shape)
     if rbz is not None:
-        arcs = unworn_arcs(mask2, th) if mask_in is None else ()
+        arcs = unworn_arcs(mask2, th, wear) if mask_in is None else ()
         refuse_inseparable_difference(s2, noise, tau, arcs)
         if unseen is not None:
-            refuse_by_consequence(q, *unseen, float(mask.mean()), arcs)
+            refuse_by_consequence(q, *unseen, float(mask.mean()), arcs, mask_in is not None)
     else:
         _refuse_inseparable(q, d, X, fit, noise, threshold, rw.shape)
         _refuse_form_tails(q, tail)
