@@ -360,5 +360,5 @@ def test_reference_study_help_states_the_reduced_size():
     from jointwear.datasets.cli_reported import reference_study_cmd
     from jointwear.datasets.reference_study import REDUCED
 
-    params = _check(reference_study_cmd, {}, {"out", "overwrite", "reduced"})
+    params = _check(reference_study_cmd, {}, {"out", "overwrite", "reduced", "verbose"})
     assert f"{REDUCED.ensemble_runs} ensemble members" in params["reduced"].help
