@@ -16,6 +16,7 @@ from ._run import (
 from ._spec import (
     CalibrationSpec as CalibrationSpec,
     MAP_QUANTITIES as MAP_QUANTITIES,
+    PREDICT_SAMPLES as PREDICT_SAMPLES,
     read_calibration_spec as read_calibration_spec,
     StatedValue as StatedValue,
 )
