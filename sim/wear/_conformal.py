@@ -258,14 +258,7 @@ class ConformalContact(DynamicContact):
     def run(
         self, wear_depth: np.ndarray, *, cycles: float, state: Any, progress: Any = None
     ) -> CycleWear:
-        res = self.cycle_function(
-            self.params,
-            cycles=cycles,
-            wear_depth=wear_depth,
-            state=state,
-            record=False,
-            progress=progress,
-        )
+        res = self._run_cycles(wear_depth, cycles=cycles, state=state, progress=progress)
         j = self.params.joint
         work = np.asarray(res.wear_work, dtype=float)
         slide = np.asarray(res.sliding_distance, dtype=float)
@@ -283,11 +276,4 @@ class ConformalContact(DynamicContact):
                 for n in range(work.shape[0])
             ]
         )
-        return CycleWear(
-            wear_work=new,
-            point_area=np.asarray(res.point_area, dtype=float),
-            normal_work=float(res.normal_work),
-            state=res.state,
-            cycles=float(res.cycles),
-            max_penetration=float(getattr(res, "max_penetration", math.nan)),
-        )
+        return self._cycle_wear(res, new)

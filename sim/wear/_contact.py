@@ -259,10 +259,11 @@ class DynamicContact:
             self._fn = run_cycles
         return self._fn
 
-    def run(
+    def _run_cycles(
         self, wear_depth: np.ndarray, *, cycles: float, state: Any, progress: Any = None
-    ) -> CycleWear:
-        res = self.cycle_function(
+    ) -> Any:
+        """The cycle function's result for these cycles over ``wear_depth`` (unrecorded)."""
+        return self.cycle_function(
             self.params,
             cycles=cycles,
             wear_depth=wear_depth,
@@ -270,20 +271,30 @@ class DynamicContact:
             record=False,
             progress=progress,
         )
-        work = np.asarray(res.wear_work, dtype=float)
-        if work.shape != self.grid.shape or not np.all(np.isfinite(work)):
-            raise SimulationError(
-                f"the dynamics returned a wear-work field of shape {work.shape} with "
-                f"{int(np.sum(~np.isfinite(work)))} non-finite values; expected finite {self.grid.shape}"
-            )
+
+    @staticmethod
+    def _cycle_wear(res: Any, wear_work: np.ndarray) -> CycleWear:
+        """A :class:`CycleWear` of ``wear_work`` [Pa m], the rest taken from the result ``res``."""
         return CycleWear(
-            wear_work=work,
+            wear_work=wear_work,
             point_area=np.asarray(res.point_area, dtype=float),
             normal_work=float(res.normal_work),
             state=res.state,
             cycles=float(res.cycles),
             max_penetration=float(getattr(res, "max_penetration", math.nan)),
         )
+
+    def run(
+        self, wear_depth: np.ndarray, *, cycles: float, state: Any, progress: Any = None
+    ) -> CycleWear:
+        res = self._run_cycles(wear_depth, cycles=cycles, state=state, progress=progress)
+        work = np.asarray(res.wear_work, dtype=float)
+        if work.shape != self.grid.shape or not np.all(np.isfinite(work)):
+            raise SimulationError(
+                f"the dynamics returned a wear-work field of shape {work.shape} with "
+                f"{int(np.sum(~np.isfinite(work)))} non-finite values; expected finite {self.grid.shape}"
+            )
+        return self._cycle_wear(res, work)
 
 
 def describe_any(model: Any) -> dict[str, Any]:
