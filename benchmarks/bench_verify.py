@@ -21,7 +21,9 @@ import os
 import sys
 import tempfile
 import time
+from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -50,6 +52,18 @@ def bootstrap_sd(study, quantity: str, resamples: int, seed: int = 0) -> float:
     out = np.asarray(out, dtype=float)
     out = out[np.isfinite(out)]
     return float(np.std(out, ddof=1)) if out.size > 2 else float("nan")
+
+
+def quantity_table(a_study, b_study, row: Callable[[str, Any, Any], dict]) -> dict[str, dict]:
+    """Per quantity of ``a_study``: its units and ``row(quantity, a, b)`` of the two studies'
+    :func:`study_uncertainty` fits (``a`` of ``a_study``, ``b`` of ``b_study``), each row
+    printed as it is made."""
+    table = {}
+    for q in (str(v) for v in a_study["quantity"].values):
+        a, b = study_uncertainty(a_study, q), study_uncertainty(b_study, q)
+        table[q] = {"units": str(a_study["quantity_units"].sel(quantity=q).values), **row(q, a, b)}
+        print(q, table[q], flush=True)
+    return table
 
 
 def run(
@@ -139,11 +153,9 @@ def main(argv: list[str] | None = None) -> None:
         ds2, c2 = run(args.cycles, 2 * default.replicates, args.workers, folder, args.reuse)
         figures["doubled_cost"] = c2
         figures["doubled_ok"] = int(ds2.attrs["n_ok"])
-        table = {}
-        for q in (str(v) for v in ds1["quantity"].values):
-            a, b = study_uncertainty(ds1, q), study_uncertainty(ds2, q)
-            row = {
-                "units": str(ds1["quantity_units"].sel(quantity=q).values),
+
+        def row(q: str, a, b) -> dict:
+            out = {
                 "value_R": a.value,
                 "value_2R": b.value,
                 "u_num_R": a.u_num,
@@ -156,12 +168,12 @@ def main(argv: list[str] | None = None) -> None:
             }
             if a.assessed and b.assessed:
                 sd = bootstrap_sd(ds1, q, args.resamples)
-                row["u_num_R_bootstrap_sd"] = sd
-                row["change"] = b.u_num - a.u_num
-                row["stable"] = bool(abs(b.u_num - a.u_num) < sd)
-            table[q] = row
-            print(q, row, flush=True)
-        figures["quantities"] = table
+                out["u_num_R_bootstrap_sd"] = sd
+                out["change"] = b.u_num - a.u_num
+                out["stable"] = bool(abs(b.u_num - a.u_num) < sd)
+            return out
+
+        figures["quantities"] = quantity_table(ds1, ds2, row)
     write_results(args.name, figures)
 
 

@@ -22,8 +22,8 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from _common import write_results  # noqa: E402
+from bench_verify import quantity_table  # noqa: E402
 
-from jointwear.refinement import study_uncertainty  # noqa: E402
 from jointwear.sim import VerifySpec, verify_wear  # noqa: E402
 
 
@@ -65,12 +65,11 @@ def main(argv: list[str] | None = None) -> None:
         }
         print(label, cost, ds.attrs["run_warnings_summary"], flush=True)
     (la, a_ds), (lb, b_ds) = studies.items()
-    table = {}
-    for q in (str(v) for v in a_ds["quantity"].values):
-        a, b = study_uncertainty(a_ds, q), study_uncertainty(b_ds, q)
-        row = {"units": str(a_ds["quantity_units"].sel(quantity=q).values)}
+
+    def row(q: str, a, b) -> dict:
+        out = {}
         for label, fit in ((la, a), (lb, b)):
-            row[label] = {
+            out[label] = {
                 "assessed": bool(fit.assessed),
                 "value": fit.value,
                 "u_num": fit.u_num,
@@ -80,11 +79,11 @@ def main(argv: list[str] | None = None) -> None:
                 "branch": fit.branch if fit.assessed else f"not assessed: {fit.reason}",
             }
         if a.assessed and b.assessed and a.u_num > 0:
-            row["u_num_ratio"] = b.u_num / a.u_num
-            row["value_change_over_u_num"] = (b.value - a.value) / max(a.u_num, b.u_num)
-        table[q] = row
-        print(q, row, flush=True)
-    figures["quantities"] = table
+            out["u_num_ratio"] = b.u_num / a.u_num
+            out["value_change_over_u_num"] = (b.value - a.value) / max(a.u_num, b.u_num)
+        return out
+
+    figures["quantities"] = quantity_table(a_ds, b_ds, row)
     write_results(args.name, figures)
 
 
