@@ -26,6 +26,7 @@ A claim the user knows to be wrong is dropped with ``ignore_header=<claim>`` (CL
 from __future__ import annotations
 
 import re
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -34,6 +35,7 @@ from jointwear.metrology.readers.units import unit_factor
 
 __all__ = [
     "CLAIMS",
+    "ValueUnit",
     "claim",
     "drop_ignored",
     "check_magnitude",
@@ -145,12 +147,32 @@ def _ratio(unit: str, other: str) -> str:
     return f"{k:.4g}"
 
 
+@dataclass(frozen=True)
+class ValueUnit:
+    """The length unit a table's values are read in, and who stated it.
+
+    Attributes
+    ----------
+    name : str
+        The unit (``"mm"``, ``"um"``, ``"inch"``, ...).
+    stated_by_file : bool
+        The unit comes from the file's header (a fix must then drop the header's unit), else
+        from ``units=``.
+    """
+
+    name: str
+    stated_by_file: bool
+
+    @property
+    def source(self) -> str:
+        """Who stated the unit, as the refusals say it."""
+        return "stated by the file" if self.stated_by_file else "units= given"
+
+
 def check_magnitude(
     values: np.ndarray,
     kind: str,
-    unit: str,
-    unit_source: str,
-    stated_by_file: bool,
+    value_unit: ValueUnit,
     meta: dict[str, str],
     limits: dict[str, float],
     where: str,
@@ -163,15 +185,18 @@ def check_magnitude(
     values : ndarray
         The value column(s) as written (file unit).
     kind : {"radius", "deviation"}
-    unit : str
-        The unit the values are read in; ``unit_source`` says who stated it.
-    stated_by_file : bool
-        The unit comes from the file (a fix must then drop the header's unit).
+    value_unit : ValueUnit
+        The unit the values are read in and who stated it.
     meta : dict
         Header metadata (for the nominal radius).
     limits : dict
         Plausibility limits (:data:`~jointwear.metrology.choices.PLAUSIBILITY` with overrides).
     """
+    unit, unit_source, stated_by_file = (
+        value_unit.name,
+        value_unit.source,
+        value_unit.stated_by_file,
+    )
     v = np.asarray(values, dtype=float)
     v = v[np.isfinite(v)]
     if v.size == 0:
@@ -291,18 +316,18 @@ def layer_form(theta_deg: np.ndarray, value: np.ndarray) -> float:
 
 
 def check_form(
-    form: float,
-    unit: str,
-    unit_source: str,
-    stated_by_file: bool,
-    meta: dict[str, str],
-    limits: dict[str, float],
-    where: str,
+    form: float, value_unit: ValueUnit, meta: dict[str, str], limits: dict[str, float], where: str
 ) -> None:
     """Refuse deviations whose form ``form`` [m] (the largest :func:`layer_form` of the
     layers) exceeds ``form_fraction`` (1 %) of the header's nominal radius: a precision bore's
     form is far smaller (a sub-micrometre form written in um under ``Units: mm`` reads 1000 x
-    too large). Nothing is checked without a stated nominal radius."""
+    too large). Nothing is checked without a stated nominal radius; ``value_unit`` is the unit
+    the values are read in (:class:`ValueUnit`)."""
+    unit, unit_source, stated_by_file = (
+        value_unit.name,
+        value_unit.source,
+        value_unit.stated_by_file,
+    )
     nominal = nominal_radius(meta, unit if stated_by_file else None)
     if nominal is None:
         return

@@ -9,6 +9,7 @@ import numpy as np
 from jointwear.errors import BadInputError
 from jointwear.metrology.readers.advice import Refusal, advise, plausibility
 from jointwear.metrology.readers.claims import (
+    ValueUnit,
     check_filter,
     check_form,
     check_magnitude,
@@ -28,6 +29,12 @@ from jointwear.metrology.readers.meaning import value_kind as decide_value_kind
 from jointwear.metrology.readers.table import ParsedFile, unit_factor
 
 __all__ = []
+
+
+def _value_unit(pf: ParsedFile) -> ValueUnit:
+    """The unit ``pf``'s values are read in: the header's (``"units"`` among the guessed
+    claims) or the one ``units=`` gave."""
+    return ValueUnit(pf.units, "units" in pf.guessed)
 
 
 @dataclass
@@ -173,9 +180,7 @@ def _check_layers(
     if out and out[0].kind == "deviation" and pf.units:
         check_form(
             max(layer_form(lay.theta_deg, lay.value) for lay in out),
-            pf.units,
-            "stated by the file" if "units" in pf.guessed else "units= given",
-            "units" in pf.guessed,
+            _value_unit(pf),
             pf.metadata,
             limits,
             where,
@@ -267,15 +272,7 @@ def _layers_from_file(
         kind = _decide_kind(pf, value_cols, value_kind, where, notes)
         absurd_length(pf.data[:, value_cols], kind, f, where, pf.line_numbers)
         check_magnitude(
-            pf.data[:, value_cols],
-            kind,
-            pf.units,
-            "stated by the file" if "units" in pf.guessed else "units= given",
-            "units" in pf.guessed,
-            pf.metadata,
-            limits,
-            where,
-            notes,
+            pf.data[:, value_cols], kind, _value_unit(pf), pf.metadata, limits, where, notes
         )
     if has_xy:
         xy = pf.data[:, [cols.index("x"), cols.index("y")]]
