@@ -2,9 +2,14 @@
 
 from __future__ import annotations
 
+import functools
+import inspect
+import typing
+from collections.abc import Callable
+from dataclasses import dataclass
 from enum import StrEnum
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Any
 
 import typer
 
@@ -66,6 +71,16 @@ _UCovers = Annotated[
     typer.Option("--u-covers", help="What the uncertainty covers, e.g. 'probe noise'."),
 ]
 
+#: the options of a CSV table (its dialect and stated uncertainty), each command's last
+_TABLE_OPTIONS = {
+    "delimiter": _Delimiter,
+    "decimal": _Decimal,
+    "u": _U,
+    "u_column": _UColumn,
+    "u_k": _UK,
+    "u_covers": _UCovers,
+}
+
 _CF_SUFFIXES = (".nc", ".nc4", ".cdf")
 """File endings read as CF netCDF; any other file is read as a CSV table."""
 
@@ -121,16 +136,60 @@ def _stated(value: str | None, column: str | None, k: float | None, covers: str 
     return StatedUncertainty(value=value, columns=columns, k=k, covers=covers)
 
 
-def _csv_only(file: Path, name: str, *given: object) -> None:
-    """The --u options state a CSV table's uncertainty; a CF file states its own."""
-    if any(v is not None for v in given):
-        from jointwear.errors import ParameterError
+@dataclass(frozen=True)
+class _TableFlags:
+    """A CSV table's options as given (None: not given): ``--delimiter``, ``--decimal`` and
+    the stated uncertainty's ``--u``, ``--u-column``, ``--u-k``, ``--u-covers``."""
 
-        raise ParameterError(
-            f"--u/--u-column/--u-k/--u-covers describe a CSV table; the CF file '{file}' states "
-            f"its uncertainty as the variable {name}_u (units, coverage_factor, comment): add it "
-            "there, or drop those options"
-        )
+    delimiter: str | None
+    decimal: str | None
+    u: str | None
+    u_column: str | None
+    u_k: float | None
+    u_covers: str | None
+
+    def reading(self, count: int) -> Any:
+        """The library's :class:`~jointwear.external.CsvReading` of these options, with at most
+        ``count`` ``--u-column`` names."""
+        from jointwear.external import CsvReading
+
+        stated = _stated(self.u, self.u_column, self.u_k, self.u_covers, count)
+        return CsvReading(delimiter=self.delimiter, decimal=self.decimal, uncertainty=stated)
+
+    def csv_only(self, file: Path, name: str) -> None:
+        """The --u options state a CSV table's uncertainty; a CF file states its own."""
+        if any(v is not None for v in (self.u, self.u_column, self.u_k, self.u_covers)):
+            from jointwear.errors import ParameterError
+
+            raise ParameterError(
+                f"--u/--u-column/--u-k/--u-covers describe a CSV table; the CF file '{file}' "
+                f"states its uncertainty as the variable {name}_u (units, coverage_factor, "
+                "comment): add it there, or drop those options"
+            )
+
+
+def _table_options(func: Callable[..., Any]) -> Callable[..., Any]:
+    """Give the command ``func`` the CSV table's options (:data:`_TABLE_OPTIONS`, last) in
+    place of its parameter ``table``, which receives them as one :class:`_TableFlags`."""
+    hints = typing.get_type_hints(func, include_extras=True)
+    params = [
+        p.replace(annotation=hints.get(p.name, p.annotation))
+        for p in inspect.signature(func).parameters.values()
+        if p.name != "table"
+    ]
+    keyword = inspect.Parameter.KEYWORD_ONLY
+    params += [
+        inspect.Parameter(n, keyword, default=None, annotation=a) for n, a in _TABLE_OPTIONS.items()
+    ]
+
+    @functools.wraps(func)
+    def command(**kwargs: Any) -> Any:
+        table = _TableFlags(**{n: kwargs.pop(n) for n in _TABLE_OPTIONS})
+        return func(**kwargs, table=table)
+
+    command.__signature__ = inspect.Signature(params)  # type: ignore[attr-defined]
+    command.__annotations__ = {p.name: p.annotation for p in params}
+    return command
 
 
 def _save(ds, out: Path, source: Path, name: str, example: str) -> None:
@@ -145,6 +204,7 @@ def _save(ds, out: Path, source: Path, name: str, example: str) -> None:
 
 
 @app.command("motion")
+@_table_options
 def motion(
     file: Annotated[Path, typer.Argument(help="CSV table (header row) or CF netCDF file.")],
     out: _Out,
@@ -164,19 +224,15 @@ def motion(
         typer.Option("--velocity-columns", help="Velocity column names x,y[,z] (bearing frame)."),
     ] = ",".join(D.VELOCITY_COLUMNS),
     tool: _Tool = None,
-    delimiter: _Delimiter = None,
-    decimal: _Decimal = None,
-    u: _U = None,
-    u_column: _UColumn = None,
-    u_k: _UK = None,
-    u_covers: _UCovers = None,
+    *,
+    table: _TableFlags,
 ) -> None:
     """Import a follower motion history: time and velocity columns with stated units."""
     from jointwear import external
 
     data_origin = origin.value if origin else None
     if file.suffix.lower() in _CF_SUFFIXES:
-        _csv_only(file, "follower_velocity", u, u_column, u_k, u_covers)
+        table.csv_only(file, "follower_velocity")
         ds = _from_cf(file, "follower_velocity", data_origin=data_origin, tool=tool)
     else:
         csv_origin, unit = _needed(
@@ -193,14 +249,13 @@ def motion(
             velocity_columns=_names(velocity_columns, "--velocity-columns", (2, 3)),
             data_origin=csv_origin,
             tool=tool,
-            delimiter=delimiter,
-            decimal=decimal,
-            uncertainty=_stated(u, u_column, u_k, u_covers, 3),
+            reading=table.reading(3),
         )
     _save(ds, out, file, "follower_velocity", "2mm/s")
 
 
 @app.command("wearmap")
+@_table_options
 def wearmap(
     file: Annotated[Path, typer.Argument(help="CSV table (theta, z, depth per row) or CF netCDF.")],
     out: _Out,
@@ -224,19 +279,15 @@ def wearmap(
         float | None, typer.Option("--cycles", help="Crank cycles the map belongs to.")
     ] = None,
     tool: _Tool = None,
-    delimiter: _Delimiter = None,
-    decimal: _Decimal = None,
-    u: _U = None,
-    u_column: _UColumn = None,
-    u_k: _UK = None,
-    u_covers: _UCovers = None,
+    *,
+    table: _TableFlags,
 ) -> None:
     """Import a wear map (depth positive where material was removed) with stated units and angle convention."""
     from jointwear import external
 
     data_origin = origin.value if origin else None
     if file.suffix.lower() in _CF_SUFFIXES:
-        _csv_only(file, "wear_depth", u, u_column, u_k, u_covers)
+        table.csv_only(file, "wear_depth")
         ds = _from_cf(
             file,
             "wear_depth",
@@ -268,9 +319,7 @@ def wearmap(
             z_mid_width=z_mid_width,
             cycles=cycles,
             tool=tool,
-            delimiter=delimiter,
-            decimal=decimal,
-            uncertainty=_stated(u, u_column, u_k, u_covers, 1),
+            reading=table.reading(1),
         )
     _save(ds, out, file, "wear_depth", "0.5um")
 

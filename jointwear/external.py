@@ -21,6 +21,7 @@ from __future__ import annotations
 import csv
 import re
 from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 from functools import cache
 from io import StringIO
 from pathlib import Path
@@ -39,6 +40,7 @@ __all__ = [
     "DATA_ORIGINS",
     "to_si",
     "read_table",
+    "CsvReading",
     "import_motion",
     "import_wear_map",
     "import_cf",
@@ -281,6 +283,31 @@ def _vector(
     )
 
 
+@dataclass(frozen=True)
+class CsvReading:
+    """How an own-data CSV table is read, and the uncertainty its user states for it.
+
+    Parameters
+    ----------
+    delimiter : {"tab", "semicolon", "comma", "whitespace"} or the character, optional
+        Field delimiter (``--delimiter``, :func:`read_table`); sniffed when not given.
+    decimal : {".", ","} (or "point", "comma"), optional
+        Decimal mark (``--decimal``, :func:`read_table`); sniffed when not given.
+    uncertainty : StatedUncertainty, optional
+        The imported quantity's uncertainty as the user states it (``--u`` or ``--u-column``,
+        in the quantity's unit unless it says its own), stored as ``<name>_u``. None: not
+        stated, and V&V 20 criteria on these data are *not assessed*.
+    """
+
+    delimiter: str | None = None
+    decimal: str | None = None
+    uncertainty: StatedUncertainty | None = None
+
+    def read(self, path: Path) -> pd.DataFrame:
+        """The table at ``path`` read with this delimiter and decimal mark (:func:`read_table`)."""
+        return read_table(path, delimiter=self.delimiter, decimal=self.decimal)
+
+
 def import_motion(
     path: str | Path,
     *,
@@ -292,9 +319,7 @@ def import_motion(
     position_columns: Sequence[str] | None = None,
     position_unit: str | None = None,
     tool: str | None = None,
-    delimiter: str | None = None,
-    decimal: str | None = None,
-    uncertainty: StatedUncertainty | None = None,
+    reading: CsvReading = CsvReading(),
 ) -> xr.Dataset:
     """Import a follower motion history (CSV table) from another simulator or instrument.
 
@@ -317,12 +342,9 @@ def import_motion(
         Follower position columns and their unit, if the file has them.
     tool : str, optional
         The program that wrote the file (e.g. ``"Adams 2024"``), recorded in ``source``.
-    delimiter, decimal : str, optional
-        Field delimiter and decimal mark (:func:`read_table`); sniffed when not given.
-    uncertainty : StatedUncertainty, optional
-        The velocity's uncertainty as the user states it (``--u`` or ``--u-column``, in the
-        velocity unit unless it says its own), stored as ``follower_velocity_u``. None: not
-        stated, and V&V 20 criteria on these data are *not assessed*.
+    reading : CsvReading, optional
+        The table's delimiter and decimal mark (sniffed when not given) and the velocity's
+        stated uncertainty (``follower_velocity_u``, one column or one per component).
 
     Returns
     -------
@@ -337,7 +359,8 @@ def import_motion(
         raise ParameterError(
             f"--velocity-columns: give 2 or 3 column names (x, y[, z]), got {list(velocity_columns)}"
         )
-    table = read_table(path, delimiter=delimiter, decimal=decimal)
+    uncertainty = reading.uncertainty
+    table = reading.read(path)
     t = to_si(
         _column(table, time_column, path, "--time-column"),
         time_unit,
@@ -394,9 +417,7 @@ def import_wear_map(
     z_reversed: bool = False,
     cycles: float | None = None,
     tool: str | None = None,
-    delimiter: str | None = None,
-    decimal: str | None = None,
-    uncertainty: StatedUncertainty | None = None,
+    reading: CsvReading = CsvReading(),
 ) -> xr.Dataset:
     """Import a wear map given as a long table (one row per bearing point: theta, z, depth).
 
@@ -423,12 +444,9 @@ def import_wear_map(
         Crank cycles the map belongs to; adds a ``cycles`` dimension of length 1.
     tool : str, optional
         The program that wrote the file.
-    delimiter, decimal : str, optional
-        Field delimiter and decimal mark (:func:`read_table`); sniffed when not given.
-    uncertainty : StatedUncertainty, optional
-        The depth's uncertainty as the user states it (``--u`` or ``--u-column``, in the depth
-        unit unless it says its own), stored as ``wear_depth_u``. None: not stated, and V&V 20
-        criteria on these data are *not assessed*.
+    reading : CsvReading, optional
+        The table's delimiter and decimal mark (sniffed when not given) and the depth's stated
+        uncertainty (``wear_depth_u``, one value or one column).
 
     Returns
     -------
@@ -440,7 +458,8 @@ def import_wear_map(
     if len(columns) != 3:
         raise ParameterError(f"--columns: give three names (theta, z, depth), got {list(columns)}")
     convention = conventions.AngleConvention(angle_zero, angle_direction)
-    table = read_table(path, delimiter=delimiter, decimal=decimal)
+    uncertainty = reading.uncertainty
+    table = reading.read(path)
     theta = to_si(
         _column(table, columns[0], path, "--columns"),
         theta_unit,

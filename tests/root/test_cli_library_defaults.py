@@ -283,13 +283,16 @@ def test_cycle_and_calibrate_kw_defaults_are_the_librarys():
 
 def test_import_defaults_are_the_librarys():
     from jointwear.cli_import import _names, motion, wearmap
-    from jointwear.external import import_motion, import_wear_map
+    from jointwear.external import CsvReading, import_motion, import_wear_map
 
     # the stated uncertainty's options make one StatedUncertainty (uncertainty=None: not stated)
     stated = {"u", "u_column", "u_k", "u_covers"}
+    reading = _fields(CsvReading)
+    assert reading["uncertainty"] is None
+    dialect = _same(reading, "delimiter", "decimal")
     kw = _keywords(import_motion)
-    assert kw["uncertainty"] is None
-    mapping = _same(kw, "time_unit", "time_column", "tool", "delimiter", "decimal")
+    assert kw["reading"] == CsvReading()
+    mapping = _same(kw, "time_unit", "time_column", "tool") | dialect
     params = _check(
         motion,
         mapping,
@@ -299,8 +302,8 @@ def test_import_defaults_are_the_librarys():
     assert tuple(_names(columns, "--velocity-columns", (2, 3))) == kw["velocity_columns"]
 
     kw = _keywords(import_wear_map)
-    assert kw["uncertainty"] is None
-    mapping = _same(kw, "z_mid_width", "cycles", "tool", "delimiter", "decimal")
+    assert kw["reading"] == CsvReading()
+    mapping = _same(kw, "z_mid_width", "cycles", "tool") | dialect
     required = ("theta_unit", "z_unit", "depth_unit", "angle_zero", "angle_direction")
     assert all(kw[n] is inspect.Parameter.empty for n in required)
     mapping |= dict.fromkeys(required, (None, None))  # None: the command asks for them
