@@ -311,6 +311,7 @@ class CsvReading:
 def import_motion(
     path: str | Path,
     *,
+    reading: CsvReading = CsvReading(),
     velocity_unit: str,
     data_origin: str,
     time_unit: str = D.TIME_UNIT,
@@ -319,7 +320,6 @@ def import_motion(
     position_columns: Sequence[str] | None = None,
     position_unit: str | None = None,
     tool: str | None = None,
-    reading: CsvReading = CsvReading(),
 ) -> xr.Dataset:
     """Import a follower motion history (CSV table) from another simulator or instrument.
 
@@ -327,6 +327,9 @@ def import_motion(
     ----------
     path : path
         CSV/TSV table with a header row: a time column and one column per velocity component.
+    reading : CsvReading, optional
+        The table's delimiter and decimal mark (sniffed when not given) and the velocity's
+        stated uncertainty (``follower_velocity_u``, one column or one per component).
     velocity_unit : str
         Unit of the velocity columns (``"mm/s"``, ``"m s-1"``, ...). Required: never guessed.
     data_origin : {"simulated", "measured", "synthetic"}
@@ -342,9 +345,6 @@ def import_motion(
         Follower position columns and their unit, if the file has them.
     tool : str, optional
         The program that wrote the file (e.g. ``"Adams 2024"``), recorded in ``source``.
-    reading : CsvReading, optional
-        The table's delimiter and decimal mark (sniffed when not given) and the velocity's
-        stated uncertainty (``follower_velocity_u``, one column or one per component).
 
     Returns
     -------
@@ -406,6 +406,7 @@ def import_motion(
 def import_wear_map(
     path: str | Path,
     *,
+    reading: CsvReading = CsvReading(),
     theta_unit: str,
     z_unit: str,
     depth_unit: str,
@@ -417,7 +418,6 @@ def import_wear_map(
     z_reversed: bool = False,
     cycles: float | None = None,
     tool: str | None = None,
-    reading: CsvReading = CsvReading(),
 ) -> xr.Dataset:
     """Import a wear map given as a long table (one row per bearing point: theta, z, depth).
 
@@ -425,6 +425,9 @@ def import_wear_map(
     ----------
     path : path
         CSV/TSV with a header row. Every (z, theta) pair of a regular grid must appear exactly once.
+    reading : CsvReading, optional
+        The table's delimiter and decimal mark (sniffed when not given) and the depth's stated
+        uncertainty (``wear_depth_u``, one value or one column).
     theta_unit, z_unit, depth_unit : str
         Units of the three columns (``"deg"``/``"rad"``, ``"mm"``, ``"um"``). Required.
     angle_zero, angle_direction : str
@@ -444,9 +447,6 @@ def import_wear_map(
         Crank cycles the map belongs to; adds a ``cycles`` dimension of length 1.
     tool : str, optional
         The program that wrote the file.
-    reading : CsvReading, optional
-        The table's delimiter and decimal mark (sniffed when not given) and the depth's stated
-        uncertainty (``wear_depth_u``, one value or one column).
 
     Returns
     -------
