@@ -156,14 +156,18 @@ def _u_num(spec: CalibrationSpec, data: list[Datum], verification: Sequence[Any]
         if found is None and spec.u_num_rel is not None:
             found = (spec.u_num_rel, f"stated u_num_rel = {spec.u_num_rel:g}")
         if found is None:
-            raise CalibrationRefused(
-                f"u_num of {d.label} is not known: the likelihood needs it; give a verification "
-                "study (--verification STUDY.nc from 'jointwear sim verify') or state "
-                "u_num_rel = <fraction> in [calibrate]"
-            )
+            raise _no_u_num(d.label)
         rel[i] = found[0]
         basis.append(found[1])
     return rel, basis
+
+
+def _no_u_num(label: str) -> CalibrationRefused:
+    return CalibrationRefused(
+        f"u_num of {label} is not known: the likelihood needs it; give a verification study "
+        "(--verification STUDY.nc from 'jointwear sim verify') or state u_num_rel = <fraction> "
+        "in [calibrate]"
+    )
 
 
 def _check_emulator(emu, data: list[Datum], rel_num: np.ndarray, limit: float) -> None:
@@ -250,6 +254,8 @@ def calibrate(
             base=base,
         )
 
+    if spec.run == "wear" and spec.u_num_rel is None and not studies:  # before any run
+        raise _no_u_num(data[0].label)
     x, y, notes = _training(spec, data, bands, radius, run)
     lo, hi = _scale(spec)
     from jointwear.sim.calibrate._emulator import fit_emulator

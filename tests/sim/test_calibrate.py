@@ -209,3 +209,28 @@ def test_cli_defaults_are_the_librarys():
     )
     for name in ("params", "workers", "scheduler", "resume"):
         assert cli[name].default == lib[name].default, name
+
+
+def test_a_wear_calibration_without_u_num_is_refused_before_any_run(tmp_path):
+    import xarray as xr
+
+    from jointwear.conventions import theta_coord, z_coord
+
+    theta = np.arange(0.0, 360.0, 30.0)
+    depth = np.outer([1.0, 2.0, 1.0], 1 + np.cos(np.radians(theta))) * 1e-6
+    m = xr.Dataset(
+        {
+            "wear_depth": (("z", "theta"), depth, {"units": "m", "long_name": "wear depth"}),
+            "wear_depth_u": (("z", "theta"), depth * 0 + 1e-8, {"units": "m", "long_name": "u"}),
+        },
+        coords={"z": z_coord([-2e-3, 0.0, 2e-3]), "theta": theta_coord(theta)},
+        attrs={"data_origin": "synthetic"},
+    )
+    io.save(m, tmp_path / "map.nc")
+    spec = {
+        "calibrate": {"data": [str(tmp_path / "map.nc")], "cycles": 1000},
+        "parameters": {"wear.kw": {"distribution": "uniform", "bounds": [4.5e-16, 1.35e-15]}},
+    }
+    with pytest.raises(CalibrationRefused, match=r"u_num of max_wear_depth of map.nc .* not known"):
+        calibrate(spec, out=tmp_path / "post.nc", workers=0)
+    assert not list(tmp_path.glob("post*"))  # refused before the training runs
