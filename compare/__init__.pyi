@@ -42,6 +42,18 @@ from ._api import (
     worn_volume as worn_volume,
     wrap_angle_deg as wrap_angle_deg,
 )
+from ._cli_options import (
+    AllowOtherRigOpt as AllowOtherRigOpt,
+    AxisOpt as AxisOpt,
+    CriteriaOpt as CriteriaOpt,
+    CyclesOpt as CyclesOpt,
+    EnsembleOpt as EnsembleOpt,
+    PeriodOpt as PeriodOpt,
+    SimOpt as SimOpt,
+    StrictOpt as StrictOpt,
+    VariableOpt as VariableOpt,
+    VerificationOpt as VerificationOpt,
+)
 from ._wear import (
     band_label as band_label,
 )

@@ -8,7 +8,17 @@ from typing import Annotated
 import typer
 
 from jointwear._cli import Overwrite
-from jointwear.compare import _cli_options as opt
+from jointwear.compare import (
+    AxisOpt,
+    CriteriaOpt,
+    CyclesOpt,
+    EnsembleOpt,
+    PeriodOpt,
+    SimOpt,
+    StrictOpt,
+    VariableOpt,
+    VerificationOpt,
+)
 
 
 def report_cmd(
@@ -18,7 +28,7 @@ def report_cmd(
         typer.Option("--out", "-o", help="HTML report to write (.pdf: the PDF version only)."),
     ] = Path("report.html"),
     overwrite: Overwrite = False,
-    sim: opt.SimOpt = None,
+    sim: SimOpt = None,
     metrology: Annotated[
         list[Path] | None,
         typer.Option("--metrology", help="Measured wear map (.nc from jointwear metrology)."),
@@ -38,18 +48,18 @@ def report_cmd(
         Path | None,
         typer.Option("--comparison", help="A metrics.nc from jointwear compare instead."),
     ] = None,
-    verification: opt.VerificationOpt = None,
-    criteria: opt.CriteriaOpt = None,
+    verification: VerificationOpt = None,
+    criteria: CriteriaOpt = None,
     pdf: Annotated[
         Path | None, typer.Option("--pdf", help="Also write a PDF (no browser needed).")
     ] = None,
     title: Annotated[str | None, typer.Option("--title", help="Report title.")] = None,
-    cycles: opt.CyclesOpt = None,
-    period: opt.PeriodOpt = None,
-    variables: opt.VariableOpt = None,
-    ensemble: opt.EnsembleOpt = None,
-    axes: opt.AxisOpt = None,
-    strict: opt.StrictOpt = False,
+    cycles: CyclesOpt = None,
+    period: PeriodOpt = None,
+    variables: VariableOpt = None,
+    ensemble: EnsembleOpt = None,
+    axes: AxisOpt = None,
+    strict: StrictOpt = False,
 ) -> None:
     """Build a self-contained HTML validation report from simulation and measurement files.
 
