@@ -19,7 +19,7 @@ from jointwear.sim._cli_options import (
     check_executor,
     check_lost_runs,
 )
-from jointwear.sim.calibrate._spec import PREDICT_SAMPLES
+from jointwear.sim.calibrate._defaults import PREDICT_SAMPLES
 from jointwear.sim.parameters import DEFAULT_PARAMETER_SET
 
 __all__ = ["register"]

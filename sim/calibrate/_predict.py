@@ -21,7 +21,7 @@ import numpy as np
 import xarray as xr
 
 from jointwear.errors import BadInputError
-from jointwear.sim.calibrate._spec import PREDICT_SAMPLES
+from jointwear.sim.calibrate._defaults import PREDICT_SAMPLES
 
 __all__ = ["predict", "PREDICTION_FILE"]
 

@@ -37,6 +37,7 @@ from pathlib import Path
 from typing import Any
 
 from jointwear.errors import ParameterError
+from jointwear.sim.calibrate._defaults import PREDICT_SAMPLES
 
 __all__ = [
     "CalibrationSpec",
@@ -46,8 +47,6 @@ __all__ = [
     "PREDICT_SAMPLES",
 ]
 
-#: Default number of posterior samples ``sim predict`` simulates (the ensemble's size).
-PREDICT_SAMPLES = 16
 
 #: Quantities of a measured wear map, computed within its band (its z range).
 MAP_QUANTITIES = ("max_wear_depth", "worn_volume", "cylindricity")
