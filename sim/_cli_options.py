@@ -3,6 +3,8 @@ and the check that closes the commands that run sweeps of dask tasks."""
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Annotated, Any
 
@@ -21,6 +23,7 @@ __all__ = [
     "Resume",
     "check_executor",
     "check_lost_runs",
+    "sweep_runs",
 ]
 
 Base = Annotated[
@@ -73,6 +76,29 @@ def check_executor(workers: int | None, scheduler: str | None) -> None:
         from jointwear.errors import BadInputError
 
         raise BadInputError("give --workers or --scheduler, not both")
+
+
+@contextmanager
+def sweep_runs(
+    what: str, *, workers: int | None, scheduler: str | None, resume: bool, progress: bool | None
+) -> Iterator[dict[str, Any]]:
+    """Where and how a command's sweep of dask tasks runs, with a run counter shown meanwhile.
+
+    Refuses ``--workers`` with ``--scheduler`` (:func:`check_executor`), then, inside a
+    progress bar labelled ``what`` (``--progress``), yields the keywords the library's sweep
+    functions (``run_sweep``, ``calibrate``, ``predict``, ``verify_wear``) take for it:
+    ``workers``, ``scheduler``, ``resume`` and ``on_progress`` (the bar's run counter).
+    """
+    from jointwear.progress import progress_bar, run_counter
+
+    check_executor(workers, scheduler)
+    with progress_bar(what, total=None, enabled=progress) as bar:
+        yield {
+            "workers": workers,
+            "scheduler": scheduler,
+            "resume": resume,
+            "on_progress": run_counter(bar, what),
+        }
 
 
 def check_lost_runs(ds: Any, where: str = "") -> None:

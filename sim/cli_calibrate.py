@@ -16,8 +16,8 @@ from jointwear.sim._cli_options import (
     Scheduler,
     WearParams,
     Workers,
-    check_executor,
     check_lost_runs,
+    sweep_runs,
 )
 from jointwear.sim.calibrate._defaults import PREDICT_SAMPLES
 from jointwear.sim.parameters import DEFAULT_PARAMETER_SET
@@ -51,22 +51,12 @@ def calibrate_cmd(
     an emulator error above the spec's fraction of the data's u, an unconverged chain, a
     datum outside its posterior predictive interval.
     """
-    from jointwear.progress import progress_bar, run_counter
     from jointwear.sim.calibrate import calibrate
 
-    check_executor(workers, scheduler)
-    with progress_bar("training runs", total=None, enabled=progress) as bar:
-        ds = calibrate(
-            spec,
-            out=out,
-            params=params,
-            base=base,
-            workers=workers,
-            scheduler=scheduler,
-            resume=resume,
-            verification=[verification] if verification else [],
-            on_progress=run_counter(bar, "training runs"),
-        )
+    executor = {"workers": workers, "scheduler": scheduler, "resume": resume}
+    with sweep_runs("training runs", **executor, progress=progress) as runs:
+        studies = [verification] if verification else []
+        ds = calibrate(spec, out=out, params=params, base=base, verification=studies, **runs)
     typer.echo(f"{out}: posterior of {', '.join(ds['parameter'].values.tolist())}")
     for line in ds.attrs["identifiability"].splitlines():
         typer.echo(f"  {line}")
@@ -95,21 +85,11 @@ def predict_cmd(
 ) -> None:
     """Run the simulator at posterior samples: the ensemble 'jointwear compare' takes as the
     simulation (mean map compared, spread = input uncertainty)."""
-    from jointwear.progress import progress_bar, run_counter
     from jointwear.sim.calibrate import predict
 
-    check_executor(workers, scheduler)
-    with progress_bar("prediction", total=None, enabled=progress) as bar:
-        ds = predict(
-            posterior,
-            cycles=cycles,
-            out=out,
-            samples=samples,
-            workers=workers,
-            scheduler=scheduler,
-            resume=resume,
-            on_progress=run_counter(bar, "prediction"),
-        )
+    executor = {"workers": workers, "scheduler": scheduler, "resume": resume}
+    with sweep_runs("prediction", **executor, progress=progress) as runs:
+        ds = predict(posterior, cycles=cycles, out=out, samples=samples, **runs)
     typer.echo(
         f"{out}: {ds.attrs['n_runs']} runs at posterior samples, {cycles:g} cycles: "
         f"{ds.attrs['n_ok']} ok, {ds.attrs['n_failed']} failed, {ds.attrs['n_not_run']} not run"

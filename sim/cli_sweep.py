@@ -15,8 +15,8 @@ from jointwear.sim._cli_options import (
     Scheduler,
     WearParams,
     Workers,
-    check_executor,
     check_lost_runs,
+    sweep_runs,
 )
 from jointwear.sim.parameters import DEFAULT_PARAMETER_SET
 
@@ -44,26 +44,14 @@ def sweep(
 
     import numpy as np
 
-    from jointwear.progress import progress_bar, run_counter
     from jointwear.sim.sweep._driver import run_sweep
 
     # printed below, once (the runs keep their warnings in the record)
     logging.getLogger("jointwear.sim.sweep").addHandler(logging.NullHandler())
-    check_executor(workers, scheduler)
-    with progress_bar("sweep", total=None, enabled=progress) as bar:
-        on_progress = run_counter(bar, "sweep")
-
+    executor = {"workers": workers, "scheduler": scheduler, "resume": resume}
+    with sweep_runs("sweep", **executor, progress=progress) as runs:
         try:
-            ds = run_sweep(
-                spec,
-                out=out,
-                params=params,
-                workers=workers,
-                scheduler=scheduler,
-                resume=resume,
-                on_progress=on_progress,
-                base=base,
-            )
+            ds = run_sweep(spec, out=out, params=params, base=base, **runs)
         except KeyboardInterrupt:
             from jointwear.sim.sweep._store import parts_dir
 

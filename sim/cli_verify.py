@@ -13,8 +13,8 @@ from jointwear.sim._cli_options import (
     Resume,
     Scheduler,
     Workers,
-    check_executor,
     check_lost_runs,
+    sweep_runs,
 )
 from jointwear.sim.parameters import DEFAULT_PARAMETER_SET
 from jointwear.sim.sweep._verify_spec import default_study
@@ -74,11 +74,9 @@ def verify(
     u_num = sqrt(u_stat^2 + u_refinement^2 + u_grid^2) as a standard uncertainty (k = 1).
     """
     from jointwear.errors import BadInputError
-    from jointwear.progress import progress_bar, run_counter
     from jointwear.sim.sweep._verify import verify_wear
     from jointwear.summary import describe_study
 
-    check_executor(workers, scheduler)
     band = None
     if band_mm is not None:
         try:
@@ -88,21 +86,9 @@ def verify(
         band = (lo, hi)
     if spec is None and cycles is None:
         raise BadInputError("the default study needs --cycles N (or give a SPEC.toml)")
-    with progress_bar("verify", total=None, enabled=progress) as bar:
-        on_progress = run_counter(bar, "verify")
-
-        ds = verify_wear(
-            params,
-            cycles=cycles,
-            spec=spec,
-            seed=seed,
-            workers=workers,
-            scheduler=scheduler,
-            band=band,
-            out=out,
-            resume=resume,
-            on_progress=on_progress,
-        )
+    executor = {"workers": workers, "scheduler": scheduler, "resume": resume}
+    with sweep_runs("verify", **executor, progress=progress) as runs:
+        ds = verify_wear(params, cycles=cycles, spec=spec, seed=seed, band=band, out=out, **runs)
     typer.echo(
         f"{out}: {ds.attrs['n_runs']} runs on {ds.attrs['executor']}: {ds.attrs['n_ok']} ok, "
         f"{ds.attrs['n_failed']} failed, {ds.attrs['n_not_run']} not run"
