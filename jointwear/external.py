@@ -33,6 +33,7 @@ import xarray as xr
 
 from jointwear import _import_defaults as D
 from jointwear import conventions
+from jointwear.dialect import DELIMITER_NAMES, delimiter_char, sniff_separators, sniff_thousands
 from jointwear.errors import BadInputError, ParameterError
 from jointwear.import_uncertainty import StatedUncertainty, attach_uncertainty
 
@@ -127,8 +128,8 @@ def read_table(
     """Read a CSV/TSV/whitespace table with a header row; ``#`` starts a comment line.
 
     The field delimiter and the decimal mark are the metrology readers' decisions
-    (:func:`jointwear.metrology.readers.table.sniff` on the data rows, the thousands mark
-    :func:`jointwear.metrology.readers.pretext.sniff_thousands`), so a semicolon table with
+    (:func:`jointwear.dialect.sniff_separators` on the data rows, the thousands mark
+    :func:`jointwear.dialect.sniff_thousands`), so a semicolon table with
     decimal commas (``0,25;1,5``) reads as numbers; what was sniffed is in ``table.attrs``.
 
     Parameters
@@ -154,7 +155,7 @@ def read_table(
             f"'{path}' is not UTF-8 text; export it as CSV (UTF-8) from the tool that wrote it"
         ) from None
     lines = [ln for ln in text.splitlines() if ln.strip() and not ln.lstrip().startswith("#")]
-    sep, dec, thousands, how = _format(lines, path, delimiter, decimal)
+    sep, dec, thousands, how = _format(lines, delimiter, decimal)
     try:
         table = pd.read_csv(
             StringIO("\n".join(lines)),
@@ -183,43 +184,42 @@ _DECIMALS = {".": ".", "point": ".", "dot": ".", ",": ",", "comma": ","}
 
 
 def _format(
-    lines: list[str], path: Path, delimiter: str | None, decimal: str | None
+    lines: list[str], delimiter: str | None, decimal: str | None
 ) -> tuple[str | None, str, str | None, str]:
     """(pandas ``sep``, decimal mark, thousands mark, what was read how) of a table's lines
-    (the header row first): the metrology readers' sniffer on its data rows."""
-    from jointwear.metrology.readers.pretext import sniff_thousands
-    from jointwear.metrology.readers.table import TextFormat, sniff
-
+    (the header row first): the metrology readers' sniffer (:mod:`jointwear.dialect`) on its
+    data rows."""
     if decimal is not None and str(decimal).strip().lower() not in _DECIMALS:
         raise ParameterError(f"--decimal {decimal!r}: use point or comma")
     dec = None if decimal is None else _DECIMALS[str(decimal).strip().lower()]
     try:
-        fmt = TextFormat(delimiter=delimiter, decimal=dec, header_lines=0)
+        delim = delimiter_char(delimiter)
     except BadInputError as exc:
         raise ParameterError(f"--delimiter {delimiter!r}: {exc}") from None
     data = lines[1:51]
-    if not data or (fmt.delimiter is not None and fmt.decimal is not None):
-        found, guessed = fmt, {}
-    else:
-        try:
-            found, guessed = sniff("\n".join(data), fmt, path=str(path))
-        except BadInputError:  # a column of text: the table is read as it was before
-            found, guessed = fmt, {}
-    if found.delimiter is None:  # not decided: csv's sniffer (any delimiter), decimal point
-        return None, found.decimal or ".", None, "delimiter sniffed by csv, decimal point"
+    sample = [ln for ln in "\n".join(data).splitlines() if ln.strip()][:50]
+    found, guessed = (delim, dec), set()
+    if sample and (delim is None or dec is None):
+        sniffed = sniff_separators(sample, delim, dec)
+        if sniffed is not None:  # else a column of text: the table is read as it was before
+            guessed = {"delimiter"} if delim is None else set()
+            guessed |= {"decimal"} if dec is None else set()
+            found = sniffed
+    delim, dec = found
+    if delim is None:  # not decided: csv's sniffer (any delimiter), decimal point
+        return None, dec or ".", None, "delimiter sniffed by csv, decimal point"
     thousands = None
-    if found.decimal is not None:
-        thousands = sniff_thousands(data, found.delimiter)
-        thousands = None if thousands == found.decimal else thousands
-    sep = r"\s+" if found.delimiter == " " else found.delimiter
-    names = {"\t": "tab", ";": "semicolon", ",": "comma", " ": "whitespace"}
+    if dec is not None:
+        thousands = sniff_thousands(data, delim)
+        thousands = None if thousands == dec else thousands
+    sep = r"\s+" if delim == " " else delim
     how = (
-        f"delimiter {names[found.delimiter]} ({'sniffed' if 'delimiter' in guessed else 'given'}), "
-        f"decimal {'comma' if found.decimal == ',' else 'point'} "
+        f"delimiter {DELIMITER_NAMES[delim]} ({'sniffed' if 'delimiter' in guessed else 'given'}), "
+        f"decimal {'comma' if dec == ',' else 'point'} "
         f"({'sniffed' if 'decimal' in guessed else 'given'})"
         + (f", thousands mark {thousands!r} (sniffed)" if thousands else "")
     )
-    return sep, found.decimal or ".", thousands, how
+    return sep, dec or ".", thousands, how
 
 
 def _column(table: pd.DataFrame, name: str, path: Path, option: str) -> np.ndarray:

@@ -15,7 +15,9 @@ marks, concatenated per-layer blocks; formats that are not supported are named.
   1 mm``, the column names again), is split into blocks (:func:`split_blocks`).
 
 :func:`sniff_delimiter`, :func:`sniff_thousands`, :func:`fields` and :data:`MISSING` are the
-sniffer's parts that other importers reuse (lines in, decisions out; nothing read from disk).
+sniffer's parts that other importers reuse (lines in, decisions out; nothing read from disk);
+the last three, with the delimiter/decimal sniffer, live in :mod:`jointwear.dialect`, which the
+root library may use, and are re-exported here.
 """
 
 from __future__ import annotations
@@ -25,6 +27,14 @@ import io
 import re
 from collections.abc import Sequence
 
+from jointwear.dialect import (
+    DELIMITERS,
+    MISSING,
+    fields,
+    is_missing,
+    sniff_thousands,
+)
+from jointwear.dialect import grouped_number as _grouped
 from jointwear.metrology.readers.advice import Refusal
 
 __all__ = [
@@ -61,42 +71,9 @@ THOUSANDS_NAMES: dict[str, str] = {
 }
 #: The name a suggestion uses for each mark (one the shell passes as it is).
 THOUSANDS_WORD = {",": "comma", ".": "point", "'": "apostrophe", " ": "space"}
-#: Field delimiters in the order they are tried (``" "``: any run of whitespace).
-DELIMITERS = ("\t", ";", ",", " ")
-#: Cells that mean "no value here" (a missing point), compared lower-cased.
-MISSING = frozenset(
-    (
-        "",
-        "-",
-        "--",
-        "---",
-        "----",
-        "*",
-        "**",
-        "***",
-        "nan",
-        "-nan",
-        "+nan",
-        "na",
-        "n/a",
-        "#n/a",
-        "null",
-        "none",
-        "?",
-        "invalid",
-        "void",
-        "missing",
-        "#value!",
-    )
-)
 _LOOSE = re.compile(
     r"^[-+]?(?:\d{1,3}(?:[,.'\u00a0\u202f ]\d{3})+|\d+)?(?:[.,]\d*)?(?:[eE][-+]?\d+)?$"
 )
-
-
-def is_missing(cell: str) -> bool:
-    """True for a cell that marks a missing point (:data:`MISSING`: ``---``, ``NaN``, empty…)."""
-    return cell.strip().lower() in MISSING
 
 
 def thousands_mark(name: str | None) -> str | None:
@@ -111,17 +88,6 @@ def thousands_mark(name: str | None) -> str | None:
             "apostrophe or space"
         )
     return THOUSANDS_NAMES[key]
-
-
-def fields(line: str, delimiter: str | None) -> list[str]:
-    """The stripped fields of ``line`` split at ``delimiter`` (``" "``: any whitespace run;
-    None: the whole line is one field); a trailing delimiter adds no field."""
-    if delimiter is None:
-        return [line.strip()]
-    if delimiter == " ":
-        return line.split()
-    toks = [t.strip() for t in line.strip().split(delimiter)]
-    return toks[:-1] if len(toks) > 1 and toks[-1] == "" else toks
 
 
 def _numberish(tok: str) -> bool:
@@ -156,56 +122,6 @@ def sniff_delimiter(lines: Sequence[str]) -> str | None:
                 counts[len(toks)] = counts.get(len(toks), 0) + 1
         if counts and max(counts.values()) >= 0.9 * len(rows):
             return d
-    return None
-
-
-def _grouped(sep: str, dec: str | None) -> re.Pattern:
-    """A number whose integer part is grouped by ``sep`` (or has at most 3 digits)."""
-    d = "[.,]" if dec is None else re.escape(dec)
-    s = re.escape(sep)
-    return re.compile(rf"^[-+]?\d{{1,3}}(?:{s}\d{{3}})*(?:{d}\d*)?(?:[eE][-+]?\d+)?$")
-
-
-def _plain(dec: str) -> re.Pattern:
-    d = re.escape(dec)
-    return re.compile(rf"^[-+]?(?:\d+(?:{d}\d*)?|{d}\d+)(?:[eE][-+]?\d+)?$")
-
-
-def sniff_thousands(lines: Sequence[str], delimiter: str | None) -> str | None:
-    """A thousands mark that the table shows unambiguously, else None.
-
-    Parameters
-    ----------
-    lines : sequence of str
-        Data lines.
-    delimiter : str or None
-        Their field delimiter (:func:`sniff_delimiter`); None for one column.
-
-    Returns
-    -------
-    str or None
-        ``sep`` when, within the fields, (1) neither ``sep`` nor the decimal mark is the
-        delimiter, (2) at least one number holds ``sep`` and the decimal mark
-        (``8,001.234``), and (3) every value of every column holding ``sep`` is grouped by it
-        (``999.5`` yes; ``1234.5`` or ``0.458`` with ``sep='.'`` no) and every other column
-        reads with the decimal mark alone.
-    """
-    table = [fields(ln, delimiter) for ln in lines if ln.strip()]
-    if not table:
-        return None
-    width = max(map(len, table))
-    cols = [[r[j] for r in table if j < len(r) and not is_missing(r[j])] for j in range(width)]
-    for sep, dec in ((",", "."), (".", ","), ("'", "."), ("'", ","), (" ", ","), (" ", ".")):
-        if delimiter in (sep, dec) or (delimiter is None and sep == " "):
-            continue
-        both = re.compile(rf"^[-+]?\d{{1,3}}(?:{re.escape(sep)}\d{{3}})+{re.escape(dec)}\d+")
-        if not any(both.match(v) for col in cols for v in col):
-            continue
-        grouped, plain = _grouped(sep, dec), _plain(dec)
-        if all(
-            all(map((grouped if any(sep in v for v in col) else plain).match, col)) for col in cols
-        ):
-            return sep
     return None
 
 

@@ -11,6 +11,11 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from jointwear.dialect import DELIMITER_NAMES as _DELIMS
+from jointwear.dialect import NUMBER as _NUM
+from jointwear.dialect import delimiter_char, sniff_separators
+from jointwear.dialect import is_number as _is_num
+from jointwear.dialect import split_fields as _split
 from jointwear.errors import BadInputError
 from jointwear.metrology.readers.advice import Refusal
 from jointwear.metrology.readers.claims import drop_ignored
@@ -18,7 +23,6 @@ from jointwear.metrology.readers.columns import COLUMN_KINDS, _guess_columns, _k
 from jointwear.metrology.readers.pretext import (
     MISSING,
     fields,
-    is_missing,
     missing_row,
     normalise,
     numeric_line,
@@ -39,12 +43,6 @@ __all__ = [
     "parse_file",
     "parse_blocks",
 ]
-
-
-_DELIMS = {"\t": "tab", ";": "semicolon", ",": "comma", " ": "whitespace"}
-
-
-_NUM = r"[-+]?(?:\d+(?:[.,]\d*)?|[.,]\d+)(?:[eE][-+]?\d+)?"
 
 
 _NUM_RE = re.compile(rf"^\s*{_NUM}\s*$")
@@ -99,15 +97,7 @@ class TextFormat:
     thousands: str | None = None
 
     def __post_init__(self) -> None:
-        if self.delimiter is not None and self.delimiter not in _DELIMS:
-            names = {"tab": "\t", "semicolon": ";", "comma": ",", "whitespace": " ", "space": " "}
-            if self.delimiter in names:
-                object.__setattr__(self, "delimiter", names[self.delimiter])
-            else:
-                raise BadInputError(
-                    f"delimiter {self.delimiter!r} is not supported; use tab, ';', ',' or ' ' "
-                    "(whitespace)"
-                )
+        object.__setattr__(self, "delimiter", delimiter_char(self.delimiter))
         if self.decimal not in (None, ".", ","):
             raise BadInputError(f"decimal {self.decimal!r} must be '.' or ','")
         if self.columns is not None:
@@ -151,42 +141,6 @@ class ParsedFile:
     z_units: str | None = None  # stated in the header ("Z unit: mm") or by the user
     arc: str | None = None  # stated in the header ("Arc: full")
     block: int | None = None  # number of the block in a file of concatenated layer blocks
-
-
-def _split(line: str, delim: str) -> list[str]:
-    if delim == " ":
-        return line.split()
-    return [t.strip() for t in line.strip().split(delim)]
-
-
-def _is_num(tok: str, dec: str) -> bool:
-    if not tok:
-        return False
-    if dec == ".":
-        if "," in tok:
-            return False
-    elif "." in tok:
-        return False
-    return bool(_NUM_RE.match(tok))
-
-
-def _score(lines: Sequence[str], delim: str, dec: str) -> tuple[int, float] | None:
-    """(modal number of columns, fraction of sample lines that are that many numbers)."""
-    if delim == dec:
-        return None
-    counts: dict[int, int] = {}
-    for ln in lines:
-        toks = _split(ln, delim)
-        if delim != " " and toks and toks[-1] == "":
-            toks = toks[:-1]  # trailing delimiter
-        nums = [_is_num(t, dec) for t in toks]
-        if any(nums) and all(n or is_missing(t) for n, t in zip(nums, toks, strict=True)):
-            counts[len(toks)] = counts.get(len(toks), 0) + 1
-    if not counts:
-        return None
-    n, c = max(counts.items(), key=lambda kv: (kv[1], kv[0]))
-    frac = c / len(lines)
-    return (n, frac) if frac >= 0.75 else None
 
 
 def _numeric_line(line: str) -> bool:
@@ -234,31 +188,7 @@ def sniff(
         )
     delim, dec = fmt.delimiter, fmt.decimal
     if delim is None or dec is None:
-        best = None
-        for d in [delim] if delim else ["\t", ";", ",", " "]:
-            for c in [dec] if dec else [".", ","]:
-                sc = _score(data_sample, d, c)
-                if sc is None:
-                    continue
-                # lines that all parse first, then more columns, then an explicit delimiter
-                key = (sc[1] >= 0.95, sc[0], sc[1], d != " ")
-                # a comma that only ever separates integers with leading zeros is a decimal comma
-                if d == "," and c == ".":
-                    toks = [_split(ln, ",") for ln in data_sample]
-                    ints = all(all(re.fullmatch(r"[-+]?\d+", t) for t in row) for row in toks)
-                    lead0 = any(
-                        len(row) > 1 and any(t.startswith("0") and len(t) > 1 for t in row[1:])
-                        for row in toks
-                    )
-                    # two integer fields whose second always has the same width (>= 2 digits):
-                    # fixed decimals with a decimal comma, not two integer columns
-                    fixed = all(len(row) == 2 for row in toks) and (
-                        len({len(row[1]) for row in toks}) == 1 and len(toks[0][1]) >= 2
-                    )
-                    if ints and (lead0 or (fixed and len(toks) >= 3)):
-                        continue
-                if best is None or key > best[0]:
-                    best = (key, d, c)
+        best = sniff_separators(data_sample, delim, dec)
         if best is None:
             bad = data_sample[0]
             line_no = lines.index(bad) + 1 if bad in lines else header_lines + 1
@@ -275,7 +205,7 @@ def sniff(
                 f"{fix}delimiter=... and decimal=..., or fix the line",
                 ({"thousands": hint},) if hint and fmt.thousands is None else (),
             )
-        _, d, c = best
+        d, c = best
         if delim is None:
             guessed["delimiter"] = _DELIMS[d]
             delim = d
