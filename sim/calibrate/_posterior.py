@@ -182,30 +182,29 @@ def to_dataset(
         ("ppc_hi", ppc.hi, f"posterior predictive {(1 + ppc.level) / 2:.3%} quantile"),
     ):
         ds[key] = _var("datum", np.asarray(v, dtype=float), unit, long)
-    ds["ppc_p_below"] = _var("datum", ppc.p_below, "1", "predictive probability below the datum")
-    ds["datum_quantity"] = _var("datum", np.array(du), "1", "quantity of the datum")
-    ds["emulator_cv_error"] = _var(
-        "datum",
-        emulator.cv_error,
-        "1",
-        "leave-one-out RMS error of the emulator (relative where emulator_log = 1)",
-    )
-    ds["emulator_scatter"] = _var(
-        "datum",
-        emulator.scatter,
-        "1",
-        "the simulator's scatter between training runs (the emulator's white-noise term; "
-        "relative where emulator_log = 1)",
-    )
-    ds["emulator_error"] = _var(
-        "datum",
-        emulator.error,
-        "1",
-        "error of the emulated mean, sqrt(cv_error^2 - scatter^2) (relative where emulator_log = 1)",
-    )
-    ds["emulator_log"] = _var(
-        "datum", emulator.log.astype(np.int8), "1", "1: emulated in the logarithm"
-    )
+    for key, v, long in (  # dimensionless, one per datum
+        ("ppc_p_below", ppc.p_below, "predictive probability below the datum"),
+        ("datum_quantity", np.array(du), "quantity of the datum"),
+        (
+            "emulator_cv_error",
+            emulator.cv_error,
+            "leave-one-out RMS error of the emulator (relative where emulator_log = 1)",
+        ),
+        (
+            "emulator_scatter",
+            emulator.scatter,
+            "the simulator's scatter between training runs (the emulator's white-noise term; "
+            "relative where emulator_log = 1)",
+        ),
+        (
+            "emulator_error",
+            emulator.error,
+            "error of the emulated mean, sqrt(cv_error^2 - scatter^2) (relative where "
+            "emulator_log = 1)",
+        ),
+        ("emulator_log", emulator.log.astype(np.int8), "1: emulated in the logarithm"),
+    ):
+        ds[key] = _var("datum", v, "1", long)
     lines = ident.lines(names)
     ds.attrs.update(
         {
