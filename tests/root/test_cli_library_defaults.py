@@ -281,6 +281,20 @@ def test_cycle_and_calibrate_kw_defaults_are_the_librarys():
     _check(calibrate, mapping, without)
 
 
+def test_calibrate_and_predict_defaults_are_the_librarys():
+    from jointwear.sim.calibrate import calibrate, predict
+    from jointwear.sim.cli_calibrate import calibrate_cmd, predict_cmd
+    from jointwear.sim.parameters import DEFAULT_PARAMETER_SET
+
+    runs = {"progress", "overwrite"}
+    kw = _keywords(predict)
+    mapping = _same(kw, "samples", "workers", "scheduler", "resume")
+    _check(predict_cmd, mapping, {"posterior", "cycles", "out"} | runs)
+    kw = _keywords(calibrate)
+    mapping = _same(kw, "workers", "scheduler", "resume") | {"base": (DEFAULT_PARAMETER_SET, None)}
+    _check(calibrate_cmd, mapping, {"spec", "out", "params", "verification"} | runs)
+
+
 def test_import_defaults_are_the_librarys():
     from jointwear.cli_import import _names, motion, wearmap
     from jointwear.external import CsvReading, import_motion, import_wear_map
