@@ -9,7 +9,7 @@ import numbers
 import tomllib
 import types
 import typing
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from pathlib import Path
 from typing import Any, TypeVar
 
@@ -17,6 +17,7 @@ from jointwear.errors import BadInputError, ParameterError
 
 __all__ = [
     "from_mapping",
+    "check_known_keys",
     "read_toml",
     "to_jsonable",
     "replace_nested",
@@ -253,6 +254,37 @@ def from_mapping(cls: type[T], mapping: Mapping[str, Any], *, where: str | None 
         raise
     except (TypeError, ValueError) as exc:
         raise ParameterError(f"{where or cls.__name__}: {exc}") from None
+
+
+def check_known_keys(table: str, given: Iterable[str], known: Iterable[str]) -> None:
+    """Refuse the keys of the TOML table ``[table]`` that are not ``known``.
+
+    Parameters
+    ----------
+    table : str
+        The table's name, as the message shows it (``"sweep"``: ``[sweep]``).
+    given, known : iterable of str
+        The keys the file gives; the keys the table takes (listed in this order).
+
+    Raises
+    ------
+    ParameterError
+        Naming each unknown key with the closest known one ("did you mean ...?") and the known
+        keys.
+    """
+    known = list(known)
+    bad = sorted(set(given) - set(known))
+    if bad:
+        import difflib
+
+        hints = [
+            k
+            + (f" (did you mean {c[0]}?)" if (c := difflib.get_close_matches(k, known, 1)) else "")
+            for k in bad
+        ]
+        raise ParameterError(
+            f"[{table}]: unknown key(s) {', '.join(hints)}; known: {', '.join(known)}"
+        )
 
 
 def replace_nested(obj: T, **changes: Any) -> T:

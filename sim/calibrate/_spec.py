@@ -28,7 +28,6 @@ method on a problem with a closed-form posterior).
 from __future__ import annotations
 
 import dataclasses
-import difflib
 import json
 import math
 from collections.abc import Mapping
@@ -37,6 +36,7 @@ from pathlib import Path
 from typing import Any
 
 from jointwear.errors import ParameterError
+from jointwear.params import check_known_keys
 from jointwear.sim.calibrate._defaults import PREDICT_SAMPLES
 
 __all__ = [
@@ -267,16 +267,7 @@ def _parse(data: Mapping[str, Any], folder: Path | None) -> CalibrationSpec:
     cal = data.get("calibrate")
     if not isinstance(cal, Mapping):
         raise ParameterError("the spec has no [calibrate] table")
-    bad = sorted(set(cal) - set(_KEYS))
-    if bad:
-        hints = [
-            k
-            + (f" (did you mean {c[0]}?)" if (c := difflib.get_close_matches(k, _KEYS, 1)) else "")
-            for k in bad
-        ]
-        raise ParameterError(
-            f"[calibrate]: unknown key(s) {', '.join(hints)}; known: {', '.join(_KEYS)}"
-        )
+    check_known_keys("calibrate", cal, _KEYS)
     table = data.get("parameters")
     if not isinstance(table, Mapping) or not table:
         raise ParameterError(

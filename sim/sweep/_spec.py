@@ -37,6 +37,7 @@ from typing import Any
 import numpy as np
 
 from jointwear.errors import ParameterError
+from jointwear.params import check_known_keys
 from jointwear.sim.sweep._outputs import FIELDS, available_outputs
 from jointwear.sim.sweep._params import ParameterSpec, parse_parameter
 
@@ -199,15 +200,7 @@ def _check_tables(spec: Mapping[str, Any]):
     if not isinstance(data.get("sweep"), Mapping):
         raise ParameterError("the spec has no [sweep] table")
     sw = dict(data["sweep"])
-    bad = sorted(set(sw) - set(_SWEEP_KEYS))
-    if bad:
-        msgs = []
-        for k in bad:
-            close = difflib.get_close_matches(k, list(_SWEEP_KEYS), n=1)
-            msgs.append(f"{k}" + (f" (did you mean {close[0]}?)" if close else ""))
-        raise ParameterError(
-            f"[sweep]: unknown key(s) {', '.join(msgs)}; known: {', '.join(_SWEEP_KEYS)}"
-        )
+    check_known_keys("sweep", sw, _SWEEP_KEYS)
     run = sw.get("run", "wear")
     if run not in RUNS:
         raise ParameterError(f"[sweep] run = {run!r}: expected one of {', '.join(RUNS)}")

@@ -162,3 +162,14 @@ def test_declared_field_checks_accept_the_bounds_and_keep_converted_values():
 def test_a_malformed_interval_is_refused_at_declaration():
     with pytest.raises(ValueError, match="interval '0, 1'"):
         within(0.5, "0, 1")
+
+
+def test_check_known_keys_names_each_unknown_key_and_the_closest_known_one():
+    from jointwear.params import check_known_keys
+
+    check_known_keys("sweep", ["seed", "run"], ["run", "method", "seed"])  # all known: no error
+    with pytest.raises(ParameterError) as info:
+        check_known_keys("sweep", ["run", "sead", "zzz"], ["run", "method", "seed"])
+    assert str(info.value) == (
+        "[sweep]: unknown key(s) sead (did you mean seed?), zzz; known: run, method, seed"
+    )
