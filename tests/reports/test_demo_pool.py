@@ -137,12 +137,18 @@ def test_worker_pool_forks_a_lone_thread_and_spawns_beside_others(monkeypatch):
     import jointwear.reports.demo_pool as demo_pool
 
     cpu: list[float] = []
-    # threads left by earlier tests of the suite must not decide this case: a lone thread
+    # threads left by earlier tests of the suite (numba's pool among them) must not decide this
+    # case: a lone thread
     monkeypatch.setattr(demo_pool.threading, "active_count", lambda: 1)
+    monkeypatch.setattr(demo_pool, "numba_threads_launched", lambda: False)
     with worker_pool(2, cpu) as pool:
         assert pool._mp_context.get_start_method() == "fork"
         assert pool.submit(os.getpid).result() != os.getpid()
         pool.submit(_spin, 0.3).result()
+    # a lone thread whose numba thread pool runs is spawned, not forked
+    monkeypatch.setattr(demo_pool, "numba_threads_launched", lambda: True)
+    with worker_pool(2) as pool:
+        assert pool._mp_context.get_start_method() == "spawn"
     monkeypatch.undo()
     if os.path.exists("/proc/self/stat"):  # each worker's CPU, the spinning one's included
         assert len(cpu) == 2 and 0.25 <= max(cpu) < 5.0
