@@ -31,6 +31,8 @@ from typing import Any
 
 import xarray as xr
 
+from jointwear import io
+
 __all__ = ["NUMERICAL", "rig_parameters", "rig_differences", "check_rig"]
 
 #: sections of the simulator's parameters that describe the rig
@@ -51,19 +53,16 @@ _DERIVED = {"joint.radial_clearance": ("joint.bearing_radius",)}
 
 
 def _records(ds: xr.Dataset) -> Iterable[Any]:
-    for key in ("parameters_json",):
-        text = ds.attrs.get(key)
-        if isinstance(text, str):
-            try:
-                yield json.loads(text)
-            except ValueError:
-                pass
-    text = ds.attrs.get("provenance")
+    """The parameter records a file carries: a study's ``parameters_json``, then its provenance's."""
+    text = ds.attrs.get("parameters_json")
     if isinstance(text, str):
         try:
-            yield json.loads(text).get("parameters")
-        except (ValueError, AttributeError):
+            yield json.loads(text)
+        except ValueError:
             pass
+    provenance = io.parse_provenance(ds)  # {} when absent or unreadable
+    if isinstance(provenance, dict):
+        yield provenance.get("parameters")
 
 
 def _find(record: Any, keys: tuple[str, ...]) -> Mapping[str, Any] | None:
