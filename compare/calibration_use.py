@@ -17,7 +17,6 @@ the card, the file's ``validation_passed`` = 0).
 from __future__ import annotations
 
 import dataclasses
-import hashlib
 import json
 from collections.abc import Sequence
 from pathlib import Path
@@ -78,14 +77,8 @@ def _file_keys(path: str | Path) -> tuple[str, frozenset[str]]:
     """sha256 of a file and the sha256 of its own provenance inputs (empty if none)."""
     from jointwear import io
 
-    path = Path(path)
-    digest = hashlib.sha256(path.read_bytes()).hexdigest()
-    try:
-        prov = io.parse_provenance(io.load(path, validate=False))
-        inputs = frozenset(str(i["sha256"]) for i in prov.get("inputs", []) if i.get("sha256"))
-    except (BadInputError, OSError, ValueError, KeyError, TypeError):
-        inputs = frozenset()
-    return digest, inputs
+    digest, inputs = io.file_snapshot(path)
+    return digest, frozenset(inputs)
 
 
 def calibration_reuse(

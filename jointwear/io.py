@@ -21,7 +21,7 @@ import numpy as np
 from jointwear import outputs
 from jointwear._version import source_attribute
 from jointwear.errors import BadInputError
-from jointwear.provenance import build_provenance, dumps, history_line
+from jointwear.provenance import build_provenance, dumps, history_line, sha256_file
 
 if TYPE_CHECKING:  # xarray is imported where a Dataset is read or written (start-up cost)
     import xarray as xr
@@ -37,6 +37,7 @@ __all__ = [
     "encode_attrs",
     "decode_attrs",
     "parse_provenance",
+    "file_snapshot",
     "file_attrs",
 ]
 
@@ -143,6 +144,19 @@ def parse_provenance(ds: xr.Dataset) -> dict[str, Any]:
         return json.loads(text)
     except (TypeError, ValueError):
         return {}
+
+
+def file_snapshot(path: str | Path) -> tuple[str, tuple[str, ...]]:
+    """What identifies a file's data: its sha256 and the sorted sha256 of the inputs its own
+    provenance names (the scans it was made from; empty for a file without readable
+    provenance). Two files made from the same scans share the second part."""
+    digest = sha256_file(path)
+    try:
+        prov = parse_provenance(load(path, validate=False))
+        inputs = sorted(str(i["sha256"]) for i in prov.get("inputs", []) if i.get("sha256"))
+    except (BadInputError, OSError, ValueError, KeyError, TypeError):
+        inputs = []
+    return digest, tuple(inputs)
 
 
 def save_figure(fig: Any, path: str | Path, *, dpi: float = 110, what: str = "--out") -> Path:

@@ -14,7 +14,6 @@ module's own definition). The measured value's standard uncertainty u_D is the m
 
 from __future__ import annotations
 
-import hashlib
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -97,15 +96,8 @@ def file_record(path: str | Path) -> dict[str, object]:
     """Path, sha256 and the sha256 of its own provenance inputs (the snapshot it was made from)."""
     from jointwear import io
 
-    path = Path(path)
-    digest = hashlib.sha256(path.read_bytes()).hexdigest()
-    inputs: list[str] = []
-    try:
-        prov = io.parse_provenance(io.load(path, validate=False))
-        inputs = sorted(str(i["sha256"]) for i in prov.get("inputs", []) if i.get("sha256"))
-    except (BadInputError, OSError, ValueError, KeyError, TypeError):
-        pass
-    return {"path": str(path), "sha256": digest, "inputs_sha256": inputs}
+    digest, inputs = io.file_snapshot(path)
+    return {"path": str(path), "sha256": digest, "inputs_sha256": list(inputs)}
 
 
 def read_band(ds: xr.Dataset, where: str) -> Band:
