@@ -11,8 +11,7 @@ from typing import Annotated, Any
 import typer
 
 from jointwear._cli import Scheduler
-from jointwear.sim.mechanisms import MECHANISMS
-from jointwear.sim.parameters import DEFAULT_PARAMETER_SET
+from jointwear.sim._defaults import DEFAULT_PARAMETER_SET
 
 __all__ = [
     "Base",
@@ -26,14 +25,24 @@ __all__ = [
     "sweep_runs",
 ]
 
+#: The parameter sets of the registered mechanisms, as ``--base`` lists them: written out, so
+#: that ``jointwear --help`` need not import the mechanism registry and the parameter sets
+#: (17-20 ms); ``tests/sim/test_mechanisms.py`` holds it equal to :func:`base_sets` of
+#: ``jointwear.sim.mechanisms.MECHANISMS``.
+BASE_SETS = "zhang2023 (four-bar), slider_crank (slider-crank)"
+
+
+def base_sets(mechanisms: Any) -> str:
+    """``--base``'s list of parameter sets: each mechanism's set and title, in table order."""
+    return ", ".join(f"{m.parameter_set} ({m.title})" for m in mechanisms.values())
+
+
 Base = Annotated[
     str,
     typer.Option(
         "--base",
         help="Named parameter set the --params overrides apply to, which chooses the "
-        "mechanism: "
-        + ", ".join(f"{m.parameter_set} ({m.title})" for m in MECHANISMS.values())
-        + f"; default {DEFAULT_PARAMETER_SET}.",
+        f"mechanism: {BASE_SETS}; default {DEFAULT_PARAMETER_SET}.",
     ),
 ]
 """``--base``: the named parameter set under ``--params`` (default ``DEFAULT_PARAMETER_SET``)."""

@@ -10,10 +10,11 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from jointwear.errors import BadInputError, ParameterError, SimulationError
-from jointwear.sim.parameters import SimParameters
 
 if TYPE_CHECKING:  # light: the CLI reads DEFAULT_CRANK_CYCLES without the numerical stack
     import xarray as xr
+
+    from jointwear.sim.parameters import SimParameters
 
 #: Crank cycles a cycle run simulates unless told.
 DEFAULT_CRANK_CYCLES = 1.0

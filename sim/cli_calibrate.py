@@ -19,8 +19,8 @@ from jointwear.sim._cli_options import (
     check_lost_runs,
     sweep_runs,
 )
+from jointwear.sim._defaults import DEFAULT_PARAMETER_SET
 from jointwear.sim.calibrate._defaults import PREDICT_SAMPLES
-from jointwear.sim.parameters import DEFAULT_PARAMETER_SET
 
 __all__ = ["register"]
 

@@ -10,7 +10,7 @@ import typer
 from jointwear._cli import NetcdfOut, Overwrite
 from jointwear.sim._cli_options import Base, Progress
 from jointwear.sim._cycle_file import DEFAULT_CRANK_CYCLES
-from jointwear.sim.parameters import DEFAULT_PARAMETER_SET
+from jointwear.sim._defaults import DEFAULT_PARAMETER_SET
 
 __all__ = ["register"]
 

@@ -16,7 +16,7 @@ from jointwear.sim._cli_options import (
     check_lost_runs,
     sweep_runs,
 )
-from jointwear.sim.parameters import DEFAULT_PARAMETER_SET
+from jointwear.sim._defaults import DEFAULT_PARAMETER_SET
 from jointwear.sim.sweep._verify_spec import default_study
 
 __all__ = ["register"]

@@ -9,7 +9,7 @@ import typer
 
 from jointwear._cli import Overwrite
 from jointwear.sim._cli_options import Base, Progress, WearParams
-from jointwear.sim.parameters import DEFAULT_PARAMETER_SET, JointParameters
+from jointwear.sim._defaults import BORE_LAYERS, BORE_POINTS, DEFAULT_PARAMETER_SET
 from jointwear.sim.wear._settings import CALIBRATION_RTOL, DEFAULT_CYCLES, WearSettings
 
 __all__ = ["register"]
@@ -273,13 +273,11 @@ _Settle = Annotated[
 ]
 _Layers = Annotated[
     int | None,
-    typer.Option(
-        "--layers", help=f"Layers over the bearing width (Nl); default {JointParameters.n_layers}."
-    ),
+    typer.Option("--layers", help=f"Layers over the bearing width (Nl); default {BORE_LAYERS}."),
 ]
 _Points = Annotated[
     int | None,
-    typer.Option("--points", help=f"Points per layer (Nd); default {JointParameters.n_points}."),
+    typer.Option("--points", help=f"Points per layer (Nd); default {BORE_POINTS}."),
 ]
 _Contact = Annotated[
     Literal["dynamics", "winkler"],

@@ -24,6 +24,7 @@ from jointwear.params import (
     within,
 )
 from jointwear.sim._crank import CrankDriven, inertias
+from jointwear.sim._defaults import BORE_LAYERS, BORE_POINTS, DEFAULT_PARAMETER_SET
 from jointwear.sim.slider_crank import BENCHMARK_TABLES, SliderCrankParameters
 
 __all__ = [
@@ -105,8 +106,8 @@ class JointParameters:
     bearing_width: float = positive(15e-3)
     axial_clearance: float = non_negative(1e-3)
     thrust_radius: float = positive(9.5e-3)
-    n_layers: int = 20
-    n_points: int = 200
+    n_layers: int = BORE_LAYERS
+    n_points: int = BORE_POINTS
     axial_grading: float = 0.75
     tilt_stiffness: float = non_negative(0.0)
     tilt_damping: float = non_negative(0.0)
@@ -234,10 +235,6 @@ class SolverParameters:
         check_fields(self, "solver")
         if self.min_step >= self.max_step:
             raise ParameterError("solver.min_step must be smaller than solver.max_step")
-
-
-#: Name of the default parameter set (Tables 1-2 of the reference study).
-DEFAULT_PARAMETER_SET = "zhang2023"
 
 
 @dataclasses.dataclass(frozen=True)

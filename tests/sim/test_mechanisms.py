@@ -171,3 +171,16 @@ def test_a_registered_toy_mechanism_is_what_every_switch_reads():
         MECHANISMS.pop("toy")
     with pytest.raises(ParameterError, match="no registered mechanism"):
         mechanism_of(params)
+
+
+def test_base_help_lists_every_registered_parameter_set():
+    # --base's help is written out (jointwear --help does not import the registry): it must
+    # list the registry's sets and titles, and its default must be one of them
+    from jointwear.sim._cli_options import BASE_SETS, Base, base_sets
+    from jointwear.sim._defaults import DEFAULT_PARAMETER_SET
+
+    assert base_sets(MECHANISMS) == BASE_SETS
+    assert {m.parameter_set for m in MECHANISMS.values()} == set(PARAMETER_SETS)
+    assert DEFAULT_PARAMETER_SET in PARAMETER_SETS
+    help_text = Base.__metadata__[0].help
+    assert f"mechanism: {BASE_SETS}; default {DEFAULT_PARAMETER_SET}." in help_text
