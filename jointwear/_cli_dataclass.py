@@ -15,7 +15,11 @@ dataclass, and :func:`options_from` expands that parameter into one option per f
   :class:`jointwear._cli.Command` rewrites with the flag (``subset_size=8`` → ``--subset 8``);
 - a length in SI shown in millimetres or micrometres says so in its flag (``Opt("z_amplitude",
   unit="mm")`` is ``--z-amplitude-mm``, converted to metres for the field);
-- a variable-length tuple field (``tuple[int, ...]``) is a repeatable option.
+- a variable-length tuple field (``tuple[int, ...]``) is a repeatable option;
+- a field annotated with a declared option (``workers: Workers = None``, where ``Workers`` is
+  ``Annotated[int | None, typer.Option("--workers", help=...)]``) is offered as declared: its
+  flags and help are the declaration's, its default the field's. A dataclass of such fields is
+  an option group several commands share (``jointwear.sim._cli_options.SweepRun``).
 
 Light: imports typer, ``docstring_parser`` and the standard library only, so the CLI's start-up
 does not pay for numpy.
@@ -98,6 +102,16 @@ def field_help(cls: type) -> dict[str, str]:
     return out
 
 
+def _declared(hint: Any) -> tuple[Any, Any]:
+    """A field's type without ``Annotated``, and the typer option it declares (or None)."""
+    from typer.models import OptionInfo
+
+    if typing.get_origin(hint) is not Annotated:
+        return hint, None
+    option = next((m for m in hint.__metadata__ if isinstance(m, OptionInfo)), None)
+    return hint.__origin__, option
+
+
 def _option_type(hint: Any) -> tuple[Any, bool]:
     """The option's type for a field's type, and whether it is a repeatable tuple."""
     if typing.get_origin(hint) is tuple:
@@ -130,9 +144,9 @@ class _Expanded:
 
 
 def _expanded(cls: type, specs: tuple[str | Opt, ...]) -> list[_Expanded]:
-    hints = typing.get_type_hints(cls)
+    hints = typing.get_type_hints(cls, include_extras=True)
     fields = {f.name: f for f in dataclasses.fields(cls)}
-    helps = field_help(cls)
+    helps = functools.cache(lambda: field_help(cls))
     out = []
     for spec in (s if isinstance(s, Opt) else Opt(s) for s in specs):
         if spec.field not in fields:
@@ -140,11 +154,21 @@ def _expanded(cls: type, specs: tuple[str | Opt, ...]) -> list[_Expanded]:
         field_default = default = fields[spec.field].default
         if default is dataclasses.MISSING:
             raise TypeError(f"{cls.__name__}.{spec.field} has no default to show")
-        kind, repeatable = _option_type(hints[spec.field])
+        hint, declared = _declared(hints[spec.field])
+        if declared is not None:  # offered as declared: one declaration, flags and help
+            if spec != Opt(spec.field):
+                raise TypeError(f"{cls.__name__}.{spec.field}: its option is declared already")
+            keyword = inspect.Parameter.KEYWORD_ONLY
+            parameter = inspect.Parameter(
+                spec.field, keyword, default=default, annotation=hints[spec.field]
+            )
+            out.append(_Expanded(spec, parameter, default, False))
+            continue
+        kind, repeatable = _option_type(hint)
         if spec.unit:  # shown rounded; to_field maps it back to the exact field default
             kind = float if default is not None else float | None
             default = None if default is None else float(f"{default / spec.factor:.12g}")
-        help_text = spec.help or helps.get(spec.field)
+        help_text = spec.help or helps().get(spec.field)
         if help_text is None:
             raise TypeError(
                 f"{cls.__name__}.{spec.field}: no help (give Opt(help=...) or document it)"

@@ -2,10 +2,6 @@
 
 from __future__ import annotations
 
-import functools
-import inspect
-import typing
-from collections.abc import Callable
 from dataclasses import dataclass
 from enum import StrEnum
 from pathlib import Path
@@ -15,6 +11,7 @@ import typer
 
 from jointwear import _import_defaults as D
 from jointwear._cli import AngleDirection, AngleZero, Overwrite
+from jointwear._cli_dataclass import options_from
 
 app = typer.Typer(
     help="Import your own data (CSV or CF netCDF from other simulators and instruments).",
@@ -70,16 +67,6 @@ _UCovers = Annotated[
     str | None,
     typer.Option("--u-covers", help="What the uncertainty covers, e.g. 'probe noise'."),
 ]
-
-#: the options of a CSV table (its dialect and stated uncertainty), each command's last
-_TABLE_OPTIONS = {
-    "delimiter": _Delimiter,
-    "decimal": _Decimal,
-    "u": _U,
-    "u_column": _UColumn,
-    "u_k": _UK,
-    "u_covers": _UCovers,
-}
 
 _CF_SUFFIXES = (".nc", ".nc4", ".cdf")
 """File endings read as CF netCDF; any other file is read as a CSV table."""
@@ -139,14 +126,15 @@ def _stated(value: str | None, column: str | None, k: float | None, covers: str 
 @dataclass(frozen=True)
 class _TableFlags:
     """A CSV table's options as given (None: not given): ``--delimiter``, ``--decimal`` and
-    the stated uncertainty's ``--u``, ``--u-column``, ``--u-k``, ``--u-covers``."""
+    the stated uncertainty's ``--u``, ``--u-column``, ``--u-k``, ``--u-covers``; an option
+    group (``@options_from("table", _TableFlags)``), each command's last options."""
 
-    delimiter: str | None
-    decimal: str | None
-    u: str | None
-    u_column: str | None
-    u_k: float | None
-    u_covers: str | None
+    delimiter: _Delimiter = None
+    decimal: _Decimal = None
+    u: _U = None
+    u_column: _UColumn = None
+    u_k: _UK = None
+    u_covers: _UCovers = None
 
     def reading(self, count: int) -> Any:
         """The library's :class:`~jointwear.external.CsvReading` of these options, with at most
@@ -168,30 +156,6 @@ class _TableFlags:
             )
 
 
-def _table_options(func: Callable[..., Any]) -> Callable[..., Any]:
-    """Give the command ``func`` the CSV table's options (:data:`_TABLE_OPTIONS`, last) in
-    place of its parameter ``table``, which receives them as one :class:`_TableFlags`."""
-    hints = typing.get_type_hints(func, include_extras=True)
-    params = [
-        p.replace(annotation=hints.get(p.name, p.annotation))
-        for p in inspect.signature(func).parameters.values()
-        if p.name != "table"
-    ]
-    keyword = inspect.Parameter.KEYWORD_ONLY
-    params += [
-        inspect.Parameter(n, keyword, default=None, annotation=a) for n, a in _TABLE_OPTIONS.items()
-    ]
-
-    @functools.wraps(func)
-    def command(**kwargs: Any) -> Any:
-        table = _TableFlags(**{n: kwargs.pop(n) for n in _TABLE_OPTIONS})
-        return func(**kwargs, table=table)
-
-    command.__signature__ = inspect.Signature(params)  # type: ignore[attr-defined]
-    command.__annotations__ = {p.name: p.annotation for p in params}
-    return command
-
-
 def _save(ds, out: Path, source: Path, name: str, example: str) -> None:
     from jointwear import io
     from jointwear.import_uncertainty import NO_UNCERTAINTY_NOTE
@@ -204,7 +168,7 @@ def _save(ds, out: Path, source: Path, name: str, example: str) -> None:
 
 
 @app.command("motion")
-@_table_options
+@options_from("table", _TableFlags)
 def motion(
     file: Annotated[Path, typer.Argument(help="CSV table (header row) or CF netCDF file.")],
     out: _Out,
@@ -255,7 +219,7 @@ def motion(
 
 
 @app.command("wearmap")
-@_table_options
+@options_from("table", _TableFlags)
 def wearmap(
     file: Annotated[Path, typer.Argument(help="CSV table (theta, z, depth per row) or CF netCDF.")],
     out: _Out,

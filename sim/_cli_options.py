@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from collections.abc import Iterator
 from contextlib import contextmanager
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Annotated, Any
 
@@ -20,9 +21,9 @@ __all__ = [
     "Workers",
     "Scheduler",
     "Resume",
+    "SweepRun",
     "check_executor",
     "check_lost_runs",
-    "sweep_runs",
 ]
 
 #: The parameter sets of the registered mechanisms, as ``--base`` lists them: written out, so
@@ -87,27 +88,34 @@ def check_executor(workers: int | None, scheduler: str | None) -> None:
         raise BadInputError("give --workers or --scheduler, not both")
 
 
-@contextmanager
-def sweep_runs(
-    what: str, *, workers: int | None, scheduler: str | None, resume: bool, progress: bool | None
-) -> Iterator[dict[str, Any]]:
-    """Where and how a command's sweep of dask tasks runs, with a run counter shown meanwhile.
+@dataclass(frozen=True)
+class SweepRun:
+    """Where and how a command's sweep of dask tasks runs: the options ``--workers``,
+    ``--scheduler``, ``--resume`` and ``--progress/--no-progress`` as given, declared once for
+    every command that runs one (``@options_from("run", SweepRun)`` puts them where the
+    command's parameter ``run: SweepRun`` stands)."""
 
-    Refuses ``--workers`` with ``--scheduler`` (:func:`check_executor`), then, inside a
-    progress bar labelled ``what`` (``--progress``), yields the keywords the library's sweep
-    functions (``run_sweep``, ``calibrate``, ``predict``, ``verify_wear``) take for it:
-    ``workers``, ``scheduler``, ``resume`` and ``on_progress`` (the bar's run counter).
-    """
-    from jointwear.progress import progress_bar, run_counter
+    workers: Workers = None
+    scheduler: Scheduler = None
+    resume: Resume = False
+    progress: Progress = None
 
-    check_executor(workers, scheduler)
-    with progress_bar(what, total=None, enabled=progress) as bar:
-        yield {
-            "workers": workers,
-            "scheduler": scheduler,
-            "resume": resume,
-            "on_progress": run_counter(bar, what),
-        }
+    @contextmanager
+    def runs(self, what: str) -> Iterator[dict[str, Any]]:
+        """Refuses ``--workers`` with ``--scheduler`` (:func:`check_executor`), then, inside a
+        progress bar labelled ``what`` (``--progress``), yields the keywords the library's
+        sweep functions (``run_sweep``, ``calibrate``, ``predict``, ``verify_wear``) take:
+        ``workers``, ``scheduler``, ``resume`` and ``on_progress`` (the bar's run counter)."""
+        from jointwear.progress import progress_bar, run_counter
+
+        check_executor(self.workers, self.scheduler)
+        with progress_bar(what, total=None, enabled=self.progress) as bar:
+            yield {
+                "workers": self.workers,
+                "scheduler": self.scheduler,
+                "resume": self.resume,
+                "on_progress": run_counter(bar, what),
+            }
 
 
 def check_lost_runs(ds: Any, where: str = "") -> None:

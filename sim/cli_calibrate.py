@@ -9,30 +9,22 @@ from typing import Annotated
 import typer
 
 from jointwear._cli import Overwrite
-from jointwear.sim._cli_options import (
-    Base,
-    Progress,
-    Resume,
-    Scheduler,
-    WearParams,
-    Workers,
-    check_lost_runs,
-    sweep_runs,
-)
+from jointwear._cli_dataclass import options_from
+from jointwear.sim._cli_options import Base, SweepRun, WearParams, check_lost_runs
 from jointwear.sim._defaults import DEFAULT_PARAMETER_SET
 from jointwear.sim.calibrate._defaults import PREDICT_SAMPLES
 
 __all__ = ["register"]
 
 
+@options_from("run", SweepRun)
 def calibrate_cmd(
     spec: Annotated[Path, typer.Argument(help="Calibration spec (TOML; see docs/calibration.md).")],
     out: Annotated[Path, typer.Option("--out", help="Posterior file (netCDF).")],
     params: WearParams = None,
     base: Base = DEFAULT_PARAMETER_SET,
-    workers: Workers = None,
-    scheduler: Scheduler = None,
-    resume: Resume = False,
+    *,
+    run: SweepRun,
     verification: Annotated[
         Path | None,
         typer.Option(
@@ -41,7 +33,6 @@ def calibrate_cmd(
             "(else the spec's u_num_rel).",
         ),
     ] = None,
-    progress: Progress = None,
     overwrite: Overwrite = False,
 ) -> None:
     """Calibrate uncertain inputs on measured data: emulator over the prior, posterior by MCMC.
@@ -53,8 +44,7 @@ def calibrate_cmd(
     """
     from jointwear.sim.calibrate import calibrate
 
-    executor = {"workers": workers, "scheduler": scheduler, "resume": resume}
-    with sweep_runs("training runs", **executor, progress=progress) as runs:
+    with run.runs("training runs") as runs:
         studies = [verification] if verification else []
         ds = calibrate(spec, out=out, params=params, base=base, verification=studies, **runs)
     typer.echo(f"{out}: posterior of {', '.join(ds['parameter'].values.tolist())}")
@@ -70,6 +60,7 @@ def calibrate_cmd(
         )
 
 
+@options_from("run", SweepRun)
 def predict_cmd(
     posterior: Annotated[Path, typer.Argument(help="Posterior file of 'jointwear sim calibrate'.")],
     cycles: Annotated[float, typer.Option("--cycles", help="Crank cycles to simulate.")],
@@ -77,18 +68,15 @@ def predict_cmd(
     samples: Annotated[
         int, typer.Option("--samples", min=2, help="Posterior samples simulated.")
     ] = PREDICT_SAMPLES,
-    workers: Workers = None,
-    scheduler: Scheduler = None,
-    resume: Resume = False,
-    progress: Progress = None,
+    *,
+    run: SweepRun,
     overwrite: Overwrite = False,
 ) -> None:
     """Run the simulator at posterior samples: the ensemble 'jointwear compare' takes as the
     simulation (mean map compared, spread = input uncertainty)."""
     from jointwear.sim.calibrate import predict
 
-    executor = {"workers": workers, "scheduler": scheduler, "resume": resume}
-    with sweep_runs("prediction", **executor, progress=progress) as runs:
+    with run.runs("prediction") as runs:
         ds = predict(posterior, cycles=cycles, out=out, samples=samples, **runs)
     typer.echo(
         f"{out}: {ds.attrs['n_runs']} runs at posterior samples, {cycles:g} cycles: "

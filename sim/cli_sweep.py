@@ -8,30 +8,20 @@ from typing import Annotated
 import typer
 
 from jointwear._cli import Overwrite
-from jointwear.sim._cli_options import (
-    Base,
-    Progress,
-    Resume,
-    Scheduler,
-    WearParams,
-    Workers,
-    check_lost_runs,
-    sweep_runs,
-)
+from jointwear._cli_dataclass import options_from
+from jointwear.sim._cli_options import Base, SweepRun, WearParams, check_lost_runs
 from jointwear.sim._defaults import DEFAULT_PARAMETER_SET
 
 __all__ = ["register"]
 
 
+@options_from("run", SweepRun)
 def sweep(
     spec: Annotated[Path, typer.Argument(help="Sweep spec (TOML; see docs/sweeps.md).")],
     out: Annotated[Path, typer.Option("--out", help="Result file (netCDF).")],
-    workers: Workers = None,
-    scheduler: Scheduler = None,
-    resume: Resume = False,
+    run: SweepRun,
     params: WearParams = None,
     base: Base = DEFAULT_PARAMETER_SET,
-    progress: Progress = None,
     overwrite: Overwrite = False,
 ) -> None:
     """Run a parameter sweep or ensemble of simulations; each run is one dask task.
@@ -48,8 +38,7 @@ def sweep(
 
     # printed below, once (the runs keep their warnings in the record)
     logging.getLogger("jointwear.sim.sweep").addHandler(logging.NullHandler())
-    executor = {"workers": workers, "scheduler": scheduler, "resume": resume}
-    with sweep_runs("sweep", **executor, progress=progress) as runs:
+    with run.runs("sweep") as runs:
         try:
             ds = run_sweep(spec, out=out, params=params, base=base, **runs)
         except KeyboardInterrupt:

@@ -8,20 +8,15 @@ from typing import Annotated
 import typer
 
 from jointwear._cli import Overwrite
-from jointwear.sim._cli_options import (
-    Progress,
-    Resume,
-    Scheduler,
-    Workers,
-    check_lost_runs,
-    sweep_runs,
-)
+from jointwear._cli_dataclass import options_from
+from jointwear.sim._cli_options import SweepRun, check_lost_runs
 from jointwear.sim._defaults import DEFAULT_PARAMETER_SET
 from jointwear.sim.sweep._verify_spec import default_study
 
 __all__ = ["register"]
 
 
+@options_from("run", SweepRun)
 def verify(
     out: Annotated[Path, typer.Option("--out", help="Study file (netCDF).")],
     spec: Annotated[
@@ -53,9 +48,8 @@ def verify(
             "depends on them.",
         ),
     ] = None,
-    workers: Workers = None,
-    scheduler: Scheduler = None,
-    resume: Resume = False,
+    *,
+    run: SweepRun,
     band_mm: Annotated[
         str | None,
         typer.Option(
@@ -64,7 +58,6 @@ def verify(
             "maximum depth, volume and cylindricity within it as quantities.",
         ),
     ] = None,
-    progress: Progress = None,
     overwrite: Overwrite = False,
 ) -> None:
     """Estimate u_num of a wear run: replicates at >= 4 update intervals dN and a grid run.
@@ -86,8 +79,7 @@ def verify(
         band = (lo, hi)
     if spec is None and cycles is None:
         raise BadInputError("the default study needs --cycles N (or give a SPEC.toml)")
-    executor = {"workers": workers, "scheduler": scheduler, "resume": resume}
-    with sweep_runs("verify", **executor, progress=progress) as runs:
+    with run.runs("verify") as runs:
         ds = verify_wear(params, cycles=cycles, spec=spec, seed=seed, band=band, out=out, **runs)
     typer.echo(
         f"{out}: {ds.attrs['n_runs']} runs on {ds.attrs['executor']}: {ds.attrs['n_ok']} ok, "

@@ -4,7 +4,7 @@ dataclass the options describe, with the field's default, help, unit and limits.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Literal
+from typing import Annotated, Literal
 
 import pytest
 import typer
@@ -51,6 +51,18 @@ class _Bore:
     """
 
     radius: float | None = None
+
+
+_Workers = Annotated[int | None, typer.Option("--workers", "-w", help="Worker processes.")]
+_Resume = Annotated[bool, typer.Option("--resume", help="Continue.")]
+
+
+@dataclass(frozen=True)
+class _Run:
+    """An option group: fields that are declared options (no numpydoc)."""
+
+    workers: _Workers = None
+    resume: _Resume = False
 
 
 def _app(*fields):
@@ -187,3 +199,26 @@ def test_the_refusals_suggested_values_are_taken(capsys, tmp_path):
     code = main([*args, "--out", str(out)])
     capsys.readouterr()
     assert code == 0 and out.exists()
+
+
+def test_a_group_of_declared_options_is_offered_as_declared():
+    seen = []
+
+    @options_from("run", _Run)
+    def cmd(name: str = "x", *, run: _Run, last: int = 0) -> None:
+        seen.append((name, run, last))
+
+    app = typer.Typer(add_completion=False)
+    app.command()(cmd)
+    app.command("other")(lambda: None)
+    params = get_command(app).commands["cmd"].params
+    # in the group's place, with the declaration's flags and help and the field's default
+    assert [p.name for p in params] == ["name", "workers", "resume", "last"]
+    assert params[1].opts == ["--workers", "-w"] and params[1].help == "Worker processes."
+    assert (params[1].default, params[2].default, params[2].is_flag) == (None, False, True)
+    assert CliRunner().invoke(app, ["cmd", "-w", "3", "--resume", "--last", "2"]).exit_code == 0
+    assert CliRunner().invoke(app, ["cmd"]).exit_code == 0
+    assert seen == [("x", _Run(workers=3, resume=True), 2), ("x", _Run(), 0)]
+    # a declared option is not re-declared through Opt
+    with pytest.raises(TypeError, match="declared already"):
+        options_from("run", _Run, Opt("workers", "--jobs"))(cmd.__wrapped__)
