@@ -192,6 +192,7 @@ def dataset(
             "the study's literal per-point sum: forces and wear work depend on the grid"
         )
     ds.attrs["wear_projection"] = params.contact.wear_projection
+    ds.attrs["wear_pressure"] = params.contact.wear_pressure
     ds.attrs["impact_latch"] = params.contact.impact_latch
     ds.attrs["contact_stiffness_model"] = params.contact.stiffness
     ds.attrs["bearing_on"] = params.mechanism.bearing_on

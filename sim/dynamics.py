@@ -79,7 +79,9 @@ class CycleResult:
         Integral of p |ds| at each bearing point over the run [Pa m] (p normal contact pressure,
         ds sliding increment).
     point_area : ndarray (Nl, Nd)
-        Area each point represents [m2]; sum(wear_work * point_area) == normal_work.
+        Area each point represents [m2]; sum(wear_work * point_area) == normal_work with the
+        default ``contact.wear_pressure = "hertz"`` (``"conformal"``: at least normal_work, the
+        pressure's resultant being the force, so a wide arc carries more pressure than force).
     normal_work : float
         Integral of F_n |v_t| dt over all bore contacts [N m].
     state : SimState
@@ -367,7 +369,8 @@ def run_cycles(
     zl, wl = _layers(params)
     hmin = h.min(axis=1).copy()
     area = point_area(params, h)
-    ww = np.zeros((2, *h.shape))
+    conformal = params.contact.wear_pressure == "conformal"
+    ww = np.zeros((4 if conformal else 2, *h.shape))  # 4: the contacts' centres too
     acc = np.zeros(4)  # normal work, axial normal work, normal impulse, max penetration
     y = st.y.astype(float).copy()
     vimp = st.impact_velocity.astype(float).copy()
@@ -411,6 +414,8 @@ def run_cycles(
         if progress is not None:
             progress((k + 1) / n_chunks)
     new_state = SimState(t, y.copy(), hstep, vimp.copy(), model, _mechanism(params))
+    if conformal:
+        ww = _conformal_maps(params, ww, h, area)
     ds = _record(params, t_rel, diag, t0) if record else None
     if ds is not None:
         ds = add_maps(ds, params, ww, area)
@@ -429,6 +434,34 @@ def run_cycles(
         n_steps=int(nacc_total),
         max_penetration=float(acc[3]),
     )
+
+
+def _conformal_maps(
+    params: SimParameters, ww: np.ndarray, h: np.ndarray, area: np.ndarray
+) -> np.ndarray:
+    """(wear work, sliding distance) with the wear work under the conformal (Winkler) pressure
+    of ``contact.wear_pressure = "conformal"``, from the contacts' centres the kernel recorded
+    in ``ww[2:]`` (:func:`jointwear.sim.wear.conformal_wear_work`)."""
+    from jointwear.sim.wear import conformal_wear_work
+
+    if np.sum(ww[0] * area) > 0 and not np.any(ww[2] > 0):
+        raise SimulationError(
+            "contact.wear_pressure = 'conformal': the kernel recorded no contact centre although "
+            "the bore wore; its compiled code predates the option (numba's cache does not follow "
+            "calls across modules): delete the caches (find . -name '*.nbi' -o -name '*.nbc' | "
+            "xargs rm) or set NUMBA_CACHE_DIR to an empty folder"
+        )
+    j = params.joint
+    work = conformal_wear_work(
+        ww[2],
+        ww[3],
+        h,
+        area,
+        journal_radius=j.journal_radius,
+        bearing_radius=j.bearing_radius,
+        reduced_modulus=0.75 * contact_constant(params)[0],  # E* = (3/4) 4 / (3 pi (hj + hb))
+    )
+    return np.stack([work, ww[1]])
 
 
 def _record(params: SimParameters, t_rel: np.ndarray, diag: np.ndarray, t0: float) -> xr.Dataset:

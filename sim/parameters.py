@@ -174,6 +174,12 @@ class ContactParameters:
     ``worn_radius_in_denominator``: the eq. 9 variant with Rb + h also in Rb - Rj.
     ``axial_stiffness``: L-N stiffness of the end-face (thrust) contact [N/m^n]; 0 means "same
     as the radial K of eq. 7".
+    ``wear_pressure`` (slice formulation): the pressure that turns a slice's force into wear
+    work. ``"hertz"`` (default): spread over the points the journal overlaps, weights
+    sqrt(delta). ``"conformal"``: the elastic-foundation (Winkler) pressure of the journal
+    seated in the worn bore along the contact's direction, its modulus matched to Hertz's width
+    on the unworn bore, so that a groove that fits the journal carries the load over a wider
+    arc (docs/sim-wear.md, "Conformal contact"; ``jointwear.sim.wear.conformal_wear_work``).
     """
 
     formulation: Literal["slice", "per_point"] = "slice"
@@ -190,9 +196,15 @@ class ContactParameters:
     impact_velocity_floor: float = positive(1e-2)
     axial_stiffness: float = non_negative(0.0)
     max_penetration_fraction: float = positive(0.5)
+    wear_pressure: Literal["hertz", "conformal"] = "hertz"
 
     def __post_init__(self) -> None:
         check_fields(self, "contact")
+        if self.wear_pressure == "conformal" and self.formulation != "slice":
+            raise ParameterError(
+                "contact.wear_pressure = 'conformal' spreads each slice's force; the per-point "
+                "formulation has no slice forces: set contact.formulation = 'slice'"
+            )
 
 
 @dataclasses.dataclass(frozen=True)

@@ -40,6 +40,7 @@ from jointwear.sim.kernels._layout import (
     C_ZL,
     CA,
     CE,
+    DPHI,
     GRADED,
     I_CONTACT,
     I_PEN,
@@ -349,8 +350,19 @@ def _penetrating_run(n, ms, J0, u, P, H, ZL, Nd, buf):
 def _spread(n, ms, fn, vt, hstep, J0, u, P, H, ZL, Nd, AREA, WW, buf):
     """Spread a layer's normal force over its contiguous penetrating nodes, weights sqrt(delta),
     adding p |v_t| dt to WW[0] and |v_t| dt to WW[1]; every node is evaluated once. ``buf``
-    (at least ``2 (Nd // 2) + 1``) is scratch for :func:`_penetrating_run`."""
+    (at least ``2 (Nd // 2) + 1``) is scratch for :func:`_penetrating_run`. A ``WW`` of four
+    planes also gets the contact, unspread, in the direction of the journal's axis point in
+    the layer (split linearly between the two nodes around it): F |v_t| dt in WW[2] and
+    F^2 |v_t| dt in WW[3] (the conformal wear pressure, ``jointwear.sim.wear._conformal``)."""
     half = Nd // 2
+    if WW.shape[0] > 2:
+        s0 = (ZL[n] - J0[2]) / u[2]
+        f = math.atan2(J0[1] + s0 * u[1], -(J0[0] + s0 * u[0])) / P[DPHI]
+        m = int(math.floor(f))
+        f -= m
+        for k, share in ((m, 1.0 - f), (m + 1, f)):
+            WW[2, n, k % Nd] += share * fn * vt * hstep
+            WW[3, n, k % Nd] += share * fn * fn * vt * hstep
     lo, hi = _penetrating_run(n, ms, J0, u, P, H, ZL, Nd, buf)
     wsum = 0.0
     for mm in range(lo, hi + 1):

@@ -13,6 +13,9 @@ from ._calibration import (
     MultiCalibration as MultiCalibration,
     resimulator as resimulator,
 )
+from ._conformal import (
+    conformal_wear_work as conformal_wear_work,
+)
 from ._contact import (
     ConstantContact as ConstantContact,
     ContactModel as ContactModel,

@@ -1,43 +1,52 @@
-"""Conformal-contact wear: the wear pressure from an elastic (Winkler) foundation over the worn
-bore's local geometry, as an option of the wear loop.
+"""Conformal-contact wear pressure: the pressure of an elastic (Winkler) foundation over the
+worn bore's local geometry, the option ``contact.wear_pressure = "conformal"``.
 
-The dynamics spread each slice's normal force over the points the rigid journal overlaps, with
-the Hertz weights of a non-conforming contact (docs/sim.md). As the bore wears into the
-journal's shape the contact conforms: the gap between journal and bore closes over a wide arc,
-the same load is carried over more of it, the peak pressure falls and so does the depth rate
-where the bore is deepest (the volume rate, kw times the normal work, does not change). The
-elastic-foundation (Winkler) model is the usual description of such conformal contact in
-revolute joints with wear (S. Mukras, N.H. Kim, N.A. Mauntler, T.L. Schmitz, W.G. Sawyer,
-"Analysis of planar multibody systems with revolute joint wear", Wear 268 (2010) 643-652;
-K.L. Johnson, *Contact Mechanics*, 1985, sections 5.9 and 9.2). A Winkler foundation is
-a poor model of a non-conforming contact, and its modulus is not a material constant (for an
-elastic layer of thickness t on a rigid base ``kf = (1 - nu) E / ((1 + nu)(1 - 2 nu) t)``,
-:func:`foundation_modulus`; the bush's wall is not known here). The modulus is therefore
-matched, per contact and load, so that on the *unworn* bore the foundation gives Hertz's
-contact width for a cylinder in a cylinder (:func:`hertz_matched_modulus`): the option then
-changes nothing where the contact does not conform and spreads the load where it does.
+By default (``"hertz"``) the kernel spreads each slice's force, at each step, over the points the
+rigid journal overlaps at its simulated position, with weights sqrt(delta) (docs/sim.md). The
+overlap comes from the Lankarani-Nikravesh law, a point-contact law: on the reference rig it is
+about eight times Hertz's line-contact width, and it does not know how well the worn bore fits
+the journal. The elastic-foundation (Winkler) model is the usual description of conformal
+contact in revolute joints with wear (S. Mukras, N.H. Kim, N.A. Mauntler, T.L. Schmitz,
+W.G. Sawyer, "Analysis of planar multibody systems with revolute joint wear", Wear 268 (2010)
+643-652; K.L. Johnson, *Contact Mechanics*, 1985, sections 5.9 and 9.2): a rigid journal
+seated in the worn bore along the load's direction and pressed into a foundation with the load,
+``p = kf max(d0 cos(phi - psi) - gap(phi), 0)``, ``d0`` such that the pressure's resultant
+equals the load. A groove of the journal's radius then carries the load over its whole arc at
+a lower peak; on the unworn bore the contact is Hertz's.
 
-:class:`ConformalContact` runs the dynamics as :class:`~jointwear.sim.DynamicContact` does and
-then, per layer and per point with wear work, spreads that work by the Winkler pressure of a rigid
-journal seated in the worn bore in that point's direction and pressed with the line load its
-pressure implies (:func:`conformal_layer`, :func:`winkler_line_pressure` the scalar reference),
-conserving each layer's wear work (so the worn volume is still kw times the normal work). Every
-point a contact covers is taken to slide as the contact does (as the kernel does for a slice).
+The foundation modulus is not a material constant (for a thin elastic layer of thickness t on a
+rigid base it is ``(1 - nu) E / ((1 + nu)(1 - 2 nu) t)``, :func:`foundation_modulus`, and the
+bush's wall is not known here); it is matched per load so that on the *unworn* bore the
+foundation gives Hertz's contact width for a cylinder in a cylinder
+(:func:`hertz_matched_modulus`).
+
+The kernel records, for every slice and step, the contact's centre (its deepest node: the
+direction of its force) with the work ``F |v_t| dt`` and ``F^2 |v_t| dt`` there
+(:func:`jointwear.sim.run_cycles` with the option). :func:`conformal_wear_work` spreads each
+node's work by the Winkler pressure of the journal seated in the worn bore in that node's
+direction under the work-weighted mean force. An earlier attempt spread the kernel's *already
+spread* map point by point, re-seating the journal in each point's own direction: on a groove's
+flank that direction is not the load's, the journal touched the rim first and the work moved
+outwards (max depth 28.5 against 20.6 um on an 8 x 120 rig). Recording the contact's centre in
+the kernel removes both errors.
+
+Normalisation: the pressure's *resultant* is the slice's force, so on a wide arc the pressure
+integrates to more than the force (by 1 / mean cos over the arc) and, by Archard's local law, so
+does the wear: the worn volume is kw times the integral of p |ds|, which exceeds kw times the
+normal work by that factor where the contact conforms (on the unworn bore they agree).
 """
 
 from __future__ import annotations
 
 import math
-from typing import Any
 
 import numpy as np
 from scipy.optimize import brentq
 
 from jointwear.errors import ParameterError
-from jointwear.sim.wear._contact import CycleWear, DynamicContact
 
 __all__ = [
-    "ConformalContact",
+    "conformal_wear_work",
     "foundation_modulus",
     "hertz_matched_modulus",
     "seated_gap",
@@ -57,28 +66,33 @@ def foundation_modulus(modulus: float, poisson: float, thickness: float) -> floa
 
 
 def hertz_matched_modulus(
-    line_load: float,
+    line_load: float | np.ndarray,
     journal_radius: float,
-    bore_radius: float,
+    bearing_radius: float,
     reduced_modulus: float,
-) -> float:
+) -> float | np.ndarray:
     """Winkler modulus [Pa/m] that gives Hertz's contact width on the unworn bore.
 
-    Hertz, cylinder in a cylindrical bore under ``line_load`` F' [N/m]: half-width
-    ``b = sqrt(4 F' R' / (pi E*))``, ``R' = Rj Rb / (Rb - Rj)``. The foundation under a journal
-    seated in the unworn bore (gap ``c' (1 - cos phi)``, ``c' = Rb c / Rj``) touches
-    ``|phi| < a`` with ``cos a = c' / (d0 + c')`` and carries
+    Hertz, cylinder in a cylindrical bore under ``line_load`` F' [N/m] (a number or an array):
+    half-width ``b = sqrt(4 F' R' / (pi E*))``, ``R' = Rj Rb / (Rb - Rj)``. The foundation
+    under a journal seated in the unworn bore (gap ``c' (1 - cos phi)``, ``c' = Rb c / Rj``)
+    touches ``|phi| < a`` with ``cos a = c' / (d0 + c')`` and carries
     ``F' = kf Rb ((d0 + c')(a + sin a cos a) - 2 c' sin a)``; with ``a = b / Rb`` this gives kf.
     """
-    rj, rb = journal_radius, bore_radius
+    rj, rb = journal_radius, bearing_radius
     clearance = rb - rj
     r_eff = rj * rb / clearance
-    b = math.sqrt(4 * line_load * r_eff / (math.pi * reduced_modulus))
-    a = min(b / rb, 0.5 * math.pi - 1e-6)
+    load = np.asarray(line_load, dtype=float)
+    b = np.sqrt(4 * load * r_eff / (math.pi * reduced_modulus))
+    a = np.minimum(b / rb, 0.5 * math.pi - 1e-6)
     cp = rb * clearance / rj
-    d0 = cp * (1 / math.cos(a) - 1)
-    carried = rb * ((d0 + cp) * (a + math.sin(a) * math.cos(a)) - 2 * cp * math.sin(a))
-    return line_load / carried
+    # (d0 + c')(a + sin a cos a) - 2 c' sin a with d0 + c' = c' / cos a: f(a) c'; below
+    # a = 0.05 its series (relative error below 1e-12), which avoids cancelling 2a
+    closed = (a + np.sin(a) * np.cos(a)) / np.cos(a) - 2 * np.sin(a)
+    series = a**3 * (2 / 3 + a**2 * (1 / 5 + a**2 * (107 / 1260 + a**2 * 779 / 22680)))
+    carried = rb * cp * np.where(a < 0.05, series, closed)
+    out = load / carried
+    return float(out) if out.ndim == 0 else out
 
 
 def seated_gap(
@@ -163,117 +177,89 @@ def _seated_gaps(rho: np.ndarray, journal_radius: float, phi: np.ndarray, src: n
     return np.where(near, np.maximum(gap, 0.0), np.inf), cos
 
 
-def conformal_layer(
-    work: np.ndarray,
-    sliding: np.ndarray,
-    bore_radius: np.ndarray,
+def _advance(gap: np.ndarray, cos: np.ndarray, rho: np.ndarray, need: np.ndarray) -> np.ndarray:
+    """The journal's advance ``d0`` [m] per row at which ``sum rho cos max(d0 cos - gap, 0)``
+    reaches ``need`` [m²] (the load over ``kf dphi``), exactly.
+
+    Point k joins the contact at ``d0 = gap_k / cos_k``; between two such thresholds the sum
+    is linear in ``d0``, ``d0 S1 - S2`` with ``S1 = sum rho cos²``, ``S2 = sum rho gap cos``
+    over the points already in contact, so the root follows from the thresholds in order.
+    """
+    ok = cos > 1e-9
+    thresh = np.where(ok, gap / np.where(ok, cos, 1.0), np.inf)
+    order = np.argsort(thresh, axis=1, kind="stable")
+    t = np.take_along_axis(thresh, order, axis=1)
+    c = np.take_along_axis(np.where(ok, cos, 0.0), order, axis=1)
+    g = np.take_along_axis(np.where(ok, gap, 0.0), order, axis=1)
+    r = np.take_along_axis(np.broadcast_to(rho, cos.shape), order, axis=1)
+    s1 = np.cumsum(r * c * c, axis=1)
+    s2 = np.cumsum(r * g * c, axis=1)
+    # carried when the next point is about to join (the last: unbounded)
+    nxt = np.concatenate([t[:, 1:], np.full((t.shape[0], 1), np.inf)], axis=1)
+    with np.errstate(invalid="ignore"):
+        at_next = np.where(np.isfinite(nxt), nxt * s1 - s2, np.inf)
+    i = np.argmax(at_next >= need[:, None], axis=1)
+    rows = np.arange(t.shape[0])
+    return (need + s2[rows, i]) / s1[rows, i]
+
+
+def conformal_wear_work(
+    centre_work: np.ndarray,
+    centre_force_work: np.ndarray,
+    wear_depth: np.ndarray,
+    point_area: np.ndarray,
+    *,
     journal_radius: float,
-    unworn_radius: float,
+    bearing_radius: float,
     reduced_modulus: float,
 ) -> np.ndarray:
-    """One layer's wear work [Pa m] redistributed point by point by the Winkler pressure.
-
-    ``work``, ``sliding`` and ``bore_radius`` (worn, Rb + h) per point of the layer (canonical
-    angles at equal spacing). Each point's work is taken as made by a contact centred there,
-    whose line load follows from its mean pressure while sliding ``p = work / sliding`` read as
-    Hertz's peak pressure, ``F' = pi R' p^2 / E*``; it is spread over the points the journal,
-    seated in the worn bore in that direction and pressed with ``F'`` into a foundation matched
-    to Hertz's width (:func:`hertz_matched_modulus`), compresses, in proportion to the
-    pressure. On the unworn bore that spread is Hertz's width (a fraction of a grid step at the
-    reference rig's loads: nothing changes); in a conforming groove it covers the groove. The
-    layer's total work (area-weighted) is kept.
-    """
-    n = work.size
-    src = np.flatnonzero((work > 0) & (sliding > 0))
-    if not src.size:
-        return np.array(work, dtype=float)
-    phi = np.arange(n) * 2 * math.pi / n
-    dphi = 2 * math.pi / n
-    rho = np.asarray(bore_radius, dtype=float)
-    clearance = unworn_radius - journal_radius
-    r_eff = journal_radius * unworn_radius / clearance
-    pbar = work[src] / sliding[src]
-    load = math.pi * r_eff * pbar**2 / reduced_modulus
-    kf = np.array(
-        [hertz_matched_modulus(f, journal_radius, unworn_radius, reduced_modulus) for f in load]
-    )
-    gap, cos = _seated_gaps(rho, journal_radius, phi, src)
-    cpos = np.maximum(cos, 0.0)
-    r = float(np.mean(rho))
-
-    def carried(d0: np.ndarray) -> np.ndarray:
-        comp = np.maximum(d0[:, None] * cos - gap, 0.0)
-        return kf * np.sum(comp * cpos, axis=1) * r * dphi
-
-    lo = np.zeros(src.size)
-    hi = load / (kf * r * dphi) + 1e-15
-    while np.any(carried(hi) < load):
-        hi = np.where(carried(hi) < load, 2 * hi, hi)
-    for _ in range(60):  # bisection on every source at once (relative precision 1e-18)
-        mid = 0.5 * (lo + hi)
-        low = carried(mid) < load
-        lo, hi = np.where(low, mid, lo), np.where(low, hi, mid)
-    p = np.maximum(0.5 * (lo + hi)[:, None] * cos - gap, 0.0)
-    weight = np.sum(p * rho[None, :], axis=1)
-    out = np.array(work, dtype=float)
-    out[src] = 0.0
-    spread = weight > 0
-    share = (work[src] * rho[src])[spread] / weight[spread]
-    out += np.sum(share[:, None] * p[spread], axis=0)
-    out[src[~spread]] += work[src[~spread]]
-    return out
-
-
-class ConformalContact(DynamicContact):
-    """EXPERIMENTAL, not validated: the dynamics with conformal-contact wear pressure.
-
-    Not an option of ``jointwear sim wear`` and not exported: on the reference rig (8 x 120,
-    8e3 cycles at 50 x kw) it made the maximum depth 39 % *deeper* than the dynamics' own
-    pressure: re-seating the journal along each point's direction moves the work off the point
-    where the dynamics pressed (on the flank of a 20-um groove, 5 deg outwards onto the rim it
-    touches first), so the worn shape drifts (docs/sim-wear.md, "Conformal contact"). The
-    pressure belongs in the kernel's spreading, where the journal's true position is known.
+    """The wear work [Pa m] per point under the conformal (Winkler) pressure.
 
     Parameters
     ----------
-    params : SimParameters
-        The rig (the materials give E*, the bore the unworn radius).
-    cycle_function : callable, optional
-        As for :class:`DynamicContact`.
+    centre_work : ndarray (Nl, Nd)
+        Per layer and node, the work ``sum F |v_t| dt`` [N m] of the contacts centred there
+        (the slice's force F along that node's normal; the kernel's third wear plane).
+    centre_force_work : ndarray (Nl, Nd)
+        ``sum F^2 |v_t| dt`` [N² m] at the same nodes: ``centre_force_work / centre_work`` is
+        the work-weighted mean force [N] of those contacts.
+    wear_depth : ndarray (Nl, Nd)
+        The worn bore's depth h [m] (bore radius ``bearing_radius + h``), nodes at equal
+        angular spacing.
+    point_area : ndarray (Nl, Nd)
+        The bore area of each point [m²] (``slice width x (Rb + h) dphi``).
+    journal_radius, bearing_radius : float
+        Rj and the unworn bore radius Rb [m].
+    reduced_modulus : float
+        E* of the pair [Pa] (Hertz's width, to which the foundation is matched).
+
+    Returns
+    -------
+    ndarray (Nl, Nd)
+        ``integral p |ds|`` [Pa m]: each centre's work spread by its Winkler pressure, the
+        pressure's resultant equal to its force (so the sum of work times area exceeds the
+        centres' work by 1 / mean cos over a wide arc).
     """
-
-    def __init__(self, params: Any, cycle_function: Any = None) -> None:
-        super().__init__(params, cycle_function)
-        c = params.contact
-        self.reduced_modulus = 1.0 / (
-            (1 - c.journal_poisson**2) / c.journal_modulus
-            + (1 - c.bearing_poisson**2) / c.bearing_modulus
-        )
-
-    def describe(self) -> dict[str, Any]:
-        out = super().describe()
-        out["wear_pressure"] = "conformal (Winkler foundation over the worn bore, Hertz-matched)"
-        return out
-
-    def run(
-        self, wear_depth: np.ndarray, *, cycles: float, state: Any, progress: Any = None
-    ) -> CycleWear:
-        res = self._run_cycles(wear_depth, cycles=cycles, state=state, progress=progress)
-        j = self.params.joint
-        work = np.asarray(res.wear_work, dtype=float)
-        slide = np.asarray(res.sliding_distance, dtype=float)
-        radius = j.bearing_radius + np.asarray(wear_depth, dtype=float)
-        new = np.stack(
-            [
-                conformal_layer(
-                    work[n],
-                    slide[n],
-                    radius[n],
-                    j.journal_radius,
-                    j.bearing_radius,
-                    self.reduced_modulus,
-                )
-                for n in range(work.shape[0])
-            ]
-        )
-        return self._cycle_wear(res, new)
+    work = np.asarray(centre_work, dtype=float)
+    force_work = np.asarray(centre_force_work, dtype=float)
+    h = np.asarray(wear_depth, dtype=float)
+    area = np.asarray(point_area, dtype=float)
+    nl, nd = work.shape
+    phi = np.arange(nd) * 2 * math.pi / nd
+    dphi = 2 * math.pi / nd
+    out = np.zeros((nl, nd))
+    for n in range(nl):
+        src = np.flatnonzero(work[n] > 0)
+        if not src.size:
+            continue
+        rho = bearing_radius + h[n]
+        width = float(area[n, 0] / (rho[0] * dphi))  # the slice's axial width [m]
+        force = force_work[n, src] / work[n, src]
+        line_load = force / width
+        kf = hertz_matched_modulus(line_load, journal_radius, bearing_radius, reduced_modulus)
+        gap, cos = _seated_gaps(rho, journal_radius, phi, src)
+        d0 = _advance(gap, cos, rho, line_load / (kf * dphi))
+        p = kf[:, None] * np.maximum(d0[:, None] * cos - gap, 0.0)  # [Pa]
+        resultant = np.sum(p * np.maximum(cos, 0.0) * area[n][None, :], axis=1)  # [N]
+        out[n] = np.sum((work[n, src] / resultant)[:, None] * p, axis=0)
+    return out
