@@ -18,11 +18,23 @@ interpolated (log scale) and the fit re-simulated.
 
 Run: ``python benchmarks/bench_tilt.py`` (about 10 min CPU; ``--quick``: two points at
 4e4/1.2e5 cycles). Results: benchmarks/results/tilt.json.
+
+``--speed`` (issue 41, stiff tilt <= 60 s CPU; about 4 min CPU): at k = 1e3 and 3e3 N m/rad
+(offset 10 mm) the full default prediction twice, with ``solver.rate_error_scale =
+"component"`` (every rate's error against its own magnitude: the integration before issue 41,
+bit for bit) and with the default (``"auto"``: the rotating body's angular velocity measured as
+one vector when the joint has a tilt spring); CPU time, simulated cycles, and the difference
+of max depth, volume and cylindricity at both snapshots against the two runs' stated
+uncertainties combined (sqrt(u1^2 + u2^2), k = 2; the run states none for the cylindricity,
+so its max depth's stands in, the deepest points setting both). Also the tilt mode's natural
+frequency sqrt(k / I3y) against the crank's, for the quasi-static alternative not taken.
+Results: benchmarks/results/tilt_speed.json.
 """
 
 from __future__ import annotations
 
 import math
+import os
 import sys
 import time
 from pathlib import Path
@@ -45,6 +57,10 @@ from jointwear.sim import (  # noqa: E402
 )
 
 QUICK = "--quick" in sys.argv
+SPEED = "--speed" in sys.argv
+SPEED_POINTS = (1e3, 3e3)  # tilt stiffness [N m/rad], offset 10 mm
+SPEED_LIMIT_S = 60.0  # issue 41: CPU seconds for 1.2e6 cycles at k <= 3e3
+SPEED_SCALES = ("component", "auto")  # before issue 41; the default
 CYCLES = 1.2e5 if QUICK else 1.2e6
 EARLY = 4e4 if QUICK else 4e5
 # (tilt stiffness [N m/rad], joint offset [m]); the default rig is (0, 0.01)
@@ -85,11 +101,14 @@ def _tilt_on_final_bore(overrides: dict[str, float], ds) -> dict[str, float]:
     }
 
 
-def run_point(stiffness: float, offset: float, kw: float = DEFAULT_KW) -> dict:
+def run_point(
+    stiffness: float, offset: float, kw: float = DEFAULT_KW, rate_error_scale: str = "auto"
+) -> dict:
     overrides = {
         "joint.tilt_stiffness": stiffness,
         "mechanism.joint_offset": offset,
         "wear.kw": kw,
+        "solver.rate_error_scale": rate_error_scale,
     }
     c0 = time.process_time()
     ds = simulate_wear(cycles=CYCLES, snapshots=[EARLY], overrides=overrides)
@@ -108,6 +127,9 @@ def run_point(stiffness: float, offset: float, kw: float = DEFAULT_KW) -> dict:
         "max_depth_um": [round(float(v) * 1e6, 3) for v in ds["max_wear_depth"].values],
         "max_depth_u_um_k2": [round(float(v) * 1e6, 3) for v in ds["max_wear_depth_u"].values],
         "worn_volume_mm3": [round(float(v) * 1e9, 5) for v in ds["worn_volume"].values],
+        "worn_volume_u_mm3_k2": [round(float(v) * 1e9, 5) for v in ds["worn_volume_u"].values],
+        "rate_error_scale": rate_error_scale,
+        "load_average_1min": round(os.getloadavg()[0], 2),
         "snapshot_cycles": [float(c) for c in ds["cycles"].values],
         "peaks_early": _peak_angles(ds, EARLY),
         "peaks_final": _peak_angles(ds, CYCLES),
@@ -151,8 +173,77 @@ def _crossing(points: list[dict], ratio_meas: float) -> float | None:
     return None
 
 
+def _agreement(old: dict, new: dict) -> dict:
+    """new - old of max depth, volume and cylindricity per snapshot against the combined u."""
+    u_depth = [
+        math.hypot(a, b)
+        for a, b in zip(old["max_depth_u_um_k2"], new["max_depth_u_um_k2"], strict=True)
+    ]
+    u_vol = [
+        math.hypot(a, b)
+        for a, b in zip(old["worn_volume_u_mm3_k2"], new["worn_volume_u_mm3_k2"], strict=True)
+    ]
+    out = {}
+    for key, u in (
+        ("max_depth_um", u_depth),
+        ("worn_volume_mm3", u_vol),
+        ("cylindricity_um", u_depth),
+    ):
+        diff = [b - a for a, b in zip(old[key], new[key], strict=True)]
+        out[key] = {
+            "difference": [float(f"{d:.4g}") for d in diff],
+            "combined_u_k2": [float(f"{v:.4g}") for v in u],
+            "within": all(abs(d) <= v for d, v in zip(diff, u, strict=True)),
+        }
+    return out
+
+
+def speed() -> None:
+    """Issue 41 item 4: CPU of the stiff rigs before and after, and their results' agreement."""
+    inertia = PARAMETER_SETS["zhang2023"].mechanism.follower_inertia[1]
+    crank_hz = PARAMETER_SETS["zhang2023"].mechanism.crank_speed_rpm / 60.0
+    rows = []
+    for k in SPEED_POINTS:
+        runs = {scale: run_point(k, 0.01, rate_error_scale=scale) for scale in SPEED_SCALES}
+        old, new = runs["component"], runs["auto"]
+        f_n = math.sqrt(k / inertia) / (2.0 * math.pi)
+        rows.append(
+            {
+                "tilt_stiffness_N_m_per_rad": k,
+                "cpu_s_component": old["cpu_s"],
+                "cpu_s_auto": new["cpu_s"],
+                "speedup": round(old["cpu_s"] / new["cpu_s"], 2),
+                "within_limit": new["cpu_s"] <= SPEED_LIMIT_S,
+                "tilt_mode_hz": round(f_n, 1),
+                "tilt_mode_over_crank_frequency": round(f_n / crank_hz, 1),
+                "agreement": _agreement(old, new),
+                "runs": runs,
+            }
+        )
+    write_results(
+        "tilt_speed",
+        {
+            "cycles": CYCLES,
+            "early_snapshot": EARLY,
+            "limit_cpu_s": SPEED_LIMIT_S,
+            "note": "CPU seconds of this process for one full default wear prediction; the "
+            "machine is shared (2 cores, several agents): load average per run in runs",
+            "rate_error_scale": "component: every angular rate's local error against its own "
+            "magnitude (before issue 41, bit for bit); auto (default): with a tilt spring, the "
+            "rotating body's angular velocity against the vector's magnitude",
+            "tilt_mode": "sqrt(k / I3y), the follower rocking about its own axis on the spring "
+            "alone (line contact stiffens it further)",
+            "cylindricity_u": "not stated by the run: its max depth's stands in",
+            "points": rows,
+        },
+    )
+
+
 def main() -> None:
     simulate_wear(cycles=10, snapshots=[])  # compile/load the kernels outside the timings
+    if SPEED:
+        speed()
+        return
     grid = []
     for k, offset in POINTS:
         point = run_point(k, offset)

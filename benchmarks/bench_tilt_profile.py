@@ -8,6 +8,10 @@ and the cycle's normal work (what the wear depends on). Issue 41 item 4 (the sti
 the extra cost is more steps (accuracy or stability of the line contact's vibration) or more
 work per step (every layer in contact).
 
+Rows 0-5 measure every rate's error against its own magnitude (``solver.rate_error_scale =
+"component"``, the integration before issue 41, bit for bit); the last two rows the default
+since (``"auto"``: with a tilt spring the rotating body's angular velocity as one vector).
+
 Usage: ``python benchmarks/bench_tilt_profile.py``. The machine is shared: the load average is
 recorded; CPU seconds of this process.
 """
@@ -29,7 +33,7 @@ from jointwear.sim import PARAMETER_SETS, run_cycles  # noqa: E402
 CYCLES = 2
 
 
-def profile(k: float, rtol: float) -> dict[str, float]:
+def profile(k: float, rtol: float, scale: str = "component") -> dict[str, float]:
     """One configuration's steps and cost per cycle (after two settling cycles)."""
     counts = {"accepted": 0, "rejected": 0}
     integrate = dynamics.integrate
@@ -41,7 +45,8 @@ def profile(k: float, rtol: float) -> dict[str, float]:
         return out
 
     p = replace_nested(
-        PARAMETER_SETS["zhang2023"], **{"joint.tilt_stiffness": k, "solver.rtol": rtol}
+        PARAMETER_SETS["zhang2023"],
+        **{"joint.tilt_stiffness": k, "solver.rtol": rtol, "solver.rate_error_scale": scale},
     )
     state = run_cycles(p, cycles=2, record=False).state
     dynamics.integrate = counted
@@ -54,6 +59,7 @@ def profile(k: float, rtol: float) -> dict[str, float]:
     return {
         "tilt_stiffness": k,
         "rtol": rtol,
+        "rate_error_scale": scale,
         "cpu_s_per_cycle": cpu / CYCLES,
         "accepted_steps_per_cycle": counts["accepted"] / CYCLES,
         "rejected_steps_per_cycle": counts["rejected"] / CYCLES,
@@ -64,10 +70,13 @@ def profile(k: float, rtol: float) -> dict[str, float]:
 
 def main() -> None:
     rows = [profile(k, rtol) for k in (0.0, 1e3, 3e3) for rtol in (1e-6, 1e-5)]
+    # the default since issue 41: with a tilt spring the angular velocity as one vector
+    rows += [profile(k, 1e-6, "auto") for k in (1e3, 3e3)]
     for r in rows:
         print(r, flush=True)
     base = rows[0]
     stiff = next(r for r in rows if r["tilt_stiffness"] == 3e3 and r["rtol"] == 1e-6)
+    stiff_auto = rows[-1]
     write_results(
         "tilt_profile",
         {
@@ -79,6 +88,10 @@ def main() -> None:
             / base["accepted_steps_per_cycle"],
             "cost_per_step_ratio_3e3_to_0": stiff["cpu_us_per_accepted_step"]
             / base["cpu_us_per_accepted_step"],
+            "steps_ratio_3e3_component_to_auto": stiff["accepted_steps_per_cycle"]
+            / stiff_auto["accepted_steps_per_cycle"],
+            "cpu_ratio_3e3_component_to_auto": stiff["cpu_s_per_cycle"]
+            / stiff_auto["cpu_s_per_cycle"],
         },
     )
 

@@ -159,6 +159,21 @@ def _pack(params: SimParameters) -> tuple[np.ndarray, np.ndarray]:
     return P, IP
 
 
+def _error_flags(params: SimParameters) -> np.ndarray:
+    """What the integrator measures each state component's local error against (the kernels'
+    ``ERR_*``): the mechanism's angle flags, and the rotating body's angular velocity as one
+    vector when ``solver.rate_error_scale`` says so (``"auto"``: with a tilt spring or damper)."""
+    model = params.joint.model
+    flags = _side(params).ANGLE_FLAGS[model].copy()
+    scale = params.solver.rate_error_scale
+    if scale == "auto":
+        tilt = params.joint.tilt_stiffness > 0 or params.joint.tilt_damping > 0
+        scale = "vector" if tilt else "component"
+    if scale == "vector" and model == "clearance":
+        flags[kn.Y_OMEGA : kn.Y_OMEGA + 3] = kn.ERR_VECTOR
+    return flags
+
+
 def _mechanism(params: SimParameters) -> str:
     return mechanism_of(params).name
 
@@ -383,7 +398,7 @@ def run_cycles(
     nacc_total = 0
     inputs = (P, IP, h, hmin, zl, wl, area, vimp, ww, acc)
     solver = (
-        _side(params).ANGLE_FLAGS[model],
+        _error_flags(params),
         float(s.rtol),
         float(s.atol),
         float(s.max_step),

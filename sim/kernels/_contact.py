@@ -33,6 +33,7 @@ from jointwear.sim.kernels._layout import (
     C_P,
     C_SON,
     C_SRATE,
+    C_TRIG,
     C_VIMP,
     C_WL,
     C_WSC,
@@ -132,6 +133,7 @@ def _slices(J0, u, V0, W, ctx, wrench, acc, hstep):
     layers, opposite-sides flag, contact length fraction).
     """
     P, IP, H, HMIN, ZL, WL, AREA, vimp, srate, son, WW, acc_out = _inputs(ctx)
+    TRIG = ctx[C_TRIG]
     Nl = IP[NL]
     Nd = IP[ND]
     nexp = P[NEXP]
@@ -160,7 +162,7 @@ def _slices(J0, u, V0, W, ctx, wrench, acc, hstep):
                 pen = sd[n]
             continue
         m0 = _facing_node(axs[n], ays[n], P, Nd)
-        ms, dm, d0, dp, nm, n0, npp = _search(n, m0, J0, u, P, H, ZL, Nd)
+        ms, dm, d0, dp, nm, n0, npp = _search(n, m0, J0, u, P, H, ZL, Nd, TRIG)
         b = 0.5 * (dp - dm)
         dd = 2.0 * d0 - dp - dm
         x = 0.0
@@ -249,7 +251,7 @@ def _slices(J0, u, V0, W, ctx, wrench, acc, hstep):
                 wsc[n, 1] = fw * vt
                 wsc[n, 2] = vt
             elif fw > 0.0:
-                _spread(n, sm[n], fw, vt, hstep, J0, u, P, H, ZL, Nd, AREA, WW, ctx[C_BUF])
+                _spread(n, sm[n], fw, vt, hstep, J0, u, P, H, ZL, Nd, TRIG, AREA, WW, ctx[C_BUF])
             acc_out[0] += fn * vt * hstep
             acc_out[2] += fn * hstep
         nslice += 1
@@ -262,7 +264,7 @@ def _slices(J0, u, V0, W, ctx, wrench, acc, hstep):
         elif f0x * hx + f0y * hy + f0z * hz < 0.0:
             two = True
     if acc and proj == WPROJ_CONSERVING:
-        _spread_regions(wsc, sm, son, hstep, J0, u, P, H, ZL, Nd, AREA, WW, ctx[C_BUF])
+        _spread_regions(wsc, sm, son, hstep, J0, u, P, H, ZL, Nd, TRIG, AREA, WW, ctx[C_BUF])
     return energy, fnsum, pen, kdeep, nslice, two, clen
 
 
@@ -287,7 +289,7 @@ def _wear_force(n, fn, sd, kk, fel, WL, proj, P):
 
 
 @kernel
-def _spread_regions(wsc, sm, son, hstep, J0, u, P, H, ZL, Nd, AREA, WW, buf):
+def _spread_regions(wsc, sm, son, hstep, J0, u, P, H, ZL, Nd, TRIG, AREA, WW, buf):
     """Spread the local wear forces, scaled per contact region to its normal work.
 
     ``wsc[n]`` = (F_n |v_t|, local wear force x |v_t|, |v_t|) of contacting layer n. In each
@@ -314,30 +316,30 @@ def _spread_regions(wsc, sm, son, hstep, J0, u, P, H, ZL, Nd, AREA, WW, buf):
             else:  # no layer of the region penetrates at its node: lumped
                 fw = wsc[k, 0] / wsc[k, 2] if wsc[k, 2] > 0.0 else 0.0
             if fw > 0.0:
-                _spread(k, sm[k], fw, wsc[k, 2], hstep, J0, u, P, H, ZL, Nd, AREA, WW, buf)
+                _spread(k, sm[k], fw, wsc[k, 2], hstep, J0, u, P, H, ZL, Nd, TRIG, AREA, WW, buf)
         n = end
 
 
 @kernel
-def _penetrating_run(n, ms, J0, u, P, H, ZL, Nd, buf):
+def _penetrating_run(n, ms, J0, u, P, H, ZL, Nd, TRIG, buf):
     """Contiguous run of penetrating nodes of layer n around node ms.
 
     Returns (lo, hi) and the penetrations in ``buf[m - ms + Nd // 2]`` for m in [lo, hi]
     (``buf[Nd // 2]`` = that of ms, possibly <= 0); every node is evaluated once.
     """
     half = Nd // 2
-    d0 = _node_delta(n, ms, J0, u, P, H, ZL, Nd)
+    d0 = _node_delta(n, ms, J0, u, P, H, ZL, Nd, TRIG)
     lo = ms
     hi = ms
     if d0 > 0.0:
         while lo - ms > -half:
-            dk = _node_delta(n, lo - 1, J0, u, P, H, ZL, Nd)
+            dk = _node_delta(n, lo - 1, J0, u, P, H, ZL, Nd, TRIG)
             if dk <= 0.0:
                 break
             lo -= 1
             buf[lo - ms + half] = dk
         while hi - ms < half:
-            dk = _node_delta(n, hi + 1, J0, u, P, H, ZL, Nd)
+            dk = _node_delta(n, hi + 1, J0, u, P, H, ZL, Nd, TRIG)
             if dk <= 0.0:
                 break
             hi += 1
@@ -347,7 +349,7 @@ def _penetrating_run(n, ms, J0, u, P, H, ZL, Nd, buf):
 
 
 @kernel
-def _spread(n, ms, fn, vt, hstep, J0, u, P, H, ZL, Nd, AREA, WW, buf):
+def _spread(n, ms, fn, vt, hstep, J0, u, P, H, ZL, Nd, TRIG, AREA, WW, buf):
     """Spread a layer's normal force over its contiguous penetrating nodes, weights sqrt(delta),
     adding p |v_t| dt to WW[0] and |v_t| dt to WW[1]; every node is evaluated once. ``buf``
     (at least ``2 (Nd // 2) + 1``) is scratch for :func:`_penetrating_run`. A ``WW`` of four
@@ -363,7 +365,7 @@ def _spread(n, ms, fn, vt, hstep, J0, u, P, H, ZL, Nd, AREA, WW, buf):
         for k, share in ((m, 1.0 - f), (m + 1, f)):
             WW[2, n, k % Nd] += share * fn * vt * hstep
             WW[3, n, k % Nd] += share * fn * fn * vt * hstep
-    lo, hi = _penetrating_run(n, ms, J0, u, P, H, ZL, Nd, buf)
+    lo, hi = _penetrating_run(n, ms, J0, u, P, H, ZL, Nd, TRIG, buf)
     wsum = 0.0
     for mm in range(lo, hi + 1):
         dk = buf[mm - ms + half]
@@ -387,6 +389,7 @@ def _per_point(J0, u, V0, W, ctx, wrench, acc, hstep):
     Returns the same tuple as :func:`_slices`.
     """
     P, IP, H, HMIN, ZL, WL, AREA, vimp, srate, son, WW, acc_out = _inputs(ctx)
+    TRIG = ctx[C_TRIG]
     Nl = IP[NL]
     Nd = IP[ND]
     nexp = P[NEXP]
@@ -411,17 +414,17 @@ def _per_point(J0, u, V0, W, ctx, wrench, acc, hstep):
                 pen_rad = dest
             continue
         m0 = _facing_node(ax, ay, P, Nd)
-        ms, _dm, d0, _dp, _nm, _n0, _np = _search(n, m0, J0, u, P, H, ZL, Nd)
+        ms, _dm, d0, _dp, _nm, _n0, _np = _search(n, m0, J0, u, P, H, ZL, Nd, TRIG)
         if d0 > pen_rad:
             pen_rad = d0
         if d0 <= 0.0:
             continue
-        lo, hi = _penetrating_run(n, ms, J0, u, P, H, ZL, Nd, buf)
+        lo, hi = _penetrating_run(n, ms, J0, u, P, H, ZL, Nd, TRIG, buf)
         hx, hy, hz = 0.0, 0.0, 0.0
         rate0 = 0.0
         kdk = 0.0
         for mm in range(lo, hi + 1):
-            nd = _node(n, mm, J0, u, P, H, ZL, Nd)
+            nd = _node(n, mm, J0, u, P, H, ZL, Nd, TRIG)
             dk = nd[0]
             if dk <= 0.0:
                 continue

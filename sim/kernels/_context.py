@@ -9,6 +9,8 @@ scratch arrays hold nothing from one evaluation to the next.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numba import njit
 
@@ -16,6 +18,7 @@ from jointwear.sim.kernels._jit import inline_kernel
 from jointwear.sim.kernels._layout import (
     C_MAT,
     C_VEC,
+    DPHI,
     N_VEC,
     ND,
     NINFO,
@@ -49,7 +52,14 @@ def make_context(P, IP, H, HMIN, ZL, WL, AREA, vimp, WW, acc_out):
     joint = (np.empty((N_VEC, 12)), np.empty((2, 3, 3)))
     layers = (np.empty((Nl, 8)), np.empty((Nl, 3, 6)), np.empty(Nl, dtype=np.int64))
     wear = (np.empty((Nl, 3)), np.empty(Nd + 1))
-    return inputs + rates_and_info + (WW, acc_out) + joint + layers + wear
+    # the bore points' angles never change within an integration: their cos and sin once here
+    # (the same libm values the contact search computed at every node visit before)
+    trig = np.empty((Nd, 2))
+    for m in range(Nd):
+        phi = m * P[DPHI]
+        trig[m, 0] = math.cos(phi)
+        trig[m, 1] = math.sin(phi)
+    return inputs + rates_and_info + (WW, acc_out) + joint + layers + wear + (trig,)
 
 
 @inline_kernel

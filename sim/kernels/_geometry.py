@@ -38,17 +38,17 @@ def body_rotation(y, R):
 
 
 @kernel
-def _node(n, m, J0, u, P, H, ZL, Nd):
+def _node(n, m, J0, u, P, H, ZL, Nd, TRIG):
     """Signed penetration of bearing point (n, m) by the journal and its geometry (bearing frame).
 
+    ``TRIG`` (Nd, 2): cos and sin of the points' angles (:func:`._context.make_context`).
     Returns delta, Dx, Dy, Dz (the point), nx, ny, nz (unit normal from the journal axis towards
     the point), s (axial position of the foot on the journal axis, from the journal centre).
     """
     m = m % Nd
-    phi = m * P[DPHI]
     R = P[RB] + H[n, m]
-    Dx = -R * math.cos(phi)
-    Dy = R * math.sin(phi)
+    Dx = -R * TRIG[m, 0]
+    Dy = R * TRIG[m, 1]
     Dz = ZL[n]
     wx, wy, wz = Dx - J0[0], Dy - J0[1], Dz - J0[2]
     s = wx * u[0] + wy * u[1] + wz * u[2]
@@ -68,9 +68,9 @@ def _dl(t, P):
 
 
 @kernel
-def _node_delta(n, m, J0, u, P, H, ZL, Nd):
+def _node_delta(n, m, J0, u, P, H, ZL, Nd, TRIG):
     """Penetration of bearing point (n, m), -1 beyond the journal's ends."""
-    return _dl(_node(n, m, J0, u, P, H, ZL, Nd), P)
+    return _dl(_node(n, m, J0, u, P, H, ZL, Nd, TRIG), P)
 
 
 @kernel
@@ -148,42 +148,42 @@ def _seg(a, b, nexp):
 
 
 @kernel
-def _search(n, m0, J0, u, P, H, ZL, Nd):
+def _search(n, m0, J0, u, P, H, ZL, Nd, TRIG):
     """Deepest node of layer n near node m0: (ms, delta at ms-1, ms, ms+1, their node tuples)."""
     # climb from the node facing the eccentricity to the nearest local maximum of the
     # penetration on each side; keep the deeper one (on a worn profile the journal can
     # bridge a narrow groove and touch both flanks: the deeper flank carries the slice)
-    t0 = _node(n, m0, J0, u, P, H, ZL, Nd)
-    tp = _node(n, m0 + 1, J0, u, P, H, ZL, Nd)
-    tm = _node(n, m0 - 1, J0, u, P, H, ZL, Nd)
+    t0 = _node(n, m0, J0, u, P, H, ZL, Nd, TRIG)
+    tp = _node(n, m0 + 1, J0, u, P, H, ZL, Nd, TRIG)
+    tm = _node(n, m0 - 1, J0, u, P, H, ZL, Nd, TRIG)
     c0, cp, cm = _dl(t0, P), _dl(tp, P), _dl(tm, P)
     ms, dm, d0, dp = m0, cm, c0, cp
     nm, n0, npp = tm, t0, tp
     found = False
     if cp > c0:
         r, b0, b1 = m0 + 1, t0, tp
-        b2 = _node(n, m0 + 2, J0, u, P, H, ZL, Nd)
+        b2 = _node(n, m0 + 2, J0, u, P, H, ZL, Nd, TRIG)
         a0, a1, a2 = c0, cp, _dl(b2, P)
         for _ in range(Nd // 2):
             if a2 <= a1:
                 break
             r += 1
             a0, a1, b0, b1 = a1, a2, b1, b2
-            b2 = _node(n, r + 1, J0, u, P, H, ZL, Nd)
+            b2 = _node(n, r + 1, J0, u, P, H, ZL, Nd, TRIG)
             a2 = _dl(b2, P)
         ms, dm, d0, dp = r, a0, a1, a2
         nm, n0, npp = b0, b1, b2
         found = True
     if cm > c0:
         r, b0, b1 = m0 - 1, t0, tm
-        b2 = _node(n, m0 - 2, J0, u, P, H, ZL, Nd)
+        b2 = _node(n, m0 - 2, J0, u, P, H, ZL, Nd, TRIG)
         a0, a1, a2 = c0, cm, _dl(b2, P)
         for _ in range(Nd // 2):
             if a2 <= a1:
                 break
             r -= 1
             a0, a1, b0, b1 = a1, a2, b1, b2
-            b2 = _node(n, r - 1, J0, u, P, H, ZL, Nd)
+            b2 = _node(n, r - 1, J0, u, P, H, ZL, Nd, TRIG)
             a2 = _dl(b2, P)
         if not found or a1 > d0:
             ms, dm, d0, dp = r, a2, a1, a0

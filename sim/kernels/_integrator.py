@@ -17,6 +17,8 @@ from jointwear.sim.kernels._layout import (
     C_INFO,
     C_SON,
     C_SRATE,
+    ERR_ABSOLUTE,
+    ERR_VECTOR,
     I_BAD,
     I_CONTACT,
     I_PEN,
@@ -76,8 +78,12 @@ def integrate(t, y, hstep, t_end, record, i_out, inputs, solver):
 
     ``record`` = (t_out, diag_out): output times, diagnostics rows written from row ``i_out``;
     ``inputs`` = (P, IP, H, HMIN, ZL, WL, AREA, vimp, WW, acc_out) of :func:`.make_context`;
-    ``solver`` = (ANG, rtol, atol, hmax, hmin, onset, pen_limit). Returns (status, t, hstep,
-    i_out, n_accepted, n_rejected); status 0 done, 1 step-size collapse, 2 penetration beyond
+    ``solver`` = (ANG, rtol, atol, hmax, hmin, onset, pen_limit); ``ANG[i]`` says what the
+    local error of component i is measured against (``_layout.ERR_*``): atol + rtol |y_i|,
+    atol alone (angles), or atol + rtol |v| with v the vector of the components flagged
+    ``ERR_VECTOR`` (the rotating body's angular velocity: a component that vibrates about zero
+    is then held to rtol of the whole rotation rate, not of its own amplitude). Returns
+    (status, t, hstep, i_out, n_accepted, n_rejected); status 0 done, 1 step-size collapse, 2 penetration beyond
     ``pen_limit``, 3 non-finite state, 4 journal axis flipped. Adds to ``acc_out`` the normal,
     axial normal work and normal impulse; keeps there the largest end-of-step penetration.
     """
@@ -127,10 +133,19 @@ def integrate(t, y, hstep, t_end, record, i_out, inputs, solver):
         _eval(t + h, y1, ctx, Ks[6], False, 0.0, nodiag)
         err = 0.0
         finite = True
+        va = 0.0
+        vb = 0.0
+        for i in range(n):
+            if ANG[i] == ERR_VECTOR:
+                va += y[i] * y[i]
+                vb += y1[i] * y1[i]
+        vsc = atol + rtol * math.sqrt(va if va > vb else vb)
         for i in range(n):
             ei = h * _combine(Ks, _E, 7, i)
-            if ANG[i] == 1:
+            if ANG[i] == ERR_ABSOLUTE:
                 sc = atol
+            elif ANG[i] == ERR_VECTOR:
+                sc = vsc
             else:
                 a = abs(y[i])
                 b = abs(y1[i])

@@ -122,6 +122,7 @@ C_GEO = 16  # (Nl, 3, 6) the three nodes around each layer's deepest: point, nor
 C_NODE = 17  # (Nl,) int: each layer's deepest node
 C_WSC = 18  # (Nl, 3) per-layer work of the conserving wear projection
 C_BUF = 19  # (Nd + 1,) penetrations of a layer's penetrating run of nodes
+C_TRIG = 20  # (Nd, 2) cos and sin of each bore point's angle phi_m = m DPHI
 
 
 # rows of ctx[C_VEC]: bearing centre, journal centre, journal axis (global); wrench on the
@@ -131,6 +132,15 @@ V_OG, V_CJ, V_UG, V_FM, V_J0, V_U, V_V0, V_W, V_WRENCH = 0, 1, 2, 3, 4, 5, 6, 7,
 
 
 N_VEC = 9
+
+
+# ---- state components and their error flags (the integrator's ``ANG``) ------------------------
+Y_OMEGA = 8  # the clearance state's y[8:11]: the rotating body's angular velocity (body axes)
+
+
+# local error per component: 0 against atol + rtol |y_i|, 1 against atol (angles), 2 against
+# atol + rtol |v| with v the vector of all components flagged 2 (the angular velocity)
+ERR_RELATIVE, ERR_ABSOLUTE, ERR_VECTOR = 0, 1, 2
 
 
 # contact modes
