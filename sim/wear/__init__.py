@@ -13,6 +13,11 @@ import lazy_loader
 # The public names: the __all__ of these modules (module -> None) or the names listed. They are
 # imported on first use so that the command line starts fast; ``python docs/scripts/lazy_stubs.py``
 # writes them into __init__.pyi, which lazy_loader reads.
-_EXPORTS = {"_loop": None, "_contact": None, "_calibration": None, "_conformal": ["conformal_wear_work"]}
+_EXPORTS = {
+    "_loop": None,
+    "_contact": None,
+    "_calibration": None,
+    "_conformal": ["conformal_wear_work"],
+}
 
 __getattr__, __dir__, __all__ = lazy_loader.attach_stub(__name__, __file__)

@@ -592,6 +592,9 @@ class WearRun:
         }
         if warning:
             attrs["accuracy_warning"] = warning
+        params = getattr(self.contact, "params", None)
+        if params is not None:  # the dynamics: how a slice's force became wear work
+            attrs["wear_pressure"] = params.contact.wear_pressure
         attrs.update(self.contact_validity()["attrs"])
         conv = self.convergence_warning()
         if conv:

@@ -237,3 +237,22 @@ def test_a_stale_kernel_is_refused_not_read_as_no_wear():
     ww[0, 0, 0] = 1.0
     with pytest.raises(SimulationError, match="NUMBA_CACHE_DIR"):
         _conformal_maps(conf, ww, np.zeros(shape), np.ones(shape))
+
+
+def test_wear_command_refuses_conformal_on_per_point_and_its_fix_runs(tmp_path, capsys):
+    from jointwear import io
+    from jointwear.cli import main
+
+    toml = tmp_path / "rig.toml"
+    toml.write_text('[contact]\nwear_pressure = "conformal"\nformulation = "per_point"\n')
+    out = tmp_path / "w.nc"
+    args = ["sim", "wear", "--layers", "4", "--points", "48", "--out", str(out)]
+    args += ["--cycles", "4", "--scheme", "fixed", "--dn", "2", "--snapshots", "4"]
+    assert main([*args, "--params", str(toml)]) == 3
+    err = capsys.readouterr().err
+    assert "contact.wear_pressure = 'conformal'" in err and "contact.formulation = 'slice'" in err
+    toml.write_text('[contact]\nwear_pressure = "conformal"\nformulation = "slice"\n')
+    assert main([*args, "--params", str(toml)]) == 0
+    ds = io.load(out)
+    assert float(ds["worn_volume"][-1]) > 0
+    assert ds.attrs["wear_pressure"] == "conformal"
