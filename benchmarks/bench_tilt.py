@@ -45,6 +45,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from _common import write_results  # noqa: E402
 
+from jointwear.params import replace_nested  # noqa: E402
 from jointwear.sim import (  # noqa: E402
     DEFAULT_KW,
     PARAMETER_SETS,
@@ -87,8 +88,15 @@ def _peak_angles(ds, cycles: float) -> dict[str, float]:
     }
 
 
-def _tilt_on_final_bore(overrides: dict[str, float], ds) -> dict[str, float]:
-    params, _ = apply_overrides(PARAMETER_SETS["zhang2023"], WearSettings(), overrides)
+def _base(rate_error_scale: str):
+    """The reference rig with the given ``solver.rate_error_scale`` (not a float override)."""
+    return replace_nested(
+        PARAMETER_SETS["zhang2023"], **{"solver.rate_error_scale": rate_error_scale}
+    )
+
+
+def _tilt_on_final_bore(overrides: dict[str, float], ds, rate_error_scale: str) -> dict[str, float]:
+    params, _ = apply_overrides(_base(rate_error_scale), WearSettings(), overrides)
     h = wear_depth_on_grid(ds["wear_depth"], params)
     settle = run_cycles(params, cycles=1, wear_depth=h, record=False)
     rec = run_cycles(params, cycles=2, wear_depth=h, state=settle.state).dataset
@@ -108,10 +116,10 @@ def run_point(
         "joint.tilt_stiffness": stiffness,
         "mechanism.joint_offset": offset,
         "wear.kw": kw,
-        "solver.rate_error_scale": rate_error_scale,
     }
     c0 = time.process_time()
-    ds = simulate_wear(cycles=CYCLES, snapshots=[EARLY], overrides=overrides)
+    params = _base(rate_error_scale)
+    ds = simulate_wear(params, cycles=CYCLES, snapshots=[EARLY], overrides=overrides)
     cpu = time.process_time() - c0
     share = edge_volume_share(ds["wear_depth"])
     cyl = ds["cylindricity"]
@@ -133,7 +141,7 @@ def run_point(
         "snapshot_cycles": [float(c) for c in ds["cycles"].values],
         "peaks_early": _peak_angles(ds, EARLY),
         "peaks_final": _peak_angles(ds, CYCLES),
-        **_tilt_on_final_bore(overrides, ds),
+        **_tilt_on_final_bore(overrides, ds, rate_error_scale),
     }
     print(out, flush=True)
     return out
