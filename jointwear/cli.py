@@ -18,6 +18,7 @@ from typing import Annotated
 import typer
 
 from jointwear._cli import CommandGroup, Overwrite, apply_classes, lazy_groups
+from jointwear._compile import ensure_compiled
 from jointwear._compile_notice import announce_compilation
 from jointwear._version import __version__
 from jointwear.errors import EXIT_BAD_INPUT, EXIT_USAGE, JointwearError
@@ -168,6 +169,7 @@ def main(argv: list[str] | None = None) -> int:
         except ValueError:  # not the main thread
             pass
     try:
+        ensure_compiled(args)  # the first command that computes compiles every kernel, once
         app(args=args, prog_name="jointwear", standalone_mode=True)
     except SystemExit as exc:  # click's own exits: 0, usage errors (2), aborts
         code = exc.code

@@ -1,0 +1,218 @@
+"""Compile once (jointwear._compile): the warm-up compiles every kernel of its manifest into
+numba's cache in worker processes, so that a later process compiles nothing."""
+
+from __future__ import annotations
+
+import inspect
+import os
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+import pytest
+
+from jointwear import _compile
+
+#: Two toy kernels (one of them with two argument types) for the machinery's tests.
+TOY = '''
+from numba import njit
+
+
+@njit(cache=True)
+def total(a):
+    return a.sum()
+
+
+@njit(cache=True)
+def scaled(a, k):
+    return a * k
+
+
+def _lazy_impl(a):
+    return a.sum()
+
+
+def _lazy(a):
+    """Compiled on first use."""
+    global _lazy
+    from numba import njit
+
+    _lazy = njit(cache=True)(_lazy_impl)
+    return _lazy(a)
+'''
+
+MANIFEST = """
+KERNELS = (
+    ("toy_kernels", "total", "(Array(float64, 1, 'C', False, aligned=True),)", 2.0),
+    ("toy_kernels", "scaled", "(Array(float64, 1, 'C', False, aligned=True), float64)", 1.0),
+    ("toy_kernels", "scaled", "(Array(float64, 1, 'C', False, aligned=True), int64)", 1.0),
+    ("toy_kernels", "_lazy_impl", "(Array(float64, 1, 'C', False, aligned=True),)", 1.0),
+    ("toy_kernels", "total", "(float64, float64)", 0.5),
+)
+"""
+
+#: Calls every toy kernel as a user would; prints how many kernels numba compiled.
+CALLS = """
+import numpy as np
+from numba.core import event
+
+compiled = []
+
+
+class Count(event.Listener):
+    def on_start(self, ev):
+        fn = ev.data["dispatcher"].py_func
+        if fn.__module__ == "toy_kernels":
+            compiled.append(fn.__name__)
+
+    def on_end(self, ev):
+        pass
+
+
+event.register("numba:compile", Count())
+import toy_kernels as t
+
+a = np.arange(4.0)
+assert t.total(a) == 6.0 and t.scaled(a, 2.0)[3] == 6.0 and t.scaled(a, 2)[3] == 6.0
+assert t._lazy(a) == 6.0
+print("COMPILED", *compiled)
+"""
+
+
+@pytest.fixture
+def toy(tmp_path, monkeypatch):
+    """The toy kernels and their manifest on the path, an empty numba cache, the warm-up on."""
+    (tmp_path / "toy_kernels.py").write_text(TOY)
+    (tmp_path / "toy_manifest.py").write_text(MANIFEST)
+    monkeypatch.syspath_prepend(str(tmp_path))
+    path = os.pathsep.join([str(tmp_path), os.environ.get("PYTHONPATH", "")])
+    monkeypatch.setenv("PYTHONPATH", path)
+    monkeypatch.setenv("JOINTWEAR_KERNEL_MANIFEST", "toy_manifest")
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path / "cache"))
+    monkeypatch.setenv(_compile.SWITCH, "1")
+    sys.modules.pop("toy_manifest", None)
+    return tmp_path
+
+
+def _compiled_by_calls(folder: Path) -> list[str]:
+    run = subprocess.run(
+        [sys.executable, "-c", CALLS], cwd=folder, capture_output=True, text=True, check=True
+    )
+    return run.stdout.split("COMPILED")[-1].split()
+
+
+def test_the_warm_up_leaves_nothing_to_compile_and_names_the_stale_entry(toy):
+    import io
+
+    out = io.StringIO()
+    done = _compile.warm_up(workers=2, stream=out)
+    assert done["workers"] == 2 and done["kernels"] == 5 and done["compiled"] == 4
+    # the entry whose types the kernel does not take is named, with numba's reason
+    assert [f["kernel"] for f in done["failed"]] == ["toy_kernels.total"]
+    assert "Signature mismatch" in done["failed"][0]["reason"]
+    assert _compile.stamp_path().exists()
+    text = out.getvalue()
+    assert "compiling the numerical kernels once" in text
+    assert "compiled 4 kernels" in text and "1 could not be compiled ahead" in text
+    # a later process loads every kernel from the cache: nothing compiles
+    assert _compiled_by_calls(toy) == []
+
+
+def test_without_the_warm_up_the_same_calls_compile(toy):
+    """The check above can fail: the toy calls do compile on an empty cache."""
+    assert sorted(_compiled_by_calls(toy)) == ["_lazy_impl", "scaled", "scaled", "total"]
+
+
+def test_a_command_that_computes_warms_up_once_and_help_never(toy):
+    import io
+
+    out = io.StringIO()
+    _compile.ensure_compiled(["--help"], stream=out)
+    _compile.ensure_compiled(["dic", "correlate", "--help"], stream=out)
+    _compile.ensure_compiled(["info", "a.nc"], stream=out)
+    assert out.getvalue() == "" and not _compile.stamp_path().exists()
+    _compile.ensure_compiled(["dic", "correlate", "a.png", "b.png"], stream=out)
+    assert _compile.stamp_path().exists() and "compiled 4 kernels" in out.getvalue()
+    again = io.StringIO()
+    _compile.ensure_compiled(["demo"], stream=again)  # the stamp says it is done
+    assert again.getvalue() == ""
+
+
+def test_the_stamp_changes_with_a_kernel_module(toy):
+    before = _compile.stamp_path()
+    kernels = toy / "toy_kernels.py"
+    kernels.write_text(kernels.read_text() + "\n# edited\n")
+    assert _compile.stamp_path() != before
+    assert before.parent == toy / "cache"
+
+
+def test_which_commands_compute():
+    yes = (["demo"], ["demo", "--quick"], ["dic", "correlate", "a", "b"], ["sim", "wear"])
+    no = (
+        [],
+        ["--help"],
+        ["--version"],
+        ["sim"],
+        ["dic", "correlate", "--help"],
+        ["info", "a.nc"],
+        ["import", "motion", "a.csv"],
+        ["compare", "a", "b"],
+    )
+    assert all(_compile.needs_kernels(a) for a in yes)
+    assert not any(_compile.needs_kernels(a) for a in no)
+
+
+def test_the_plan_keeps_a_kernel_in_one_worker_and_balances_the_rest(toy):
+    shares = _compile.plan(2)
+    assert sorted(i for s in shares for i in s) == [0, 1, 2, 3, 4]
+    # both argument types of 'scaled' (entries 1 and 2), and both of 'total' (0 and 4), together
+    owner = {i: k for k, s in enumerate(shares) for i in s}
+    assert owner[1] == owner[2] and owner[0] == owner[4]
+    assert _compile.plan(1) == [[0, 4, 1, 2, 3]] or len(_compile.plan(1)) == 1
+
+
+def test_every_manifest_entry_names_a_kernel_and_its_argument_types():
+    """The manifest is not stale: each entry's kernel exists, takes that many arguments, and its
+    types read back as numba wrote them (docs/scripts/kernel_manifest.py rewrites it)."""
+    from jointwear._compile_manifest import KERNELS
+
+    assert KERNELS
+    for module, name, args, cpu_s in KERNELS:
+        dispatcher = _compile.resolve(module, name)
+        types = _compile.parse_types(args)
+        assert repr(types) == args
+        n = len(inspect.signature(dispatcher.py_func).parameters)
+        assert len(types) == n, f"{module}.{name}: {len(types)} types for {n} arguments"
+        assert cpu_s >= 0
+
+
+@pytest.mark.slow
+def test_after_the_first_command_dic_correlate_compiles_nothing(tmp_path):
+    """A fresh install: the first command (a speckle pair) compiles every kernel ahead; then
+    ``dic correlate`` on the pair compiles none (numba's cache log says what it saved)."""
+    env = {
+        **os.environ,
+        "NUMBA_CACHE_DIR": str(tmp_path / "cache"),
+        _compile.SWITCH: "1",
+        "NUMBA_NUM_THREADS": "2",
+    }
+    env.pop("JOINTWEAR_KERNEL_MANIFEST", None)
+    jw = [sys.executable, "-m", "jointwear"]
+    first = subprocess.run(
+        [*jw, "datasets", "speckle", str(tmp_path / "pair"), "--size", "128x128"],
+        env=env, capture_output=True, text=True, timeout=1800,
+    )  # fmt: skip
+    assert first.returncode == 0, first.stderr[-2000:]
+    assert "compiling the numerical kernels once" in first.stderr
+    pair = tmp_path / "pair"
+    run = subprocess.run(
+        [*jw, "dic", "correlate", str(pair / "reference.png"), str(pair / "deformed.png"),
+         "--subset", "21", "--step", "16", "--out", str(tmp_path / "f.nc")],
+        env={**env, "NUMBA_DEBUG_CACHE": "1"}, capture_output=True, text=True, timeout=600,
+    )  # fmt: skip
+    assert run.returncode == 0, run.stderr[-2000:]
+    assert "data loaded" in run.stdout  # the kernels came from the cache ...
+    assert "data saved" not in run.stdout  # ... and none was compiled
+    assert "compiling" not in run.stderr and "compiled" not in run.stderr
+    assert textwrap.dedent(run.stderr).count("jointwear:") == 0
