@@ -182,17 +182,22 @@ def motion_verification(params: Any, size: DemoSize, main: xr.Dataset) -> xr.Dat
     )
 
 
-def ensemble_spec(params: Any, size: Any, *, kw: float | None = None) -> dict[str, Any]:
+def ensemble_spec(
+    params: Any, size: Any, *, kw: float | None = None, calibrated: tuple[str, ...] = ()
+) -> dict[str, Any]:
     """The demo's sweep spec (``jointwear sim sweep`` format): LHS over :data:`ENSEMBLE_INPUTS`.
 
     ``size`` gives ``ensemble_cycles`` and ``ensemble_runs``; ``kw`` the nominal wear
     coefficient (default :data:`jointwear.sim.DEFAULT_KW`). An input whose nominal value is 0
-    (e.g. a frictionless model) is not varied: a relative spread of 0 is no distribution.
+    (e.g. a frictionless model) is not varied: a relative spread of 0 is no distribution; nor is
+    an input in ``calibrated`` (its spread is the posterior prediction's).
     """
     from jointwear.sim import DEFAULT_KW
 
     parameters: dict[str, Any] = {}
     for name, (rel, _) in ENSEMBLE_INPUTS.items():
+        if name in calibrated:
+            continue
         section, field = name.split(".")
         if name == "wear.kw":
             mean = DEFAULT_KW if kw is None else float(kw)
@@ -218,7 +223,12 @@ def ensemble_spec(params: Any, size: Any, *, kw: float | None = None) -> dict[st
 
 
 def run_ensemble(
-    params: Any, size: DemoSize, motion_time: np.ndarray, *, progress: bool = True
+    params: Any,
+    size: DemoSize,
+    motion_time: np.ndarray,
+    *,
+    progress: bool = True,
+    calibrated: tuple[str, ...] = (),
 ) -> xr.Dataset:
     """A small real ensemble over the uncertain inputs, through :func:`jointwear.sim.run_sweep`.
 
@@ -226,7 +236,8 @@ def run_ensemble(
     reduced cycles, in this process) keeping each run's final wear map; each member's motion is
     then simulated with the same sampled inputs and its follower velocity
     ``(run, time, axis)`` added on ``motion_time``, so that the compared in-plane velocity RMS
-    has an ensemble spread too (the sweep's own motion output is the speed RMS).
+    has an ensemble spread too (the sweep's own motion output is the speed RMS). The inputs in
+    ``calibrated`` are not varied (:func:`ensemble_spec`).
     """
     from jointwear import conventions
     from jointwear.params import replace_nested
@@ -242,7 +253,7 @@ def run_ensemble(
             )
 
     ds = run_sweep(
-        ensemble_spec(params, size),
+        ensemble_spec(params, size, calibrated=calibrated),
         params=params,
         wear=WearSettings(scheme="fixed", dn=dn),
         workers=0,
@@ -250,7 +261,11 @@ def run_ensemble(
     )
     vel, crank = [], []
     for r in range(ds.sizes["run"]):
-        changes = {k: float(ds[k].values[r]) for k in ENSEMBLE_INPUTS if not k.startswith("wear.")}
+        changes = {
+            k: float(ds[k].values[r])
+            for k in ENSEMBLE_INPUTS
+            if not k.startswith("wear.") and k in ds
+        }
         try:
             m = run_cycles(replace_nested(params, **changes), cycles=size.motion_cycles).dataset
         except JointwearError as exc:

@@ -35,11 +35,11 @@ def test_the_compared_wear_file_is_the_study_run_and_the_serial_run(tmp_path, ca
     from jointwear.sim import simulate_wear
 
     params, task = _run0()
-    result, (path, metrology) = demo._compared_study_run(task, tmp_path, TINY, params, False)
+    result, (path, metrology, early) = demo._compared_study_run(task, tmp_path, TINY, params, False)
     said = capsys.readouterr().err  # a study run states no accuracy of its own: the study's
     assert "u_num: the study" in said and "nan" not in said
     saved = io.load(path)
-    assert result.status == "ok" and metrology is None
+    assert result.status == "ok" and metrology is None and early is None
     assert saved.attrs["data_origin"] == "simulated"
     # the study keeps exactly the map the compared file holds ...
     final = np.asarray(saved["wear_depth"].isel(cycles=-1).values)

@@ -1,0 +1,127 @@
+"""The demo's calibrate -> validate step and its motion truth (issues 35 item 5, 36 item 6)."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+import xarray as xr
+
+from jointwear import io
+from jointwear.errors import BadInputError
+from jointwear.reports import demo
+from jointwear.reports.demo_calibration import (
+    CALIBRATED,
+    base_toml,
+    calibrate_and_predict,
+    spec_toml,
+    with_prediction,
+)
+from jointwear.reports.demo_studies import ensemble_spec, main_wear_settings
+
+
+def test_the_calibration_params_file_is_the_demos_rig_and_verified_scheme(tmp_path):
+    """``calibration_params.toml`` read as ``sim calibrate --params`` reads it gives the demo's
+    rig and the wear settings its verification study verified (so its u_num applies)."""
+    from jointwear.params import from_mapping, read_toml
+    from jointwear.sim import WearSettings, load_parameters
+
+    path = tmp_path / "p.toml"
+    path.write_text(base_toml(demo.FULL))
+    assert load_parameters(path) == demo._params(demo.FULL)
+    wear = from_mapping(WearSettings, read_toml(path)["wear"], where="wear")
+    assert wear == main_wear_settings(demo.FULL)
+
+
+def test_the_spec_calibrates_kw_around_nominal_on_the_earlier_snapshot(tmp_path):
+    from jointwear.sim import DEFAULT_KW
+    from jointwear.sim.calibrate import read_calibration_spec
+
+    data = tmp_path / "metrology_wear_calibration.nc"
+    data.write_bytes(b"")
+    path = tmp_path / "calibration.toml"
+    path.write_text(spec_toml(data, demo.FULL, demo._params(demo.FULL)))
+    spec = read_calibration_spec(path)
+    assert spec.names == list(CALIBRATED) == ["wear.kw"]
+    assert spec.cycles == (demo.FULL.calibration_cycles,) and spec.data == (data,)
+    assert spec.samples == demo.FULL.training_runs
+    lo, hi = spec.parameters[0].bounds
+    assert lo == pytest.approx(0.5 * DEFAULT_KW) and hi == pytest.approx(1.5 * DEFAULT_KW)
+    # the earlier snapshot is another, earlier scan of the same bore; the validation is later
+    assert 0 < demo.FULL.calibration_cycles < demo.FULL.cycles
+
+
+def test_the_input_ensemble_leaves_the_calibrated_inputs_to_the_posterior():
+    """Two ensembles varying kw would be refused by compare (an input counted twice)."""
+    full = ensemble_spec(demo._params(demo.FULL), demo.FULL)["parameters"]
+    rest = ensemble_spec(demo._params(demo.FULL), demo.FULL, calibrated=tuple(CALIBRATED))
+    assert "wear.kw" in full and set(full) - set(rest["parameters"]) == set(CALIBRATED)
+    assert demo._calibrated(demo.FULL) == tuple(CALIBRATED)
+    assert demo._calibrated(demo.QUICK) == ()  # --quick does not calibrate
+
+
+def test_the_motion_truth_is_not_the_simulated_linkage():
+    """The rig's crank runs MOTION_SPEED_FACTOR faster than the simulated crank: a straight
+    crank angle at 120 rpm gives the rig 120.6 rpm, within a drive's 1 % tolerance."""
+    t = np.linspace(0.0, 0.75, 400)
+    phi = 30.0 + 2 * np.pi * 2.0 * t  # 120 rpm
+    motion = xr.Dataset({"crank_angle": ("time", np.angle(np.exp(1j * phi)))}, {"time": t})
+    rpm = demo.rig_speed_rpm(motion)
+    assert rpm == pytest.approx(120.0 * demo.MOTION_SPEED_FACTOR, rel=1e-9)
+    assert rpm != pytest.approx(120.0, rel=1e-3) and abs(rpm / 120.0 - 1) <= 0.01
+    # the report says what the footage is: the rig's kinematics at another speed
+    assert "faster than the simulated one" in demo.SYNTHETIC_NOTE
+
+
+#: Small enough for CI: a 5 x 24 bore, 2e4 cycles (ΔN 1250), calibrated at 1e4.
+SMALL = dataclasses.replace(
+    demo.FULL,
+    cycles=2e4,
+    snapshots=(2e4,),
+    n_layers=5,
+    n_points=24,
+    instrument_points=720,
+    rig_size=None,
+    verification_replicates=2,
+    calibration_cycles=1e4,
+    training_runs=10,
+    prediction_runs=3,
+)
+
+
+@pytest.mark.slow
+def test_calibrated_on_one_snapshot_validated_on_the_other(tmp_path):
+    """The whole step at reduced size: the synthetic bore (the model's map 10 % deeper, turned
+    6 degree) scanned at 1e4 and 2e4 cycles; kw calibrated on the 1e4 map comes out above the
+    nominal (the truth wears more), the prediction is compared with the 2e4 map, and the 1e4
+    map is refused as validation data."""
+    from jointwear.compare import as_ensemble, compare
+    from jointwear.reports.demo_studies import wear_verification
+    from jointwear.sim import DEFAULT_KW, simulate_wear
+
+    params = demo._params(SMALL)
+    wear = simulate_wear(
+        params, cycles=SMALL.cycles, snapshots=[SMALL.cycles], settings=main_wear_settings(SMALL)
+    )
+    sim_path = demo._save_wear(tmp_path, SMALL, params, wear, 0.0)
+    validation, early = demo._measured(tmp_path, sim_path, SMALL, params, True)
+    assert io.load(early).attrs["cycles"] == SMALL.calibration_cycles
+    assert io.load(validation).attrs["cycles"] == SMALL.cycles
+    study, _ = wear_verification(params, SMALL, tmp_path)
+    step = calibrate_and_predict(tmp_path, SMALL, params, early, study, say=lambda _: None)
+    post = io.load(step.posterior, validate=False)
+    mean, ratio = float(post["posterior_mean"].values[0]), float(post["width_ratio"].values[0])
+    # the truth wears 10 % more than the nominal model: kw comes out above nominal, informed
+    assert DEFAULT_KW < mean < 1.3 * DEFAULT_KW and ratio < 0.5, (mean / DEFAULT_KW, ratio)
+    sims, sim_ds, ens_paths, ens_ds = with_prediction(step, [sim_path], [validation], [], [])
+    assert sims == [step.prediction] and ens_paths == [step.prediction]
+    result = compare(
+        sim_ds,
+        [io.load(validation)],
+        ensemble=as_ensemble(ens_ds, ["prediction.nc"]),
+        verification=[io.load(study, validate=False)],
+    )
+    assert "max_wear_depth" in set(result.decisions.key)
+    with pytest.raises(BadInputError, match="calibration data never validate"):
+        with_prediction(step, [sim_path], [early], [], [])
