@@ -38,7 +38,14 @@ from typing import TYPE_CHECKING, TextIO
 if TYPE_CHECKING:
     from collections.abc import Sequence
 
-__all__ = ["GROUPS", "ensure_compiled", "needs_kernels", "stamp_path", "warm_up"]
+__all__ = [
+    "GROUPS",
+    "ensure_compiled",
+    "light_cache_loads",
+    "needs_kernels",
+    "stamp_path",
+    "warm_up",
+]
 
 #: The command groups (and commands) whose commands call numba kernels.
 GROUPS = frozenset({"demo", "sim", "dic", "datasets"})
@@ -319,6 +326,7 @@ class _Progress:
         self.n_done = 0
         self.failed: list[dict] = []
         self._last = 0.0
+        self._said = ""
         total = sum(k[3] for k in kernels)
         print(
             f"jointwear: compiling the numerical kernels once for this installation "
@@ -364,12 +372,15 @@ class _Progress:
         )
 
     def show(self) -> None:
-        """On a terminal, the line rewritten in place; otherwise a line every 15 s."""
+        """On a terminal, the line rewritten in place; otherwise a new line when more kernels
+        are done (at most every 15 s), and once a minute while none is."""
         now = time.perf_counter()
-        if not self.tty and now - self._last < 15.0:
-            return
-        self._last = now
         text = self.line()
+        if not self.tty:  # a log: a line when a kernel is done (at most every 15 s), or a minute on
+            fresh = text.split(";")[0] != self._said.split(";")[0]
+            if now - self._last < (15.0 if fresh else 60.0):
+                return
+        self._last, self._said = now, text
         try:
             if self.tty:
                 self.stream.write("\r\033[K" + text[:200])
@@ -393,6 +404,40 @@ class _Progress:
             self.stream.flush()
         except (OSError, ValueError):
             pass
+
+
+def light_cache_loads() -> None:
+    """numba's cache loads without first building its whole compiler (CLI processes).
+
+    Before loading a cached kernel numba refreshes its compiler: it imports every typing and
+    lowering module it has (``numba.np.arraymath`` alone imports ``scipy.linalg`` to see whether
+    BLAS is there) and installs them, about 0.35 CPU s here, half of the start-up of a command
+    that computes. A cached kernel needs none of it: its machine code, numba's C helpers (loaded
+    with the target context) and the runtime (``rtsys.initialize``, done here). A cache miss
+    refreshes as numba does before its compilation (which refreshes again by itself), and any
+    error here falls back to numba's own load.
+    """
+    from numba.core import caching
+
+    original = caching.Cache.load_overload
+    if getattr(original, "light", False):
+        return
+
+    def load_overload(self, sig, target_context):
+        try:
+            from numba.core.runtime import rtsys
+
+            rtsys.initialize(target_context)
+            with self._guard_against_spurious_io_errors():
+                loaded = self._load_overload(sig, target_context)
+        except Exception:  # not as this numba expects: its own way
+            return original(self, sig, target_context)
+        if loaded is None:  # a miss: numba compiles next, on a refreshed compiler
+            target_context.refresh()
+        return loaded
+
+    load_overload.light = True
+    caching.Cache.load_overload = load_overload
 
 
 # --- in the worker process -------------------------------------------------------------------
