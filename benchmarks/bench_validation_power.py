@@ -11,18 +11,21 @@ truth), each with its own ensemble and u_num, and the right model's map turned b
 Figures: per truth and candidate, the detection probability of each wear criterion and the
 any-fail rate (the right model's = its false-fail rate); see :mod:`jointwear.reports.power`.
 
-The size (``BENCH_SIZE``: 1e4 cycles on 10 x 36 points, 10 replicates, 4-run ensembles, a
-4-level study, two grid runs) is what the shared 2-core machine allowed; it is written with the results.
-Results are written after each truth (a stopped run keeps the truths it finished).
+The size (``BENCH_SIZE``: 4e5 cycles on 10 x 36 points, 20 replicates, 6-run ensembles, a
+4-level study, two grid runs) is what the shared 2-core machine allowed; it is written with the
+results. Results are written after each truth; every run and scan is kept in ``--cache``, so a
+stopped benchmark resumes and a change of the criteria re-decides without simulating.
 
 Writes ``benchmarks/results/validation_power.json``.
 """
 
 from __future__ import annotations
 
+import argparse
 import logging
 import os
 import sys
+import tempfile
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
@@ -33,6 +36,15 @@ from jointwear.reports.power import BENCH_SIZE, run_power  # noqa: E402
 
 
 def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument(
+        "--cache",
+        type=Path,
+        default=Path(tempfile.gettempdir()) / "jointwear_validation_power",
+        help="folder of the runs and scans (kept: a stopped run resumes, a criterion change "
+        "re-decides without simulating)",
+    )
+    args = parser.parse_args()
     logging.disable(logging.WARNING)  # the adaptive update's noise warnings, once per run
 
     def save(result: dict) -> None:
@@ -42,7 +54,7 @@ def main() -> None:
             {**result, "load_1min": load, "note": "2-core machine shared with other jobs"},
         )
 
-    run_power(BENCH_SIZE, progress=lambda m: print(m, flush=True), on_truth=save)
+    run_power(BENCH_SIZE, folder=args.cache, progress=lambda m: print(m, flush=True), on_truth=save)
 
 
 if __name__ == "__main__":

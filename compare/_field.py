@@ -93,12 +93,19 @@ class FieldTest:
 
 
 def mahalanobis_test(
-    e: np.ndarray, cov: np.ndarray, alpha: float, s: np.ndarray | None = None
+    e: np.ndarray,
+    cov: np.ndarray,
+    alpha: float,
+    s: np.ndarray | None = None,
+    estimated: tuple[np.ndarray, int] | None = None,
 ) -> FieldTest:
     """Mahalanobis distance of ``e`` with covariance ``cov``, decided at false-fail rate ``alpha``.
 
     Components whose variance is below ``1e-12`` of the largest are dropped (a pseudo-inverse):
-    ``cov`` may be singular (shares summing to 1).
+    ``cov`` may be singular (shares summing to 1). ``estimated = (dev, nu)``: the part of
+    ``cov`` that is a sample covariance, ``devᵀ dev`` with ``dev`` the ``n`` members' deviations
+    from their mean over ``sqrt(nu)`` (``nu = n - 1``); its estimation error is then part of the
+    limit (:func:`_estimated_limit`), not only χ².
     """
     lam, vec = np.linalg.eigh(0.5 * (cov + cov.T))
     keep = lam > 1e-12 * max(float(lam.max()), 0.0)
@@ -107,11 +114,54 @@ def mahalanobis_test(
     d2 = float(np.sum(proj**2 / lam))
     dof = int(keep.sum())
     thr = float(stats.chi2.ppf(1.0 - alpha, dof)) if dof else float("nan")
+    p_value = float(stats.chi2.sf(d2, dof)) if dof else float("nan")
+    if estimated is not None and dof and estimated[0].shape[0] >= 2:
+        draws = _estimated_null(vec, lam, *estimated)
+        thr = float(np.quantile(draws, 1.0 - alpha))
+        p_value = float(np.mean(draws > d2))
     res = float("nan")
     if s is not None and dof:
         ss = float(np.sum((vec.T @ s) ** 2 / lam))
         res = float(np.sqrt(thr / ss)) if ss > 0 else float("inf")
-    return FieldTest(d2, dof, thr, float(stats.chi2.sf(d2, dof)) if dof else float("nan"), res)
+    return FieldTest(d2, dof, thr, p_value, res)
+
+
+#: parametric-bootstrap draws of D² when part of the covariance is estimated (fixed seed: a
+#: comparison's verdict is reproducible)
+NULL_DRAWS = 4000
+NULL_SEED = 36
+
+
+def _estimated_null(vec: np.ndarray, lam: np.ndarray, dev: np.ndarray, nu: int) -> np.ndarray:
+    """Draws of D² under the hypothesis that the model is right, with the ensemble's part of the
+    covariance estimated from ``n = dev.shape[0]`` members, as the comparison estimates it.
+
+    A parametric bootstrap (Efron & Tibshirani 1993, ch. 6): in the kept components, the
+    ensemble's part ``A = devᵀ dev`` (``dev`` already over ``sqrt(nu)``) and the known rest
+    ``R = diag(lam) - A``; each draw makes a new ensemble of ``n`` members from ``N(0, A)``, its
+    sample covariance ``A*`` (``nu`` degrees of freedom), a difference ``e* ~ N(0, A + R)`` and
+    ``D²* = e*ᵀ (A* + R)⁻¹ e*``. With ``R = 0`` this is Hotelling's T² with ``(K, nu)``, whose
+    limit is ``K nu / (nu - K + 1) F(K, nu - K + 1)`` (Hotelling 1931; tested); with a large
+    ensemble it tends to χ²(K).
+    """
+    rng = np.random.default_rng(NULL_SEED)
+    root = vec.T @ dev.T  # (K, n): A = root rootᵀ
+    k, n = root.shape
+    a = root @ root.T
+    rest = np.diag(lam) - a
+    w, v = np.linalg.eigh(0.5 * (rest + rest.T))
+    rest_root = v * np.sqrt(np.clip(w, 0.0, None))
+    fake = root @ rng.standard_normal((NULL_DRAWS, n, n))  # members as columns (NULL_DRAWS, K, n)
+    fake -= fake.mean(axis=2, keepdims=True)
+    a_star = fake @ fake.transpose(0, 2, 1) / nu
+    e = root @ rng.standard_normal((n, NULL_DRAWS)) + rest_root @ rng.standard_normal(
+        (k, NULL_DRAWS)
+    )
+    e = e.T[:, :, None]
+    c_star = a_star + rest
+    floor = 1e-12 * float(lam.max()) * np.eye(k)
+    sol = np.linalg.solve(c_star + floor, e)
+    return np.sum(e * sol, axis=(1, 2))
 
 
 def _bins(n: int, k: int) -> list[np.ndarray]:
@@ -177,9 +227,13 @@ class Features:
 class _Parts:
     cov: np.ndarray
     basis: str
+    estimated: tuple[np.ndarray, int] | None = None
 
 
-def _input_part(c, feature: Features, fs: np.ndarray) -> tuple[np.ndarray | None, str]:
+def _input_part(
+    c, feature: Features, fs: np.ndarray
+) -> tuple[np.ndarray | None, str, np.ndarray | None]:
+    """(C_input, its basis, the members' deviations over sqrt(n - 1) when it is estimated)."""
     ens = c.al.get("wear_depth_sim_ensemble")
     members = (
         [] if ens is None else [m for m in np.asarray(ens.values, float) if np.isfinite(m).any()]
@@ -191,17 +245,27 @@ def _input_part(c, feature: Features, fs: np.ndarray) -> tuple[np.ndarray | None
         dev = x - x.mean(axis=0)
         if not feature.shares:  # a reduced ensemble: its deviations scaled to the compared total
             dev = dev * (np.sum(fs) / np.sum(x.mean(axis=0)))
-        return dev.T @ dev / (
-            len(x) - 1
-        ), f"C_input: sample covariance of {len(x)} ensemble members"
-    if rel is not None and not feature.shares:
-        return rel**2 * np.outer(fs, fs), f"C_input: user-stated {rel:g}·s as a common scale"
-    if rel is not None:
-        return None, (
-            "a stated wear_u_input_rel is a common scale, which says nothing of the form's input "
-            "uncertainty: give an ensemble that keeps its wear maps (--ensemble)"
+        dev = dev / np.sqrt(len(x) - 1)
+        return (
+            dev.T @ dev,
+            (
+                f"C_input: sample covariance of {len(x)} ensemble members (its estimation error in "
+                "the limit)"
+            ),
+            dev,
         )
-    return None, "no ensemble that keeps its wear maps (--ensemble) and no wear_u_input_rel"
+    if rel is not None and not feature.shares:
+        return rel**2 * np.outer(fs, fs), f"C_input: user-stated {rel:g}·s as a common scale", None
+    if rel is not None:
+        return (
+            None,
+            (
+                "a stated wear_u_input_rel is a common scale, which says nothing of the form's input "
+                "uncertainty: give an ensemble that keeps its wear maps (--ensemble)"
+            ),
+            None,
+        )
+    return None, "no ensemble that keeps its wear maps (--ensemble) and no wear_u_input_rel", None
 
 
 def _study_rel(c) -> float | None:
@@ -221,7 +285,7 @@ def _covariance(c, feature: Features) -> tuple[_Parts | None, str]:
 
     al, s, d, crit = c.al, c.s, c.d, c.criteria
     fs = feature(s)
-    c_in, note = _input_part(c, feature, fs)
+    c_in, note, dev = _input_part(c, feature, fs)
     if c_in is None:
         return None, note
     parts, notes = [c_in], [note]
@@ -253,7 +317,8 @@ def _covariance(c, feature: Features) -> tuple[_Parts | None, str]:
     if crit.probe_u_m is not None and not feature.shares:
         parts.append(crit.probe_u_m**2 * np.ones((fs.size, fs.size)))
         notes.append(f"offset {crit.probe_u_m * 1e6:.3g} µm")
-    return _Parts(sum(parts), "; ".join(notes)), ""
+    estimated = (dev, dev.shape[0] - 1) if dev is not None else None
+    return _Parts(sum(parts), "; ".join(notes), estimated), ""
 
 
 def _decide(c, key: str, label: str, feature: Features, what: str) -> None:
@@ -262,8 +327,9 @@ def _decide(c, key: str, label: str, feature: Features, what: str) -> None:
     feature = feature.where(c.s, c.d)
     fs, fd = feature(c.s), feature(c.d)
     criterion = (
-        f"Mahalanobis D² <= chi²(1 - {alpha:g}, K) over the principal components of C_input + "
-        f"C_num + C_D ({what}; false-fail rate {alpha:.0%})"
+        f"Mahalanobis D² <= its 1 - {alpha:g} limit over the principal components of C_input + "
+        f"C_num + C_D (chi²(K); with an ensemble's sample covariance, its estimation error "
+        f"included by parametric bootstrap) ({what}; false-fail rate {alpha:.0%})"
     )
     if not (np.all(np.isfinite(fs)) and np.all(np.isfinite(fd))):
         c.decisions.append(
@@ -278,10 +344,18 @@ def _decide(c, key: str, label: str, feature: Features, what: str) -> None:
                      key=key)
         )  # fmt: skip
         return
-    test = mahalanobis_test(fs - fd, parts.cov, alpha, None if feature.shares else fs)
+    test = mahalanobis_test(
+        fs - fd, parts.cov, alpha, None if feature.shares else fs, parts.estimated
+    )
     c.rows.add(key, "mahalanobis_d2", test.d2, "1", parts.basis)
     c.rows.add(key, "mahalanobis_dof", float(test.dof), "1")
-    c.rows.add(key, "mahalanobis_threshold", test.threshold, "1", f"chi2(1 - {alpha:g})")
+    limit = (
+        f"parametric bootstrap, 1 - {alpha:g} quantile, the ensemble's {parts.estimated[1] + 1} "
+        "members re-drawn"
+        if parts.estimated is not None
+        else f"chi2(1 - {alpha:g})"
+    )
+    c.rows.add(key, "mahalanobis_threshold", test.threshold, "1", limit)
     c.rows.add(key, "mahalanobis_p", test.p_value, "1")
     resolution = f"detects D² > {test.threshold:.3g} (K = {test.dof})"
     if not feature.shares and np.isfinite(test.scale_resolution):

@@ -268,64 +268,6 @@ class WearCase:
         return self.src.criteria
 
 
-def turn_resolution(s: np.ndarray, theta_deg: np.ndarray, r_min: float) -> float:
-    """The smallest turn of the pattern ``s`` that the shape criterion detects [degree].
-
-    The Pearson r of ``s`` against itself turned by whole grid steps, both ways; the first turn
-    at which r falls below ``r_min`` (linear between steps), the larger of the two directions.
-    NaN when no turn up to 180 degree brings r below ``r_min``.
-    """
-    n = s.shape[1]
-    step = 360.0 / n if n else float("nan")
-    out = []
-    for sign in (1, -1):
-        prev_r, found = 1.0, float("nan")
-        for k in range(1, n // 2 + 1):
-            r = mt.pearson_r(s, np.roll(s, sign * k, axis=1))
-            if not np.isfinite(r):
-                break
-            if r < r_min:
-                found = step * (k - 1 + (prev_r - r_min) / (prev_r - r))
-                break
-            prev_r = r
-        out.append(found)
-    return float(max(out)) if all(np.isfinite(out)) else float("nan")
-
-
-def shape_criterion(c: WearCase) -> None:
-    """Wear map shape: Pearson r >= ``wear_r_min``, scale-invariant (NRMSE shown, not decided).
-
-    NRMSE (RMSE / range of D) cannot fail a scaled map: a map whose rms is 0.09 of its range
-    gives NRMSE < 0.25 even for a zero prediction, so only r ever decided. The criterion says so:
-    it judges the pattern, not its size (the maximum depth, worn volume and wear field judge the
-    size), and states as its resolution the turn of the simulated pattern it detects.
-    """
-    criteria, nr, r = c.criteria, mt.nrmse(c.s, c.d), mt.pearson_r(c.s, c.d)
-    th = np.asarray(c.al["theta"].values)
-    turn = turn_resolution(c.s, th, criteria.wear_r_min)
-    c.rows.add("wear_depth", "detectable_turn", turn, "degree", "r(S, S turned) = wear_r_min")
-    resolution = (
-        f"scale-invariant (any scale of the same pattern passes); detects a turn of the "
-        f"pattern beyond ±{turn:.0f} degree"
-        if np.isfinite(turn)
-        else "scale-invariant; no turn of this pattern brings r below wear_r_min"
-    )
-    c.decisions.append(
-        decision(
-            f"wear map shape {c.band}",
-            f"r >= {criteria.wear_r_min:g} (Pearson; scale-invariant, the pattern not its size)",
-            f"r = {r:.3g} (NRMSE = {nr:.3g}, shown, not decided)",
-            vd.NOT_COMPARABLE
-            if c.whole_nc
-            else threshold_state(bool(r >= criteria.wear_r_min), bool(np.isfinite(r))),
-            "threshold",
-            c.whole_nc,
-            key="wear_depth",
-            resolution=resolution,
-        )
-    )
-
-
 def angle_criterion(c: WearCase) -> None:
     """Angle of the maximum wear against ``max_angle_error_deg``."""
     ts, td = c.sim_max[2], c.meas_max[2]

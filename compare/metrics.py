@@ -141,10 +141,21 @@ DEFINITIONS: dict[str, tuple[str, str, str]] = {
     "time_shift_u": ("standard uncertainty of the time shift", "u of time_shift", "same"),
     "phase_shift": ("phase of the motion alignment", "time_shift / period * 360", "same"),
     "phase_shift_u": ("standard uncertainty of the phase", "u of phase_shift", "same"),
+    "pearson_r_alpha": (
+        "lower quantile of the Pearson r if the model is right",
+        "the field_false_fail_rate quantile of r(S, S + e), e drawn from the comparison's "
+        "C_input, u_num and u_D (Monte Carlo): the shape criterion fails below min(wear_r_min, it)",
+        "1",
+    ),
+    "pearson_r_u": (
+        "standard uncertainty of the Pearson r if the model is right",
+        "standard deviation of r(S, S + e) over the same draws",
+        "1",
+    ),
     "detectable_turn": (
         "smallest detectable turn of the wear pattern",
         "the turn of the simulated map (both ways, the larger) at which its Pearson r with "
-        "itself falls to wear_r_min: the resolution of the shape criterion",
+        "itself falls to the shape criterion's limit, min(wear_r_min, r_alpha): its resolution",
         "degree",
     ),
     "mahalanobis_d2": (

@@ -70,8 +70,8 @@ _VV20 = "detectable relative errors, both ways (detectable_error_low/high)"
 
 #: the criteria table, in the order of the decision card
 CRITERIA: tuple[Criterion, ...] = (
-    Criterion("wear_shape", "wear", f"{_WEAR}:shape_criterion", "threshold",
-              "none stated: NRMSE and r against thresholds"),
+    Criterion("wear_shape", "wear", "jointwear.compare._shape:shape_criterion", "threshold",
+              "the turn of the pattern that brings r below min(wear_r_min, r_alpha)"),
     Criterion("max_wear_angle", "wear", f"{_WEAR}:angle_criterion", "threshold",
               "the threshold itself (max_angle_error_deg)"),
     Criterion("max_wear_z", "wear", f"{_WEAR}:axial_criterion", "threshold",
