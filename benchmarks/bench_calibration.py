@@ -3,8 +3,8 @@
 Truth: the rig with ``joint.tilt_stiffness = 1000`` N m/rad and kw = 1.15 x the default (on a
 reduced bore grid and few cycles, so that the whole study fits a shared 2-core machine: the
 size is stated in the JSON). Each replicate starts the truth at another crank angle (phase)
-and adds its own measurement noise (1 % of the peak depth per point, stated as the map's
-``wear_depth_u``); kw is calibrated (prior uniform ±50 % around the default, the model's form
+and adds its own measurement noise (1 % of the peak depth per point, independent from point to
+point, stated as the map's ``wear_depth_u`` and ``wear_depth_u_random``); kw is calibrated (prior uniform ±50 % around the default, the model's form
 right) on the early snapshot's band quantities. Figures:
 
 * coverage: the share of replicates whose 95 % posterior interval holds the true kw;
@@ -40,25 +40,73 @@ from _common import write_results  # noqa: E402
 from jointwear import io  # noqa: E402
 
 QUICK = "--quick" in sys.argv
-SIZE = {
-    "replicates": 3 if QUICK else 10,
-    "n_layers": 5 if QUICK else 7,
-    "n_points": 24 if QUICK else 36,
-    "calibration_cycles": 200 if QUICK else 400,
-    "validation_cycles": 400 if QUICK else 800,
-    "training_runs": 40,
-    "prediction_runs": 4 if QUICK else 8,
-    "wear_update": "fixed dn = 100 cycles",
+
+
+def _arg(name: str, default: str) -> str:
+    """``--name VALUE`` from the command line, else ``default``."""
+    return sys.argv[sys.argv.index(name) + 1] if name in sys.argv else default
+
+
+#: sizes: "quick" (CI), "reduced" (a 7 x 36 bore, fixed dn = 100, 400/800 cycles) and "full"
+#: (the default bore and wear scheme, calibrated after 2e5 cycles, validated after 4e5: the
+#: issue's size)
+SIZES = {
+    "quick": {
+        "replicates": 3,
+        "n_layers": 5,
+        "n_points": 24,
+        "calibration_cycles": 200,
+        "validation_cycles": 400,
+        "training_runs": 40,
+        "prediction_runs": 4,
+        "wear_update": "fixed dn = 100 cycles",
+    },
+    "reduced": {
+        "replicates": 10,
+        "n_layers": 7,
+        "n_points": 36,
+        "calibration_cycles": 400,
+        "validation_cycles": 800,
+        "training_runs": 40,
+        "prediction_runs": 8,
+        "wear_update": "fixed dn = 100 cycles",
+    },
+    "full": {
+        "replicates": 10,
+        "n_layers": None,
+        "n_points": None,
+        "calibration_cycles": 200000,
+        "validation_cycles": 400000,
+        "training_runs": 24,
+        "prediction_runs": 4,
+        "wear_update": "the default (adaptive)",
+    },
 }
-TILT, KW_FACTOR, NOISE, U_NUM_REL = 1000.0, 1.15, 0.01, 0.02
+SIZE_NAME = "quick" if QUICK else _arg("--size", "reduced")
+SIZE = dict(SIZES[SIZE_NAME])
+#: the truths (not the default rig): the rig each differs by, besides kw
+TRUTHS = {
+    "tilt1000": {"joint.tilt_stiffness": 1000.0},
+    "clearance0.7": {"joint.journal_radius": 7.3e-3},  # radial clearance 0.7 mm (default 0.5)
+}
+TRUTH = _arg("--truth", "tilt1000")
+KW_FACTOR, NOISE, U_NUM_REL = 1.15, 0.01, 0.02
 
 
-def base_toml(size: dict[str, Any], tilt: float = TILT) -> str:
-    return (
-        f"[joint]\nn_layers = {size['n_layers']}\nn_points = {size['n_points']}\n"
-        f"tilt_stiffness = {tilt}\n"
+def base_toml(size: dict[str, Any], truth: str = TRUTH, tilt: float | None = None) -> str:
+    """The rig of ``truth`` at ``size`` (``tilt``: another tilt stiffness, the wrong form)."""
+    joint = {k.split(".")[1]: v for k, v in TRUTHS[truth].items()}
+    if tilt is not None:
+        joint["tilt_stiffness"] = tilt
+    if size["n_layers"] is not None:
+        joint.update(n_layers=size["n_layers"], n_points=size["n_points"])
+    lines = "".join(f"{k} = {v!r}\n" for k, v in joint.items())
+    wear = (
         '[wear]\nscheme = "fixed"\ndn = 100\nsettle_cycles = 0.25\ninitial_settle_cycles = 0.5\n'
+        if size["n_layers"] is not None
+        else ""
     )
+    return f"[joint]\n{lines}{wear}"
 
 
 def truth_maps(folder: Path, size: dict[str, Any], rep: int, kw: float) -> tuple[Path, Path]:
@@ -66,15 +114,18 @@ def truth_maps(folder: Path, size: dict[str, Any], rep: int, kw: float) -> tuple
     from jointwear.params import from_mapping, read_toml
     from jointwear.sim import WearSettings, load_parameters, simulate_wear
 
+    c1, c2 = size["calibration_cycles"], size["validation_cycles"]
+    done = [folder / f"truth-{rep}-{c}.nc" for c in (c1, c2)]
+    if all(p.is_file() for p in done):  # a kept study folder (--folder): the truth as made
+        return done[0], done[1]
     base = folder / "base.toml"
     p = load_parameters(base)
     p = dataclasses.replace(
         p, mechanism=dataclasses.replace(p.mechanism, initial_crank_angle_deg=37.0 * rep)
     )
     w = dataclasses.replace(
-        from_mapping(WearSettings, read_toml(base)["wear"], where="wear"), kw=kw
+        from_mapping(WearSettings, read_toml(base).get("wear", {}), where="wear"), kw=kw
     )
-    c1, c2 = size["calibration_cycles"], size["validation_cycles"]
     ds = simulate_wear(p, cycles=c2, settings=w, snapshots=[c1, c2])
     paths = []
     for c in (c1, c2):
@@ -86,6 +137,9 @@ def truth_maps(folder: Path, size: dict[str, Any], rep: int, kw: float) -> tuple
         m["wear_depth_u"] = (m["wear_depth"] * 0 + u).assign_attrs(
             units="m", long_name="standard uncertainty of wear_depth", coverage_factor=1
         )
+        m["wear_depth_u_random"] = m["wear_depth_u"].assign_attrs(
+            long_name="independent (point-to-point random) part of wear_depth_u"
+        )  # the noise is independent from point to point: all of the u
         m.attrs = {"data_origin": "synthetic", "cycles": c, "bearing_radius_m": 8e-3}
         path = folder / f"truth-{rep}-{c}.nc"
         io.save(m, path)
@@ -123,7 +177,7 @@ def wrong_form(folder: Path, size: dict[str, Any], early: Path, late: Path, kw0:
     from jointwear.sim.calibrate import calibrate, predict
 
     wrong = folder / "wrong"
-    wrong.mkdir()
+    wrong.mkdir(exist_ok=True)
     for f in (early, late):
         shutil.copy(f, wrong / f.name)
     (wrong / "base.toml").write_text(base_toml(size, tilt=0.0))
@@ -131,7 +185,9 @@ def wrong_form(folder: Path, size: dict[str, Any], early: Path, late: Path, kw0:
     spec.write_text(spec_text(early, size, kw0))
     out: dict[str, Any] = {"joint.tilt_stiffness": 0.0}
     try:
-        ds = calibrate(spec, out=wrong / "post.nc", params=wrong / "base.toml", workers=0)
+        ds = calibrate(
+            spec, out=wrong / "post.nc", params=wrong / "base.toml", workers=0, resume=True
+        )
     except BadInputError as exc:  # refused: the wrong form cannot fit the calibration data
         return out | {"calibration": f"refused: {exc}", "failed": None}
     out["posterior_kw_mean"] = float(ds["posterior_mean"][0])
@@ -160,7 +216,7 @@ def prior_side(folder: Path, size: dict[str, Any], kw0: float) -> tuple[Path, Pa
         "parameters": {"wear.kw": {"distribution": "uniform", "bounds": [0.5 * kw0, 1.5 * kw0]}},
     }
     ens = folder / "prior-ensemble.nc"
-    run_sweep(sweep, out=ens, params=folder / "base.toml", workers=0)
+    run_sweep(sweep, out=ens, params=folder / "base.toml", workers=0, resume=True)
     from jointwear.sim.sweep._spec import read_spec
 
     sim, wear, record, _ = _base(read_spec(sweep), folder / "base.toml", None)
@@ -170,16 +226,20 @@ def prior_side(folder: Path, size: dict[str, Any], kw0: float) -> tuple[Path, Pa
     return path, ens
 
 
-def run(size: dict[str, Any], folder: Path) -> dict[str, Any]:
+def run(
+    size: dict[str, Any], folder: Path, truth: str = TRUTH, with_wrong_form: bool = True
+) -> dict[str, Any]:
+    """The study at ``size`` on ``truth`` in ``folder`` (a kept folder's truths and design are
+    reused: the training runs and the truth do not depend on the likelihood)."""
     from jointwear.sim.calibrate import calibrate, predict
     from jointwear.sim.calibrate._run import design_path
     from jointwear.sim.wear._settings import DEFAULT_KW
 
-    (folder / "base.toml").write_text(base_toml(size))
+    (folder / "base.toml").write_text(base_toml(size, truth))
     kw_true = KW_FACTOR * DEFAULT_KW
     covered, widths, cpu_cal, means = [], [], [], []
     design_cpu = float("nan")
-    first_design = None
+    master = folder / "design-master.nc"  # the training runs do not depend on the data
     reps = []
     for rep in range(size["replicates"]):
         early, late = truth_maps(folder, size, rep, kw_true)
@@ -187,24 +247,32 @@ def run(size: dict[str, Any], folder: Path) -> dict[str, Any]:
         spec.write_text(spec_text(early, size, DEFAULT_KW))
         post = folder / f"post-{rep}.nc"
         design = design_path(post, size["calibration_cycles"])
-        if first_design is not None:  # the training runs do not depend on the data
-            shutil.copy(first_design, design)
+        if master.is_file():
+            shutil.copy(master, design)
         t0 = time.process_time()
         ds = calibrate(spec, out=post, params=folder / "base.toml", workers=0, resume=True)
         cpu = time.process_time() - t0
-        if first_design is None:
-            first_design, design_cpu = design, cpu
+        if not master.is_file():
+            shutil.copy(design, master)
+            design_cpu = cpu
         else:
             cpu_cal.append(cpu)
         lo, hi = float(ds["posterior_q025"][0]), float(ds["posterior_q975"][0])
+        mean, sd = float(ds["posterior_mean"][0]), float(ds["posterior_sd"][0])
         covered.append(lo <= kw_true <= hi)
-        widths.append(float(ds["posterior_sd"][0] / ds["posterior_mean"][0]))
-        means.append(float(ds["posterior_mean"][0]))
-        reps.append({"kw_q025": lo, "kw_q975": hi, "covered": covered[-1], "late": late})
+        widths.append(sd / mean)
+        means.append(mean)
+        reps.append(
+            {
+                "kw_q025": lo,
+                "kw_q975": hi,
+                "covered": bool(covered[-1]),
+                "z": (mean - kw_true) / sd,
+                "phase_deg": (37.0 * rep) % 360.0,
+            }
+        )
     # validation at the later snapshot of replicate 0: prior ensemble vs posterior prediction
-    late = reps[0].pop("late")
-    for r in reps[1:]:
-        r.pop("late")
+    late = folder / f"truth-0-{size['validation_cycles']}.nc"
     mean_run, prior_ens = prior_side(folder, size, DEFAULT_KW)
     c2 = size["validation_cycles"]
     before = u_val_ratio(folder, mean_run, late, [prior_ens], c2)
@@ -214,11 +282,15 @@ def run(size: dict[str, Any], folder: Path) -> dict[str, Any]:
     cpu_pred = time.process_time() - t0
     after = u_val_ratio(folder, pred, late, [], c2)
     early0 = folder / f"truth-0-{size['calibration_cycles']}.nc"
-    wrong = wrong_form(folder, size, early0, late, DEFAULT_KW)
+    wrong = (
+        wrong_form(folder, size, early0, late, DEFAULT_KW)
+        if with_wrong_form and truth == "tilt1000"
+        else "not run at this size (see the reduced size's figures)"
+    )
     prior_sd_over_mean = (1.0 / np.sqrt(3)) * 0.5  # uniform ±50 %: sd = width / sqrt(12)
     return {
         "size": size,
-        "truth": {"joint.tilt_stiffness": TILT, "wear.kw": kw_true, "kw_factor": KW_FACTOR},
+        "truth": TRUTHS[truth] | {"name": truth, "wear.kw": kw_true, "kw_factor": KW_FACTOR},
         "coverage_95": float(np.mean(covered)),
         "replicates_covered": int(np.sum(covered)),
         "posterior_sd_over_mean_median": float(np.median(widths)),
@@ -232,21 +304,22 @@ def run(size: dict[str, Any], folder: Path) -> dict[str, Any]:
             "calibration_median": float(np.median(cpu_cal)) if cpu_cal else float("nan"),
             "prediction": cpu_pred,
         },
-        "replicates": [
-            {k: v for k, v in r.items() if k != "late"} | {"covered": bool(r["covered"])}
-            for r in reps
-        ],
-        "note": "CPU times on a shared machine (see the load average); reduced rig and cycles",
+        "replicates": reps,
+        "z_rms": float(np.sqrt(np.mean([r["z"] ** 2 for r in reps]))),
+        "note": "CPU times on a shared machine (see the load average); size as stated",
     }
 
 
 def main() -> None:
-    folder = Path(tempfile.mkdtemp(prefix="bench-calibration-"))
+    keep = _arg("--folder", "")
+    folder = Path(keep) if keep else Path(tempfile.mkdtemp(prefix="bench-calibration-"))
+    folder.mkdir(parents=True, exist_ok=True)
     try:
-        figures = run(SIZE, folder)
+        figures = run(SIZE, folder, TRUTH, "--no-wrong-form" not in sys.argv)
     finally:
-        shutil.rmtree(folder, ignore_errors=True)
-    write_results("calibration_quick" if QUICK else "calibration", figures)
+        if not keep:
+            shutil.rmtree(folder, ignore_errors=True)
+    write_results("calibration_quick" if QUICK else f"calibration_{SIZE_NAME}_{TRUTH}", figures)
     json.dumps(figures)  # the figures are plain JSON
 
 

@@ -144,17 +144,9 @@ def _label(name: str, q: Mapping[str, Any]) -> str:
 
 def _baseline(rep: xr.Dataset, q: Mapping[str, Any]) -> str | None:
     """The new-bore cylindricity (cycles = 0, same reference and place) of a cylindricity."""
-    for name, var in rep.data_vars.items():
-        a = var.attrs
-        if (
-            a.get("kind") == "cylindricity"
-            and float(a.get("cycles", -1)) == 0.0
-            and a.get("reference") == q.get("reference")
-            and int(a.get("layer", -1)) == int(q.get("layer", -1))
-            and a.get("z_m") == q.get("z_m")
-        ):
-            return str(name)
-    return None
+    from jointwear.reported import new_bore_baseline
+
+    return new_bore_baseline(rep, q)
 
 
 def _measured(

@@ -53,6 +53,8 @@ __all__ = [
     "reported_dataset",
     "is_reported",
     "standard_uncertainty",
+    "new_bore_baseline",
+    "cylindricity_growth",
 ]
 
 #: the value of the top-level ``schema`` key this reader understands
@@ -532,3 +534,53 @@ def read_reported(path: str | Path) -> xr.Dataset:
 def is_reported(ds: xr.Dataset) -> bool:
     """True for a dataset of reported measurements (``jointwear_file = "reported"``)."""
     return isinstance(ds, xr.Dataset) and ds.attrs.get("jointwear_file") == "reported"
+
+
+def new_bore_baseline(ds: xr.Dataset, q: Mapping[str, Any]) -> str | None:
+    """The new bore's cylindricity of a cylindricity with attributes ``q``: the quantity of
+    ``ds`` at ``cycles = 0`` with the same reference and place (layer or z), or None."""
+    for other, var in ds.data_vars.items():
+        a = var.attrs
+        if (
+            a.get("kind") == "cylindricity"
+            and float(a.get("cycles", -1)) == 0.0
+            and a.get("reference") == q.get("reference")
+            and int(a.get("layer", -1)) == int(q.get("layer", -1))
+            and a.get("z_m") == q.get("z_m")
+        ):
+            return str(other)
+    return None
+
+
+def cylindricity_growth(ds: xr.Dataset, name: str) -> tuple[float, float, str]:
+    """The growth ``C(N) - C(0)`` of reported cylindricity ``name`` [m], its standard
+    uncertainty [m] (NaN: not assessed) and the basis of it.
+
+    Cylindricity does not add: the worn bore's value lies within ``C_wear ± C(0)``, so the
+    new-bore form enters as a rectangular term ``C(0)/sqrt(3)`` besides the two readings' own
+    uncertainties. Without the new bore's value (:func:`new_bore_baseline`) the growth is the
+    reported value and its uncertainty NaN (the wear's part cannot be separated).
+    """
+    c, u = float(ds[name].values), float(ds[f"{name}_u"].values)
+    base = new_bore_baseline(ds, ds[name].attrs)
+    if base is None:
+        return (
+            c,
+            float("nan"),
+            (
+                "the new bore's cylindricity is not reported (a cylindricity at cycles = 0, same "
+                "reference and place): the growth due to wear cannot be separated from the "
+                "initial form"
+            ),
+        )
+    c0, u0 = float(ds[base].values), float(ds[f"{base}_u"].values)
+    form = c0 / math.sqrt(3.0)
+    return (
+        c - c0,
+        math.sqrt(u**2 + u0**2 + form**2),
+        (
+            f"growth {name} - {base}: u = sqrt(u({name})^2 + u({base})^2 + (C0/sqrt(3))^2), the last "
+            "term because cylindricity does not add (the new bore's form may add to or cancel the "
+            "wear's)"
+        ),
+    )

@@ -56,6 +56,21 @@ class Emulator:
         """Error of the emulated mean, ``sqrt(max(cv_error² - scatter², 0))`` (n_q,)."""
         return np.sqrt(np.maximum(self.cv_error**2 - self.scatter**2, 0.0))
 
+    @property
+    def correlation(self) -> np.ndarray:
+        """Correlation of the runs' scatter between the quantities (n_q, n_q): that of the
+        leave-one-out residuals (a start phase that deepens the maximum need not add as much
+        volume), made positive semi-definite; 1 on the diagonal."""
+        r = self.cv_residuals
+        with np.errstate(invalid="ignore", divide="ignore"):
+            c = np.atleast_2d(np.corrcoef(r, rowvar=False))
+        c = np.where(np.isfinite(c), c, 0.0)
+        np.fill_diagonal(c, 1.0)
+        lam, vec = np.linalg.eigh(c)
+        c = (vec * np.maximum(lam, 0.0)) @ vec.T
+        d = np.sqrt(np.clip(np.diag(c), 1e-300, None))
+        return c / np.outer(d, d)
+
     def predict(self, x: np.ndarray) -> np.ndarray:
         """Emulated quantities at scaled inputs ``x`` (n, n_p) -> (n, n_q), in their units."""
         x = np.atleast_2d(x)

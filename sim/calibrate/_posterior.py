@@ -165,7 +165,10 @@ def to_dataset(
     ds["effective_sample_size"] = _var("parameter", chain.ess, "1", "effective sample size")
     ds["split_rhat"] = _var("parameter", chain.rhat, "1", "split-R-hat across walkers")
     du = [d.quantity for d in data]
-    dunits = ["m3" if q == "worn_volume" else ("m" if q in _M else "1") for q in du]
+    dunits = [
+        "m3" if q == "worn_volume" else ("m" if q in _M or q.startswith("wear_field_") else "1")
+        for q in du
+    ]
     unit = dunits[0] if len(set(dunits)) == 1 else "see each datum's quantity"
     for key, v, long in (
         ("measured", [d.value for d in data], "measured value"),

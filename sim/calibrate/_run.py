@@ -7,13 +7,15 @@ quantities (:mod:`jointwear.sim.calibrate._data`), trains the emulator
 (:mod:`~jointwear.sim.calibrate._sampler`) of the Gaussian likelihood
 
     ln L = -1/2 [r(x)ᵀ Σ(x)⁻¹ r(x) + ln det Σ(x)],   r = y - η(x),
-    Σ_ij = δ_ij (u_D,i² + u_emulator,i²) + ρ_ij u_num,i u_num,j,
+    Σ_ij = δ_ij (u_D,i² + u_emulator,i²) + T_ij (ρ_ij s_i s_j + b_i b_j),
 
-with u_D the datum's own uncertainty, u_num the numerical uncertainty (a ``sim verify`` study on
-the datum's band, or the stated ``u_num_rel``; the same sources compare uses; at least the
-training runs' own scatter) and u_emulator the emulator's cross-validated error. ρ_ij is 1 for
-two quantities of the same map (a start phase or an update interval that deepens the maximum
-also adds volume and cylindricity: they are not independent evidence), else 0. The emulator is trusted only inside its training range: the
+with u_D the datum's own uncertainty, u_emulator the emulator's cross-validated error, s the
+training runs' scatter (start phase, update intervals), and b = sqrt(max(u_num² - s², 0)) the
+numerical uncertainty beyond it (u_num: a ``sim verify`` study on the datum's band, or the
+stated ``u_num_rel``; the same sources compare uses). T_ij is 1 for two quantities of the same
+map, else 0 (different maps independent); within a map the scatter is correlated as the
+training runs' residuals are (ρ: a start phase that deepens the maximum adds less to the
+volume, measured 0.6-0.75), the rest fully. The emulator is trusted only inside its training range: the
 posterior is cut there (and refused where it would need more room than an unbounded prior
 allows). It refuses (``CalibrationRefused``, exit 3), naming the figure and the fix: an emulator
 error above ``emulator_max_fraction`` of a datum's u, a chain that did not converge, a datum
@@ -31,7 +33,7 @@ import numpy as np
 import xarray as xr
 
 from jointwear.errors import BadInputError
-from jointwear.sim.calibrate._data import Band, Datum, band_quantities, file_record, on_band
+from jointwear.sim.calibrate._data import Band, Datum, file_record, on_band
 from jointwear.sim.calibrate._spec import CalibrationSpec, read_calibration_spec
 
 __all__ = ["calibrate", "CalibrationRefused", "design_path"]
@@ -102,6 +104,7 @@ def _training(
             ["max_wear_depth"] if spec.run == "wear" else []
         )
         ds = run(_sweep_mapping(spec, cycles, outputs, maps), cycles)
+        reduced: dict[tuple[int, int], dict[str, float]] = {}
         ok = np.asarray(ds["status"].values) == 0
         if not ok.all():
             first = str(ds["error"].values[np.flatnonzero(~ok)[0]])
@@ -115,10 +118,11 @@ def _training(
                 continue
             col = np.full(ds.sizes["run"], np.nan)
             for r in np.flatnonzero(ok):
-                h = on_band(ds["wear_depth"].isel(run=r), bands[d.band])
-                col[r] = band_quantities(h, bands[d.band].z, bands[d.band].theta, radius)[
-                    d.quantity
-                ]
+                if (d.band, r) not in reduced:  # a band's quantities once per run
+                    b = bands[d.band]
+                    h = on_band(ds["wear_depth"].isel(run=r), b)
+                    reduced[d.band, r] = b.quantities(h, radius)
+                col[r] = reduced[d.band, r][d.quantity]
             columns[i] = col
     x = x_all[0]
     y = np.column_stack([columns[i] for i in range(len(data))])
@@ -147,7 +151,7 @@ def _u_num(spec: CalibrationSpec, data: list[Datum], verification: Sequence[Any]
             band = bands[d.band]
 
             def fn(run: xr.DataArray, band=band, q=d.quantity) -> float:
-                return band_quantities(on_band(run, band), band.z, band.theta, radius)[q]
+                return band.quantities(on_band(run, band), radius)[q]
 
             fit = study_uncertainty(verification[0], d.quantity, fn)
             u_run = float(getattr(fit, "u_num_run", np.nan))
@@ -240,7 +244,7 @@ def calibrate(
     )
     radius = float(sim.joint.bearing_radius) if sim is not None else 1.0
     studies = [io.load(p, validate=False) for p in verification]
-    data, bands = _read_data(spec, radius)
+    data, bands, read_notes = _read_data(spec, radius)
 
     def run(mapping: dict, cycles: float) -> xr.Dataset:
         return run_sweep(
@@ -273,7 +277,7 @@ def calibrate(
         "base_set": base or "",
         "u_num_basis": json.dumps(num_basis),
         "u_d_basis": json.dumps([d.u_d_basis or d.source for d in data]),
-        "calibration_notes": "\n".join(notes),
+        "calibration_notes": "\n".join(read_notes + notes),
         "run": spec.run,
     }
     from jointwear.sim.calibrate._posterior import to_dataset
@@ -306,21 +310,47 @@ def _probe_outputs(spec: CalibrationSpec) -> list[str]:
     return ["max_wear_depth"]
 
 
-def _read_data(spec: CalibrationSpec, radius: float) -> tuple[list[Datum], list[Band]]:
+def _read_data(spec: CalibrationSpec, radius: float) -> tuple[list[Datum], list[Band], list[str]]:
+    """The data (measured maps, reported files, inline values), their bands and notes."""
     from jointwear import io
+    from jointwear.reported import is_reported
     from jointwear.sim.calibrate._data import map_data
+    from jointwear.sim.calibrate._reported import reported_data
 
     data: list[Datum] = []
     bands: list[Band] = []
+    notes: list[str] = []
     for i, path in enumerate(spec.data):
-        band, rows = map_data(
-            io.load(path, validate=False), path, i, spec.cycles_of(i), spec.quantities, radius
-        )
-        bands.append(band)
+        if path.suffix.lower() == ".toml":  # a reported-measurement file itself
+            from jointwear.reported import read_reported
+
+            ds = read_reported(path)
+        else:
+            ds = io.load(path, validate=False)
+        if is_reported(ds):
+            new_bands, rows, why = reported_data(ds, path, len(bands))
+            bands += new_bands
+            notes += why
+        else:
+            band, rows = map_data(
+                ds,
+                path,
+                len(bands),
+                spec.cycles_of(i),
+                spec.quantities,
+                radius,
+                (spec.field_bins_z, spec.field_bins_theta),
+            )
+            bands.append(band)
         data += rows
     for v in spec.values:
-        data.append(Datum(v.quantity, spec.cycles[0], v.value, v.u, v.source, -1, v.source))
-    return data, bands
+        band = -1
+        if v.z:  # measured on these layers: the simulated map reduced there, every 1 degree
+            nan = np.full((len(v.z), 360), np.nan)
+            bands.append(Band(np.array(v.z), np.arange(360.0), nan, nan, None))
+            band = len(bands) - 1
+        data.append(Datum(v.quantity, spec.cycles[0], v.value, v.u, v.source, band, v.source))
+    return data, bands, notes
 
 
 def _sample(spec: CalibrationSpec, data: list[Datum], emu, rel_num, lo, hi):
@@ -331,15 +361,19 @@ def _sample(spec: CalibrationSpec, data: list[Datum], emu, rel_num, lo, hi):
     priors = [p._scipy() for p in spec.parameters]
     y_d = np.array([d.value for d in data])
     u_d2 = np.array([d.u_d for d in data]) ** 2
-    # u_num (and the runs' scatter) of the quantities of one map move together: a phase or an
-    # update interval that deepens the maximum also adds volume and cylindricity
+    # the quantities of one map share a run: its scatter (start phase, update intervals) moves
+    # them together as the training runs' residuals say (their correlation), and u_num beyond
+    # that scatter (a stated or verified discretisation error) moves them fully together
     group = np.array([d.band if d.band >= 0 else -1 - i for i, d in enumerate(data)])
     together = (group[:, None] == group[None, :]).astype(float)
+    rho = together * emu.correlation
 
     def noise_cov(y: np.ndarray) -> np.ndarray:
-        u_sim = np.maximum(rel_num * np.abs(y), emu.scatter_sd(y))  # the runs' scatter: a floor
+        scatter = emu.scatter_sd(y)
+        beyond = np.sqrt(np.maximum((rel_num * np.abs(y)) ** 2 - scatter**2, 0.0))
         diag = u_d2 + emu.error_sd(y) ** 2
-        cov = together * u_sim[:, :, None] * u_sim[:, None, :]
+        cov = rho * scatter[:, :, None] * scatter[:, None, :]
+        cov = cov + together * beyond[:, :, None] * beyond[:, None, :]
         return cov + diag[:, :, None] * np.eye(len(y_d))
 
     def log_prob(x: np.ndarray) -> np.ndarray:

@@ -50,12 +50,19 @@ __all__ = [
 
 #: Quantities of a measured wear map, computed within its band (its z range).
 MAP_QUANTITIES = ("max_wear_depth", "worn_volume", "cylindricity")
+#: the whole-band wear field (a datum per bin; not a default: it adds field_bins_z x
+#: field_bins_theta data, each emulated)
+FIELD_QUANTITY = "wear_field"
 
 _KEYS = {
-    "data": "measured wear maps (metrology wearmap), paths relative to the spec file",
+    "data": "measured wear maps (metrology wearmap) and reported-values files (import reported, "
+    "netCDF or its TOML), paths relative to the spec file",
     "values": "stated values: tables with quantity, value, u (standard uncertainty) and source",
     "cycles": "crank cycles of the data: one value, or one per data file",
-    "quantities": "quantities of each map (default max_wear_depth, worn_volume, cylindricity)",
+    "quantities": "quantities of each map (default max_wear_depth, worn_volume, cylindricity; "
+    "also wear_field, the mean depth in field_bins_z x field_bins_theta bins of the band)",
+    "field_bins_z": "wear_field: bins of the band in z (default 4, as compare's criteria)",
+    "field_bins_theta": "wear_field: bins of the band in theta (default 12, as compare's criteria)",
     "samples": "training runs of the emulator (default 10 per parameter, at least 12)",
     "seed": "seed of the design and of the sampler (default 0)",
     "u_num_rel": "stated numerical uncertainty as a fraction of the simulated value",
@@ -86,12 +93,17 @@ class StatedValue:
         Value and its standard uncertainty (k = 1), SI.
     source : str
         Where the value comes from (provenance).
+    z : tuple of float
+        Layers [m] a map quantity was measured on (``z = [...]``): the quantity is computed on
+        these layers of each simulated map, over the whole circle; empty: the simulation's own
+        output over the whole bore.
     """
 
     quantity: str
     value: float
     u: float
     source: str = "stated in the calibration spec"
+    z: tuple[float, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -103,6 +115,8 @@ class CalibrationSpec:
     values: tuple[StatedValue, ...] = ()
     cycles: tuple[float, ...] = (1.0,)
     quantities: tuple[str, ...] = MAP_QUANTITIES
+    field_bins_z: int = 4
+    field_bins_theta: int = 12
     samples: int = 12
     seed: int = 0
     u_num_rel: float | None = None
@@ -157,14 +171,20 @@ def _stated(items: Any) -> tuple[StatedValue, ...]:
         where = f"[[calibrate.values]] #{i + 1}"
         if not isinstance(t, Mapping):
             raise ParameterError(f"{where}: expected a table with quantity, value, u")
-        bad = sorted(set(t) - {"quantity", "value", "u", "source"})
+        bad = sorted(set(t) - {"quantity", "value", "u", "source", "z"})
         missing = sorted({"quantity", "value", "u"} - set(t))
         if bad or missing:
             raise ParameterError(
                 f"{where}: "
                 + (f"unknown key(s) {', '.join(bad)}; " if bad else "")
                 + (f"missing {', '.join(missing)}; " if missing else "")
-                + "a stated value has quantity, value, u (standard uncertainty) and source"
+                + "a stated value has quantity, value, u (standard uncertainty), source and z"
+            )
+        z = t.get("z", [])
+        if not isinstance(z, list) or (z and str(t["quantity"]) not in MAP_QUANTITIES):
+            raise ParameterError(
+                f"{where} z: expected a list of layer positions [m] of a map quantity "
+                f"({', '.join(MAP_QUANTITIES)})"
             )
         out.append(
             StatedValue(
@@ -172,6 +192,7 @@ def _stated(items: Any) -> tuple[StatedValue, ...]:
                 _number(t["value"], f"{where} value"),
                 _number(t["u"], f"{where} u", positive=True),
                 str(t.get("source", "stated in the calibration spec")),
+                tuple(_number(v, f"{where} z") for v in z),
             )
         )
     return tuple(out)
@@ -218,6 +239,10 @@ def _options(cal: Mapping[str, Any], n_par: int) -> dict[str, Any]:
         "seed": _whole(cal.get("seed", 0), "[calibrate] seed", 0),
         "walkers": _whole(cal.get("walkers", 32), "[calibrate] walkers", 2 * n_par + 2),
         "max_steps": _whole(cal.get("max_steps", 20000), "[calibrate] max_steps", 200),
+        "field_bins_z": _whole(cal.get("field_bins_z", 4), "[calibrate] field_bins_z", 1),
+        "field_bins_theta": _whole(
+            cal.get("field_bins_theta", 12), "[calibrate] field_bins_theta", 1
+        ),
     }
     for key, default in (
         ("emulator_max_fraction", 0.5),
@@ -297,10 +322,10 @@ def _parse(data: Mapping[str, Any], folder: Path | None) -> CalibrationSpec:
     if isinstance(quantities, str) or not isinstance(quantities, list) or not quantities:
         raise ParameterError(f"[calibrate] quantities: expected a list, got {quantities!r}")
     for q in quantities:
-        if q not in MAP_QUANTITIES:
+        if q not in (*MAP_QUANTITIES, FIELD_QUANTITY):
             raise ParameterError(
                 f"[calibrate] quantities: {q!r} is not a map quantity; known: "
-                f"{', '.join(MAP_QUANTITIES)}"
+                f"{', '.join((*MAP_QUANTITIES, FIELD_QUANTITY))}"
             )
     if run == "function" and "function" not in cal:
         raise ParameterError('[calibrate] run = "function" needs function = "<name>"')
