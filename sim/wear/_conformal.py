@@ -249,7 +249,7 @@ def conformal_wear_work(
     dphi = 2 * math.pi / nd
     out = np.zeros((nl, nd))
     for n in range(nl):
-        src = np.flatnonzero(work[n] > 0)
+        src = np.flatnonzero((work[n] > 0) & (force_work[n] > 0))
         if not src.size:
             continue
         rho = bearing_radius + h[n]
