@@ -406,6 +406,23 @@ class _Progress:
             pass
 
 
+def _blas_without_scipy_linalg() -> None:
+    """Import ``numba.np.arraymath`` (a cached kernel's environment may name it) without its
+    check for BLAS, which imports ``scipy.linalg`` (0.15 CPU s) to find it: scipy is a
+    dependency, so BLAS is there. numba checks again, for real, before it compiles a call to
+    BLAS."""
+    if "numba.np.arraymath" in sys.modules:
+        return
+    from numba.np import linalg
+
+    check = linalg.ensure_blas
+    linalg.ensure_blas = lambda: None
+    try:
+        import numba.np.arraymath  # noqa: F401
+    finally:
+        linalg.ensure_blas = check
+
+
 def light_cache_loads() -> None:
     """numba's cache loads without first building its whole compiler (CLI processes).
 
@@ -427,6 +444,7 @@ def light_cache_loads() -> None:
         try:
             from numba.core.runtime import rtsys
 
+            _blas_without_scipy_linalg()
             rtsys.initialize(target_context)
             with self._guard_against_spurious_io_errors():
                 loaded = self._load_overload(sig, target_context)

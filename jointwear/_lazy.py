@@ -26,15 +26,21 @@ def after_import(name: str, callback: Callable[[], None]) -> None:
     if name in sys.modules:
         callback()
         return
+    waiting = next(
+        (f for f in sys.meta_path if isinstance(f, _AfterImport) and f.name == name), None
+    )
+    if waiting is not None:  # one hook per module (the first finder to answer is the only one)
+        waiting.callbacks.append(callback)
+        return
     sys.meta_path.insert(0, _AfterImport(name, callback))
 
 
 class _AfterImport(importlib.abc.MetaPathFinder):
-    """Runs a callback right after the module ``name`` itself has been imported, then leaves."""
+    """Runs callbacks right after the module ``name`` itself has been imported, then leaves."""
 
     def __init__(self, name: str, callback: Callable[[], None]) -> None:
         self.name = name
-        self.callback = callback
+        self.callbacks = [callback]
 
     def find_spec(self, name: str, path: Any, target: Any = None) -> Any:
         if name != self.name:
@@ -45,11 +51,12 @@ class _AfterImport(importlib.abc.MetaPathFinder):
             return spec
         loader = spec.loader
         exec_module = loader.exec_module
-        callback = self.callback
+        callbacks = self.callbacks
 
         def exec_then_notify(module: Any) -> None:
             exec_module(module)
-            callback()
+            for callback in callbacks:
+                callback()
 
         loader.exec_module = exec_then_notify  # type: ignore[method-assign]
         return spec

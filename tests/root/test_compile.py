@@ -216,3 +216,52 @@ def test_after_the_first_command_dic_correlate_compiles_nothing(tmp_path):
     assert "data saved" not in run.stdout  # ... and none was compiled
     assert "compiling" not in run.stderr and "compiled" not in run.stderr
     assert textwrap.dedent(run.stderr).count("jointwear:") == 0
+
+
+#: A CLI process's cached kernel: loaded without numba's whole compiler (no scipy.linalg), then
+#: a fresh compilation in the same process still works.
+LIGHT = """
+import sys
+import numpy as np
+import jointwear.cli  # installs the light cache loads when numba is imported
+import toy_kernels as t
+
+a = np.arange(4.0)
+assert t.total(a) == 6.0 and t.scaled(a, 2.0)[3] == 6.0
+hits = sum(t.total.stats.cache_hits.values()) + sum(t.scaled.stats.cache_hits.values())
+light = "scipy.linalg" not in sys.modules
+from numba import njit
+
+
+@njit
+def fresh(m):
+    return np.linalg.inv(m).sum()
+
+
+assert fresh(np.eye(2) * 4.0) == 0.5
+print("LIGHT", hits, light)
+"""
+
+
+def test_a_cli_process_loads_cached_kernels_without_numba_s_whole_compiler(toy):
+    _compiled_by_calls(toy)  # compiles and caches the toy kernels
+    run = subprocess.run(
+        [sys.executable, "-c", LIGHT], cwd=toy, capture_output=True, text=True, check=True
+    )
+    assert run.stdout.split("LIGHT")[-1].split() == ["2", "True"]
+
+
+def test_several_hooks_after_one_import(tmp_path, monkeypatch):
+    """Two start-up hooks on one module both run (the CLI's compile notice and its light cache
+    loads are both on numba)."""
+    from jointwear._lazy import after_import
+
+    (tmp_path / "hooked_module.py").write_text("VALUE = 1\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    ran = []
+    after_import("hooked_module", lambda: ran.append("first"))
+    after_import("hooked_module", lambda: ran.append("second"))
+    import hooked_module  # noqa: F401
+
+    assert ran == ["first", "second"]
+    sys.modules.pop("hooked_module", None)
