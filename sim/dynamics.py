@@ -457,7 +457,7 @@ def _conformal_maps(
     """(wear work, sliding distance) with the wear work under the conformal (Winkler) pressure
     of ``contact.wear_pressure = "conformal"``, from the contacts' centres the kernel recorded
     in ``ww[2:]`` (:func:`jointwear.sim.wear.conformal_wear_work`)."""
-    from jointwear.sim.wear import conformal_wear_work
+    from jointwear.sim.wear import conformal_wear_work, foundation_modulus
 
     if np.sum(ww[0] * area) > 0 and not np.any(ww[2] > 0):
         raise SimulationError(
@@ -466,7 +466,8 @@ def _conformal_maps(
             "calls across modules): delete the caches (find . -name '*.nbi' -o -name '*.nbc' | "
             "xargs rm) or set NUMBA_CACHE_DIR to an empty folder"
         )
-    j = params.joint
+    j, c = params.joint, params.contact
+    lining = c.foundation_thickness
     work = conformal_wear_work(
         ww[2],
         ww[3],
@@ -475,6 +476,9 @@ def _conformal_maps(
         journal_radius=j.journal_radius,
         bearing_radius=j.bearing_radius,
         reduced_modulus=0.75 * contact_constant(params)[0],  # E* = (3/4) 4 / (3 pi (hj + hb))
+        foundation=(
+            foundation_modulus(c.bearing_modulus, c.bearing_poisson, lining) if lining > 0 else None
+        ),
     )
     return np.stack([work, ww[1]])
 

@@ -181,6 +181,9 @@ class ContactParameters:
     seated in the worn bore along the contact's direction, its modulus matched to Hertz's width
     on the unworn bore, so that a groove that fits the journal carries the load over a wider
     arc (docs/sim-wear.md, "Conformal contact"; ``jointwear.sim.wear.conformal_wear_work``).
+    ``foundation_thickness`` [m] (``"conformal"`` only): 0 (default) matches the foundation's
+    modulus to Hertz's width per load; > 0 takes it from an elastic lining of that thickness on
+    a rigid base, ``(1 - nu) E / ((1 + nu)(1 - 2 nu) t)`` with the bearing's E and nu.
     """
 
     formulation: Literal["slice", "per_point"] = "slice"
@@ -198,6 +201,7 @@ class ContactParameters:
     axial_stiffness: float = non_negative(0.0)
     max_penetration_fraction: float = positive(0.5)
     wear_pressure: Literal["hertz", "conformal"] = "hertz"
+    foundation_thickness: float = non_negative(0.0)
 
     def __post_init__(self) -> None:
         check_fields(self, "contact")
@@ -205,6 +209,12 @@ class ContactParameters:
             raise ParameterError(
                 "contact.wear_pressure = 'conformal' spreads each slice's force; the per-point "
                 "formulation has no slice forces: set contact.formulation = 'slice'"
+            )
+        if self.foundation_thickness > 0 and self.wear_pressure != "conformal":
+            raise ParameterError(
+                f"contact.foundation_thickness = {self.foundation_thickness!r} has no effect with "
+                f"contact.wear_pressure = {self.wear_pressure!r}: set contact.wear_pressure = "
+                "'conformal' or remove contact.foundation_thickness"
             )
 
 

@@ -18,7 +18,7 @@ _EXPORTS = {
     "_loop": None,
     "_contact": None,
     "_calibration": None,
-    "_conformal": ["conformal_wear_work"],
+    "_conformal": ["conformal_wear_work", "foundation_modulus"],
 }
 
 __getattr__, __dir__, __all__ = lazy_loader.attach_stub(__name__, __file__)

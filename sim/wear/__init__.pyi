@@ -15,6 +15,7 @@ from ._calibration import (
 )
 from ._conformal import (
     conformal_wear_work as conformal_wear_work,
+    foundation_modulus as foundation_modulus,
 )
 from ._contact import (
     ConstantContact as ConstantContact,

@@ -212,6 +212,7 @@ def conformal_wear_work(
     journal_radius: float,
     bearing_radius: float,
     reduced_modulus: float,
+    foundation: float | None = None,
 ) -> np.ndarray:
     """The wear work [Pa m] per point under the conformal (Winkler) pressure.
 
@@ -232,6 +233,9 @@ def conformal_wear_work(
         Rj and the unworn bore radius Rb [m].
     reduced_modulus : float
         E* of the pair [Pa] (Hertz's width, to which the foundation is matched).
+    foundation : float, optional
+        A fixed foundation modulus kf [Pa/m] (e.g. :func:`foundation_modulus` of a lining);
+        default: matched per load to Hertz's width (:func:`hertz_matched_modulus`).
 
     Returns
     -------
@@ -256,7 +260,10 @@ def conformal_wear_work(
         width = float(area[n, 0] / (rho[0] * dphi))  # the slice's axial width [m]
         force = force_work[n, src] / work[n, src]
         line_load = force / width
-        kf = hertz_matched_modulus(line_load, journal_radius, bearing_radius, reduced_modulus)
+        if foundation is None:
+            kf = hertz_matched_modulus(line_load, journal_radius, bearing_radius, reduced_modulus)
+        else:
+            kf = np.full(src.size, float(foundation))
         gap, cos = _seated_gaps(rho, journal_radius, phi, src)
         d0 = _advance(gap, cos, rho, line_load / (kf * dphi))
         p = kf[:, None] * np.maximum(d0[:, None] * cos - gap, 0.0)  # [Pa]

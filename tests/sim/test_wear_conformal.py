@@ -225,6 +225,10 @@ def test_the_dynamics_record_the_contacts_and_spread_them_conformally():
     assert total == pytest.approx(res.normal_work, rel=2e-3)
     assert total >= res.normal_work * (1 - 1e-12)
     assert res.wear_work.max() > hertz.wear_work.max()  # Hertz's width: narrower than the overlap
+    lined = replace_nested(conf, **{"contact.foundation_thickness": 0.5})  # a very soft lining
+    soft = run_cycles(lined, cycles=0.25, record=False)
+    assert np.sum(soft.wear_work * soft.point_area) >= res.normal_work * (1 - 1e-12)
+    assert soft.wear_work.max() < res.wear_work.max()  # softer: wider, lower peak
 
 
 def test_a_stale_kernel_is_refused_not_read_as_no_wear():
@@ -256,3 +260,49 @@ def test_wear_command_refuses_conformal_on_per_point_and_its_fix_runs(tmp_path, 
     ds = io.load(out)
     assert float(ds["worn_volume"][-1]) > 0
     assert ds.attrs["wear_pressure"] == "conformal"
+
+
+def test_a_lining_foundation_gives_the_closed_form_contact_angle():
+    """A fixed foundation (a 2 mm bronze lining) on the unworn bore: the contact half-angle a
+    of ``F' = kf Rb c' ((a + sin a cos a) / cos a - 2 sin a)``, c' = Rb c / Rj."""
+    from scipy.optimize import brentq
+
+    nd = 7200
+    kf = foundation_modulus(100e9, 0.39, 2e-3)
+    force, width = 50.0, 1e-3  # 50 kN/m
+    h = np.zeros((1, nd))
+    area = _area(nd, h[0], width)[None, :]
+    work = np.zeros((1, nd))
+    work[0, 0] = 1.0
+    out = conformal_wear_work(
+        work,
+        force * work,
+        h,
+        area,
+        journal_radius=RJ,
+        bearing_radius=RB,
+        reduced_modulus=ESTAR,
+        foundation=kf,
+    )[0]
+    cp = RB * C / RJ
+    a = brentq(
+        lambda a: (
+            kf * RB * cp * ((a + math.sin(a) * math.cos(a)) / math.cos(a) - 2 * math.sin(a))
+            - force / width
+        ),
+        1e-6,
+        1.0,
+    )
+    half = (np.count_nonzero(out) - 1) / 2 * 360 / nd
+    assert half == pytest.approx(math.degrees(a), abs=360 / nd)
+    assert math.degrees(a) > 10 * 360 / nd  # resolved by the grid
+
+
+def test_foundation_thickness_needs_the_conformal_pressure():
+    base = PARAMETER_SETS["zhang2023"]
+    with pytest.raises(ParameterError, match="set contact.wear_pressure = 'conformal'"):
+        replace_nested(base, **{"contact.foundation_thickness": 2e-3})
+    fixed = replace_nested(
+        base, **{"contact.foundation_thickness": 2e-3, "contact.wear_pressure": "conformal"}
+    )
+    assert fixed.contact.foundation_thickness == 2e-3
