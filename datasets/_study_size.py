@@ -26,6 +26,10 @@ class StudySize:
         Update interval of the ensemble members [cycles].
     seed : int
         Seed of the Latin hypercube.
+    training_runs : int
+        Training runs of the calibration on the 4e5 growth (the emulator's design).
+    prediction_runs : int
+        Simulations at posterior samples run to 1.2e6 cycles (the validated prediction).
     """
 
     layers: int = 20
@@ -34,11 +38,19 @@ class StudySize:
     ensemble_runs: int = 10
     ensemble_dn: int = 50_000
     seed: int = 11
+    training_runs: int = 20
+    prediction_runs: int = 8
 
 
 #: the benchmark's size: the study's grid (20 x 200)
 FULL = StudySize()
 #: the CI test's size: a coarse grid, coarse intervals, three members
 REDUCED = StudySize(
-    layers=8, points=72, levels=(400_000, 200_000, 100_000), ensemble_runs=3, ensemble_dn=400_000
+    layers=8,
+    points=72,
+    levels=(400_000, 200_000, 100_000),
+    ensemble_runs=3,
+    ensemble_dn=400_000,
+    training_runs=16,
+    prediction_runs=4,
 )

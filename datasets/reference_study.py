@@ -39,6 +39,7 @@ __all__ = [
     "ENSEMBLE_INPUTS",
     "reference_file",
     "run_reference_study",
+    "update_study",
 ]
 
 #: The reference rig's uncertain model inputs (this study's ensemble and the demo's): dotted parameter name -> (relative standard deviation,
@@ -67,6 +68,33 @@ def _run(params: Any, cycles: list[float], dn: int, overrides: dict[str, float])
         settings=WearSettings(scheme="fixed", dn=dn),
         overrides=overrides,
     )
+
+
+def update_study(
+    params: Any,
+    cycles: list[float],
+    size: StudySize,
+    overrides: dict[str, float],
+    say: Callable[[str], None] = lambda _: None,
+) -> tuple[xr.Dataset, xr.Dataset]:
+    """The wear run at every update interval of ``size.levels`` (coarse to fine), maps kept at
+    ``cycles``: (the finest run, the study ``wear_depth(dn, cycles, z, theta)``)."""
+    maps = []
+    for dn in size.levels:
+        say(f"verification level dN = {dn}")
+        maps.append(_run(params, cycles, dn, overrides))
+    study = xr.Dataset({"wear_depth": xr.concat([m["wear_depth"] for m in maps], dim="dn")})
+    study = study.assign_coords(
+        dn=(
+            "dn",
+            np.asarray(size.levels, float),
+            {"units": "1", "long_name": "wear-update interval dN (refinement parameter h)"},
+        )
+    )
+    study.attrs.update(
+        {"title": "verification: wear maps versus the update interval", "data_origin": "simulated"}
+    )
+    return maps[-1], study
 
 
 def _inputs(params: Any, size: StudySize) -> dict[str, np.ndarray]:
@@ -123,23 +151,8 @@ def run_reference_study(
     )
     params = PARAMETER_SETS["zhang2023"]
     grid = {"joint.n_layers": size.layers, "joint.n_points": size.points}
-    maps = []
-    for dn in size.levels:
-        say(f"verification level dN = {dn}")
-        maps.append(_run(params, cycles, dn, grid))
-    sim = maps[-1]
+    sim, study = update_study(params, cycles, size, grid, say)
     sim_path = io.save(sim, out / "sim_wear.nc", parameters={"size": size, "dn": size.levels[-1]})
-    study = xr.Dataset({"wear_depth": xr.concat([m["wear_depth"] for m in maps], dim="dn")})
-    study = study.assign_coords(
-        dn=(
-            "dn",
-            np.asarray(size.levels, float),
-            {"units": "1", "long_name": "wear-update interval dN (refinement parameter h)"},
-        )
-    )
-    study.attrs.update(
-        {"title": "verification: wear maps versus the update interval", "data_origin": "simulated"}
-    )
     ver_path = io.save(study, out / "verification.nc", parameters={"size": size})
     ens = None
     paths = [rep_path, sim_path, ver_path]

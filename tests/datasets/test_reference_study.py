@@ -43,7 +43,8 @@ def study(tmp_path_factory):
     with contextlib.redirect_stdout(printed):
         code = main(["datasets", "reference-study", str(out), "--reduced"])
     result = load_comparison(io.load(out / "metrics.nc"))
-    assert code == (1 if result.any_failed else 0)
+    calibrated = load_comparison(io.load(out / "metrics_calibrated.nc"))
+    assert code == (1 if result.any_failed or calibrated.any_failed else 0)
     _PRINTED.append(printed.getvalue())
     return out, result
 
@@ -55,6 +56,8 @@ _PRINTED: list[str] = []  # what the command printed (its default output)
 def test_the_default_output_has_at_most_three_lines_per_criterion(study):
     _, result = study
     lines = _PRINTED[0].splitlines()
+    head = next(i for i, ln in enumerate(lines) if ln.startswith("calibrated on the 4e5"))
+    lines, calibration = lines[:head], lines[head + 1 :]
     card = [ln for ln in lines if not ln.startswith(("unstated:", "to decide them", "note:"))][:-1]
     blocks: list[list[str]] = []
     for line in card:
@@ -63,6 +66,12 @@ def test_the_default_output_has_at_most_three_lines_per_criterion(study):
     assert not any("layers centred at z" in ln for ln in lines)  # the readings: --verbose
     n = len(result.decisions) - 1  # the new bore is the baseline, not a criterion
     assert lines[-1 - sum(ln.startswith("note:") for ln in lines)].startswith(f"{n} criteria: ")
+    # then the calibrate -> validate block: one line per input, the 1.2e6 verdict in <= 3 lines
+    assert calibration[0].startswith("CALIBRATED") and "wear.kw" in calibration[0]
+    assert calibration[1].startswith("NOT INFORMED") and "joint.tilt_stiffness" in calibration[1]
+    verdict = calibration[2:]
+    assert "cylindricity_1_2e6" in verdict[0] and len(verdict) <= 3
+    assert "growth ratio 4e5/1.2e6: measured 0.68" in verdict[1]
 
 
 @pytest.mark.slow
