@@ -583,6 +583,12 @@ def _skipped(size: DemoSize, parts: _Parts, sim_ok: bool, metrology_ok: bool) ->
             "the simulation's own wear_depth_u (update interval and cycle-to-cycle "
             "variability; the wear grid is not assessed)"
         )
+    if sim_ok and not size.calibration_cycles:
+        parts.missing.append(
+            "calibration: skipped with --quick (it needs the verification study's u_num and "
+            "about 25 more wear runs); kw is the nominal one, not calibrated on the bore; run "
+            "'jointwear demo' without --quick to calibrate on one snapshot and validate on another"
+        )
     if not (size.ensemble_runs and sim_ok):
         _say("  ensemble skipped (--quick): u_input not assessed")
         parts.missing.append(

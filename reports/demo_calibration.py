@@ -6,12 +6,12 @@ calibration data, ``metrology_wear_calibration.nc``) and at ``size.cycles`` (the
 ``metrology_wear.nc``; its worn scan is another file, so ``jointwear compare`` does not refuse it
 as calibration data). The step writes what a user would run:
 
-* ``calibration_params.toml``: the demo's rig (its grid) and the verified wear-update scheme (the
+* ``calibrate_params.toml``: the demo's rig (its grid) and the verified wear-update scheme (the
   fixed ΔN of the verification study's finest level, whose u_num is then the runs');
-* ``calibration.toml``: the priors (:data:`CALIBRATED`, uniform) and the ``[calibrate]`` table;
+* ``calibrate.toml``: the priors (:data:`CALIBRATED`, uniform) and the ``[calibrate]`` table;
 
-and calls the library as ``jointwear sim calibrate calibration.toml --params
-calibration_params.toml --verification sim_verification.nc --out posterior.nc`` and ``jointwear sim
+and calls the library as ``jointwear sim calibrate calibrate.toml --params
+calibrate_params.toml --verification sim_verification.nc --out posterior.nc`` and ``jointwear sim
 predict posterior.nc --cycles N --out prediction.nc --samples M`` would
 (:func:`jointwear.sim.calibrate.calibrate`, :func:`jointwear.sim.calibrate.predict`), the
 training and prediction runs on the demo's pool of worker processes.
@@ -137,8 +137,8 @@ def calibrate_and_predict(
     from jointwear.sim.calibrate import calibrate, predict
 
     t0 = time.process_time()
-    spec = folder / "calibration.toml"
-    base = folder / "calibration_params.toml"
+    spec = folder / "calibrate.toml"
+    base = folder / "calibrate_params.toml"
     base.write_text(base_toml(size), encoding="utf-8")
     spec.write_text(spec_toml(data, size, params), encoding="utf-8")
     run = {"workers": 0, "scheduler": pool}

@@ -22,7 +22,7 @@ from jointwear.reports.demo_studies import ensemble_spec, main_wear_settings
 
 
 def test_the_calibration_params_file_is_the_demos_rig_and_verified_scheme(tmp_path):
-    """``calibration_params.toml`` read as ``sim calibrate --params`` reads it gives the demo's
+    """``calibrate_params.toml`` read as ``sim calibrate --params`` reads it gives the demo's
     rig and the wear settings its verification study verified (so its u_num applies)."""
     from jointwear.params import from_mapping, read_toml
     from jointwear.sim import WearSettings, load_parameters
@@ -40,7 +40,7 @@ def test_the_spec_calibrates_kw_around_nominal_on_the_earlier_snapshot(tmp_path)
 
     data = tmp_path / "metrology_wear_calibration.nc"
     data.write_bytes(b"")
-    path = tmp_path / "calibration.toml"
+    path = tmp_path / "calibrate.toml"
     path.write_text(spec_toml(data, demo.FULL, demo._params(demo.FULL)))
     spec = read_calibration_spec(path)
     assert spec.names == list(CALIBRATED) == ["wear.kw"]
