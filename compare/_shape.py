@@ -66,9 +66,13 @@ class RDistribution:
 def _input_deviations(c) -> tuple[np.ndarray | None, str]:
     """The ensemble members' deviations on the band, ``(n, z, theta)``, scaled to the compared
     total, or None with the reason (an empty ``(0, z, theta)`` array: a common scale, no term)."""
+    from jointwear.compare._field import too_few_members
+
     ens = c.al.get("wear_depth_sim_ensemble")
     members = [] if ens is None else [np.asarray(m, float) for m in np.asarray(ens.values, float)]
     members = [m for m in members if np.all(np.isfinite(m) | ~np.isfinite(c.s))]
+    if len(members) >= 3 and (few := too_few_members(c, len(members))):
+        return None, few
     if len(members) >= 3:
         x = np.nan_to_num(np.stack(members))
         mean = x.mean(axis=0)

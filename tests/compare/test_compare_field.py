@@ -126,3 +126,36 @@ def test_field_criteria_not_assessed_without_their_uncertainties():
     c = compare(sim_map(field()), no_u, ensemble=ensemble(np.random.default_rng(2), 8),
                 criteria=Criteria(wear_u_num_rel=0.02))  # fmt: skip
     assert c.state("wear field") == "not_assessed"
+
+
+def test_an_estimated_covariance_gives_hotellings_limit():
+    """With the whole covariance a sample covariance of n members (nothing else known), the
+    bootstrap limit is Hotelling's T²: K nu / (nu - K + 1) F(K, nu - K + 1), nu = n - 1."""
+    from scipy import stats
+
+    rng = np.random.default_rng(7)
+    k, n = 3, 10
+    x = rng.standard_normal((n, k)) @ np.diag([3.0, 1.0, 0.3])
+    dev = (x - x.mean(axis=0)) / np.sqrt(n - 1)
+    test = mahalanobis_test(np.zeros(k), dev.T @ dev, 0.05, estimated=(dev, n - 1))
+    nu = n - 1
+    hotelling = k * nu / (nu - k + 1) * stats.f.ppf(0.95, k, nu - k + 1)
+    assert test.threshold == pytest.approx(hotelling, rel=0.1)
+    assert test.threshold > 1.5 * stats.chi2.ppf(0.95, k)  # what chi² alone would have used
+
+
+def test_an_ensemble_with_no_more_members_than_inputs_is_not_enough():
+    """n members span n - 1 directions: over 4 varied inputs, 4 members leave the field criteria
+    not assessed (naming the fix), 5 decide them."""
+    rng = np.random.default_rng(8)
+    meas = meas_map(
+        field() + 0.6e-6 * rng.standard_normal(Z.size * TH.size).reshape(13, 72), 0.6e-6
+    )
+    for n, state in ((4, "not_assessed"), (5, "pass")):
+        ens = ensemble(rng, n)
+        ens.attrs["sweep_parameters"] = ["a", "th0", "w", "slope"]
+        c = compare(sim_map(field()), meas, ensemble=ens, criteria=Criteria(wear_u_num_rel=0.02))
+        assert c.state("wear field") == state, n
+        if state == "not_assessed":
+            why = c.decisions.set_index("key").loc["wear_field", "reason"]
+            assert "at least 5 members" in why and "4 inputs" in why
