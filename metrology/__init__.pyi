@@ -28,6 +28,7 @@ from ._api import (
     register_angle as register_angle,
     remove_outliers as remove_outliers,
     roundness as roundness,
+    ScanReading as ScanReading,
     STANDARD_CUTOFFS as STANDARD_CUTOFFS,
     TextFormat as TextFormat,
     transmission as transmission,

@@ -28,7 +28,13 @@ from jointwear.metrology.form import (
     roundness,
 )
 from jointwear.metrology.plot import plot_wear_map
-from jointwear.metrology.readers import TextFormat, read_scan, read_talyrond, read_text
+from jointwear.metrology.readers import (
+    ScanReading,
+    TextFormat,
+    read_scan,
+    read_talyrond,
+    read_text,
+)
 from jointwear.metrology.wearmap import register_angle, wear_map, worn_volume
 
 __all__ = [
@@ -37,6 +43,7 @@ __all__ = [
     "CentringWarning",
     "CircleFit",
     "CylinderFit",
+    "ScanReading",
     "TextFormat",
     "ZoneResult",
     "assess",

@@ -8,9 +8,10 @@ offers exactly what the library accepts. Options shared with other folders' comm
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from enum import StrEnum
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Any
 
 import typer
 
@@ -67,7 +68,7 @@ def _opt(flag: str, help: str, **kw) -> typer.models.OptionInfo:
     return typer.Option(flag, help=help, **kw)
 
 
-# --- import: the file and its format -----------------------------------------------------
+# --- import ---------------------------------------------------------------------------------
 ScanPaths = Annotated[
     list[Path],
     typer.Argument(
@@ -82,7 +83,6 @@ PresetOpt = Annotated[
     Preset,
     _opt("--preset", "; ".join(f"{k}: {doc}" for k, (_, doc) in READERS.items()) + "."),
 ]
-LayoutOpt = Annotated[Layout, _opt("--layout", f"{', '.join(LAYOUTS)}.")]
 Units = Annotated[
     str | None,
     _opt(
@@ -92,150 +92,231 @@ Units = Annotated[
         callback=_length_unit,
     ),
 ]
-Delimiter = Annotated[str | None, _opt("--delimiter", "tab, semicolon, comma or whitespace.")]
-DecimalOpt = Annotated[Decimal | None, _opt("--decimal", "Decimal separator: '.' or ','.")]
-HeaderLines = Annotated[int | None, _opt("--header-lines", "Lines before the numeric table.")]
-Columns = Annotated[
-    str | None,
-    _opt(
-        "--columns",
-        "Comma-separated column meanings: angle_deg, angle_rad, index, x, y, z, radius, "
-        "deviation, ignore.",
-    ),
-]
-ValueKindOpt = Annotated[
-    ValueKind,
-    typer.Option(
-        "--value-kind",
-        "--value",
-        help="Values are radius or deviation (auto: from the column name, else from "
-        "unambiguous numbers, else refused).",
-    ),
-]
-AngleUnitOpt = Annotated[
-    AngleUnit | None,
-    _opt(
-        "--angle-unit",
-        "Unit of the angle column when the file does not state it: deg, rad, index (point "
-        "number over one turn) or grad.",
-    ),
-]
-ArcOpt = Annotated[
-    Arc | None,
-    _opt(
-        "--arc",
-        "Each layer is one full turn or a partial arc (settles an ambiguous angle unit; "
-        "'full' is needed for files without an angle column).",
-    ),
-]
-Sheet = Annotated[
-    str | None, _opt("--sheet", "Worksheet of an Excel workbook with several sheets.")
-]
-Thousands = Annotated[
-    str | None, _opt("--thousands", "Thousands separator of the numbers: , . ' or space.")
-]
-IgnoreHeader = Annotated[
-    list[str] | None,
-    _opt(
-        "--ignore-header",
-        "A header claim known to be wrong (repeat): units, nominal_radius, points, filter, "
-        "layers, z_extent, layer_spacing, z.",
-    ),
-]
-
-# --- import: layers and z ------------------------------------------------------------------
-ZUnits = Annotated[
-    str | None,
-    _opt("--z-units", "Unit of z (column, header, file names) when not stated: mm, um, m."),
-]
-LayerSpacingMm = Annotated[float | None, _opt("--layer-spacing-mm", "Layer spacing [mm].")]
-ZMidMm = Annotated[
-    float | None,
-    _opt(
-        "--z-mid-mm",
-        "Instrument height of the bearing mid-width [mm] (default: middle of the layers).",
-    ),
-]
-ZSource = Annotated[
-    str,
-    _opt(
-        "--z-source",
-        f"Where z comes from: {', '.join(Z_SOURCES)} (auto refuses when two sources disagree).",
-    ),
-]
-Heights = Annotated[
-    Path | None,
-    _opt(
-        "--heights",
-        "File of layer file, height lines (any delimiter; unit in its first line, e.g. "
-        "'file,height_mm', else --z-units); a folder's manifest/heights/index.csv is found "
-        "without it.",
-    ),
-]
-ZMm = Annotated[
-    str | None,
-    _opt(
-        "--z-mm",
-        "Height of each layer [mm], comma-separated in file/column order, e.g. 0,1.5,4 (uneven "
-        "z; overrides every other source).",
-    ),
-]
-ExpectedPoints = Annotated[int | None, _opt("--expected-points", "Points every layer must have.")]
-AllowPartial = Annotated[bool, _opt("--allow-partial", "Accept incomplete layers (NaN).")]
-Resample = Annotated[bool, _opt("--resample", "Interpolate layers onto one uniform grid.")]
 Batch = Annotated[bool, _opt("--batch", "Each entry of each PATH folder is a separate scan.")]
-Pattern = Annotated[
-    str, _opt("--pattern", "Glob of the per-layer files in a folder, e.g. '*.txt'.")
-]
-Instrument = Annotated[str | None, _opt("--instrument", "Instrument name for 'source'.")]
 
-# --- import: plausibility limits of the header cross-checks --------------------------------
-RadiusRangeMm = Annotated[
-    tuple[float, float] | None,
-    _opt(
-        "--radius-range-mm",
-        f"Plausible bore radius MIN MAX [mm] (default {_LIM['radius_min'] * 1e3:g} "
-        f"{_LIM['radius_max'] * 1e3:g}).",
-    ),
-]
-MaxDeviationMm = Annotated[
-    float | None,
-    _opt(
-        "--max-deviation-mm",
-        f"Largest plausible |deviation| [mm] (default {_LIM['max_deviation'] * 1e3:g}).",
-    ),
-]
-NominalTolerance = Annotated[
-    float | None,
-    _opt(
-        "--nominal-tolerance",
-        "Relative tolerance of the radius against the header's nominal (default "
-        f"{_LIM['nominal_tolerance']:g}).",
-    ),
-]
-MinFormNm = Annotated[
-    float | None,
-    _opt(
-        "--min-form-nm",
-        f"Smallest plausible peak-to-valley of deviations [nm] ({_LIM['min_form'] * 1e9:g}).",
-    ),
-]
-FormFraction = Annotated[
-    float | None,
-    _opt(
-        "--form-fraction",
-        "Largest plausible peak-to-valley of deviations relative to the header's nominal "
-        f"radius (default {_LIM['form_fraction']:g}).",
-    ),
-]
-MaxMissing = Annotated[
-    float | None,
-    _opt(
-        "--max-missing",
-        "Largest share of a layer's points that may be missing ('---', 'NaN', empty cells) "
-        f"(default {_LIM['max_missing']:g}).",
-    ),
-]
+
+def _si(value: float | None, scale: float) -> float | None:
+    """An option given in mm/nm in SI (None stays None)."""
+    return value * scale if value is not None else None
+
+
+def _z_list(z_mm: str | None) -> tuple[float, ...] | None:
+    """``--z-mm 0,1.5,4`` as heights in metres (None when not given)."""
+    if z_mm is None:
+        return None
+    try:
+        return tuple(float(v) * 1e-3 for v in z_mm.replace(" ", "").split(",") if v)
+    except ValueError:
+        raise typer.BadParameter(
+            f"--z-mm {z_mm!r}: expected comma-separated numbers in mm, e.g. 0,1.5,4"
+        ) from None
+
+
+def _text(value: Any) -> str | None:
+    """A choice option's value as the library's string (None stays None)."""
+    return str(value) if value is not None else None
+
+
+@dataclass(frozen=True)
+class ScanFlags:
+    """How ``metrology import`` reads a scan: the reader's options as given (None: not given,
+    sniffed), an option group (``@options_from("reading", ScanFlags)``); :meth:`keywords` gives
+    them as the reader's keywords (:class:`~jointwear.metrology.readers.scan.ScanReading`'s
+    fields) in SI."""
+
+    layout: Annotated[Layout, _opt("--layout", f"{', '.join(LAYOUTS)}.")] = Layout.auto
+    units: Units = None
+    delimiter: Annotated[
+        str | None, _opt("--delimiter", "tab, semicolon, comma or whitespace.")
+    ] = None
+    decimal: Annotated[Decimal | None, _opt("--decimal", "Decimal separator: '.' or ','.")] = None
+    header_lines: Annotated[
+        int | None, _opt("--header-lines", "Lines before the numeric table.")
+    ] = None
+    columns: Annotated[
+        str | None,
+        _opt(
+            "--columns",
+            "Comma-separated column meanings: angle_deg, angle_rad, index, x, y, z, radius, "
+            "deviation, ignore.",
+        ),
+    ] = None
+    value: Annotated[
+        ValueKind,
+        typer.Option(
+            "--value-kind",
+            "--value",
+            help="Values are radius or deviation (auto: from the column name, else from "
+            "unambiguous numbers, else refused).",
+        ),
+    ] = ValueKind.auto
+    angle_unit: Annotated[
+        AngleUnit | None,
+        _opt(
+            "--angle-unit",
+            "Unit of the angle column when the file does not state it: deg, rad, index (point "
+            "number over one turn) or grad.",
+        ),
+    ] = None
+    arc: Annotated[
+        Arc | None,
+        _opt(
+            "--arc",
+            "Each layer is one full turn or a partial arc (settles an ambiguous angle unit; "
+            "'full' is needed for files without an angle column).",
+        ),
+    ] = None
+    z_units: Annotated[
+        str | None,
+        _opt("--z-units", "Unit of z (column, header, file names) when not stated: mm, um, m."),
+    ] = None
+    sheet: Annotated[
+        str | None, _opt("--sheet", "Worksheet of an Excel workbook with several sheets.")
+    ] = None
+    layer_spacing_mm: Annotated[float | None, _opt("--layer-spacing-mm", "Layer spacing [mm].")] = (
+        None
+    )
+    z_mid_mm: Annotated[
+        float | None,
+        _opt(
+            "--z-mid-mm",
+            "Instrument height of the bearing mid-width [mm] (default: middle of the layers).",
+        ),
+    ] = None
+    expected_points: Annotated[
+        int | None, _opt("--expected-points", "Points every layer must have.")
+    ] = None
+    allow_partial: Annotated[bool, _opt("--allow-partial", "Accept incomplete layers (NaN).")] = (
+        False
+    )
+    resample: Annotated[bool, _opt("--resample", "Interpolate layers onto one uniform grid.")] = (
+        False
+    )
+    pattern: Annotated[
+        str, _opt("--pattern", "Glob of the per-layer files in a folder, e.g. '*.txt'.")
+    ] = "*"
+    instrument: Annotated[str | None, _opt("--instrument", "Instrument name for 'source'.")] = None
+    ignore_header: Annotated[
+        list[str] | None,
+        _opt(
+            "--ignore-header",
+            "A header claim known to be wrong (repeat): units, nominal_radius, points, filter, "
+            "layers, z_extent, layer_spacing, z.",
+        ),
+    ] = None
+    z_source: Annotated[
+        str,
+        _opt(
+            "--z-source",
+            f"Where z comes from: {', '.join(Z_SOURCES)} (auto refuses when two sources disagree).",
+        ),
+    ] = "auto"
+    thousands: Annotated[
+        str | None, _opt("--thousands", "Thousands separator of the numbers: , . ' or space.")
+    ] = None
+    radius_range_mm: Annotated[
+        tuple[float, float] | None,
+        _opt(
+            "--radius-range-mm",
+            f"Plausible bore radius MIN MAX [mm] (default {_LIM['radius_min'] * 1e3:g} "
+            f"{_LIM['radius_max'] * 1e3:g}).",
+        ),
+    ] = None
+    max_deviation_mm: Annotated[
+        float | None,
+        _opt(
+            "--max-deviation-mm",
+            f"Largest plausible |deviation| [mm] (default {_LIM['max_deviation'] * 1e3:g}).",
+        ),
+    ] = None
+    nominal_tolerance: Annotated[
+        float | None,
+        _opt(
+            "--nominal-tolerance",
+            "Relative tolerance of the radius against the header's nominal (default "
+            f"{_LIM['nominal_tolerance']:g}).",
+        ),
+    ] = None
+    min_form_nm: Annotated[
+        float | None,
+        _opt(
+            "--min-form-nm",
+            f"Smallest plausible peak-to-valley of deviations [nm] ({_LIM['min_form'] * 1e9:g}).",
+        ),
+    ] = None
+    form_fraction: Annotated[
+        float | None,
+        _opt(
+            "--form-fraction",
+            "Largest plausible peak-to-valley of deviations relative to the header's nominal "
+            f"radius (default {_LIM['form_fraction']:g}).",
+        ),
+    ] = None
+    max_missing: Annotated[
+        float | None,
+        _opt(
+            "--max-missing",
+            "Largest share of a layer's points that may be missing ('---', 'NaN', empty cells) "
+            f"(default {_LIM['max_missing']:g}).",
+        ),
+    ] = None
+    heights: Annotated[
+        Path | None,
+        _opt(
+            "--heights",
+            "File of layer file, height lines (any delimiter; unit in its first line, e.g. "
+            "'file,height_mm', else --z-units); a folder's manifest/heights/index.csv is found "
+            "without it.",
+        ),
+    ] = None
+    z_mm: Annotated[
+        str | None,
+        _opt(
+            "--z-mm",
+            "Height of each layer [mm], comma-separated in file/column order, e.g. 0,1.5,4 (uneven "
+            "z; overrides every other source).",
+        ),
+    ] = None
+
+    def keywords(self) -> dict[str, Any]:
+        """The reader's keywords (SI; ``instrument`` and ``units`` only when given, so that a
+        preset's own default stands)."""
+        options = dict(
+            layout=str(self.layout),
+            delimiter=self.delimiter,
+            decimal=_text(self.decimal),
+            header_lines=self.header_lines,
+            columns=tuple(c.strip() for c in self.columns.split(",")) if self.columns else None,
+            value=str(self.value),
+            angle_unit=_text(self.angle_unit),
+            arc=_text(self.arc),
+            z_units=self.z_units,
+            sheet=self.sheet,
+            layer_spacing=_si(self.layer_spacing_mm, 1e-3),
+            z_mid=self.z_mid_mm * 1e-3 if self.z_mid_mm is not None else "centre",
+            expected_points=self.expected_points,
+            allow_partial=self.allow_partial,
+            resample=self.resample,
+            pattern=self.pattern,
+            ignore_header=tuple(self.ignore_header or ()),
+            z_source=self.z_source,
+            thousands=self.thousands,
+            radius_range=tuple(v * 1e-3 for v in self.radius_range_mm)
+            if self.radius_range_mm
+            else None,
+            max_deviation=_si(self.max_deviation_mm, 1e-3),
+            nominal_tolerance=self.nominal_tolerance,
+            min_form=_si(self.min_form_nm, 1e-9),
+            form_fraction=self.form_fraction,
+            max_missing=self.max_missing,
+            heights=str(self.heights) if self.heights is not None else None,
+            z=_z_list(self.z_mm),
+        )
+        if self.instrument is not None:
+            options["instrument"] = self.instrument
+        if self.units is not None:
+            options["units"] = self.units
+        return options
 
 
 # --- assess ---------------------------------------------------------------------------------

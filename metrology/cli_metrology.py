@@ -8,6 +8,7 @@ from typing import Annotated
 import typer
 
 from jointwear._cli import AngleDirection, AngleZero, FigureOut, Overwrite
+from jointwear._cli_dataclass import options_from
 from jointwear._version import source_attribute
 from jointwear.metrology import _cli_options as opt
 from jointwear.metrology._cli_options import FilterKind, Shape
@@ -35,28 +36,7 @@ def _assess_point_file(path: Path, target: Path | None, units: str | None) -> No
         typer.echo(f"wrote {target}")
 
 
-def _si(value: float | None, scale: float) -> float | None:
-    """An option given in mm/nm in SI (None stays None)."""
-    return value * scale if value is not None else None
-
-
-def _z_list(z_mm: str | None) -> tuple[float, ...] | None:
-    """``--z-mm 0,1.5,4`` as heights in metres (None when not given)."""
-    if z_mm is None:
-        return None
-    try:
-        return tuple(float(v) * 1e-3 for v in z_mm.replace(" ", "").split(",") if v)
-    except ValueError:
-        raise typer.BadParameter(
-            f"--z-mm {z_mm!r}: expected comma-separated numbers in mm, e.g. 0,1.5,4"
-        ) from None
-
-
-def _text(value) -> str | None:
-    """A choice option's value as the library's string (None stays None)."""
-    return str(value) if value is not None else None
-
-
+@options_from("reading", opt.ScanFlags)
 def import_cmd(
     paths: opt.ScanPaths,
     out: opt.ImportOut = Path("scan.nc"),
@@ -64,73 +44,12 @@ def import_cmd(
     angle_zero: AngleZero = None,
     angle_direction: AngleDirection = None,
     preset: opt.PresetOpt = opt.Preset.generic,
-    layout: opt.LayoutOpt = opt.Layout.auto,
-    units: opt.Units = None,
-    delimiter: opt.Delimiter = None,
-    decimal: opt.DecimalOpt = None,
-    header_lines: opt.HeaderLines = None,
-    columns: opt.Columns = None,
-    value: opt.ValueKindOpt = opt.ValueKind.auto,
-    angle_unit: opt.AngleUnitOpt = None,
-    arc: opt.ArcOpt = None,
-    z_units: opt.ZUnits = None,
-    sheet: opt.Sheet = None,
-    layer_spacing_mm: opt.LayerSpacingMm = None,
-    z_mid_mm: opt.ZMidMm = None,
-    expected_points: opt.ExpectedPoints = None,
-    allow_partial: opt.AllowPartial = False,
-    resample: opt.Resample = False,
     batch: opt.Batch = False,
-    pattern: opt.Pattern = "*",
-    instrument: opt.Instrument = None,
-    ignore_header: opt.IgnoreHeader = None,
-    z_source: opt.ZSource = "auto",
-    thousands: opt.Thousands = None,
-    radius_range_mm: opt.RadiusRangeMm = None,
-    max_deviation_mm: opt.MaxDeviationMm = None,
-    nominal_tolerance: opt.NominalTolerance = None,
-    min_form_nm: opt.MinFormNm = None,
-    form_fraction: opt.FormFraction = None,
-    max_missing: opt.MaxMissing = None,
-    heights: opt.Heights = None,
-    z_mm: opt.ZMm = None,
+    *,
+    reading: opt.ScanFlags,
 ) -> None:
     """Import roundness/cylindricity text exports into contract netCDF files."""
     from jointwear.metrology.readers.importing import import_scans
-
-    options = dict(
-        layout=str(layout),
-        delimiter=delimiter,
-        decimal=_text(decimal),
-        header_lines=header_lines,
-        columns=tuple(c.strip() for c in columns.split(",")) if columns else None,
-        value=str(value),
-        angle_unit=_text(angle_unit),
-        arc=_text(arc),
-        z_units=z_units,
-        sheet=sheet,
-        layer_spacing=_si(layer_spacing_mm, 1e-3),
-        z_mid=z_mid_mm * 1e-3 if z_mid_mm is not None else "centre",
-        expected_points=expected_points,
-        allow_partial=allow_partial,
-        resample=resample,
-        pattern=pattern,
-        ignore_header=tuple(ignore_header or ()),
-        z_source=z_source,
-        thousands=thousands,
-        radius_range=tuple(v * 1e-3 for v in radius_range_mm) if radius_range_mm else None,
-        max_deviation=_si(max_deviation_mm, 1e-3),
-        nominal_tolerance=nominal_tolerance,
-        min_form=_si(min_form_nm, 1e-9),
-        form_fraction=form_fraction,
-        max_missing=max_missing,
-        heights=str(heights) if heights is not None else None,
-        z=_z_list(z_mm),
-    )
-    if instrument is not None:
-        options["instrument"] = instrument
-    if units is not None:
-        options["units"] = units
 
     def summary(target: Path, ds) -> None:
         var = "radius" if "radius" in ds else "radial_deviation"
@@ -154,7 +73,7 @@ def import_cmd(
         preset=str(preset),
         batch=batch,
         on_saved=summary,
-        **options,
+        **reading.keywords(),
     )
 
 

@@ -3,6 +3,7 @@
 from jointwear.metrology.readers.talyrond import TALYROND_DEFAULTS, read_talyrond
 from jointwear.metrology.readers.text import (  # the split modules, re-exported
     COLUMN_KINDS,
+    ScanReading,
     TextFormat,
     parse_file,
     read_scan,
@@ -12,6 +13,7 @@ from jointwear.metrology.readers.text import (  # the split modules, re-exported
 
 __all__ = [
     "COLUMN_KINDS",
+    "ScanReading",
     "TALYROND_DEFAULTS",
     "TextFormat",
     "parse_file",

@@ -39,8 +39,9 @@ from __future__ import annotations
 
 import re
 from collections.abc import Iterable, Sequence
-from dataclasses import asdict, replace
+from dataclasses import asdict, dataclass, fields, replace
 from pathlib import Path
+from typing import Any
 
 import xarray as xr
 
@@ -57,69 +58,20 @@ from jointwear.metrology.readers.layers import _Layer, _layers_from_file
 from jointwear.metrology.readers.table import TextFormat, parse_blocks
 from jointwear.metrology.readers.zsource import assign_z, layer_numbers_from_meta
 
-__all__ = ["read_text", "read_scan"]
+__all__ = ["ScanReading", "read_text", "read_scan"]
 
 
 def _natural_key(p: Path) -> list:
     return [int(t) if t.isdigit() else t.lower() for t in re.split(r"(\d+)", p.name)]
 
 
-def read_text(
-    path: str | Path,
-    *,
-    convention: AngleConvention | tuple[str, str] | None = None,
-    **options,
-) -> xr.Dataset:
-    """Read one text export (a single trace, a long file or a wide file).
-
-    Shorthand for :func:`read_scan` with one path; see there for the options.
-    """
-    return read_scan(path, convention=convention, **options)
-
-
-def read_scan(
-    paths: str | Path | Iterable[str | Path],
-    *,
-    convention: AngleConvention | tuple[str, str] | None = None,
-    layout: str = "auto",
-    fmt: TextFormat | None = None,
-    delimiter: str | None = None,
-    decimal: str | None = None,
-    header_lines: int | None = None,
-    columns: Sequence[str] | None = None,
-    units: str | None = None,
-    value: str = "auto",
-    angle_unit: str | None = None,
-    arc: str | None = None,
-    z_units: str | None = None,
-    sheet: str | None = None,
-    z: Sequence[float] | None = None,
-    layer_spacing: float | None = None,
-    z_mid: float | str = "centre",
-    expected_points: int | None = None,
-    allow_partial: bool = False,
-    resample: bool = False,
-    pattern: str = "*",
-    instrument: str | None = None,
-    ignore_header: Sequence[str] = (),
-    z_source: str = "auto",
-    thousands: str | None = None,
-    radius_range: tuple[float, float] | None = None,
-    max_deviation: float | None = None,
-    nominal_tolerance: float | None = None,
-    min_form: float | None = None,
-    form_fraction: float | None = None,
-    max_missing: float | None = None,
-    heights: str | Path | None = None,
-) -> xr.Dataset:
-    """Read a roundness / cylindricity scan from text exports into a contract Dataset.
+@dataclass(frozen=True)
+class ScanReading:
+    """How :func:`read_scan` reads a scan: every choice it would otherwise sniff, or refuse
+    when the file does not settle it. The defaults sniff everything.
 
     Parameters
     ----------
-    paths : path, folder or list of paths
-        One file (single trace, long, wide or blocks layout), a folder or list of layer files.
-    convention : AngleConvention or (zero, direction)
-        The instrument's angle convention in the bearing frame. Required: never guessed.
     layout : {"auto", "single", "folder", "long", "wide", "blocks"}
         Multi-layer layout (``auto``: a folder/list -> folder; layer blocks in one file ->
         blocks; a z column -> long; several value columns -> wide; else single).
@@ -171,6 +123,135 @@ def read_scan(
     max_missing : float, optional
         Largest share of a layer's points that may be missing (``---``, ``NaN``, empty cells:
         read as NaN points, counted in ``missing_points``); default 0.05.
+    """
+
+    layout: str = "auto"
+    fmt: TextFormat | None = None
+    delimiter: str | None = None
+    decimal: str | None = None
+    header_lines: int | None = None
+    columns: Sequence[str] | str | None = None
+    units: str | None = None
+    value: str = "auto"
+    angle_unit: str | None = None
+    arc: str | None = None
+    z_units: str | None = None
+    sheet: str | None = None
+    z: Sequence[float] | None = None
+    layer_spacing: float | None = None
+    z_mid: float | str = "centre"
+    expected_points: int | None = None
+    allow_partial: bool = False
+    resample: bool = False
+    pattern: str = "*"
+    instrument: str | None = None
+    ignore_header: Sequence[str] = ()
+    z_source: str = "auto"
+    thousands: str | None = None
+    radius_range: tuple[float, float] | None = None
+    max_deviation: float | None = None
+    nominal_tolerance: float | None = None
+    min_form: float | None = None
+    form_fraction: float | None = None
+    max_missing: float | None = None
+    heights: str | Path | None = None
+
+    def __post_init__(self) -> None:
+        if self.value not in ("auto", *VALUE_KINDS):
+            raise BadInputError(
+                f"value must be 'auto', 'radius' or 'deviation', got {self.value!r}"
+            )
+        if self.layout not in LAYOUTS:
+            raise BadInputError(
+                f"layout {self.layout!r} is not known; use auto, single, folder, long, wide or "
+                "blocks"
+            )
+
+    def given(self) -> dict[str, Any]:
+        """The fields set to other than their defaults (what a preset must not override)."""
+        return {
+            f.name: getattr(self, f.name)
+            for f in fields(self)
+            if _differs(getattr(self, f.name), f.default)
+        }
+
+    def text_format(self) -> TextFormat:
+        """``fmt`` (default: sniff everything) with the format options given (not None)."""
+        columns = self.columns
+        if columns is not None:
+            columns = columns.split(",") if isinstance(columns, str) else tuple(columns)
+        over = dict(
+            delimiter=self.delimiter,
+            decimal=self.decimal,
+            header_lines=self.header_lines,
+            columns=columns,
+            units=self.units,
+            z_units=self.z_units,
+            sheet=self.sheet,
+            ignore_header=tuple(self.ignore_header) if self.ignore_header else None,
+            thousands=self.thousands,
+        )
+        base = self.fmt or TextFormat()
+        over = {k: v for k, v in over.items() if v is not None}
+        return replace(base, **over) if over else base
+
+    def limits(self) -> dict[str, float]:
+        """The plausibility limits with the options given."""
+        rmin, rmax = (None, None) if self.radius_range is None else self.radius_range
+        return plausibility(
+            radius_min=rmin,
+            radius_max=rmax,
+            max_deviation=self.max_deviation,
+            nominal_tolerance=self.nominal_tolerance,
+            min_form=self.min_form,
+            form_fraction=self.form_fraction,
+            max_missing=self.max_missing,
+        )
+
+
+def _differs(value: Any, default: Any) -> bool:
+    """Whether a field's value is not its default (an array of heights always is)."""
+    if value is default:
+        return False
+    try:
+        return bool(value != default)
+    except (TypeError, ValueError):
+        return True
+
+
+def read_text(
+    path: str | Path,
+    *,
+    convention: AngleConvention | tuple[str, str] | None = None,
+    **options,
+) -> xr.Dataset:
+    """Read one text export (a single trace, a long file or a wide file).
+
+    Shorthand for :func:`read_scan` with one path; see there for the options.
+    """
+    return read_scan(path, convention=convention, **options)
+
+
+def read_scan(
+    paths: str | Path | Iterable[str | Path],
+    *,
+    convention: AngleConvention | tuple[str, str] | None = None,
+    reading: ScanReading | None = None,
+    **options: Any,
+) -> xr.Dataset:
+    """Read a roundness / cylindricity scan from text exports into a contract Dataset.
+
+    Parameters
+    ----------
+    paths : path, folder or list of paths
+        One file (single trace, long, wide or blocks layout), a folder or list of layer files.
+    convention : AngleConvention or (zero, direction)
+        The instrument's angle convention in the bearing frame. Required: never guessed.
+    reading : ScanReading, optional
+        How the files are read (:class:`ScanReading`; default: every choice sniffed).
+    **options
+        Fields of :class:`ScanReading`, given directly (``layout="long"``, ``units="um"``):
+        they replace ``reading``'s. This is how presets and refusals' suggestions pass them.
 
     Returns
     -------
@@ -191,39 +272,25 @@ def read_scan(
     >>> dict(scan.sizes), scan["radial_deviation"].attrs["units"], scan.attrs["data_origin"]
     ({'z': 3, 'theta': 360}, 'm', 'synthetic')
     """
-    conv = _checked(convention, value, layout)
-    base = _text_format(
-        fmt,
-        delimiter,
-        decimal,
-        header_lines,
-        columns,
-        units,
-        z_units,
-        sheet,
-        ignore_header,
-        thousands,
-    )
-    files, folder = _collect_files(paths, pattern, heights)
-    limits = _limits(
-        radius_range, max_deviation, nominal_tolerance, min_form, form_fraction, max_missing
-    )
+    conv = _as_convention(convention)
+    opts = replace(reading or ScanReading(), **options)
+    base = opts.text_format()
+    files, folder = _collect_files(paths, opts.pattern, opts.heights)
+    limits = opts.limits()
     parsed = [pf for f in files for pf in parse_blocks(f, base)]
-    layers, metadata, notes = _read_layers(
-        parsed, len(files), expected_points, allow_partial, value, angle_unit, arc, limits
-    )
-    layout_used = _layout_used(layout, parsed, layers, files)
+    layers, metadata, notes = _read_layers(parsed, len(files), opts, limits)
+    layout_used = _layout_used(opts.layout, parsed, layers, files)
     zsrc = assign_z(
         layers,
         parsed,
         layout_used,
         folder,
-        z=None if z is None else list(z),
-        layer_spacing=layer_spacing,
-        z_units=z_units,
-        z_source=z_source,
+        z=None if opts.z is None else list(opts.z),
+        layer_spacing=opts.layer_spacing,
+        z_units=opts.z_units,
+        z_source=opts.z_source,
         where=f"'{folder or files[0]}'",
-        heights=None if heights is None else Path(heights),
+        heights=None if opts.heights is None else Path(opts.heights),
     )
     notes["z_from"] = zsrc
     where = f"'{files[0] if len(files) == 1 else folder}'"
@@ -231,44 +298,16 @@ def read_scan(
     ds = _assemble(
         layers,
         convention=conv,
-        z_mid=z_mid,
-        instrument=_instrument(instrument, metadata),
+        z_mid=opts.z_mid,
+        instrument=_instrument(opts.instrument, metadata),
         fmt_notes=notes,
         metadata=metadata,
         files=[str(f) for f in files],
         layout=layout_used,
-        allow_partial=allow_partial,
-        resample=resample,
+        allow_partial=opts.allow_partial,
+        resample=opts.resample,
     )
     return _record_reading(ds, parsed[0], notes, unconfirmed)
-
-
-def _checked(convention, value: str, layout: str) -> AngleConvention:
-    """The instrument's angle convention, once the choices are checked."""
-    conv = _as_convention(convention)
-    if value not in ("auto", *VALUE_KINDS):
-        raise BadInputError(f"value must be 'auto', 'radius' or 'deviation', got {value!r}")
-    if layout not in LAYOUTS:
-        raise BadInputError(
-            f"layout {layout!r} is not known; use auto, single, folder, long, wide or blocks"
-        )
-    return conv
-
-
-def _limits(
-    radius_range, max_deviation, nominal_tolerance, min_form, form_fraction, max_missing
-) -> dict[str, float]:
-    """The plausibility limits with the options given."""
-    rmin, rmax = (None, None) if radius_range is None else radius_range
-    return plausibility(
-        radius_min=rmin,
-        radius_max=rmax,
-        max_deviation=max_deviation,
-        nominal_tolerance=nominal_tolerance,
-        min_form=min_form,
-        form_fraction=form_fraction,
-        max_missing=max_missing,
-    )
 
 
 def _instrument(given: str | None, metadata: dict) -> str:
@@ -277,28 +316,6 @@ def _instrument(given: str | None, metadata: dict) -> str:
         return given
     keys = ("instrument", "machine", "model", "gauge", "device")
     return next((v for k, v in metadata.items() if k.lower() in keys), "roundness instrument")
-
-
-def _text_format(
-    fmt, delimiter, decimal, header_lines, columns, units, z_units, sheet, ignore_header, thousands
-) -> TextFormat:
-    """``fmt`` (default: sniff everything) with the options given (not None) replaced."""
-    base = fmt or TextFormat()
-    over = dict(
-        delimiter=delimiter,
-        decimal=decimal,
-        header_lines=header_lines,
-        columns=(columns.split(",") if isinstance(columns, str) else tuple(columns))
-        if columns is not None
-        else None,
-        units=units,
-        z_units=z_units,
-        sheet=sheet,
-        ignore_header=tuple(ignore_header) if ignore_header else None,
-        thousands=thousands,
-    )
-    over = {k: v for k, v in over.items() if v is not None}
-    return replace(base, **over) if over else base
 
 
 def _collect_files(paths, pattern: str, heights=None) -> tuple[list[Path], Path | None]:
@@ -331,17 +348,11 @@ def _collect_files(paths, pattern: str, heights=None) -> tuple[list[Path], Path 
 
 
 def _read_layers(
-    parsed: list,
-    n_files: int,
-    expected_points: int | None,
-    allow_partial: bool,
-    value: str,
-    angle_unit: str | None,
-    arc: str | None,
-    limits: dict,
+    parsed: list, n_files: int, opts: ScanReading, limits: dict
 ) -> tuple[list[_Layer], dict, dict]:
     """The layers of every parsed file (or block), the first file's header metadata, and the
     guesses made per file (``reader_guesses``)."""
+    expected_points, allow_partial = opts.expected_points, opts.allow_partial
     layers: list[_Layer] = []
     metadata: dict = {}
     notes: dict = {}
@@ -350,9 +361,9 @@ def _read_layers(
         ls = _layers_from_file(
             pf,
             None if allow_partial else expected_points,
-            value_kind=None if value == "auto" else value,
-            angle_unit=angle_unit,
-            arc=arc or pf.arc,
+            value_kind=None if opts.value == "auto" else opts.value,
+            angle_unit=opts.angle_unit,
+            arc=opts.arc or pf.arc,
             notes=decided,
             limits=limits,
         )

@@ -53,16 +53,20 @@ def read_talyrond(
         Where the instrument's 0 degree points in the bearing frame and which way its angle
         turns (seen from +z). Required.
     **options
-        Any option of :func:`~jointwear.metrology.readers.text.read_scan`; defaults
-        :data:`TALYROND_DEFAULTS` (values in µm unless the header states a unit; the header's
-        unit wins over this default but not over an explicit ``units=``).
+        Any option of :func:`~jointwear.metrology.readers.text.read_scan` (``reading=`` a
+        :class:`~jointwear.metrology.readers.scan.ScanReading`, or its fields, which replace
+        the reading's); defaults :data:`TALYROND_DEFAULTS` where neither sets the option (values
+        in µm unless the header states a unit; the header's unit wins over this default but not
+        over an explicit ``units=``).
 
     Returns
     -------
     Dataset
         ``radial_deviation`` (or ``radius``) [m] over (z, theta) in the canonical convention.
     """
-    options = {k: v for k, v in options.items() if v is not None}  # None = not given
+    reading = options.pop("reading", None)
+    given = reading.given() if reading is not None else {}
+    options = given | {k: v for k, v in options.items() if v is not None}  # None = not given
     opts = dict(TALYROND_DEFAULTS)
     explicit_units = "units" in options
     opts.update(options)

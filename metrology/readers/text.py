@@ -10,7 +10,7 @@ table), :mod:`~jointwear.metrology.readers.columns` (column meanings),
 from __future__ import annotations
 
 from jointwear.metrology.readers.columns import COLUMN_KINDS
-from jointwear.metrology.readers.scan import read_scan, read_text
+from jointwear.metrology.readers.scan import ScanReading, read_scan, read_text
 from jointwear.metrology.readers.table import (
     UNITS,
     ParsedFile,
@@ -23,6 +23,7 @@ from jointwear.metrology.readers.table import (
 __all__ = [
     "COLUMN_KINDS",
     "UNITS",
+    "ScanReading",
     "TextFormat",
     "ParsedFile",
     "sniff",

@@ -51,6 +51,17 @@ def _dev(rng, n, layers):
     return np.array([a[k] * np.cos(2 * t + k) + 0.05 * np.sin(7 * t) for k in range(layers)])
 
 
+def _wide(head: str, th, zs, values, cell, *, sep="\t", name="z={z:g}mm", angle="{:.1f}") -> str:
+    """A wide export's text: the ``head`` lines, the column names (the angle's, then one per
+    layer at ``zs`` [mm]), then per angle ``th`` the angle and each layer's ``cell(value)``."""
+    names = sep.join(name.format(z=z) for z in zs)
+    rows = "".join(
+        angle.format(t) + sep + sep.join(cell(v[i]) for v in values) + "\n"
+        for i, t in enumerate(th)
+    )
+    return f"{head}Angle (deg){sep}{names}\n{rows}"
+
+
 def _write(kind: str, d, rng):
     """Write one export of ``kind``; return (input path, truth, fill) with truth = (theta
     [degree], z [m] from mid-width, values [m], variable) and fill the placeholder values."""
@@ -104,14 +115,8 @@ def _write(kind: str, d, rng):
         kc = float(rng.choice([15, 50]))
         raw = _dev(rng, n, layers) + 0.01 * rng.standard_normal((layers, n))
         dev = np.round(filter_profile(raw * 1e-6, kc) * 1e6, 4)
-        f.write_text(
-            f"Units: um\nFilter: Gaussian {kc:g} UPR\nAngle (deg)\t"
-            + "\t".join(f"z={z:g}mm" for z in zs)
-            + "\n"
-            + "".join(
-                f"{th[i]:.2f}\t" + "\t".join(f"{v[i]:.4f}" for v in dev) + "\n" for i in range(n)
-            )
-        )
+        head = f"Units: um\nFilter: Gaussian {kc:g} UPR\n"
+        f.write_text(_wide(head, th, zs, dev, "{:.4f}".format, angle="{:.2f}"))
     elif kind == "missing":
         mark = str(rng.choice(["---", "NaN", "nan", "", "-", "*", "n/a"]))
         gone = rng.choice(n * layers, size=layers * n // 100, replace=False)
@@ -119,14 +124,7 @@ def _write(kind: str, d, rng):
         dev.flat[gone] = np.nan
         sep = str(rng.choice([",", ";", "\t"]))
         cell = lambda v: mark if np.isnan(v) else f"{v:.3f}"  # noqa: E731
-        f.write_text(
-            f"Units: um\nAngle (deg){sep}"
-            + sep.join(f"Dev z={z:g} mm" for z in zs)
-            + "\n"
-            + "".join(
-                f"{th[i]:.1f}{sep}" + sep.join(cell(v[i]) for v in dev) + "\n" for i in range(n)
-            )
-        )
+        f.write_text(_wide("Units: um\n", th, zs, dev, cell, sep=sep, name="Dev z={z:g} mm"))
     elif kind == "heights":
         f = d / "scan"
         f.mkdir()
@@ -162,24 +160,10 @@ def _write(kind: str, d, rng):
     elif kind == "uin":
         dev = np.round(dev * 40.0, 2)  # in micro-inch
         fill["--units"] = "uin"
-        f.write_text(
-            "Units: uin\nAngle (deg)\t"
-            + "\t".join(f"z={z:g}mm" for z in zs)
-            + "\n"
-            + "".join(
-                f"{th[i]:.1f}\t" + "\t".join(f"{v[i]:.2f}" for v in dev) + "\n" for i in range(n)
-            )
-        )
+        f.write_text(_wide("Units: uin\n", th, zs, dev, "{:.2f}".format))
         return f, (th, (zs - 0.5 * (zs.min() + zs.max())) * 1e-3, dev * 25.4e-9, var), fill
     elif kind == "unknown_unit":
-        f.write_text(
-            "Einheit: Mikrometer\nAngle (deg)\t"
-            + "\t".join(f"z={z:g}mm" for z in zs)
-            + "\n"
-            + "".join(
-                f"{th[i]:.1f}\t" + "\t".join(f"{v[i]:.3f}" for v in dev) + "\n" for i in range(n)
-            )
-        )
+        f.write_text(_wide("Einheit: Mikrometer\n", th, zs, dev, "{:.3f}".format))
     elif kind == "probes":  # two angle/value pairs: two probes, the first one is the truth
         layers, zs = 1, zs[:1]
         other = np.round(_dev(rng, n, 1)[0], 3)
@@ -195,15 +179,8 @@ def _write(kind: str, d, rng):
         var = "radius"
         nm = np.round((8000.0 + dev) * 1000.0)
         fill["--thousands"], fill["--units"] = "apostrophe", "nm"
-        f.write_text(
-            "Units: nm\nAngle (deg)\t"
-            + "\t".join(f"Radius z={z:g} mm" for z in zs)
-            + "\n"
-            + "".join(
-                f"{th[i]:.1f}\t" + "\t".join(f"{int(v[i]):,}".replace(",", "'") for v in nm) + "\n"
-                for i in range(n)
-            )
-        )
+        grouped = lambda v: f"{int(v):,}".replace(",", "'")  # noqa: E731
+        f.write_text(_wide("Units: nm\n", th, zs, nm, grouped, name="Radius z={z:g} mm"))
         return f, (th, (zs - 0.5 * (zs.min() + zs.max())) * 1e-3, nm * 1e-9, var), fill
     return f, (th, (zs - 0.5 * (zs.min() + zs.max())) * 1e-3, dev * 1e-6, var), fill
 
