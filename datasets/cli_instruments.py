@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Annotated, Literal
 
 import typer
 
 from jointwear._cli import Overwrite
+from jointwear._cli_dataclass import options_from
 from jointwear._version import source_attribute
 from jointwear.datasets import _instrument_defaults as D
 
@@ -24,6 +26,82 @@ def _ecc_um() -> tuple[float, float]:
     return (_shown(D.ECCENTRICITY[0], 1e6), _shown(D.ECCENTRICITY[1], 1e6))
 
 
+@dataclass(frozen=True)
+class _ExportFormat:
+    """How the instrument's files are written (an option group of ``instruments_cmd``)."""
+
+    layout: Annotated[
+        Literal["folder", "folder-names", "folder-header", "long", "wide", "single"],
+        typer.Option("--layout", help="folder, folder-names, folder-header, long, wide or single."),
+    ] = D.LAYOUT
+    value: Annotated[
+        Literal["deviation", "radius"], typer.Option("--value", help="deviation or radius.")
+    ] = D.VALUE
+    units: Annotated[str, typer.Option("--units", help="um, mm, m or inch.")] = D.UNITS
+    angle: Annotated[
+        Literal["deg", "rad", "index", "none", "xy"],
+        typer.Option("--angle", help="Angle column: deg, rad, index, none or xy."),
+    ] = D.ANGLE
+    delimiter: Annotated[
+        str, typer.Option("--delimiter", help="tab, semicolon, comma or space.")
+    ] = next(k for k, v in DELIMITERS.items() if v == D.DELIMITER)
+    decimal: Annotated[str, typer.Option("--decimal", help="'.' or ','.")] = D.DECIMAL
+
+    def keywords(self) -> dict[str, str]:
+        """The keywords of :func:`jointwear.datasets.instruments.write`."""
+        return {
+            "layout": self.layout,
+            "value": self.value,
+            "units": self.units,
+            "angle": self.angle,
+            "delimiter": DELIMITERS.get(self.delimiter, self.delimiter),
+            "decimal": self.decimal,
+        }
+
+
+@dataclass(frozen=True)
+class _ImposedWear:
+    """The wear imposed on the bore: the built-in pattern of ``--wear-um`` deep, or a simulated
+    bore's (``--wear-from``, scaled and turned); an option group of ``instruments_cmd``."""
+
+    wear_um: Annotated[
+        float, typer.Option("--wear-um", help="Peak depth of the imposed wear [µm] (0: none).")
+    ] = _shown(D.WEAR_DEPTH, 1e6)
+    wear_from: Annotated[
+        Path | None,
+        typer.Option(
+            "--wear-from",
+            help="Take the imposed wear from a 'jointwear sim wear' result (last snapshot) "
+            "instead of the built-in pattern; --wear-um is then not used.",
+        ),
+    ] = None
+    wear_scale: Annotated[
+        float,
+        typer.Option("--wear-scale", help="Factor on the wear taken with --wear-from [1]."),
+    ] = 1.0
+    wear_rotation_deg: Annotated[
+        float,
+        typer.Option(
+            "--wear-rotation-deg",
+            help="Turn of the wear taken with --wear-from, canonical sense [degree].",
+        ),
+    ] = 0.0
+
+    def pattern(self) -> tuple[object, float | None]:
+        """The generator's ``wear`` ("default", None or the simulated map) and the simulated
+        bore's radius [m] (None: not stated, or no simulation)."""
+        if self.wear_from is None:
+            return ("default" if self.wear_um > 0 else None), None
+        from jointwear import io
+        from jointwear.datasets.simulated_wear import wear_from_simulation
+
+        sim = io.load(self.wear_from)
+        wear = wear_from_simulation(sim, scale=self.wear_scale, rotation_deg=self.wear_rotation_deg)
+        return wear, sim.attrs.get("bearing_radius_m")
+
+
+@options_from("export", _ExportFormat)
+@options_from("imposed", _ImposedWear)
 def instruments_cmd(
     out: Annotated[Path, typer.Argument(help="Output folder (or file for long/wide/single).")],
     overwrite: Overwrite = False,
@@ -40,50 +118,15 @@ def instruments_cmd(
     spacing_mm: Annotated[float, typer.Option("--spacing-mm", help="Layer spacing [mm].")] = _shown(
         D.LAYER_SPACING, 1e3
     ),
-    layout: Annotated[
-        Literal["folder", "folder-names", "folder-header", "long", "wide", "single"],
-        typer.Option("--layout", help="folder, folder-names, folder-header, long, wide or single."),
-    ] = D.LAYOUT,
-    value: Annotated[
-        Literal["deviation", "radius"], typer.Option("--value", help="deviation or radius.")
-    ] = D.VALUE,
-    units: Annotated[str, typer.Option("--units", help="um, mm, m or inch.")] = D.UNITS,
-    angle: Annotated[
-        Literal["deg", "rad", "index", "none", "xy"],
-        typer.Option("--angle", help="Angle column: deg, rad, index, none or xy."),
-    ] = D.ANGLE,
-    delimiter: Annotated[
-        str, typer.Option("--delimiter", help="tab, semicolon, comma or space.")
-    ] = next(k for k, v in DELIMITERS.items() if v == D.DELIMITER),
-    decimal: Annotated[str, typer.Option("--decimal", help="'.' or ','.")] = D.DECIMAL,
+    *,
+    export: _ExportFormat,
     eccentricity_um: Annotated[
         tuple[float, float], typer.Option("--eccentricity-um", help="Set-up offset x y [µm].")
     ] = _ecc_um(),
     tilt: Annotated[
         tuple[float, float], typer.Option("--tilt", help="Axis slopes dx/dz dy/dz [1].")
     ] = D.TILT,
-    wear_um: Annotated[
-        float, typer.Option("--wear-um", help="Peak depth of the imposed wear [µm] (0: none).")
-    ] = _shown(D.WEAR_DEPTH, 1e6),
-    wear_from: Annotated[
-        Path | None,
-        typer.Option(
-            "--wear-from",
-            help="Take the imposed wear from a 'jointwear sim wear' result (last snapshot) "
-            "instead of the built-in pattern; --wear-um is then not used.",
-        ),
-    ] = None,
-    wear_scale: Annotated[
-        float,
-        typer.Option("--wear-scale", help="Factor on the wear taken with --wear-from [1]."),
-    ] = 1.0,
-    wear_rotation_deg: Annotated[
-        float,
-        typer.Option(
-            "--wear-rotation-deg",
-            help="Turn of the wear taken with --wear-from, canonical sense [degree].",
-        ),
-    ] = 0.0,
+    imposed: _ImposedWear,
     noise_um: Annotated[float, typer.Option("--noise-um", help="Probe noise [µm].")] = _shown(
         D.NOISE, 1e6
     ),
@@ -110,15 +153,10 @@ def instruments_cmd(
     from jointwear import io
     from jointwear.datasets.instruments import generate, write
 
-    wear: object = "default" if wear_um > 0 else None
+    wear, sim_radius = imposed.pattern()
     radius = D.RADIUS if radius_mm is None else radius_mm / 1e3
-    if wear_from is not None:
-        from jointwear.datasets.simulated_wear import wear_from_simulation
-
-        sim = io.load(wear_from)
-        wear = wear_from_simulation(sim, scale=wear_scale, rotation_deg=wear_rotation_deg)
-        if radius_mm is None:
-            radius = float(sim.attrs.get("bearing_radius_m", radius))
+    if radius_mm is None and sim_radius is not None:
+        radius = float(sim_radius)
     sc = generate(
         n_layers=layers,
         n_points=points,
@@ -127,23 +165,14 @@ def instruments_cmd(
         eccentricity=(eccentricity_um[0] / 1e6, eccentricity_um[1] / 1e6),
         tilt=tilt,
         wear=wear,
-        wear_depth=wear_um / 1e6,
+        wear_depth=imposed.wear_um / 1e6,
         noise=noise_um / 1e6,
         quantisation=quantisation_nm / 1e9,
         convention=(angle_zero, angle_direction),
         seed=seed,
         noise_seed=noise_seed,
     )
-    files = write(
-        sc,
-        out,
-        layout=layout,
-        value=value,
-        units=units,
-        angle=angle,
-        delimiter=DELIMITERS.get(delimiter, delimiter),
-        decimal=decimal,
-    )
+    files = write(sc, out, **export.keywords())
     typer.echo(f"wrote {len(files)} file(s) under {out}")
     typer.echo(
         f"import with: jointwear metrology import {out} --angle-zero {angle_zero} "
@@ -159,10 +188,10 @@ def instruments_cmd(
                 "layers": layers,
                 "points": points,
                 "seed": seed,
-                "layout": layout,
-                "wear_from": None if wear_from is None else str(wear_from),
-                "wear_scale": wear_scale,
-                "wear_rotation_deg": wear_rotation_deg,
+                "layout": export.layout,
+                "wear_from": None if imposed.wear_from is None else str(imposed.wear_from),
+                "wear_scale": imposed.wear_scale,
+                "wear_rotation_deg": imposed.wear_rotation_deg,
             },
         )
         typer.echo(f"wrote {truth}")

@@ -40,33 +40,6 @@ _Tool = Annotated[
     str | None, typer.Option("--tool", help="The program that wrote the file, e.g. 'Adams 2024'.")
 ]
 
-_Delimiter = Annotated[
-    str | None,
-    typer.Option("--delimiter", help="CSV field delimiter: tab, semicolon, comma or whitespace."),
-]
-_Decimal = Annotated[
-    str | None, typer.Option("--decimal", help="CSV decimal mark: point or comma.")
-]
-_U = Annotated[
-    str | None,
-    typer.Option(
-        "--u",
-        metavar="VALUE[unit]",
-        help="Uncertainty of every point, e.g. 0.5um (default unit: the data's).",
-    ),
-]
-_UColumn = Annotated[
-    str | None,
-    typer.Option("--u-column", help="Column(s) of the table holding each row's uncertainty."),
-]
-_UK = Annotated[
-    float | None,
-    typer.Option("--u-k", help="Coverage factor of --u/--u-column: 1 standard, 2 expanded (95 %)."),
-]
-_UCovers = Annotated[
-    str | None,
-    typer.Option("--u-covers", help="What the uncertainty covers, e.g. 'probe noise'."),
-]
 
 _CF_SUFFIXES = (".nc", ".nc4", ".cdf")
 """File endings read as CF netCDF; any other file is read as a CSV table."""
@@ -129,12 +102,37 @@ class _TableFlags:
     the stated uncertainty's ``--u``, ``--u-column``, ``--u-k``, ``--u-covers``; an option
     group (``@options_from("table", _TableFlags)``), each command's last options."""
 
-    delimiter: _Delimiter = None
-    decimal: _Decimal = None
-    u: _U = None
-    u_column: _UColumn = None
-    u_k: _UK = None
-    u_covers: _UCovers = None
+    delimiter: Annotated[
+        str | None,
+        typer.Option(
+            "--delimiter", help="CSV field delimiter: tab, semicolon, comma or whitespace."
+        ),
+    ] = None
+    decimal: Annotated[
+        str | None, typer.Option("--decimal", help="CSV decimal mark: point or comma.")
+    ] = None
+    u: Annotated[
+        str | None,
+        typer.Option(
+            "--u",
+            metavar="VALUE[unit]",
+            help="Uncertainty of every point, e.g. 0.5um (default unit: the data's).",
+        ),
+    ] = None
+    u_column: Annotated[
+        str | None,
+        typer.Option("--u-column", help="Column(s) of the table holding each row's uncertainty."),
+    ] = None
+    u_k: Annotated[
+        float | None,
+        typer.Option(
+            "--u-k", help="Coverage factor of --u/--u-column: 1 standard, 2 expanded (95 %)."
+        ),
+    ] = None
+    u_covers: Annotated[
+        str | None,
+        typer.Option("--u-covers", help="What the uncertainty covers, e.g. 'probe noise'."),
+    ] = None
 
     def reading(self, count: int) -> Any:
         """The library's :class:`~jointwear.external.CsvReading` of these options, with at most

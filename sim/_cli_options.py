@@ -18,9 +18,7 @@ __all__ = [
     "Base",
     "WearParams",
     "Progress",
-    "Workers",
     "Scheduler",
-    "Resume",
     "SweepRun",
     "check_executor",
     "check_lost_runs",
@@ -64,21 +62,6 @@ Progress = Annotated[
 ]
 """``--progress/--no-progress``: None shows the bar on a terminal only."""
 
-#: Options of the commands that run sweeps of dask tasks (sim sweep, sim verify; --scheduler is
-#: shared with other groups' commands, from jointwear._cli).
-Workers = Annotated[
-    int | None,
-    typer.Option(
-        "--workers",
-        help="Local dask worker processes, one thread each (default: one per core; "
-        "0 = in this process, no dask).",
-    ),
-]
-Resume = Annotated[
-    bool,
-    typer.Option("--resume", help="Continue an interrupted run: compute only the missing runs."),
-]
-
 
 def check_executor(workers: int | None, scheduler: str | None) -> None:
     """Refuse ``--workers`` (local processes) together with ``--scheduler`` (a cluster)."""
@@ -95,9 +78,21 @@ class SweepRun:
     every command that runs one (``@options_from("run", SweepRun)`` puts them where the
     command's parameter ``run: SweepRun`` stands)."""
 
-    workers: Workers = None
-    scheduler: Scheduler = None
-    resume: Resume = False
+    workers: Annotated[
+        int | None,
+        typer.Option(
+            "--workers",
+            help="Local dask worker processes, one thread each (default: one per core; "
+            "0 = in this process, no dask).",
+        ),
+    ] = None
+    scheduler: Scheduler = None  # shared with other groups' commands (jointwear._cli)
+    resume: Annotated[
+        bool,
+        typer.Option(
+            "--resume", help="Continue an interrupted run: compute only the missing runs."
+        ),
+    ] = False
     progress: Progress = None
 
     @contextmanager

@@ -56,3 +56,26 @@ def test_missing_snapshot_or_variable_is_refused():
         wear_from_simulation(xr.Dataset())
     with pytest.raises(BadInputError, match="--wear-scale"):
         wear_from_simulation(_map(_smooth), scale=-1.0)
+
+
+def test_the_command_imposes_the_simulated_wear_scaled_turned_on_its_bore(tmp_path):
+    from jointwear import io
+    from jointwear.cli import main
+    from jointwear.conventions import theta_coord, z_coord
+
+    sim = _map(_smooth)
+    sim = sim.assign_coords(theta=theta_coord(sim["theta"].values), z=z_coord(sim["z"].values))
+    sim["cycles"].attrs.update(units="1", long_name="crank cycles")
+    sim["wear_depth"].attrs.update(units="m", long_name="wear depth")
+    sim.attrs.update(data_origin="simulated", bearing_radius_m=7.9e-3)
+    io.save(sim, tmp_path / "sim.nc")
+    args = ["datasets", "instruments", str(tmp_path / "scan.txt"), "--layout", "long"]
+    args += ["--wear-from", str(tmp_path / "sim.nc"), "--wear-scale", "1.1"]
+    args += ["--wear-rotation-deg", "6", "--truth", str(tmp_path / "truth.nc")]
+    assert main(args) == 0
+    truth = io.load(tmp_path / "truth.nc")
+    expected = wear_from_simulation(sim, scale=1.1, rotation_deg=6.0)
+    theta, z = np.meshgrid(truth["theta"].values, truth["z"].values)
+    np.testing.assert_allclose(truth["wear_depth"].values, expected(theta, z), rtol=1e-12)
+    assert truth.attrs["nominal_radius"] == 7.9e-3  # the simulated bore's, not the default
+    assert (tmp_path / "scan.txt").is_file()
