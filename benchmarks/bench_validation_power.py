@@ -22,10 +22,12 @@ Writes ``benchmarks/results/validation_power.json``.
 from __future__ import annotations
 
 import argparse
+import json
 import logging
 import os
 import sys
 import tempfile
+from dataclasses import asdict, replace
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
@@ -44,6 +46,16 @@ def main() -> None:
         help="folder of the runs and scans (kept: a stopped run resumes, a criterion change "
         "re-decides without simulating)",
     )
+    parser.add_argument(
+        "--truth",
+        action="append",
+        default=[],
+        help="run only this truth (repeatable; its results go to the cache folder, and --merge "
+        "writes the JSON from them): truths in parallel processes",
+    )
+    parser.add_argument(
+        "--merge", action="store_true", help="write the JSON from the truths run with --truth"
+    )
     args = parser.parse_args()
     logging.disable(logging.WARNING)  # the adaptive update's noise warnings, once per run
 
@@ -54,7 +66,29 @@ def main() -> None:
             {**result, "load_1min": load, "note": "2-core machine shared with other jobs"},
         )
 
-    run_power(BENCH_SIZE, folder=args.cache, progress=lambda m: print(m, flush=True), on_truth=save)
+    parts = args.cache / "truth_results"
+    if args.merge:
+        merged: dict = {"size": asdict(BENCH_SIZE), "truths": {}, "cpu_s": 0.0}
+        for name in BENCH_SIZE.truths:
+            part = json.loads((parts / f"{name}.json").read_text())
+            merged["truths"][name] = part["truths"][name]
+            merged["cpu_s"] += part["cpu_s"]
+        save(merged)
+        return
+    size = replace(BENCH_SIZE, truths=tuple(args.truth)) if args.truth else BENCH_SIZE
+
+    def keep_part(result: dict) -> None:
+        parts.mkdir(parents=True, exist_ok=True)
+        for name in result["truths"]:
+            out = {"truths": {name: result["truths"][name]}, "cpu_s": result["cpu_s"]}
+            (parts / f"{name}.json").write_text(json.dumps(out))
+
+    run_power(
+        size,
+        folder=args.cache,
+        progress=lambda m: print(m, flush=True),
+        on_truth=keep_part if args.truth else save,
+    )
 
 
 if __name__ == "__main__":

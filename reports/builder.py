@@ -36,6 +36,7 @@ from jointwear.reports._sections import (
     _verdict,
     format_value,
 )
+from jointwear.reports.power import power_paragraph
 
 __all__ = [
     "ReportInput",
@@ -139,6 +140,7 @@ def _context(c: Comparison, page: _Page) -> dict[str, Any]:
         "verdict": verdict,
         "summary": c.summary(),
         "resolution": c.resolution(),
+        "power": power_paragraph(c),
         "n_passed": n_pass,
         "n_decisions": n,
         "failed": list(dict.fromkeys(c.failed())),

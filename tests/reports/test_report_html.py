@@ -103,6 +103,12 @@ def test_report_structure(built):
     html = path.read_text(encoding="utf-8")
     assert "<style>" in html and "<metadata>" not in html
     assert "jointwear report (test)" in html
+    # the power of this comparison: each decided criterion's resolution, and what a pass means
+    decided = result.decisions[result.decisions.state.isin(["pass", "fail"])]
+    power = html.split("Power of this comparison.</strong>")[1].split("</p>")[0]
+    for r in decided[decided.resolution != ""].itertuples():
+        assert r.quantity in power
+    assert "passes whether the model is right or not" in power
 
 
 def test_report_lists_inputs_with_sha256(built, report_files):
