@@ -20,7 +20,7 @@ from collections.abc import Callable, Iterator
 from concurrent.futures import Executor, Future, ProcessPoolExecutor
 from typing import Any
 
-from jointwear._worker_threads import limit_worker_threads, numba_threads_launched
+from jointwear._workers import limit_worker_threads, numba_threads_launched
 
 __all__ = [
     "InlineExecutor",

@@ -49,7 +49,7 @@ from pathlib import Path
 
 import xarray as xr
 
-from jointwear._dask import connect_scheduler
+from jointwear._workers import connect_scheduler
 from jointwear.dic.calibration import StereoCalibration
 from jointwear.dic.footage._config import FRAME_FLAGS, BodySpec, TrackConfig, read_bodies
 from jointwear.dic.footage._features import (  # noqa: F401 (re-exported)

@@ -16,8 +16,7 @@ from collections.abc import Callable, Sequence
 from concurrent import futures as cf
 from typing import Any
 
-from jointwear._dask import connect_scheduler
-from jointwear._worker_threads import WORKER_ENV
+from jointwear._workers import WORKER_ENV, connect_scheduler
 from jointwear.sim.sweep._run import RunResult, RunTask, evaluate_run
 
 __all__ = ["execute", "WORKER_ENV", "LOOPBACK"]

@@ -8,7 +8,7 @@ import time
 
 import pytest
 
-from jointwear._dask import connect_scheduler
+from jointwear._workers import connect_scheduler
 from jointwear.errors import BadInputError
 
 

@@ -1,6 +1,8 @@
-"""Thread counts of worker processes: one thread each for numba and BLAS (one run per core).
+"""Where the parallel runs execute: local worker processes with one thread each, or the
+dask.distributed scheduler a user names with ``--scheduler`` (``dic track``, ``sim sweep``).
 
-numba reads ``NUMBA_NUM_THREADS`` when it is imported and again before every compilation
+A worker process runs one thread for numba and BLAS (one run per core). numba reads
+``NUMBA_NUM_THREADS`` when it is imported and again before every compilation
 (``numba.core.config.reload_config``); once its thread pool is running, a changed value is an
 error ("Cannot set NUMBA_NUM_THREADS to a different value once the threads have been
 launched"). So the variable is set only in a process that has not imported numba (a fresh
@@ -14,8 +16,11 @@ from __future__ import annotations
 
 import os
 import sys
+from typing import Any
 
-__all__ = ["WORKER_ENV", "limit_worker_threads", "numba_threads_launched"]
+from jointwear.errors import BadInputError
+
+__all__ = ["WORKER_ENV", "connect_scheduler", "limit_worker_threads", "numba_threads_launched"]
 
 #: Environment of local workers: one thread each for numba and BLAS (one run per core).
 WORKER_ENV = {
@@ -46,3 +51,28 @@ def limit_worker_threads() -> None:
         del env["NUMBA_NUM_THREADS"]
         numba.set_num_threads(1)
     os.environ.update(env)
+
+
+def connect_scheduler(address: str, *, timeout: str = "20s") -> Any:
+    """A ``distributed.Client`` on the scheduler at ``address`` (not made the default client).
+
+    Raises
+    ------
+    BadInputError
+        Nothing answers at ``address`` within ``timeout`` (or ``distributed`` is missing): the
+        message names ``--scheduler`` and how to fix it.
+    """
+    try:
+        from distributed import Client
+    except ImportError:  # pragma: no cover - distributed is a dependency
+        raise BadInputError(
+            "--scheduler needs the 'distributed' package (pip install distributed)"
+        ) from None
+    try:
+        return Client(address, timeout=timeout, set_as_default=False)
+    except (OSError, TimeoutError) as exc:
+        raise BadInputError(
+            f"--scheduler {address}: cannot reach a dask scheduler there ({exc}); check the "
+            "address (tcp://host:port) and that the scheduler is running (start one with "
+            "`dask scheduler` and workers with `dask worker ADDRESS`), or drop --scheduler"
+        ) from None
