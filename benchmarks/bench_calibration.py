@@ -285,7 +285,7 @@ def run(
     wrong = (
         wrong_form(folder, size, early0, late, DEFAULT_KW)
         if with_wrong_form and truth == "tilt1000"
-        else "not run at this size (see the reduced size's figures)"
+        else "not run (--no-wrong-form, or a truth other than tilt1000)"
     )
     prior_sd_over_mean = (1.0 / np.sqrt(3)) * 0.5  # uniform ±50 %: sd = width / sqrt(12)
     return {
