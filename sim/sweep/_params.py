@@ -57,6 +57,7 @@ _UNITS_BY_NAME = {
     "journal_modulus": "Pa",
     "bearing_modulus": "Pa",
     "axial_stiffness": "N m-1.5",
+    "foundation_thickness": "m",
     "stick_velocity": "m s-1",
     "slide_velocity": "m s-1",
     "impact_velocity_floor": "m s-1",
