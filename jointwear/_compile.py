@@ -113,13 +113,13 @@ def _module_files() -> list[Path]:
 def _key() -> str:
     """What the cached kernels depend on: versions, and the kernel modules' size and mtime."""
     import hashlib
-    import importlib.util
+    import importlib.machinery
 
     from jointwear._version import __version__
 
     parts = [__version__, sys.version]
-    for dependency in ("numba", "llvmlite"):
-        spec = importlib.util.find_spec(dependency)
+    for dependency in ("numba", "llvmlite"):  # found on the path, past the import hooks
+        spec = importlib.machinery.PathFinder.find_spec(dependency)
         parts.append(f"{dependency}:{spec.origin if spec else None}")
         if spec is not None and spec.origin:
             stat = os.stat(spec.origin)

@@ -43,19 +43,22 @@ class _AfterImport(importlib.abc.MetaPathFinder):
         self.callbacks = [callback]
 
     def find_spec(self, name: str, path: Any, target: Any = None) -> Any:
+        # the hook leaves when the module is executed, not when it is found: a mere look-up
+        # (importlib.util.find_spec) must not use it up
         if name != self.name:
             return None
-        sys.meta_path.remove(self)
         spec = importlib.machinery.PathFinder.find_spec(name, path)
         if spec is None or spec.loader is None:
             return spec
         loader = spec.loader
         exec_module = loader.exec_module
-        callbacks = self.callbacks
 
         def exec_then_notify(module: Any) -> None:
             exec_module(module)
-            for callback in callbacks:
+            if self not in sys.meta_path:  # notified already
+                return
+            sys.meta_path.remove(self)
+            for callback in self.callbacks:
                 callback()
 
         loader.exec_module = exec_then_notify  # type: ignore[method-assign]

@@ -3,6 +3,7 @@ numba's cache in worker processes, so that a later process compiles nothing."""
 
 from __future__ import annotations
 
+import importlib.util
 import inspect
 import os
 import subprocess
@@ -224,6 +225,9 @@ LIGHT = """
 import sys
 import numpy as np
 import jointwear.cli  # installs the light cache loads when numba is imported
+from jointwear import _compile
+
+_compile.stamp_path()  # as the CLI's check before a command: it looks numba up
 import toy_kernels as t
 
 a = np.arange(4.0)
@@ -261,6 +265,8 @@ def test_several_hooks_after_one_import(tmp_path, monkeypatch):
     ran = []
     after_import("hooked_module", lambda: ran.append("first"))
     after_import("hooked_module", lambda: ran.append("second"))
+    assert importlib.util.find_spec("hooked_module") is not None  # a look-up: no import
+    assert ran == []
     import hooked_module  # noqa: F401
 
     assert ran == ["first", "second"]
