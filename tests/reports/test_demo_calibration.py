@@ -125,3 +125,32 @@ def test_calibrated_on_one_snapshot_validated_on_the_other(tmp_path):
     assert "max_wear_depth" in set(result.decisions.key)
     with pytest.raises(BadInputError, match="calibration data never validate"):
         with_prediction(step, [sim_path], [early], [], [])
+
+
+def test_the_report_says_what_the_known_truths_give():
+    """The notes after the comparison: the resolution the calibrated comparison reached, and
+    what the motion criteria decided about the rig's faster crank (states and resolutions as
+    the comparison gave them; no motion rows, no motion note)."""
+    import types
+
+    import pandas as pd
+
+    rows = pd.DataFrame(
+        {
+            "key": ["max_wear_depth", "wear_field", "follower_velocity_x_rms", "wear_depth"],
+            "quantity": ["max depth", "wear field", "x RMS", "shape"],
+            "state": ["pass", "fail", "pass", "not_assessed"],
+            "resolution": ["detects errors outside −12 %…+13 %", "D² > 73", "−2 %…+2 %", ""],
+        }
+    )
+    result = types.SimpleNamespace(decisions=rows)
+    parts = demo._Parts(calibration=object())
+    wear, motion = demo._outcome_notes(result, parts)
+    assert "max depth PASS, detects errors outside −12 %…+13 %" in wear
+    assert "wear field FAIL" in wear and "6-degree turn" in wear
+    assert "0.5% faster" in motion and "x RMS PASS (−2 %…+2 %)" in motion
+    assert "shape" not in motion  # an undecided row is not reported as a decision
+    uncalibrated = demo._outcome_notes(result, demo._Parts())
+    assert len(uncalibrated) == 1 and "Motion truth" in uncalibrated[0]
+    no_motion = types.SimpleNamespace(decisions=rows[~rows.key.str.startswith("follower")])
+    assert not any("Motion" in n for n in demo._outcome_notes(no_motion, demo._Parts()))
