@@ -23,8 +23,10 @@ modification time of the manifest and of every kernel module, so that an upgrade
 kernel runs the warm-up again (a kernel still in the cache is then loaded, not compiled). It lives
 in ``NUMBA_CACHE_DIR`` when that is set (an emptied cache folder empties it too), else next to
 the package (``jointwear/__pycache__``) or in the user's cache folder. ``JOINTWEAR_WARM_UP=0``
-turns the warm-up off (a kernel then compiles on first use, as numba does by itself).
-Nothing here imports numba in the command's own process: the check costs a few file look-ups.
+turns the warm-up off (a kernel then compiles on first use, as numba does by itself; so does
+``NUMBA_DISABLE_JIT``). Nothing here imports numba in the command's own process: the check
+costs a few file look-ups (about 2 ms). :func:`light_cache_loads` is the other half of a fast
+start: a command then loads its cached kernels without building numba's whole compiler.
 """
 
 from __future__ import annotations
@@ -142,7 +144,9 @@ def ensure_compiled(args: Sequence[str], stream: TextIO | None = None) -> None:
     """Before a command that calls numba kernels: compile every kernel once, unless the stamp
     says they are compiled (or ``JOINTWEAR_WARM_UP=0``). A failure here never stops the command:
     it says so on ``stream`` and the command compiles what it needs itself."""
-    if os.environ.get(SWITCH, "1") == "0" or not needs_kernels(args):
+    if os.environ.get(SWITCH, "1") == "0" or os.environ.get("NUMBA_DISABLE_JIT", "0") != "0":
+        return
+    if not needs_kernels(args):
         return
     stream = stream or sys.stderr
     try:
