@@ -1,7 +1,7 @@
 """``jointwear datasets instruments OUT``: write realistic roundness-instrument files with truth."""
 
-from __future__ import annotations
-
+# (no ``from __future__ import annotations``: the option declarations are evaluated once, here,
+# not compiled again from strings when ``options_from`` reads them at every start of the CLI)
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Annotated, Literal

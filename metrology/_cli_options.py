@@ -6,8 +6,8 @@ offers exactly what the library accepts. Options shared with other folders' comm
 (``--angle-zero``, ``--angle-direction``, ``--overwrite``) live in :mod:`jointwear._cli`.
 """
 
-from __future__ import annotations
-
+# (no ``from __future__ import annotations``: the option declarations are evaluated once, here,
+# not compiled again from strings when ``options_from`` reads them at every start of the CLI)
 from dataclasses import dataclass
 from enum import StrEnum
 from pathlib import Path
