@@ -32,8 +32,10 @@ def _store_point(i, p, z, it, fl, w, zncc_min, P, out):
 
 
 @njit(cache=True)
-def _refine_chunk(ch, n_chunks, ref, dfm, opts, centres, P, active, out):
-    """Refine the active points ``ch, ch + n_chunks, ...`` from ``P[i]`` (in place)."""
+def _refine_chunk(ch, n_chunks, ref, dfm, opts, centres, scale, P, active, out):
+    """Refine the active points ``ch, ch + n_chunks, ...`` from ``P[i]`` (in place);
+    ``scale[i]`` multiplies point i's Gauss-Newton steps (its kappa, see
+    :func:`~jointwear.dic.icgn._solve._iterate`)."""
     n = centres.shape[0]
     work = make_work(opts[0])
     p = np.empty(12)
@@ -42,24 +44,25 @@ def _refine_chunk(ch, n_chunks, ref, dfm, opts, centres, P, active, out):
             continue
         for q in range(12):
             p[q] = P[i, q]
-        z, it, fl = solve_point(ref, dfm, opts, centres[i, 0], centres[i, 1], p, work)
+        z, it, fl = solve_point(ref, dfm, opts, centres[i, 0], centres[i, 1], p, work, scale[i])
         _store_point(i, p, z, it, fl, work[4], opts[7], P, out)
 
 
 @njit(cache=True, parallel=True)
-def icgn_many(ref, dfm, opts, centres, P, active, out):
-    """Refine every active point from its initial parameters ``P[i]`` (in place), in parallel."""
+def icgn_many(ref, dfm, opts, centres, scale, P, active, out):
+    """Refine every active point from its initial parameters ``P[i]`` (in place), in parallel
+    (``scale``: the points' step factors, see :func:`_refine_chunk`)."""
     n_chunks = min(centres.shape[0], 64)
     for ch in prange(n_chunks):
-        _refine_chunk(ch, n_chunks, ref, dfm, opts, centres, P, active, out)
+        _refine_chunk(ch, n_chunks, ref, dfm, opts, centres, scale, P, active, out)
 
 
 @njit(cache=True)
-def icgn_serial(ref, dfm, opts, centres, P, active, out):
+def icgn_serial(ref, dfm, opts, centres, scale, P, active, out):
     """As :func:`icgn_many` on one thread (for a handful of points, e.g. seeds)."""
     n_chunks = min(centres.shape[0], 64)
     for ch in range(n_chunks):
-        _refine_chunk(ch, n_chunks, ref, dfm, opts, centres, P, active, out)
+        _refine_chunk(ch, n_chunks, ref, dfm, opts, centres, scale, P, active, out)
 
 
 @njit(cache=True, nogil=True)
@@ -87,7 +90,7 @@ def affine_references(ref, opts, centres, F, GX, GY, HINV, JF, JS, FN, FLAG0):
 
 
 @njit(cache=True, nogil=True)
-def icgn_affine_loaded(loaded, dfm, opts, centres, P, active, out):
+def icgn_affine_loaded(loaded, dfm, opts, centres, scale, P, active, out):
     """As :func:`icgn_serial` (affine shape) with the reference subsets preloaded by
     :func:`affine_references` (``loaded`` = ``(F, GX, GY, HINV, JF, JS, FN, FLAG0)``): a tracker
     matching the same subsets in many frames skips the per-frame loading and Hessian. Runs
@@ -114,7 +117,7 @@ def icgn_affine_loaded(loaded, dfm, opts, centres, P, active, out):
         w[3, 5] = np.nan
         z, it, fl = _iterate_affine(
             F[i], GX[i], GY[i], FN[i], HINV[i], JF[i], JS[i], def_coef, def_invalid, order,
-            centres[i, 0], centres[i, 1], half, p, max_iter, tol, max_shift, border, w,
+            centres[i, 0], centres[i, 1], half, p, max_iter, tol, max_shift, border, w, scale[i],
         )  # fmt: skip
         _store_point(i, p, z, it, fl, w, zncc_min, P, out)
 
@@ -161,7 +164,7 @@ def _heap_pop(keys, vals, size):
 
 
 @njit(cache=True)
-def _propagate_group(g, group, ref, dfm, opts, centres, nb_ptr, nb_idx, P, out, done):
+def _propagate_group(g, group, ref, dfm, opts, centres, scale, nb_ptr, nb_idx, P, out, done):
     """Propagation within group ``g`` (all points when ``g < 0``), see :func:`rg_propagate`."""
     zncc, _, flags, _ = out
     n = centres.shape[0]
@@ -180,7 +183,9 @@ def _propagate_group(g, group, ref, dfm, opts, centres, nb_ptr, nb_idx, P, out, 
             if done[j] or (g >= 0 and group[j] != g):
                 continue
             _extrapolate(P[i], centres[j, 0] - centres[i, 0], centres[j, 1] - centres[i, 1], guess)
-            z, it, fl = solve_point(ref, dfm, opts, centres[j, 0], centres[j, 1], guess, work)
+            z, it, fl = solve_point(
+                ref, dfm, opts, centres[j, 0], centres[j, 1], guess, work, scale[j]
+            )
             done[j] = True
             _store_point(j, guess, z, it, fl, work[4], opts[7], P, out)
             if flags[j] == FLAG_OK:
@@ -188,13 +193,13 @@ def _propagate_group(g, group, ref, dfm, opts, centres, nb_ptr, nb_idx, P, out, 
 
 
 @njit(cache=True, parallel=True)
-def rg_propagate(n_groups, group, ref, dfm, opts, centres, nb_ptr, nb_idx, P, out, done):
+def rg_propagate(n_groups, group, ref, dfm, opts, centres, scale, nb_ptr, nb_idx, P, out, done):
     """Reliability-guided propagation: from the solved (``done`` and ok) points of each group,
     always extend from the best-correlated point to its unsolved neighbours (guess = its
     parameters extrapolated). Groups run in parallel; ``n_groups = 0`` runs one global pass
     ignoring groups."""
     if n_groups == 0:
-        _propagate_group(-1, group, ref, dfm, opts, centres, nb_ptr, nb_idx, P, out, done)
+        _propagate_group(-1, group, ref, dfm, opts, centres, scale, nb_ptr, nb_idx, P, out, done)
         return
     for g in prange(n_groups):
-        _propagate_group(g, group, ref, dfm, opts, centres, nb_ptr, nb_idx, P, out, done)
+        _propagate_group(g, group, ref, dfm, opts, centres, scale, nb_ptr, nb_idx, P, out, done)

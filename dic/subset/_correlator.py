@@ -321,11 +321,12 @@ class SubsetCorrelator:
         ref, dfm = self._kernel_args(dspl, dinv)
         out = (st.zncc, st.iterations, st.flag, st.sigma)
         opts = self._solver_options()
+        scale = self._kappa_of_points()
         if self._loaded is not None:
-            _icgn.icgn_affine_loaded(self._loaded, dfm, opts, self.centres, P, active, out)
+            _icgn.icgn_affine_loaded(self._loaded, dfm, opts, self.centres, scale, P, active, out)
             return
         kernel = _icgn.icgn_serial if serial else _icgn.icgn_many
-        kernel(ref, dfm, opts, self.centres, P, active, out)
+        kernel(ref, dfm, opts, self.centres, scale, P, active, out)
 
     def _propagate(self, dspl, dinv, st, done, group, n_groups):
         from jointwear.dic import icgn as _icgn
@@ -338,6 +339,7 @@ class SubsetCorrelator:
             dfm,
             self._solver_options(),
             self.centres,
+            self._kappa_of_points(),
             self._nb_ptr,
             self._nb_idx,
             st.params,
@@ -491,7 +493,14 @@ class SubsetCorrelator:
         return st
 
     def _sigma_scale(self) -> np.ndarray:
-        """Per-point factor on the IC-GN's ``sigma^2 H^-1`` uncertainty (N,).
+        """Per-point factor on the IC-GN's ``sigma^2 H^-1`` uncertainty (N,): the points'
+        kappa (:meth:`_kappa_of_points`)."""
+        return self._kappa_of_points()
+
+    def _kappa_of_points(self) -> np.ndarray:
+        """Per-point ``kappa`` (N,), computed once per reference: the IC-GN's step factor
+        (see :func:`jointwear.dic.icgn._solve._iterate`) and the factor on its
+        ``sigma^2 H^-1`` uncertainty.
 
         The Jacobian uses central-difference gradients ``g_c`` (less biased, see
         :mod:`jointwear.dic.icgn._interp`), which on fine speckle are smaller than the interpolant's
