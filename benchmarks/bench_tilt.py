@@ -19,7 +19,7 @@ interpolated (log scale) and the fit re-simulated.
 Run: ``python benchmarks/bench_tilt.py`` (about 10 min CPU; ``--quick``: two points at
 4e4/1.2e5 cycles). Results: benchmarks/results/tilt.json.
 
-``--speed`` (issue 41, stiff tilt <= 60 s CPU; about 4 min CPU): at k = 1e3 and 3e3 N m/rad
+``--speed`` (issue 41, stiff tilt <= 60 s CPU; about 6 min CPU): at k = 1e3 and 3e3 N m/rad
 (offset 10 mm) the full default prediction twice, with ``solver.rate_error_scale =
 "component"`` (every rate's error against its own magnitude: the integration before issue 41,
 bit for bit) and with the default (``"auto"``: the rotating body's angular velocity measured as
@@ -27,7 +27,9 @@ one vector when the joint has a tilt spring); CPU time, simulated cycles, and th
 of max depth, volume and cylindricity at both snapshots against the two runs' stated
 uncertainties combined (sqrt(u1^2 + u2^2), k = 2; the run states none for the cylindricity,
 so its max depth's stands in, the deepest points setting both). Also the tilt mode's natural
-frequency sqrt(k / I3y) against the crank's, for the quasi-static alternative not taken.
+frequency sqrt(k / I3y) against the crank's, for the quasi-static alternative not taken, and
+a bias check: the mean normal work per cycle on the final bore with each scale (and the vector
+at a tenth of ``solver.rtol``), against its standard error.
 Results: benchmarks/results/tilt_speed.json.
 """
 
@@ -62,6 +64,7 @@ SPEED = "--speed" in sys.argv
 SPEED_POINTS = (1e3, 3e3)  # tilt stiffness [N m/rad], offset 10 mm
 SPEED_LIMIT_S = 60.0  # issue 41: CPU seconds for 1.2e6 cycles at k <= 3e3
 SPEED_SCALES = ("component", "auto")  # before issue 41; the default
+WORK_CYCLES = 40  # single cycles per mean normal work on the final bore (bias check)
 CYCLES = 1.2e5 if QUICK else 1.2e6
 EARLY = 4e4 if QUICK else 4e5
 # (tilt stiffness [N m/rad], joint offset [m]); the default rig is (0, 0.01)
@@ -110,7 +113,11 @@ def _tilt_on_final_bore(overrides: dict[str, float], ds, rate_error_scale: str) 
 
 
 def run_point(
-    stiffness: float, offset: float, kw: float = DEFAULT_KW, rate_error_scale: str = "auto"
+    stiffness: float,
+    offset: float,
+    kw: float = DEFAULT_KW,
+    rate_error_scale: str = "auto",
+    datasets: dict | None = None,
 ) -> dict:
     overrides = {
         "joint.tilt_stiffness": stiffness,
@@ -121,6 +128,8 @@ def run_point(
     params = _base(rate_error_scale)
     ds = simulate_wear(params, cycles=CYCLES, snapshots=[EARLY], overrides=overrides)
     cpu = time.process_time() - c0
+    if datasets is not None:
+        datasets[rate_error_scale] = ds
     share = edge_volume_share(ds["wear_depth"])
     cyl = ds["cylindricity"]
     out = {
@@ -206,14 +215,55 @@ def _agreement(old: dict, new: dict) -> dict:
     return out
 
 
+def _work_per_cycle(stiffness: float, offset: float, wear_depth) -> dict:
+    """Mean normal work per cycle on a fixed worn bore, per error scale (a bias check).
+
+    The wear runs are chaotic: two integrations of the same rig differ like two start phases.
+    A bias of the vector scale would show as a mean normal work (the worn volume per cycle over
+    kw) that differs beyond its standard error from the per-component one and does not come
+    back at a tenth of the tolerance.
+    """
+    out = {}
+    for label, scale, rtol in (
+        ("component", "component", 1e-6),
+        ("auto", "auto", 1e-6),
+        ("vector_rtol_1e-7", "vector", 1e-7),
+    ):
+        base = replace_nested(_base(scale), **{"solver.rtol": rtol})
+        overrides = {"joint.tilt_stiffness": stiffness, "mechanism.joint_offset": offset}
+        params, _ = apply_overrides(base, WearSettings(), overrides)
+        h = wear_depth_on_grid(wear_depth, params)
+        state = run_cycles(params, cycles=2, wear_depth=h, record=False).state
+        works = []
+        for _ in range(WORK_CYCLES):
+            res = run_cycles(params, cycles=1, wear_depth=h, state=state, record=False)
+            state = res.state
+            works.append(res.normal_work)
+        w = np.array(works)
+        out[label] = {
+            "mean_N_m": float(f"{w.mean():.5g}"),
+            "standard_error_N_m": float(f"{w.std(ddof=1) / math.sqrt(w.size):.3g}"),
+        }
+    diff = out["auto"]["mean_N_m"] - out["component"]["mean_N_m"]
+    se = math.hypot(out["auto"]["standard_error_N_m"], out["component"]["standard_error_N_m"])
+    out["auto_minus_component_in_standard_errors"] = round(diff / se, 2)
+    out["cycles_each"] = WORK_CYCLES
+    return out
+
+
 def speed() -> None:
     """Issue 41 item 4: CPU of the stiff rigs before and after, and their results' agreement."""
     inertia = PARAMETER_SETS["zhang2023"].mechanism.follower_inertia[1]
     crank_hz = PARAMETER_SETS["zhang2023"].mechanism.crank_speed_rpm / 60.0
     rows = []
     for k in SPEED_POINTS:
-        runs = {scale: run_point(k, 0.01, rate_error_scale=scale) for scale in SPEED_SCALES}
+        datasets: dict = {}
+        runs = {
+            scale: run_point(k, 0.01, rate_error_scale=scale, datasets=datasets)
+            for scale in SPEED_SCALES
+        }
         old, new = runs["component"], runs["auto"]
+        final = datasets["component"]["wear_depth"].isel(cycles=-1)
         f_n = math.sqrt(k / inertia) / (2.0 * math.pi)
         rows.append(
             {
@@ -225,6 +275,7 @@ def speed() -> None:
                 "tilt_mode_hz": round(f_n, 1),
                 "tilt_mode_over_crank_frequency": round(f_n / crank_hz, 1),
                 "agreement": _agreement(old, new),
+                "work_per_cycle_on_final_bore": _work_per_cycle(k, 0.01, final),
                 "runs": runs,
             }
         )
@@ -242,6 +293,8 @@ def speed() -> None:
             "tilt_mode": "sqrt(k / I3y), the follower rocking about its own axis on the spring "
             "alone (line contact stiffens it further)",
             "cylindricity_u": "not stated by the run: its max depth's stands in",
+            "work_per_cycle_on_final_bore": "normal work per cycle, mean and standard error "
+            "over single cycles on the per-component run's final bore, after 2 settling cycles",
             "points": rows,
         },
     )

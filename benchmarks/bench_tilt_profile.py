@@ -9,8 +9,9 @@ the extra cost is more steps (accuracy or stability of the line contact's vibrat
 work per step (every layer in contact).
 
 Rows 0-5 measure every rate's error against its own magnitude (``solver.rate_error_scale =
-"component"``, the integration before issue 41, bit for bit); the last two rows the default
-since (``"auto"``: with a tilt spring the rotating body's angular velocity as one vector).
+"component"``, the integration before issue 41, bit for bit); rows 6-7 the default since
+(``"auto"``: with a tilt spring the rotating body's angular velocity as one vector); row 8 the
+rigid rig with ``"vector"`` (its default stays ``"component"``).
 
 Usage: ``python benchmarks/bench_tilt_profile.py``. The machine is shared: the load average is
 recorded; CPU seconds of this process.
@@ -72,11 +73,16 @@ def main() -> None:
     rows = [profile(k, rtol) for k in (0.0, 1e3, 3e3) for rtol in (1e-6, 1e-5)]
     # the default since issue 41: with a tilt spring the angular velocity as one vector
     rows += [profile(k, 1e-6, "auto") for k in (1e3, 3e3)]
+    # the rigid rig with the vector scale (not its default: that keeps its results bit for bit)
+    rows.append(profile(0.0, 1e-6, "vector"))
     for r in rows:
         print(r, flush=True)
     base = rows[0]
     stiff = next(r for r in rows if r["tilt_stiffness"] == 3e3 and r["rtol"] == 1e-6)
-    stiff_auto = rows[-1]
+    stiff_auto = next(
+        r for r in rows if r["tilt_stiffness"] == 3e3 and r["rate_error_scale"] == "auto"
+    )
+    rigid_vector = rows[-1]
     write_results(
         "tilt_profile",
         {
@@ -92,6 +98,8 @@ def main() -> None:
             / stiff_auto["accepted_steps_per_cycle"],
             "cpu_ratio_3e3_component_to_auto": stiff["cpu_s_per_cycle"]
             / stiff_auto["cpu_s_per_cycle"],
+            "steps_ratio_0_component_to_vector": base["accepted_steps_per_cycle"]
+            / rigid_vector["accepted_steps_per_cycle"],
         },
     )
 

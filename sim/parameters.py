@@ -259,7 +259,8 @@ class SolverParameters:
     stay bit for bit. A tilt spring makes the body vibrate about its own axis at hundreds of Hz
     about zero rate; per component, that vibration is resolved to rtol of its own small
     amplitude and sets the step (2.3 times the steps at 3e3 N m/rad; docs/sim.md, "Estimating
-    the tilt stiffness of a rig").
+    the tilt stiffness of a rig"). The vector scale's wear rate differs from the per-component
+    one by up to 0.85 % at the default rtol (docs/sim-wear.md, "Tilt stiffness").
     """
 
     rtol: float = positive(1e-6)
