@@ -293,7 +293,7 @@ def test_wear_field_and_reported_file_calibrations_recover_the_truth(truth):
     text = text.replace("standard = 0.2", f"standard = {0.03 * depth!r}")
     cut = text.index("[quantity.depth_top]")
     sheet.write_text(text[:cut] + text[text.index("[quantity.depth_all]") :])
-    post = calibrated(folder, "sheet", "sheet.toml")
+    post = calibrated(folder, "from-sheet", "sheet.toml")
     assert sorted(str(q) for q in post["datum_quantity"].values) == [
         "cylindricity",
         "max_wear_depth",
