@@ -19,7 +19,7 @@ the same name. The workers therefore save under one file lock (:func:`_lock_cach
 all argument types of one kernel are compiled by the same worker.
 
 The stamp is keyed by the versions of jointwear, numba, llvmlite and Python and by the size and
-modification time of the manifest and of every kernel module, so that an upgrade or an edited
+modification time of the manifest and of every module it names, so that an upgrade or an edited
 kernel runs the warm-up again (a kernel still in the cache is then loaded, not compiled). It lives
 in ``NUMBA_CACHE_DIR`` when that is set (an emptied cache folder empties it too), else next to
 the package (``jointwear/__pycache__``) or in the user's cache folder. ``JOINTWEAR_WARM_UP=0``
@@ -89,8 +89,9 @@ def _cache_root() -> Path:
 
 
 def _module_files() -> list[Path]:
-    """The manifest and every module in the folders of the modules it names (found without
-    importing them)."""
+    """The manifest and every module it names (found without importing them). Only these: numba
+    decides whether a cached kernel is stale by its own module's file, not by the modules of the
+    kernels it calls, so a warm-up after an edit there would load the same code again."""
     import importlib.util
 
     manifest = _manifest()
@@ -100,15 +101,15 @@ def _module_files() -> list[Path]:
         if spec is not None and spec.submodule_search_locations:
             roots[package] = Path(next(iter(spec.submodule_search_locations)))
     files = {Path(manifest.__file__)}
-    for module, *_ in manifest.KERNELS:
+    for module in {k[0] for k in manifest.KERNELS}:
         package = next((p for p in roots if module.startswith(p + ".")), None)
-        if package is not None:  # the kernel's module and its siblings (the kernels it calls)
-            folder = roots[package].joinpath(*module[len(package) + 1 :].split(".")[:-1])
+        if package is not None:
+            rest = module[len(package) + 1 :].split(".")
+            files.add(roots[package].joinpath(*rest[:-1], rest[-1] + ".py"))
         else:  # another package's (a test's): found by its spec
             spec = importlib.util.find_spec(module)
-            folder = Path(spec.origin).parent if spec and spec.origin else None
-        if folder is not None:
-            files.update(folder.glob("*.py"))
+            if spec is not None and spec.origin:
+                files.add(Path(spec.origin))
     return sorted(files)
 
 
