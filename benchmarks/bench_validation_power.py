@@ -69,18 +69,28 @@ def main() -> None:
     parts = args.cache / "truth_results"
     if args.merge:
         merged: dict = {"size": asdict(BENCH_SIZE), "truths": {}, "cpu_s": 0.0}
+        missing = []
         for name in BENCH_SIZE.truths:
-            part = json.loads((parts / f"{name}.json").read_text())
+            path = parts / f"{name}.json"
+            if not path.exists():  # not finished in the time: said, not hidden
+                missing.append(name)
+                continue
+            part = json.loads(path.read_text())
             merged["truths"][name] = part["truths"][name]
             merged["cpu_s"] += part["cpu_s"]
-        save(merged)
+            merged.setdefault("load_1min_at_end_by_truth", {})[name] = part.get("load_1min")
+        save({**merged, "truths_not_measured": missing})
         return
     size = replace(BENCH_SIZE, truths=tuple(args.truth)) if args.truth else BENCH_SIZE
 
     def keep_part(result: dict) -> None:
         parts.mkdir(parents=True, exist_ok=True)
         for name in result["truths"]:
-            out = {"truths": {name: result["truths"][name]}, "cpu_s": result["cpu_s"]}
+            out = {
+                "truths": {name: result["truths"][name]},
+                "cpu_s": result["cpu_s"],
+                "load_1min": os.getloadavg()[0],
+            }
             (parts / f"{name}.json").write_text(json.dumps(out))
 
     run_power(
