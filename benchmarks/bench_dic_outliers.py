@@ -9,7 +9,8 @@ of Gaussian noise on both images (then 8-bit rounding): 25-pixel subsets every 1
 whole grid. For each noise level and shift, without the test (``u_outlier_factor=0``) and with
 the default factor: the share of ok points off by more than 0.05 pixel, the worst error of an ok
 point, and the share of the points that are within 0.05 pixel without the test which the test
-flags ("good points flagged").
+flags ("good points flagged"); and, on the matches without the test, the same two shares for
+other thresholds on u (multiples of the median with a 0.01 or 0.02 pixel floor, median + k MAD).
 """
 
 from __future__ import annotations
@@ -45,8 +46,10 @@ def _pair(image: np.ndarray, shift, noise: float, rng) -> tuple[np.ndarray, np.n
 def _case(a, b, shift) -> dict:
     out = {}
     err = {}
+    runs = {}
     for name, factor in (("without", 0.0), ("with", CorrelationParams.u_outlier_factor)):
         ds = correlate(a, b, subset_size=25, step=12, u_outlier_factor=factor)
+        runs[name] = ds
         ok = ds.flag.values == 0
         e = np.hypot(ds.u.values - shift[0], ds.v.values - shift[1])
         err[name] = (ok, e)
@@ -59,6 +62,33 @@ def _case(a, b, shift) -> dict:
     good = ok0 & (e0 <= LIMIT)
     flagged = good & ~err["with"][0]
     out["good_points_flagged_pct"] = float(100 * flagged.sum() / good.sum())
+    out["rules"] = _rules(ok0, e0, np.fmax(runs["without"].u_u.values, runs["without"].v_u.values))
+    return out
+
+
+def _rules(ok, e, u) -> dict:
+    """Other thresholds on u over the same matches (without the test): per rule, the share of
+    good points it flags and of ok points off by more than LIMIT it keeps [%]."""
+    good = ok & (e <= LIMIT)
+    s = u[ok & np.isfinite(u)]
+    med = np.median(s)
+    mad = 1.4826 * np.median(np.abs(s - med))
+    thresholds = {
+        **{
+            f"{f:g}x_median_floor_{fl:g}px": max(f * med, fl)
+            for f in (3, 3.5, 4)
+            for fl in (0.01, 0.02)
+        },
+        **{f"median_plus_{k}_mad": max(med + k * mad, 0.02) for k in (3, 5, 10, 20)},
+    }
+    out = {}
+    for name, t in thresholds.items():
+        fl = ok & (u > t)
+        kept = ok & ~fl
+        out[name] = {
+            "good_flagged_pct": float(100 * (good & fl).sum() / good.sum()),
+            "off_kept_pct": float(100 * (kept & (e > LIMIT)).sum() / kept.sum()),
+        }
     return out
 
 
@@ -86,6 +116,14 @@ def main() -> None:
         "share_off_pct_with_max": max(c["with"]["share_off_pct"] for c in cases.values()),
         "good_points_flagged_pct_max": max(c["good_points_flagged_pct"] for c in cases.values()),
         "good_points_flagged_pct_min": min(c["good_points_flagged_pct"] for c in cases.values()),
+        # other rules on u, worst case over the six: (good points flagged, off points kept) [%]
+        "rules_worst": {
+            rule: {
+                q: max(c["rules"][rule][q] for c in cases.values())
+                for q in ("good_flagged_pct", "off_kept_pct")
+            }
+            for rule in next(iter(cases.values()))["rules"]
+        },
     }
     write_results("dic_outliers", figures)
 

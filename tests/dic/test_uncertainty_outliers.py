@@ -10,7 +10,11 @@ import pytest
 from jointwear.datasets import speckle as sp
 from jointwear.datasets.speckle import SpeckleParams
 from jointwear.dic import CorrelationParams, correlate
-from jointwear.dic.icgn._flags import FLAG_U_OUTLIER, flag_uncertainty_outliers
+from jointwear.dic.icgn._flags import (
+    FLAG_U_OUTLIER,
+    U_OUTLIER_FLOOR_PX,
+    flag_uncertainty_outliers,
+)
 from jointwear.errors import ParameterError
 
 SHIFT = (0.35, -0.2)
@@ -50,10 +54,12 @@ def test_points_off_by_many_times_the_typical_error_are_flagged(faded):
     # the rule, recomputed: larger component above 3 times the median over the ok points
     ok0 = before.flag.values == 0
     u = np.fmax(before.u_u.values, before.v_u.values)
-    np.testing.assert_array_equal(flagged, ok0 & (u > max(3 * np.median(u[ok0]), 0.01)))
-    # the well-textured part keeps its points: only the faint texture is flagged
+    floor = U_OUTLIER_FLOOR_PX
+    np.testing.assert_array_equal(flagged, ok0 & (u > max(3 * np.median(u[ok0]), floor)))
+    # the well-textured part keeps its points: only the faint texture is flagged (its faintest
+    # part; where u is still below U_OUTLIER_FLOOR_PX the matches are kept, and are right)
     x = np.broadcast_to(after.x.values, flagged.shape)
-    assert flagged[x < 260].mean() <= 0.02 and flagged[x > 330].mean() > 0.5
+    assert flagged[x < 260].mean() <= 0.02 and flagged[x > 330].mean() > 0.3
 
 
 def test_the_rule_per_image_and_its_limits():
@@ -82,7 +88,8 @@ def test_the_full_field_flags_them_too(faded):
     meanings = ds.flag.attrs["flag_meanings"].split()
     assert meanings[FLAG_U_OUTLIER] == "uncertainty_outlier"
     flagged = ds.flag.values[1] == FLAG_U_OUTLIER
-    assert flagged[ds.x.values > 330].mean() > 0.3 and not flagged[ds.x.values < 260].any()
+    # the faintest texture (u above U_OUTLIER_FLOOR_PX) is flagged, none of the well-textured part
+    assert flagged[ds.x.values > 330].mean() > 0.2 and not flagged[ds.x.values < 260].any()
     ok = ds.flag.values[1] == 0
     err = np.hypot(*(ds.displacement.values[1, ok] - SHIFT).T)
     assert (err > 0.05).mean() <= 0.002
