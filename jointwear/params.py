@@ -54,6 +54,7 @@ def read_toml(path: str | Path) -> dict[str, Any]:
         raise BadInputError(f"parameter file '{path}' is a folder; give a .toml file") from None
 
 
+@functools.cache
 def _field_types(cls: type) -> dict[str, Any]:
     return typing.get_type_hints(cls)
 
@@ -287,8 +288,26 @@ def check_known_keys(table: str, given: Iterable[str], known: Iterable[str]) -> 
         )
 
 
+def _is_literal(tp: Any) -> bool:
+    """Whether the field type ``tp`` is a ``Literal`` (or a union holding one)."""
+    if typing.get_origin(tp) is typing.Literal:
+        return True
+    if typing.get_origin(tp) in (typing.Union, types.UnionType):
+        return any(_is_literal(arg) for arg in typing.get_args(tp))
+    return False
+
+
 def replace_nested(obj: T, **changes: Any) -> T:
-    """``dataclasses.replace`` that accepts dotted names (``"joint.radial_clearance"``)."""
+    """``dataclasses.replace`` that accepts dotted names (``"joint.radial_clearance"``).
+
+    A ``Literal`` field's value is checked as the TOML reader checks it (:func:`from_mapping`):
+    a value outside the allowed ones raises :class:`~jointwear.errors.ParameterError` naming the
+    dotted field and the allowed values.
+    """
+    return _replace_nested(obj, changes, "")
+
+
+def _replace_nested(obj: T, changes: Mapping[str, Any], prefix: str) -> T:
     direct: dict[str, Any] = {}
     nested: dict[str, dict[str, Any]] = {}
     for key, value in changes.items():
@@ -303,8 +322,12 @@ def replace_nested(obj: T, **changes: Any) -> T:
             raise ParameterError(
                 f"unknown parameter '{head}' for {type(obj).__name__}; known: {', '.join(sorted(names))}"
             )
+    types_ = _field_types(type(obj))
+    for head, value in direct.items():
+        if _is_literal(types_.get(head)):
+            direct[head] = _coerce(value, types_[head], prefix + head)
     for head, sub in nested.items():
-        direct[head] = replace_nested(getattr(obj, head), **sub)
+        direct[head] = _replace_nested(getattr(obj, head), sub, f"{prefix}{head}.")
     return dataclasses.replace(obj, **direct)
 
 

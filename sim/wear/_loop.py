@@ -644,7 +644,7 @@ def simulate_wear(
     resume: bool = False,
     initial_wear: np.ndarray | None = None,
     on_update: Callable[[dict[str, Any]], None] | None = None,
-    overrides: Mapping[str, float] | None = None,
+    overrides: Mapping[str, float | str] | None = None,
 ) -> xr.Dataset:
     """Simulate Archard wear of the bearing over ``cycles`` crank cycles.
 
@@ -673,10 +673,10 @@ def simulate_wear(
         Initial profile [m].
     on_update : callable, optional
         Progress callback (see :class:`WearRun`).
-    overrides : mapping of str to float, optional
+    overrides : mapping of str to float or str, optional
         Dotted parameter names and values applied on top of ``params`` and ``settings``, e.g.
         ``{"mechanism.joint_offset": 0.005, "friction.dynamic_coefficient": 0.15,
-        "wear.kw": 1e-15}`` (what a sensitivity sweep varies); see :func:`apply_overrides`.
+        "wear.kw": 1e-15, "contact.formulation": "per_point"}`` (what a sensitivity sweep varies); see :func:`apply_overrides`.
 
     Returns
     -------
@@ -733,13 +733,21 @@ def simulate_wear(
     ds = run.run()
     if overrides:
         ds.attrs["parameter_overrides"] = json.dumps(
-            {k: float(v) for k, v in overrides.items()}, sort_keys=True
+            {k: _provenance_value(v) for k, v in overrides.items()}, sort_keys=True
         )
     return ds
 
 
+def _provenance_value(value: Any) -> Any:
+    """An override's value as the provenance record keeps it: a number as float, a string
+    (``contact.formulation``) or a boolean as given."""
+    if isinstance(value, (str, bool, np.bool_)):
+        return value if isinstance(value, str) else bool(value)
+    return float(value)
+
+
 def apply_overrides(
-    params: Any, settings: WearSettings, overrides: Mapping[str, float] | None
+    params: Any, settings: WearSettings, overrides: Mapping[str, float | str] | None
 ) -> tuple[Any, WearSettings]:
     """Apply dotted overrides: ``"wear.<field>"`` to the settings, the rest to the parameters.
 

@@ -80,6 +80,31 @@ def test_replace_nested_and_json():
         replace_nested(Params(), **{"jiont.layers": 1})
 
 
+def test_replace_nested_checks_literal_fields_as_the_toml_reader_does():
+    # the same message as from_mapping's, naming the dotted field and the allowed values
+    with pytest.raises(
+        ParameterError, match=r"joint.model: expected one of \['line', 'point'\], got 'area'"
+    ):
+        replace_nested(Params(), **{"joint.model": "area"})
+    with pytest.raises(ParameterError, match=r"^model: expected one of"):
+        replace_nested(Joint(), model="x")
+    assert replace_nested(Params(), **{"joint.model": "point"}).joint.model == "point"
+
+
+def test_replace_nested_refuses_an_unknown_simulator_formulation():
+    from jointwear.sim import PARAMETER_SETS
+
+    base = PARAMETER_SETS["zhang2023"]
+    with pytest.raises(
+        ParameterError, match=r"contact.formulation: expected one of \['slice', 'per_point'\]"
+    ):
+        replace_nested(base, **{"contact.formulation": "x"})
+    assert (
+        replace_nested(base, **{"contact.formulation": "per_point"}).contact.formulation
+        == "per_point"
+    )
+
+
 @dataclasses.dataclass(frozen=True)
 class WithTuple:
     pair: tuple[int, float] = (1, 2.0)

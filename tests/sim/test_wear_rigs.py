@@ -71,6 +71,25 @@ def test_overrides_reach_the_simulator():
         simulate_wear(PARAMS, cycles=10, overrides={"wear.kww": 1e-15})
 
 
+def test_a_string_override_reaches_the_simulator_and_its_provenance():
+    fixed = WearSettings(kw=DEFAULT_KW, scheme="fixed", dn=100, settle_cycles=0)
+    base = simulate_wear(PARAMS, cycles=100, snapshots=[], settings=fixed)
+    ds = simulate_wear(
+        PARAMS,
+        cycles=100,
+        snapshots=[],
+        settings=fixed,
+        overrides={"contact.formulation": "per_point", "wear.kw": DEFAULT_KW},
+    )
+    assert json.loads(ds.attrs["parameter_overrides"]) == {
+        "contact.formulation": "per_point",
+        "wear.kw": DEFAULT_KW,
+    }
+    assert not np.array_equal(base["wear_depth"].values, ds["wear_depth"].values)
+    with pytest.raises(ParameterError, match=r"contact.formulation: expected one of"):
+        simulate_wear(PARAMS, cycles=100, snapshots=[], overrides={"contact.formulation": "x"})
+
+
 def test_halving_tol_moves_the_max_depth_less_than_the_reported_accuracy():
     out = []
     for tol in (0.2, 0.1):
