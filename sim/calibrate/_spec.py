@@ -3,9 +3,11 @@
 ::
 
     [calibrate]
-    data = ["wear-2e5.nc"]        # measured wear maps (metrology wearmap), relative to the spec
+    data = ["wear-2e5.nc"]        # measured wear maps (metrology wearmap) and reported-values
+                                  # files (import reported: their quantities carry their cycles)
     cycles = 2e5                  # crank cycles of the data: one value, or one per file
-    quantities = ["max_wear_depth", "worn_volume", "cylindricity"]   # the default
+    quantities = ["max_wear_depth", "worn_volume", "cylindricity"]   # the default; "wear_field":
+                                  # the band's mean depth in field_bins_z x field_bins_theta bins
     samples = 24                  # training runs of the emulator (Latin hypercube over the prior)
     seed = 1
     u_num_rel = 0.03              # stated u_num / |S| (else: --verification STUDY.nc)

@@ -273,7 +273,7 @@ def test_wear_field_and_reported_file_calibrations_recover_the_truth(truth):
     assert float(post["posterior_q025"][0]) <= TRUTH_KW <= float(post["posterior_q975"][0])
     assert float(post["posterior_sd"][0] / post["posterior_mean"][0]) < 0.1
     # the truth's numbers as a lab sheet reports them: the largest depth over the 5 layers and
-    # the growth of the MZ cylindricity from a new bore of 0.5 um, 3 % standard uncertainty
+    # the growth of the MZ cylindricity from a new bore of 1 nm, 3 % standard uncertainty
     from jointwear.sim.calibrate._data import Band, on_band
 
     z = np.asarray(clean["z"].values)
@@ -282,9 +282,11 @@ def test_wear_field_and_reported_file_calibrations_recover_the_truth(truth):
     q = band.quantities(on_band(clean, band), 8e-3)
     depth, cyl = q["max_wear_depth"] / UM, q["cylindricity"] / UM
     sheet = reported_toml(folder / "sheet.toml", z_centre='"0 mm"')
-    text = sheet.read_text().replace('spacing = "2 mm"', f'spacing = "{(z[1] - z[0]) * 1e3!r} mm"')
-    text = text.replace("count = 3", "count = 5").replace("value = 5.0", "value = 0.5")
-    text = text.replace("value = 12.0", f"value = {cyl + 0.5!r}").replace(
+    text = sheet.read_text().replace(
+        'spacing = "2 mm"', f'spacing = "{float(z[1] - z[0]) * 1e3!r} mm"'
+    )
+    text = text.replace("count = 3", "count = 5").replace("value = 5.0", "value = 0.001")
+    text = text.replace("value = 12.0", f"value = {cyl + 0.001!r}").replace(
         "cycles = 2e5", "cycles = 200"
     )
     text = text.replace("value = 9.0", f"value = {depth!r}").replace(
@@ -293,7 +295,9 @@ def test_wear_field_and_reported_file_calibrations_recover_the_truth(truth):
     text = text.replace("standard = 0.2", f"standard = {0.03 * depth!r}")
     cut = text.index("[quantity.depth_top]")
     sheet.write_text(text[:cut] + text[text.index("[quantity.depth_all]") :])
-    post = calibrated(folder, "from-sheet", "sheet.toml")
+    # the emulated mean's error is about the 3 % u at 200 cycles (2 wear updates: the start
+    # phase scatters the runs), as for the field above
+    post = calibrated(folder, "from-sheet", "sheet.toml", "emulator_max_fraction = 1.5\n")
     assert sorted(str(q) for q in post["datum_quantity"].values) == [
         "cylindricity",
         "max_wear_depth",
