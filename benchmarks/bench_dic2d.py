@@ -216,6 +216,9 @@ def versus_pyvale(repeat: int = 3) -> None:
                     "points": n_jw,
                     "cpu_s_min": round(min(jw), 4),
                     "poi_per_cpu_s": round(n_jw / min(jw)),
+                    "mean_iterations": round(
+                        float(ds.iterations.values[ds.flag.values == 0].mean()), 2
+                    ),
                     **_accuracy(u.ravel(), v.ravel(), x.ravel(), y.ravel(), pair),
                 },
                 "pyvale": {
