@@ -356,12 +356,16 @@ class _Progress:
 
     def left_s(self) -> float:
         """Seconds left: each worker's recorded CPU seconds still to do, times this machine's
-        pace so far (wall seconds per recorded second), less the time its current kernel has
-        taken; the busiest worker's."""
+        pace (wall seconds per recorded second: of the finished kernels, or of a running one
+        that has taken longer already), less the time its current kernel has taken; the
+        busiest worker's."""
         now = time.perf_counter()
         worked = sum(t - self.start for t in self.since)  # wall seconds of finished kernels
         pace = worked / self.recorded_done if self.recorded_done > 1.0 else 1.0
-        pace = min(max(pace, 0.3), 10.0)
+        for q, t in zip(self.queues, self.since, strict=True):
+            if q:  # a running kernel already slower than the pace says: the machine is slower
+                pace = max(pace, (now - t) / max(self.kernels[q[0]][3], 0.1))
+        pace = min(max(pace, 0.3), 30.0)
         left = [
             max(sum(self.kernels[i][3] for i in q) * pace - (now - t), 1.0 if q else 0.0)
             for q, t in zip(self.queues, self.since, strict=True)
