@@ -10,8 +10,10 @@ work per step (every layer in contact).
 
 Rows 0-5 measure every rate's error against its own magnitude (``solver.rate_error_scale =
 "component"``, the integration before issue 41, bit for bit); rows 6-7 the default since
-(``"auto"``: with a tilt spring the rotating body's angular velocity as one vector); row 8 the
-rigid rig with ``"vector"`` (its default stays ``"component"``).
+(``"auto"``: with a tilt spring the rotating body's angular velocity as one vector, at
+``AUTO_VECTOR_RTOL_FACTOR`` times the rtol: ``rtol_held``); row 8 the rigid rig with
+``"vector"`` (its default stays ``"component"``); row 9 the stiff rig with ``"vector"`` at the
+given rtol (the vector scale without the default's factor).
 
 Usage: ``python benchmarks/bench_tilt_profile.py``. The machine is shared: the load average is
 recorded; CPU seconds of this process.
@@ -30,6 +32,7 @@ from _common import write_results  # noqa: E402
 import jointwear.sim.dynamics as dynamics  # noqa: E402
 from jointwear.params import replace_nested  # noqa: E402
 from jointwear.sim import PARAMETER_SETS, run_cycles  # noqa: E402
+from jointwear.sim.parameters import AUTO_VECTOR_RTOL_FACTOR  # noqa: E402
 
 CYCLES = 2
 
@@ -60,6 +63,7 @@ def profile(k: float, rtol: float, scale: str = "component") -> dict[str, float]
     return {
         "tilt_stiffness": k,
         "rtol": rtol,
+        "rtol_held": dynamics._effective_rtol(p),
         "rate_error_scale": scale,
         "cpu_s_per_cycle": cpu / CYCLES,
         "accepted_steps_per_cycle": counts["accepted"] / CYCLES,
@@ -75,6 +79,8 @@ def main() -> None:
     rows += [profile(k, 1e-6, "auto") for k in (1e3, 3e3)]
     # the rigid rig with the vector scale (not its default: that keeps its results bit for bit)
     rows.append(profile(0.0, 1e-6, "vector"))
+    # the stiff rig with the vector scale at the given rtol (what "auto" was before its factor)
+    rows.append(profile(3e3, 1e-6, "vector"))
     for r in rows:
         print(r, flush=True)
     base = rows[0]
@@ -82,7 +88,7 @@ def main() -> None:
     stiff_auto = next(
         r for r in rows if r["tilt_stiffness"] == 3e3 and r["rate_error_scale"] == "auto"
     )
-    rigid_vector = rows[-1]
+    rigid_vector, stiff_vector = rows[8], rows[9]
     write_results(
         "tilt_profile",
         {
@@ -100,6 +106,9 @@ def main() -> None:
             / stiff_auto["cpu_s_per_cycle"],
             "steps_ratio_0_component_to_vector": base["accepted_steps_per_cycle"]
             / rigid_vector["accepted_steps_per_cycle"],
+            "steps_ratio_3e3_auto_to_vector": stiff_auto["accepted_steps_per_cycle"]
+            / stiff_vector["accepted_steps_per_cycle"],
+            "auto_vector_rtol_factor": AUTO_VECTOR_RTOL_FACTOR,
         },
     )
 

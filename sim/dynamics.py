@@ -25,7 +25,7 @@ from jointwear.sim.contact import contact_constant
 from jointwear.sim.kernels import _layout as kn
 from jointwear.sim.kernels._integrator import integrate
 from jointwear.sim.mechanisms import mechanism_of
-from jointwear.sim.parameters import SimParameters
+from jointwear.sim.parameters import AUTO_VECTOR_RTOL_FACTOR, SimParameters
 from jointwear.sim.validity import contact_validity, penetration_stop_advice
 
 __all__ = [
@@ -159,19 +159,37 @@ def _pack(params: SimParameters) -> tuple[np.ndarray, np.ndarray]:
     return P, IP
 
 
-def _error_flags(params: SimParameters) -> np.ndarray:
-    """What the integrator measures each state component's local error against (the kernels'
-    ``ERR_*``): the mechanism's angle flags, and the rotating body's angular velocity as one
-    vector when ``solver.rate_error_scale`` says so (``"auto"``: with a tilt spring or damper)."""
-    model = params.joint.model
-    flags = _side(params).ANGLE_FLAGS[model].copy()
+def _rate_scale(params: SimParameters) -> str:
+    """``solver.rate_error_scale`` resolved: ``"auto"`` is ``"vector"`` with a tilt spring or
+    damper on the clearance joint, else ``"component"``; the ideal joint has no rotating body
+    state to measure, so it is always ``"component"``."""
+    if params.joint.model != "clearance":
+        return "component"
     scale = params.solver.rate_error_scale
     if scale == "auto":
         tilt = params.joint.tilt_stiffness > 0 or params.joint.tilt_damping > 0
         scale = "vector" if tilt else "component"
-    if scale == "vector" and model == "clearance":
+    return scale
+
+
+def _error_flags(params: SimParameters) -> np.ndarray:
+    """What the integrator measures each state component's local error against (the kernels'
+    ``ERR_*``): the mechanism's angle flags, and the rotating body's angular velocity as one
+    vector when ``solver.rate_error_scale`` says so (``"auto"``: with a tilt spring or damper)."""
+    flags = _side(params).ANGLE_FLAGS[params.joint.model].copy()
+    if _rate_scale(params) == "vector":
         flags[kn.Y_OMEGA : kn.Y_OMEGA + 3] = kn.ERR_VECTOR
     return flags
+
+
+def _effective_rtol(params: SimParameters) -> float:
+    """The relative tolerance the integrator holds: ``solver.rtol``, times
+    :data:`~jointwear.sim.parameters.AUTO_VECTOR_RTOL_FACTOR` when ``"auto"`` chose the vector
+    scale (the vector scale alone biases the wear rate of a tilt rig; docs/sim-wear.md)."""
+    rtol = float(params.solver.rtol)
+    if params.solver.rate_error_scale == "auto" and _rate_scale(params) == "vector":
+        rtol *= AUTO_VECTOR_RTOL_FACTOR
+    return rtol
 
 
 def _mechanism(params: SimParameters) -> str:
@@ -399,7 +417,7 @@ def run_cycles(
     inputs = (P, IP, h, hmin, zl, wl, area, vimp, ww, acc)
     solver = (
         _error_flags(params),
-        float(s.rtol),
+        _effective_rtol(params),
         float(s.atol),
         float(s.max_step),
         float(s.min_step),

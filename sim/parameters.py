@@ -241,6 +241,14 @@ class FrictionParameters:
 #: (:attr:`SolverParameters.rate_error_scale`).
 RateErrorScale = Literal["auto", "component", "vector"]
 
+#: The factor on ``solver.rtol`` that ``rate_error_scale = "auto"`` applies with the vector
+#: scale (a tilt rig). The vector scale alone biases a tilt rig's normal work per cycle (the
+#: wear rate) by +0.6-0.85 % at the default rtol, about the expanded u of its worn volume; the
+#: bias falls as rtol^0.7 (measured at 1e-6 ... 1e-7, k = 1e3 N m/rad), and this factor brings
+#: it to a third of that u (0.2 %: 5 % more u in quadrature) at 1.4 times the steps
+#: (benchmarks/results/tilt_speed.json, ``rtol_scan``; docs/sim-wear.md, "Tilt stiffness").
+AUTO_VECTOR_RTOL_FACTOR = 0.2
+
 
 @dataclasses.dataclass(frozen=True)
 class SolverParameters:
@@ -259,8 +267,10 @@ class SolverParameters:
     stay bit for bit. A tilt spring makes the body vibrate about its own axis at hundreds of Hz
     about zero rate; per component, that vibration is resolved to rtol of its own small
     amplitude and sets the step (2.3 times the steps at 3e3 N m/rad; docs/sim.md, "Estimating
-    the tilt stiffness of a rig"). The vector scale's wear rate differs from the per-component
-    one by up to 0.85 % at the default rtol (docs/sim-wear.md, "Tilt stiffness").
+    the tilt stiffness of a rig"). ``"auto"`` holds the vector scale to
+    :data:`AUTO_VECTOR_RTOL_FACTOR` times ``rtol``: at ``rtol`` itself the vector scale biases
+    a tilt rig's wear rate by up to 0.85 % (docs/sim-wear.md, "Tilt stiffness"); an explicit
+    ``"vector"`` uses ``rtol`` as given.
     """
 
     rtol: float = positive(1e-6)

@@ -16,8 +16,9 @@ from test_tilt_spring import _free_rig  # noqa: I001
 from jointwear.errors import ParameterError
 from jointwear.params import replace_nested
 from jointwear.sim import PARAMETER_SETS, run_cycles
-from jointwear.sim.dynamics import _error_flags
+from jointwear.sim.dynamics import _effective_rtol, _error_flags
 from jointwear.sim.kernels import _layout as kn
+from jointwear.sim.parameters import AUTO_VECTOR_RTOL_FACTOR
 
 BASE = PARAMETER_SETS["zhang2023"]
 OMEGA = slice(kn.Y_OMEGA, kn.Y_OMEGA + 3)
@@ -43,6 +44,21 @@ def test_auto_keeps_the_rigid_rig_per_component_and_a_tilt_spring_per_vector():
     assert np.all(_flags(**{"solver.rate_error_scale": "vector"})[OMEGA] == kn.ERR_VECTOR)
     ideal = _flags(**{"joint.model": "ideal", "solver.rate_error_scale": "vector"})
     assert not np.any(ideal == kn.ERR_VECTOR)  # the ideal model has no rotating body state
+
+
+def test_auto_tightens_rtol_only_where_it_chose_the_vector_scale():
+    def rtol(**changes):
+        return _effective_rtol(replace_nested(BASE, **{"solver.rtol": 2e-6, **changes}))
+
+    assert 0 < AUTO_VECTOR_RTOL_FACTOR < 1
+    assert rtol() == 2e-6  # the rigid rig: bit for bit as before
+    assert rtol(**{"joint.tilt_stiffness": 1e3}) == 2e-6 * AUTO_VECTOR_RTOL_FACTOR
+    assert rtol(**{"joint.tilt_damping": 1.0}) == 2e-6 * AUTO_VECTOR_RTOL_FACTOR
+    # an explicit choice keeps the given rtol
+    for scale in ("vector", "component"):
+        assert rtol(**{"joint.tilt_stiffness": 1e3, "solver.rate_error_scale": scale}) == 2e-6
+    ideal = {"joint.tilt_stiffness": 1e3, "joint.model": "ideal"}
+    assert rtol(**ideal) == 2e-6  # no rotating body state: nothing chosen
 
 
 def test_an_unknown_scale_is_refused():
