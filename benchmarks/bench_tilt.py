@@ -266,8 +266,8 @@ def _work_per_cycle(stiffness: float, offset: float, wear_depth, scan: bool) -> 
 
 def _rtol_fit(work: dict, u_rel: float) -> dict:
     """The vector scale's bias against rtol, fitted as b (rtol / 1e-6)^p over the scan points
-    resolved (beyond 3 standard errors), and the factor on rtol that brings the bias to a third
-    of the volume's relative expanded u (5 % more u in quadrature)."""
+    resolved (beyond 3 standard errors), and the factor on rtol that brings the bias to half
+    the volume's relative expanded u (``u_rel``: at most 12 % more u in quadrature)."""
     pts = [
         (v["rtol"], v["bias_vs_component"])
         for key, v in work.items()
@@ -278,7 +278,7 @@ def _rtol_fit(work: dict, u_rel: float) -> dict:
     x = np.log([r / RTOL for r, _ in pts])
     y = np.log([b for _, b in pts])
     p, logb = np.polyfit(x, y, 1)
-    target = u_rel / 3.0
+    target = u_rel / 2.0
     return {
         "points_fitted": len(pts),
         "bias_at_default_rtol": float(f"{math.exp(logb):.3g}"),
@@ -304,8 +304,9 @@ def _speed_point(k: float) -> dict:
     f_n = math.sqrt(k / inertia) / (2.0 * math.pi)
     work = _work_per_cycle(k, 0.01, final, scan=k == SCAN_POINT)
     u_rel = new["worn_volume_u_mm3_k2"][-1] / new["worn_volume_mm3"][-1]
-    if k == SCAN_POINT:
-        work["rtol_scan"] = _rtol_fit(work, u_rel)
+    if k == SCAN_POINT:  # the smaller of the two runs' stated u
+        u_old = old["worn_volume_u_mm3_k2"][-1] / old["worn_volume_mm3"][-1]
+        work["rtol_scan"] = _rtol_fit(work, min(u_rel, u_old))
     return {
         "tilt_stiffness_N_m_per_rad": k,
         "cpu_s_component": old["cpu_s"],
