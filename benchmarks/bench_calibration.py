@@ -165,10 +165,12 @@ def compared(folder: Path, sim: Path, meas: Path, ens: list[Path], cycles: float
     return compare_files([sim], [meas], folder / "m.nc", criteria=crit, cycles=cycles, ensemble=ens)
 
 
-def u_val_ratio(folder: Path, sim: Path, meas: Path, ens: list[Path], cycles: float) -> float:
-    """U_val / |D| of the band's maximum depth from ``jointwear compare``."""
+def u_val_ratio(folder: Path, sim: Path, meas: Path, ens: list[Path], cycles: float):
+    """U_val / |D| of the band's maximum depth from ``jointwear compare``, and its verdict
+    (the failed criteria and the summary line)."""
     res = compared(folder, sim, meas, ens, cycles)
-    return res.value("max_wear_depth", "U_val") / abs(res.value("max_wear_depth", "value_meas"))
+    ratio = res.value("max_wear_depth", "U_val") / abs(res.value("max_wear_depth", "value_meas"))
+    return ratio, {"failed": res.failed(), "summary": res.summary()}
 
 
 def wrong_form(folder: Path, size: dict[str, Any], early: Path, late: Path, kw0: float) -> dict:
@@ -240,6 +242,9 @@ def run(
     covered, widths, cpu_cal, means = [], [], [], []
     design_cpu = float("nan")
     master = folder / "design-master.nc"  # the training runs do not depend on the data
+    master_cpu = folder / "design-master-cpu.json"  # its CPU, kept with it for a resumed study
+    if master.is_file() and master_cpu.is_file():
+        design_cpu = float(json.loads(master_cpu.read_text())["cpu_s"])
     reps = []
     for rep in range(size["replicates"]):
         early, late = truth_maps(folder, size, rep, kw_true)
@@ -255,6 +260,7 @@ def run(
         if not master.is_file():
             shutil.copy(design, master)
             design_cpu = cpu
+            master_cpu.write_text(json.dumps({"cpu_s": cpu}))
         else:
             cpu_cal.append(cpu)
         lo, hi = float(ds["posterior_q025"][0]), float(ds["posterior_q975"][0])
@@ -275,12 +281,12 @@ def run(
     late = folder / f"truth-0-{size['validation_cycles']}.nc"
     mean_run, prior_ens = prior_side(folder, size, DEFAULT_KW)
     c2 = size["validation_cycles"]
-    before = u_val_ratio(folder, mean_run, late, [prior_ens], c2)
+    before, _ = u_val_ratio(folder, mean_run, late, [prior_ens], c2)
     t0 = time.process_time()
     pred = folder / "prediction.nc"
     predict(folder / "post-0.nc", cycles=c2, out=pred, samples=size["prediction_runs"], workers=0)
     cpu_pred = time.process_time() - t0
-    after = u_val_ratio(folder, pred, late, [], c2)
+    after, verdict = u_val_ratio(folder, pred, late, [], c2)
     early0 = folder / f"truth-0-{size['calibration_cycles']}.nc"
     wrong = (
         wrong_form(folder, size, early0, late, DEFAULT_KW)
@@ -298,6 +304,7 @@ def run(
         "posterior_mean_over_truth_median": float(np.median(means) / kw_true),
         "prior_sd_over_mean": prior_sd_over_mean,
         "u_val_over_d_max_depth": {"before_prior_ensemble": before, "after_posterior": after},
+        "right_model_validation": verdict,
         "wrong_form": wrong,
         "cpu_s": {
             "training_design_and_first_calibration": design_cpu,
