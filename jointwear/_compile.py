@@ -202,21 +202,23 @@ def warm_up(*, workers: int | None = None, stream: TextIO | None = None) -> dict
     reason: their kernels compile on first use), ``workers``, ``wall_s``, ``cpu_s`` (the
     workers' CPU seconds). Another process warming up the same cache is waited for.
     """
-    import fcntl
     import json
+
+    from filelock import FileLock, Timeout
 
     kernels = _manifest().KERNELS
 
     stream = stream or sys.stderr
     root = _cache_root()
     root.mkdir(parents=True, exist_ok=True)
-    with open(root / "jointwear-kernels.lock", "a") as lock:
-        try:
-            fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except BlockingIOError:
-            print("jointwear: waiting for another jointwear process compiling the kernels...",
-                  file=stream, flush=True)  # fmt: skip
-            fcntl.flock(lock, fcntl.LOCK_EX)
+    lock = FileLock(root / "jointwear-kernels.lock")
+    try:
+        lock.acquire(timeout=0)
+    except Timeout:
+        print("jointwear: waiting for another jointwear process compiling the kernels...",
+              file=stream, flush=True)  # fmt: skip
+        lock.acquire()
+    try:
         stamp = stamp_path()
         if stamp.exists():
             return json.loads(stamp.read_text())
@@ -226,6 +228,8 @@ def warm_up(*, workers: int | None = None, stream: TextIO | None = None) -> dict
             tmp = stamp.with_suffix(f".{os.getpid()}.tmp")
             tmp.write_text(json.dumps(done, indent=1))
             os.replace(tmp, stamp)
+    finally:
+        lock.release()
     return done
 
 
@@ -518,8 +522,7 @@ def resolve(module: str, name: str):
 def _lock_cache_saves(root: Path) -> None:
     """numba's cache saves of this process under one file lock shared by the workers (see the
     module's docstring)."""
-    import fcntl
-
+    from filelock import FileLock
     from numba.core import caching
 
     # the class of numba's index-and-data cache files (its name changed in numba 0.61)
@@ -527,15 +530,11 @@ def _lock_cache_saves(root: Path) -> None:
     if cls is None or not hasattr(cls, "save"):
         return  # another numba: its saves are left as they are
     save = cls.save
-    lock_path = root / "jointwear-kernels.save.lock"
+    lock = FileLock(root / "jointwear-kernels.save.lock")
 
     def locked_save(self, key, data):
-        with open(lock_path, "a") as lock:
-            fcntl.flock(lock, fcntl.LOCK_EX)
-            try:
-                return save(self, key, data)
-            finally:
-                fcntl.flock(lock, fcntl.LOCK_UN)
+        with lock:
+            return save(self, key, data)
 
     cls.save = locked_save
 
