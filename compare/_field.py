@@ -58,6 +58,7 @@ from scipy import stats
 
 import jointwear.compare.verdicts as vd
 from jointwear.compare._decide import decision
+from jointwear.wear_field import field_bins, field_means
 
 __all__ = ["Features", "FieldTest", "mahalanobis_test", "field_criterion", "axial_criterion_field"]
 
@@ -164,10 +165,6 @@ def _estimated_null(vec: np.ndarray, lam: np.ndarray, dev: np.ndarray, nu: int) 
     return np.sum(e * sol, axis=(1, 2))
 
 
-def _bins(n: int, k: int) -> list[np.ndarray]:
-    return [b for b in np.array_split(np.arange(n), min(k, n)) if b.size]
-
-
 @dataclass(frozen=True)
 class Features:
     """A feature vector of a band map: functions of the means over groups of cells.
@@ -185,13 +182,7 @@ class Features:
 
     def means(self, f: np.ndarray) -> np.ndarray:
         """Mean over each group's finite cells (NaN for a group with none: an angular gap)."""
-        out = np.full(len(self.groups), np.nan)
-        for k, (i, j) in enumerate(self.groups):
-            cells = f[np.ix_(i, j)]
-            ok = np.isfinite(cells)
-            if ok.any():
-                out[k] = float(cells[ok].mean())
-        return out
+        return field_means(f, self.groups)
 
     def where(self, *maps: np.ndarray) -> Features:
         """The groups restricted to the cells finite in every map (a partial arc's gap left
@@ -401,10 +392,11 @@ def _decide(c, key: str, label: str, feature: Features, what: str) -> None:
 def field_criterion(c) -> None:
     """The whole-band wear field: bin means, Mahalanobis distance (``wear_field``)."""
     crit = c.criteria
-    zb = _bins(c.s.shape[0], crit.field_bins_z)
-    tb = _bins(c.s.shape[1], crit.field_bins_theta)
-    feature = Features([(i, j) for i in zb for j in tb])
-    what = f"mean depth in {len(zb)} × {len(tb)} bins"
+    n_z, n_theta = c.s.shape[0], c.s.shape[1]
+    feature = Features(field_bins(n_z, n_theta, crit.field_bins_z, crit.field_bins_theta))
+    what = (
+        f"mean depth in {min(crit.field_bins_z, n_z)} × {min(crit.field_bins_theta, n_theta)} bins"
+    )
     _decide(c, "wear_field", f"wear field {c.band}", feature, what)
 
 
