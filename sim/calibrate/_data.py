@@ -134,6 +134,7 @@ def file_record(path: str | Path) -> dict[str, object]:
 def read_band(ds: xr.Dataset, where: str) -> Band:
     """The measured map of ``ds`` on its own grid, in the canonical angle convention."""
     from jointwear import conventions
+    from jointwear.wear_field import random_part
 
     if "wear_depth" not in ds:
         raise BadInputError(
@@ -159,7 +160,7 @@ def read_band(ds: xr.Dataset, where: str) -> Band:
         np.asarray(da.values, dtype=float),
         u,
         float(radius) if radius is not None else None,
-        np.minimum(u_random, u),
+        random_part(u, u_random, where),
         win,
     )
 
@@ -244,15 +245,15 @@ def band_quantities(
 
 
 def _u_from_points(band: Band, radius: float) -> dict[str, tuple[float, str]]:
+    from jointwear.wear_field import split_u
+
     u = band.u
     if not np.isfinite(u).any():
         return {}
     i, j = np.unravel_index(np.nanargmax(band.depth), band.depth.shape)
     w = volume_weights(band.z, band.theta, radius)
-    rnd = band.u_random if band.u_random is not None else np.full(u.shape, np.nan)
-    rnd = np.where(np.isfinite(rnd), rnd, 0.0)
-    u0 = np.nan_to_num(u)
-    sys_part = np.sqrt(np.maximum(u0**2 - rnd**2, 0.0))
+    sys_part, rnd = split_u(u, band.u_random)
+    sys_part = np.nan_to_num(sys_part)  # a point whose u is not stated adds none
     vol = math.sqrt(float(np.sum(w * sys_part)) ** 2 + float(np.sum((w * rnd) ** 2)))
     vol_basis = (
         "per-point wear_depth_u: its independent part (wear_depth_u_random) summed in "

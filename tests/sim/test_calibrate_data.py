@@ -17,7 +17,7 @@ from jointwear.reported import read_reported
 from jointwear.sim.calibrate._data import band_quantities, map_data, volume_weights
 from jointwear.sim.calibrate._emulator import fit_emulator
 from jointwear.sim.calibrate._reported import reported_data
-from jointwear.wear_field import field_bins, field_means, field_u
+from jointwear.wear_field import field_bins, field_means, field_u, split_u
 
 UM = 1e-6
 CANONICAL_ATTRS = {"angle_zero": CANONICAL.zero, "angle_direction": CANONICAL.direction}
@@ -138,6 +138,45 @@ def test_wear_field_bins_means_and_u_closed_form():
     np.testing.assert_allclose(field_u(u, None, bins), 0.3)
     half = field_u(u, np.full((5, 24), 0.3 * math.sqrt(0.5)), bins)[0]
     assert half == pytest.approx(math.hypot(0.3 * math.sqrt(0.5), 0.3 * math.sqrt(0.5 / 18)))
+
+
+def test_split_u_hand_computation():
+    # u = 5 of which 3 independent -> 4 correlated; no stated part -> all correlated; no u ->
+    # nothing (NaN, left out of a bin); a part above u by round-off -> capped, all independent
+    u = np.array([[5.0, 2.0, np.nan, 1.0]])
+    rnd = np.array([[3.0, np.nan, 1.0, 1.0 + 1e-9]])
+    sys_part, ind = split_u(u, rnd)
+    np.testing.assert_array_equal(sys_part, [[4.0, 2.0, np.nan, 0.0]])
+    np.testing.assert_array_equal(ind, [[3.0, 0.0, 0.0, 1.0]])
+    one_bin = [(np.array([0]), np.arange(4))]
+    # three points with a u: mean correlated part (4 + 2 + 0) / 3, independent sqrt(9 + 1) / 3
+    assert field_u(u, rnd, one_bin)[0] == pytest.approx(math.hypot(2.0, math.sqrt(10.0) / 3))
+
+
+def test_an_independent_part_above_its_u_is_refused_naming_the_file():
+    ds = map_dataset(np.full((3, 8), 1e-6), 1e-7, u_random=True)
+    ds["wear_depth_u_random"] = ds["wear_depth_u"].copy()
+    ds["wear_depth_u_random"][1, 2] = 1.5e-7  # more than the whole u of that point
+    with pytest.raises(
+        BadInputError,
+        match=r"m\.nc: wear_depth_u_random exceeds wear_depth_u at 1 of 24 points \(up to 1\.5 x\)",
+    ):
+        map_data(ds, Path("m.nc"), 0, 1, ("worn_volume",), 8e-3)
+    with pytest.raises(BadInputError, match="m.nc"):
+        map_data(ds, Path("m.nc"), 0, 1, ("wear_field",), 8e-3)
+    ds["wear_depth_u_random"][1, 2] = 1e-7 * (1 + 1e-9)  # round-off: capped at u
+    _, [d] = map_data(ds, Path("m.nc"), 0, 1, ("worn_volume",), 8e-3)
+    w = volume_weights(np.linspace(-6e-3, 6e-3, 3), np.arange(8) * 45.0, 8e-3)
+    assert d.u_d == pytest.approx(1e-7 * math.sqrt(np.sum(w**2)), rel=1e-12)
+
+
+def test_volume_u_of_a_partly_independent_u_by_hand():
+    ds = map_dataset(np.full((3, 8), 1e-6), 1e-7, u_random=True)
+    ds["wear_depth_u_random"] = ds["wear_depth_u"] * 0.6  # 0.6 independent, 0.8 correlated
+    _, [d] = map_data(ds, Path("m.nc"), 0, 1, ("worn_volume",), 8e-3)
+    w = volume_weights(np.linspace(-6e-3, 6e-3, 3), np.arange(8) * 45.0, 8e-3)
+    hand = math.hypot(0.8e-7 * w.sum(), 0.6e-7 * math.sqrt(np.sum(w**2)))
+    assert d.u_d == pytest.approx(hand, rel=1e-12)
 
 
 def map_dataset(depth: np.ndarray, u: float, *, u_random: bool, stated_max: float | None = None):
