@@ -124,11 +124,21 @@ def r_distribution(c, draws: int = R_DRAWS, seed: int = R_SEED) -> tuple[RDistri
     e = rng.standard_normal((draws, s.size)) * u
     if dev.shape[0]:
         e += rng.standard_normal((draws, dev.shape[0])) @ dev
+    r = _pearson_rows(s, s + e)
+    return RDistribution(r[np.isfinite(r)], f"{note}; {cell_note}"), ""
+
+
+def _pearson_rows(s: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """Pearson r of ``s`` (n,) against each row of ``x`` (draws, n) [1], in [-1, 1].
+
+    Vectorised :func:`~jointwear.compare.metrics.pearson_r`, clipped as it is: round-off makes
+    a row's r exceed 1 by a few ulp (a row equal to ``s``); NaN where either is constant.
+    """
     sc = s - s.mean()
-    dc = (s + e) - (s + e).mean(axis=1, keepdims=True)
+    dc = x - x.mean(axis=1, keepdims=True)
     den = np.sqrt(np.sum(sc**2) * np.sum(dc**2, axis=1))
     r = np.where(den > 0, (dc @ sc) / np.where(den > 0, den, 1.0), np.nan)
-    return RDistribution(r[np.isfinite(r)], f"{note}; {cell_note}"), ""
+    return np.clip(r, -1.0, 1.0)
 
 
 def turn_resolution(s: np.ndarray, theta_deg: np.ndarray, r_min: float) -> float:

@@ -54,3 +54,19 @@ def test_without_the_measurement_u_it_is_decided_on_r_min_alone_and_says_so():
     row = _shape(c)
     assert "uncertainty not assessed" in row.value and "wear_r_min alone" in row.value
     assert row.state == ("pass" if c.value("wear_depth", "pearson_r") >= 0.5 else "fail")
+
+
+def test_r_of_identical_maps_is_clipped_to_one_where_round_off_exceeds_it():
+    from jointwear.compare._shape import _pearson_rows
+
+    rng = np.random.default_rng(0)
+    maps = [rng.random(144) * 1e-6 for _ in range(20)]
+    # the unclipped vectorised r of a map against itself: round-off takes some above 1
+    sc = [m - m.mean() for m in maps]
+    raw = [float(c @ c / np.sqrt(np.sum(c**2) * np.sum(c**2))) for c in sc]
+    assert max(raw) > 1.0
+    for m in maps:
+        r = _pearson_rows(m, np.stack([m, m, -m, 3 * m + 1e-6]))
+        assert np.all(np.abs(r) <= 1.0)
+        np.testing.assert_allclose(r, [1.0, 1.0, -1.0, 1.0], rtol=0, atol=1e-15)
+    assert np.isnan(_pearson_rows(maps[0], np.ones((1, 144)))[0])  # a constant row: undefined
