@@ -213,8 +213,16 @@ def within(default: float, interval: str) -> Any:
 
 def check_fields(obj: Any, where: str) -> None:
     """Run the checks the fields of the dataclass instance ``obj`` declare (:func:`checked`), in
-    field order; errors name ``where.field``. A check's converted value replaces the field's."""
+    field order; errors name ``where.field``. A check's converted value replaces the field's.
+
+    A ``Literal`` field (or a union holding one) is checked against its allowed values as the
+    TOML reader and :func:`replace_nested` check it (the same message, naming ``where.field``
+    and the allowed values), so a wrong value is refused by construction too.
+    """
+    literals = _literal_fields(type(obj))
     for f in dataclasses.fields(obj):
+        if f.name in literals:
+            _coerce(getattr(obj, f.name), literals[f.name], f"{where}.{f.name}")
         check = f.metadata.get("check")
         if check is not None:
             value = getattr(obj, f.name)
@@ -295,6 +303,13 @@ def _is_literal(tp: Any) -> bool:
     if typing.get_origin(tp) in (typing.Union, types.UnionType):
         return any(_is_literal(arg) for arg in typing.get_args(tp))
     return False
+
+
+@functools.cache
+def _literal_fields(cls: type) -> dict[str, Any]:
+    """The type of each field of the dataclass ``cls`` that is a ``Literal`` (:func:`_is_literal`)."""
+    types_ = _field_types(cls)
+    return {f.name: types_[f.name] for f in dataclasses.fields(cls) if _is_literal(types_[f.name])}
 
 
 def replace_nested(obj: T, **changes: Any) -> T:

@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import typing
 from pathlib import Path
 from typing import Literal
 
@@ -286,11 +285,6 @@ class SolverParameters:
 
     def __post_init__(self) -> None:
         check_fields(self, "solver")
-        if self.rate_error_scale not in typing.get_args(RateErrorScale):
-            raise ParameterError(
-                f"solver.rate_error_scale must be one of {list(typing.get_args(RateErrorScale))}, "
-                f"got {self.rate_error_scale!r}"
-            )
         if self.min_step >= self.max_step:
             raise ParameterError("solver.min_step must be smaller than solver.max_step")
 

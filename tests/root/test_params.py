@@ -184,6 +184,28 @@ def test_declared_field_checks_accept_the_bounds_and_keep_converted_values():
         dataclasses.replace(Declared(), share=0.0)
 
 
+@dataclasses.dataclass(frozen=True)
+class Chosen:
+    model: Literal["line", "point"] = "line"
+    maybe: Literal["a", "b"] | None = None
+    length: float = positive(1.0)
+
+    def __post_init__(self) -> None:
+        check_fields(self, "part")
+
+
+def test_check_fields_refuses_a_literal_field_outside_its_choices_by_construction():
+    with pytest.raises(
+        ParameterError, match=r"^part\.model: expected one of \['line', 'point'\], got 'area'$"
+    ):
+        Chosen(model="area")
+    with pytest.raises(ParameterError, match=r"part\.maybe: expected one of \['a', 'b'\]"):
+        dataclasses.replace(Chosen(), maybe="c")
+    with pytest.raises(ParameterError, match=r"^model: expected one of"):  # replace_nested's
+        replace_nested(Chosen(), model="x")
+    assert (Chosen(model="point", maybe="b").model, Chosen().maybe) == ("point", None)
+
+
 def test_a_malformed_interval_is_refused_at_declaration():
     with pytest.raises(ValueError, match="interval '0, 1'"):
         within(0.5, "0, 1")

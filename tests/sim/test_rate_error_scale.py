@@ -61,9 +61,23 @@ def test_auto_tightens_rtol_only_where_it_chose_the_vector_scale():
     assert rtol(**ideal) == 2e-6  # no rotating body state: nothing chosen
 
 
-def test_an_unknown_scale_is_refused():
-    with pytest.raises(ParameterError, match="rate_error_scale.*'auto', 'component', 'vector'"):
-        replace_nested(BASE, **{"solver.rate_error_scale": "norm"})
+def test_an_unknown_scale_is_refused_by_construction_override_and_toml():
+    import dataclasses
+
+    from jointwear.params import from_mapping
+    from jointwear.sim.parameters import SimParameters, SolverParameters
+
+    # one check (params.check_fields' Literal check), one message naming the field and choices
+    said = r"^solver\.rate_error_scale: expected one of \['auto', 'component', 'vector'\], got 'x'$"
+    with pytest.raises(ParameterError, match=said):
+        SolverParameters(rate_error_scale="x")
+    with pytest.raises(ParameterError, match=said):
+        dataclasses.replace(BASE.solver, rate_error_scale="x")
+    with pytest.raises(ParameterError, match=said):
+        replace_nested(BASE, **{"solver.rate_error_scale": "x"})
+    with pytest.raises(ParameterError, match=said):
+        from_mapping(SimParameters, {"solver": {"rate_error_scale": "x"}})
+    assert SolverParameters(rate_error_scale="vector").rate_error_scale == "vector"
 
 
 @pytest.mark.parametrize("scale", ["component", "vector"])
