@@ -13,7 +13,6 @@ from pathlib import Path
 import pytest
 
 from jointwear import _compile
-from jointwear._compile_notice import NOTICE
 
 #: Two toy kernels (one of them with two argument types) for the machinery's tests.
 TOY = '''
@@ -186,38 +185,6 @@ def test_every_manifest_entry_names_a_kernel_and_its_argument_types():
         n = len(inspect.signature(dispatcher.py_func).parameters)
         assert len(types) == n, f"{module}.{name}: {len(types)} types for {n} arguments"
         assert cpu_s >= 0
-
-
-@pytest.mark.slow
-def test_after_the_first_command_dic_correlate_compiles_nothing(tmp_path):
-    """A fresh install: the first command (a speckle pair) compiles every kernel ahead; then
-    ``dic correlate`` on the pair compiles none (numba's cache log says what it saved)."""
-    env = {
-        **os.environ,
-        "NUMBA_CACHE_DIR": str(tmp_path / "cache"),
-        _compile.SWITCH: "1",
-        "NUMBA_NUM_THREADS": "2",
-    }
-    env.pop("JOINTWEAR_KERNEL_MANIFEST", None)
-    jw = [sys.executable, "-m", "jointwear"]
-    first = subprocess.run(
-        [*jw, "datasets", "speckle", str(tmp_path / "pair"), "--size", "128x128"],
-        env=env, capture_output=True, text=True, timeout=1800,
-    )  # fmt: skip
-    assert first.returncode == 0, first.stderr[-2000:]
-    assert "compiling the numerical kernels once" in first.stderr
-    pair = tmp_path / "pair"
-    run = subprocess.run(
-        [*jw, "dic", "correlate", str(pair / "reference.png"), str(pair / "deformed.png"),
-         "--subset", "21", "--step", "16", "--out", str(tmp_path / "f.nc")],
-        env={**env, "NUMBA_DEBUG_CACHE": "1"}, capture_output=True, text=True, timeout=600,
-    )  # fmt: skip
-    assert run.returncode == 0, run.stderr[-2000:]
-    assert "data loaded" in run.stdout  # the kernels came from the cache ...
-    assert "data saved" not in run.stdout  # ... and none was compiled
-    # nor did the command compile one itself (its compile notice); a second warm-up, which only
-    # loads, happens when a kernel module changed in between (a developer's tree)
-    assert NOTICE not in run.stderr and "kernel(s)" not in run.stderr
 
 
 #: A CLI process's cached kernel: loaded without numba's whole compiler (no scipy.linalg), then
