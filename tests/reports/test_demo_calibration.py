@@ -2,21 +2,15 @@
 
 from __future__ import annotations
 
-import dataclasses
-
 import numpy as np
 import pytest
 import xarray as xr
 
-from jointwear import io
-from jointwear.errors import BadInputError
 from jointwear.reports import demo
 from jointwear.reports.demo_calibration import (
     CALIBRATED,
     base_toml,
-    calibrate_and_predict,
     spec_toml,
-    with_prediction,
 )
 from jointwear.reports.demo_studies import ensemble_spec, main_wear_settings
 
@@ -72,59 +66,6 @@ def test_the_motion_truth_is_not_the_simulated_linkage():
     assert rpm != pytest.approx(120.0, rel=1e-3) and abs(rpm / 120.0 - 1) <= 0.01
     # the report says what the footage is: the rig's kinematics at another speed
     assert "faster than the simulated one" in demo.SYNTHETIC_NOTE
-
-
-#: Small enough for CI: a 5 x 24 bore, 2e4 cycles (ΔN 1250), calibrated at 1e4.
-SMALL = dataclasses.replace(
-    demo.FULL,
-    cycles=2e4,
-    snapshots=(2e4,),
-    n_layers=5,
-    n_points=24,
-    instrument_points=720,
-    rig_size=None,
-    verification_replicates=2,
-    calibration_cycles=1e4,
-    training_runs=10,
-    prediction_runs=3,
-)
-
-
-@pytest.mark.slow
-def test_calibrated_on_one_snapshot_validated_on_the_other(tmp_path):
-    """The whole step at reduced size: the synthetic bore (the model's map 10 % deeper, turned
-    6 degree) scanned at 1e4 and 2e4 cycles; kw calibrated on the 1e4 map comes out above the
-    nominal (the truth wears more), the prediction is compared with the 2e4 map, and the 1e4
-    map is refused as validation data."""
-    from jointwear.compare import as_ensemble, compare
-    from jointwear.reports.demo_studies import wear_verification
-    from jointwear.sim import DEFAULT_KW, simulate_wear
-
-    params = demo._params(SMALL)
-    wear = simulate_wear(
-        params, cycles=SMALL.cycles, snapshots=[SMALL.cycles], settings=main_wear_settings(SMALL)
-    )
-    sim_path = demo._save_wear(tmp_path, SMALL, params, wear, 0.0)
-    validation, early = demo._measured(tmp_path, sim_path, SMALL, params, True)
-    assert io.load(early).attrs["cycles"] == SMALL.calibration_cycles
-    assert io.load(validation).attrs["cycles"] == SMALL.cycles
-    study, _ = wear_verification(params, SMALL, tmp_path)
-    step = calibrate_and_predict(tmp_path, SMALL, params, early, study, say=lambda _: None)
-    post = io.load(step.posterior, validate=False)
-    mean, ratio = float(post["posterior_mean"].values[0]), float(post["width_ratio"].values[0])
-    # the truth wears 10 % more than the nominal model: kw comes out above nominal, informed
-    assert DEFAULT_KW < mean < 1.3 * DEFAULT_KW and ratio < 0.5, (mean / DEFAULT_KW, ratio)
-    sims, sim_ds, ens_paths, ens_ds = with_prediction(step, [sim_path], [validation], [], [])
-    assert sims == [step.prediction] and ens_paths == [step.prediction]
-    result = compare(
-        sim_ds,
-        [io.load(validation)],
-        ensemble=as_ensemble(ens_ds, ["prediction.nc"]),
-        verification=[io.load(study, validate=False)],
-    )
-    assert "max_wear_depth" in set(result.decisions.key)
-    with pytest.raises(BadInputError, match="calibration data never validate"):
-        with_prediction(step, [sim_path], [early], [], [])
 
 
 def test_the_report_says_what_the_known_truths_give():

@@ -276,7 +276,7 @@ def test_the_full_demo_on_an_empty_kernel_cache_then_dic_correlate_compiles_noth
     for name in ("sim_wear.nc", "metrology_wear.nc", "ensemble.nc", "sim_verification.nc",
                  "dic_motion.nc", "posterior.nc", "prediction.nc", "metrics.nc"):  # fmt: skip
         assert (out / name).is_file(), name
-    assert io.load(out / "metrics.nc").attrs  # a file jointwear reads back
+    _check_the_calibration_step(out)
     # the next commands load every kernel from the cache: none is compiled
     logged = {**env, "NUMBA_DEBUG_CACHE": "1"}
     pair = tmp_path / "pair"
@@ -297,3 +297,31 @@ def test_the_full_demo_on_an_empty_kernel_cache_then_dic_correlate_compiles_noth
     # nor did the command warm up again or compile one itself (its compile notice)
     assert NOTICE not in run.stderr and "kernel(s)" not in run.stderr
     assert "compiling the numerical kernels" not in run.stderr + made.stderr
+
+
+def _check_the_calibration_step(out):
+    """The demo's calibrate -> validate step (#35 item 5): the synthetic bore (the model's map
+    10 % deeper, turned 6 degree) scanned at 1e5 and 2e5 cycles; kw calibrated on the 1e5 map
+    comes out above the nominal (the truth wears more) and informed, the prediction is the
+    compared simulation, and the 1e5 map is refused as validation data."""
+    from jointwear.compare import load_comparison
+    from jointwear.errors import BadInputError
+    from jointwear.reports.demo_calibration import CalibrationStep, with_prediction
+    from jointwear.sim import DEFAULT_KW
+
+    early, validation = out / "metrology_wear_calibration.nc", out / "metrology_wear.nc"
+    assert io.load(early).attrs["cycles"] == demo.FULL.calibration_cycles
+    assert io.load(validation).attrs["cycles"] == demo.FULL.cycles
+    post = io.load(out / "posterior.nc", validate=False)
+    mean, ratio = float(post["posterior_mean"].values[0]), float(post["width_ratio"].values[0])
+    assert DEFAULT_KW < mean < 1.3 * DEFAULT_KW and ratio < 0.5, (mean / DEFAULT_KW, ratio)
+    step = CalibrationStep(
+        out / "posterior.nc", out / "prediction.nc", early, out / "calibrate.toml",
+        out / "calibrate_params.toml", 0.0,
+    )  # fmt: skip
+    sims, _, ens_paths, _ = with_prediction(step, [out / "sim_wear.nc"], [validation], [], [])
+    assert sims == [step.prediction] and ens_paths == [step.prediction]
+    with pytest.raises(BadInputError, match="calibration data never validate"):
+        with_prediction(step, [out / "sim_wear.nc"], [early], [], [])
+    states = load_comparison(io.load(out / "metrics.nc")).decisions.set_index("key").state
+    assert states["max_wear_depth"] == "pass" and states["wear_field"] == "fail"
