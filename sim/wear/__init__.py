@@ -4,8 +4,8 @@ Owns the wear loop (:func:`simulate_wear`, :class:`WearRun`: cycle updates, adap
 interval, checkpoints and resume) and what it is made of: the run settings and the checks on
 kw, the contact models that give one cycle's wear work, the conformal (Winkler) wear pressure
 of ``contact.wear_pressure = "conformal"``, the update-interval control, the wear-map Dataset
-of a run, versioned checkpoints, and the calibration of the wear coefficient kw against
-measured wear. The modules are private; the public names are importable from here
+of a run and its verdicts, versioned checkpoints, the dotted parameter overrides of a run, and
+the calibration of the wear coefficient kw against measured wear. The modules are private; the public names are importable from here
 and from :mod:`jointwear.sim`, loaded on first use.
 """
 

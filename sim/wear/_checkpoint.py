@@ -11,6 +11,10 @@ Version policy: :data:`FORMAT_VERSION` is written; a checkpoint of another versi
 with a message naming the file and how to start over (older pickle checkpoints, format 1, are
 recognised and refused without being unpickled). A later version that keeps the state layout
 compatible can add a migration in :func:`_migrate`.
+
+A wear run's own checkpoint methods (:class:`RunCheckpoints`, a base of
+:class:`~jointwear.sim.wear.WearRun`): its fingerprint, saving, and resuming only with the
+parameters it was written with.
 """
 
 from __future__ import annotations
@@ -19,16 +23,21 @@ import dataclasses
 import importlib
 import io
 import json
+import math
 import zipfile
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
-from typing import Any
+from typing import Any, Self
 
 import numpy as np
 
 from jointwear.errors import BadInputError
 from jointwear.io import atomic_path
+from jointwear.params import to_jsonable
+from jointwear.sim.wear._contact import describe_any
+from jointwear.sim.wear._settings import WearSettings
 
-__all__ = ["FORMAT", "FORMAT_VERSION", "write_checkpoint", "read_checkpoint"]
+__all__ = ["FORMAT", "FORMAT_VERSION", "write_checkpoint", "read_checkpoint", "RunCheckpoints"]
 
 FORMAT = "jointwear.sim.wear checkpoint"
 FORMAT_VERSION = 2
@@ -210,3 +219,112 @@ def read_checkpoint(path: str | Path) -> tuple[dict[str, Any], Any]:
             f"checkpoint '{path}' could not be read ({type(exc).__name__}: {exc}); {_START_OVER}"
         ) from None
     return fingerprint, state
+
+
+def _flatten(obj: Any, prefix: str = "") -> dict[str, Any]:
+    out: dict[str, Any] = {}
+    if isinstance(obj, Mapping):
+        for k, v in obj.items():
+            out.update(_flatten(v, f"{prefix}{k}."))
+        return out
+    out[prefix[:-1]] = obj
+    return out
+
+
+class RunCheckpoints:
+    """The checkpoint side of :class:`~jointwear.sim.wear.WearRun` (a base of it): its
+    fingerprint, writing its state, and starting or resuming a run from a checkpoint (refused
+    when the parameters differ)."""
+
+    def fingerprint(self) -> dict[str, Any]:
+        """Everything that determines the result (JSON-ready): model and wear settings."""
+        fp = {
+            "contact": to_jsonable(describe_any(self.contact)),
+            "wear": to_jsonable(self.settings),
+            "initial_wear_max": float(np.max(self._s["initial_wear"])),
+            "initial_wear_sum": float(np.sum(self._s["initial_wear"])),
+        }
+        return json.loads(json.dumps(fp))  # as a checkpoint stores it (tuples become lists)
+
+    def save_checkpoint(self, path: str | Path | None = None) -> Path:
+        """Write the complete state atomically to ``path`` or :attr:`checkpoint` (npz + JSON)."""
+        path = Path(path) if path is not None else self.checkpoint
+        if path is None:
+            raise BadInputError("no checkpoint path given")
+        return write_checkpoint(path, self.fingerprint(), self._s)
+
+    @classmethod
+    def start(
+        cls,
+        contact: Any,
+        settings: WearSettings | None = None,
+        *,
+        resume: bool = False,
+        **run: Any,
+    ) -> Self:
+        """A new run, ``WearRun(contact, settings, **run)``, or with ``resume`` the run of
+        ``run["checkpoint"]`` continued (:meth:`resume`; the initial wear is the checkpoint's)."""
+        if not resume:
+            return cls(contact, settings, **run)
+        checkpoint = run.pop("checkpoint", None)
+        if checkpoint is None:
+            raise BadInputError("resume=True needs the checkpoint path")
+        run.pop("initial_wear", None)
+        return cls.resume(checkpoint, contact, settings, **run)
+
+    @classmethod
+    def resume(
+        cls,
+        checkpoint: str | Path,
+        contact: Any,
+        settings: WearSettings | None = None,
+        *,
+        cycles: float,
+        snapshots: Sequence[float] | None = None,
+        on_update: Callable[[dict[str, Any]], None] | None = None,
+    ) -> Self:
+        """Continue a run from its checkpoint; refuse if the parameters differ.
+
+        Raises
+        ------
+        BadInputError
+            The checkpoint is missing, unreadable, of another format version, was written with
+            different parameters (the message names them), or the target is below the cycles
+            already done.
+        """
+        path = Path(checkpoint)
+        old_fp, state = read_checkpoint(path)
+        run = cls(
+            contact,
+            settings,
+            cycles=max(float(cycles), 1.0),
+            snapshots=None,
+            checkpoint=path,
+            on_update=on_update,
+        )
+        if isinstance(state, dict):  # checkpoints written before the noise probe existed
+            state.setdefault("probe_noise", math.nan)
+        if not isinstance(state, dict) or set(state) != set(run._s):
+            raise BadInputError(
+                f"checkpoint '{path}' does not hold a wear-run state this version understands; "
+                "start over without --resume (the old checkpoint is then replaced)"
+            )
+        if np.shape(state["initial_wear"]) == run.grid.shape:
+            run._s["initial_wear"] = state["initial_wear"]
+        old = _flatten(old_fp)
+        new = _flatten(run.fingerprint())
+        differing = sorted(k for k in set(old) | set(new) if old.get(k) != new.get(k))
+        if differing:
+            shown = "; ".join(
+                f"{k}: {old.get(k, '<absent>')!r} in the checkpoint, {new.get(k, '<absent>')!r} now"
+                for k in differing[:5]
+            )
+            more = f" (and {len(differing) - 5} more)" if len(differing) > 5 else ""
+            raise BadInputError(
+                f"checkpoint '{path}' was written with different parameters - {shown}{more}. "
+                "Resume with the original parameters, or start over without --resume (the old "
+                "checkpoint is then replaced)"
+            )
+        run._s = state
+        run._set_target(cycles, snapshots)
+        return run

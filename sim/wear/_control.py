@@ -30,6 +30,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from jointwear.sim.wear._settings import WearSettings
+
 __all__ = [
     "RateSample",
     "ErrorBudget",
@@ -39,6 +41,8 @@ __all__ = [
     "effective_tolerance",
     "cycles_to_average",
     "next_interval",
+    "propose_interval",
+    "smoothed_noise",
     "COVERAGE",
     "DETECTION_SIGMAS",
     "UNRESOLVED_RATE_CHANGE",
@@ -170,6 +174,36 @@ def next_interval(dn: int, eta: float, tol_eff: float, dn_min: int, dn_max: int)
     """The next update interval: ``dN * 0.9 tol_eff / eta``, at most doubled, at least 0.2x."""
     fac = 2.0 if eta == 0 else min(2.0, max(0.2, 0.9 * tol_eff / eta))
     return int(min(dn_max, max(dn_min, int(dn * fac))))
+
+
+def propose_interval(
+    settings: WearSettings, dn_next: int, accepted: int, rate: np.ndarray, room: int
+) -> tuple[int, int]:
+    """The interval of the next update: (dN to use now, dN proposed before clipping to ``room``).
+
+    ``dn_next`` is the control's proposal (``"schedule"``: the schedule's entry after
+    ``accepted`` accepted updates, its last one repeated); ``settings.max_increment`` [m]
+    caps the deepest point's increment ``dN max(rate)`` (never below ``dn_min`` in the adaptive
+    scheme, 1 otherwise); ``room`` is the number of cycles left to the next stop.
+    """
+    st = settings
+    dn = int(dn_next)
+    if st.scheme == "schedule":
+        dn = st.schedule[min(accepted, len(st.schedule) - 1)]
+    if st.max_increment is not None:
+        rmax = float(np.max(rate))
+        if rmax > 0:  # cap the deepest increment (never below dn_min in the adaptive scheme)
+            floor = st.dn_min if st.scheme == "adaptive" else 1
+            dn = min(dn, max(floor, int(st.max_increment / rmax)))
+    dn = max(1, dn)
+    return min(dn, room), dn
+
+
+def smoothed_noise(noise_hist: Sequence[float]) -> float:
+    """Smoothed relative single-cycle variability (RMS of the last four finite estimates) [1];
+    NaN when none is known."""
+    vals = [v for v in noise_hist[-4:] if np.isfinite(v)]
+    return math.sqrt(float(np.mean(np.square(vals)))) if vals else math.nan
 
 
 #: Smallest factor by which one update may damp an earlier depth error (see :func:`damping`).

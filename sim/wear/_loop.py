@@ -42,12 +42,19 @@ kw
 --
 ``kw`` is the dimensional wear coefficient [m³/(N m) = m²/N]; see :data:`DEFAULT_KW` and
 docs/sim-wear.md for how the default was obtained.
+
+Modules
+-------
+This module holds the cycle loop (:class:`WearRun`'s set-up, measurements and updates) and
+:func:`simulate_wear`. The interval's proposal and the noise estimate are
+:mod:`._control`'s; the run's fingerprint, checkpoints and resume are
+:class:`._checkpoint.RunCheckpoints`, its verdicts and wear map :class:`._output.RunOutput`
+(both bases of :class:`WearRun`); the dotted parameter overrides are :mod:`._overrides`.
 """
 
 from __future__ import annotations
 
 import dataclasses
-import json
 import logging
 import math
 from collections.abc import Callable, Mapping, Sequence
@@ -57,14 +64,13 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from jointwear.errors import BadInputError, ParameterError
+from jointwear.errors import BadInputError
 from jointwear.io import check_writable
-from jointwear.params import to_jsonable
-from jointwear.sim.validity import contact_validity
 from jointwear.sim.wear import _control as ctl
-from jointwear.sim.wear._checkpoint import read_checkpoint, write_checkpoint
-from jointwear.sim.wear._contact import CycleWear, describe_any
-from jointwear.sim.wear._output import build_dataset
+from jointwear.sim.wear._checkpoint import RunCheckpoints
+from jointwear.sim.wear._contact import CycleWear
+from jointwear.sim.wear._output import RunOutput
+from jointwear.sim.wear._overrides import apply_overrides, overrides_record
 from jointwear.sim.wear._settings import (
     DEFAULT_CYCLES,
     DEFAULT_KW,
@@ -88,21 +94,7 @@ __all__ = [
 _log = logging.getLogger("jointwear.sim.wear")
 
 
-#: Columns of the update history.
-HISTORY = ("start", "dn", "rate_change", "accepted", "cycles_averaged", "rate_change_noise")
-
-
-def _flatten(obj: Any, prefix: str = "") -> dict[str, Any]:
-    out: dict[str, Any] = {}
-    if isinstance(obj, Mapping):
-        for k, v in obj.items():
-            out.update(_flatten(v, f"{prefix}{k}."))
-        return out
-    out[prefix[:-1]] = obj
-    return out
-
-
-class WearRun:
+class WearRun(RunCheckpoints, RunOutput):
     """A wear computation that can be advanced, checkpointed, interrupted and resumed.
 
     Parameters
@@ -218,100 +210,6 @@ class WearRun:
         """Cycles actually simulated by the contact model so far (settling included)."""
         return float(self._s["cycles_simulated"])
 
-    def fingerprint(self) -> dict[str, Any]:
-        """Everything that determines the result (JSON-ready): model and wear settings."""
-        fp = {
-            "contact": to_jsonable(describe_any(self.contact)),
-            "wear": to_jsonable(self.settings),
-            "initial_wear_max": float(np.max(self._s["initial_wear"])),
-            "initial_wear_sum": float(np.sum(self._s["initial_wear"])),
-        }
-        return json.loads(json.dumps(fp))  # as a checkpoint stores it (tuples become lists)
-
-    # --- checkpoints ------------------------------------------------------------------------
-    def save_checkpoint(self, path: str | Path | None = None) -> Path:
-        """Write the complete state atomically to ``path`` or :attr:`checkpoint` (npz + JSON)."""
-        path = Path(path) if path is not None else self.checkpoint
-        if path is None:
-            raise BadInputError("no checkpoint path given")
-        return write_checkpoint(path, self.fingerprint(), self._s)
-
-    @classmethod
-    def start(
-        cls,
-        contact: Any,
-        settings: WearSettings | None = None,
-        *,
-        resume: bool = False,
-        **run: Any,
-    ) -> WearRun:
-        """A new run, ``WearRun(contact, settings, **run)``, or with ``resume`` the run of
-        ``run["checkpoint"]`` continued (:meth:`resume`; the initial wear is the checkpoint's)."""
-        if not resume:
-            return cls(contact, settings, **run)
-        checkpoint = run.pop("checkpoint", None)
-        if checkpoint is None:
-            raise BadInputError("resume=True needs the checkpoint path")
-        run.pop("initial_wear", None)
-        return cls.resume(checkpoint, contact, settings, **run)
-
-    @classmethod
-    def resume(
-        cls,
-        checkpoint: str | Path,
-        contact: Any,
-        settings: WearSettings | None = None,
-        *,
-        cycles: float,
-        snapshots: Sequence[float] | None = None,
-        on_update: Callable[[dict[str, Any]], None] | None = None,
-    ) -> WearRun:
-        """Continue a run from its checkpoint; refuse if the parameters differ.
-
-        Raises
-        ------
-        BadInputError
-            The checkpoint is missing, unreadable, of another format version, was written with
-            different parameters (the message names them), or the target is below the cycles
-            already done.
-        """
-        path = Path(checkpoint)
-        old_fp, state = read_checkpoint(path)
-        run = cls(
-            contact,
-            settings,
-            cycles=max(float(cycles), 1.0),
-            snapshots=None,
-            checkpoint=path,
-            on_update=on_update,
-        )
-        if isinstance(state, dict):  # checkpoints written before the noise probe existed
-            state.setdefault("probe_noise", math.nan)
-        if not isinstance(state, dict) or set(state) != set(run._s):
-            raise BadInputError(
-                f"checkpoint '{path}' does not hold a wear-run state this version understands; "
-                "start over without --resume (the old checkpoint is then replaced)"
-            )
-        if np.shape(state["initial_wear"]) == run.grid.shape:
-            run._s["initial_wear"] = state["initial_wear"]
-        old = _flatten(old_fp)
-        new = _flatten(run.fingerprint())
-        differing = sorted(k for k in set(old) | set(new) if old.get(k) != new.get(k))
-        if differing:
-            shown = "; ".join(
-                f"{k}: {old.get(k, '<absent>')!r} in the checkpoint, {new.get(k, '<absent>')!r} now"
-                for k in differing[:5]
-            )
-            more = f" (and {len(differing) - 5} more)" if len(differing) > 5 else ""
-            raise BadInputError(
-                f"checkpoint '{path}' was written with different parameters - {shown}{more}. "
-                "Resume with the original parameters, or start over without --resume (the old "
-                "checkpoint is then replaced)"
-            )
-        run._s = state
-        run._set_target(cycles, snapshots)
-        return run
-
     # --- the loop ---------------------------------------------------------------------------
     def _measure(
         self, h: np.ndarray, state: Any, settle: float, n: int
@@ -340,26 +238,6 @@ class WearRun:
             works.append(res.normal_work / res.cycles)
         return ctl.sample_rates(rates, works, self.grid.point_area), state, simulated, pen
 
-    def _propose(self, rate: np.ndarray, stop: int) -> tuple[int, int]:
-        """(dn to use now, dn proposed before clipping to the next stop)."""
-        st = self.settings
-        dn = int(self._s["dn_next"])
-        if st.scheme == "schedule":
-            k = sum(1 for item in self._s["history"] if item[3] == 1)
-            dn = st.schedule[min(k, len(st.schedule) - 1)]
-        if st.max_increment is not None:
-            rmax = float(np.max(rate))
-            if rmax > 0:  # cap the deepest increment (never below dn_min in the adaptive scheme)
-                floor = st.dn_min if st.scheme == "adaptive" else 1
-                dn = min(dn, max(floor, int(st.max_increment / rmax)))
-        dn = max(1, dn)
-        return min(dn, stop - self._s["done"]), dn
-
-    def _sigma(self, noise_hist: list[float]) -> float:
-        """Smoothed relative single-cycle variability (RMS of the last four estimates)."""
-        vals = [v for v in noise_hist[-4:] if np.isfinite(v)]
-        return math.sqrt(float(np.mean(np.square(vals)))) if vals else math.nan
-
     def step(self) -> bool:
         """Advance by one update (or one rejected attempt). Returns False at the target.
 
@@ -376,7 +254,7 @@ class WearRun:
             s["max_penetration"] = _max_known(s.get("max_penetration", -math.inf), pen)
             s["noise_hist"] = [s["sample"].rel_noise]
             if adaptive:
-                sigma = self._sigma(s["noise_hist"])
+                sigma = ctl.smoothed_noise(s["noise_hist"])
                 s["m_next"] = ctl.cycles_to_average(
                     sigma, st.tol, st.average_cycles, st.max_average_cycles
                 )
@@ -388,7 +266,10 @@ class WearRun:
             return False
         stop = next(c for c in self._stops if c > old["done"])
         before: ctl.RateSample = old["sample"]
-        dn, dn_wanted = self._propose(before.rate, stop)
+        accepted = sum(1 for item in old["history"] if item[3] == 1)
+        dn, dn_wanted = ctl.propose_interval(
+            st, old["dn_next"], accepted, before.rate, stop - old["done"]
+        )
         h_new = old["h"] + dn * before.rate
         new, state_new, n_sim, pen = self._measure(
             h_new, old["state"], st.settle_cycles, old["m_next"]
@@ -399,7 +280,7 @@ class WearRun:
         s["cycles_simulated"] = old["cycles_simulated"] + n_sim
         s["max_penetration"] = _max_known(old.get("max_penetration", -math.inf), pen)
         s["noise_hist"] = [*old["noise_hist"][-3:], new.rel_noise]
-        sigma = self._sigma(s["noise_hist"])
+        sigma = ctl.smoothed_noise(s["noise_hist"])
         sig_eta = ctl.change_noise(sigma, new.n, before.n) if adaptive else 0.0
         eta = ctl.systematic_change(eta_raw, sig_eta)
         tol_eff = ctl.effective_tolerance(st.tol, sig_eta)
@@ -463,13 +344,6 @@ class WearRun:
         )
         return pair.rel_noise, res.cycles, getattr(res, "max_penetration", math.nan)
 
-    def rate_noise(self) -> float:
-        """The run's relative single-cycle rate noise [1]: the adaptive scheme's last estimate,
-        or the fixed/schedule schemes' probe on the final profile (NaN: not measured yet)."""
-        if self.settings.scheme == "adaptive":
-            return self._sigma(self._s["noise_hist"])
-        return float(self._s.get("probe_noise", math.nan))
-
     def _save(self) -> None:
         if self.checkpoint is not None:
             self.save_checkpoint()
@@ -502,109 +376,6 @@ class WearRun:
             if key in ds.attrs:
                 _log.warning("%s", ds.attrs[key])
         return ds
-
-    # --- verdicts ---------------------------------------------------------------------------
-    def contact_validity(self) -> dict[str, Any]:
-        """The run's contact model against its validity limits (:mod:`jointwear.sim.validity`).
-
-        Only the dynamics know their parameters and penetration; other contact models give
-        an empty record.
-        """
-        params = getattr(self.contact, "params", None)
-        if params is None:
-            return {"status": "not assessed", "warning": None, "attrs": {}}
-        pen = float(self._s.get("max_penetration", math.nan))
-        return contact_validity(params, pen if pen > -math.inf else math.nan, kw=self.settings.kw)
-
-    def _convergence_notes(self) -> tuple[str | None, str | None]:
-        hist = self.history()
-        acc = hist[hist[:, 3] == 1]
-        adaptive = self.settings.scheme == "adaptive"
-        sigma = self.rate_noise()
-        # the adaptive scheme's noise per update; one cycle per measurement otherwise
-        noise = acc[:, 5] if adaptive else np.full(len(acc), ctl.change_noise(sigma, 1, 1))
-        return ctl.convergence_notes(acc, noise, sigma, measured=adaptive or np.isfinite(sigma))
-
-    def convergence_warning(self) -> str | None:
-        """A message if the update interval did not resolve the profile feedback, else None
-        (:func:`~jointwear.sim.wear._control.convergence_notes`)."""
-        return self._convergence_notes()[0]
-
-    def rate_outliers(self) -> str | None:
-        """A note on isolated updates whose rate change the noise does not explain, else None
-        (:func:`~jointwear.sim.wear._control.convergence_notes`)."""
-        return self._convergence_notes()[1]
-
-    def history(self) -> np.ndarray:
-        """The update history, one row per update, columns :data:`HISTORY`."""
-        return np.array(self._s["history"], dtype=float).reshape(-1, len(HISTORY))
-
-    def accuracy(self) -> tuple[str, str | None]:
-        """(``accuracy_status``, warning or None): whether ``tol`` could be held throughout."""
-        st = self.settings
-        if st.scheme != "adaptive" or not np.isfinite(self._sigma(self._s["noise_hist"])):
-            return "not assessed", None
-        n = int(self._s["noise_limited"])
-        if n == 0:
-            return "reached", None
-        sigma = self._sigma(self._s["noise_hist"])
-        n_acc = int(np.sum(self.history()[:, 3] == 1))
-        worst = float(self._s["worst_detection"])
-        # what would hold tol: a tol above the noise's detection limit, or averaging enough
-        # cycles to bring that limit under tol (it falls as 1/sqrt(cycles averaged))
-        tol_ok = math.ceil(worst * 20.0 - 1e-9) / 20.0
-        cycles_ok = math.ceil(st.max_average_cycles * (worst / st.tol) ** 2)
-        return "not reached", (
-            f"tol = {st.tol:g} not held in {n} of {n_acc} updates: the wear rate's "
-            f"cycle-to-cycle noise ({100 * sigma:.0f} % per cycle) hid changes below "
-            f"{100 * worst:.0f} %; the stated accuracy (the *_u, k = 2) includes it; to hold "
-            f"tol, set tol = {tol_ok:g} or wear.max_average_cycles = {cycles_ok}."
-        )
-
-    # --- output -----------------------------------------------------------------------------
-    def to_dataset(self, *, cylindricity: bool = True) -> xr.Dataset:
-        """The wear map so far: snapshots with their accuracy, the update history.
-
-        If the target has not been reached (interrupted run), the current profile is added as a
-        last snapshot and the attribute ``status`` says ``"partial"``.
-        """
-        s = self._s
-        snaps = list(s["snapshots"])
-        complete = s["done"] >= self.target
-        if not complete and (not snaps or snaps[-1][0] != s["done"]):
-            b: ctl.ErrorBudget = s["budget"]
-            snaps.append((s["done"], s["h"].copy(), s["normal_work"], b.depth_u(), b.volume_u()))
-        status, warning = self.accuracy()
-        st = self.settings
-        attrs = {
-            "kw_m2_per_N": st.kw,
-            "wear_scheme": st.scheme,
-            "wear_settings": json.dumps(to_jsonable(st), sort_keys=True),
-            "cycles_target": self.target,
-            "cycles_done": s["done"],
-            "cycles_simulated": s["cycles_simulated"],
-            "rate_noise": self.rate_noise(),
-            "status": "complete" if complete else "partial",
-            "accuracy_status": status,
-            "wear_note": "Archard dh = kw p ds per point; explicit cycle updates of dN cycles, "
-            f"each preceded by {st.settle_cycles:g} settling cycle(s) whose wear is discarded",
-            "contact_model": str(describe_any(self.contact).get("model", "?")),
-        }
-        if warning:
-            attrs["accuracy_warning"] = warning
-        params = getattr(self.contact, "params", None)
-        if params is not None:  # the dynamics: how a slice's force became wear work
-            attrs["wear_pressure"] = params.contact.wear_pressure
-        attrs.update(self.contact_validity()["attrs"])
-        conv = self.convergence_warning()
-        if conv:
-            attrs["convergence_warning"] = conv
-        outliers = self.rate_outliers()
-        if outliers:
-            attrs["rate_change_outliers"] = outliers
-        return build_dataset(
-            snaps, self.history(), self.grid, kw=st.kw, attrs=attrs, cylindricity=cylindricity
-        )
 
 
 def _max_known(a: float, b: float) -> float:
@@ -732,67 +503,5 @@ def simulate_wear(
     )
     ds = run.run()
     if overrides:
-        ds.attrs["parameter_overrides"] = json.dumps(
-            {k: _provenance_value(v) for k, v in overrides.items()}, sort_keys=True
-        )
+        ds.attrs["parameter_overrides"] = overrides_record(overrides)
     return ds
-
-
-def _provenance_value(value: Any) -> Any:
-    """An override's value as the provenance record keeps it: a number as float, a string
-    (``contact.formulation``) or a boolean as given."""
-    if isinstance(value, (str, bool, np.bool_)):
-        return value if isinstance(value, str) else bool(value)
-    return float(value)
-
-
-def apply_overrides(
-    params: Any, settings: WearSettings, overrides: Mapping[str, float | str] | None
-) -> tuple[Any, WearSettings]:
-    """Apply dotted overrides: ``"wear.<field>"`` to the settings, the rest to the parameters.
-
-    Parameters
-    ----------
-    params : SimParameters or None
-        Simulator parameters (None: only ``wear.*`` overrides are allowed, e.g. with a
-        prescribed contact model).
-    settings : WearSettings
-        Wear settings.
-    overrides : mapping
-        ``{"mechanism.joint_offset": 0.0, "joint.thrust_radius": 9.0e-3, "wear.kw": 1e-15}``;
-        SI values, as in the parameter file.
-
-    Raises
-    ------
-    ParameterError
-        An unknown name (the message lists the known ones) or an invalid value.
-    """
-    from jointwear.sim.mechanisms import replace_checked
-
-    if not overrides:
-        return params, settings
-    wear = {k[5:]: v for k, v in overrides.items() if k.startswith("wear.")}
-    sim = {k: v for k, v in overrides.items() if not k.startswith("wear.")}
-    if wear:
-        names = {f.name for f in dataclasses.fields(WearSettings)}
-        unknown = sorted(set(wear) - names)
-        if unknown:
-            raise ParameterError(
-                f"unknown wear setting(s) {', '.join('wear.' + u for u in unknown)}; known: "
-                f"{', '.join(sorted(names))}"
-            )
-        settings = dataclasses.replace(settings, **wear)
-    if sim:
-        if params is None:
-            raise ParameterError(
-                f"override(s) {', '.join(sorted(sim))} need the multibody dynamics; a prescribed "
-                "contact model takes only wear.* overrides"
-            )
-        if any("." not in k for k in sim):
-            bad = sorted(k for k in sim if "." not in k)
-            raise ParameterError(
-                f"override(s) {', '.join(bad)} must be dotted names such as "
-                "'mechanism.joint_offset' or 'wear.kw'"
-            )
-        params = replace_checked(params, sim, where="overrides")
-    return params, settings
