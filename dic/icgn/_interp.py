@@ -404,16 +404,29 @@ def _filter_columns(c, j0, j1, z1, z2, npoles):
                 c[k, j] = z * (c[k + 1, j] - c[k, j])
 
 
+#: rows filtered together by :func:`_prefilter_2d` (8 measured fastest of 4-32 on 512^2)
+_STRIP = 8
+
+
 @njit(cache=True, nogil=True)
 def _prefilter_2d(img, order, out):
     """B-spline coefficients of ``img`` written into ``out`` with a mirrored border of PAD."""
     h, w = img.shape
     z1, z2, npoles = _poles(order)
     tmp = np.empty((h, w))
-    for i in range(h):
-        line = img[i].copy()
-        _filter_line(line, z1, z2, npoles)
-        tmp[i] = line
+    # along rows: strips of _STRIP rows copied transposed into a small buffer and filtered as
+    # its columns (the strip's lines recurse side by side, vectorised, instead of one line's
+    # latency-bound recursion at a time; the same operations on each line, the same numbers)
+    buf = np.empty((w, _STRIP))
+    for i0 in range(0, h, _STRIP):
+        nr = min(_STRIP, h - i0)
+        for k in range(w):
+            for r in range(nr):
+                buf[k, r] = img[i0 + r, k]
+        _filter_columns(buf, 0, nr, z1, z2, npoles)
+        for r in range(nr):
+            for k in range(w):
+                tmp[i0 + r, k] = buf[k, r]
     nb = (w + 63) // 64
     for blk in range(nb):
         _filter_columns(tmp, blk * 64, min(w, blk * 64 + 64), z1, z2, npoles)

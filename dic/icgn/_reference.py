@@ -11,7 +11,6 @@ from numba import njit
 from jointwear.dic.icgn._flags import FLAG_INVALID_PIXELS, FLAG_NO_TEXTURE, FLAG_OK, FLAG_OUTSIDE
 from jointwear.dic.icgn._interp import (
     PAD,
-    _node_gradients,
     interp_value,
     node_filters,
     node_row_sums,
@@ -134,9 +133,7 @@ def subset_std(img, invalid, centres, half, border):
     size = 2 * half + 1
     # sums over each subset from summed-area tables: O(image + points), not O(points x subset)
     # (integer grey levels sum exactly in float64, as they did pixel by pixel)
-    finite = np.where(np.isfinite(img), img, 0.0)  # subsets with invalid pixels are skipped
-    S = _integral(finite)
-    S2 = _integral(finite * finite)
+    S, S2 = _integrals_finite(img)  # subsets with invalid pixels are skipped
     for i in range(n):
         xc = centres[i, 0]
         yc = centres[i, 1]
@@ -158,16 +155,100 @@ def subset_std(img, invalid, centres, half, border):
 
 
 @njit(cache=True)
-def _integral(a):
-    """Summed-area table ``T`` (h + 1, w + 1) of ``a``: ``T[y, x] = sum a[:y, :x]``."""
-    h, w = a.shape
-    T = np.zeros((h + 1, w + 1))
+def _integrals_finite(img):
+    """Summed-area tables ``T`` (h + 1, w + 1) of ``img`` and ``img^2``, ``T[y, x] = sum
+    a[:y, :x]`` (non-finite pixels as 0), in one pass without temporary arrays."""
+    h, w = img.shape
+    T = np.empty((h + 1, w + 1))
+    T2 = np.empty((h + 1, w + 1))
+    for x in range(w + 1):
+        T[0, x] = 0.0
+        T2[0, x] = 0.0
     for y in range(h):
+        T[y + 1, 0] = 0.0
+        T2[y + 1, 0] = 0.0
         row = 0.0
+        row2 = 0.0
         for x in range(w):
-            row += a[y, x]
+            v = img[y, x]
+            if not math.isfinite(v):
+                v = 0.0
+            row += v
+            row2 += v * v
             T[y + 1, x + 1] = T[y, x + 1] + row
-    return T
+            T2[y + 1, x + 1] = T2[y, x + 1] + row2
+    return T, T2
+
+
+@njit(cache=True)
+def _kappa_tables(coef, order, gx, gy, x0, y0, x1, y1):
+    """Summed-area tables over the box ``[x0, x1) x [y0, y1)`` of ``|g_c|^2``, ``g_c . g_s``
+    (0 where either is not finite) and of the count of such nodes, ``g_s`` the interpolant's
+    exact node derivative (:func:`~jointwear.dic.icgn._interp._node_gradients`' sums, the
+    same numbers) computed on the fly: one pass, no box-sized temporaries but the x-filtered
+    rows."""
+    val, der = node_filters(order)
+    r = val.shape[0] // 2
+    bh = y1 - y0
+    bw = x1 - x0
+    # along x first (value and derivative filters) on the box's rows -r..bh+r; every loop
+    # runs over a row's nodes (vectorised), each sum in the order of node_row_sums
+    tv = np.zeros((bh + 2 * r, bw))
+    td = np.zeros((bh + 2 * r, bw))
+    for i in range(bh + 2 * r):
+        row = coef[y0 + i + PAD - r]
+        tvi = tv[i]
+        tdi = td[i]
+        for b in range(2 * r + 1):
+            vb = val[b]
+            db = der[b]
+            j0 = x0 + PAD - r + b
+            for j in range(bw):
+                cv = row[j0 + j]
+                tvi[j] += vb * cv
+                tdi[j] += db * cv
+    A = np.empty((bh + 1, bw + 1))
+    B = np.empty((bh + 1, bw + 1))
+    N = np.empty((bh + 1, bw + 1))
+    for x in range(bw + 1):
+        A[0, x] = 0.0
+        B[0, x] = 0.0
+        N[0, x] = 0.0
+    sx = np.empty(bw)
+    sy = np.empty(bw)
+    for i in range(bh):
+        sx[:] = 0.0
+        sy[:] = 0.0
+        for a in range(2 * r + 1):
+            va = val[a]
+            da = der[a]
+            tda = td[i + a]
+            tva = tv[i + a]
+            for j in range(bw):
+                sx[j] += va * tda[j]
+                sy[j] += da * tva[j]
+        A[i + 1, 0] = 0.0
+        B[i + 1, 0] = 0.0
+        N[i + 1, 0] = 0.0
+        ra = 0.0
+        rb = 0.0
+        rn = 0.0
+        gxi = gx[y0 + i]
+        gyi = gy[y0 + i]
+        for j in range(bw):
+            cx = gxi[x0 + j]
+            cy = gyi[x0 + j]
+            pa = cx * cx + cy * cy
+            pb = cx * sx[j] + cy * sy[j]
+            if math.isfinite(pa) and math.isfinite(pb):
+                ra += pa
+                rb += pb
+            else:
+                rn += 1.0
+            A[i + 1, j + 1] = A[i, j + 1] + ra
+            B[i + 1, j + 1] = B[i, j + 1] + rb
+            N[i + 1, j + 1] = N[i, j + 1] + rn
+    return A, B, N
 
 
 @njit(cache=True, inline="always")
@@ -225,19 +306,10 @@ def subset_kappa(coef, order, gx, gy, centres, half, out):
             x0, x1, y0, y1 = min(x0, xa), max(x1, xb), min(y0, ya), max(y1, yb)
     box = max(x1 - x0, 0) * max(y1 - y0, 0)
     dense = box > 0 and centres.shape[0] * (2 * half + 1) ** 2 > box
-    exact_x = np.empty((y1 - y0, x1 - x0) if dense else (1, 1))
-    exact_y = np.empty_like(exact_x)
-    if dense:  # the box's nodes, from its rows and columns of the padded coefficients
-        _node_gradients(coef[y0 : y1 + 2 * PAD, x0 : x1 + 2 * PAD], order, exact_x, exact_y)
-        bx = gx[y0:y1, x0:x1]
-        by = gy[y0:y1, x0:x1]
-        # per-subset sums from summed-area tables of the two products (O(box + points))
-        pa = bx * bx + by * by
-        pb = bx * exact_x + by * exact_y
-        bad = ~(np.isfinite(pa) & np.isfinite(pb))  # a subset holding one keeps kappa 1
-        A = _integral(np.where(bad, 0.0, pa))
-        B = _integral(np.where(bad, 0.0, pb))
-        N = _integral(bad.astype(np.float64))
+    if dense:
+        # per-subset sums from summed-area tables of the two products (O(box + points)); a
+        # subset holding a non-finite product keeps kappa 1
+        A, B, N = _kappa_tables(coef, order, gx, gy, x0, y0, x1, y1)
         for i in range(centres.shape[0]):
             out[i] = 1.0
             xa, xb, ya, yb = _square(centres, i, half, w, h)
