@@ -39,6 +39,10 @@ _HOPELESS_ZNCC = 0.5
 _FM = {"nsz", "arcp", "contract", "reassoc"}  # fastmath without no-NaN/no-inf assumptions
 
 
+#: position in a block's six moments (1, c, r, cc, cr, rr) of the products of (1, c, r)
+_MOMENT = (0, 1, 2, 1, 3, 4, 2, 4, 5)
+
+
 @njit(cache=True, fastmath=_FM)
 def _hessian_affine(f, gx, gy, half, Hm, jf, js):
     """Affine Gauss-Newton Hessian ``sum J J^T``, ``sum J f`` and ``sum J`` (row-wise sums)."""
@@ -92,20 +96,12 @@ def _hessian_affine(f, gx, gy, half, Hm, jf, js):
     for blk_i in range(2):
         for blk_j in range(blk_i, 2):
             o = 0 if (blk_i == 0 and blk_j == 0) else (6 if blk_i != blk_j else 12)
-            M3 = np.empty((3, 3))
-            M3[0, 0] = m[o]
-            M3[0, 1] = m[o + 1]
-            M3[0, 2] = m[o + 2]
-            M3[1, 0] = m[o + 1]
-            M3[1, 1] = m[o + 3]
-            M3[1, 2] = m[o + 4]
-            M3[2, 0] = m[o + 2]
-            M3[2, 1] = m[o + 4]
-            M3[2, 2] = m[o + 5]
             for i in range(3):
                 for j in range(3):
-                    Hm[3 * blk_i + i, 3 * blk_j + j] = M3[i, j]
-                    Hm[3 * blk_j + j, 3 * blk_i + i] = M3[i, j]
+                    # the symmetric 3x3 moment block: (1, c, r) x (1, c, r) -> m[o + _MOMENT]
+                    v = m[o + _MOMENT[i * 3 + j]]
+                    Hm[3 * blk_i + i, 3 * blk_j + j] = v
+                    Hm[3 * blk_j + j, 3 * blk_i + i] = v
 
 
 @njit(cache=True, nogil=True)

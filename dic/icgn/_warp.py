@@ -30,8 +30,8 @@ def _solve_spd(A, b, n):
                 L[i, j] = s / L[j, j]
     # forward / backward substitution for each column of b
     m = b.shape[1]
+    y = np.empty(n)
     for c in range(m):
-        y = np.zeros(n)
         for i in range(n):
             s = b[i, c]
             for k in range(i):
