@@ -76,6 +76,7 @@ def correlate(
     border: int = 4,
     threads: int = 0,
     u_outlier_factor: float = CorrelationParams.u_outlier_factor,
+    neighbour_outlier_factor: float = CorrelationParams.neighbour_outlier_factor,
 ) -> xr.Dataset:
     """Subset DIC between two images (ZNSSD criterion, IC-GN on B-spline interpolation).
 
@@ -116,9 +117,12 @@ def correlate(
         less exact.
     threads : int
         numba threads (0: min(2, available)).
-    u_outlier_factor : float
-        Matches whose uncertainty exceeds this multiple of the median are flagged
-        ``uncertainty_outlier`` (0: no test; see :class:`CorrelationParams`).
+    u_outlier_factor, neighbour_outlier_factor : float
+        The outlier tests: matches that disagree with their grid neighbours by
+        ``neighbour_outlier_factor`` times the image's median uncertainty are flagged
+        ``neighbour_outlier``, matches without neighbours whose uncertainty exceeds
+        ``u_outlier_factor`` times it ``uncertainty_outlier`` (0: no test; see
+        :class:`CorrelationParams`).
 
     Returns
     -------
@@ -158,6 +162,7 @@ def correlate(
         border=border,
         threads=threads,
         u_outlier_factor=u_outlier_factor,
+        neighbour_outlier_factor=neighbour_outlier_factor,
     )
     corr = SubsetCorrelator(reference, points=points, roi=roi, params=params)
     return corr.correlate(deformed, initial_guess=initial_guess, seed_points=seed_points)

@@ -41,6 +41,12 @@ CORRELATION = (
         help="Flag matches whose uncertainty exceeds this multiple of the image's median (0: off).",
         min=0,
     ),
+    Opt(
+        "neighbour_outlier_factor",
+        help="Flag matches further from their grid neighbours than this multiple of the "
+        "image's median uncertainty (0: off).",
+        min=0,
+    ),
 )
 OutOpt = NetcdfOut
 CalibrationOpt = Annotated[

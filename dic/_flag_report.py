@@ -133,6 +133,19 @@ def _hint(meaning: str, ds: xr.Dataset | Record, k: int | None, where: np.ndarra
         return "the subsets hold invalid (NaN) pixels: restrict the ROI to valid pixels"
     if meaning == "subset_crosses_roi_edge":
         return "the ROI's edge cuts the subsets: use a smaller --subset or a larger ROI"
+    if meaning in ("neighbour_outlier", "uncertainty_outlier"):
+        factors = (
+            f"--neighbour-outlier-factor {ds.attrs.get('dic_neighbour_outlier_factor')}, "
+            f"--u-outlier-factor {ds.attrs.get('dic_u_outlier_factor')}"
+        )
+        return (
+            "the matches disagree with their neighbours (or, without neighbours, their own "
+            "uncertainty is high) by more than the tests allow in units of the image's median "
+            f"uncertainty ({factors}): on most of an image that is not a few outliers but "
+            "a field the grid does not resolve (a discontinuity, a crack, a strain "
+            "concentration finer than --step) or a texture too faint for the --subset; use "
+            "a smaller --step or a larger --subset, or raise the factors (0 turns a test off)"
+        )
     if meaning == "left_right_inconsistent":
         return (
             "the subsets straddle a depth step or a second surface (forward and backward "

@@ -51,10 +51,10 @@ __all__ = ["read_field", "FIELD_FORMATS", "import_summary"]
 FIELD_FORMATS = ("vic3d-csv", "dice")
 _UNITS = {"m": 1.0, "mm": 1e-3, "um": 1e-6, "µm": 1e-6, "cm": 1e-2, "in": 0.0254}
 
-#: flags of an imported field: the field's own (a jointwear CSV's names map back to them) and
-#: ``failed_in_source`` (the source's own failure marker)
-IMPORT_FLAG_MEANINGS = (*FIELD_FLAG_MEANINGS.split(), "failed_in_source")
-FLAG_FAILED_IN_SOURCE = len(IMPORT_FLAG_MEANINGS) - 1
+#: flags of an imported field: the field's own (a jointwear CSV's names map back to them),
+#: among them ``failed_in_source`` (the source's own failure marker, value 12)
+IMPORT_FLAG_MEANINGS = tuple(FIELD_FLAG_MEANINGS.split())
+FLAG_FAILED_IN_SOURCE = IMPORT_FLAG_MEANINGS.index("failed_in_source")
 #: format -> columns whose negative value marks a row the source did not solve
 _FAILURE_COLUMNS = {"vic3d-csv": ("sigma",), "dice": ("MATCH", "SIGMA", "GAMMA")}
 #: format -> the source's status column kept as ``foreign_status`` (not a failure test)

@@ -60,9 +60,10 @@ FLAG_ROI_EDGE = 9
 FLAG_LEFT_RIGHT = 10
 FIELD_FLAG_MEANINGS = (
     _flags.FLAG_MEANINGS + " epipolar_mismatch subset_crosses_roi_edge left_right_inconsistent"
-    " uncertainty_outlier"
-)
+    " uncertainty_outlier failed_in_source neighbour_outlier"
+)  # failed_in_source (12): imported fields only (dic.field._import), the value kept for them
 assert FIELD_FLAG_MEANINGS.split().index("uncertainty_outlier") == _flags.FLAG_U_OUTLIER
+assert FIELD_FLAG_MEANINGS.split().index("neighbour_outlier") == _flags.FLAG_NEIGHBOUR_OUTLIER
 
 
 def _frames(source, what: str) -> tuple[list[np.ndarray], list[str]]:
@@ -155,14 +156,15 @@ def left_right_deviation(corr_params, right_img, left_img, centres, rx, ry, subs
     return dev, sig
 
 
-def _match_images(corr, L, Rr, calibration, centres, epipolar_max_px=1.0):
+def _match_images(corr, L, Rr, calibration, centres, epipolar_max_px=1.0, index=None):
     """Match the left reference subsets in every left image and (stereo) every right image.
 
     Returns shape parameters ``PL``, ``PR`` (T, N, 12), their (u, v) uncertainties ``SL``,
     ``SR`` (T, N, 2) [pixel] (NaN where the match failed), ZNCC ``Z``, flags ``F``
     (T, cameras, N) and (stereo) the reference pair's fit to the calibration
     (:func:`~jointwear.dic.field._stereo.check_calibration_fits`: refused before the later
-    images are matched when it does not fit).
+    images are matched when it does not fit). ``index`` (N, 2): the points' grid (row, column)
+    for the neighbour outlier test (-1 or None: points off a grid, tested on their u only).
     """
     from jointwear.dic.field._stereo import check_calibration_fits, plane_guess
 
@@ -199,10 +201,16 @@ def _match_images(corr, L, Rr, calibration, centres, epipolar_max_px=1.0):
                 centre = (_median_or(PR[:k, :, 0], 0.0), _median_or(PR[:k, :, 6], 0.0))
                 res = _track(corr, Rr[k], g, centre)
             PR[k], SR[k], Z[k, 1], F[k, 1] = res.params, res.sigma, res.zncc, res.flag
-    factor = corr.params.u_outlier_factor
-    F[1:, 0] = _flags.flag_uncertainty_outliers(F[1:, 0], SL[1:], factor)
+    cp = corr.params
+    test = dict(
+        centres=centres, index=index, neighbour_factor=cp.neighbour_outlier_factor,
+        reach=_flags.neighbour_reach(cp.subset_size, cp.step),
+    )  # fmt: skip
+    F[1:, 0] = _flags.flag_uncertainty_outliers(
+        F[1:, 0], SL[1:], cp.u_outlier_factor, P=PL[1:], **test
+    )
     if stereo:
-        F[:, 1] = _flags.flag_uncertainty_outliers(F[:, 1], SR, factor)
+        F[:, 1] = _flags.flag_uncertainty_outliers(F[:, 1], SR, cp.u_outlier_factor, P=PR, **test)
     ok_img = F == _flags.FLAG_OK
     PL[~ok_img[:, 0]] = np.nan
     SL[~ok_img[:, 0]] = np.nan
@@ -339,7 +347,7 @@ def measure_field(
         grid = grid_points(mask, cp.subset_size, cp.step, cp.border)
     corr = SubsetCorrelator(L[0], points=grid.centres, params=cp)
     PL, PR, SL, SR, Z, F, fit = _match_images(
-        corr, L, Rr, calibration, grid.centres, prm.epipolar_max_px
+        corr, L, Rr, calibration, grid.centres, prm.epipolar_max_px, grid.index
     )
     DL, DR = _relative_sigma(L, Rr, PL, PR, grid.centres, cp, corr._sigma_scale())
     m = _Matches(L, Rr, lnames, rnames, t, grid, PL, PR, SR, DL, DR, Z, F)
@@ -355,6 +363,8 @@ def measure_field(
             "dic_zncc_min": float(cp.zncc_min),
             "dic_max_iterations": int(cp.max_iterations),
             "dic_u_outlier_factor": float(cp.u_outlier_factor),
+            "dic_neighbour_outlier_factor": float(cp.neighbour_outlier_factor),
+            "dic_outlier_floor_pixel": float(_flags.U_OUTLIER_FLOOR_PX),
             "dic_shape_function": "affine",
             "dic_interpolation": f"{cp.interpolation} B-spline (prefiltered)",
             "dic_criterion": "ZNSSD (IC-GN), image gradients by central differences",

@@ -41,7 +41,8 @@ class FieldParams:
         ``left_right_inconsistent`` (or 5 times the two matches' median combined noise if larger; on
         the virtual rig's static scenes the two agree within 0.002 pixel, subsets straddling a
         20 mm depth step miss by 0.05-0.36 pixel).
-    interpolation, tolerance, max_iterations, search_radius, threads, u_outlier_factor
+    interpolation, tolerance, max_iterations, search_radius, threads, u_outlier_factor,
+    neighbour_outlier_factor
         As :class:`jointwear.dic.CorrelationParams`.
     """
 
@@ -58,6 +59,7 @@ class FieldParams:
     search_radius: int = CorrelationParams.search_radius
     threads: int = CorrelationParams.threads
     u_outlier_factor: float = CorrelationParams.u_outlier_factor
+    neighbour_outlier_factor: float = CorrelationParams.neighbour_outlier_factor
 
     def __post_init__(self) -> None:
         w = self.strain_window
@@ -87,4 +89,5 @@ class FieldParams:
             search_radius=self.search_radius,
             threads=self.threads,
             u_outlier_factor=self.u_outlier_factor,
+            neighbour_outlier_factor=self.neighbour_outlier_factor,
         )

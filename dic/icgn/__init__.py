@@ -17,6 +17,7 @@ _EXPORTS = {
         "FLAG_INVALID_PIXELS",
         "FLAG_LOW_CORRELATION",
         "FLAG_MEANINGS",
+        "FLAG_NEIGHBOUR_OUTLIER",
         "FLAG_NOT_CONVERGED",
         "FLAG_NOT_REACHED",
         "FLAG_NO_TEXTURE",
@@ -25,7 +26,9 @@ _EXPORTS = {
         "FLAG_U_OUTLIER",
         "OUTPUT_FLAG_MEANINGS",
         "OUTPUT_FLAG_VALUES",
+        "U_OUTLIER_FLOOR_PX",
         "flag_uncertainty_outliers",
+        "neighbour_reach",
     ),
     # the matching kernels the subset correlator drives, in its order: texture, reference
     # subsets, the solve (preloaded affine, many points, one by one), propagation over the grid

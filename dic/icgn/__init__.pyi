@@ -10,6 +10,7 @@ from ._flags import (
     FLAG_INVALID_PIXELS as FLAG_INVALID_PIXELS,
     FLAG_LOW_CORRELATION as FLAG_LOW_CORRELATION,
     FLAG_MEANINGS as FLAG_MEANINGS,
+    FLAG_NEIGHBOUR_OUTLIER as FLAG_NEIGHBOUR_OUTLIER,
     FLAG_NO_TEXTURE as FLAG_NO_TEXTURE,
     FLAG_NOT_CONVERGED as FLAG_NOT_CONVERGED,
     FLAG_NOT_REACHED as FLAG_NOT_REACHED,
@@ -17,8 +18,10 @@ from ._flags import (
     FLAG_OUTSIDE as FLAG_OUTSIDE,
     FLAG_U_OUTLIER as FLAG_U_OUTLIER,
     flag_uncertainty_outliers as flag_uncertainty_outliers,
+    neighbour_reach as neighbour_reach,
     OUTPUT_FLAG_MEANINGS as OUTPUT_FLAG_MEANINGS,
     OUTPUT_FLAG_VALUES as OUTPUT_FLAG_VALUES,
+    U_OUTLIER_FLOOR_PX as U_OUTLIER_FLOOR_PX,
 )
 from ._interp import (
     prefilter as prefilter,

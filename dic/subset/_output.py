@@ -20,27 +20,43 @@ if TYPE_CHECKING:
 __all__ = ["result_dataset", "result_record"]
 
 
-def result_dataset(
-    centres, P, zncc, iterations, flag, params: CorrelationParams, grid=None, sigma=None
-) -> xr.Dataset:
-    """Per-point arrays -> Dataset following the data contract (leading dims allowed).
+def result_dataset(*args, **kwargs) -> xr.Dataset:
+    """Per-point arrays -> Dataset following the data contract (leading dims allowed): the
+    :func:`result_record` of the same arguments, as a Dataset.
 
-    ``sigma`` (..., N, 2): standard uncertainty of (u, v) [pixel] -> ``u_u``, ``v_u``.
+    ``sigma`` (..., N, 2): standard uncertainty of (u, v) [pixel] -> ``u_u``, ``v_u``;
+    ``neighbour_images``: the images the neighbour outlier test applies to (default: all).
     """
-    return result_record(
-        centres, P, zncc, iterations, flag, params, grid=grid, sigma=sigma
-    ).to_dataset()
+    return result_record(*args, **kwargs).to_dataset()
 
 
 def result_record(
-    centres, P, zncc, iterations, flag, params: CorrelationParams, grid=None, sigma=None
+    centres,
+    P,
+    zncc,
+    iterations,
+    flag,
+    params: CorrelationParams,
+    grid=None,
+    sigma=None,
+    neighbour_images=None,
 ) -> Record:
     """Per-point arrays -> :class:`~jointwear._netcdf.Record` of :func:`result_dataset`;
-    matches whose uncertainty is ``params.u_outlier_factor`` times their image's median are
-    flagged ``uncertainty_outlier`` (:func:`~jointwear.dic.icgn._flags.flag_uncertainty_outliers`)."""
+    matches that disagree with their grid neighbours by ``params.neighbour_outlier_factor`` times
+    their image's median u are flagged ``neighbour_outlier``, matches off a grid whose u is
+    ``params.u_outlier_factor`` times it ``uncertainty_outlier``
+    (:func:`~jointwear.dic.icgn._flags.flag_uncertainty_outliers`)."""
     P = np.asarray(P, float)
     if sigma is not None:
-        flag = _flags.flag_uncertainty_outliers(flag, sigma, params.u_outlier_factor)
+        index = None
+        if grid is not None:  # the points in row-major order over (y, x)
+            index = np.indices((grid[1].size, grid[0].size)).reshape(2, -1).T
+        flag = _flags.flag_uncertainty_outliers(
+            flag, sigma, params.u_outlier_factor, P=P, centres=np.asarray(centres, float),
+            index=index, neighbour_factor=params.neighbour_outlier_factor,
+            reach=_flags.neighbour_reach(params.subset_size, params.step),
+            neighbour_images=neighbour_images,
+        )  # fmt: skip
     ok = np.asarray(flag) == _flags.FLAG_OK
     lead = P.shape[:-2]
     lead_dims = ("time",) if len(lead) == 1 else ()
@@ -130,6 +146,8 @@ def result_record(
         "dic_tolerance_pixel": float(params.tolerance),
         "dic_max_iterations": int(params.max_iterations),
         "dic_u_outlier_factor": float(params.u_outlier_factor),
+        "dic_neighbour_outlier_factor": float(params.neighbour_outlier_factor),
+        "dic_outlier_floor_pixel": float(_flags.U_OUTLIER_FLOOR_PX),
         "dic_zncc_min": float(params.zncc_min),
         "displacement_convention": (
             "Lagrangian: the subset centred at (x, y) of the reference moved by (u, v); x to "

@@ -73,11 +73,21 @@ class CorrelationParams:
     threads : int
         numba threads (at most 2 on the shared machine; 0 = min(2, available)).
     u_outlier_factor : float
-        Matches whose standard uncertainty (the larger of u's and v's) exceeds this multiple of
-        the image's median over its ok points (and 0.01 pixel: on noise-free images all are
-        tiny) are flagged ``uncertainty_outlier`` (0: no test).
-        On the GT4 texture moved by a known shift with 1-2 grey levels of noise, 3 leaves at
-        most 0.11 % of the ok points off by more than 0.05 pixel (3.5-4 % without it).
+        A match whose standard uncertainty (the larger of u's and v's) exceeds this multiple of
+        the image's median over its ok points is on faint texture: it is no reference for its
+        neighbours' test, its own gradients do not excuse a disagreement with them, and
+        without 3 other usable grid neighbours (or off a grid) it is flagged
+        ``uncertainty_outlier`` when its u also exceeds 0.02 pixel (on noise-free images all
+        u are tiny). 0: no such test.
+    neighbour_outlier_factor : float
+        A match on a grid whose displacement lies further from its usable neighbours' median
+        than this multiple of the image's median u (and 0.02 pixel), also after carrying the
+        neighbours' values to it along the image's median gradient and along the measured
+        gradients, is flagged ``neighbour_outlier`` (0: no test; see
+        :func:`jointwear.dic.icgn._flags.flag_uncertainty_outliers`). On the GT4 texture moved by
+        a known shift with 1-2 grey levels of noise (benchmarks/bench_dic_outliers.py), 4 (with
+        ``u_outlier_factor`` 2) leaves at most 0.2 % of the ok points off by more than 0.05
+        pixel and flags at most 2 % of the points within 0.05 pixel.
     """
 
     subset_size: int = 31
@@ -91,7 +101,8 @@ class CorrelationParams:
     min_texture: float = 0.05
     border: int = 4
     threads: int = 0
-    u_outlier_factor: float = 3.0
+    u_outlier_factor: float = 2.0
+    neighbour_outlier_factor: float = 4.0
 
     def __post_init__(self) -> None:
         s = self.subset_size
@@ -119,7 +130,13 @@ class CorrelationParams:
         if not (self.u_outlier_factor == 0 or self.u_outlier_factor > 1):
             raise ParameterError(
                 f"u_outlier_factor={self.u_outlier_factor!r}: expected a multiple of the median "
-                "uncertainty > 1 (3 flags the far tail), or 0 for no test"
+                "uncertainty > 1 (2 marks the far tail), or 0 for no test"
+            )
+        if not (self.neighbour_outlier_factor == 0 or self.neighbour_outlier_factor >= 1):
+            raise ParameterError(
+                f"neighbour_outlier_factor={self.neighbour_outlier_factor!r}: expected a "
+                "multiple of the median uncertainty >= 1 (4 flags points far from their "
+                "neighbours), or 0 for no test"
             )
         if self.search_radius < 0:
             raise ParameterError(f"search_radius={self.search_radius!r}: expected >= 0 pixel")

@@ -381,8 +381,9 @@ class _SequenceTracker:
 
         base, prm, ref_frame = self.base, self.base.params, self.ref_frame
         ds = result_dataset(
-            base.centres, self.P, self.Z, self.It, self.Fl, prm, base.grid, sigma=self.S
-        )
+            base.centres, self.P, self.Z, self.It, self.Fl, prm, base.grid, sigma=self.S,
+            neighbour_images=ref_frame == 0,  # composed displacements: see _flags
+        )  # fmt: skip
         if reference == "incremental":
             for name in prm.shape_function.not_incremental:
                 ds[name].values[ref_frame > 0] = np.nan

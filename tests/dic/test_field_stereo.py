@@ -204,10 +204,12 @@ def test_subsets_straddling_a_depth_step_are_flagged_left_right_inconsistent():
     ds = sc.measure(pairs, subset_size=25, step=12, strain_window=0)
     flag = ds.flag.values[0]
     assert (flag == 0).mean() > 0.9
-    flagged = np.isin(flag, (10, 11))  # uncertainty_outlier (11) flags them first
+    # the outlier tests (uncertainty_outlier 11, neighbour_outlier 13) flag them first
+    flagged = np.isin(flag, (10, 11, 13))
     assert flagged.sum() >= 5
     # the left-right test alone finds them as well
-    no_u = sc.measure(pairs, subset_size=25, step=12, strain_window=0, u_outlier_factor=0)
+    off = dict(u_outlier_factor=0, neighbour_outlier_factor=0)
+    no_u = sc.measure(pairs, subset_size=25, step=12, strain_window=0, **off)
     np.testing.assert_array_equal(no_u.flag.values[0] == 10, flagged)
     # where the flagged subsets are: across the step (left image, the step's column)
     col = sc.calibration.left.project(np.array([[0.29, 0.16, 0.0]]))[0, 0]
@@ -215,7 +217,7 @@ def test_subsets_straddling_a_depth_step_are_flagged_left_right_inconsistent():
     P = ds.position.values[flag == 0]
     assert np.abs(P[:, 2] - step(P[:, 0], P[:, 1])).max() < 25e-6
     loose = sc.measure(
-        pairs, subset_size=25, step=12, strain_window=0, consistency_max_px=1e9, u_outlier_factor=0
+        pairs, subset_size=25, step=12, strain_window=0, consistency_max_px=1e9, **off
     )
     Q = loose.position.values[loose.flag.values[0] == 0]
     assert np.abs(Q[:, 2] - step(Q[:, 0], Q[:, 1])).max() > 100e-6  # what the flag prevents
