@@ -74,7 +74,19 @@ def grid_neighbours(index: np.ndarray, reach: int = 1) -> np.ndarray:
     return nb
 
 
-def neighbour_residuals(ok, P, centres, nb, usable=None) -> tuple[np.ndarray, np.ndarray]:
+def _median_of_neighbours(A: np.ndarray) -> np.ndarray:
+    """Median over axis 1 ignoring NaN, every row holding at least one finite value: what
+    ``np.nanmedian(A, axis=1)`` gives, by one sort (NaN sorts last), several times faster."""
+    B = np.sort(np.moveaxis(A, 1, -1), axis=-1)
+    c = np.count_nonzero(~np.isnan(B), axis=-1)[..., None]
+    lo = np.take_along_axis(B, (c - 1) // 2, axis=-1)
+    hi = np.take_along_axis(B, c // 2, axis=-1)
+    return ((lo + hi) / 2)[..., 0]
+
+
+def neighbour_residuals(
+    ok, P, centres, nb, usable=None, threshold=0.0
+) -> tuple[np.ndarray, np.ndarray]:
     """How far each ok point's displacement lies from what its usable grid neighbours
     (``usable``, default ``ok``; ``nb`` from :func:`grid_neighbours`) say [pixel].
 
@@ -94,7 +106,8 @@ def neighbour_residuals(ok, P, centres, nb, usable=None) -> tuple[np.ndarray, np
     -------
     res : ndarray (N, 4)
         The four distances; NaN where a point has fewer than :data:`MIN_NEIGHBOURS` usable
-        neighbours.
+        neighbours, and 1-3 NaN where the first is ``threshold`` [pixel] or less (they are
+        allowances: they only matter where the plain median test fails).
     count : ndarray (N,) int
         How many usable neighbours each ok point has.
     """
@@ -102,28 +115,33 @@ def neighbour_residuals(ok, P, centres, nb, usable=None) -> tuple[np.ndarray, np
     res = np.full((n, 4), np.nan)
     usable = ok if usable is None else usable
     has = (nb >= 0) & usable[np.where(nb >= 0, nb, 0)] & ok[:, None]
-    count = has.sum(axis=1)
+    count = np.count_nonzero(has, axis=1)
     test = count >= MIN_NEIGHBOURS
     if not test.any():
         return res, count
     A = np.asarray(P, float)[:, AFFINE_INDEX]
     d = A[:, [0, 3]]  # (u, v)
     g = A[:, [1, 2, 4, 5]].reshape(-1, 2, 2)  # [[du/dx, du/dy], [dv/dx, dv/dy]]
-    j = np.where(has[test], nb[test], 0)
-    m = ~has[test]
-    D = np.where(m[..., None], np.nan, d[j])  # (M, 8, 2)
-    G = np.where(m[..., None, None], np.nan, g[j])  # (M, 8, 2, 2)
-    delta = centres[j] - centres[test][:, None, :]  # (M, 8, 2) [pixel]
+    idx = np.flatnonzero(test)
+    # the median test first; the allowances only where it fails (they can only excuse)
+    j = np.where(has[idx], nb[idx], 0)
+    D = np.where(has[idx][..., None], d[j], np.nan)  # (M, 8, 2)
+    res[idx, 0] = np.hypot(*(d[idx] - _median_of_neighbours(D)).T)
+    keep = res[idx, 0] > threshold
+    idx, j, D = idx[keep], j[keep], D[keep]
+    if not idx.size:
+        return res, count
+    G = np.where(has[idx][..., None, None], g[j], np.nan)  # (M, 8, 2, 2)
+    delta = centres[j] - centres[idx][:, None, :]  # (M, 8, 2) [pixel]
     uniform = np.median(g[ok], axis=0)
-    gm = np.nanmedian(G, axis=1)
+    gm = _median_of_neighbours(G)
     preds = (
-        D,
         D - np.einsum("ab,mjb->mja", uniform, delta),
-        D - np.einsum("mjab,mjb->mja", G + g[test][:, None], delta) / 2,
+        D - np.einsum("mjab,mjb->mja", G + g[idx][:, None], delta) / 2,
         D - np.einsum("mjab,mjb->mja", G + gm[:, None], delta) / 2,
     )
-    for k, pred in enumerate(preds):
-        res[test, k] = np.hypot(*(d[test] - np.nanmedian(pred, axis=1)).T)
+    for k, pred in enumerate(preds, start=1):
+        res[idx, k] = np.hypot(*(d[idx] - _median_of_neighbours(pred)).T)
     return res, count
 
 
@@ -218,11 +236,11 @@ def flag_uncertainty_outliers(
         tested = np.zeros(n, bool)
         if use_nb and (neighbour_images is None or np.ravel(neighbour_images)[k]):
             # neighbours on faint texture (high u) are not a reference for others
-            res, count = neighbour_residuals(ok, Ps[k], centres, nb, ok & ~high_u)
+            T = max(neighbour_factor * med, U_OUTLIER_FLOOR_PX)
+            res, count = neighbour_residuals(ok, Ps[k], centres, nb, ok & ~high_u, T)
             tested = ok & (count >= MIN_NEIGHBOURS)
             # a point on faint texture (high u) is not excused by its own noisy gradients
             res[high_u, 2] = np.inf
-            T = max(neighbour_factor * med, U_OUTLIER_FLOOR_PX)
             off = tested & (np.nanmin(res, axis=1, initial=np.inf) > T)
             f[off] = FLAG_NEIGHBOUR_OUTLIER
         if factor:
