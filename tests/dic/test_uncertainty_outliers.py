@@ -204,3 +204,22 @@ def test_an_image_mostly_of_outliers_names_the_factors():
     (line,) = flag_report(ds).lines
     assert "16 of 20 points flagged, mostly neighbour_outlier" in line
     assert "--neighbour-outlier-factor 4.0" in line and "--u-outlier-factor 2.0" in line
+
+
+def test_the_command_refuses_a_factor_below_1_and_runs_the_fix(tmp_path, capsys):
+    """A factor between 0 and 1 would flag most good points: exit 3 naming the parameter;
+    the values the message offers (>= 1, or 0) run, and the file states them."""
+    from jointwear.cli import main
+    from jointwear.io import load_header
+
+    data = tmp_path / "s"
+    assert main(["datasets", "speckle", str(data), "--size", "96x96"]) == 0
+    images = [str(data / "reference.png"), str(data / "deformed.png")]
+    out = tmp_path / "f.nc"
+    base = ["dic", "correlate", *images, "--out", str(out), "--subset", "21"]
+    assert main([*base, "--neighbour-outlier-factor", "0.5"]) == 3
+    err = capsys.readouterr().err
+    assert "--neighbour-outlier-factor 0.5" in err and "or 0 for no test" in err
+    for value in ("1", "0"):
+        assert main([*base, "--neighbour-outlier-factor", value, "--overwrite"]) == 0
+        assert load_header(out).attrs["dic_neighbour_outlier_factor"] == float(value)

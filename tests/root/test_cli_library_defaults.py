@@ -174,8 +174,9 @@ def test_field_defaults_help_and_limits_are_the_librarys():
 
     f = _fields(FieldParams)
     mapping = _same(
-        f, "subset_size", "step", "zncc_min", "search_radius", "threads", "u_outlier_factor"
-    )
+        f, "subset_size", "step", "zncc_min", "search_radius", "threads", "u_outlier_factor",
+        "neighbour_outlier_factor",
+    )  # fmt: skip
     mapping |= _stated("strain_window", "frame", "epipolar_max")
     mapping["origin"] = (_keywords(measure_field_files)["data_origin"], None)
     without = {"images", "left", "right", "calibration", "roi", "points", "fps"}
