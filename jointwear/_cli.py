@@ -21,10 +21,12 @@ from __future__ import annotations
 import importlib
 import pkgutil
 import re
+from enum import Enum
 from pathlib import Path
-from typing import Annotated, Any
+from typing import Annotated, Any, get_args, get_origin
 
 import typer
+from typer._typing import is_literal_type, literal_values
 from typer.core import TyperArgument, TyperCommand, TyperGroup, TyperOption
 
 __all__ = [
@@ -35,6 +37,8 @@ __all__ = [
     "Overwrite",
     "OUTPUT_PARAMS",
     "speak_flags",
+    "plain_value",
+    "DECLINED",
     "lazy_groups",
     "AngleZero",
     "AngleDirection",
@@ -84,10 +88,133 @@ def _refuse_empty_path(param: Any, value: Any, positional: bool = False) -> None
         )
 
 
+# --- values: plain ones without pydantic ----------------------------------------------------
+# typer converts every option value through a pydantic ``TypeAdapter`` it builds per parameter
+# (``typer._adapters``): importing pydantic and building the adapters costs about 0.1 CPU s of a
+# command's start-up, more than a ``dic correlate`` on a small pair computes in. The values of
+# jointwear's options are almost all plain: a ``str``, a ``Path``, an ``int`` or a ``float``
+# written in decimal, one of a command's choices, lists and pairs of these. :func:`plain_value`
+# converts exactly those, with typer's own path and choice functions, to the value typer would
+# give; anything else (a number written otherwise, a value out of its range, a wrong choice, a
+# custom parser) it declines, and typer converts it as always, with its own message.
+# ``tests/root/test_cli_coerce.py`` holds the two equal on every parameter of the command line.
+
+#: Returned when a value is not plain: typer converts it.
+DECLINED = object()
+
+_INT = re.compile(r"[+-]?[0-9]+\Z")
+_FLOAT = re.compile(r"[+-]?([0-9]+\.?[0-9]*|\.[0-9]+)([eE][+-]?[0-9]+)?\Z")
+
+
+def plain_value(param: Any, ctx: Any, value: Any) -> Any:
+    """``value`` of ``param`` (a typer option or argument) as typer's conversion gives it, or
+    :data:`DECLINED` where the conversion is not plain."""
+    described = getattr(param, "type_descriptor", None)
+    if described is None or described.file_annotation is not None:
+        return DECLINED
+    info = described.parameter_info
+    if info.parser is not None or getattr(info, "click_type", None) is not None:
+        return DECLINED
+    multi = param.multiple or param.nargs == -1
+    if value is None:
+        return () if multi else None
+    annotation = described.annotation
+    if multi:
+        if isinstance(value, str) or get_origin(annotation) is not list:
+            return DECLINED
+    origin = get_origin(annotation)
+    if origin is list:
+        if not isinstance(value, list | tuple):
+            value = [value]
+        items = [_leaf(get_args(annotation)[0], info, param, ctx, v) for v in value]
+        return DECLINED if any(v is DECLINED for v in items) else items
+    if origin is tuple:
+        kinds = get_args(annotation)
+        if not isinstance(value, list | tuple) or len(value) != len(kinds) or ... in kinds:
+            return DECLINED
+        items = [_leaf(k, info, param, ctx, v) for k, v in zip(kinds, value, strict=True)]
+        return DECLINED if any(v is DECLINED for v in items) else tuple(items)
+    return _leaf(annotation, info, param, ctx, value)
+
+
+def _leaf(annotation: Any, info: Any, param: Any, ctx: Any, value: Any) -> Any:
+    if annotation is str:
+        return value if isinstance(value, str) else DECLINED
+    if annotation is bool:
+        return value if isinstance(value, bool) else DECLINED
+    if annotation is int or annotation is float:
+        return _number(annotation, info, value)
+    if annotation is Path:
+        return _path(info, param, ctx, value)
+    if (isinstance(annotation, type) and issubclass(annotation, Enum)) or is_literal_type(
+        annotation
+    ):
+        return _choice(annotation, info, ctx, value)
+    return DECLINED
+
+
+def _number(kind: type, info: Any, value: Any) -> Any:
+    if getattr(info, "clamp", False):
+        return DECLINED
+    if isinstance(value, str):
+        if not (_INT if kind is int else _FLOAT).match(value):
+            return DECLINED
+        number = kind(value)
+    elif isinstance(value, int | float) and not isinstance(value, bool):
+        if kind is int and not isinstance(value, int):
+            return DECLINED
+        number = kind(value)
+    else:
+        return DECLINED
+    if (info.min is not None and number < info.min) or (info.max is not None and number > info.max):
+        return DECLINED  # typer's range message
+    return number
+
+
+def _path(info: Any, param: Any, ctx: Any, value: Any) -> Any:
+    from typer._param_types import coerce_cli_path
+
+    if info.path_type is not None and info.path_type is not Path:
+        return DECLINED
+    if isinstance(value, str):
+        if "\x00" in value:
+            return DECLINED
+        value = Path(value)
+    if not isinstance(value, Path):
+        return DECLINED
+    # typer's own checks (exists, file or folder, readable ...), with its messages
+    return coerce_cli_path(value, info, path_type=Path, param=param, ctx=ctx)
+
+
+def _choice(annotation: Any, info: Any, ctx: Any, value: Any) -> Any:
+    from typer._param_types import coerce_cli_choice
+
+    choices = list(annotation) if isinstance(annotation, type) else literal_values(annotation)
+    try:
+        return coerce_cli_choice(
+            value, choices=choices, case_sensitive=info.case_sensitive, ctx=ctx
+        )
+    except ValueError:
+        return DECLINED  # typer's "not one of" message
+
+
+def _process(param: Any, ctx: Any, value: Any, typer_process: Any) -> Any:
+    """typer's ``process_value`` with a plain value converted without pydantic
+    (:func:`plain_value`); any other value as typer converts it."""
+    from typer._click.exceptions import MissingParameter
+
+    plain = plain_value(param, ctx, value)
+    if plain is DECLINED:
+        return typer_process(ctx, value)
+    if param.required and param.value_is_missing(plain):
+        raise MissingParameter(ctx=ctx, param=param)
+    return param.callback(ctx, param, plain) if param.callback is not None else plain
+
+
 class _TidyOption(TyperOption):
     def process_value(self, ctx: Any, value: Any) -> Any:
         _refuse_empty_path(self, value)
-        return super().process_value(ctx, value)
+        return _process(self, ctx, value, super().process_value)
 
     def display_type(self, ctx: Any) -> str:
         if self.is_flag and not self.count:
@@ -104,7 +231,7 @@ class _TidyOption(TyperOption):
 class _TidyArgument(TyperArgument):
     def process_value(self, ctx: Any, value: Any) -> Any:
         _refuse_empty_path(self, value, positional=True)
-        return super().process_value(ctx, value)
+        return _process(self, ctx, value, super().process_value)
 
     def _usage_display_name(self) -> str:
         # FILE, [DEFORMED], PATHS... (click's convention) rather than {file}
