@@ -17,6 +17,14 @@ results. Results are written after each truth; every run and scan is kept in ``-
 stopped benchmark resumes and a change of the criteria re-decides without simulating.
 
 Writes ``benchmarks/results/validation_power.json``.
+
+``--with-calibration``: the calibrate-then-validate path
+(:mod:`jointwear.reports.power_calibrated`, size ``CAL_BENCH_SIZE``: kw calibrated on the
+truth's 2e5-cycle scans, the posterior prediction validated at 4e5, every candidate also
+compared without calibration on the same maps), written to
+``benchmarks/results/validation_power_calibrated.json``; ``--only NAME`` (repeatable: "right"
+or a wrong model) runs those candidates into the cache's ``calibrated_parts`` (start a second
+process once the first has made the scans) and ``--merge`` writes the JSON from the parts.
 """
 
 from __future__ import annotations
@@ -56,8 +64,28 @@ def main() -> None:
     parser.add_argument(
         "--merge", action="store_true", help="write the JSON from the truths run with --truth"
     )
+    parser.add_argument(
+        "--with-calibration",
+        action="store_true",
+        help="the calibrate-then-validate path (validation_power_calibrated.json)",
+    )
+    parser.add_argument(
+        "--only",
+        action="append",
+        default=None,
+        help="--with-calibration: run only this candidate ('right' or a wrong model; repeatable)",
+    )
+    parser.add_argument(
+        "--wrong-replicates",
+        type=int,
+        default=None,
+        help="--with-calibration: replicates of each wrong model (default CAL_BENCH_SIZE's)",
+    )
     args = parser.parse_args()
     logging.disable(logging.WARNING)  # the adaptive update's noise warnings, once per run
+    if args.with_calibration:
+        _with_calibration(args)
+        return
 
     def save(result: dict) -> None:
         load = os.getloadavg()[0]
@@ -98,6 +126,64 @@ def main() -> None:
         folder=args.cache,
         progress=lambda m: print(m, flush=True),
         on_truth=keep_part if args.truth else save,
+    )
+
+
+def _with_calibration(args: argparse.Namespace) -> None:
+    """The calibrate-then-validate power study (parts with --only, merged with --merge)."""
+    from jointwear.reports.power_calibrated import (
+        CAL_BENCH_SIZE,
+        kw_over_truth_median,
+        run_power_calibrated,
+    )
+
+    parts = args.cache / "calibrated_parts"
+    note = "2-core machine shared with other agents' jobs; CPU s of this process"
+    if args.merge:
+        merged: dict = {"size": CAL_BENCH_SIZE.describe(), "truths": {}, "cpu_s": 0.0}
+        loads = {}
+        for path in sorted(parts.glob("*.json")):
+            part = json.loads(path.read_text())
+            merged["cpu_s"] += part["cpu_s"]
+            loads[path.stem] = part["load_1min"]
+            for name, truth in part["truths"].items():
+                into = merged["truths"].setdefault(name, {**truth, "candidates": {}, "cpu_s": 0.0})
+                for entry in truth["candidates"].values():  # parts run before it was kept
+                    w = entry["with_calibration"]
+                    w["kw_over_truth_median"] = kw_over_truth_median(w["replicates_detail"])
+                into["candidates"].update(truth["candidates"])
+                into["cpu_s"] += truth["cpu_s"]
+        wanted = {t: ("right", *CAL_BENCH_SIZE.wrong.get(t, ())) for t in CAL_BENCH_SIZE.truths}
+        missing = {
+            t: [c for c in names if c not in merged["truths"].get(t, {}).get("candidates", {})]
+            for t, names in wanted.items()
+        }
+        write_results(
+            "validation_power_calibrated",
+            {**merged, "load_1min_by_part": loads, "not_measured": missing, "note": note},
+        )
+        return
+
+    def save(result: dict) -> None:
+        load = os.getloadavg()[0]
+        if args.only:
+            parts.mkdir(parents=True, exist_ok=True)
+            slug = "_".join("".join(ch if ch.isalnum() else "_" for ch in o) for o in args.only)
+            (parts / f"{slug}.json").write_text(json.dumps({**result, "load_1min": load}))
+        else:
+            write_results(
+                "validation_power_calibrated", {**result, "load_1min": load, "note": note}
+            )
+
+    size = CAL_BENCH_SIZE
+    if args.wrong_replicates is not None:
+        size = replace(size, wrong_replicates=args.wrong_replicates)
+    run_power_calibrated(
+        size,
+        folder=args.cache,
+        progress=lambda m: print(m, flush=True),
+        on_truth=save,
+        only=tuple(args.only) if args.only else None,
     )
 
 

@@ -35,12 +35,27 @@ __all__ = [
     "calibration_reuse",
     "as_calibration_check",
     "prepare",
+    "posterior_note",
+    "POSTERIOR_NOTE",
 ]
 
 #: ``jointwear_file`` of a posterior prediction (the contract with ``jointwear sim predict``)
 PREDICTION_FILE = "posterior_prediction"
 #: the label of every row of a comparison with calibration data
 CALIBRATION_CHECK = "calibration check, not validation"
+
+
+#: the start of the note of a comparison whose simulation is a posterior prediction (the report's
+#: power paragraph looks for it)
+POSTERIOR_NOTE = "the simulation compared is the posterior prediction"
+
+
+def posterior_note(names: Sequence[str]) -> str:
+    """The comparison's note that its simulation is the posterior prediction ``names``."""
+    return (
+        f"{POSTERIOR_NOTE} {', '.join(names)} (jointwear sim predict): its mean map over the "
+        "runs, their spread the input uncertainty of the calibrated inputs"
+    )
 
 
 def is_prediction(ds: xr.Dataset) -> bool:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 from collections.abc import Callable, Sequence
 from pathlib import Path
@@ -273,6 +274,9 @@ def compare_files(
     sims = [load_for_comparison(p, role="simulated", warn=warn) for p in sim]
     meass = [load_for_comparison(p, role="measured", warn=warn) for p in meas]
     ens = [io.load(p) for p in ensemble]
+    posterior = [
+        Path(p).name for p, ds in zip(sim, sims, strict=True) if calibration_use.is_prediction(ds)
+    ]
     sims, ens, ens_names, used = calibration_use.prepare(
         sims, sim, meas, ens, [Path(p).name for p in ensemble], calibration_check
     )
@@ -290,6 +294,9 @@ def compare_files(
         verification=vers or None,
         allow_other_rig=allow_other_rig,
     )
+    if posterior:
+        note = calibration_use.posterior_note(posterior)
+        result = dataclasses.replace(result, notes=(*result.notes, note))
     if used:
         result = calibration_use.as_calibration_check(result, used)
     save_comparison(

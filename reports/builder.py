@@ -140,7 +140,7 @@ def _context(c: Comparison, page: _Page) -> dict[str, Any]:
         "verdict": verdict,
         "summary": c.summary(),
         "resolution": c.resolution(),
-        "power": power_paragraph(c),
+        "power": power_paragraph(c, notes),
         "n_passed": n_pass,
         "n_decisions": n,
         "failed": list(dict.fromkeys(c.failed())),

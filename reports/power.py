@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import tempfile
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
@@ -49,10 +49,13 @@ __all__ = [
 ]
 
 
-def power_paragraph(c: Any) -> str:
+def power_paragraph(c: Any, notes: Sequence[str] = ()) -> str:
     """The report's "power of this comparison": what each decided criterion could have detected
-    (its resolution) and what a pass therefore means ('' when no criterion is decided)."""
+    (its resolution) and what a pass therefore means ('' when no criterion is decided); when the
+    simulation is a posterior prediction (a note of ``c`` or ``notes`` says so), what the
+    calibrate-then-validate path was measured to detect."""
     import jointwear.compare.verdicts as vd
+    from jointwear.compare.calibration_use import POSTERIOR_NOTE
 
     rows = c.decisions[
         c.decisions.state.isin([vd.PASS, vd.FAIL]) & (c.decisions.resolution.astype(str) != "")
@@ -69,8 +72,17 @@ def power_paragraph(c: Any) -> str:
         "its stated false-fail rate. How often these criteria detect graded wrong models (wear "
         "coefficient, friction, clearance, speed, offset, a wrong tilt form) on three known "
         "truths is measured in docs/compare-report.md (benchmarks/bench_validation_power.py)."
-    )
+    ) + (CALIBRATED_POWER if any(POSTERIOR_NOTE in n.lower() for n in (*c.notes, *notes)) else "")
 
+
+#: the power paragraph's sentence for a comparison of a posterior prediction
+CALIBRATED_POWER = (
+    " This simulation is a posterior prediction (calibrated, then validated): calibrating the "
+    "wear coefficient absorbs a wrong depth scale by design, and how often the criteria still "
+    "detect the other graded errors after calibration, or the calibration itself refuses them, "
+    "is measured in the same section's with-calibration columns (benchmarks/"
+    "bench_validation_power.py --with-calibration)."
+)
 
 #: the truth rigs: name -> parameter overrides of the reference set
 TRUTHS: dict[str, dict[str, float]] = {
@@ -209,12 +221,16 @@ def _simulate(
     return ds
 
 
-def _ensemble(size: PowerSize, overrides: dict[str, float]) -> xr.Dataset:
+def _ensemble(
+    size: PowerSize, overrides: dict[str, float], calibrated: tuple[str, ...] = ()
+) -> xr.Dataset:
+    """The LHS input ensemble around ``overrides`` (``calibrated`` inputs not varied: their
+    spread is a posterior prediction's)."""
     from jointwear.reports.demo_studies import ensemble_spec
     from jointwear.sim import WearSettings, apply_overrides, run_sweep
 
     params, settings = apply_overrides(_params(size), WearSettings(), overrides or None)
-    spec = ensemble_spec(params, size, kw=settings.kw)
+    spec = ensemble_spec(params, size, kw=settings.kw, calibrated=calibrated)
     dn = int(size.ensemble_cycles // size.ensemble_updates)
     return run_sweep(spec, params=params, wear=WearSettings(scheme="fixed", dn=dn), workers=0)
 
@@ -268,8 +284,14 @@ def _unworn_arcs(truth: xr.Dataset, share: float = 0.01) -> list[tuple[float, fl
     return [(float(a), float(b)) for a, b in arcs]
 
 
-def _measure(truth: xr.Dataset, size: PowerSize, seed: int, folder: Path) -> xr.Dataset:
-    """Virtual scans of the truth (worn and before wear), imported and made a wear map."""
+def _measure(
+    truth: xr.Dataset, size: PowerSize, seed: int, folder: Path, cycles: float | None = None
+) -> xr.Dataset:
+    """Virtual scans of the truth (worn and before wear), imported and made a wear map.
+
+    ``cycles``: the truth's snapshot scanned (default its last, labelled ``size.cycles``); the
+    worn scan of another snapshot has its own noise, the before-wear scan of a replicate is the
+    same for every snapshot (one scan before the test)."""
     from jointwear.datasets import instruments
     from jointwear.datasets.simulated_wear import wear_from_simulation
     from jointwear.metrology import wear_map
@@ -278,12 +300,15 @@ def _measure(truth: xr.Dataset, size: PowerSize, seed: int, folder: Path) -> xr.
     convention = ("+y", "counterclockwise")
     radius = float(truth.attrs.get("bearing_radius_m", 8e-3))
     common = {"n_layers": 13, "n_points": size.instrument_points, "radius": radius}
+    at = f"_{cycles:.0f}" if cycles is not None else ""
     worn = instruments.generate(
         **common,
-        wear=wear_from_simulation(truth),
+        wear=wear_from_simulation(truth, cycles=cycles),
         convention=convention,
         seed=2023,
-        noise_seed=1000 + seed,
+        noise_seed=1000 + seed
+        if cycles is None
+        else 10_000_000 + 1000 * int(cycles // 1000) + seed,
     )
     before = instruments.generate(
         **common,
@@ -295,7 +320,7 @@ def _measure(truth: xr.Dataset, size: PowerSize, seed: int, folder: Path) -> xr.
         noise_seed=2000 + seed,
     )
     paths = []
-    for name, scan in (("worn", worn), ("before", before)):
+    for name, scan in ((f"worn{at}", worn), ("before", before)):
         path = folder / f"{name}_{seed}"
         instruments.write(scan, path, layout="folder")
         paths.append(read_talyrond(path, convention=convention))
@@ -308,7 +333,7 @@ def _measure(truth: xr.Dataset, size: PowerSize, seed: int, folder: Path) -> xr.
             f"the truth's arcs worn less than 1 % of its maximum, {arcs} degree, as a user who "
             "knows them would"
         )
-    wm.attrs["cycles"] = float(size.cycles)
+    wm.attrs["cycles"] = float(size.cycles if cycles is None else cycles)
     return wm
 
 

@@ -4,7 +4,10 @@ Usage: ``python docs/scripts/power_figures.py`` writes ``docs/img/validation-pow
 (detection probability against the size of the wear-coefficient error per criterion on the
 reference truth, and every other candidate's detection by criterion) and rewrites the table
 between ``<!-- power-table begin -->`` and ``<!-- power-table end -->`` in docs/compare-report.md,
-each figure with its marker (``docs/scripts/quoted_figures.py`` checks them).
+each figure with its marker (``docs/scripts/quoted_figures.py`` checks them). From
+``validation_power_calibrated.json`` (when it exists) it draws
+``docs/img/validation-power-calibrated.png`` and writes the with/without-calibration table
+between ``<!-- power-calibrated-table begin -->`` and ``<!-- power-calibrated-table end -->``.
 """
 
 from __future__ import annotations
@@ -17,6 +20,16 @@ ROOT = Path(__file__).resolve().parents[2]
 RESULTS = ROOT / "benchmarks" / "results" / "validation_power.json"
 DOC = ROOT / "docs" / "compare-report.md"
 IMG = ROOT / "docs" / "img" / "validation-power.png"
+CAL_RESULTS = ROOT / "benchmarks" / "results" / "validation_power_calibrated.json"
+CAL_IMG = ROOT / "docs" / "img" / "validation-power-calibrated.png"
+#: with/without-calibration table columns: header -> criterion in the JSON
+CAL_COLUMNS = {
+    "max depth": "maximum wear depth",
+    "volume": "worn volume",
+    "cylindricity": "cylindricity of the wear (LSCY)",
+    "field": "wear field",
+    "axial distribution": "axial distribution of the wear",
+}
 
 #: table columns: header -> criterion name in the JSON (None: any criterion)
 COLUMNS = {
@@ -110,15 +123,122 @@ def figure(fig: dict) -> None:
     print(IMG)
 
 
-def main() -> None:
-    fig = json.loads(RESULTS.read_text())["figures"]
-    figure(fig)
-    text = DOC.read_text()
-    begin, end = "<!-- power-table begin -->", "<!-- power-table end -->"
+def _cal_cell(truth: str, cand: str, path: str, value: float | None, factor: float = 100) -> str:
+    if value is None:
+        return "—"
+    fmt = f"{value * factor:.0f}" if factor == 100 else f"{value:.2f}"
+    scale = " *100" if factor == 100 else ""
+    ref = f"figures/truths/{truth}/candidates/{cand}/{path}"
+    return f"{fmt} <!-- fig: validation_power_calibrated.json:{ref}{scale} -->"
+
+
+def cal_table(fig: dict) -> str:
+    """Per candidate: fail rates [%] without → with calibration, the refused-at-calibration and
+    detection rates, U_val/|D| of the maximum depth both ways, kw's posterior mean / truth."""
+    heads = ["truth", "candidate", "any: without", "with", "refused at calibration",
+             "detected with"]  # fmt: skip
+    heads += [f"{h}: without | with" for h in CAL_COLUMNS]
+    heads += ["U_val/D max depth: without | with", "posterior kw / truth (median)"]
+    lines = ["| " + " | ".join(heads) + " |", "|" + "---|" * len(heads)]
+    for truth, res in fig["truths"].items():
+        for cand, e in res["candidates"].items():
+            w, wo = e["with_calibration"], e["without_calibration"]
+            n = f"{w['replicates']}"
+            cells = [f"{truth}", f"{'right model' if cand == 'right' else cand} ({n})"]
+            cells.append(_cal_cell(truth, cand, "without_calibration/any_fail", wo["any_fail"]))
+            cells.append(_cal_cell(truth, cand, "with_calibration/any_fail", w["any_fail"]))
+            cells.append(
+                _cal_cell(
+                    truth,
+                    cand,
+                    "with_calibration/refused_at_calibration",
+                    w["refused_at_calibration"],
+                )  # fmt: skip
+            )
+            cells.append(_cal_cell(truth, cand, "with_calibration/detected", w["detected"]))
+            for c in CAL_COLUMNS.values():
+                a = _cal_cell(truth, cand, f"without_calibration/fail_rate/{c}",
+                              wo["fail_rate"].get(c))  # fmt: skip
+                b = _cal_cell(truth, cand, f"with_calibration/fail_rate/{c}",
+                              w["fail_rate"].get(c) if w["validated"] else None)  # fmt: skip
+                cells.append(f"{a} \\| {b}")
+            key = "u_val_over_d_max_depth_median"
+            a = _cal_cell(truth, cand, f"without_calibration/{key}", wo.get(key), 1)
+            b = _cal_cell(truth, cand, f"with_calibration/{key}", w.get(key), 1)
+            cells.append(f"{a} \\| {b}")
+            cells.append(
+                _cal_cell(
+                    truth,
+                    cand,
+                    "with_calibration/kw_over_truth_median",
+                    w.get("kw_over_truth_median"),
+                    1,
+                )  # fmt: skip
+            )
+            lines.append("| " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
+def cal_figure(fig: dict) -> None:
+    """Per candidate: detection without and with calibration (failed, refused at calibration),
+    and the wear field's and axial distribution's fail rates both ways."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    labels, rows = [], []
+    for truth, res in fig["truths"].items():
+        for cand, e in res["candidates"].items():
+            labels.append(f"{'right model' if cand == 'right' else cand} ({truth})")
+            rows.append((e["without_calibration"], e["with_calibration"]))
+    f, axes = plt.subplots(1, 3, figsize=(12, 0.45 * len(labels) + 1.6), sharey=True)
+    y = list(range(len(labels)))
+    h = 0.38
+    ax = axes[0]
+    ax.barh([i - h / 2 for i in y], [wo["any_fail"] for wo, _ in rows], h, label="without")
+    ax.barh([i + h / 2 for i in y], [w["any_fail"] for _, w in rows], h, label="with: failed")
+    ax.barh([i + h / 2 for i in y], [w["refused_at_calibration"] for _, w in rows], h,
+            left=[w["any_fail"] for _, w in rows], label="with: refused at calibration",
+            hatch="//", color="tab:red", alpha=0.6)  # fmt: skip
+    ax.set_title("any criterion (detection)", fontsize=10)
+    for ax, crit in zip(axes[1:], ("wear field", "axial distribution of the wear"), strict=True):
+        ax.barh([i - h / 2 for i in y], [wo["fail_rate"].get(crit, 0) for wo, _ in rows], h,
+                label="without")  # fmt: skip
+        ax.barh([i + h / 2 for i in y], [w["fail_rate"].get(crit, 0) for _, w in rows], h,
+                label="with calibration")  # fmt: skip
+        ax.set_title(crit, fontsize=10)
+    for ax in axes:
+        ax.set_xlim(0, 1.0)
+        ax.set_xlabel("share of replicates")
+        ax.legend(fontsize=7, loc="lower right")
+    axes[0].set_yticks(y, labels, fontsize=8)
+    axes[0].invert_yaxis()
+    f.suptitle("kw calibrated on the earlier snapshot, validated at the later: "
+               "right model = false-fail rate", fontsize=10)  # fmt: skip
+    f.tight_layout()
+    f.savefig(CAL_IMG, dpi=110)
+    print(CAL_IMG)
+
+
+def _rewrite(text: str, begin: str, end: str, body: str) -> str:
     pattern = re.compile(re.escape(begin) + ".*?" + re.escape(end), re.S)
     if not pattern.search(text):
         raise SystemExit(f"{DOC}: no {begin} … {end} block to rewrite")
-    DOC.write_text(pattern.sub(lambda _m: f"{begin}\n{table(fig)}\n{end}", text))
+    return pattern.sub(lambda _m: f"{begin}\n{body}\n{end}", text)
+
+
+def main() -> None:
+    fig = json.loads(RESULTS.read_text())["figures"]
+    figure(fig)
+    text = _rewrite(DOC.read_text(), "<!-- power-table begin -->", "<!-- power-table end -->",
+                    table(fig))  # fmt: skip
+    if CAL_RESULTS.exists():
+        cal = json.loads(CAL_RESULTS.read_text())["figures"]
+        cal_figure(cal)
+        text = _rewrite(text, "<!-- power-calibrated-table begin -->",
+                        "<!-- power-calibrated-table end -->", cal_table(cal))  # fmt: skip
+    DOC.write_text(text)
     print(DOC)
 
 
