@@ -99,8 +99,11 @@ def neighbour_residuals(
        homogeneous strain at a grid edge too; ``G`` is a median over the image: noise-free);
     2. trapezoidally along the point's own and each neighbour's measured gradients,
        ``d_j - (g_j + g) (x_j - x) / 2`` (exact for a quadratic field: a real strain
-       gradient is not a disagreement; only as good as the point's gradients);
-    3. the same with the neighbours' median gradient in place of the point's own.
+       gradient is not a disagreement; only as good as the point's gradients), with the
+       Euler-Maclaurin term ``+ (x_j - x)^T (H_j - H) (x_j - x) / 12`` where the shape
+       function measures second derivatives ``H`` (exact to the fourth order);
+    3. the same with the neighbours' median gradient (and second derivatives) in place of
+       the point's own.
 
     Returns
     -------
@@ -122,6 +125,9 @@ def neighbour_residuals(
     A = np.asarray(P, float)[:, AFFINE_INDEX]
     d = A[:, [0, 3]]  # (u, v)
     g = A[:, [1, 2, 4, 5]].reshape(-1, 2, 2)  # [[du/dx, du/dy], [dv/dx, dv/dy]]
+    # second derivatives [component, a, b] (zero for the affine shape function)
+    Pf = np.asarray(P, float)
+    h = Pf[:, [3, 4, 4, 5, 9, 10, 10, 11]].reshape(-1, 2, 2, 2) if Pf.shape[1] >= 12 else None
     idx = np.flatnonzero(test)
     # the median test first; the allowances only where it fails (they can only excuse)
     j = np.where(has[idx], nb[idx], 0)
@@ -135,11 +141,17 @@ def neighbour_residuals(
     delta = centres[j] - centres[idx][:, None, :]  # (M, 8, 2) [pixel]
     uniform = np.median(g[ok], axis=0)
     gm = _median_of_neighbours(G)
-    preds = (
+    preds = [
         D - np.einsum("ab,mjb->mja", uniform, delta),
         D - np.einsum("mjab,mjb->mja", G + g[idx][:, None], delta) / 2,
         D - np.einsum("mjab,mjb->mja", G + gm[:, None], delta) / 2,
-    )
+    ]
+    if h is not None and np.any(h[ok]):  # Euler-Maclaurin: + dx^T (H_j - H) dx / 12
+        H = np.where(has[idx][..., None, None, None], h[j], np.nan)  # (M, 8, 2, 2, 2)
+        for k, h0 in ((1, h[idx]), (2, _median_of_neighbours(H))):
+            preds[k] = (
+                preds[k] + np.einsum("mjcab,mja,mjb->mjc", H - h0[:, None], delta, delta) / 12
+            )
     for k, pred in enumerate(preds, start=1):
         res[idx, k] = np.hypot(*(d[idx] - _median_of_neighbours(pred)).T)
     return res, count
