@@ -31,7 +31,8 @@ OUTPUT_FLAG_VALUES = np.array([*range(8), FLAG_U_OUTLIER, FLAG_NEIGHBOUR_OUTLIER
 OUTPUT_FLAG_MEANINGS = FLAG_MEANINGS + " uncertainty_outlier neighbour_outlier"
 #: fewer ok points than this in an image: no robust median, no outlier test
 MIN_POINTS_OUTLIER_TEST = 10
-#: a point with fewer ok grid neighbours than this (of its 8) is tested on its own u only
+#: a point with fewer usable grid neighbours than this (of its 8: ok, not on faint texture) is
+#: tested on its own u only
 MIN_NEIGHBOURS = 3
 #: no outlier below this [pixel], neither a u nor a disagreement with the neighbours: on
 #: (nearly) noise-free images every u is tiny (1e-6-1e-3 px) and ratios to the median say
@@ -237,7 +238,8 @@ def flag_uncertainty_outliers(
     use_nb = bool(neighbour_factor) and P is not None and centres is not None and index is not None
     if use_nb:
         nb = grid_neighbours(index, reach)
-        Ps = np.asarray(P, float).reshape(-1, n, P.shape[-1])
+        P = np.asarray(P, float)
+        Ps = P.reshape(-1, n, P.shape[-1])
         centres = np.asarray(centres, float)
     for k, (f, s) in enumerate(zip(rows, u, strict=True)):
         ok = (f == FLAG_OK) & np.isfinite(s)
