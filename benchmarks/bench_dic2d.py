@@ -9,8 +9,12 @@ the CPU time of one call on one thread is also given (``poi_per_cpu_second_1_thr
 other users of the machine do not distort. Quote medians with the load average.
 
 ``--pyvale``: jointwear and pyvale (``pip install pyvale``, not a dependency) side by side in one
-run, CPU time on one thread, min of 3 interleaved repeats, and the CLI process against the
-library call at step 4 (``results/dic2d_pyvale.json``).
+run, CPU time on one thread, min of 3 interleaved repeats (with the part of jointwear's call
+spent on the output Dataset and its outlier tests, ``output_cpu_s_of_min``), and the CLI process
+against the library call at step 4 (``results/dic2d_pyvale.json``).
+
+``--split``: where one call's CPU time goes (IC-GN set-up and iterations per point, fixed cost
+per call; ``results/dic2d_cost_split.json``).
 """
 
 from __future__ import annotations
@@ -26,7 +30,7 @@ import numpy as np  # noqa: E402
 from _common import median_time, write_results  # noqa: E402
 
 from jointwear.datasets import speckle as sp  # noqa: E402
-from jointwear.dic import SubsetCorrelator, correlate  # noqa: E402
+from jointwear.dic import CorrelationParams, SubsetCorrelator, correlate  # noqa: E402
 
 SHIFT = (3.3, -2.7)
 
@@ -136,9 +140,24 @@ def _pyvale_cpu(pair, step: int, out: Path) -> tuple[float, object]:
 
 
 def _library_cpu(pair, step: int):
+    """CPU seconds of the library call on one thread (what :func:`_correlate` does: reference
+    prepared, matched, packaged), the Dataset, and the CPU seconds of the last part alone (the
+    output Dataset with the outlier tests)."""
+    params = CorrelationParams(subset_size=33, step=step, interpolation="quintic", threads=1)
     t0 = time.process_time()
-    ds = _correlate(pair, step, "quintic", threads=1)
-    return time.process_time() - t0, ds
+    corr = SubsetCorrelator(pair.reference, params=params)
+    res = corr.match(pair.deformed)
+    t1 = time.process_time()
+    ds = corr.to_dataset(res)
+    t2 = time.process_time()
+    return t2 - t0, ds, t2 - t1
+
+
+def _correlate_cpu(pair, step: int) -> float:
+    """CPU seconds of one ``correlate`` call on one thread (quintic, 33-pixel subsets)."""
+    t0 = time.process_time()
+    _correlate(pair, step, "quintic", threads=1)
+    return time.process_time() - t0
 
 
 def _cli_cpu(ref_png: Path, def_png: Path, out: Path, step: int) -> float:
@@ -200,10 +219,12 @@ def versus_pyvale(repeat: int = 3) -> None:
     }
     for step in (16, 4):
         for name, pair in pairs.items():
-            jw, pv = [], []
+            jw, pv, out_part = [], [], []
+            load = os.getloadavg()[0]
             for _ in range(repeat):  # interleaved
-                t, ds = _library_cpu(pair, step)
+                t, ds, t_out = _library_cpu(pair, step)
                 jw.append(t)
+                out_part.append(t_out)
                 t, res = _pyvale_cpu(pair, step, tmp)
                 pv.append(t)
             n_jw = int(ds.flag.size)
@@ -215,6 +236,7 @@ def versus_pyvale(repeat: int = 3) -> None:
                 "jointwear": {
                     "points": n_jw,
                     "cpu_s_min": round(min(jw), 4),
+                    "output_cpu_s_of_min": round(out_part[int(np.argmin(jw))], 4),
                     "poi_per_cpu_s": round(n_jw / min(jw)),
                     "mean_iterations": round(
                         float(ds.iterations.values[ds.flag.values == 0].mean()), 2
@@ -228,6 +250,7 @@ def versus_pyvale(repeat: int = 3) -> None:
                     **_accuracy(pu, pv_, px, py, pair),
                 },
             }
+            row["load_average_1min_at_start"] = round(load, 2)
             row["speed_ratio"] = round(
                 row["jointwear"]["poi_per_cpu_s"] / row["pyvale"]["poi_per_cpu_s"], 2
             )
@@ -239,7 +262,7 @@ def versus_pyvale(repeat: int = 3) -> None:
     cv2.imwrite(str(def_png), pair.deformed)
     lib, cli = [], []
     for _ in range(repeat):
-        lib.append(_library_cpu(pair, 4)[0])
+        lib.append(_correlate_cpu(pair, 4))
         (tmp / "cli.nc").unlink(missing_ok=True)
         cli.append(_cli_cpu(ref_png, def_png, tmp / "cli.nc", 4))
     figures["step4_cli"] = {
@@ -251,8 +274,60 @@ def versus_pyvale(repeat: int = 3) -> None:
     write_results("dic2d_pyvale", figures)
 
 
+def cost_split(repeat: int = 5) -> None:
+    """Where one quintic call's CPU time goes at steps 4 and 16 (one thread, min of ``repeat``):
+    the whole call; per point, the IC-GN's set-up (reference subset, Hessian: the kernel run
+    with 0 iterations from the converged parameters, points in raster order) and one iteration
+    (the same with 1, minus the set-up); the rest is fixed cost per call (prefilters, kappa,
+    texture, seeds, output, and the propagation's own bookkeeping).
+    Writes ``results/dic2d_cost_split.json``."""
+    from jointwear.dic.icgn._drive import _refine_chunk
+
+    pair = sp.speckle_pair((512, 512), sp.RigidField(SHIFT), seed=1)
+    figures: dict = {"image": "512x512, 8 bit, speckle 5 px, quintic, 33-px subsets, 1 thread"}
+    for step in (16, 4):
+        params = CorrelationParams(subset_size=33, step=step, interpolation="quintic", threads=1)
+        whole = min(_correlate_cpu(pair, step) for _ in range(repeat))
+        corr = SubsetCorrelator(pair.reference, params=params)
+        res = corr.match(pair.deformed)
+        dspl, dinv, _ = corr._prepare_deformed(pair.deformed)
+        ref, dfm = corr._kernel_args(dspl, dinv)
+        n = corr.n_points
+        scale = corr._kappa_of_points()
+        kernel_s = {}
+        for iterations in (0, 1):
+            opts = list(corr._solver_options())
+            opts[2] = iterations
+            out = (np.zeros(n), np.zeros(n, np.int32), np.zeros(n, np.int8), np.zeros((n, 2)))
+            times = []
+            for _ in range(repeat + 1):
+                P = res.params.copy()
+                t0 = time.process_time()
+                # all points in raster order (one chunk): neighbours share their pixels in
+                # the caches, as in the propagation
+                _refine_chunk(0, 1, ref, dfm, tuple(opts), corr.centres, scale, P, res.ok, out)
+                times.append(time.process_time() - t0)
+            kernel_s[iterations] = min(times[1:])
+        setup, one = kernel_s[0] / n, (kernel_s[1] - kernel_s[0]) / n
+        iters = float(res.iterations[res.ok].mean())
+        figures[f"step{step}"] = {
+            "points": n,
+            "call_cpu_s_min": round(whole, 4),
+            "setup_us_per_point": round(setup * 1e6, 1),
+            "iteration_us": round(one * 1e6, 1),
+            "mean_iterations": round(iters, 2),
+            "ic_gn_share_of_call": round(n * (setup + iters * one) / whole, 2),
+            "fixed_cpu_s_per_call": round(whole - n * (setup + iters * one), 4),
+        }
+        print(step, figures[f"step{step}"], flush=True)
+    figures["load_average_1min_at_end"] = os.getloadavg()[0]
+    write_results("dic2d_cost_split", figures)
+
+
 if __name__ == "__main__":
     if "--pyvale" in sys.argv:
         versus_pyvale()
+    elif "--split" in sys.argv:
+        cost_split()
     else:
         main()
