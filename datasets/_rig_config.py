@@ -153,10 +153,6 @@ class RigConfig:
         check_fields(self, "rig")
         if self.motion_blur_samples < 1:
             raise BadInputError("motion_blur_samples must be >= 1")
-        if self.board_kind not in BOARD_KINDS:
-            raise BadInputError(
-                f"board_kind {self.board_kind!r}: expected 'chessboard' or 'charuco'"
-            )
 
     @property
     def focal_px(self) -> float:

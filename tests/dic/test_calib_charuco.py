@@ -37,5 +37,8 @@ def test_charuco_calibration_recovers_the_cameras(legacy):
 
 
 def test_board_kind_is_checked():
-    with pytest.raises(BadInputError, match="board_kind 'circles'"):
+    with pytest.raises(
+        BadInputError,
+        match=r"rig\.board_kind: expected one of \['chessboard', 'charuco'\], got 'circles'",
+    ):
         RigConfig(board_kind="circles")
