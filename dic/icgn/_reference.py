@@ -37,6 +37,26 @@ def _box_has_invalid(integral, x0, y0, x1, y1):
     return s > 0
 
 
+#: fastmath without no-NaN/no-inf assumptions: sums may be reassociated (vectorised)
+_FM = {"nsz", "arcp", "contract", "reassoc"}
+
+
+@njit(cache=True, fastmath=_FM)
+def _centre(f, n):
+    """Subtract the mean of ``f[:n]`` in place and return the norm of the result. The sums
+    are vectorised (reassociated): each is a chain of ``n`` additions otherwise, whose latency
+    was a third of a subset's set-up; the same numbers to rounding (1e-16 relative)."""
+    fm = 0.0
+    for k in range(n):
+        fm += f[k]
+    fm /= n
+    fn = 0.0
+    for k in range(n):
+        f[k] -= fm
+        fn += f[k] * f[k]
+    return math.sqrt(fn)
+
+
 @njit(cache=True)
 def _load_reference(
     ref_img,
@@ -99,15 +119,7 @@ def _load_reference(
                     - interp_value(ref_coef, order, x, y - 1.0, w[0], w[1])
                 )
                 k += 1
-    fm = 0.0
-    for k in range(n):
-        fm += f[k]
-    fm /= n
-    fn = 0.0
-    for k in range(n):
-        f[k] -= fm
-        fn += f[k] * f[k]
-    fn = math.sqrt(fn)
+    fn = _centre(f, n)
     if fn <= min_std * math.sqrt(n):
         return FLAG_NO_TEXTURE, fn
     return FLAG_OK, fn
