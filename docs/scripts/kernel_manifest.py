@@ -9,8 +9,8 @@ event every kernel compiled for a call from Python (the outermost compilations: 
 another kernel calls is compiled with it), in every process (the demo's workers too), with its
 argument types and the CPU seconds its compilation took here. It takes about five minutes of CPU.
 Run it after adding a kernel or changing the types a command passes to one;
-``tests/root/test_compile.py`` checks that every entry still names a kernel and that, after the
-warm-up, ``dic correlate`` compiles nothing.
+``tests/root/test_compile.py`` checks that every entry still names a kernel, and
+``tests/reports/test_demo_pool.py`` that, after the warm-up, ``dic correlate`` compiles nothing.
 """
 
 from __future__ import annotations

@@ -100,7 +100,11 @@ def integrate(t, y, hstep, t_end, record, i_out, inputs, solver):
     yi = np.empty(n)
     nodiag = np.empty(0)
     ndg = np.empty(ND_DIAG)
-    _eval(t, y, ctx, Ks[0], False, 0.0, nodiag)
+    # whether _eval accumulates wear work, as run-time values: a literal True/False would
+    # compile the whole clearance-joint chain once per value (numba types each literal)
+    accumulate = np.ones(1, np.bool_)[0]
+    look = not accumulate
+    _eval(t, y, ctx, Ks[0], look, 0.0, nodiag)
     pen0 = info[I_PEN]
     contact0 = info[I_CONTACT]
     nacc = 0
@@ -108,7 +112,7 @@ def integrate(t, y, hstep, t_end, record, i_out, inputs, solver):
     n_out = t_out.shape[0]
     # record an output point sitting exactly at the start
     while i_out < n_out and t_out[i_out] <= t:
-        _eval(t, y, ctx, yi, False, 0.0, ndg)
+        _eval(t, y, ctx, yi, look, 0.0, ndg)
         for j in range(ND_DIAG):
             diag_out[i_out, j] = ndg[j]
         i_out += 1
@@ -127,10 +131,10 @@ def integrate(t, y, hstep, t_end, record, i_out, inputs, solver):
                     yt[i] = y[i] + h * _A[1, 0] * Ks[0, i]
                 else:
                     yt[i] = y[i] + h * _combine(Ks, _A[s], s, i)
-            _eval(t + _C[s] * h, yt, ctx, Ks[s], False, 0.0, nodiag)
+            _eval(t + _C[s] * h, yt, ctx, Ks[s], look, 0.0, nodiag)
         for i in range(n):
             y1[i] = y[i] + h * _combine(Ks, _B, 6, i)
-        _eval(t + h, y1, ctx, Ks[6], False, 0.0, nodiag)
+        _eval(t + h, y1, ctx, Ks[6], look, 0.0, nodiag)
         err = 0.0
         finite = True
         va = 0.0
@@ -198,7 +202,7 @@ def integrate(t, y, hstep, t_end, record, i_out, inputs, solver):
             h11 = th**3 - th**2
             for i in range(n):
                 yi[i] = h00 * y[i] + h10 * h * Ks[0, i] + h01 * y1[i] + h11 * h * Ks[6, i]
-            _eval(t_out[i_out], yi, ctx, yt, False, 0.0, ndg)
+            _eval(t_out[i_out], yi, ctx, yt, look, 0.0, ndg)
             for j in range(ND_DIAG):
                 diag_out[i_out, j] = ndg[j]
             i_out += 1
@@ -214,7 +218,7 @@ def integrate(t, y, hstep, t_end, record, i_out, inputs, solver):
         nacc += 1
         # wear work and impact-velocity memory at the new state
         if contact1 != 0.0:
-            _eval(t, y, ctx, Ks[0], True, h, nodiag)
+            _eval(t, y, ctx, Ks[0], accumulate, h, nodiag)
         else:
             for i in range(n):
                 Ks[0, i] = Ks[6, i]
