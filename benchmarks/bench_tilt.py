@@ -399,6 +399,10 @@ def main() -> None:
             "early_snapshot": EARLY,
             "grid": "20 x 200, axial_grading 0.75",
             "tilt_damping": 0.0,
+            "rate_error_scale": "auto (the default since issue 41): with a tilt spring the "
+            "rotating body's angular velocity against the vector's magnitude at "
+            f"{AUTO_VECTOR_RTOL_FACTOR:g} x solver.rtol; without one (k = 0) per component, "
+            "bit for bit as before",
             "measured_cylindricity_growth_um": {str(k): v for k, v in MEASURED_UM.items()},
             "measured_growth_ratio": round(ratio_meas, 4),
             "measured_peak_angles_deg_after_1.2e6": MEASURED_PEAK_DEG,
