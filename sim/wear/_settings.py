@@ -134,10 +134,6 @@ class WearSettings:
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "kw", check_kw(self.kw))
-        if self.scheme not in ("adaptive", "fixed", "schedule"):
-            raise ParameterError(
-                f"wear scheme must be 'adaptive', 'fixed' or 'schedule', got {self.scheme!r}"
-            )
         try:
             sched = tuple(int(v) for v in self.schedule)
         except (TypeError, ValueError):

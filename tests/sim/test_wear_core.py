@@ -277,7 +277,11 @@ def test_contact_models_refuse_a_non_positive_length_or_modulus(model, name, val
 
 
 def test_bad_settings_and_targets():
-    with pytest.raises(ParameterError, match="scheme must be .adaptive., .fixed. or .schedule."):
+    # the Literal field's check (params.check_fields), as for every parameter dataclass
+    with pytest.raises(
+        ParameterError,
+        match=r"^wear\.scheme: expected one of \['adaptive', 'fixed', 'schedule'\], got 'implicit'$",
+    ):
         WearSettings(scheme="implicit")
     with pytest.raises(ParameterError, match="needs a non-empty wear.schedule"):
         WearSettings(scheme="schedule")
