@@ -47,12 +47,17 @@ _MOMENT = (0, 1, 2, 1, 3, 4, 2, 4, 5)
 def _hessian_affine(f, gx, gy, half, Hm, jf, js):
     """Affine Gauss-Newton Hessian ``sum J J^T``, ``sum J f`` and ``sum J`` (row-wise sums)."""
     m = np.zeros(18)  # aa, ab, bb moments: 1, c, r, cc, cr, rr
-    k = 0
+    size = 2 * half + 1
+    k0 = 0
     for r in range(-half, half + 1):
         rr = float(r)
         raa = raac = raacc = rab = rabc = rabcc = rbb = rbbc = rbbcc = 0.0
         rfa = rfac = rfb = rfbc = rsa = rsac = rsb = rsbc = 0.0
-        for c in range(-half, half + 1):
+        # the row's pixels by a count from 0 (a form the compiler vectorises: twice as fast
+        # as the loop over c = -half..half), the column offset c as a float
+        for j in range(size):
+            k = k0 + j
+            c = float(j - half)
             a = gx[k]
             b = gy[k]
             fk = f[k]
@@ -76,7 +81,7 @@ def _hessian_affine(f, gx, gy, half, Hm, jf, js):
             rsac += a * c
             rsb += b
             rsbc += b * c
-            k += 1
+        k0 += size
         for o, s1, sc, scc in (
             (0, raa, raac, raacc),
             (6, rab, rabc, rabcc),
