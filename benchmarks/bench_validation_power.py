@@ -81,6 +81,13 @@ def main() -> None:
         default=None,
         help="--with-calibration: replicates of each wrong model (default CAL_BENCH_SIZE's)",
     )
+    parser.add_argument(
+        "--prior-half-width",
+        type=float,
+        default=None,
+        help="--with-calibration --only: kw's prior ± this fraction instead of CAL_BENCH_SIZE's "
+        "(a variant, merged apart under 'prior_variants')",
+    )
     args = parser.parse_args()
     logging.disable(logging.WARNING)  # the adaptive update's noise warnings, once per run
     if args.with_calibration:
@@ -138,7 +145,11 @@ def _with_calibration(args: argparse.Namespace) -> None:
     )
 
     parts = args.cache / "calibrated_parts"
-    note = "2-core machine shared with other agents' jobs; CPU s of this process"
+    note = (
+        "2-core machine shared with other agents' jobs (nice); cpu_s: the CPU of the processes "
+        "that wrote the parts, runs already in the cache (the power benchmark's study, ensembles "
+        "and runs; a part's posteriors and predictions when it was resumed) not counted again"
+    )
     if args.merge:
         merged: dict = {"size": CAL_BENCH_SIZE.describe(), "truths": {}, "cpu_s": 0.0}
         loads = {}
@@ -146,6 +157,12 @@ def _with_calibration(args: argparse.Namespace) -> None:
             part = json.loads(path.read_text())
             merged["cpu_s"] += part["cpu_s"]
             loads[path.stem] = part["load_1min"]
+            if "prior_half_width" in part:  # a variant: another prior, kept apart
+                key = f"kw prior ±{100 * part['prior_half_width']:.0f} %"
+                into = merged.setdefault("prior_variants", {}).setdefault(key, {})
+                for name, truth in part["truths"].items():
+                    into.setdefault(name, {}).update(truth["candidates"])
+                continue
             for name, truth in part["truths"].items():
                 into = merged["truths"].setdefault(name, {**truth, "candidates": {}, "cpu_s": 0.0})
                 for entry in truth["candidates"].values():  # parts run before it was kept
@@ -169,7 +186,12 @@ def _with_calibration(args: argparse.Namespace) -> None:
         if args.only:
             parts.mkdir(parents=True, exist_ok=True)
             slug = "_".join("".join(ch if ch.isalnum() else "_" for ch in o) for o in args.only)
-            (parts / f"{slug}.json").write_text(json.dumps({**result, "load_1min": load}))
+            extra = {}
+            if args.prior_half_width is not None:
+                slug += f"_prior{100 * args.prior_half_width:.0f}"
+                extra = {"prior_half_width": args.prior_half_width}
+            out = {**result, **extra, "load_1min": load}
+            (parts / f"{slug}.json").write_text(json.dumps(out))
         else:
             write_results(
                 "validation_power_calibrated", {**result, "load_1min": load, "note": note}
@@ -178,6 +200,11 @@ def _with_calibration(args: argparse.Namespace) -> None:
     size = CAL_BENCH_SIZE
     if args.wrong_replicates is not None:
         size = replace(size, wrong_replicates=args.wrong_replicates)
+    if args.prior_half_width is not None:
+        if not args.only:
+            parser_error = "--prior-half-width is a variant: give the candidates with --only"
+            raise SystemExit(parser_error)
+        size = replace(size, prior_half_width=args.prior_half_width)
     run_power_calibrated(
         size,
         folder=args.cache,

@@ -78,10 +78,11 @@ def power_paragraph(c: Any, notes: Sequence[str] = ()) -> str:
 #: the power paragraph's sentence for a comparison of a posterior prediction
 CALIBRATED_POWER = (
     " This simulation is a posterior prediction (calibrated, then validated): calibrating the "
-    "wear coefficient absorbs a wrong depth scale by design, and how often the criteria still "
-    "detect the other graded errors after calibration, or the calibration itself refuses them, "
-    "is measured in the same section's with-calibration columns (benchmarks/"
-    "bench_validation_power.py --with-calibration)."
+    "wear coefficient absorbs a wrong depth scale by design, and with it any error a kw scale "
+    "can imitate (measured: a 20 % speed error passed after calibration), while errors of the "
+    "wear's form were refused at calibration or still failed the wear field; the "
+    "with-calibration table in the same section says how often, per error "
+    "(benchmarks/bench_validation_power.py --with-calibration)."
 )
 
 #: the truth rigs: name -> parameter overrides of the reference set

@@ -330,7 +330,10 @@ def _calibrated(
     rec["kw_sd_over_mean"] = float(ds["posterior_sd"][0] / ds["posterior_mean"][0])
     if not pred.is_file():
         t0 = time.process_time()
-        predict(post, cycles=size.base.cycles, out=pred, samples=size.prediction_samples, workers=0)
+        predict(
+            post, cycles=size.base.cycles, out=pred, samples=size.prediction_samples, workers=0,
+            resume=True,
+        )  # fmt: skip
         rec["predict_cpu_s"] = time.process_time() - t0
     crit = Criteria(wear_u_num_rel=cand.u_num_rel) if cand.u_num_rel is not None else Criteria()
     c = compare_files(

@@ -123,59 +123,56 @@ def figure(fig: dict) -> None:
     print(IMG)
 
 
-def _cal_cell(truth: str, cand: str, path: str, value: float | None, factor: float = 100) -> str:
+def _cal_cell(prefix: str, path: str, value: float | None, factor: float = 100) -> str:
     if value is None:
         return "—"
     fmt = f"{value * factor:.0f}" if factor == 100 else f"{value:.2f}"
     scale = " *100" if factor == 100 else ""
-    ref = f"figures/truths/{truth}/candidates/{cand}/{path}"
-    return f"{fmt} <!-- fig: validation_power_calibrated.json:{ref}{scale} -->"
+    return f"{fmt} <!-- fig: validation_power_calibrated.json:{prefix}/{path}{scale} -->"
+
+
+def _cal_rows(fig: dict) -> list[tuple[str, str, str, dict]]:
+    """(truth, candidate label, JSON path of its entry, entry): the candidates, then the prior
+    variants."""
+    rows = []
+    for truth, res in fig["truths"].items():
+        for cand, e in sorted(res["candidates"].items(), key=lambda t: (t[0] != "right", t[0])):
+            label = "right model" if cand == "right" else cand
+            rows.append((truth, label, f"figures/truths/{truth}/candidates/{cand}", e))
+    for variant, truths in fig.get("prior_variants", {}).items():
+        for truth, cands in truths.items():
+            for cand, e in cands.items():
+                path = f"figures/prior_variants/{variant}/{truth}/{cand}"
+                rows.append((truth, f"{cand}, {variant}", path, e))
+    return rows
 
 
 def cal_table(fig: dict) -> str:
     """Per candidate: fail rates [%] without → with calibration, the refused-at-calibration and
     detection rates, U_val/|D| of the maximum depth both ways, kw's posterior mean / truth."""
     heads = ["truth", "candidate", "any: without", "with", "refused at calibration",
-             "detected with"]  # fmt: skip
-    heads += [f"{h}: without | with" for h in CAL_COLUMNS]
-    heads += ["U_val/D max depth: without | with", "posterior kw / truth (median)"]
+             "not decided", "detected with"]  # fmt: skip
+    heads += [f"{h}: without \\| with" for h in CAL_COLUMNS]
+    heads += ["U_val/D max depth: without \\| with", "posterior kw / truth (median)"]
     lines = ["| " + " | ".join(heads) + " |", "|" + "---|" * len(heads)]
-    for truth, res in fig["truths"].items():
-        for cand, e in res["candidates"].items():
-            w, wo = e["with_calibration"], e["without_calibration"]
-            n = f"{w['replicates']}"
-            cells = [f"{truth}", f"{'right model' if cand == 'right' else cand} ({n})"]
-            cells.append(_cal_cell(truth, cand, "without_calibration/any_fail", wo["any_fail"]))
-            cells.append(_cal_cell(truth, cand, "with_calibration/any_fail", w["any_fail"]))
-            cells.append(
-                _cal_cell(
-                    truth,
-                    cand,
-                    "with_calibration/refused_at_calibration",
-                    w["refused_at_calibration"],
-                )  # fmt: skip
-            )
-            cells.append(_cal_cell(truth, cand, "with_calibration/detected", w["detected"]))
-            for c in CAL_COLUMNS.values():
-                a = _cal_cell(truth, cand, f"without_calibration/fail_rate/{c}",
-                              wo["fail_rate"].get(c))  # fmt: skip
-                b = _cal_cell(truth, cand, f"with_calibration/fail_rate/{c}",
-                              w["fail_rate"].get(c) if w["validated"] else None)  # fmt: skip
-                cells.append(f"{a} \\| {b}")
-            key = "u_val_over_d_max_depth_median"
-            a = _cal_cell(truth, cand, f"without_calibration/{key}", wo.get(key), 1)
-            b = _cal_cell(truth, cand, f"with_calibration/{key}", w.get(key), 1)
+    for truth, label, pre, e in _cal_rows(fig):
+        w, wo = e["with_calibration"], e["without_calibration"]
+        cells = [truth, f"{label} ({w['replicates']})"]
+        cells.append(_cal_cell(pre, "without_calibration/any_fail", wo["any_fail"]))
+        for key in ("any_fail", "refused_at_calibration", "not_decided", "detected"):
+            cells.append(_cal_cell(pre, f"with_calibration/{key}", w[key]))
+        for c in CAL_COLUMNS.values():
+            a = _cal_cell(pre, f"without_calibration/fail_rate/{c}", wo["fail_rate"].get(c))
+            b = _cal_cell(pre, f"with_calibration/fail_rate/{c}",
+                          w["fail_rate"].get(c) if w["validated"] else None)  # fmt: skip
             cells.append(f"{a} \\| {b}")
-            cells.append(
-                _cal_cell(
-                    truth,
-                    cand,
-                    "with_calibration/kw_over_truth_median",
-                    w.get("kw_over_truth_median"),
-                    1,
-                )  # fmt: skip
-            )
-            lines.append("| " + " | ".join(cells) + " |")
+        key = "u_val_over_d_max_depth_median"
+        a = _cal_cell(pre, f"without_calibration/{key}", wo.get(key), 1)
+        b = _cal_cell(pre, f"with_calibration/{key}", w.get(key), 1)
+        cells.append(f"{a} \\| {b}")
+        kw = w.get("kw_over_truth_median")
+        cells.append(_cal_cell(pre, "with_calibration/kw_over_truth_median", kw, 1))
+        lines.append("| " + " | ".join(cells) + " |")
     return "\n".join(lines)
 
 
@@ -188,10 +185,9 @@ def cal_figure(fig: dict) -> None:
     import matplotlib.pyplot as plt
 
     labels, rows = [], []
-    for truth, res in fig["truths"].items():
-        for cand, e in res["candidates"].items():
-            labels.append(f"{'right model' if cand == 'right' else cand} ({truth})")
-            rows.append((e["without_calibration"], e["with_calibration"]))
+    for _truth, label, _pre, e in _cal_rows(fig):
+        labels.append(f"{label} ({e['with_calibration']['replicates']})")
+        rows.append((e["without_calibration"], e["with_calibration"]))
     f, axes = plt.subplots(1, 3, figsize=(12, 0.45 * len(labels) + 1.6), sharey=True)
     y = list(range(len(labels)))
     h = 0.38
@@ -211,7 +207,7 @@ def cal_figure(fig: dict) -> None:
     for ax in axes:
         ax.set_xlim(0, 1.0)
         ax.set_xlabel("share of replicates")
-        ax.legend(fontsize=7, loc="lower right")
+        ax.legend(fontsize=7, loc="upper right")
     axes[0].set_yticks(y, labels, fontsize=8)
     axes[0].invert_yaxis()
     f.suptitle("kw calibrated on the earlier snapshot, validated at the later: "
