@@ -88,6 +88,12 @@ def main() -> None:
         help="--with-calibration --only: kw's prior ± this fraction instead of CAL_BENCH_SIZE's "
         "(a variant, merged apart under 'prior_variants')",
     )
+    parser.add_argument(
+        "--training-runs",
+        type=int,
+        default=None,
+        help="--with-calibration --prior-half-width: the variant's training runs (samples)",
+    )
     args = parser.parse_args()
     logging.disable(logging.WARNING)  # the adaptive update's noise warnings, once per run
     if args.with_calibration:
@@ -159,6 +165,8 @@ def _with_calibration(args: argparse.Namespace) -> None:
             loads[path.stem] = part["load_1min"]
             if "prior_half_width" in part:  # a variant: another prior, kept apart
                 key = f"kw prior ±{100 * part['prior_half_width']:.0f} %"
+                if part.get("training_runs"):
+                    key += f", {part['training_runs']} training runs"
                 into = merged.setdefault("prior_variants", {}).setdefault(key, {})
                 for name, truth in part["truths"].items():
                     into.setdefault(name, {}).update(truth["candidates"])
@@ -190,6 +198,9 @@ def _with_calibration(args: argparse.Namespace) -> None:
             if args.prior_half_width is not None:
                 slug += f"_prior{100 * args.prior_half_width:.0f}"
                 extra = {"prior_half_width": args.prior_half_width}
+                if args.training_runs is not None:
+                    slug += f"_runs{args.training_runs}"
+                    extra["training_runs"] = args.training_runs
             out = {**result, **extra, "load_1min": load}
             (parts / f"{slug}.json").write_text(json.dumps(out))
         else:
@@ -205,6 +216,8 @@ def _with_calibration(args: argparse.Namespace) -> None:
             parser_error = "--prior-half-width is a variant: give the candidates with --only"
             raise SystemExit(parser_error)
         size = replace(size, prior_half_width=args.prior_half_width)
+        if args.training_runs is not None:
+            size = replace(size, training_runs=args.training_runs)
     run_power_calibrated(
         size,
         folder=args.cache,

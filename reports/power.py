@@ -80,7 +80,8 @@ CALIBRATED_POWER = (
     " This simulation is a posterior prediction (calibrated, then validated): calibrating the "
     "wear coefficient absorbs a wrong depth scale by design, and with it any error a kw scale "
     "can imitate (measured: a 20 % speed error passed after calibration), while errors of the "
-    "wear's form were refused at calibration or still failed the wear field; the "
+    "wear's form were refused at calibration (relative to the stated prior of kw) or still "
+    "failed the wear field; the "
     "with-calibration table in the same section says how often, per error "
     "(benchmarks/bench_validation_power.py --with-calibration)."
 )
