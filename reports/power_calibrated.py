@@ -126,8 +126,9 @@ class CalibratedSize:
         return out
 
 
-#: CI: the reference truth at 1e5/2e5 cycles on 6 x 24 points, 2 right-model replicates, kw x 1.5
-#: (absorbed) and joint offset 0, 3 prediction runs, 4-member ensembles, no study
+#: CI: the reference truth calibrated at 2e5 and validated at 4e5 cycles on 10 x 36 points (the
+#: power CI size), 2 right-model replicates, kw x 1.5 (absorbed) and joint offset 0, 3 prediction
+#: runs, 4-member ensembles, no study; about 100 CPU s, most of it the 24 training runs per candidate
 CAL_CI_SIZE = CalibratedSize(
     pw.CI_SIZE, 2e5, 3, ("default",), {"default": ("kw x 1.5", "joint offset 0")},
     {"default": 2}, 1, wear_updates=8, paired=False,
