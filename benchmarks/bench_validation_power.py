@@ -193,7 +193,9 @@ def _with_calibration(args: argparse.Namespace) -> None:
         load = os.getloadavg()[0]
         if args.only:
             parts.mkdir(parents=True, exist_ok=True)
-            slug = "_".join("".join(ch if ch.isalnum() else "_" for ch in o) for o in args.only)
+            slug = "_".join(
+                "".join(ch if ch.isalnum() else "_" for ch in o) for o in (*args.truth, *args.only)
+            )
             extra = {}
             if args.prior_half_width is not None:
                 slug += f"_prior{100 * args.prior_half_width:.0f}"
@@ -209,6 +211,10 @@ def _with_calibration(args: argparse.Namespace) -> None:
             )
 
     size = CAL_BENCH_SIZE
+    if args.truth:  # another truth of CAL_BENCH_SIZE's lists (a part per truth and candidates)
+        if not args.only:
+            raise SystemExit("--with-calibration --truth: give the candidates with --only")
+        size = replace(size, truths=tuple(args.truth))
     if args.wrong_replicates is not None:
         size = replace(size, wrong_replicates=args.wrong_replicates)
     if args.prior_half_width is not None:

@@ -79,7 +79,8 @@ def power_paragraph(c: Any, notes: Sequence[str] = ()) -> str:
 CALIBRATED_POWER = (
     " This simulation is a posterior prediction (calibrated, then validated): calibrating the "
     "wear coefficient absorbs a wrong depth scale by design, and with it any error a kw scale "
-    "can imitate (measured: a 20 % speed error passed after calibration), while errors of the "
+    "can imitate (measured: a 20 % speed error passed after calibration on one of three truths), "
+    "while errors of the "
     "wear's form were refused at calibration (relative to the stated prior of kw) or still "
     "failed the wear field; the "
     "with-calibration table in the same section says how often, per error "

@@ -185,8 +185,8 @@ def cal_figure(fig: dict) -> None:
     import matplotlib.pyplot as plt
 
     labels, rows = [], []
-    for _truth, label, _pre, e in _cal_rows(fig):
-        labels.append(f"{label} ({e['with_calibration']['replicates']})")
+    for truth, label, _pre, e in _cal_rows(fig):
+        labels.append(f"{truth}: {label} ({e['with_calibration']['replicates']})")
         rows.append((e["without_calibration"], e["with_calibration"]))
     f, axes = plt.subplots(1, 3, figsize=(12, 0.45 * len(labels) + 1.6), sharey=True)
     y = list(range(len(labels)))
@@ -210,7 +210,7 @@ def cal_figure(fig: dict) -> None:
         ax.legend(fontsize=7, loc="upper right")
     axes[0].set_yticks(y, labels, fontsize=8)
     axes[0].invert_yaxis()
-    f.suptitle("kw calibrated on the earlier snapshot, validated at the later: "
+    f.suptitle("per truth: kw calibrated on the earlier snapshot, validated at the later; "
                "right model = false-fail rate", fontsize=10)  # fmt: skip
     f.tight_layout()
     f.savefig(CAL_IMG, dpi=110)
