@@ -377,10 +377,13 @@ def _outcome(c: Any) -> dict[str, Any]:
     }
 
 
-def _rates(outs: list[dict[str, Any]]) -> dict[str, Any]:
-    """Per criterion, the share of replicates where it failed / was decided; any-fail rate."""
+def _rates(outs: list[dict[str, Any]], n: int | None = None) -> dict[str, Any]:
+    """Per criterion, the share of replicates where it failed / was decided; any-fail rate.
+
+    ``n``: the replicates the shares are of (default: the outcomes; the with-calibration study
+    counts the replicates refused at calibration, which have no outcome, too)."""
     names = sorted({q for o in outs for q in o["states"]})
-    n = len(outs)
+    n = len(outs) if n is None else n
     return {
         "replicates": n,
         "any_fail": sum(o["n_fail"] > 0 for o in outs) / n,
@@ -526,13 +529,33 @@ def run_power(
         turned map's exit codes, the measurement's error against u_D; CPU seconds.
     """
     say = progress or (lambda _m: None)
+    return _each_truth(
+        asdict(size),
+        size.truths,
+        lambda name, work: _one_truth(size, name, work, say, keep),
+        folder,
+        on_truth,
+    )
+
+
+def _each_truth(
+    size_record: dict[str, Any],
+    truths: tuple[str, ...],
+    one_truth: Callable[[str, Path], dict[str, Any]],
+    folder: str | Path | None,
+    on_truth: Callable[[dict[str, Any]], None] | None,
+) -> dict[str, Any]:
+    """``one_truth(name, work)`` for every truth in the work folder ``folder`` (a temporary one
+    when None), the results so far handed to ``on_truth`` after each; CPU seconds in ``cpu_s``.
+    The loop of :func:`run_power` and of the with-calibration study
+    (:func:`jointwear.reports.power_calibrated.run_power_calibrated`)."""
     t0 = time.process_time()
-    result: dict[str, Any] = {"size": asdict(size), "truths": {}}
+    result: dict[str, Any] = {"size": size_record, "truths": {}}
     with tempfile.TemporaryDirectory() as tmp:
         work = Path(folder) if folder is not None else Path(tmp)
         work.mkdir(parents=True, exist_ok=True)
-        for name in size.truths:
-            result["truths"][name] = _one_truth(size, name, work, say, keep)
+        for name in truths:
+            result["truths"][name] = one_truth(name, work)
             result["cpu_s"] = time.process_time() - t0
             if on_truth is not None:
                 on_truth(result)

@@ -45,7 +45,6 @@ from __future__ import annotations
 
 import json
 import shutil
-import tempfile
 import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass
@@ -370,17 +369,14 @@ def calibrated_rates(reps: list[dict[str, Any]]) -> dict[str, Any]:
     """
     n = len(reps)
     outs = [x["outcome"] for x in reps if x["outcome"] is not None]
-    names = sorted({q for o in outs for q in o["states"]})
     ppc = sum(x["calibration"] == "refused_ppc" for x in reps)
     failed = sum(o["n_fail"] > 0 for o in outs)
     return {
-        "replicates": n,
+        **pw._rates(outs, n),  # replicates, any_fail, fail_rate, decided_rate: shares of all n
         "validated": len(outs),
         "refused_at_calibration": ppc / n,
         "not_decided": sum(x["calibration"] == "refused_other" for x in reps) / n,
-        "any_fail": failed / n,
         "detected": (failed + ppc) / n,
-        "fail_rate": {q: sum(o["states"].get(q) == "fail" for o in outs) / n for q in names},
     }
 
 
@@ -518,14 +514,10 @@ def run_power_calibrated(
         same maps); CPU seconds.
     """
     say = progress or (lambda _m: None)
-    t0 = time.process_time()
-    result: dict[str, Any] = {"size": size.describe(), "truths": {}}
-    with tempfile.TemporaryDirectory() as tmp:
-        work = Path(folder) if folder is not None else Path(tmp)
-        work.mkdir(parents=True, exist_ok=True)
-        for name in size.truths:
-            result["truths"][name] = _one_truth(size, name, work, say, only)
-            result["cpu_s"] = time.process_time() - t0
-            if on_truth is not None:
-                on_truth(result)
-    return result
+    return pw._each_truth(
+        size.describe(),
+        size.truths,
+        lambda name, work: _one_truth(size, name, work, say, only),
+        folder,
+        on_truth,
+    )
