@@ -336,7 +336,7 @@ def _sample_quadratic_warp(f, gx, gy, def_coef, def_invalid, order, xc, yc, half
 @njit(cache=True, inline="always")
 def _iterate(
     f, gx, gy, fn, Hinv, jf, js, def_coef, def_invalid, order, xc, yc, half, p, max_iter, tol,
-    max_shift, border, w, quadratic, scale,
+    max_shift, border, w, quadratic, scale, rho,
 ):  # fmt: skip
     """Gauss-Newton iterations of the IC-GN from the loaded reference subset, affine or
     second order (``quadratic``); :func:`_iterate_affine` and :func:`_iterate_quadratic` are
@@ -354,6 +354,15 @@ def _iterate(
     that. The solution (where ``sum J_c e = 0``) is the same: on 2 grey levels of noise the
     matches move by less than the tolerance and the iterations fall from 2.5-2.9 to 2.0
     (``benchmarks/bench_dic2d.py``).
+
+    Convergence: the iterations stop when the predicted remaining error ``rho |dp|`` of the
+    last step ``dp`` (:func:`_step_norm`, pixels at the subset's edge) falls below ``tol``.
+    ``rho`` is the contraction of one iteration (the ratio of successive steps): 1, the
+    classic criterion ``|dp| < tol`` of Pan, Li & Tong (2013), which assumes nothing about it;
+    the propagation passes the contraction it measured on the first points it solved (see
+    :func:`~jointwear.dic.icgn._drive.rg_propagate`), which stops most points one iteration
+    earlier, a verification step that would have moved them by about ``rho |dp|``. The first
+    two step norms are left in ``w[3, 0]`` and ``w[3, 1]`` (NaN when not taken).
     """
     box = _valid_box(def_coef, border)
     n = (2 * half + 1) ** 2
@@ -386,7 +395,10 @@ def _iterate(
             return zncc, it, FLAG_DIVERGED
         if _diverged(p, p_start_u, p_start_v, max_shift):
             return np.nan, it, FLAG_DIVERGED
-        if _step_norm(dp, half, quadratic) < tol:
+        step = _step_norm(dp, half, quadratic)
+        if it <= 2:
+            w[3, it - 1] = step
+        if rho * step < tol:
             _store_sigma(w, fn, zncc, n, m, Hinv[0, 0], Hinv[m // 2, m // 2])
             return zncc, it, FLAG_OK
     return zncc, it, FLAG_NOT_CONVERGED
@@ -398,11 +410,11 @@ def _specialise(name: str, quadratic: bool, doc: str, **jit_options):
 
     def iterate(
         f, gx, gy, fn, Hinv, jf, js, def_coef, def_invalid, order, xc, yc, half, p, max_iter,
-        tol, max_shift, border, w, scale,
+        tol, max_shift, border, w, scale, rho,
     ):  # fmt: skip
         return _iterate(
             f, gx, gy, fn, Hinv, jf, js, def_coef, def_invalid, order, xc, yc, half, p,
-            max_iter, tol, max_shift, border, w, quadratic, scale,
+            max_iter, tol, max_shift, border, w, quadratic, scale, rho,
         )  # fmt: skip
 
     iterate.__name__ = iterate.__qualname__ = name
@@ -429,19 +441,21 @@ def make_work(half):
 
 
 @njit(cache=True)
-def solve_point(ref, dfm, opts, xc, yc, p, work, scale):
+def solve_point(ref, dfm, opts, xc, yc, p, work, scale, rho=1.0):
     """Match one subset centred at (xc, yc) of the reference; refines ``p`` (12,) in place.
 
     ``work`` comes from :func:`make_work`; ``scale`` multiplies the Gauss-Newton steps (the
-    subset's kappa, see :func:`_iterate`). Returns ``(zncc, iterations, flag)``; the standard
-    uncertainty of (u, v) is left in ``work[4][3, 4:6]`` (NaN unless ok).
+    subset's kappa, see :func:`_iterate`); ``rho`` the contraction per iteration the
+    convergence test may assume (1: the classic test, see :func:`_iterate`). Returns
+    ``(zncc, iterations, flag)``; the standard uncertainty of (u, v) is left in
+    ``work[4][3, 4:6]`` (NaN unless ok), the first two step norms in ``work[4][3, 0:2]``.
     """
     ref_img, ref_gx, ref_gy, ref_coef, ref_invalid = ref
     def_coef, def_invalid = dfm
     half, quadratic, max_iter, tol, min_std, max_shift, border, _, order = opts
     f, gx, gy, _g, w = work
-    w[3, 4] = np.nan
-    w[3, 5] = np.nan
+    for q in (0, 1, 4, 5):
+        w[3, q] = np.nan
     flag0, fn = _load_reference(
         ref_img, ref_gx, ref_gy, ref_coef, ref_invalid, order, xc, yc, half, min_std, border,
         f, gx, gy, w,
@@ -457,11 +471,11 @@ def solve_point(ref, dfm, opts, xc, yc, p, work, scale):
             return np.nan, 0, FLAG_NO_TEXTURE
         return _iterate_quadratic(
             f, gx, gy, fn, Hinv, jf, js, def_coef, def_invalid, order, xc, yc, half, p,
-            max_iter, tol, max_shift, border, w, scale,
+            max_iter, tol, max_shift, border, w, scale, rho,
         )  # fmt: skip
     if not _affine_system(f, gx, gy, half, Hinv, jf, js):
         return np.nan, 0, FLAG_NO_TEXTURE
     return _iterate_affine(
         f, gx, gy, fn, Hinv, jf, js, def_coef, def_invalid, order, xc, yc, half, p, max_iter,
-        tol, max_shift, border, w, scale,
+        tol, max_shift, border, w, scale, rho,
     )  # fmt: skip
