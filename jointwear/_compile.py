@@ -31,14 +31,17 @@ start: a command then loads its cached kernels without building numba's whole co
 
 from __future__ import annotations
 
+import contextlib
+import importlib.abc
+import importlib.machinery
 import os
 import sys
 import time
 from pathlib import Path
-from typing import TYPE_CHECKING, TextIO
+from typing import TYPE_CHECKING, Any, TextIO
 
 if TYPE_CHECKING:
-    from collections.abc import Sequence
+    from collections.abc import Iterator, Sequence
 
 __all__ = [
     "GROUPS",
@@ -419,21 +422,47 @@ class _Progress:
             pass
 
 
-def _blas_without_scipy_linalg() -> None:
-    """Import ``numba.np.arraymath`` (a cached kernel's environment may name it) without its
-    check for BLAS, which imports ``scipy.linalg`` (0.15 CPU s) to find it: scipy is a
-    dependency, so BLAS is there. numba checks again, for real, before it compiles a call to
-    BLAS."""
-    if "numba.np.arraymath" in sys.modules:
-        return
-    from numba.np import linalg
+class _ArraymathWithoutBlasProbe(importlib.abc.MetaPathFinder):
+    """While a cached kernel loads: ``numba.np.arraymath``, if the kernel's environment names it,
+    imported without its check for BLAS, which imports ``scipy.linalg`` (0.15 CPU s) to find it:
+    scipy is a dependency, so BLAS is there, and numba checks again, for real, before it
+    compiles a call to BLAS. A kernel that does not name it (none of ``dic correlate``'s) does
+    not import it, nor ``numba.np.linalg`` under it (0.03 CPU s)."""
 
-    check = linalg.ensure_blas
-    linalg.ensure_blas = lambda: None
+    def find_spec(self, name: str, path: Any, target: Any = None) -> Any:
+        if name != "numba.np.arraymath":
+            return None
+        spec = importlib.machinery.PathFinder.find_spec(name, path)
+        if spec is None or spec.loader is None:
+            return spec
+        exec_module = spec.loader.exec_module
+
+        def exec_without_probe(module: Any) -> None:
+            from numba.np import linalg
+
+            check = linalg.ensure_blas
+            linalg.ensure_blas = lambda: None
+            try:
+                exec_module(module)
+            finally:
+                linalg.ensure_blas = check
+
+        spec.loader.exec_module = exec_without_probe  # type: ignore[method-assign]
+        return spec
+
+
+@contextlib.contextmanager
+def _arraymath_without_blas_probe() -> Iterator[None]:
+    """:class:`_ArraymathWithoutBlasProbe` on the import path for the ``with`` block only."""
+    if "numba.np.arraymath" in sys.modules:
+        yield
+        return
+    finder = _ArraymathWithoutBlasProbe()
+    sys.meta_path.insert(0, finder)
     try:
-        import numba.np.arraymath  # noqa: F401
+        yield
     finally:
-        linalg.ensure_blas = check
+        sys.meta_path.remove(finder)
 
 
 def light_cache_loads() -> None:
@@ -457,9 +486,8 @@ def light_cache_loads() -> None:
         try:
             from numba.core.runtime import rtsys
 
-            _blas_without_scipy_linalg()
             rtsys.initialize(target_context)
-            with self._guard_against_spurious_io_errors():
+            with self._guard_against_spurious_io_errors(), _arraymath_without_blas_probe():
                 loaded = self._load_overload(sig, target_context)
         except Exception:  # not as this numba expects: its own way
             return original(self, sig, target_context)

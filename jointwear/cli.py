@@ -9,6 +9,7 @@ stderr; the traceback only with ``--debug``).
 
 from __future__ import annotations
 
+import gc
 import os
 import signal
 import sys
@@ -158,9 +159,34 @@ def _quiet_broken_pipe() -> None:
         pass
 
 
+#: The ``jointwear`` script's garbage collector: young collections every 10,000 allocations
+#: instead of 700. A command that computes imports some 700 modules, whose objects live until
+#: the process ends; with the default thresholds the collector walks them again and again while
+#: they are imported (about 0.02 CPU s of a ``dic correlate``, ``benchmarks/bench_startup.py``).
+#: At most that many young objects wait a little longer for their collection.
+SCRIPT_GC_THRESHOLD = (10_000, 10, 10)
+
+
+def _script_exit_gc() -> None:
+    """The script's process ends: every object is frozen (``gc.freeze``), so that the
+    interpreter's last collections at exit skip them (about 0.07 CPU s of a ``dic correlate``,
+    a tenth of its start-up). Everything is still released as the interpreter tears its modules
+    down (open files flushed and closed); only reference cycles are left to the operating
+    system, which the interpreter does not promise to finalise at exit either."""
+    gc.freeze()
+
+
 def main(argv: list[str] | None = None) -> int:
-    """Entry point of the ``jointwear`` script; returns the exit code."""
+    """Entry point of the ``jointwear`` script; returns the exit code.
+
+    Without ``argv`` (the script, ``python -m jointwear``) the process is the command's: the
+    garbage collector runs with :data:`SCRIPT_GC_THRESHOLD` and the objects are frozen at the
+    end (:func:`_script_exit_gc`). ``main([...])`` in a caller's process leaves both as they
+    are.
+    """
     args = sys.argv[1:] if argv is None else list(argv)
+    if argv is None:
+        gc.set_threshold(*SCRIPT_GC_THRESHOLD)
     debug = "--debug" in args
     compiled = announce_compilation()
     _STATE["signal"] = None
@@ -224,6 +250,8 @@ def main(argv: list[str] | None = None) -> int:
             except OSError:
                 pass
         _redeliver(argv)
+        if argv is None:
+            _script_exit_gc()
     return 0
 
 

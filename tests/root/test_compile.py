@@ -224,6 +224,64 @@ def test_a_cli_process_loads_cached_kernels_without_numba_s_whole_compiler(toy):
     assert run.stdout.split("LIGHT")[-1].split() == ["2", "True"]
 
 
+#: A loop kernel and a median kernel, whose cached environment names ``numba.np.arraymath``.
+NUMPY_TOY = """
+import numpy as np
+from numba import njit
+
+
+@njit(cache=True)
+def loop(a):
+    s = 0.0
+    for x in a:
+        s += x
+    return s
+
+
+@njit(cache=True)
+def median(a):
+    return np.median(a)
+"""
+
+#: In a CLI process: after each load, whether numba's array-math and linear-algebra modules and
+#: scipy.linalg are imported.
+NUMPY_LOADS = """
+import sys
+import numpy as np
+import jointwear.cli
+import numpy_toy as t
+
+
+def loaded():
+    names = ("numba.np.arraymath", "numba.np.linalg", "scipy.linalg")
+    return [name in sys.modules for name in names]
+
+
+a = np.array([4.0, 1.0, 3.0])
+assert t.loop(a) == 8.0
+after_loop = loaded()
+assert t.median(a) == 3.0
+hits = sum(t.loop.stats.cache_hits.values()) + sum(t.median.stats.cache_hits.values())
+print("LOADS", hits, after_loop, loaded())
+"""
+
+
+def test_a_cached_kernel_loads_numba_s_array_math_only_if_it_names_it(tmp_path, monkeypatch):
+    """The loop kernel loads without numba.np.arraymath and numba.np.linalg (0.03 CPU s of a
+    ``dic correlate``, whose kernels name neither); the median kernel's environment names
+    arraymath, which is then imported without its BLAS probe (no scipy.linalg)."""
+    (tmp_path / "numpy_toy.py").write_text(NUMPY_TOY)
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path / "cache"))
+    monkeypatch.setenv(_compile.SWITCH, "0")
+    first = "import numpy as np, numpy_toy as t\nt.loop(np.ones(2)); t.median(np.ones(2))"
+    subprocess.run([sys.executable, "-c", first], cwd=tmp_path, check=True)  # caches both
+    run = subprocess.run(
+        [sys.executable, "-c", NUMPY_LOADS], cwd=tmp_path, capture_output=True, text=True
+    )
+    assert run.returncode == 0, run.stderr
+    assert run.stdout.split("LOADS")[-1].strip() == "2 [False, False, False] [True, True, False]"
+
+
 def test_several_hooks_after_one_import(tmp_path, monkeypatch):
     """Two start-up hooks on one module both run (the CLI's compile notice and its light cache
     loads are both on numba)."""
