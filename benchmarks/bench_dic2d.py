@@ -206,6 +206,7 @@ def versus_pyvale(repeat: int = 3) -> None:
     from importlib.metadata import version
 
     tmp = Path(tempfile.mkdtemp())
+    os.chdir(tmp)  # pyvale writes a log file into the working directory when imported
     pairs = {
         "noise_free": sp.speckle_pair((512, 512), sp.RigidField(SHIFT), seed=1),
         "noise_2gl": sp.speckle_pair(

@@ -7,6 +7,7 @@ hoists the branch out of the pixel loop and each order runs its own straight-lin
 
 from __future__ import annotations
 
+import numpy as np
 from numba import njit
 
 from jointwear.dic.icgn._interp import PAD
@@ -81,21 +82,91 @@ def add_row_sums(out, o, s, sc, rr):
     out[o + 2] += s * rr
 
 
+@njit(cache=True, inline="always")
+def _row_nodes(order, x0, y0, a11, a21, size, col, row, wx, wy):
+    """Pass 1 of a subset row: for pixel ``j`` at ``(x0 + a11 j, y0 + a21 j)``, the first
+    node's column and row on the padded coefficients and the B-spline weights along x and y
+    (``wx[:, j]``, ``wy[:, j]``; 4 cubic, 6 quintic). Independent per pixel: it vectorises."""
+    if order == 3:
+        for j in range(size):
+            xw = x0 + a11 * j
+            yw = y0 + a21 * j
+            ix = int(xw)
+            iy = int(yw)
+            col[j] = ix + PAD - 1
+            row[j] = iy + PAD - 1
+            wx[0, j], wx[1, j], wx[2, j], wx[3, j] = bspline3(xw - ix)
+            wy[0, j], wy[1, j], wy[2, j], wy[3, j] = bspline3(yw - iy)
+    else:
+        for j in range(size):
+            xw = x0 + a11 * j
+            yw = y0 + a21 * j
+            ix = int(xw)
+            iy = int(yw)
+            col[j] = ix + PAD - 2
+            row[j] = iy + PAD - 2
+            wx[0, j], wx[1, j], wx[2, j], wx[3, j], wx[4, j], wx[5, j] = bspline5(xw - ix)
+            wy[0, j], wy[1, j], wy[2, j], wy[3, j], wy[4, j], wy[5, j] = bspline5(yw - iy)
+
+
+@njit(cache=True, inline="always")
+def _row_taps(coef, order, size, col, row, wx, wy, g):
+    """Pass 2 of a subset row: the spline values ``g[j]`` from pass 1's nodes and weights
+    (the 16 or 36 taps, each coefficient row read contiguously)."""
+    if order == 3:
+        for j in range(size):
+            bx = col[j]
+            by = row[j]
+            acc = 0.0
+            for q in range(4):
+                rw = coef[by + q]
+                acc += wy[q, j] * (
+                    (wx[0, j] * rw[bx] + wx[1, j] * rw[bx + 1])
+                    + (wx[2, j] * rw[bx + 2] + wx[3, j] * rw[bx + 3])
+                )
+            g[j] = acc * (1.0 / 36.0)
+    else:
+        for j in range(size):
+            bx = col[j]
+            by = row[j]
+            acc = 0.0
+            for q in range(6):
+                rw = coef[by + q]
+                acc += wy[q, j] * (
+                    (wx[0, j] * rw[bx] + wx[1, j] * rw[bx + 1])
+                    + (wx[2, j] * rw[bx + 2] + wx[3, j] * rw[bx + 3])
+                    + (wx[4, j] * rw[bx + 4] + wx[5, j] * rw[bx + 5])
+                )
+            g[j] = acc * (1.0 / 14400.0)
+
+
 @njit(cache=True, fastmath=_FM)
 def sample_affine(coef, order, x_start, y_start, a11, a12, a21, a22, half, f, gx, gy, acc):
     """Sample the affinely warped subset and accumulate into ``acc`` (9,): sum g, sum g^2,
-    sum g f and the six sums J g (J = gradient times (1, column, row))."""
+    sum g f and the six sums J g (J = gradient times (1, column, row)).
+
+    Each subset row in three passes: nodes and weights of all its pixels (vectorised), the
+    taps, then the sums; about 30 % faster than one pixel at a time, where each pixel's
+    weights, taps and sums form one long dependent chain (``benchmarks/bench_dic2d.py``)."""
+    size = 2 * half + 1
+    col = np.empty(size, dtype=np.int64)
+    row = np.empty(size, dtype=np.int64)
+    wx = np.empty((6, size))
+    wy = np.empty((6, size))
+    g = np.empty(size)
     for i in range(9):
         acc[i] = 0.0
-    k = 0
+    k0 = 0
     for r in range(-half, half + 1):
         rr = float(r)
-        xw = x_start + a12 * rr
-        yw = y_start + a22 * rr
+        _row_nodes(order, x_start + a12 * rr, y_start + a22 * rr, a11, a21, size, col, row, wx, wy)
+        _row_taps(coef, order, size, col, row, wx, wy, g)
         ga = gac = gb = gbc = 0.0
         sg = sgg = sgf = 0.0
-        for c in range(-half, half + 1):
-            gv = interp_point(coef, order, xw, yw)
+        for j in range(size):
+            gv = g[j]
+            k = k0 + j
+            c = float(j - half)
             sg += gv
             sgg += gv * gv
             sgf += gv * f[k]
@@ -105,9 +176,7 @@ def sample_affine(coef, order, x_start, y_start, a11, a12, a21, a22, half, f, gx
             q = gy[k] * gv
             gb += q
             gbc += q * c
-            xw += a11
-            yw += a21
-            k += 1
+        k0 += size
         acc[0] += sg
         acc[1] += sgg
         acc[2] += sgf
