@@ -31,11 +31,34 @@ def _store_point(i, p, z, it, fl, w, zncc_min, P, out):
     sigma[i, 1] = w[3, 5]
 
 
+#: points of a propagation group that measure the IC-GN's contraction with the classic
+#: convergence test before the group's later points may assume it
+CONTRACTION_PROBES = 16
+#: smallest contraction assumed (the test then stops at a step of 20 x the tolerance)
+CONTRACTION_FLOOR = 0.05
+
+
+@njit(cache=True, inline="always")
+def _measure_contraction(probe, it, fl, w):
+    """Update a propagation group's contraction probe ``probe`` = (points measured, largest ratio, rho in
+    use) with one solved point: a point that converged (classic test) after two iterations or
+    more gives the ratio of its last step to the one before (``w[3, 0:2]``; the last steps,
+    nearest to the solution, where the Gauss-Newton converges linearly). After
+    ``CONTRACTION_PROBES`` such points, rho = the largest ratio (at least the floor)."""
+    if probe[0] < CONTRACTION_PROBES and fl == FLAG_OK and it >= 2 and w[3, 0] > 0.0:
+        probe[1] = max(probe[1], w[3, 1] / w[3, 0])
+        probe[0] += 1.0
+        if probe[0] == CONTRACTION_PROBES:
+            probe[2] = min(max(probe[1], CONTRACTION_FLOOR), 1.0)
+
+
 @njit(cache=True)
 def _refine_chunk(ch, n_chunks, ref, dfm, opts, centres, scale, P, active, out):
     """Refine the active points ``ch, ch + n_chunks, ...`` from ``P[i]`` (in place);
     ``scale[i]`` multiplies point i's Gauss-Newton steps (its kappa, see
-    :func:`~jointwear.dic.icgn._solve._iterate`)."""
+    :func:`~jointwear.dic.icgn._solve._iterate`), with the classic convergence test: guessed
+    points often share their start offset (a previous frame's field), so stopping them short
+    (see :func:`rg_propagate`) would leave a common bias rather than scatter."""
     n = centres.shape[0]
     work = make_work(opts[0])
     p = np.empty(12)
@@ -127,12 +150,6 @@ def icgn_affine_loaded(loaded, dfm, opts, centres, scale, P, active, out):
 
 # ---------------------------------------------------------------- reliability-guided propagation
 
-#: points of a propagation that measure the IC-GN's contraction (with the classic convergence
-#: test) before the others may assume it
-CONTRACTION_PROBES = 16
-#: smallest contraction assumed (the test then stops at a step of 20 x the tolerance)
-CONTRACTION_FLOOR = 0.05
-
 
 @njit(cache=True)
 def _heap_push(keys, vals, size, key, val):
@@ -186,9 +203,7 @@ def _propagate_group(g, group, ref, dfm, opts, centres, scale, nb_ptr, nb_idx, P
     guess = np.empty(12)
     work = make_work(opts[0])
     w = work[4]
-    rho = 1.0  # the classic test until CONTRACTION_PROBES points have measured the contraction
-    probes = 0
-    rho_max = 0.0
+    probe = np.array([0.0, 0.0, 1.0])  # points measured, largest ratio, rho in use
     while size > 0:
         i, size = _heap_pop(keys, vals, size)
         for q in range(nb_ptr[i], nb_ptr[i + 1]):
@@ -197,15 +212,10 @@ def _propagate_group(g, group, ref, dfm, opts, centres, scale, nb_ptr, nb_idx, P
                 continue
             _extrapolate(P[i], centres[j, 0] - centres[i, 0], centres[j, 1] - centres[i, 1], guess)
             z, it, fl = solve_point(
-                ref, dfm, opts, centres[j, 0], centres[j, 1], guess, work, scale[j], rho
+                ref, dfm, opts, centres[j, 0], centres[j, 1], guess, work, scale[j], probe[2]
             )
             done[j] = True
-            if probes < CONTRACTION_PROBES and fl == FLAG_OK and it >= 2 and w[3, 0] > 0.0:
-                # the ratio of the second step to the first: the contraction per iteration
-                rho_max = max(rho_max, w[3, 1] / w[3, 0])
-                probes += 1
-                if probes == CONTRACTION_PROBES:
-                    rho = min(max(rho_max, CONTRACTION_FLOOR), 1.0)
+            _measure_contraction(probe, it, fl, w)
             _store_point(j, guess, z, it, fl, w, opts[7], P, out)
             if flags[j] == FLAG_OK:
                 size = _heap_push(keys, vals, size, z, j)
@@ -220,7 +230,7 @@ def rg_propagate(n_groups, group, ref, dfm, opts, centres, scale, nb_ptr, nb_idx
 
     Convergence: each group's first ``CONTRACTION_PROBES`` points that take two iterations or
     more run the classic test (step below the tolerance) and measure the contraction per
-    iteration, the ratio of their second step to their first; the group's later points stop
+    iteration, the ratio of their last step to the one before; the group's later points stop
     when the step times the largest ratio measured (at least ``CONTRACTION_FLOOR``) is below
     the tolerance (:func:`~jointwear.dic.icgn._solve._iterate`). From a neighbour's solution
     the first step is the noise of that neighbour and the contraction 0.02-0.05 (affine; up to

@@ -359,9 +359,9 @@ def _iterate(
     last step ``dp`` (:func:`_step_norm`, pixels at the subset's edge) falls below ``tol``.
     ``rho`` is the contraction of one iteration (the ratio of successive steps): 1, the
     classic criterion ``|dp| < tol`` of Pan, Li & Tong (2013), which assumes nothing about it;
-    the propagation passes the contraction it measured on the first points it solved (see
+    the propagation passes the contraction it measured on each group's first points (see
     :func:`~jointwear.dic.icgn._drive.rg_propagate`), which stops most points one iteration
-    earlier, a verification step that would have moved them by about ``rho |dp|``. The first
+    earlier, a verification step that would have moved them by about ``rho |dp|``. The last
     two step norms are left in ``w[3, 0]`` and ``w[3, 1]`` (NaN when not taken).
     """
     box = _valid_box(def_coef, border)
@@ -396,8 +396,8 @@ def _iterate(
         if _diverged(p, p_start_u, p_start_v, max_shift):
             return np.nan, it, FLAG_DIVERGED
         step = _step_norm(dp, half, quadratic)
-        if it <= 2:
-            w[3, it - 1] = step
+        w[3, 0] = w[3, 1]  # the last two step norms: the contraction is their ratio
+        w[3, 1] = step
         if rho * step < tol:
             _store_sigma(w, fn, zncc, n, m, Hinv[0, 0], Hinv[m // 2, m // 2])
             return zncc, it, FLAG_OK
@@ -448,7 +448,7 @@ def solve_point(ref, dfm, opts, xc, yc, p, work, scale, rho=1.0):
     subset's kappa, see :func:`_iterate`); ``rho`` the contraction per iteration the
     convergence test may assume (1: the classic test, see :func:`_iterate`). Returns
     ``(zncc, iterations, flag)``; the standard uncertainty of (u, v) is left in
-    ``work[4][3, 4:6]`` (NaN unless ok), the first two step norms in ``work[4][3, 0:2]``.
+    ``work[4][3, 4:6]`` (NaN unless ok), the last two step norms in ``work[4][3, 0:2]``.
     """
     ref_img, ref_gx, ref_gy, ref_coef, ref_invalid = ref
     def_coef, def_invalid = dfm
