@@ -40,15 +40,16 @@ CONTRACTION_FLOOR = 0.05
 
 @njit(cache=True, inline="always")
 def _measure_contraction(probe, it, fl, w):
-    """Update a propagation group's contraction probe ``probe`` = (points measured, largest ratio, rho in
-    use) with one solved point: a point that converged (classic test) after two iterations or
-    more gives the ratio of its last step to the one before (``w[3, 0:2]``; the last steps,
-    nearest to the solution, where the Gauss-Newton converges linearly). After
-    ``CONTRACTION_PROBES`` such points, rho = the largest ratio (at least the floor)."""
-    if probe[0] < CONTRACTION_PROBES and fl == FLAG_OK and it >= 2 and w[3, 0] > 0.0:
+    """Update a propagation group's contraction probe ``probe`` = (points measured, largest
+    ratio, rho in use, points to measure) with one solved point: a point that converged with
+    the classic test after two iterations or more gives the ratio of its last step to the one
+    before (``w[3, 0:2]``; the last steps, nearest to the solution, where the Gauss-Newton
+    converges linearly). Once ``probe[3]`` points have, rho = the largest ratio (at least
+    ``CONTRACTION_FLOOR``); ``probe[3] <= 0`` keeps the classic test."""
+    if probe[0] < probe[3] and fl == FLAG_OK and it >= 2 and w[3, 0] > 0.0:
         probe[1] = max(probe[1], w[3, 1] / w[3, 0])
         probe[0] += 1.0
-        if probe[0] == CONTRACTION_PROBES:
+        if probe[0] == probe[3]:
             probe[2] = min(max(probe[1], CONTRACTION_FLOOR), 1.0)
 
 
@@ -190,7 +191,9 @@ def _heap_pop(keys, vals, size):
 
 
 @njit(cache=True)
-def _propagate_group(g, group, ref, dfm, opts, centres, scale, nb_ptr, nb_idx, P, out, done):
+def _propagate_group(
+    g, group, ref, dfm, opts, centres, scale, nb_ptr, nb_idx, P, out, done, probes
+):
     """Propagation within group ``g`` (all points when ``g < 0``), see :func:`rg_propagate`."""
     zncc, _, flags, _ = out
     n = centres.shape[0]
@@ -203,7 +206,8 @@ def _propagate_group(g, group, ref, dfm, opts, centres, scale, nb_ptr, nb_idx, P
     guess = np.empty(12)
     work = make_work(opts[0])
     w = work[4]
-    probe = np.array([0.0, 0.0, 1.0])  # points measured, largest ratio, rho in use
+    # points measured, largest ratio, rho in use, points to measure
+    probe = np.array([0.0, 0.0, 1.0, float(probes)])
     while size > 0:
         i, size = _heap_pop(keys, vals, size)
         for q in range(nb_ptr[i], nb_ptr[i + 1]):
@@ -222,22 +226,30 @@ def _propagate_group(g, group, ref, dfm, opts, centres, scale, nb_ptr, nb_idx, P
 
 
 @njit(cache=True, parallel=True)
-def rg_propagate(n_groups, group, ref, dfm, opts, centres, scale, nb_ptr, nb_idx, P, out, done):
+def rg_propagate(
+    n_groups, group, ref, dfm, opts, centres, scale, nb_ptr, nb_idx, P, out, done, probes
+):
     """Reliability-guided propagation: from the solved (``done`` and ok) points of each group,
     always extend from the best-correlated point to its unsolved neighbours (guess = its
     parameters extrapolated). Groups run in parallel; ``n_groups = 0`` runs one global pass
     ignoring groups.
 
-    Convergence: each group's first ``CONTRACTION_PROBES`` points that take two iterations or
-    more run the classic test (step below the tolerance) and measure the contraction per
-    iteration, the ratio of their last step to the one before; the group's later points stop
-    when the step times the largest ratio measured (at least ``CONTRACTION_FLOOR``) is below
-    the tolerance (:func:`~jointwear.dic.icgn._solve._iterate`). From a neighbour's solution
-    the first step is the noise of that neighbour and the contraction 0.02-0.05 (affine; up to
-    0.4 with the second-order shape on a wave, or at 5 grey levels of noise on a low-contrast
-    pattern), so most points stop after one iteration instead of two."""
+    Convergence: each group's first ``probes`` points (``CONTRACTION_PROBES`` in the
+    correlator; 0 keeps the classic test throughout) that take two iterations or more run the
+    classic test (step below the tolerance) and measure the contraction per iteration, the
+    ratio of their last step to the one before; the group's later points may also stop on
+    their first or second step when it times the largest ratio measured (at least
+    ``CONTRACTION_FLOOR``) is below the tolerance (:func:`~jointwear.dic.icgn._solve._iterate`).
+    From a neighbour's solution the first step is the noise of that neighbour and the
+    contraction 0.02-0.05 (affine; up to 0.4 with the second-order shape on a wave, or at 5
+    grey levels of noise on a low-contrast pattern), so most points stop after one iteration
+    instead of two."""
     if n_groups == 0:
-        _propagate_group(-1, group, ref, dfm, opts, centres, scale, nb_ptr, nb_idx, P, out, done)
+        _propagate_group(
+            -1, group, ref, dfm, opts, centres, scale, nb_ptr, nb_idx, P, out, done, probes
+        )
         return
     for g in prange(n_groups):
-        _propagate_group(g, group, ref, dfm, opts, centres, scale, nb_ptr, nb_idx, P, out, done)
+        _propagate_group(
+            g, group, ref, dfm, opts, centres, scale, nb_ptr, nb_idx, P, out, done, probes
+        )

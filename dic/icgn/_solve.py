@@ -334,6 +334,16 @@ def _sample_quadratic_warp(f, gx, gy, def_coef, def_invalid, order, xc, yc, half
 
 
 @njit(cache=True, inline="always")
+def _contracting(it, step, previous):
+    """May a point stop on an assumed contraction after its ``it``-th step (norm ``step``,
+    ``previous`` the one before)? Only on its first step (nothing of its own is known yet) or
+    on its second if that halved the first: a point still iterating after two steps, or whose
+    steps do not shrink, is wandering (weak texture, a wrong basin), and stopping it on a small
+    step would report a point that never converged."""
+    return it == 1 or (it == 2 and step <= 0.5 * previous)
+
+
+@njit(cache=True, inline="always")
 def _iterate(
     f, gx, gy, fn, Hinv, jf, js, def_coef, def_invalid, order, xc, yc, half, p, max_iter, tol,
     max_shift, border, w, quadratic, scale, rho,
@@ -355,10 +365,11 @@ def _iterate(
     matches move by less than the tolerance and the iterations fall from 2.5-2.9 to 2.0
     (``benchmarks/bench_dic2d.py``).
 
-    Convergence: the iterations stop when the predicted remaining error ``rho |dp|`` of the
-    last step ``dp`` (:func:`_step_norm`, pixels at the subset's edge) falls below ``tol``.
-    ``rho`` is the contraction of one iteration (the ratio of successive steps): 1, the
-    classic criterion ``|dp| < tol`` of Pan, Li & Tong (2013), which assumes nothing about it;
+    Convergence: the iterations stop when the last step ``dp`` (:func:`_step_norm`, pixels at
+    the subset's edge) is below ``tol``, the classic criterion of Pan, Li & Tong (2013), or
+    when its predicted remaining error ``rho |dp|`` is, on the point's first or second step
+    only (:func:`_contracting`). ``rho`` is the contraction of one iteration (the ratio of
+    successive steps): 1 assumes nothing about it (the classic criterion alone);
     the propagation passes the contraction it measured on each group's first points (see
     :func:`~jointwear.dic.icgn._drive.rg_propagate`), which stops most points one iteration
     earlier, a verification step that would have moved them by about ``rho |dp|``. The last
@@ -398,7 +409,7 @@ def _iterate(
         step = _step_norm(dp, half, quadratic)
         w[3, 0] = w[3, 1]  # the last two step norms: the contraction is their ratio
         w[3, 1] = step
-        if rho * step < tol:
+        if step < tol or (rho * step < tol and _contracting(it, step, w[3, 0])):
             _store_sigma(w, fn, zncc, n, m, Hinv[0, 0], Hinv[m // 2, m // 2])
             return zncc, it, FLAG_OK
     return zncc, it, FLAG_NOT_CONVERGED

@@ -105,6 +105,11 @@ class SubsetCorrelator:
         All options; keyword arguments (``subset_size=...``) override its fields.
     """
 
+    #: points per propagation group that measure the IC-GN's contraction before the others
+    #: may assume it (None: ``CONTRACTION_PROBES``; 0: the classic convergence test only; see
+    #: :func:`jointwear.dic.icgn._drive.rg_propagate`)
+    _contraction_probes: int | None = None
+
     def __init__(
         self,
         reference: np.ndarray,
@@ -330,6 +335,7 @@ class SubsetCorrelator:
 
     def _propagate(self, dspl, dinv, st, done, group, n_groups):
         from jointwear.dic import icgn as _icgn
+        from jointwear.dic.icgn import _drive
 
         ref, dfm = self._kernel_args(dspl, dinv)
         _icgn.rg_propagate(
@@ -345,6 +351,9 @@ class SubsetCorrelator:
             st.params,
             (st.zncc, st.iterations, st.flag, st.sigma),
             done,
+            _drive.CONTRACTION_PROBES
+            if self._contraction_probes is None
+            else int(self._contraction_probes),
         )
 
     def _retry_failed(self, dspl, dinv, st, done, group) -> None:

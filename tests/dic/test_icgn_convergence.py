@@ -126,9 +126,33 @@ def test_solve_point_classic_test_and_assumed_contraction():
         assert rho * w[3, 1] < tol  # the last step
         if it >= 2:
             assert not rho * w[3, 0] < tol  # the one before did not stop it
+        if it >= 3:  # past its second step a point stops on the classic test only
+            assert w[3, 1] < tol
         out[rho] = (p.copy(), it)
     assert out[CONTRACTION_FLOOR][1] <= out[1.0][1]
     d = out[1.0][0] - out[CONTRACTION_FLOOR][0]
     assert _edge_norm(d[None, :], opts[0])[0] < tol
     tu, tv = pair.truth(xc, yc)
     assert abs(out[1.0][0][0] - tu) < 0.01 and abs(out[1.0][0][6] - tv) < 0.01
+
+
+def test_a_point_that_never_converges_is_not_stopped_on_the_assumed_contraction():
+    """Weak texture (contrast 0.05, 2 grey levels of noise): some points wander without
+    converging in 40 iterations under the classic test. None of them is reported ok by the
+    default run, whose assumed contraction applies to a point's first two steps only (a
+    wandering point's step, sometimes small, would otherwise stop it at a random place)."""
+    pair = sp.speckle_pair(
+        (256, 256),
+        sp.RigidField((0.4, -0.3)),
+        params=sp.SpeckleParams(contrast=0.05, noise_std=2.0),
+        seed=5,
+    )
+    out = {}
+    for probes in (0, None):  # 0: the classic test throughout; None: the default
+        corr = SubsetCorrelator(pair.reference, subset_size=21, step=6, threads=1, zncc_min=0.5)
+        corr._contraction_probes = probes
+        out[probes] = corr.match(pair.deformed)
+    classic, default = out[0], out[None]
+    wandering = classic.flag == 1  # not_converged
+    assert wandering.sum() >= 5
+    assert not np.any(default.ok & ~classic.ok)
