@@ -234,3 +234,29 @@ def test_provenance_versions_are_importlib_metadata_s_for_every_installed_distri
     with pytest.raises(metadata.PackageNotFoundError):
         installed_version("no-such-distribution-jointwear")
     assert software_versions()["numpy"] == np.__version__
+
+
+def test_a_command_reads_the_options_of_its_own_command_only(monkeypatch, capsys):
+    """``jointwear dic correlate`` builds ``correlate`` alone (typer reads each command's
+    options from its signature); the group's help lists, so builds, all of them."""
+    import typer
+
+    from jointwear.cli import main
+
+    built = []
+    build = typer.main.get_command_from_info
+
+    def counted(command_info, **kwargs):
+        command = build(command_info, **kwargs)
+        built.append(command.name)
+        return command
+
+    monkeypatch.setattr(typer.main, "get_command_from_info", counted)
+    others = {"field", "calibrate", "track", "import-field"}  # more commands of the dic group
+    assert main(["dic", "correlate", "--help"]) == 0
+    assert built.count("correlate") == 1 and not others & set(built)
+    built.clear()
+    assert main(["dic", "--help"]) == 0
+    assert {"correlate", *others} <= set(built)
+    listing = capsys.readouterr().out.split("correlate [OPTIONS]")[-1]
+    assert all(f" {name} " in listing for name in {"correlate", *others})
