@@ -88,12 +88,13 @@ def installed_version(name: str) -> str | None:
 
     The ``Version`` field is in the header, which ends at the first blank line; the long
     description that follows (60-80 kB for scipy and matplotlib) is not parsed: eight look-ups
-    cost 4 instead of 10 ms, about 1 % of a ``dic correlate`` process.
+    cost 2 instead of 10 ms, about 1 % of a ``dic correlate`` process.
     """
     dist = metadata.distribution(name)
     # the files importlib.metadata reads, in its order
-    text = dist.read_text("METADATA") or dist.read_text("PKG-INFO") or dist.read_text("")
-    return email.parser.HeaderParser().parsestr(text or "")["Version"]
+    text = dist.read_text("METADATA") or dist.read_text("PKG-INFO") or dist.read_text("") or ""
+    header = text.split("\n\n", 1)[0]  # the parser ends the header there too
+    return email.parser.HeaderParser().parsestr(header)["Version"]
 
 
 def software_versions() -> dict[str, str]:
