@@ -1,8 +1,10 @@
 """Sampling the deformed image for the IC-GN (numba): B-spline weights written once, the value
-at one point, and one pass over a warped subset with the sums the Gauss-Newton step needs.
+at one point, and a warped subset row by row with the sums the Gauss-Newton step needs.
 
-The cubic and quintic kernels are one source: ``order`` is a loop invariant, so the compiler
-hoists the branch out of the pixel loop and each order runs its own straight-line code.
+The cubic and quintic kernels are one source; the branch on ``order`` sits outside each pixel
+loop (inside it, it stops the compiler from vectorising the loop). A subset row is sampled in
+passes (:func:`sample_row`): the nodes and weights of all its pixels, then the taps; one pixel
+at a time its weights, taps and sums formed one long dependent chain, about 30 % slower.
 """
 
 from __future__ import annotations
@@ -83,14 +85,14 @@ def add_row_sums(out, o, s, sc, rr):
 
 
 @njit(cache=True, inline="always")
-def _row_nodes(order, x0, y0, a11, a21, size, col, row, wx, wy):
-    """Pass 1 of a subset row: for pixel ``j`` at ``(x0 + a11 j, y0 + a21 j)``, the first
+def _row_nodes(order, xs, ys, size, col, row, wx, wy):
+    """Pass 1 of a subset row: for pixel ``j`` at ``(xs[j], ys[j])`` [pixel, >= 0], the first
     node's column and row on the padded coefficients and the B-spline weights along x and y
     (``wx[:, j]``, ``wy[:, j]``; 4 cubic, 6 quintic). Independent per pixel: it vectorises."""
     if order == 3:
         for j in range(size):
-            xw = x0 + a11 * j
-            yw = y0 + a21 * j
+            xw = xs[j]
+            yw = ys[j]
             ix = int(xw)
             iy = int(yw)
             col[j] = ix + PAD - 1
@@ -99,14 +101,38 @@ def _row_nodes(order, x0, y0, a11, a21, size, col, row, wx, wy):
             wy[0, j], wy[1, j], wy[2, j], wy[3, j] = bspline3(yw - iy)
     else:
         for j in range(size):
-            xw = x0 + a11 * j
-            yw = y0 + a21 * j
+            xw = xs[j]
+            yw = ys[j]
             ix = int(xw)
             iy = int(yw)
             col[j] = ix + PAD - 2
             row[j] = iy + PAD - 2
             wx[0, j], wx[1, j], wx[2, j], wx[3, j], wx[4, j], wx[5, j] = bspline5(xw - ix)
             wy[0, j], wy[1, j], wy[2, j], wy[3, j], wy[4, j], wy[5, j] = bspline5(yw - iy)
+
+
+@njit(cache=True)
+def row_scratch(size):
+    """Scratch arrays of :func:`sample_row` for rows of ``size`` pixels: positions x and y,
+    node columns and rows, weights along x and y, values."""
+    return (
+        np.empty(size),
+        np.empty(size),
+        np.empty(size, dtype=np.int64),
+        np.empty(size, dtype=np.int64),
+        np.empty((6, size)),
+        np.empty((6, size)),
+        np.empty(size),
+    )
+
+
+@njit(cache=True, inline="always")
+def sample_row(coef, order, size, scratch):
+    """Spline values ``scratch[6][:size]`` at the positions ``scratch[0:2]`` of one subset
+    row (nodes and weights first, then the taps)."""
+    xs, ys, col, row, wx, wy, g = scratch
+    _row_nodes(order, xs, ys, size, col, row, wx, wy)
+    _row_taps(coef, order, size, col, row, wx, wy, g)
 
 
 @njit(cache=True, inline="always")
@@ -145,22 +171,21 @@ def sample_affine(coef, order, x_start, y_start, a11, a12, a21, a22, half, f, gx
     """Sample the affinely warped subset and accumulate into ``acc`` (9,): sum g, sum g^2,
     sum g f and the six sums J g (J = gradient times (1, column, row)).
 
-    Each subset row in three passes: nodes and weights of all its pixels (vectorised), the
-    taps, then the sums; about 30 % faster than one pixel at a time, where each pixel's
-    weights, taps and sums form one long dependent chain (``benchmarks/bench_dic2d.py``)."""
+    Each subset row: its pixels' positions, :func:`sample_row`, then the sums."""
     size = 2 * half + 1
-    col = np.empty(size, dtype=np.int64)
-    row = np.empty(size, dtype=np.int64)
-    wx = np.empty((6, size))
-    wy = np.empty((6, size))
-    g = np.empty(size)
+    scratch = row_scratch(size)
+    xs, ys, g = scratch[0], scratch[1], scratch[6]
     for i in range(9):
         acc[i] = 0.0
     k0 = 0
     for r in range(-half, half + 1):
         rr = float(r)
-        _row_nodes(order, x_start + a12 * rr, y_start + a22 * rr, a11, a21, size, col, row, wx, wy)
-        _row_taps(coef, order, size, col, row, wx, wy, g)
+        x0 = x_start + a12 * rr
+        y0 = y_start + a22 * rr
+        for j in range(size):
+            xs[j] = x0 + a11 * j
+            ys[j] = y0 + a21 * j
+        sample_row(coef, order, size, scratch)
         ga = gac = gb = gbc = 0.0
         sg = sgg = sgf = 0.0
         for j in range(size):

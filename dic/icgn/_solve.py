@@ -29,7 +29,7 @@ from jointwear.dic.icgn._flags import (
 )
 from jointwear.dic.icgn._interp import PAD
 from jointwear.dic.icgn._reference import _box_has_invalid, _load_reference, _store_sigma
-from jointwear.dic.icgn._sample import add_row_sums, interp_point, sample_affine
+from jointwear.dic.icgn._sample import add_row_sums, row_scratch, sample_affine, sample_row
 from jointwear.dic.icgn._warp import _compose_inverse, _solve_spd
 
 # a subset still below this ZNCC after this many iterations is not going to match
@@ -284,7 +284,8 @@ def _sample_affine_warp(f, gx, gy, def_coef, def_invalid, order, xc, yc, half, p
 @njit(cache=True, inline="always")
 def _sample_quadratic_warp(f, gx, gy, def_coef, def_invalid, order, xc, yc, half, p, box, acc):
     """As :func:`_sample_affine_warp` for the second-order warp: every warped pixel
-    bounds-checked, the 12-parameter ``sum J g``."""
+    bounds-checked, the 12-parameter ``sum J g``; each row's positions first, then the row
+    sampled in passes (:func:`~jointwear.dic.icgn._sample.sample_row`)."""
     lo, hix, hiy = box
     jg = acc[3:]
     for i in range(12):
@@ -294,23 +295,34 @@ def _sample_quadratic_warp(f, gx, gy, def_coef, def_invalid, order, xc, yc, half
     xmax = -1e300
     ymin = 1e300
     ymax = -1e300
-    k = 0
+    size = 2 * half + 1
+    scratch = row_scratch(size)
+    xs, ys, g = scratch[0], scratch[1], scratch[6]
+    k0 = 0
     for r in range(-half, half + 1):
         rr = float(r)
+        # the warp along the row: a quadratic in the column offset c
+        x0 = xc + p[0] + p[2] * rr + 0.5 * p[5] * rr * rr
+        x1 = 1.0 + p[1] + p[4] * rr
+        y0 = yc + rr + p[6] + p[8] * rr + 0.5 * p[11] * rr * rr
+        y1 = p[7] + p[10] * rr
+        for j in range(size):
+            cc = float(j - half)
+            xs[j] = x0 + x1 * cc + 0.5 * p[3] * cc * cc
+            ys[j] = y0 + y1 * cc + 0.5 * p[9] * cc * cc
+        for j in range(size):
+            if not (xs[j] >= lo and ys[j] >= lo and xs[j] <= hix and ys[j] <= hiy):
+                return FLAG_OUTSIDE  # (NaN included)
+            xmin = min(xmin, xs[j])
+            xmax = max(xmax, xs[j])
+            ymin = min(ymin, ys[j])
+            ymax = max(ymax, ys[j])
+        sample_row(def_coef, order, size, scratch)
         ra = rb = rac = rbc = racc = rbcc = 0.0
-        for c in range(-half, half + 1):
-            cc = float(c)
-            xw = xc + cc + p[0] + p[1] * cc + p[2] * rr
-            xw += 0.5 * p[3] * cc * cc + p[4] * cc * rr + 0.5 * p[5] * rr * rr
-            yw = yc + rr + p[6] + p[7] * cc + p[8] * rr
-            yw += 0.5 * p[9] * cc * cc + p[10] * cc * rr + 0.5 * p[11] * rr * rr
-            if not (xw >= lo and yw >= lo and xw <= hix and yw <= hiy):
-                return FLAG_OUTSIDE
-            xmin = min(xmin, xw)
-            xmax = max(xmax, xw)
-            ymin = min(ymin, yw)
-            ymax = max(ymax, yw)
-            gv = interp_point(def_coef, order, xw, yw)
+        for j in range(size):
+            k = k0 + j
+            cc = float(j - half)
+            gv = g[j]
             sg += gv
             sgg += gv * gv
             sgf += gv * f[k]
@@ -322,7 +334,7 @@ def _sample_quadratic_warp(f, gx, gy, def_coef, def_invalid, order, xc, yc, half
             rb += qb
             rbc += qb * cc
             rbcc += qb * cc * cc
-            k += 1
+        k0 += size
         _add_second_order_row_sums(jg, 0, ra, rac, racc, rr)
         _add_second_order_row_sums(jg, 6, rb, rbc, rbcc, rr)
     if _invalid_near(def_invalid, xmin, ymin, xmax, ymax):
