@@ -96,7 +96,10 @@ def _summary(ds, out: Path, elapsed: float, plot: Path | None, mode, update_zncc
     *opt.CORRELATION,
     Opt("shape", help="Shape function: affine or quadratic."),
     Opt("interpolation", help="B-spline: quintic or cubic."),
-    Opt("tolerance", help="IC-GN convergence: last update norm (pixels)."),
+    Opt(
+        "tolerance",
+        help="IC-GN convergence: last update norm, or its predicted remaining error (pixels).",
+    ),
     "max_iterations",
 )
 def correlate_cmd(

@@ -56,9 +56,14 @@ class CorrelationParams:
     max_iterations : int
         IC-GN iteration limit per point.
     tolerance : float
-        Convergence: norm of the last parameter update, gradients scaled by the subset
-        half-width [pixel] (Pan et al. 2013 use 0.001). Gauss-Newton converges fast near the
-        optimum, so the remaining error is far below this value.
+        Convergence: a point stops when its last parameter update (gradients scaled by the
+        subset half-width) moves the subset edge by less than this [pixel] (Pan et al. 2013
+        use 0.001). Gauss-Newton converges fast near the optimum, so the remaining error is far
+        below this value; the propagation therefore measures the contraction per iteration
+        ``rho`` on its first points and lets later points also stop on their first or second
+        update when ``rho`` times it, the predicted remaining error, is below this value
+        (:func:`jointwear.dic.icgn._drive.rg_propagate`; points refined from given guesses
+        use the first criterion only).
     zncc_min : float
         Points below this ZNCC are flagged ``low_correlation`` and do not propagate.
     search_radius : int
