@@ -39,6 +39,7 @@ _EXPORTS = {
         "icgn_many",
         "icgn_serial",
         "rg_propagate",
+        "CONTRACTION_PROBES",
     ),
     "_shapes": ("ShapeFunction", "shape_function"),
 }

@@ -30,6 +30,7 @@ from ._interp import (
 )
 from ._match import (
     affine_references as affine_references,
+    CONTRACTION_PROBES as CONTRACTION_PROBES,
     icgn_affine_loaded as icgn_affine_loaded,
     icgn_many as icgn_many,
     icgn_serial as icgn_serial,

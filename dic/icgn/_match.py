@@ -44,6 +44,7 @@ from __future__ import annotations
 import numpy as np
 
 from jointwear.dic.icgn._drive import (
+    CONTRACTION_PROBES,
     affine_references,
     icgn_affine_loaded,
     icgn_many,
@@ -56,6 +57,7 @@ from jointwear.dic.icgn._solve import make_work, solve_point
 from jointwear.dic.icgn._warp import _compose_inverse, _extrapolate
 
 __all__ = [
+    "CONTRACTION_PROBES",
     "QUADRATIC_INDEX",
     "affine_references",
     "icgn_affine_loaded",

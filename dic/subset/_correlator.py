@@ -335,7 +335,6 @@ class SubsetCorrelator:
 
     def _propagate(self, dspl, dinv, st, done, group, n_groups):
         from jointwear.dic import icgn as _icgn
-        from jointwear.dic.icgn import _drive
 
         ref, dfm = self._kernel_args(dspl, dinv)
         _icgn.rg_propagate(
@@ -351,7 +350,7 @@ class SubsetCorrelator:
             st.params,
             (st.zncc, st.iterations, st.flag, st.sigma),
             done,
-            _drive.CONTRACTION_PROBES
+            _icgn.CONTRACTION_PROBES
             if self._contraction_probes is None
             else int(self._contraction_probes),
         )
