@@ -95,18 +95,21 @@ KW_FACTOR, NOISE, U_NUM_REL = 1.15, 0.01, 0.02
 
 def base_toml(size: dict[str, Any], truth: str = TRUTH, tilt: float | None = None) -> str:
     """The rig of ``truth`` at ``size`` (``tilt``: another tilt stiffness, the wrong form)."""
-    joint = {k.split(".")[1]: v for k, v in TRUTHS[truth].items()}
+    import tomli_w
+
+    joint: dict[str, Any] = {k.split(".")[1]: float(v) for k, v in TRUTHS[truth].items()}
     if tilt is not None:
-        joint["tilt_stiffness"] = tilt
+        joint["tilt_stiffness"] = float(tilt)
+    tables: dict[str, Any] = {"joint": joint}
     if size["n_layers"] is not None:
-        joint.update(n_layers=size["n_layers"], n_points=size["n_points"])
-    lines = "".join(f"{k} = {v!r}\n" for k, v in joint.items())
-    wear = (
-        '[wear]\nscheme = "fixed"\ndn = 100\nsettle_cycles = 0.25\ninitial_settle_cycles = 0.5\n'
-        if size["n_layers"] is not None
-        else ""
-    )
-    return f"[joint]\n{lines}{wear}"
+        joint.update(n_layers=int(size["n_layers"]), n_points=int(size["n_points"]))
+        tables["wear"] = {
+            "scheme": "fixed",
+            "dn": 100,
+            "settle_cycles": 0.25,
+            "initial_settle_cycles": 0.5,
+        }
+    return tomli_w.dumps(tables)
 
 
 def truth_maps(folder: Path, size: dict[str, Any], rep: int, kw: float) -> tuple[Path, Path]:
@@ -148,12 +151,17 @@ def truth_maps(folder: Path, size: dict[str, Any], rep: int, kw: float) -> tuple
 
 
 def spec_text(early: Path, size: dict[str, Any], kw0: float) -> str:
-    return (
-        f'[calibrate]\ndata = ["{early.name}"]\ncycles = {size["calibration_cycles"]}\n'
-        f"samples = {size['training_runs']}\nseed = 1\nu_num_rel = {U_NUM_REL}\n"
-        '[parameters."wear.kw"]\ndistribution = "uniform"\n'
-        f"bounds = [{0.5 * kw0!r}, {1.5 * kw0!r}]\n"
-    )
+    import tomli_w
+
+    calibrate = {
+        "data": [early.name],
+        "cycles": int(round(float(size["calibration_cycles"]))),
+        "samples": int(size["training_runs"]),
+        "seed": 1,
+        "u_num_rel": U_NUM_REL,
+    }
+    prior = {"distribution": "uniform", "bounds": [0.5 * kw0, 1.5 * kw0]}
+    return tomli_w.dumps({"calibrate": calibrate, "parameters": {"wear.kw": prior}})
 
 
 def compared(folder: Path, sim: Path, meas: Path, ens: list[Path], cycles: float):

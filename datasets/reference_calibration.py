@@ -82,39 +82,39 @@ def _growth(rep: xr.Dataset, key: str) -> tuple[float, float]:
 
 
 def _spec(rep: xr.Dataset, size: Any, u_num_rel: float) -> str:
+    import tomli_w
+
     from jointwear.sim import DEFAULT_KW
 
     value, u = _growth(rep, CALIBRATION_KEY)
     cycles = float(rep[CALIBRATION_KEY].attrs["cycles"])
-    source = str(rep[CALIBRATION_KEY].attrs.get("source", CALIBRATION_KEY)).replace('"', "'")
-    lines = [
-        "[calibrate]",
-        f"cycles = {cycles:.0f}",
-        f"samples = {size.training_runs}",
-        "seed = 1",
-        f"u_num_rel = {u_num_rel!r}",
-        "[[calibrate.values]]",
-        'quantity = "cylindricity"',
-        f"value = {value!r}",
-        f"u = {u!r}",
-        f'source = "growth since new, Zhang et al. 2023 ({source}), 13 layers centred"',
-        f"z = {_layers(rep.attrs)!r}",
-    ]
+    source = str(rep[CALIBRATION_KEY].attrs.get("source", CALIBRATION_KEY))
+    datum = {
+        "quantity": "cylindricity",
+        "value": float(value),
+        "u": float(u),
+        "source": f"growth since new, Zhang et al. 2023 ({source}), 13 layers centred",
+        "z": _layers(rep.attrs),
+    }
+    calibrate = {
+        "cycles": int(round(cycles)),
+        "samples": int(size.training_runs),
+        "seed": 1,
+        "u_num_rel": float(u_num_rel),
+        "values": [datum],
+    }
+    priors = {}
     for name, (lo, hi) in PRIORS.items():
         scale = float(DEFAULT_KW) if name == "wear.kw" else 1.0
-        lines += [
-            f'[parameters."{name}"]',
-            'distribution = "uniform"',
-            f"bounds = [{lo * scale!r}, {hi * scale!r}]",
-        ]
-    return "\n".join(lines) + "\n"
+        priors[name] = {"distribution": "uniform", "bounds": [lo * scale, hi * scale]}
+    return tomli_w.dumps({"calibrate": calibrate, "parameters": priors})
 
 
 def _params_toml(size: Any) -> str:
-    return (
-        f"[joint]\nn_layers = {size.layers}\nn_points = {size.points}\n"
-        f'[wear]\nscheme = "fixed"\ndn = {size.levels[-1]}\n'
-    )
+    import tomli_w
+
+    joint = {"n_layers": int(size.layers), "n_points": int(size.points)}
+    return tomli_w.dumps({"joint": joint, "wear": {"scheme": "fixed", "dn": int(size.levels[-1])}})
 
 
 def _centred(reported: dict[str, Any]) -> dict[str, Any]:

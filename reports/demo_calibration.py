@@ -52,12 +52,16 @@ def _say(msg: str) -> None:
 def base_toml(size: Any) -> str:
     """The ``--params`` file of the calibration: the demo's grid and its verified wear scheme
     (:func:`jointwear.reports.demo_studies.main_wear_settings`)."""
+    import tomli_w
+
     from jointwear.reports.demo_studies import main_wear_settings
 
     wear = main_wear_settings(size)
-    lines = ["[joint]", f"n_layers = {size.n_layers}", f"n_points = {size.n_points}", "[wear]"]
-    lines += [f'scheme = "{wear.scheme}"'] + ([f"dn = {wear.dn}"] if wear.scheme == "fixed" else [])
-    return "\n".join(lines) + "\n"
+    wear_table: dict[str, Any] = {"scheme": wear.scheme}
+    if wear.scheme == "fixed":
+        wear_table["dn"] = int(wear.dn)
+    joint = {"n_layers": int(size.n_layers), "n_points": int(size.n_points)}
+    return tomli_w.dumps({"joint": joint, "wear": wear_table})
 
 
 def nominal(params: Any, name: str) -> float:
@@ -73,21 +77,19 @@ def nominal(params: Any, name: str) -> float:
 def spec_toml(data: Path, size: Any, params: Any) -> str:
     """The calibration spec: uniform priors (:data:`CALIBRATED`) on the map ``data`` at
     ``size.calibration_cycles``, ``size.training_runs`` training runs."""
-    lines = [
-        "[calibrate]",
-        f'data = ["{data.name}"]',
-        f"cycles = {size.calibration_cycles:.0f}",
-        f"samples = {size.training_runs}",
-        "seed = 1",
-    ]
+    import tomli_w
+
+    calibrate = {
+        "data": [data.name],
+        "cycles": int(round(size.calibration_cycles)),
+        "samples": int(size.training_runs),
+        "seed": 1,
+    }
+    priors = {}
     for name, half in CALIBRATED.items():
         x = nominal(params, name)
-        lines += [
-            f'[parameters."{name}"]',
-            'distribution = "uniform"',
-            f"bounds = [{(1 - half) * x!r}, {(1 + half) * x!r}]",
-        ]
-    return "\n".join(lines) + "\n"
+        priors[name] = {"distribution": "uniform", "bounds": [(1 - half) * x, (1 + half) * x]}
+    return tomli_w.dumps({"calibrate": calibrate, "parameters": priors})
 
 
 @dataclass(frozen=True)

@@ -155,42 +155,35 @@ CAL_BENCH_SIZE = CalibratedSize(
 
 def _rig_toml(overrides: dict[str, float], base: pw.PowerSize, extra: int, wear: Any) -> str:
     """The ``--params`` file of a candidate: its overrides, grid and wear-update scheme."""
+    import tomli_w
+
     tables: dict[str, dict[str, Any]] = {
-        "joint": {"n_layers": base.n_layers, "n_points": base.n_points + extra}
+        "joint": {"n_layers": int(base.n_layers), "n_points": int(base.n_points + extra)}
     }
     for key, value in overrides.items():
         section, attr = key.split(".")
         tables.setdefault(section, {})[attr] = float(value)
     if wear is not None and wear.scheme == "fixed":
         tables.setdefault("wear", {}).update(scheme="fixed", dn=int(wear.dn))
-    lines = []
-    for section, items in tables.items():
-        lines.append(f"[{section}]")
-        lines += [
-            f"{k} = {json.dumps(v) if isinstance(v, str) else repr(v)}" for k, v in items.items()
-        ]
-    return "\n".join(lines) + "\n"
+    return tomli_w.dumps(tables)
 
 
 def _spec_toml(data: Path, size: CalibratedSize, kw: float, u_num_rel: float | None) -> str:
     """The calibration spec: kw uniform ±``prior_half_width`` around ``kw`` on the map
     ``data``, ``training_runs`` samples; every other key at ``jointwear sim calibrate``'s
     default."""
+    import tomli_w
+
     half = size.prior_half_width
-    lines = [
-        "[calibrate]",
-        f'data = ["{data.name}"]',
-        f"cycles = {size.calibration_cycles:.0f}",
-        f"samples = {size.training_runs}",
-    ]
+    calibrate: dict[str, Any] = {
+        "data": [data.name],
+        "cycles": int(round(size.calibration_cycles)),
+        "samples": int(size.training_runs),
+    }
     if u_num_rel is not None:
-        lines.append(f"u_num_rel = {u_num_rel!r}")
-    lines += [
-        f'[parameters."{CALIBRATED}"]',
-        'distribution = "uniform"',
-        f"bounds = [{(1 - half) * kw!r}, {(1 + half) * kw!r}]",
-    ]
-    return "\n".join(lines) + "\n"
+        calibrate["u_num_rel"] = float(u_num_rel)
+    prior = {"distribution": "uniform", "bounds": [(1 - half) * kw, (1 + half) * kw]}
+    return tomli_w.dumps({"calibrate": calibrate, "parameters": {CALIBRATED: prior}})
 
 
 def _own_u_num_rel(run: Any) -> float:
