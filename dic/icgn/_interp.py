@@ -413,10 +413,10 @@ def _prefilter_2d(img, order, out):
     """B-spline coefficients of ``img`` written into ``out`` with a mirrored border of PAD."""
     h, w = img.shape
     z1, z2, npoles = _poles(order)
-    tmp = np.empty((h, w))
     # along rows: strips of _STRIP rows copied transposed into a small buffer and filtered as
     # its columns (the strip's lines recurse side by side, vectorised, instead of one line's
-    # latency-bound recursion at a time; the same operations on each line, the same numbers)
+    # latency-bound recursion at a time; the same operations on each line, the same numbers),
+    # written straight into out's interior
     buf = np.empty((w, _STRIP))
     for i0 in range(0, h, _STRIP):
         nr = min(_STRIP, h - i0)
@@ -425,16 +425,26 @@ def _prefilter_2d(img, order, out):
                 buf[k, r] = img[i0 + r, k]
         _filter_columns(buf, 0, nr, z1, z2, npoles)
         for r in range(nr):
+            orow = out[PAD + i0 + r]
             for k in range(w):
-                tmp[i0 + r, k] = buf[k, r]
+                orow[PAD + k] = buf[k, r]
+    # along columns, in place on the interior rows, 64 columns at a time
+    inner = out[PAD : PAD + h]
     nb = (w + 63) // 64
     for blk in range(nb):
-        _filter_columns(tmp, blk * 64, min(w, blk * 64 + 64), z1, z2, npoles)
-    # mirrored padding (reflect without repeating the edge sample)
-    for i in range(h + 2 * PAD):
-        si = _reflect(i - PAD, h)
+        _filter_columns(inner, PAD + blk * 64, PAD + min(w, blk * 64 + 64), z1, z2, npoles)
+    # mirrored padding (reflect without repeating the edge sample): the interior rows' left
+    # and right pads, then the whole top and bottom rows
+    for i in range(PAD, PAD + h):
+        for j in range(PAD):
+            out[i, j] = out[i, PAD + _reflect(j - PAD, w)]
+            out[i, PAD + w + j] = out[i, PAD + _reflect(w + j, w)]
+    for i in range(PAD):
+        top = PAD + _reflect(i - PAD, h)
+        bottom = PAD + _reflect(h + i, h)
         for j in range(w + 2 * PAD):
-            out[i, j] = tmp[si, _reflect(j - PAD, w)]
+            out[i, j] = out[top, j]
+            out[PAD + h + i, j] = out[bottom, j]
 
 
 @njit(cache=True, inline="always")
@@ -453,13 +463,18 @@ def _central_gradients(img, gx, gy):
     (zero on the first and last row/column)."""
     h, w = img.shape
     for i in range(h):
-        for j in range(w):
+        il = i - 1 if i > 0 else min(1, h - 1)
+        ir = i + 1 if i < h - 1 else max(h - 2, 0)
+        row, up, down = img[i], img[il], img[ir]
+        gxi, gyi = gx[i], gy[i]
+        for j in range(w):  # y: no branch in the row (vectorised)
+            gyi[j] = 0.5 * (down[j] - up[j])
+        for j in range(1, w - 1):  # x inside the row, then its two ends mirrored
+            gxi[j] = 0.5 * (row[j + 1] - row[j - 1])
+        for j in (0, w - 1):
             jl = j - 1 if j > 0 else min(1, w - 1)
             jr = j + 1 if j < w - 1 else max(w - 2, 0)
-            il = i - 1 if i > 0 else min(1, h - 1)
-            ir = i + 1 if i < h - 1 else max(h - 2, 0)
-            gx[i, j] = 0.5 * (img[i, jr] - img[i, jl])
-            gy[i, j] = 0.5 * (img[ir, j] - img[il, j])
+            gxi[j] = 0.5 * (row[jr] - row[jl])
 
 
 @njit(cache=True)
