@@ -130,9 +130,33 @@ apply_classes(app)
 
 
 def _on_signal(signum: int, frame: object) -> None:
-    """Ctrl-C and SIGTERM: commands keep their partial results; exit 130 or 143."""
+    """Ctrl-C and SIGTERM: commands keep their partial results; exit 130 or 143.
+
+    A signal that arrives while a finalizer (``__del__``) runs, e.g. during a garbage
+    collection, is delivered again a moment later instead: Python prints an exception raised
+    in a finalizer and drops it, and the command would run on as if never interrupted."""
     _STATE["signal"] = signum
+    if _in_finalizer(frame):
+        import threading
+
+        timer = threading.Timer(REDELIVERY_S, signal.raise_signal, args=(signum,))
+        timer.daemon = True
+        timer.start()
+        return
     raise KeyboardInterrupt()
+
+
+#: delay [s] before a signal that arrived inside a finalizer is delivered again
+REDELIVERY_S = 0.02
+
+
+def _in_finalizer(frame: object) -> bool:
+    """True if ``frame`` or a frame that called it is a ``__del__`` method."""
+    while frame is not None:
+        if getattr(getattr(frame, "f_code", None), "co_name", None) == "__del__":
+            return True
+        frame = getattr(frame, "f_back", None)
+    return False
 
 
 def _interrupted() -> int | None:

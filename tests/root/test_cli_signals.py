@@ -62,3 +62,32 @@ def test_a_signal_during_an_in_process_command_stops_pytest(tmp_path, sig):
         assert "KeyboardInterrupt" in text and "passed" not in text
     else:  # pytest leaves SIGTERM at its default: the session ends at once
         assert proc.returncode == -signal.SIGTERM, text
+
+
+def test_a_signal_inside_a_finalizer_is_delivered_again_not_dropped():
+    """Ctrl-C during a ``__del__`` (a garbage collection runs finalizers at any allocation):
+    an exception raised there is printed and dropped by Python, and the command would run on
+    to its end; the handler delivers the signal again once the finalizer is done, and the
+    command stops with KeyboardInterrupt (a sim wear run in CI lost its Ctrl-C this way)."""
+    from jointwear import cli
+
+    raised_in_finalizer = []
+
+    class Finalized:
+        def __del__(self):
+            try:
+                cli._on_signal(signal.SIGINT, sys._getframe())
+            except KeyboardInterrupt:  # would be dropped by Python here
+                raised_in_finalizer.append(True)
+
+    previous = signal.signal(signal.SIGINT, cli._on_signal)
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            obj = Finalized()
+            del obj  # the finalizer runs here and takes the signal
+            time.sleep(5)  # the command's work: the redelivered signal stops it
+    finally:
+        signal.signal(signal.SIGINT, previous)
+        cli._STATE["signal"] = None
+    assert raised_in_finalizer == []
+    assert not cli._in_finalizer(sys._getframe())
