@@ -85,30 +85,33 @@ def add_row_sums(out, o, s, sc, rr):
 
 
 @njit(cache=True, inline="always")
+def _nodes(xs, ys, size, col, row, wx, wy, lead, weights):
+    """:func:`_row_nodes` for one spline order: ``lead`` nodes before a point's own,
+    ``weights`` its B-spline weight function (:func:`bspline3` or :func:`bspline5`)."""
+    for j in range(size):
+        xw = xs[j]
+        yw = ys[j]
+        ix = int(xw)
+        iy = int(yw)
+        col[j] = ix + PAD - lead
+        row[j] = iy + PAD - lead
+        tx = weights(xw - ix)
+        ty = weights(yw - iy)
+        for k in range(len(tx)):
+            wx[k, j] = tx[k]
+            wy[k, j] = ty[k]
+
+
+@njit(cache=True, inline="always")
 def _row_nodes(order, xs, ys, size, col, row, wx, wy):
     """Pass 1 of a subset row: for pixel ``j`` at ``(xs[j], ys[j])`` [pixel, >= 0], the first
     node's column and row on the padded coefficients and the B-spline weights along x and y
-    (``wx[:, j]``, ``wy[:, j]``; 4 cubic, 6 quintic). Independent per pixel: it vectorises."""
+    (``wx[:, j]``, ``wy[:, j]``; 4 cubic, 6 quintic). Independent per pixel: it vectorises;
+    the branch on the order stays outside the pixel loop."""
     if order == 3:
-        for j in range(size):
-            xw = xs[j]
-            yw = ys[j]
-            ix = int(xw)
-            iy = int(yw)
-            col[j] = ix + PAD - 1
-            row[j] = iy + PAD - 1
-            wx[0, j], wx[1, j], wx[2, j], wx[3, j] = bspline3(xw - ix)
-            wy[0, j], wy[1, j], wy[2, j], wy[3, j] = bspline3(yw - iy)
+        _nodes(xs, ys, size, col, row, wx, wy, 1, bspline3)
     else:
-        for j in range(size):
-            xw = xs[j]
-            yw = ys[j]
-            ix = int(xw)
-            iy = int(yw)
-            col[j] = ix + PAD - 2
-            row[j] = iy + PAD - 2
-            wx[0, j], wx[1, j], wx[2, j], wx[3, j], wx[4, j], wx[5, j] = bspline5(xw - ix)
-            wy[0, j], wy[1, j], wy[2, j], wy[3, j], wy[4, j], wy[5, j] = bspline5(yw - iy)
+        _nodes(xs, ys, size, col, row, wx, wy, 2, bspline5)
 
 
 @njit(cache=True)
@@ -136,34 +139,29 @@ def sample_row(coef, order, size, scratch):
 
 
 @njit(cache=True, inline="always")
+def _taps(coef, size, col, row, wx, wy, g, n, scale):
+    """:func:`_row_taps` for one spline order: ``n`` x ``n`` taps, ``scale`` its weight norm."""
+    for j in range(size):
+        bx = col[j]
+        by = row[j]
+        acc = 0.0
+        for q in range(n):
+            rw = coef[by + q]
+            h = 0.0
+            for k in range(n):
+                h += wx[k, j] * rw[bx + k]
+            acc += wy[q, j] * h
+        g[j] = acc * scale
+
+
+@njit(cache=True, inline="always")
 def _row_taps(coef, order, size, col, row, wx, wy, g):
     """Pass 2 of a subset row: the spline values ``g[j]`` from pass 1's nodes and weights
     (the 16 or 36 taps, each coefficient row read contiguously)."""
     if order == 3:
-        for j in range(size):
-            bx = col[j]
-            by = row[j]
-            acc = 0.0
-            for q in range(4):
-                rw = coef[by + q]
-                acc += wy[q, j] * (
-                    (wx[0, j] * rw[bx] + wx[1, j] * rw[bx + 1])
-                    + (wx[2, j] * rw[bx + 2] + wx[3, j] * rw[bx + 3])
-                )
-            g[j] = acc * (1.0 / 36.0)
+        _taps(coef, size, col, row, wx, wy, g, 4, 1.0 / 36.0)
     else:
-        for j in range(size):
-            bx = col[j]
-            by = row[j]
-            acc = 0.0
-            for q in range(6):
-                rw = coef[by + q]
-                acc += wy[q, j] * (
-                    (wx[0, j] * rw[bx] + wx[1, j] * rw[bx + 1])
-                    + (wx[2, j] * rw[bx + 2] + wx[3, j] * rw[bx + 3])
-                    + (wx[4, j] * rw[bx + 4] + wx[5, j] * rw[bx + 5])
-                )
-            g[j] = acc * (1.0 / 14400.0)
+        _taps(coef, size, col, row, wx, wy, g, 6, 1.0 / 14400.0)
 
 
 @njit(cache=True, fastmath=_FM)
